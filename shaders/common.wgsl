@@ -1,0 +1,67 @@
+// common.wgsl — data shared by every ignis shader.
+//
+// Contract: `Particle` and `SimParams` mirror `src/gpu/types.rs` byte for byte
+// (keep in sync with `Particle` and `SimParams` there; a test compares naga's layout
+// with `size_of`). A slot is alive while `pos_age.w < vel_life.w`; a slot that was never
+// spawned has age = lifetime = 0 and is therefore dead.
+
+struct Particle {
+    // xyz: world position (m), w: age (s).
+    pos_age: vec4<f32>,
+    // xyz: velocity (m/s), w: this particle's lifetime (s).
+    vel_life: vec4<f32>,
+}
+
+struct SimParams {
+    world_from_emitter: mat4x4<f32>,
+    // Shape parameters; meaning depends on `shape_kind` (see spawn.wgsl).
+    shape_a: vec4<f32>,
+    shape_b: vec4<f32>,
+    // xyz: initial direction (emitter space, unit), w: spread half-angle (rad).
+    direction_spread: vec4<f32>,
+    // speed min, speed max, lifetime min, lifetime max.
+    speed_life: vec4<f32>,
+    // xyz: constant acceleration (gravity + buoyancy), w: linear drag k (1/s).
+    accel_drag: vec4<f32>,
+    // xyz: wind (drag target velocity), w: simulated time (s, wrapped) for noise.
+    wind_time: vec4<f32>,
+    // frequency (1/m), position amplitude (m), direction amplitude, scroll (1/s).
+    noise: vec4<f32>,
+    dt_secs: f32,
+    seed: u32,
+    emitter_salt: u32,
+    shape_kind: u32,
+    capacity: u32,
+    spawn_head: u32,
+    spawn_count: u32,
+    spawn_base_lo: u32,
+    spawn_base_hi: u32,
+    flags: u32,
+    // Birth time of the k-th spawn within the step, as a fraction of the step:
+    // spawn_frac0 + k * spawn_frac_step (sub-step emission: no puffs at low frame rates).
+    spawn_frac0: f32,
+    spawn_frac_step: f32,
+}
+
+const SHAPE_POINT: u32 = 0u;
+const SHAPE_SPHERE: u32 = 1u;
+const SHAPE_DISC: u32 = 2u;
+const SHAPE_BOX: u32 = 3u;
+const SHAPE_CONE: u32 = 4u;
+const SHAPE_LINE: u32 = 5u;
+
+const PI: f32 = 3.14159265358979;
+const TAU: f32 = 6.28318530717959;
+
+fn is_alive(p: Particle) -> bool {
+    return p.pos_age.w < p.vel_life.w;
+}
+
+// True when x is neither NaN nor ±Inf (bit test, so no compiler may fold it away).
+fn finite_f32(x: f32) -> bool {
+    return (bitcast<u32>(x) & 0x7f800000u) != 0x7f800000u;
+}
+
+fn finite_vec3(v: vec3<f32>) -> bool {
+    return finite_f32(v.x) && finite_f32(v.y) && finite_f32(v.z);
+}

@@ -1,0 +1,86 @@
+// integrators.wgsl — one step of the chosen method for (pos, vel) over dt.
+//
+// Contract: `integrate(pos, vel, age, dt)` returns the new state as a 2-column matrix
+// (pos, vel) via the `State` struct. `INTEGRATOR` is a pipeline override constant, so
+// the branch is resolved when the pipeline is built and an unused method costs nothing.
+// Keep the indices in sync with `Integrator::index` in `src/effect.rs`.
+#import "common.wgsl"
+#import "forces.wgsl"
+
+override INTEGRATOR: u32 = 1u;
+
+const INTEGRATOR_EXPLICIT_EULER: u32 = 0u;
+const INTEGRATOR_SEMI_IMPLICIT_EULER: u32 = 1u;
+const INTEGRATOR_VELOCITY_VERLET: u32 = 2u;
+const INTEGRATOR_HEUN: u32 = 3u;
+const INTEGRATOR_RK4: u32 = 4u;
+const INTEGRATOR_EXPONENTIAL: u32 = 5u;
+
+struct State {
+    pos: vec3<f32>,
+    vel: vec3<f32>,
+}
+
+// phi = (1 - e^{-z})/k · … and psi = (dt - phi)/k, with series below z = 0.5 so that
+// neither loses digits to cancellation (truncation < 1e-7 relative).
+fn exp_phi_psi(k: f32, dt: f32) -> vec2<f32> {
+    let z = k * dt;
+    if z < 0.5 {
+        let phi = dt * (1.0 + z * (-1.0 / 2.0 + z * (1.0 / 6.0 + z * (-1.0 / 24.0 + z * (1.0 / 120.0
+            + z * (-1.0 / 720.0 + z * (1.0 / 5040.0 - z / 40320.0)))))));
+        let psi = dt * dt * (1.0 / 2.0 + z * (-1.0 / 6.0 + z * (1.0 / 24.0 + z * (-1.0 / 120.0
+            + z * (1.0 / 720.0 + z * (-1.0 / 5040.0 + z * (1.0 / 40320.0 - z / 362880.0)))))));
+        return vec2<f32>(phi, psi);
+    }
+    let phi = (1.0 - exp(-z)) / k;
+    return vec2<f32>(phi, (dt - phi) / k);
+}
+
+fn integrate(pos: vec3<f32>, vel: vec3<f32>, age: f32, dt: f32) -> State {
+    switch INTEGRATOR {
+        case INTEGRATOR_EXPLICIT_EULER: {
+            let a = acceleration(pos, vel, age);
+            return State(pos + vel * dt, vel + a * dt);
+        }
+        case INTEGRATOR_VELOCITY_VERLET: {
+            let a0 = acceleration(pos, vel, age);
+            let p1 = pos + vel * dt + 0.5 * a0 * dt * dt;
+            let a1 = acceleration(p1, vel + a0 * dt, age + dt);
+            return State(p1, vel + 0.5 * (a0 + a1) * dt);
+        }
+        case INTEGRATOR_HEUN: {
+            let a0 = acceleration(pos, vel, age);
+            let vp = vel + a0 * dt;
+            let a1 = acceleration(pos + vel * dt, vp, age + dt);
+            return State(pos + 0.5 * (vel + vp) * dt, vel + 0.5 * (a0 + a1) * dt);
+        }
+        case INTEGRATOR_RK4: {
+            let h = 0.5 * dt;
+            let k1v = acceleration(pos, vel, age);
+            let k1x = vel;
+            let k2x = vel + h * k1v;
+            let k2v = acceleration(pos + h * k1x, k2x, age + h);
+            let k3x = vel + h * k2v;
+            let k3v = acceleration(pos + h * k2x, k3x, age + h);
+            let k4x = vel + dt * k3v;
+            let k4v = acceleration(pos + dt * k3x, k4x, age + dt);
+            let s = dt / 6.0;
+            return State(pos + s * (k1x + 2.0 * k2x + 2.0 * k3x + k4x),
+                         vel + s * (k1v + 2.0 * k2v + 2.0 * k3v + k4v));
+        }
+        case INTEGRATOR_EXPONENTIAL: {
+            // v' = f - k v with f = a + k v held constant over the step.
+            let k = params.accel_drag.w;
+            let f = acceleration(pos, vel, age) + k * vel;
+            let pp = exp_phi_psi(k, dt);
+            let e = 1.0 - k * pp.x;
+            return State(pos + vel * pp.x + f * pp.y, vel * e + f * pp.x);
+        }
+        default: {
+            // Semi-implicit (symplectic) Euler.
+            let a = acceleration(pos, vel, age);
+            let v1 = vel + a * dt;
+            return State(pos + v1 * dt, v1);
+        }
+    }
+}

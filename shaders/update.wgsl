@@ -1,0 +1,73 @@
+// update.wgsl — pass 1: one invocation per slot, reads state A, writes state B.
+//
+// Contract (plumbing; designers change spawn.wgsl, forces.wgsl, integrators.wgsl):
+// - group 0: binding 0 `params` (SimParams, dynamic offset per step), 1 `src` (read),
+//   2 `dst` (write), 3 `counters` ([0] alive after this step, [1] non-finite kills, total).
+// - Slots in the spawn window [spawn_head, spawn_head + spawn_count) (mod capacity) are
+//   born; alive slots integrate and age; every slot is written, so B never holds stale
+//   data from two steps ago.
+// - The dispatch is 2-D (x ≤ 65535 groups) so pools beyond 16M slots fit.
+#import "common.wgsl"
+
+@group(0) @binding(0) var<uniform> params: SimParams;
+@group(0) @binding(1) var<storage, read> src: array<Particle>;
+@group(0) @binding(2) var<storage, read_write> dst: array<Particle>;
+@group(0) @binding(3) var<storage, read_write> counters: array<atomic<u32>, 2>;
+
+#import "spawn.wgsl"
+#import "integrators.wgsl"
+
+override COUNT_ALIVE: bool = true;
+
+var<workgroup> wg_alive: atomic<u32>;
+
+@compute @workgroup_size(256)
+fn main(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let slot = (wg.y * nwg.x + wg.x) * 256u + lid;
+    var alive = false;
+    if slot < params.capacity {
+        var p = src[slot];
+        // Position of this slot in the ring relative to the spawn head (capacity ≤ 2^28).
+        let rel = (slot + params.capacity - params.spawn_head) % params.capacity;
+        if rel < params.spawn_count {
+            // 64-bit spawn counter = base + rel.
+            let lo = params.spawn_base_lo + rel;
+            let hi = params.spawn_base_hi + select(0u, 1u, lo < rel);
+            p = spawn_particle(slot, spawn_key(params.seed, params.emitter_salt, slot, lo, hi));
+            // Sub-step emission: a particle born at fraction f of the step is (1 - f)·dt old
+            // at its end and has drifted that far.
+            let f = clamp(params.spawn_frac0 + f32(rel) * params.spawn_frac_step, 0.0, 1.0);
+            let age0 = (1.0 - f) * params.dt_secs;
+            p.pos_age = vec4<f32>(p.pos_age.xyz + p.vel_life.xyz * age0, age0);
+            alive = is_alive(p);
+        } else if is_alive(p) {
+            let s = integrate(p.pos_age.xyz, p.vel_life.xyz, p.pos_age.w, params.dt_secs);
+            let age = p.pos_age.w + params.dt_secs;
+            if finite_vec3(s.pos) && finite_vec3(s.vel) {
+                p = Particle(vec4<f32>(s.pos, age), vec4<f32>(s.vel, p.vel_life.w));
+                alive = age < p.vel_life.w;
+            } else {
+                // Non-finite guard: kill and count, never let NaN reach the draw.
+                p = Particle(vec4<f32>(0.0), vec4<f32>(0.0));
+                atomicAdd(&counters[1], 1u);
+            }
+        }
+        dst[slot] = p;
+    }
+    if COUNT_ALIVE {
+        if alive {
+            atomicAdd(&wg_alive, 1u);
+        }
+        workgroupBarrier();
+        if lid == 0u {
+            let n = atomicLoad(&wg_alive);
+            if n > 0u {
+                atomicAdd(&counters[0], n);
+            }
+        }
+    }
+}

@@ -1,0 +1,815 @@
+//! The effect model: what a designer edits and what a preset file stores.
+//!
+//! Everything a designer tunes lives here (no parameter lives only in a widget or a
+//! shader). The structs are plain serde data; [`Effect::validate`] checks ranges and
+//! finiteness so nothing impossible ever reaches the GPU.
+
+use serde::{Deserialize, Serialize};
+
+/// The preset format version this build writes (and the newest it reads).
+pub const CURRENT_VERSION: u32 = 1;
+
+/// A whole fire effect: a seed, time settings and a list of emitter layers.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Effect {
+    /// Preset format version (see [`CURRENT_VERSION`]).
+    pub version: u32,
+    /// Human-readable name.
+    pub name: String,
+    /// Master seed; every random number is a hash of (seed, emitter, slot, spawn counter).
+    pub seed: u32,
+    /// How simulated time advances.
+    pub time: TimeSettings,
+    /// Where the camera starts.
+    pub camera: CameraHint,
+    /// Emitter layers (flame, embers, smoke…), drawn in order.
+    pub emitters: Vec<Emitter>,
+}
+
+/// How simulated time advances relative to wall-clock frames.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TimeSettings {
+    /// Fixed step (deterministic, frame-rate independent) or one step per frame.
+    pub mode: TimeMode,
+    /// Fixed step size in seconds (fixed mode).
+    pub step_secs: f32,
+    /// At most this many steps per frame; the rest of the time is dropped and counted.
+    pub max_substeps: u32,
+    /// Largest step in frame-delta mode, in seconds (a long frame is clamped to this).
+    pub max_frame_dt_secs: f32,
+    /// Simulation speed multiplier (1 = real time).
+    pub speed: f32,
+}
+
+/// Time stepping mode.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum TimeMode {
+    /// A fixed step with an accumulator: the same result at any frame rate.
+    FixedStep,
+    /// One step per frame with dt = min(frame dt, max dt): the 2006 thesis's mode.
+    FrameDelta,
+}
+
+/// Initial camera placement (an orbit around `target_m`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CameraHint {
+    /// The orbit centre in world space, metres.
+    pub target_m: [f32; 3],
+    /// Distance from the target, metres.
+    pub distance_m: f32,
+    /// Rotation around the vertical axis, degrees.
+    pub yaw_deg: f32,
+    /// Elevation above the horizon, degrees.
+    pub pitch_deg: f32,
+    /// Vertical field of view, degrees.
+    pub fov_y_deg: f32,
+}
+
+/// One layer of the effect: its own particle pool, spawning, forces and look.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Emitter {
+    /// Display name (unique within the effect).
+    pub name: String,
+    /// Muted emitters neither simulate nor draw.
+    pub enabled: bool,
+    /// Number of particle slots in this emitter's ring.
+    pub capacity: u32,
+    /// Continuous emission rate, particles per second.
+    pub spawn_rate_per_sec: f32,
+    /// At most this many spawns per step (a long step can't cause a burst). 0 = automatic:
+    /// enough for the rate at a step of 1/15 s.
+    pub max_spawn_per_step: u32,
+    /// One-shot bursts.
+    pub bursts: Vec<Burst>,
+    /// Lifetime range, seconds; each particle draws its own.
+    pub lifetime_secs: Range,
+    /// Where particles are born (in emitter space).
+    pub shape: Shape,
+    /// Emitter placement in the world.
+    pub transform: Transform,
+    /// Initial direction (emitter space, normalised on use).
+    pub direction: [f32; 3],
+    /// Half-angle of the cone of initial directions around `direction`, degrees.
+    pub spread_deg: f32,
+    /// Initial speed range, metres per second.
+    pub speed_m_per_s: Range,
+    /// Forces acting on alive particles.
+    pub forces: Forces,
+    /// Noise that perturbs spawn positions and directions over time (flicker).
+    pub spawn_noise: SpawnNoise,
+    /// Integration method.
+    pub integrator: Integrator,
+    /// Added to the effect seed for this emitter's stream.
+    pub seed_offset: u32,
+    /// How the particles are drawn.
+    pub look: Look,
+}
+
+/// A one-shot burst of particles.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Burst {
+    /// When the burst fires, seconds after the start.
+    pub time_secs: f32,
+    /// How many particles it spawns.
+    pub count: u32,
+}
+
+/// A closed interval `[min, max]`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Range {
+    /// Lower bound.
+    pub min: f32,
+    /// Upper bound (≥ min).
+    pub max: f32,
+}
+
+impl Range {
+    /// A range `[min, max]`.
+    pub const fn new(min: f32, max: f32) -> Self {
+        Self { min, max }
+    }
+}
+
+/// Spawn shapes, all in emitter space.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Shape {
+    /// All particles start at the emitter origin.
+    Point,
+    /// A sphere around the origin.
+    Sphere {
+        /// Radius, metres.
+        radius_m: f32,
+        /// Only on the surface (true) or anywhere inside (false).
+        surface_only: bool,
+    },
+    /// A flat disc through the origin (the area emitter the 2006 thesis wished for).
+    Disc {
+        /// Radius, metres.
+        radius_m: f32,
+        /// Disc normal (normalised on use).
+        normal: [f32; 3],
+    },
+    /// An axis-aligned box around the origin.
+    Box {
+        /// Half extents, metres.
+        half_extents_m: [f32; 3],
+    },
+    /// A cone: born on its base disc (normal = emitter direction), directions within its angle.
+    Cone {
+        /// Half-angle of the cone, degrees (replaces `spread_deg`).
+        angle_deg: f32,
+        /// Radius of the base disc, metres.
+        radius_m: f32,
+    },
+    /// A segment between two points.
+    Line {
+        /// First endpoint, metres.
+        a_m: [f32; 3],
+        /// Second endpoint, metres.
+        b_m: [f32; 3],
+    },
+}
+
+impl Shape {
+    /// Stable index used on the GPU (keep in sync with `SHAPE_*` in `shaders/common.wgsl`).
+    pub fn kind_index(&self) -> u32 {
+        match self {
+            Shape::Point => 0,
+            Shape::Sphere { .. } => 1,
+            Shape::Disc { .. } => 2,
+            Shape::Box { .. } => 3,
+            Shape::Cone { .. } => 4,
+            Shape::Line { .. } => 5,
+        }
+    }
+
+    /// Name for the UI.
+    pub fn label(&self) -> &'static str {
+        match self {
+            Shape::Point => "Point",
+            Shape::Sphere { .. } => "Sphere",
+            Shape::Disc { .. } => "Disc",
+            Shape::Box { .. } => "Box",
+            Shape::Cone { .. } => "Cone",
+            Shape::Line { .. } => "Line",
+        }
+    }
+
+    /// A default instance of every shape, for pickers.
+    pub fn all_defaults() -> [Shape; 6] {
+        [
+            Shape::Point,
+            Shape::Sphere {
+                radius_m: 0.3,
+                surface_only: false,
+            },
+            Shape::Disc {
+                radius_m: 0.3,
+                normal: [0.0, 1.0, 0.0],
+            },
+            Shape::Box {
+                half_extents_m: [0.3, 0.05, 0.3],
+            },
+            Shape::Cone {
+                angle_deg: 15.0,
+                radius_m: 0.2,
+            },
+            Shape::Line {
+                a_m: [-0.4, 0.0, 0.0],
+                b_m: [0.4, 0.0, 0.0],
+            },
+        ]
+    }
+}
+
+/// Emitter placement: translation, then rotation (degrees, applied X, then Y, then Z).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Transform {
+    /// World position of the emitter origin, metres.
+    pub position_m: [f32; 3],
+    /// Euler rotation, degrees.
+    pub rotation_deg: [f32; 3],
+}
+
+impl Transform {
+    /// The matrix that takes emitter-space points to world space.
+    pub fn world_from_emitter(&self) -> glam::Mat4 {
+        let [rx, ry, rz] = self.rotation_deg.map(f32::to_radians);
+        let rotation = glam::Quat::from_euler(glam::EulerRot::ZYX, rz, ry, rx);
+        glam::Mat4::from_rotation_translation(rotation, self.position_m.into())
+    }
+}
+
+/// Forces on alive particles: a = gravity + buoyancy·up − drag·(v − wind).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Forces {
+    /// Gravity, m/s².
+    pub gravity_m_per_s2: [f32; 3],
+    /// Upward buoyancy of hot gas, m/s² along +Y (the thesis's "negative gravity").
+    pub buoyancy_m_per_s2: f32,
+    /// Linear (Stokes) drag rate k, 1/s: the velocity relaxes toward the wind.
+    pub drag_per_sec: f32,
+    /// The flow velocity drag pulls toward, m/s.
+    pub wind_m_per_s: [f32; 3],
+}
+
+impl Forces {
+    /// The constant part of the acceleration (gravity + buoyancy), m/s².
+    pub fn constant_acceleration(&self) -> glam::Vec3 {
+        glam::Vec3::from(self.gravity_m_per_s2) + glam::Vec3::Y * self.buoyancy_m_per_s2
+    }
+}
+
+/// Noise that perturbs spawn positions and directions over time, so the flame flickers.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SpawnNoise {
+    /// Spatial frequency of the noise field, 1/m.
+    pub frequency_per_m: f32,
+    /// Position offset amplitude, metres.
+    pub position_amplitude_m: f32,
+    /// Direction tilt amplitude (0..1, fraction of the direction vector).
+    pub direction_amplitude: f32,
+    /// How fast the field scrolls in time, 1/s.
+    pub scroll_per_sec: f32,
+}
+
+/// Time integration methods (keep in sync with `INTEGRATOR_*` in `shaders/integrators.wgsl`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Integrator {
+    /// x += v·dt; v += a(x, v)·dt — the 2006 thesis's method. Order 1.
+    ExplicitEuler,
+    /// v += a·dt; x += v·dt (symplectic Euler). Order 1.
+    SemiImplicitEuler,
+    /// Velocity Verlet with a predicted velocity for drag. Order 2.
+    VelocityVerlet,
+    /// Heun / RK2 (explicit trapezoid). Order 2.
+    Heun,
+    /// Classic Runge–Kutta 4 (four force evaluations). Order 4.
+    Rk4,
+    /// Exponential integrator: exact for constant acceleration plus linear drag.
+    Exponential,
+}
+
+impl Integrator {
+    /// All integrators, in UI order.
+    pub const ALL: [Integrator; 6] = [
+        Integrator::ExplicitEuler,
+        Integrator::SemiImplicitEuler,
+        Integrator::VelocityVerlet,
+        Integrator::Heun,
+        Integrator::Rk4,
+        Integrator::Exponential,
+    ];
+
+    /// Stable index used as the `INTEGRATOR` pipeline override constant.
+    pub fn index(self) -> u32 {
+        match self {
+            Integrator::ExplicitEuler => 0,
+            Integrator::SemiImplicitEuler => 1,
+            Integrator::VelocityVerlet => 2,
+            Integrator::Heun => 3,
+            Integrator::Rk4 => 4,
+            Integrator::Exponential => 5,
+        }
+    }
+
+    /// Name for the UI and tables.
+    pub fn label(self) -> &'static str {
+        match self {
+            Integrator::ExplicitEuler => "explicit Euler",
+            Integrator::SemiImplicitEuler => "semi-implicit Euler",
+            Integrator::VelocityVerlet => "velocity Verlet",
+            Integrator::Heun => "Heun (RK2)",
+            Integrator::Rk4 => "RK4",
+            Integrator::Exponential => "exponential",
+        }
+    }
+
+    /// Largest stable k·dt for pure linear drag `v' = −k v` (None = unconditionally stable).
+    ///
+    /// From the amplification factor of each method on the test equation: Euler-type and
+    /// Heun need |1 − z + …| ≤ 1 with z = k·dt, giving z < 2; RK4's real stability
+    /// interval ends at z ≈ 2.785.
+    pub fn drag_stability_limit(self) -> Option<f32> {
+        match self {
+            Integrator::ExplicitEuler
+            | Integrator::SemiImplicitEuler
+            | Integrator::VelocityVerlet
+            | Integrator::Heun => Some(2.0),
+            Integrator::Rk4 => Some(2.785_293_6),
+            Integrator::Exponential => None,
+        }
+    }
+}
+
+/// How an emitter's particles look.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Look {
+    /// Procedural sprite.
+    pub sprite: Sprite,
+    /// Billboard size (diameter) at birth, metres.
+    pub size_start_m: f32,
+    /// Billboard size at death, metres.
+    pub size_end_m: f32,
+    /// Colour and alpha over normalised age (0 = birth, 1 = death); linear RGB.
+    pub color_over_life: Vec<ColorStop>,
+    /// Multiplies the colour (HDR brightness).
+    pub intensity: f32,
+    /// How particles are blended.
+    pub blend: BlendMode,
+}
+
+/// Built-in procedural sprites.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Sprite {
+    /// A soft round disc (Gaussian-like falloff).
+    SoftDisc,
+    /// A hard-edged point (the thesis's look).
+    Point,
+    /// A bright core with a soft halo (sparks).
+    Spark,
+}
+
+impl Sprite {
+    /// Stable index used on the GPU (keep in sync with `SPRITE_*` in `shaders/billboard.wgsl`).
+    pub fn index(self) -> u32 {
+        match self {
+            Sprite::SoftDisc => 0,
+            Sprite::Point => 1,
+            Sprite::Spark => 2,
+        }
+    }
+}
+
+/// Blend modes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum BlendMode {
+    /// Light adds up (fire, sparks): order-independent.
+    Additive,
+    /// Premultiplied alpha "over" (smoke): darkens what is behind.
+    Alpha,
+}
+
+/// One stop of a colour gradient.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ColorStop {
+    /// Normalised age, 0..1.
+    pub t: f32,
+    /// Linear RGB and alpha.
+    pub rgba: [f32; 4],
+}
+
+/// The maximum number of gradient stops the GPU uniform holds.
+pub const MAX_COLOR_STOPS: usize = 8;
+
+impl Default for Effect {
+    fn default() -> Self {
+        Self {
+            version: CURRENT_VERSION,
+            name: "campfire".to_owned(),
+            seed: 1,
+            time: TimeSettings::default(),
+            camera: CameraHint::default(),
+            emitters: vec![Emitter::default()],
+        }
+    }
+}
+
+impl Default for TimeSettings {
+    fn default() -> Self {
+        Self {
+            mode: TimeMode::FixedStep,
+            step_secs: 1.0 / 120.0,
+            max_substeps: 8,
+            max_frame_dt_secs: 0.1,
+            speed: 1.0,
+        }
+    }
+}
+
+impl Default for CameraHint {
+    fn default() -> Self {
+        Self {
+            target_m: [0.0, 0.8, 0.0],
+            distance_m: 3.2,
+            yaw_deg: 0.0,
+            pitch_deg: 8.0,
+            fov_y_deg: 45.0,
+        }
+    }
+}
+
+impl Default for Emitter {
+    fn default() -> Self {
+        Self {
+            name: "flames".to_owned(),
+            enabled: true,
+            capacity: 4096,
+            spawn_rate_per_sec: 1800.0,
+            max_spawn_per_step: 0,
+            bursts: Vec::new(),
+            lifetime_secs: Range::new(0.6, 1.4),
+            shape: Shape::Disc {
+                radius_m: 0.35,
+                normal: [0.0, 1.0, 0.0],
+            },
+            transform: Transform::default(),
+            direction: [0.0, 1.0, 0.0],
+            spread_deg: 12.0,
+            speed_m_per_s: Range::new(0.3, 0.8),
+            forces: Forces::default(),
+            spawn_noise: SpawnNoise::default(),
+            integrator: Integrator::SemiImplicitEuler,
+            seed_offset: 0,
+            look: Look::default(),
+        }
+    }
+}
+
+impl Default for Transform {
+    fn default() -> Self {
+        Self {
+            position_m: [0.0, 0.0, 0.0],
+            rotation_deg: [0.0, 0.0, 0.0],
+        }
+    }
+}
+
+impl Default for Forces {
+    fn default() -> Self {
+        Self {
+            gravity_m_per_s2: [0.0, -9.81, 0.0],
+            buoyancy_m_per_s2: 11.5,
+            drag_per_sec: 1.2,
+            wind_m_per_s: [0.1, 0.0, 0.0],
+        }
+    }
+}
+
+impl Default for SpawnNoise {
+    fn default() -> Self {
+        Self {
+            frequency_per_m: 2.0,
+            position_amplitude_m: 0.08,
+            direction_amplitude: 0.25,
+            scroll_per_sec: 1.5,
+        }
+    }
+}
+
+impl Default for Look {
+    fn default() -> Self {
+        Self {
+            sprite: Sprite::SoftDisc,
+            size_start_m: 0.22,
+            size_end_m: 0.06,
+            color_over_life: vec![
+                ColorStop {
+                    t: 0.0,
+                    rgba: [1.0, 0.9, 0.6, 0.0],
+                },
+                ColorStop {
+                    t: 0.08,
+                    rgba: [1.0, 0.75, 0.3, 0.9],
+                },
+                ColorStop {
+                    t: 0.35,
+                    rgba: [1.0, 0.38, 0.06, 0.7],
+                },
+                ColorStop {
+                    t: 0.7,
+                    rgba: [0.7, 0.1, 0.02, 0.35],
+                },
+                ColorStop {
+                    t: 1.0,
+                    rgba: [0.08, 0.05, 0.05, 0.0],
+                },
+            ],
+            intensity: 1.6,
+            blend: BlendMode::Additive,
+        }
+    }
+}
+
+impl Default for Range {
+    fn default() -> Self {
+        Self::new(1.0, 1.0)
+    }
+}
+
+/// A validation failure: the field path and what is wrong with its value.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{path} = {value}: {problem}")]
+pub struct ValidationError {
+    /// Field path, e.g. `emitters[1].spawn_rate_per_sec`.
+    pub path: String,
+    /// The offending value, formatted.
+    pub value: String,
+    /// What it must be instead.
+    pub problem: String,
+}
+
+/// Largest capacity a single emitter may ask for (device limits may be lower).
+pub const MAX_CAPACITY: u32 = 1 << 28;
+
+struct Checker {
+    errors: Vec<ValidationError>,
+}
+
+impl Checker {
+    fn push(&mut self, path: String, value: impl std::fmt::Display, problem: &str) {
+        self.errors.push(ValidationError {
+            path,
+            value: value.to_string(),
+            problem: problem.to_owned(),
+        });
+    }
+
+    /// A finite number within `[lo, hi]`.
+    fn num(&mut self, path: impl Fn() -> String, v: f32, lo: f32, hi: f32) {
+        if !v.is_finite() {
+            self.push(path(), v, "must be a finite number");
+        } else if v < lo {
+            self.push(path(), v, &format!("must be ≥ {lo}"));
+        } else if v > hi {
+            self.push(path(), v, &format!("must be ≤ {hi}"));
+        }
+    }
+
+    fn vec3(&mut self, path: impl Fn() -> String, v: [f32; 3], limit: f32) {
+        for (i, c) in v.iter().enumerate() {
+            self.num(|| format!("{}[{i}]", path()), *c, -limit, limit);
+        }
+    }
+
+    fn nonzero_vec3(&mut self, path: impl Fn() -> String, v: [f32; 3]) {
+        self.vec3(&path, v, 1e6);
+        if glam::Vec3::from(v).length_squared() < 1e-12 {
+            self.push(
+                path(),
+                format!("{v:?}"),
+                "must not be the zero vector (it is a direction)",
+            );
+        }
+    }
+
+    fn range(&mut self, path: impl Fn() -> String, r: Range, lo: f32, hi: f32) {
+        self.num(|| format!("{}.min", path()), r.min, lo, hi);
+        self.num(|| format!("{}.max", path()), r.max, lo, hi);
+        if r.min.is_finite() && r.max.is_finite() && r.min > r.max {
+            self.push(
+                format!("{}.min", path()),
+                r.min,
+                &format!("must be ≤ max ({})", r.max),
+            );
+        }
+    }
+}
+
+impl Effect {
+    /// Checks every field; returns all problems found (empty = valid).
+    pub fn validate(&self) -> Result<(), Vec<ValidationError>> {
+        let mut c = Checker { errors: Vec::new() };
+        if self.version > CURRENT_VERSION {
+            c.push(
+                "version".into(),
+                self.version,
+                &format!("this build reads versions up to {CURRENT_VERSION}; update ignis"),
+            );
+        }
+        if self.version == 0 {
+            c.push("version".into(), 0, "must be ≥ 1");
+        }
+        let t = &self.time;
+        c.num(|| "time.step_secs".into(), t.step_secs, 1e-5, 1.0);
+        if t.max_substeps == 0 || t.max_substeps > 1000 {
+            c.push(
+                "time.max_substeps".into(),
+                t.max_substeps,
+                "must be in 1..=1000",
+            );
+        }
+        c.num(
+            || "time.max_frame_dt_secs".into(),
+            t.max_frame_dt_secs,
+            1e-5,
+            1.0,
+        );
+        c.num(|| "time.speed".into(), t.speed, 0.0, 100.0);
+        let cam = &self.camera;
+        c.vec3(|| "camera.target_m".into(), cam.target_m, 1e6);
+        c.num(|| "camera.distance_m".into(), cam.distance_m, 0.01, 1e5);
+        c.num(|| "camera.yaw_deg".into(), cam.yaw_deg, -3600.0, 3600.0);
+        c.num(|| "camera.pitch_deg".into(), cam.pitch_deg, -89.9, 89.9);
+        c.num(|| "camera.fov_y_deg".into(), cam.fov_y_deg, 1.0, 170.0);
+        if self.emitters.is_empty() {
+            c.push("emitters".into(), "[]", "must list at least one emitter");
+        }
+        let mut names = std::collections::HashSet::new();
+        for (i, e) in self.emitters.iter().enumerate() {
+            let p = |f: &str| format!("emitters[{i}].{f}");
+            if !names.insert(e.name.as_str()) {
+                c.push(
+                    p("name"),
+                    format!("{:?}", e.name),
+                    "duplicate emitter name; names must be unique",
+                );
+            }
+            if e.capacity == 0 || e.capacity > MAX_CAPACITY {
+                c.push(
+                    p("capacity"),
+                    e.capacity,
+                    &format!("must be in 1..={MAX_CAPACITY}"),
+                );
+            }
+            c.num(|| p("spawn_rate_per_sec"), e.spawn_rate_per_sec, 0.0, 1e9);
+            for (b, burst) in e.bursts.iter().enumerate() {
+                c.num(
+                    || p(&format!("bursts[{b}].time_secs")),
+                    burst.time_secs,
+                    0.0,
+                    1e6,
+                );
+            }
+            c.range(|| p("lifetime_secs"), e.lifetime_secs, 1e-3, 1e4);
+            match &e.shape {
+                Shape::Point => {}
+                Shape::Sphere { radius_m, .. } => {
+                    c.num(|| p("shape.radius_m"), *radius_m, 0.0, 1e4)
+                }
+                Shape::Disc { radius_m, normal } => {
+                    c.num(|| p("shape.radius_m"), *radius_m, 0.0, 1e4);
+                    c.nonzero_vec3(|| p("shape.normal"), *normal);
+                }
+                Shape::Box { half_extents_m } => {
+                    for (k, h) in half_extents_m.iter().enumerate() {
+                        c.num(|| p(&format!("shape.half_extents_m[{k}]")), *h, 0.0, 1e4);
+                    }
+                }
+                Shape::Cone {
+                    angle_deg,
+                    radius_m,
+                } => {
+                    c.num(|| p("shape.angle_deg"), *angle_deg, 0.0, 180.0);
+                    c.num(|| p("shape.radius_m"), *radius_m, 0.0, 1e4);
+                }
+                Shape::Line { a_m, b_m } => {
+                    c.vec3(|| p("shape.a_m"), *a_m, 1e6);
+                    c.vec3(|| p("shape.b_m"), *b_m, 1e6);
+                }
+            }
+            c.vec3(|| p("transform.position_m"), e.transform.position_m, 1e7);
+            c.vec3(
+                || p("transform.rotation_deg"),
+                e.transform.rotation_deg,
+                3600.0,
+            );
+            c.nonzero_vec3(|| p("direction"), e.direction);
+            c.num(|| p("spread_deg"), e.spread_deg, 0.0, 180.0);
+            c.range(|| p("speed_m_per_s"), e.speed_m_per_s, 0.0, 1e5);
+            let f = &e.forces;
+            c.vec3(|| p("forces.gravity_m_per_s2"), f.gravity_m_per_s2, 1e5);
+            c.num(
+                || p("forces.buoyancy_m_per_s2"),
+                f.buoyancy_m_per_s2,
+                -1e5,
+                1e5,
+            );
+            c.num(|| p("forces.drag_per_sec"), f.drag_per_sec, 0.0, 1e4);
+            c.vec3(|| p("forces.wind_m_per_s"), f.wind_m_per_s, 1e5);
+            let n = &e.spawn_noise;
+            c.num(
+                || p("spawn_noise.frequency_per_m"),
+                n.frequency_per_m,
+                0.0,
+                1e3,
+            );
+            c.num(
+                || p("spawn_noise.position_amplitude_m"),
+                n.position_amplitude_m,
+                0.0,
+                1e3,
+            );
+            c.num(
+                || p("spawn_noise.direction_amplitude"),
+                n.direction_amplitude,
+                0.0,
+                10.0,
+            );
+            c.num(
+                || p("spawn_noise.scroll_per_sec"),
+                n.scroll_per_sec,
+                -1e3,
+                1e3,
+            );
+            let l = &e.look;
+            c.num(|| p("look.size_start_m"), l.size_start_m, 0.0, 1e3);
+            c.num(|| p("look.size_end_m"), l.size_end_m, 0.0, 1e3);
+            c.num(|| p("look.intensity"), l.intensity, 0.0, 1e4);
+            if l.color_over_life.is_empty() || l.color_over_life.len() > MAX_COLOR_STOPS {
+                c.push(
+                    p("look.color_over_life"),
+                    format!("{} stops", l.color_over_life.len()),
+                    &format!("must have 1..={MAX_COLOR_STOPS} stops"),
+                );
+            }
+            let mut last_t = 0.0;
+            for (s, stop) in l.color_over_life.iter().enumerate() {
+                let sp = || p(&format!("look.color_over_life[{s}]"));
+                c.num(|| format!("{}.t", sp()), stop.t, 0.0, 1.0);
+                if stop.t < last_t {
+                    c.push(format!("{}.t", sp()), stop.t, "stops must be sorted by t");
+                }
+                last_t = stop.t;
+                for (k, v) in stop.rgba.iter().enumerate() {
+                    c.num(|| format!("{}.rgba[{k}]", sp()), *v, 0.0, 1e3);
+                }
+            }
+        }
+        if c.errors.is_empty() {
+            Ok(())
+        } else {
+            Err(c.errors)
+        }
+    }
+
+    /// The embedded default effect (a campfire: flames, embers and smoke).
+    pub fn default_campfire() -> Effect {
+        // The default preset file is the source of truth; it is embedded so `ignis` runs anywhere.
+        match crate::preset::parse_str(DEFAULT_PRESET_RON, "presets/campfire.ron") {
+            Ok(effect) => effect,
+            Err(err) => {
+                log::error!("embedded default preset is invalid ({err}); using built-in defaults");
+                Effect::default()
+            }
+        }
+    }
+}
+
+/// The default campfire preset, embedded in the binary.
+pub const DEFAULT_PRESET_RON: &str = include_str!("../presets/campfire.ron");
+
+impl Emitter {
+    /// The spawn cap per step actually used (see [`Emitter::max_spawn_per_step`]).
+    pub fn effective_spawn_cap(&self) -> u32 {
+        if self.max_spawn_per_step > 0 {
+            self.max_spawn_per_step
+        } else {
+            // Enough for the continuous rate at a 1/15 s step, plus any burst.
+            let burst_max = self.bursts.iter().map(|b| b.count).max().unwrap_or(0);
+            let per_step = (self.spawn_rate_per_sec as f64 / 15.0).ceil() as u64;
+            (per_step.max(1) + burst_max as u64).min(u32::MAX as u64) as u32
+        }
+    }
+}

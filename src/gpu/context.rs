@@ -1,0 +1,135 @@
+//! The GPU device: adapter choice, limits sized to the capacity, clear errors.
+
+use std::sync::Arc;
+
+/// Failures to get a usable GPU.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    /// No adapter matched.
+    #[error(
+        "no GPU adapter found ({0}); install a Vulkan driver (e.g. Mesa's lavapipe: apt install mesa-vulkan-drivers) or set WGPU_BACKEND"
+    )]
+    NoAdapter(String),
+    /// The device request failed.
+    #[error("the GPU device could not be created: {0}")]
+    Device(String),
+    /// A capacity needs more than a device limit allows.
+    #[error(
+        "emitter \"{emitter}\": capacity {capacity} needs {needed_bytes} bytes per state buffer, but this adapter's {limit} is {limit_bytes} bytes (at most {max_capacity} particles); lower the capacity"
+    )]
+    CapacityTooLarge {
+        /// Emitter name.
+        emitter: String,
+        /// Requested slots.
+        capacity: u32,
+        /// Bytes it needs.
+        needed_bytes: u64,
+        /// Which wgpu limit.
+        limit: &'static str,
+        /// The limit's value.
+        limit_bytes: u64,
+        /// Largest capacity that fits.
+        max_capacity: u64,
+    },
+}
+
+/// An adapter, device and queue, shared by the simulation and the renderers.
+#[derive(Clone)]
+pub struct GpuContext {
+    /// The adapter in use.
+    pub adapter: Arc<wgpu::Adapter>,
+    /// The device.
+    pub device: wgpu::Device,
+    /// Its queue.
+    pub queue: wgpu::Queue,
+    /// Adapter description for logs and bench files.
+    pub info: wgpu::AdapterInfo,
+}
+
+impl GpuContext {
+    /// A headless context (tests, `ignis render`, `ignis bench`). The adapter may be forced
+    /// with `WGPU_BACKEND` / `WGPU_ADAPTER_NAME`.
+    pub fn headless() -> Result<Self, GpuError> {
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(
+            &instance, None,
+        ))
+        .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
+        Self::from_adapter(adapter)
+    }
+
+    /// Creates the device on `adapter`, asking for the largest buffers it offers.
+    pub fn from_adapter(adapter: wgpu::Adapter) -> Result<Self, GpuError> {
+        let info = adapter.get_info();
+        let supported = adapter.limits();
+        let mut limits = wgpu::Limits::default().using_resolution(supported.clone());
+        limits.max_storage_buffer_binding_size = supported.max_storage_buffer_binding_size;
+        limits.max_buffer_size = supported.max_buffer_size;
+        let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("ignis device"),
+            required_features: features,
+            required_limits: limits,
+            ..Default::default()
+        }))
+        .map_err(|e| GpuError::Device(e.to_string()))?;
+        // Nothing the GPU reports may panic the editor: log what no error scope caught.
+        device.on_uncaptured_error(Arc::new(|err| {
+            log::error!("uncaptured GPU error: {err}");
+        }));
+        log::info!(
+            "GPU: {} ({:?}, {:?}, driver {} {})",
+            info.name,
+            info.device_type,
+            info.backend,
+            info.driver,
+            info.driver_info
+        );
+        Ok(Self {
+            adapter: Arc::new(adapter),
+            device,
+            queue,
+            info,
+        })
+    }
+
+    /// True on software adapters (lavapipe), whose timestamps are not trustworthy.
+    pub fn is_cpu_adapter(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
+    /// The largest particle pool one state buffer can hold on this device.
+    pub fn max_capacity(&self) -> u64 {
+        let limits = self.device.limits();
+        let per = std::mem::size_of::<crate::gpu::types::Particle>() as u64;
+        (limits.max_storage_buffer_binding_size as u64).min(limits.max_buffer_size) / per
+    }
+
+    /// Checks that `capacity` slots fit in one storage binding, naming the limit if not.
+    pub fn check_capacity(&self, emitter: &str, capacity: u32) -> Result<(), GpuError> {
+        let limits = self.device.limits();
+        let per = std::mem::size_of::<crate::gpu::types::Particle>() as u64;
+        let needed = capacity as u64 * per;
+        let (limit, limit_bytes) =
+            if (limits.max_storage_buffer_binding_size as u64) < limits.max_buffer_size {
+                (
+                    "max_storage_buffer_binding_size",
+                    limits.max_storage_buffer_binding_size as u64,
+                )
+            } else {
+                ("max_buffer_size", limits.max_buffer_size)
+            };
+        if needed > limit_bytes {
+            return Err(GpuError::CapacityTooLarge {
+                emitter: emitter.to_owned(),
+                capacity,
+                needed_bytes: needed,
+                limit,
+                limit_bytes,
+                max_capacity: limit_bytes / per,
+            });
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,6 @@
+//! GPU plumbing: the device context and the structs shared with WGSL.
+
+pub mod context;
+pub mod types;
+
+pub use context::{GpuContext, GpuError};

@@ -1,0 +1,120 @@
+//! Structs shared with WGSL. Keep in sync with `shaders/common.wgsl` and
+//! `shaders/billboard.wgsl`; `tests/shaders.rs` compares these sizes with naga's layout.
+
+use bytemuck::{Pod, Zeroable};
+
+/// One particle slot, 32 bytes (keep in sync with `Particle` in `shaders/common.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Particle {
+    /// xyz: world position (m), w: age (s).
+    pub pos_age: [f32; 4],
+    /// xyz: velocity (m/s), w: lifetime (s).
+    pub vel_life: [f32; 4],
+}
+
+impl Particle {
+    /// Alive while age < lifetime (never-spawned slots are all zero, hence dead).
+    pub fn is_alive(&self) -> bool {
+        self.pos_age[3] < self.vel_life[3]
+    }
+
+    /// World position.
+    pub fn position(&self) -> glam::Vec3 {
+        glam::Vec3::from_slice(&self.pos_age[..3])
+    }
+
+    /// Velocity.
+    pub fn velocity(&self) -> glam::Vec3 {
+        glam::Vec3::from_slice(&self.vel_life[..3])
+    }
+}
+
+/// Per-step, per-emitter simulation parameters (keep in sync with `SimParams` in
+/// `shaders/common.wgsl`). Uploaded once per step at a 256-byte aligned dynamic offset.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SimParams {
+    /// Emitter space → world.
+    pub world_from_emitter: [[f32; 4]; 4],
+    /// Shape parameters (see `shaders/spawn.wgsl`).
+    pub shape_a: [f32; 4],
+    /// More shape parameters.
+    pub shape_b: [f32; 4],
+    /// xyz: unit initial direction (emitter space), w: spread half-angle (rad).
+    pub direction_spread: [f32; 4],
+    /// speed min, speed max, lifetime min, lifetime max.
+    pub speed_life: [f32; 4],
+    /// xyz: gravity + buoyancy (m/s²), w: drag k (1/s).
+    pub accel_drag: [f32; 4],
+    /// xyz: wind (m/s), w: wrapped simulated time for noise (s).
+    pub wind_time: [f32; 4],
+    /// frequency, position amplitude, direction amplitude, scroll.
+    pub noise: [f32; 4],
+    /// Step size, seconds.
+    pub dt_secs: f32,
+    /// Effect seed.
+    pub seed: u32,
+    /// Per-emitter salt (index and seed offset mixed).
+    pub emitter_salt: u32,
+    /// `Shape::kind_index`.
+    pub shape_kind: u32,
+    /// Slots in the ring.
+    pub capacity: u32,
+    /// First slot of this step's spawn window.
+    pub spawn_head: u32,
+    /// Number of slots born this step.
+    pub spawn_count: u32,
+    /// Spawn counter of the first born slot, low 32 bits.
+    pub spawn_base_lo: u32,
+    /// High 32 bits.
+    pub spawn_base_hi: u32,
+    /// Reserved.
+    pub flags: u32,
+    /// Birth fraction (within the step) of the first spawn.
+    pub spawn_frac0: f32,
+    /// Birth fraction increment per spawn.
+    pub spawn_frac_step: f32,
+}
+
+/// Camera data for the billboard pass (keep in sync with `CameraUniform` in
+/// `shaders/billboard.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct CameraUniform {
+    /// World → clip.
+    pub clip_from_world: [[f32; 4]; 4],
+    /// xyz: camera right, w: interpolation alpha.
+    pub right_alpha: [f32; 4],
+    /// xyz: camera up.
+    pub up: [f32; 4],
+}
+
+/// Look data for the billboard pass (keep in sync with `LookUniform` in
+/// `shaders/billboard.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct LookUniform {
+    /// Gradient colours (linear RGBA).
+    pub colors: [[f32; 4]; 8],
+    /// Gradient stop positions, four per vec4.
+    pub stops: [[f32; 4]; 2],
+    /// size start, size end, intensity, stop count.
+    pub size_intensity: [f32; 4],
+    /// sprite kind, blend (0 additive, 1 alpha), unused, unused.
+    pub sprite_blend: [u32; 4],
+}
+
+/// Tonemap settings (keep in sync with `ToneUniform` in `shaders/tonemap.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ToneUniform {
+    /// x: exposure.
+    pub exposure: [f32; 4],
+}
+
+/// Byte stride between per-step `SimParams` blocks (the dynamic-offset alignment).
+pub const PARAMS_STRIDE: u64 = 256;
+
+const _: () = assert!(std::mem::size_of::<SimParams>() as u64 <= PARAMS_STRIDE);
+const _: () = assert!(std::mem::size_of::<Particle>() == 32);

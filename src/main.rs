@@ -1,0 +1,227 @@
+//! The `ignis` command line: `edit` (default), `render`, `check`.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context as _, bail};
+use clap::{Parser, Subcommand};
+
+use ignis::effect::Effect;
+use ignis::gpu::GpuContext;
+use ignis::headless::Headless;
+use ignis::shaders::{ENTRY_FILES, ShaderLibrary};
+
+#[derive(Parser)]
+#[command(name = "ignis", version, about = "Design real-time GPU fire effects")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render PNG frames of an effect headless.
+    Render {
+        /// Preset file (default: the embedded campfire).
+        preset: Option<PathBuf>,
+        /// Number of frames to write.
+        #[arg(long, default_value_t = 60)]
+        frames: u32,
+        /// Image size, WxH.
+        #[arg(long, default_value = "640x480", value_parser = parse_size)]
+        size: (u32, u32),
+        /// Output folder.
+        #[arg(long, default_value = "frames")]
+        out: PathBuf,
+        /// Override the preset's seed.
+        #[arg(long)]
+        seed: Option<u32>,
+        /// Simulated frame rate (frames per simulated second).
+        #[arg(long, default_value_t = 60.0)]
+        fps: f64,
+        /// Write only the last frame (after simulating all of them).
+        #[arg(long)]
+        last_only: bool,
+        /// Shader folder (default: ./shaders if present, else the embedded copies).
+        #[arg(long)]
+        shader_dir: Option<PathBuf>,
+    },
+    /// Validate presets and shaders without opening a window.
+    Check {
+        /// Files or folders (.ron presets, .wgsl shaders). Default: presets/ and shaders/.
+        paths: Vec<PathBuf>,
+    },
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WxH like 640x480, got {s:?}"))?;
+    let w: u32 = w
+        .trim()
+        .parse()
+        .map_err(|_| format!("bad width in {s:?}"))?;
+    let h: u32 = h
+        .trim()
+        .parse()
+        .map_err(|_| format!("bad height in {s:?}"))?;
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(format!("size {s} must be between 1x1 and 16384x16384"));
+    }
+    Ok((w, h))
+}
+
+fn main() {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        None => bail_editor(),
+        Some(Command::Render {
+            preset,
+            frames,
+            size,
+            out,
+            seed,
+            fps,
+            last_only,
+            shader_dir,
+        }) => render(
+            preset.as_deref(),
+            frames,
+            size,
+            &out,
+            seed,
+            fps,
+            last_only,
+            shader_dir.as_deref(),
+        ),
+        Some(Command::Check { paths }) => check(&paths),
+    };
+    if let Err(err) = result {
+        eprintln!("error: {err:#}");
+        std::process::exit(1);
+    }
+}
+
+fn bail_editor() -> anyhow::Result<()> {
+    bail!("the editor is not built yet")
+}
+
+fn load_effect(preset: Option<&Path>) -> anyhow::Result<Effect> {
+    match preset {
+        Some(p) => Ok(ignis::preset::load(p)?),
+        None => Ok(Effect::default_campfire()),
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn render(
+    preset: Option<&Path>,
+    frames: u32,
+    size: (u32, u32),
+    out: &Path,
+    seed: Option<u32>,
+    fps: f64,
+    last_only: bool,
+    shader_dir: Option<&Path>,
+) -> anyhow::Result<()> {
+    if !(fps.is_finite() && fps > 0.0) {
+        bail!("--fps must be a positive number, got {fps}");
+    }
+    let mut effect = load_effect(preset)?;
+    if let Some(s) = seed {
+        effect.seed = s;
+    }
+    let ctx = GpuContext::headless()?;
+    let lib = ShaderLibrary::discover(shader_dir);
+    let mut run = Headless::new(&ctx, effect, lib)?;
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let start = Instant::now();
+    let mut written = 0;
+    for f in 0..frames {
+        run.advance(1.0 / fps)?;
+        if !last_only || f + 1 == frames {
+            let image = run.render(size)?;
+            let path = out.join(format!("frame_{f:04}.png"));
+            image
+                .save(&path)
+                .with_context(|| format!("writing {}", path.display()))?;
+            written += 1;
+        }
+    }
+    let elapsed = start.elapsed().as_secs_f64();
+    println!(
+        "rendered {frames} frames ({written} written to {}) of \"{}\" at {}x{}: {} particles alive, {:.2} ms per frame on {}",
+        out.display(),
+        run.effect.name,
+        size.0,
+        size.1,
+        run.alive()?,
+        elapsed * 1000.0 / frames.max(1) as f64,
+        ctx.info.name
+    );
+    Ok(())
+}
+
+fn check(paths: &[PathBuf]) -> anyhow::Result<()> {
+    let paths: Vec<PathBuf> = if paths.is_empty() {
+        vec![PathBuf::from("presets"), PathBuf::from("shaders")]
+    } else {
+        paths.to_vec()
+    };
+    let mut presets = Vec::new();
+    let mut shader_dirs = Vec::new();
+    for p in &paths {
+        if p.is_dir() {
+            presets.extend(ignis::preset::list(p));
+            if std::fs::read_dir(p)?
+                .flatten()
+                .any(|e| e.path().extension().is_some_and(|x| x == "wgsl"))
+            {
+                shader_dirs.push(p.clone());
+            }
+        } else if p.extension().is_some_and(|x| x == "wgsl") {
+            shader_dirs.push(p.parent().unwrap_or(Path::new(".")).to_path_buf());
+        } else if p.exists() {
+            presets.push(p.clone());
+        } else {
+            bail!("{}: no such file or folder", p.display());
+        }
+    }
+    shader_dirs.sort();
+    shader_dirs.dedup();
+    let mut failures = 0;
+    for p in &presets {
+        match ignis::preset::load(p) {
+            Ok(e) => println!("ok   {} ({} emitters)", p.display(), e.emitters.len()),
+            Err(e) => {
+                failures += 1;
+                eprintln!("FAIL {e}");
+            }
+        }
+    }
+    for dir in &shader_dirs {
+        let lib = ShaderLibrary::from_dir(dir);
+        for entry in ENTRY_FILES {
+            match lib.compose(entry) {
+                Ok(c) => println!("ok   {} ({} files)", lib.display_path(entry), c.files.len()),
+                Err(e) => {
+                    failures += 1;
+                    eprintln!("FAIL {e}");
+                }
+            }
+        }
+    }
+    if failures > 0 {
+        bail!(
+            "{failures} of {} checks failed",
+            presets.len() + shader_dirs.len() * ENTRY_FILES.len()
+        );
+    }
+    println!(
+        "checked {} presets and {} shader folders: all valid",
+        presets.len(),
+        shader_dirs.len()
+    );
+    Ok(())
+}

@@ -1,0 +1,93 @@
+//! An orbit camera around a target, as in the 2006 thesis (rotate, zoom, pan).
+
+use glam::{Mat4, Vec3};
+
+use crate::effect::CameraHint;
+use crate::gpu::types::CameraUniform;
+
+/// A camera orbiting `target` at `distance`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OrbitCamera {
+    /// Orbit centre, world metres.
+    pub target: Vec3,
+    /// Distance to the target, metres.
+    pub distance: f32,
+    /// Rotation around +Y, radians.
+    pub yaw: f32,
+    /// Elevation, radians.
+    pub pitch: f32,
+    /// Vertical field of view, radians.
+    pub fov_y: f32,
+}
+
+impl OrbitCamera {
+    /// The camera a preset asks for.
+    pub fn from_hint(h: &CameraHint) -> Self {
+        Self {
+            target: h.target_m.into(),
+            distance: h.distance_m,
+            yaw: h.yaw_deg.to_radians(),
+            pitch: h.pitch_deg.to_radians(),
+            fov_y: h.fov_y_deg.to_radians(),
+        }
+    }
+
+    /// Eye position in world space.
+    pub fn eye(&self) -> Vec3 {
+        let (sy, cy) = self.yaw.sin_cos();
+        let (sp, cp) = self.pitch.sin_cos();
+        self.target + self.distance * Vec3::new(cp * sy, sp, cp * cy)
+    }
+
+    /// World → view.
+    pub fn view_from_world(&self) -> Mat4 {
+        glam::camera::rh::view::look_at_mat4(self.eye(), self.target, Vec3::Y)
+    }
+
+    /// World → clip for an aspect ratio (width / height).
+    pub fn clip_from_world(&self, aspect: f32) -> Mat4 {
+        let near = (self.distance * 0.01).max(1e-3);
+        let far = self.distance * 100.0 + 100.0;
+        // wgpu clip space: z in [0, 1], y up (the "directx" convention).
+        glam::camera::rh::proj::directx::perspective(self.fov_y, aspect.max(1e-3), near, far)
+            * self.view_from_world()
+    }
+
+    /// The uniform block for the billboard pass.
+    pub fn uniform(&self, aspect: f32, alpha: f32) -> CameraUniform {
+        let view = self.view_from_world();
+        // The camera's right and up axes in world space are the rows of the view rotation.
+        let right = Vec3::new(view.x_axis.x, view.y_axis.x, view.z_axis.x);
+        let up = Vec3::new(view.x_axis.y, view.y_axis.y, view.z_axis.y);
+        CameraUniform {
+            clip_from_world: self.clip_from_world(aspect).to_cols_array_2d(),
+            right_alpha: [right.x, right.y, right.z, alpha],
+            up: [up.x, up.y, up.z, 0.0],
+        }
+    }
+
+    /// Rotates by screen-space drag deltas (radians).
+    pub fn orbit(&mut self, d_yaw: f32, d_pitch: f32) {
+        self.yaw -= d_yaw;
+        self.pitch = (self.pitch + d_pitch).clamp(-1.55, 1.55);
+    }
+
+    /// Zooms by a factor (>1 moves away).
+    pub fn zoom(&mut self, factor: f32) {
+        self.distance = (self.distance * factor).clamp(0.05, 1e5);
+    }
+
+    /// Pans the target in the view plane by a fraction of the distance.
+    pub fn pan(&mut self, dx: f32, dy: f32) {
+        let view = self.view_from_world();
+        let right = Vec3::new(view.x_axis.x, view.y_axis.x, view.z_axis.x);
+        let up = Vec3::new(view.x_axis.y, view.y_axis.y, view.z_axis.y);
+        self.target += (-right * dx + up * dy) * self.distance;
+    }
+
+    /// Frames a sphere: centres on it and backs off to see all of it.
+    pub fn frame(&mut self, center: Vec3, radius: f32) {
+        self.target = center;
+        self.distance = (radius.max(0.05) / (0.5 * self.fov_y).sin()) * 1.1;
+    }
+}

@@ -1,0 +1,207 @@
+//! Pass 2 and the composite: billboards into an HDR target, tonemapped to sRGB.
+
+pub mod billboard;
+pub mod camera;
+pub mod tonemap;
+
+pub use billboard::BillboardPass;
+pub use camera::OrbitCamera;
+pub use tonemap::TonemapPass;
+
+use crate::effect::Effect;
+use crate::gpu::GpuContext;
+use crate::shaders::{ShaderError, ShaderLibrary};
+use crate::sim::gpu_sim::{GpuSim, SimError, map_read};
+
+/// The HDR format particles accumulate into.
+pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// The display format of headless frames.
+pub const LDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+
+/// Offscreen HDR and display targets of one size.
+pub struct Targets {
+    /// Width and height in pixels.
+    pub size: (u32, u32),
+    /// The HDR accumulation target.
+    pub hdr_view: wgpu::TextureView,
+    /// The tonemapped display image.
+    pub ldr: wgpu::Texture,
+    /// A view of `ldr`.
+    pub ldr_view: wgpu::TextureView,
+}
+
+impl Targets {
+    /// Creates both targets.
+    pub fn new(ctx: &GpuContext, size: (u32, u32)) -> Self {
+        let size = (size.0.max(1), size.1.max(1));
+        let extent = wgpu::Extent3d {
+            width: size.0,
+            height: size.1,
+            depth_or_array_layers: 1,
+        };
+        let make = |label, format, usage| {
+            ctx.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: extent,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let hdr = make(
+            "Targets::hdr",
+            HDR_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let ldr = make(
+            "Targets::ldr",
+            LDR_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+        );
+        Self {
+            size,
+            hdr_view: hdr.create_view(&Default::default()),
+            ldr_view: ldr.create_view(&Default::default()),
+            ldr,
+        }
+    }
+}
+
+/// Draws a simulation: billboards → HDR → tonemap → display texture.
+pub struct Renderer {
+    /// The billboard pass.
+    pub billboard: BillboardPass,
+    /// The tonemap pass.
+    pub tonemap: TonemapPass,
+    targets: Option<Targets>,
+    /// Exposure multiplier applied before tonemapping.
+    pub exposure: f32,
+}
+
+impl Renderer {
+    /// Builds the pipelines from `lib`.
+    pub fn new(ctx: &GpuContext, lib: &ShaderLibrary) -> Result<Self, ShaderError> {
+        Ok(Self {
+            billboard: BillboardPass::new(ctx, lib)?,
+            tonemap: TonemapPass::new(ctx, lib, LDR_FORMAT)?,
+            targets: None,
+            exposure: 1.0,
+        })
+    }
+
+    /// Rebuilds every pipeline from `lib`, keeping the old ones on error.
+    pub fn reload_shaders(
+        &mut self,
+        ctx: &GpuContext,
+        lib: &ShaderLibrary,
+    ) -> Result<(), ShaderError> {
+        self.billboard.rebuild(ctx, lib)?;
+        self.tonemap.rebuild(ctx, lib)?;
+        Ok(())
+    }
+
+    /// The targets, (re)created at `size` when needed.
+    pub fn targets(&mut self, ctx: &GpuContext, size: (u32, u32)) -> &Targets {
+        let stale = self.targets.as_ref().is_none_or(|t| t.size != size);
+        if stale {
+            self.targets = Some(Targets::new(ctx, size));
+        }
+        self.targets.get_or_insert_with(|| Targets::new(ctx, size))
+    }
+
+    /// Records the frame into `enc`: particles into the HDR target, then the tonemap
+    /// into the display texture.
+    pub fn record(
+        &mut self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        sim: &GpuSim,
+        effect: &Effect,
+        camera: &OrbitCamera,
+        alpha: f32,
+        size: (u32, u32),
+    ) {
+        self.targets(ctx, size);
+        let Some(targets) = self.targets.as_ref() else {
+            return;
+        };
+        let aspect = size.0 as f32 / size.1.max(1) as f32;
+        self.billboard.record(
+            ctx,
+            enc,
+            &targets.hdr_view,
+            sim,
+            effect,
+            camera,
+            aspect,
+            alpha,
+        );
+        self.tonemap.record(
+            ctx,
+            enc,
+            &targets.hdr_view,
+            &targets.ldr_view,
+            self.exposure,
+        );
+    }
+
+    /// Renders one frame and reads it back as an RGBA8 image (blocking).
+    pub fn render_image(
+        &mut self,
+        ctx: &GpuContext,
+        sim: &GpuSim,
+        effect: &Effect,
+        camera: &OrbitCamera,
+        alpha: f32,
+        size: (u32, u32),
+    ) -> Result<image::RgbaImage, SimError> {
+        let mut enc = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("Renderer::render_image"),
+            });
+        self.record(ctx, &mut enc, sim, effect, camera, alpha, size);
+        let Some(targets) = self.targets.as_ref() else {
+            return Err(SimError::Readback("no render target".into()));
+        };
+        let (w, h) = targets.size;
+        let row = (w * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("Renderer::readback"),
+            size: row as u64 * h as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        enc.copy_texture_to_buffer(
+            targets.ldr.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &staging,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: Some(h),
+                },
+            },
+            wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+        );
+        ctx.queue.submit([enc.finish()]);
+        let bytes = map_read(ctx, &staging)?;
+        let mut pixels = Vec::with_capacity((w * h * 4) as usize);
+        for y in 0..h as usize {
+            let start = y * row as usize;
+            pixels.extend_from_slice(&bytes[start..start + (w * 4) as usize]);
+        }
+        image::RgbaImage::from_raw(w, h, pixels)
+            .ok_or_else(|| SimError::Readback("image size mismatch".into()))
+    }
+}

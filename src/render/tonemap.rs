@@ -1,0 +1,162 @@
+//! The composite: HDR → exposure → ACES fit → sRGB display target.
+
+use crate::gpu::GpuContext;
+use crate::gpu::types::ToneUniform;
+use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
+
+/// A full-screen tonemap pass.
+pub struct TonemapPass {
+    layout: wgpu::BindGroupLayout,
+    pipeline_layout: wgpu::PipelineLayout,
+    pipeline: wgpu::RenderPipeline,
+    uniform: wgpu::Buffer,
+    format: wgpu::TextureFormat,
+}
+
+impl TonemapPass {
+    /// Builds the pass for an output `format`.
+    pub fn new(
+        ctx: &GpuContext,
+        lib: &ShaderLibrary,
+        format: wgpu::TextureFormat,
+    ) -> Result<Self, ShaderError> {
+        let layout = ctx
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("TonemapPass::layout"),
+                entries: &[
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 0,
+                        visibility: wgpu::ShaderStages::FRAGMENT,
+                        ty: wgpu::BindingType::Texture {
+                            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                            view_dimension: wgpu::TextureViewDimension::D2,
+                            multisampled: false,
+                        },
+                        count: None,
+                    },
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 1,
+                        visibility: wgpu::ShaderStages::FRAGMENT,
+                        ty: wgpu::BindingType::Buffer {
+                            ty: wgpu::BufferBindingType::Uniform,
+                            has_dynamic_offset: false,
+                            min_binding_size: None,
+                        },
+                        count: None,
+                    },
+                ],
+            });
+        let pipeline_layout = ctx
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("TonemapPass::pipeline_layout"),
+                bind_group_layouts: &[Some(&layout)],
+                immediate_size: 0,
+            });
+        let pipeline = Self::build(ctx, lib, &pipeline_layout, format)?;
+        let uniform = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("TonemapPass::uniform"),
+            size: size_of::<ToneUniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(Self {
+            layout,
+            pipeline_layout,
+            pipeline,
+            uniform,
+            format,
+        })
+    }
+
+    fn build(
+        ctx: &GpuContext,
+        lib: &ShaderLibrary,
+        layout: &wgpu::PipelineLayout,
+        format: wgpu::TextureFormat,
+    ) -> Result<wgpu::RenderPipeline, ShaderError> {
+        let composed = lib.compose("tonemap.wgsl")?;
+        create_checked(&ctx.device, &composed, lib, |module| {
+            ctx.device
+                .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some("TonemapPass::pipeline"),
+                    layout: Some(layout),
+                    vertex: wgpu::VertexState {
+                        module,
+                        entry_point: Some("vs_main"),
+                        compilation_options: Default::default(),
+                        buffers: &[],
+                    },
+                    primitive: wgpu::PrimitiveState::default(),
+                    depth_stencil: None,
+                    multisample: wgpu::MultisampleState::default(),
+                    fragment: Some(wgpu::FragmentState {
+                        module,
+                        entry_point: Some("fs_main"),
+                        compilation_options: Default::default(),
+                        targets: &[Some(format.into())],
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                })
+        })
+    }
+
+    /// Rebuilds the pipeline; keeps the old one on error.
+    pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
+        self.pipeline = Self::build(ctx, lib, &self.pipeline_layout, self.format)?;
+        Ok(())
+    }
+
+    /// Records the tonemap from `hdr` into `out`.
+    pub fn record(
+        &self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        hdr: &wgpu::TextureView,
+        out: &wgpu::TextureView,
+        exposure: f32,
+    ) {
+        ctx.queue.write_buffer(
+            &self.uniform,
+            0,
+            bytemuck::bytes_of(&ToneUniform {
+                exposure: [exposure, 0.0, 0.0, 0.0],
+            }),
+        );
+        let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("TonemapPass::bind_group"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(hdr),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: self.uniform.as_entire_binding(),
+                },
+            ],
+        });
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("TonemapPass::pass"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: out,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}

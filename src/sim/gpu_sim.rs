@@ -1,0 +1,521 @@
+//! Pass 1 on the GPU: per-emitter ping-pong state buffers and the update pipeline.
+
+use std::collections::HashMap;
+
+use crate::effect::{Effect, Integrator};
+use crate::gpu::types::{PARAMS_STRIDE, Particle, SimParams};
+use crate::gpu::{GpuContext, GpuError};
+use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
+use crate::sim::planner::EffectPlanner;
+
+/// Steps recorded per submission (the per-step params blocks live side by side).
+const STEPS_PER_SUBMIT: usize = 32;
+
+/// Simulation failures.
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    /// A shader failed to compose, validate or build.
+    #[error(transparent)]
+    Shader(#[from] ShaderError),
+    /// A device limit.
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+    /// Reading back from the GPU failed.
+    #[error("GPU readback failed: {0}")]
+    Readback(String),
+}
+
+/// The update pipelines (one per integrator, built on demand) and their layout.
+pub struct UpdatePass {
+    layout: wgpu::BindGroupLayout,
+    pipeline_layout: wgpu::PipelineLayout,
+    pipelines: HashMap<Integrator, wgpu::ComputePipeline>,
+    /// Files the current pipelines were built from.
+    pub files: Vec<String>,
+}
+
+impl UpdatePass {
+    fn new(ctx: &GpuContext) -> Self {
+        let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let layout = ctx
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("UpdatePass::layout"),
+                entries: &[
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 0,
+                        visibility: wgpu::ShaderStages::COMPUTE,
+                        ty: wgpu::BindingType::Buffer {
+                            ty: wgpu::BufferBindingType::Uniform,
+                            has_dynamic_offset: true,
+                            min_binding_size: wgpu::BufferSize::new(
+                                std::mem::size_of::<SimParams>() as u64,
+                            ),
+                        },
+                        count: None,
+                    },
+                    storage(1, true),
+                    storage(2, false),
+                    storage(3, false),
+                ],
+            });
+        let pipeline_layout = ctx
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("UpdatePass::pipeline_layout"),
+                bind_group_layouts: &[Some(&layout)],
+                immediate_size: 0,
+            });
+        Self {
+            layout,
+            pipeline_layout,
+            pipelines: HashMap::new(),
+            files: Vec::new(),
+        }
+    }
+
+    /// Builds the pipelines for `integrators` from `lib`; on any error keeps the old ones.
+    pub fn rebuild(
+        &mut self,
+        ctx: &GpuContext,
+        lib: &ShaderLibrary,
+        integrators: &[Integrator],
+    ) -> Result<(), ShaderError> {
+        let composed = lib.compose("update.wgsl")?;
+        let mut fresh = HashMap::new();
+        for &integrator in integrators {
+            let pipeline = create_checked(&ctx.device, &composed, lib, |module| {
+                ctx.device
+                    .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                        label: Some("UpdatePass::pipeline"),
+                        layout: Some(&self.pipeline_layout),
+                        module,
+                        entry_point: Some("main"),
+                        compilation_options: wgpu::PipelineCompilationOptions {
+                            constants: &[("INTEGRATOR", integrator.index() as f64)],
+                            zero_initialize_workgroup_memory: true,
+                        },
+                        cache: None,
+                    })
+            })?;
+            fresh.insert(integrator, pipeline);
+        }
+        self.pipelines = fresh;
+        self.files = composed.files;
+        Ok(())
+    }
+
+    fn ensure(
+        &mut self,
+        ctx: &GpuContext,
+        lib: &ShaderLibrary,
+        integrator: Integrator,
+    ) -> Result<(), ShaderError> {
+        if self.pipelines.contains_key(&integrator) {
+            return Ok(());
+        }
+        let mut wanted: Vec<Integrator> = self.pipelines.keys().copied().collect();
+        wanted.push(integrator);
+        self.rebuild(ctx, lib, &wanted)
+    }
+}
+
+/// One emitter's pool on the GPU.
+struct EmitterState {
+    capacity: u32,
+    buffers: [wgpu::Buffer; 2],
+    counters: wgpu::Buffer,
+    bind_groups: [wgpu::BindGroup; 2],
+    /// Which buffer holds the current state (the thesis's `mFlip`).
+    current: usize,
+    generation: u64,
+}
+
+/// The GPU simulation of an effect.
+pub struct GpuSim {
+    ctx: GpuContext,
+    library: ShaderLibrary,
+    update: UpdatePass,
+    params_buffer: wgpu::Buffer,
+    params_slots: usize,
+    emitters: Vec<EmitterState>,
+    /// CPU planning (time, spawn counts).
+    pub planner: EffectPlanner,
+    next_generation: u64,
+}
+
+/// Read-only views of an emitter's state buffers, for the draw passes.
+pub struct EmitterBuffers<'a> {
+    /// State before the last step.
+    pub previous: &'a wgpu::Buffer,
+    /// State after the last step.
+    pub current: &'a wgpu::Buffer,
+    /// Slots.
+    pub capacity: u32,
+    /// Changes whenever the buffers are recreated (bind-group caches key on it).
+    pub generation: u64,
+    /// Which of the pair is current (0 or 1).
+    pub parity: usize,
+}
+
+impl GpuSim {
+    /// Creates buffers for every emitter of `effect` and the pipelines it uses.
+    pub fn new(
+        ctx: &GpuContext,
+        library: ShaderLibrary,
+        effect: &Effect,
+    ) -> Result<Self, SimError> {
+        let mut update = UpdatePass::new(ctx);
+        let integrators = used_integrators(effect);
+        update.rebuild(ctx, &library, &integrators)?;
+        let mut sim = Self {
+            ctx: ctx.clone(),
+            library,
+            update,
+            params_buffer: ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("GpuSim::params"),
+                size: PARAMS_STRIDE,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            params_slots: 1,
+            emitters: Vec::new(),
+            planner: EffectPlanner::default(),
+            next_generation: 1,
+        };
+        sim.sync(effect)?;
+        Ok(sim)
+    }
+
+    /// The shader library in use.
+    pub fn library(&self) -> &ShaderLibrary {
+        &self.library
+    }
+
+    /// Files the update pipelines depend on.
+    pub fn shader_files(&self) -> &[String] {
+        &self.update.files
+    }
+
+    /// Rebuilds the update pipelines from `library`; the particles are untouched, and on
+    /// error the last good pipelines keep running.
+    pub fn reload_shaders(
+        &mut self,
+        library: ShaderLibrary,
+        effect: &Effect,
+    ) -> Result<(), ShaderError> {
+        self.update
+            .rebuild(&self.ctx, &library, &used_integrators(effect))?;
+        self.library = library;
+        Ok(())
+    }
+
+    /// Matches the GPU pools to the effect: new emitters get buffers, removed ones are
+    /// dropped, a changed capacity keeps the particles that fit.
+    pub fn sync(&mut self, effect: &Effect) -> Result<(), SimError> {
+        for e in &effect.emitters {
+            self.ctx.check_capacity(&e.name, e.capacity)?;
+        }
+        self.emitters.truncate(effect.emitters.len());
+        for (i, e) in effect.emitters.iter().enumerate() {
+            let capacity = e.capacity.max(1);
+            match self.emitters.get(i) {
+                Some(s) if s.capacity == capacity => {}
+                _ => {
+                    let fresh = self.create_state(capacity);
+                    if let Some(old) = self.emitters.get(i) {
+                        // Keep the particles that fit.
+                        let keep = old.capacity.min(capacity) as u64 * size_of::<Particle>() as u64;
+                        let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+                        for b in 0..2 {
+                            enc.copy_buffer_to_buffer(
+                                &old.buffers[old.current],
+                                0,
+                                &fresh.buffers[b],
+                                0,
+                                keep,
+                            );
+                        }
+                        self.ctx.queue.submit([enc.finish()]);
+                        self.emitters[i] = fresh;
+                    } else {
+                        self.emitters.push(fresh);
+                    }
+                }
+            }
+        }
+        let slots = STEPS_PER_SUBMIT * effect.emitters.len().max(1);
+        if slots > self.params_slots {
+            self.params_slots = slots;
+            self.params_buffer = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("GpuSim::params"),
+                size: slots as u64 * PARAMS_STRIDE,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            for i in 0..self.emitters.len() {
+                self.emitters[i].bind_groups =
+                    self.bind_groups(&self.emitters[i].buffers, &self.emitters[i].counters);
+            }
+        }
+        for integrator in used_integrators(effect) {
+            self.update.ensure(&self.ctx, &self.library, integrator)?;
+        }
+        Ok(())
+    }
+
+    fn create_state(&mut self, capacity: u32) -> EmitterState {
+        let size = capacity as u64 * size_of::<Particle>() as u64;
+        let make = |label| {
+            self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let buffers = [make("GpuSim::state_a"), make("GpuSim::state_b")];
+        let counters = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("GpuSim::counters"),
+            size: 8,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind_groups = self.bind_groups(&buffers, &counters);
+        let generation = self.next_generation;
+        self.next_generation += 1;
+        EmitterState {
+            capacity,
+            buffers,
+            counters,
+            bind_groups,
+            current: 0,
+            generation,
+        }
+    }
+
+    fn bind_groups(
+        &self,
+        buffers: &[wgpu::Buffer; 2],
+        counters: &wgpu::Buffer,
+    ) -> [wgpu::BindGroup; 2] {
+        let make = |src: usize| {
+            self.ctx
+                .device
+                .create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("GpuSim::bind_group"),
+                    layout: &self.update.layout,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                                buffer: &self.params_buffer,
+                                offset: 0,
+                                size: wgpu::BufferSize::new(size_of::<SimParams>() as u64),
+                            }),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: buffers[src].as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 2,
+                            resource: buffers[1 - src].as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 3,
+                            resource: counters.as_entire_binding(),
+                        },
+                    ],
+                })
+        };
+        [make(0), make(1)]
+    }
+
+    /// Runs `steps` steps of `dt_secs` (spawning, integrating, ageing) on the GPU.
+    pub fn step(&mut self, effect: &Effect, dt_secs: f32, steps: u32) -> Result<(), SimError> {
+        self.sync(effect)?;
+        let mut remaining = steps as usize;
+        while remaining > 0 {
+            let chunk = remaining.min(STEPS_PER_SUBMIT);
+            let plans: Vec<Vec<Option<SimParams>>> = (0..chunk)
+                .map(|_| self.planner.plan_step(effect, dt_secs))
+                .collect();
+            self.record_and_submit(effect, &plans);
+            remaining -= chunk;
+        }
+        Ok(())
+    }
+
+    /// Records the planned steps (one `SimParams` per enabled emitter and step) and submits.
+    pub fn record_and_submit(&mut self, effect: &Effect, plans: &[Vec<Option<SimParams>>]) {
+        let n_emitters = self.emitters.len();
+        let mut blocks = vec![0u8; plans.len() * n_emitters * PARAMS_STRIDE as usize];
+        for (s, plan) in plans.iter().enumerate() {
+            for (e, params) in plan.iter().enumerate() {
+                if let Some(p) = params {
+                    let at = (s * n_emitters + e) * PARAMS_STRIDE as usize;
+                    blocks[at..at + size_of::<SimParams>()].copy_from_slice(bytemuck::bytes_of(p));
+                }
+            }
+        }
+        self.ctx.queue.write_buffer(&self.params_buffer, 0, &blocks);
+        let mut enc = self
+            .ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("GpuSim::step"),
+            });
+        enc.push_debug_group("update particles");
+        for (s, plan) in plans.iter().enumerate() {
+            for (e, params) in plan.iter().enumerate() {
+                let (Some(p), Some(em)) = (params, self.emitters.get_mut(e)) else {
+                    continue;
+                };
+                let Some(pipeline) = self.update.pipelines.get(&effect.emitters[e].integrator)
+                else {
+                    continue;
+                };
+                enc.clear_buffer(&em.counters, 0, Some(4));
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("GpuSim::update"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(pipeline);
+                let offset = ((s * n_emitters + e) as u64 * PARAMS_STRIDE) as u32;
+                pass.set_bind_group(0, &em.bind_groups[em.current], &[offset]);
+                let (x, y) = dispatch_size(p.capacity.min(em.capacity));
+                pass.dispatch_workgroups(x, y, 1);
+                drop(pass);
+                em.current = 1 - em.current;
+            }
+        }
+        enc.pop_debug_group();
+        self.ctx.queue.submit([enc.finish()]);
+    }
+
+    /// Buffers of emitter `index` for drawing.
+    pub fn emitter_buffers(&self, index: usize) -> Option<EmitterBuffers<'_>> {
+        self.emitters.get(index).map(|s| EmitterBuffers {
+            previous: &s.buffers[1 - s.current],
+            current: &s.buffers[s.current],
+            capacity: s.capacity,
+            generation: s.generation,
+            parity: s.current,
+        })
+    }
+
+    /// Number of emitter pools.
+    pub fn emitter_count(&self) -> usize {
+        self.emitters.len()
+    }
+
+    /// Reads emitter `index`'s current state back (blocking; tests and tools).
+    pub fn read_particles(&self, index: usize) -> Result<Vec<Particle>, SimError> {
+        let s = self
+            .emitters
+            .get(index)
+            .ok_or_else(|| SimError::Readback(format!("no emitter {index}")))?;
+        let bytes = read_buffer(
+            &self.ctx,
+            &s.buffers[s.current],
+            s.capacity as u64 * size_of::<Particle>() as u64,
+        )?;
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
+    }
+
+    /// `[alive after the last step, non-finite kills so far]` of emitter `index` (blocking).
+    pub fn read_counters(&self, index: usize) -> Result<[u32; 2], SimError> {
+        let s = self
+            .emitters
+            .get(index)
+            .ok_or_else(|| SimError::Readback(format!("no emitter {index}")))?;
+        let bytes = read_buffer(&self.ctx, &s.counters, 8)?;
+        let v: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+        Ok([v[0], v[1]])
+    }
+
+    /// Kills every particle and restarts time (keeps the pipelines).
+    pub fn restart(&mut self) {
+        let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+        for s in &mut self.emitters {
+            for b in &s.buffers {
+                enc.clear_buffer(b, 0, None);
+            }
+            enc.clear_buffer(&s.counters, 0, None);
+            s.current = 0;
+        }
+        self.ctx.queue.submit([enc.finish()]);
+        self.planner.reset();
+    }
+}
+
+/// Workgroups for `slots` slots of 256, as a 2-D grid (x ≤ 65535).
+pub fn dispatch_size(slots: u32) -> (u32, u32) {
+    let groups = slots.div_ceil(256).max(1);
+    let x = groups.min(65_535);
+    (x, groups.div_ceil(x))
+}
+
+/// Every integrator the effect uses (so only those pipelines are built).
+pub fn used_integrators(effect: &Effect) -> Vec<Integrator> {
+    let mut v: Vec<Integrator> = effect.emitters.iter().map(|e| e.integrator).collect();
+    v.sort_by_key(|i| i.index());
+    v.dedup();
+    if v.is_empty() {
+        v.push(Integrator::SemiImplicitEuler);
+    }
+    v
+}
+
+/// Copies `size` bytes of `buffer` to the CPU (blocking).
+pub fn read_buffer(
+    ctx: &GpuContext,
+    buffer: &wgpu::Buffer,
+    size: u64,
+) -> Result<Vec<u8>, SimError> {
+    let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    enc.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+    ctx.queue.submit([enc.finish()]);
+    map_read(ctx, &staging)
+}
+
+/// Maps a `MAP_READ` buffer and copies its bytes out (blocking).
+pub fn map_read(ctx: &GpuContext, staging: &wgpu::Buffer) -> Result<Vec<u8>, SimError> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    staging.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    ctx.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| SimError::Readback(e.to_string()))?;
+    rx.recv()
+        .map_err(|e| SimError::Readback(e.to_string()))?
+        .map_err(|e| SimError::Readback(e.to_string()))?;
+    let data = staging
+        .slice(..)
+        .get_mapped_range()
+        .map_err(|e| SimError::Readback(e.to_string()))?
+        .to_vec();
+    staging.unmap();
+    Ok(data)
+}

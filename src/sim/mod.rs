@@ -1,0 +1,12 @@
+//! The simulation: CPU-side planning (time, exact spawn counts), the GPU update pass over
+//! ping-pong buffers, and a CPU reference of the same maths for tests.
+
+pub mod cpu_reference;
+pub mod gpu_sim;
+pub mod planner;
+pub mod stepper;
+
+pub use cpu_reference::CpuSim;
+pub use gpu_sim::{GpuSim, SimError};
+pub use planner::{EffectPlanner, EmitterPlanner, SpawnStats};
+pub use stepper::{StepPlan, Stepper};

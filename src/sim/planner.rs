@@ -1,0 +1,280 @@
+//! CPU-side planning of each step: exact spawn counts in a ring of slots, and the
+//! `SimParams` block that both the GPU pass and the CPU reference consume.
+
+use std::collections::VecDeque;
+
+use crate::effect::{Effect, Emitter, Shape};
+use crate::gpu::types::SimParams;
+use crate::rng;
+
+/// Spawn accounting of one emitter (shown in the stats panel).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SpawnStats {
+    /// Particles born since the start.
+    pub spawned: u64,
+    /// Spawns dropped by the per-step cap (a long step must not cause a burst).
+    pub dropped_by_cap: u64,
+    /// Spawns dropped because one step asked for more than the whole capacity.
+    pub dropped_over_capacity: u64,
+    /// Particles cut short because the ring wrapped onto them while still alive:
+    /// the capacity is too small for rate × lifetime.
+    pub recycled_alive: u64,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Batch {
+    first_index: u64,
+    count: u32,
+    birth_secs: f64,
+}
+
+/// Exact spawn counts for one emitter: rate × dt accumulated in f64.
+#[derive(Clone, Debug, Default)]
+pub struct EmitterPlanner {
+    accumulator: f64,
+    spawned_total: u64,
+    /// Running statistics.
+    pub stats: SpawnStats,
+    history: VecDeque<Batch>,
+}
+
+/// Plans every emitter of an effect, step after step.
+#[derive(Clone, Debug, Default)]
+pub struct EffectPlanner {
+    /// One planner per emitter, in effect order.
+    pub emitters: Vec<EmitterPlanner>,
+    /// Simulated time at the start of the next step (f64 sum of step sizes).
+    pub time_secs: f64,
+    /// Steps planned so far.
+    pub step_index: u64,
+}
+
+impl EffectPlanner {
+    /// Plans one step of `dt_secs` for every emitter (disabled emitters get `None`).
+    pub fn plan_step(&mut self, effect: &Effect, dt_secs: f32) -> Vec<Option<SimParams>> {
+        self.emitters
+            .resize_with(effect.emitters.len(), Default::default);
+        let t0 = self.time_secs;
+        let params = effect
+            .emitters
+            .iter()
+            .zip(self.emitters.iter_mut())
+            .enumerate()
+            .map(|(i, (e, p))| {
+                e.enabled
+                    .then(|| p.plan_step(e, effect.seed, i as u32, t0, dt_secs))
+            })
+            .collect();
+        self.time_secs += dt_secs as f64;
+        self.step_index += 1;
+        params
+    }
+
+    /// Back to time zero with empty pools.
+    pub fn reset(&mut self) {
+        *self = Self::default();
+    }
+}
+
+impl EmitterPlanner {
+    /// Plans one step starting at `t0_secs`.
+    pub fn plan_step(
+        &mut self,
+        e: &Emitter,
+        seed: u32,
+        emitter_index: u32,
+        t0_secs: f64,
+        dt_secs: f32,
+    ) -> SimParams {
+        let dt = dt_secs as f64;
+        let rate = e.spawn_rate_per_sec.max(0.0) as f64;
+        let acc_before = self.accumulator;
+        self.accumulator += rate * dt;
+        let continuous = self.accumulator.floor();
+        self.accumulator -= continuous;
+        let mut continuous = continuous as u64;
+        let cap = e.effective_spawn_cap() as u64;
+        let capped = continuous > cap;
+        if capped {
+            self.stats.dropped_by_cap += continuous - cap;
+            continuous = cap;
+        }
+        let burst: u64 = e
+            .bursts
+            .iter()
+            .filter(|b| {
+                let t = b.time_secs as f64;
+                t >= t0_secs && t < t0_secs + dt
+            })
+            .map(|b| b.count as u64)
+            .sum();
+        let mut count = continuous + burst;
+        let capacity = e.capacity.max(1) as u64;
+        if count > capacity {
+            self.stats.dropped_over_capacity += count - capacity;
+            count = capacity;
+        }
+
+        // Birth fractions within the step: the k-th integer crossing of the accumulator.
+        let (frac0, frac_step) = if burst == 0 && !capped && rate * dt > 0.0 {
+            let per = 1.0 / (rate * dt);
+            ((1.0 - acc_before) * per, per)
+        } else if count > 0 {
+            (0.5 / count as f64, 1.0 / count as f64)
+        } else {
+            (0.0, 0.0)
+        };
+
+        let salt = rng::emitter_salt(emitter_index, e.seed_offset);
+        self.account_overwrites(e, seed, salt, count, t0_secs);
+        let base = self.spawned_total;
+        if count > 0 {
+            self.history.push_back(Batch {
+                first_index: base,
+                count: count as u32,
+                birth_secs: t0_secs + dt * frac0.clamp(0.0, 1.0),
+            });
+        }
+        self.spawned_total += count;
+        self.stats.spawned += count;
+
+        build_params(
+            e,
+            seed,
+            salt,
+            dt_secs,
+            t0_secs,
+            capacity as u32,
+            base,
+            count as u32,
+        )
+        .with_spawn_fractions(frac0 as f32, frac_step as f32)
+    }
+
+    /// Counts still-alive particles the ring is about to overwrite.
+    fn account_overwrites(&mut self, e: &Emitter, seed: u32, salt: u32, count: u64, t0: f64) {
+        let capacity = e.capacity.max(1) as u64;
+        let max_life = e.lifetime_secs.max as f64;
+        // Forget batches that are dead for sure or already overwritten.
+        while let Some(front) = self.history.front() {
+            let end = front.first_index + front.count as u64;
+            let overwritten = end + capacity <= self.spawned_total;
+            if overwritten || t0 - front.birth_secs >= max_life {
+                self.history.pop_front();
+            } else {
+                break;
+            }
+        }
+        if self.history.is_empty() || count == 0 {
+            return;
+        }
+        for j in self.spawned_total..self.spawned_total + count {
+            let Some(old) = j.checked_sub(capacity) else {
+                continue;
+            };
+            let Some(batch) = self
+                .history
+                .iter()
+                .find(|b| old >= b.first_index && old < b.first_index + b.count as u64)
+            else {
+                continue;
+            };
+            let slot = (old % capacity) as u32;
+            let r1 = rng::unorm4(rng::rand_block(rng::spawn_key(seed, salt, slot, old), 1));
+            let life = mix(e.lifetime_secs.min, e.lifetime_secs.max, r1[3]) as f64;
+            if t0 - batch.birth_secs < life {
+                self.stats.recycled_alive += 1;
+            }
+        }
+    }
+
+    /// The spawn counter: how many particles this emitter has started.
+    pub fn spawned_total(&self) -> u64 {
+        self.spawned_total
+    }
+}
+
+/// WGSL's `mix`: `a·(1 − t) + b·t`.
+pub fn mix(a: f32, b: f32, t: f32) -> f32 {
+    a * (1.0 - t) + b * t
+}
+
+impl SimParams {
+    fn with_spawn_fractions(mut self, frac0: f32, frac_step: f32) -> Self {
+        self.spawn_frac0 = frac0;
+        self.spawn_frac_step = frac_step;
+        self
+    }
+}
+
+/// Builds the uniform block for one emitter and one step.
+#[allow(clippy::too_many_arguments)]
+pub fn build_params(
+    e: &Emitter,
+    seed: u32,
+    salt: u32,
+    dt_secs: f32,
+    t0_secs: f64,
+    capacity: u32,
+    spawn_base: u64,
+    spawn_count: u32,
+) -> SimParams {
+    let (shape_a, shape_b) = match &e.shape {
+        Shape::Point => ([0.0; 4], [0.0; 4]),
+        Shape::Sphere {
+            radius_m,
+            surface_only,
+        } => (
+            [*radius_m, if *surface_only { 1.0 } else { 0.0 }, 0.0, 0.0],
+            [0.0; 4],
+        ),
+        Shape::Disc { radius_m, normal } => {
+            let n = glam::Vec3::from(*normal).normalize_or(glam::Vec3::Y);
+            ([*radius_m, 0.0, 0.0, 0.0], [n.x, n.y, n.z, 0.0])
+        }
+        Shape::Box { half_extents_m: h } => ([h[0], h[1], h[2], 0.0], [0.0; 4]),
+        Shape::Cone {
+            angle_deg,
+            radius_m,
+        } => ([angle_deg.to_radians(), *radius_m, 0.0, 0.0], [0.0; 4]),
+        Shape::Line { a_m, b_m } => ([a_m[0], a_m[1], a_m[2], 0.0], [b_m[0], b_m[1], b_m[2], 0.0]),
+    };
+    let dir = glam::Vec3::from(e.direction).normalize_or(glam::Vec3::Y);
+    let accel = e.forces.constant_acceleration();
+    let wind = e.forces.wind_m_per_s;
+    let n = &e.spawn_noise;
+    // Noise time wraps every 4096 s so the f32 never grows large.
+    let noise_time = t0_secs.rem_euclid(4096.0) as f32;
+    SimParams {
+        world_from_emitter: e.transform.world_from_emitter().to_cols_array_2d(),
+        shape_a,
+        shape_b,
+        direction_spread: [dir.x, dir.y, dir.z, e.spread_deg.to_radians()],
+        speed_life: [
+            e.speed_m_per_s.min,
+            e.speed_m_per_s.max,
+            e.lifetime_secs.min,
+            e.lifetime_secs.max,
+        ],
+        accel_drag: [accel.x, accel.y, accel.z, e.forces.drag_per_sec],
+        wind_time: [wind[0], wind[1], wind[2], noise_time],
+        noise: [
+            n.frequency_per_m,
+            n.position_amplitude_m,
+            n.direction_amplitude,
+            n.scroll_per_sec,
+        ],
+        dt_secs,
+        seed,
+        emitter_salt: salt,
+        shape_kind: e.shape.kind_index(),
+        capacity,
+        spawn_head: (spawn_base % capacity.max(1) as u64) as u32,
+        spawn_count,
+        spawn_base_lo: spawn_base as u32,
+        spawn_base_hi: (spawn_base >> 32) as u32,
+        flags: 0,
+        spawn_frac0: 0.0,
+        spawn_frac_step: 0.0,
+    }
+}
