@@ -4,6 +4,7 @@
 //! model and presets, the shader library, the GPU simulation (update pass) with its CPU
 //! reference, and the renderer (billboard pass + tonemap).
 
+pub mod editor;
 pub mod effect;
 pub mod gpu;
 pub mod headless;

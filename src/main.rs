@@ -1,4 +1,4 @@
-//! The `ignis` command line: `edit` (default), `render`, `check`.
+//! The `ignis` command line: `edit` (the default), `render`, `check`.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -6,6 +6,7 @@ use std::time::Instant;
 use anyhow::{Context as _, bail};
 use clap::{Parser, Subcommand};
 
+use ignis::editor::EditOptions;
 use ignis::effect::Effect;
 use ignis::gpu::GpuContext;
 use ignis::headless::Headless;
@@ -20,6 +21,24 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Open the editor window (the default when no command is given).
+    Edit {
+        /// Preset file (default: the embedded campfire).
+        preset: Option<PathBuf>,
+        /// Render this many frames in the window, then exit (prints the frame times).
+        #[arg(long)]
+        frames: Option<u32>,
+        /// After the last frame, save the window's image (UI included) as a PNG.
+        /// Without --frames, exits after 60 frames.
+        #[arg(long)]
+        screenshot: Option<PathBuf>,
+        /// Initial window size in logical pixels, WxH.
+        #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+        size: (u32, u32),
+        /// Shader folder (default: ./shaders if present, else the embedded copies).
+        #[arg(long)]
+        shader_dir: Option<PathBuf>,
+    },
     /// Render PNG frames of an effect headless.
     Render {
         /// Preset file (default: the embedded campfire).
@@ -75,7 +94,23 @@ fn main() {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     let result = match cli.command {
-        None => bail_editor(),
+        None => edit(EditOptions {
+            window_size: (1280, 720),
+            ..Default::default()
+        }),
+        Some(Command::Edit {
+            preset,
+            frames,
+            screenshot,
+            size,
+            shader_dir,
+        }) => edit(EditOptions {
+            frames: frames.or(screenshot.as_ref().map(|_| 60)),
+            preset,
+            screenshot,
+            shader_dir,
+            window_size: size,
+        }),
         Some(Command::Render {
             preset,
             frames,
@@ -103,8 +138,14 @@ fn main() {
     }
 }
 
-fn bail_editor() -> anyhow::Result<()> {
-    bail!("the editor is not built yet")
+fn edit(options: EditOptions) -> anyhow::Result<()> {
+    if options.frames == Some(0) {
+        bail!("--frames must be at least 1");
+    }
+    if let Some(report) = ignis::editor::run(options)? {
+        println!("{report}");
+    }
+    Ok(())
 }
 
 fn load_effect(preset: Option<&Path>) -> anyhow::Result<Effect> {

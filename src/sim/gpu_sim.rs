@@ -407,6 +407,34 @@ impl GpuSim {
         self.ctx.queue.submit([enc.finish()]);
     }
 
+    /// Follows a structural edit of the effect's emitter list (reorder, insert, remove):
+    /// `sources[new] = Some(old)` moves pool `old` (its particles and spawn accounting) to
+    /// position `new`; `None` starts an empty pool there. Pools no source names are
+    /// dropped. Call it before the next [`GpuSim::step`] with the edited effect, which then
+    /// sizes the new pools.
+    pub fn remap_emitters(&mut self, sources: &[Option<usize>]) {
+        let mut old_pools: Vec<Option<EmitterState>> =
+            std::mem::take(&mut self.emitters).into_iter().map(Some).collect();
+        let mut old_planners: Vec<Option<crate::sim::EmitterPlanner>> =
+            std::mem::take(&mut self.planner.emitters)
+                .into_iter()
+                .map(Some)
+                .collect();
+        for source in sources {
+            let pool = source
+                .and_then(|o| old_pools.get_mut(o))
+                .and_then(Option::take);
+            // A one-slot placeholder: `sync` sees the capacity differ and replaces it.
+            let pool = pool.unwrap_or_else(|| self.create_state(1));
+            self.emitters.push(pool);
+            let planner = source
+                .and_then(|o| old_planners.get_mut(o))
+                .and_then(Option::take)
+                .unwrap_or_default();
+            self.planner.emitters.push(planner);
+        }
+    }
+
     /// Buffers of emitter `index` for drawing.
     pub fn emitter_buffers(&self, index: usize) -> Option<EmitterBuffers<'_>> {
         self.emitters.get(index).map(|s| EmitterBuffers {

@@ -1,0 +1,708 @@
+//! The editor window: winit event loop, wgpu surface, egui, and the frame loop.
+//!
+//! One frame: the UI runs (edits land in `EditorState::effect`, the valid ones in
+//! `running`), the GPU pools follow structural edits, the simulation steps, the
+//! renderer records the viewport image into its own HDR target and tonemaps it, then
+//! egui draws the panel and composites that image in the same encoder.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{Context as _, anyhow};
+use winit::application::ApplicationHandler;
+use winit::event::WindowEvent;
+use winit::event_loop::{ActiveEventLoop, EventLoop};
+use winit::window::{Window, WindowId};
+
+use crate::effect::{Effect, TimeMode};
+use crate::gpu::GpuContext;
+use crate::render::{LDR_GAMMA_VIEW_FORMAT, OrbitCamera, Renderer};
+use crate::shaders::ShaderLibrary;
+use crate::sim::{GpuSim, Stepper};
+
+use super::panel::{PANEL_WIDTH, panel_ui};
+use super::remap::emitter_sources;
+use super::screenshot::{Screenshot, read_back};
+use super::state::EditorState;
+use super::stats::{EmitterStats, median};
+use super::viewport::{ViewportOutput, emitter_bounds, frame_bounds, viewport_ui};
+
+/// Read the GPU's alive counters every this many frames (a blocking readback).
+const COUNTER_INTERVAL_FRAMES: u64 = 15;
+
+/// Frames left out of the reported median (start-up: pipeline creation, first present).
+const WARMUP_FRAMES: usize = 3;
+
+/// Extra frames `--screenshot` waits for the window to hand out a frame.
+const MAX_EXTRA_FRAMES: u64 = 120;
+
+/// How `ignis edit` was started.
+#[derive(Clone, Debug, Default)]
+pub struct EditOptions {
+    /// Preset to open (default: the embedded campfire).
+    pub preset: Option<PathBuf>,
+    /// Exit after this many frames (automation).
+    pub frames: Option<u32>,
+    /// Save the window's image (UI included) after the last frame.
+    pub screenshot: Option<PathBuf>,
+    /// Shader folder (default: ./shaders if present, else the embedded copies).
+    pub shader_dir: Option<PathBuf>,
+    /// Initial window size in logical pixels.
+    pub window_size: (u32, u32),
+}
+
+/// What a run with `--frames` measured.
+#[derive(Clone, Debug)]
+pub struct RunReport {
+    /// Frames rendered.
+    pub frames: u32,
+    /// Median interval between frames after the warm-up, seconds.
+    pub median_frame_secs: f32,
+    /// Median CPU wall time of the sim + render recording, seconds.
+    pub median_cpu_secs: f32,
+    /// Particles alive at the end.
+    pub alive: u64,
+    /// The viewport's render size, pixels.
+    pub viewport_px: (u32, u32),
+    /// The window's size, pixels.
+    pub window_px: (u32, u32),
+    /// The adapter.
+    pub adapter: String,
+}
+
+impl std::fmt::Display for RunReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let fps = if self.median_frame_secs > 0.0 {
+            1.0 / self.median_frame_secs
+        } else {
+            0.0
+        };
+        write!(
+            f,
+            "edit: {} frames, median frame {:.1} ms ({:.1} fps), median CPU wall time (sim + render recording) {:.1} ms; window {}x{}, viewport {}x{} px, {} particles alive, on {}",
+            self.frames,
+            self.median_frame_secs * 1e3,
+            fps,
+            self.median_cpu_secs * 1e3,
+            self.window_px.0,
+            self.window_px.1,
+            self.viewport_px.0,
+            self.viewport_px.1,
+            self.alive,
+            self.adapter
+        )
+    }
+}
+
+/// Opens the editor window and runs until it is closed (or `--frames` are done).
+pub fn run(options: EditOptions) -> anyhow::Result<Option<RunReport>> {
+    let (effect, source) = match &options.preset {
+        Some(path) => (
+            crate::preset::load(path)?,
+            path.display().to_string(),
+        ),
+        None => (Effect::default_campfire(), "embedded default".to_owned()),
+    };
+    let event_loop = EventLoop::new().context(
+        "cannot open a window (no display?): set DISPLAY/WAYLAND_DISPLAY, or run under xvfb-run",
+    )?;
+    let instance = wgpu::Instance::new(
+        wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(
+            event_loop.owned_display_handle(),
+        )),
+    );
+    let mut app = App {
+        camera: OrbitCamera::from_hint(&effect.camera),
+        state: EditorState::new(effect, source),
+        options,
+        instance,
+        gfx: None,
+        fatal: None,
+        report: None,
+    };
+    event_loop
+        .run_app(&mut app)
+        .context("the window's event loop failed")?;
+    if let Some(err) = app.fatal {
+        return Err(err);
+    }
+    Ok(app.report)
+}
+
+struct App {
+    options: EditOptions,
+    instance: wgpu::Instance,
+    state: EditorState,
+    camera: OrbitCamera,
+    gfx: Option<Gfx>,
+    fatal: Option<anyhow::Error>,
+    report: Option<RunReport>,
+}
+
+/// Everything that exists once the window does.
+struct Gfx {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    surface_can_copy: bool,
+    ctx: GpuContext,
+    sim: GpuSim,
+    renderer: Renderer,
+    stepper: Stepper,
+    /// The effect the GPU pools currently match.
+    gpu_effect: Effect,
+    egui_ctx: egui::Context,
+    egui_state: egui_winit::State,
+    egui_renderer: egui_wgpu::Renderer,
+    viewport_texture: Option<egui::TextureId>,
+    registered_size: Option<(u32, u32)>,
+    last_alpha: f32,
+    frame_index: u64,
+    last_frame: Option<Instant>,
+    frame_log: Vec<f32>,
+    cpu_log: Vec<f32>,
+    viewport_px: (u32, u32),
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.gfx.is_some() {
+            return;
+        }
+        match Gfx::new(event_loop, &self.instance, &self.options, &self.state) {
+            Ok(gfx) => {
+                self.state.stats.adapter = gfx.ctx.info.name.clone();
+                gfx.window.request_redraw();
+                self.gfx = Some(gfx);
+            }
+            Err(err) => {
+                self.fatal = Some(err);
+                event_loop.exit();
+            }
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let Some(gfx) = self.gfx.as_mut() else {
+            return;
+        };
+        let _ = gfx.egui_state.on_window_event(&gfx.window, &event);
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) => {
+                gfx.resize(size.width, size.height);
+                gfx.window.request_redraw();
+            }
+            WindowEvent::RedrawRequested => match self.frame() {
+                Ok(true) => event_loop.exit(),
+                Ok(false) => {
+                    if let Some(gfx) = &self.gfx {
+                        gfx.window.request_redraw();
+                    }
+                }
+                Err(err) => {
+                    self.fatal = Some(err);
+                    event_loop.exit();
+                }
+            },
+            _ => {}
+        }
+    }
+}
+
+impl Gfx {
+    fn new(
+        event_loop: &ActiveEventLoop,
+        instance: &wgpu::Instance,
+        options: &EditOptions,
+        state: &EditorState,
+    ) -> anyhow::Result<Self> {
+        let (w, h) = options.window_size;
+        let attributes = Window::default_attributes()
+            .with_title(format!("ignis — {} ({})", state.effect.name, state.source))
+            .with_inner_size(winit::dpi::LogicalSize::new(w as f64, h as f64))
+            .with_min_inner_size(winit::dpi::LogicalSize::new(640.0, 400.0));
+        let window = Arc::new(
+            event_loop
+                .create_window(attributes)
+                .context("creating the editor window")?,
+        );
+        let surface = instance
+            .create_surface(window.clone())
+            .context("creating the window's GPU surface")?;
+        let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(
+            instance,
+            Some(&surface),
+        ))
+        .map_err(|e| anyhow!("no GPU adapter can draw to this window: {e}"))?;
+        let ctx = GpuContext::from_adapter(adapter)?;
+
+        let size = window.inner_size();
+        let caps = surface.get_capabilities(&ctx.adapter);
+        let format = egui_wgpu::preferred_framebuffer_format(&caps.formats)
+            .map_err(|e| anyhow!("the window surface offers no usable format: {e:?}"))?;
+        let surface_can_copy = caps.usages.contains(wgpu::TextureUsages::COPY_SRC);
+        let mut config = surface
+            .get_default_config(&ctx.adapter, size.width.max(1), size.height.max(1))
+            .ok_or_else(|| anyhow!("the adapter cannot present to this window"))?;
+        config.format = format;
+        config.usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        if surface_can_copy {
+            // Screenshots copy the frame itself; no offscreen re-render needed.
+            config.usage |= wgpu::TextureUsages::COPY_SRC;
+        }
+        // Automation measures throughput, so it does not wait for vertical blanks.
+        config.present_mode = if options.frames.is_some() {
+            wgpu::PresentMode::AutoNoVsync
+        } else {
+            wgpu::PresentMode::AutoVsync
+        };
+        surface.configure(&ctx.device, &config);
+
+        let lib = ShaderLibrary::discover(options.shader_dir.as_deref());
+        let renderer = Renderer::new(&ctx, &lib)?;
+        let sim = GpuSim::new(&ctx, lib, &state.running)?;
+
+        let egui_ctx = egui::Context::default();
+        egui_ctx.set_visuals(egui::Visuals::dark());
+        let max_texture_side = ctx.device.limits().max_texture_dimension_2d as usize;
+        let egui_state = egui_winit::State::new(
+            egui_ctx.clone(),
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            window.theme(),
+            Some(max_texture_side),
+        );
+        let egui_renderer = egui_wgpu::Renderer::new(
+            &ctx.device,
+            format,
+            egui_wgpu::RendererOptions::default(),
+        );
+        log::info!(
+            "editor: {}x{} surface {:?}, COPY_SRC {}",
+            config.width,
+            config.height,
+            config.format,
+            surface_can_copy
+        );
+        Ok(Self {
+            window,
+            surface,
+            config,
+            surface_can_copy,
+            gpu_effect: state.running.clone(),
+            ctx,
+            sim,
+            renderer,
+            stepper: Stepper::default(),
+            egui_ctx,
+            egui_state,
+            egui_renderer,
+            viewport_texture: None,
+            registered_size: None,
+            last_alpha: 1.0,
+            frame_index: 0,
+            last_frame: None,
+            frame_log: Vec::new(),
+            cpu_log: Vec::new(),
+            viewport_px: (1, 1),
+        })
+    }
+
+    fn resize(&mut self, width: u32, height: u32) {
+        if width == 0 || height == 0 {
+            return;
+        }
+        self.config.width = width;
+        self.config.height = height;
+        self.surface.configure(&self.ctx.device, &self.config);
+    }
+
+    /// Makes the GPU pools follow `state.running`; on a GPU refusal, goes back to the
+    /// last effect that worked.
+    fn apply_running(&mut self, state: &mut EditorState) {
+        if state.running == self.gpu_effect {
+            return;
+        }
+        let remap = emitter_sources(&self.gpu_effect, &state.running);
+        if let Some(sources) = &remap {
+            self.sim.remap_emitters(sources);
+        }
+        match self.sim.sync(&state.running) {
+            Ok(()) => self.gpu_effect.clone_from(&state.running),
+            Err(err) => {
+                log::warn!("effect refused by the GPU: {err}");
+                if remap.is_some()
+                    && let Some(back) = emitter_sources(&state.running, &self.gpu_effect)
+                {
+                    self.sim.remap_emitters(&back);
+                }
+                state.reject_running(&self.gpu_effect, err.to_string());
+            }
+        }
+    }
+
+    /// Runs this frame's simulation steps.
+    fn simulate(&mut self, state: &mut EditorState, frame_dt_secs: f64) -> anyhow::Result<()> {
+        let playback = &mut state.playback;
+        if playback.restart_requested {
+            playback.restart_requested = false;
+            self.sim.restart();
+            self.stepper.reset();
+        }
+        let effect = &self.gpu_effect;
+        let (steps, dt_secs) = if playback.step_requested {
+            playback.step_requested = false;
+            playback.is_paused = true;
+            let dt = match effect.time.mode {
+                TimeMode::FixedStep => effect.time.step_secs,
+                TimeMode::FrameDelta => effect.time.max_frame_dt_secs.min(1.0 / 60.0),
+            };
+            self.last_alpha = 1.0;
+            (1, dt)
+        } else if playback.is_paused {
+            (0, 0.0)
+        } else {
+            let plan = self.stepper.advance(frame_dt_secs, &effect.time);
+            self.last_alpha = plan.alpha;
+            (plan.steps, plan.dt_secs)
+        };
+        if steps > 0 {
+            self.sim
+                .step(effect, dt_secs, steps)
+                .context("simulation step")?;
+        }
+        let stats = &mut state.stats;
+        stats.steps_last_frame = steps;
+        stats.dt_secs = dt_secs;
+        stats.dropped_steps = self.stepper.dropped_steps;
+        stats.sim_time_secs = self.sim.planner.time_secs;
+        Ok(())
+    }
+
+    /// Refreshes the per-emitter counters (the alive counts only every few frames: the
+    /// readback waits for the GPU).
+    fn refresh_counters(&mut self, state: &mut EditorState, force: bool) {
+        let effect = &self.gpu_effect;
+        let stats = &mut state.stats;
+        stats
+            .emitters
+            .resize(effect.emitters.len(), EmitterStats::default());
+        let read = force || self.frame_index % COUNTER_INTERVAL_FRAMES == 1;
+        for (i, e) in effect.emitters.iter().enumerate() {
+            let s = &mut stats.emitters[i];
+            s.capacity = e.capacity;
+            s.spawn = self
+                .sim
+                .planner
+                .emitters
+                .get(i)
+                .map(|p| p.stats)
+                .unwrap_or_default();
+            if read {
+                if !e.enabled {
+                    s.alive = 0;
+                    continue;
+                }
+                match self.sim.read_counters(i) {
+                    Ok([alive, nonfinite]) => {
+                        s.alive = alive;
+                        s.nonfinite = nonfinite;
+                    }
+                    Err(err) => log::warn!("reading the counters of emitter {i}: {err}"),
+                }
+            }
+        }
+        if read {
+            stats.counters_age_frames = 0;
+        }
+    }
+
+    /// Centres the camera on the alive particles (or on the emitters when none).
+    fn frame_camera(&self, camera: &mut OrbitCamera) {
+        let mut positions = Vec::new();
+        for (i, e) in self.gpu_effect.emitters.iter().enumerate() {
+            if !e.enabled {
+                continue;
+            }
+            match self.sim.read_particles(i) {
+                Ok(particles) => positions.extend(
+                    particles
+                        .iter()
+                        .filter(|p| p.is_alive())
+                        .map(|p| p.position()),
+                ),
+                Err(err) => log::warn!("reading particles for framing: {err}"),
+            }
+        }
+        let (center, radius) =
+            frame_bounds(&positions).unwrap_or_else(|| emitter_bounds(&self.gpu_effect));
+        camera.frame(center, radius);
+    }
+
+    /// Points the egui texture at the renderer's display image (again after a resize).
+    fn register_viewport_texture(&mut self) {
+        let size = self.viewport_px;
+        if self.registered_size == Some(size) && self.viewport_texture.is_some() {
+            return;
+        }
+        let targets = self.renderer.targets(&self.ctx, size);
+        let view = targets.ldr.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("editor::viewport_view"),
+            format: Some(LDR_GAMMA_VIEW_FORMAT),
+            ..Default::default()
+        });
+        match self.viewport_texture {
+            Some(id) => self.egui_renderer.update_egui_texture_from_wgpu_texture(
+                &self.ctx.device,
+                &view,
+                wgpu::FilterMode::Linear,
+                id,
+            ),
+            None => {
+                self.viewport_texture = Some(self.egui_renderer.register_native_texture(
+                    &self.ctx.device,
+                    &view,
+                    wgpu::FilterMode::Linear,
+                ));
+            }
+        }
+        self.registered_size = Some(size);
+    }
+
+    /// Draws egui's paint jobs into `target`.
+    fn render_egui(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        paint_jobs: &[egui::ClippedPrimitive],
+        screen: &egui_wgpu::ScreenDescriptor,
+    ) {
+        let mut pass = encoder
+            .begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("editor::egui"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: target,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            })
+            .forget_lifetime();
+        self.egui_renderer.render(&mut pass, paint_jobs, screen);
+    }
+}
+
+impl App {
+    /// One frame. Returns true when the editor should exit (`--frames` done).
+    fn frame(&mut self) -> anyhow::Result<bool> {
+        let Some(gfx) = self.gfx.as_mut() else {
+            return Ok(false);
+        };
+        let now = Instant::now();
+        let frame_dt_secs = gfx
+            .last_frame
+            .map_or(1.0 / 60.0, |t| now.duration_since(t).as_secs_f64());
+        gfx.last_frame = Some(now);
+        gfx.frame_index += 1;
+
+        // 1. The UI: edits, camera, the viewport's size.
+        let raw_input = gfx.egui_state.take_egui_input(&gfx.window);
+        let state = &mut self.state;
+        let camera = &mut self.camera;
+        let texture = gfx.viewport_texture;
+        let mut viewport = ViewportOutput::default();
+        let full_output = gfx.egui_ctx.run_ui(raw_input, |ui| {
+            egui::Panel::right("inspector")
+                .resizable(true)
+                .default_size(PANEL_WIDTH)
+                .size_range(300.0..=640.0)
+                .show(ui, |ui| panel_ui(ui, state));
+            egui::CentralPanel::no_frame().show(ui, |ui| {
+                viewport = viewport_ui(ui, camera, state, texture);
+            });
+            state.end_frame(ui.ctx());
+        });
+        gfx.egui_state
+            .handle_platform_output(&gfx.window, full_output.platform_output);
+
+        // 2. The simulation follows the running effect and steps.
+        gfx.apply_running(&mut self.state);
+        let cpu_start = Instant::now();
+        gfx.simulate(&mut self.state, frame_dt_secs)?;
+
+        // 3. The viewport image: particles → HDR → tonemap, in this frame's encoder.
+        gfx.viewport_px = viewport.size_px;
+        gfx.renderer.exposure = self.state.view.exposure;
+        let mut encoder = gfx
+            .ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("editor::frame"),
+            });
+        encoder.push_debug_group("viewport");
+        gfx.renderer.record(
+            &gfx.ctx,
+            &mut encoder,
+            &gfx.sim,
+            &gfx.gpu_effect,
+            &self.camera,
+            gfx.last_alpha,
+            gfx.viewport_px,
+        );
+        encoder.pop_debug_group();
+        let cpu_secs = cpu_start.elapsed().as_secs_f32();
+        gfx.register_viewport_texture();
+
+        if self.state.frame_requested {
+            self.state.frame_requested = false;
+            gfx.frame_camera(&mut self.camera);
+        }
+        gfx.refresh_counters(&mut self.state, false);
+        if gfx.frame_index > 1 {
+            self.state.stats.push_frame(frame_dt_secs as f32, cpu_secs);
+            gfx.frame_log.push(frame_dt_secs as f32);
+            gfx.cpu_log.push(cpu_secs);
+        }
+        self.state.stats.viewport_px = gfx.viewport_px;
+
+        // 4. egui: textures first (always, even when no frame can be drawn), then paint.
+        let ppp = full_output.pixels_per_point;
+        let paint_jobs = gfx.egui_ctx.tessellate(full_output.shapes, ppp);
+        for (id, deltas) in &full_output.textures_delta.set {
+            for delta in deltas {
+                gfx.egui_renderer
+                    .update_texture(&gfx.ctx.device, &gfx.ctx.queue, *id, delta);
+            }
+        }
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [gfx.config.width, gfx.config.height],
+            pixels_per_point: ppp,
+        };
+        let callbacks = gfx.egui_renderer.update_buffers(
+            &gfx.ctx.device,
+            &gfx.ctx.queue,
+            &mut encoder,
+            &paint_jobs,
+            &screen,
+        );
+
+        let is_last = self
+            .options
+            .frames
+            .is_some_and(|n| gfx.frame_index >= n as u64);
+        let frame = match gfx.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(f) => Some(f),
+            wgpu::CurrentSurfaceTexture::Suboptimal(f) => {
+                // Draw this one; reconfigure for the next.
+                gfx.resize(gfx.config.width, gfx.config.height);
+                Some(f)
+            }
+            wgpu::CurrentSurfaceTexture::Outdated => {
+                let size = gfx.window.inner_size();
+                gfx.resize(size.width, size.height);
+                None
+            }
+            wgpu::CurrentSurfaceTexture::Lost => {
+                gfx.surface = self
+                    .instance
+                    .create_surface(gfx.window.clone())
+                    .context("recreating the lost window surface")?;
+                gfx.surface.configure(&gfx.ctx.device, &gfx.config);
+                None
+            }
+            wgpu::CurrentSurfaceTexture::Timeout
+            | wgpu::CurrentSurfaceTexture::Occluded
+            | wgpu::CurrentSurfaceTexture::Validation => None,
+        };
+
+        let mut screenshot = None;
+        if let Some(frame) = &frame {
+            let view = frame
+                .texture
+                .create_view(&wgpu::TextureViewDescriptor::default());
+            gfx.render_egui(&mut encoder, &view, &paint_jobs, &screen);
+            if is_last && let Some(path) = &self.options.screenshot {
+                if gfx.surface_can_copy {
+                    screenshot = Some(Screenshot::record(
+                        &gfx.ctx,
+                        &mut encoder,
+                        &frame.texture,
+                        path.clone(),
+                    ));
+                } else {
+                    // The surface cannot be copied from: draw the UI again offscreen.
+                    let offscreen = gfx.ctx.device.create_texture(&wgpu::TextureDescriptor {
+                        label: Some("editor::screenshot_target"),
+                        size: frame.texture.size(),
+                        mip_level_count: 1,
+                        sample_count: 1,
+                        dimension: wgpu::TextureDimension::D2,
+                        format: gfx.config.format,
+                        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                            | wgpu::TextureUsages::COPY_SRC,
+                        view_formats: &[],
+                    });
+                    let off_view = offscreen.create_view(&Default::default());
+                    gfx.render_egui(&mut encoder, &off_view, &paint_jobs, &screen);
+                    screenshot = Some(Screenshot::record(
+                        &gfx.ctx,
+                        &mut encoder,
+                        &offscreen,
+                        path.clone(),
+                    ));
+                }
+            }
+        }
+        gfx.ctx
+            .queue
+            .submit(callbacks.into_iter().chain([encoder.finish()]));
+        if let Some(frame) = frame {
+            gfx.window.pre_present_notify();
+            gfx.ctx.queue.present(frame);
+        }
+        for id in &full_output.textures_delta.free {
+            gfx.egui_renderer.free_texture(id);
+        }
+
+        if !is_last {
+            return Ok(false);
+        }
+        if let Some(shot) = screenshot {
+            let path = shot.path.clone();
+            read_back(&gfx.ctx, shot)
+                .with_context(|| format!("saving the screenshot {}", path.display()))?;
+        } else if let Some(path) = &self.options.screenshot {
+            // No frame this time: try again on the next one, but not forever.
+            let wanted = self.options.frames.unwrap_or(0) as u64;
+            if gfx.frame_index > wanted + MAX_EXTRA_FRAMES {
+                return Err(anyhow!(
+                    "no frame could be acquired from the window for the screenshot {}",
+                    path.display()
+                ));
+            }
+            return Ok(false);
+        }
+        gfx.refresh_counters(&mut self.state, true);
+        let warm = gfx.frame_log.len().min(WARMUP_FRAMES);
+        self.report = Some(RunReport {
+            frames: gfx.frame_index as u32,
+            median_frame_secs: median(&gfx.frame_log[warm..]),
+            median_cpu_secs: median(&gfx.cpu_log[warm..]),
+            alive: self.state.stats.total_alive(),
+            viewport_px: gfx.viewport_px,
+            window_px: (gfx.config.width, gfx.config.height),
+            adapter: gfx.ctx.info.name.clone(),
+        });
+        Ok(true)
+    }
+}

@@ -1,0 +1,19 @@
+//! The editor: a winit window with an egui side panel and a 3D viewport of the running
+//! effect.
+//!
+//! The UI is plain functions over [`EditorState`] (no GPU needed, so tests drive them
+//! with an `egui::Context`); [`app`] owns the window, the surface and the frame loop.
+
+pub mod app;
+pub mod look;
+pub mod panel;
+pub mod remap;
+pub mod screenshot;
+pub mod state;
+pub mod stats;
+pub mod undo;
+pub mod viewport;
+
+pub use app::{EditOptions, RunReport, run};
+pub use state::{EditorState, Playback, ViewSettings};
+pub use undo::UndoHistory;

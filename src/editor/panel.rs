@@ -1,0 +1,883 @@
+//! The side panel: one collapsible section per concern. Every widget is bound to a field
+//! of the [`Effect`] (or of the editor's view settings); no parameter lives in a widget.
+//!
+//! Ranges are clamped by the widgets themselves (`DragValue::range`), so typing or
+//! dragging cannot produce a NaN or an out-of-range value; whatever still fails
+//! [`Effect::validate`] is shown at the top and the last valid effect keeps running.
+
+use std::ops::RangeInclusive;
+
+use egui::{Color32, DragValue, Response, RichText, Ui};
+
+use crate::effect::{
+    BlendMode, Burst, Effect, Emitter, Integrator, Range, Shape, Sprite, TimeMode,
+};
+
+use super::look::look_ui;
+use super::state::{EditorState, Playback, ViewSettings};
+use super::stats::stats_ui;
+
+/// Default width of the side panel, points.
+pub const PANEL_WIDTH: f32 = 370.0;
+
+/// Largest capacity the panel offers (2^22 slots, 128 MiB per state buffer).
+pub const UI_MAX_CAPACITY: u32 = 1 << 22;
+
+/// The whole side panel: header (undo/redo, errors) and the sections.
+pub fn panel_ui(ui: &mut Ui, state: &mut EditorState) {
+    header_ui(ui, state);
+    ui.separator();
+    egui::ScrollArea::vertical()
+        .auto_shrink([false, false])
+        .show(ui, |ui| {
+            let name = state
+                .effect
+                .emitters
+                .get(state.selected)
+                .map(|e| e.name.clone())
+                .unwrap_or_default();
+            section_ui(ui, "emitter", "Emitter", "", true, |ui| {
+                emitter_ui(ui, &mut state.effect, &mut state.selected);
+            });
+            section_ui(ui, "randomness", "Randomness", &name, false, |ui| {
+                randomness_ui(ui, &mut state.effect, state.selected);
+            });
+            section_ui(ui, "forces", "Forces", &name, false, |ui| {
+                forces_ui(ui, &mut state.effect, state.selected);
+            });
+            section_ui(ui, "time", "Time", "", true, |ui| {
+                time_ui(ui, &mut state.effect, &mut state.playback, state.selected);
+            });
+            section_ui(ui, "look", "Look", &name, false, |ui| {
+                look_ui(ui, &mut state.effect, state.selected, &mut state.view);
+            });
+            section_ui(ui, "view", "View", "", false, |ui| {
+                view_ui(ui, &mut state.view, &mut state.frame_requested);
+            });
+            section_ui(ui, "stats", "Stats", "", true, |ui| {
+                stats_ui(ui, &state.stats, &state.running);
+            });
+        });
+}
+
+/// A collapsible section with a stable id (its title may name the selected emitter).
+fn section_ui(
+    ui: &mut Ui,
+    id: &str,
+    title: &str,
+    emitter: &str,
+    default_open: bool,
+    add: impl FnOnce(&mut Ui),
+) {
+    let text = if emitter.is_empty() {
+        RichText::new(title).strong()
+    } else {
+        RichText::new(format!("{title}  ·  {emitter}")).strong()
+    };
+    egui::CollapsingHeader::new(text)
+        .id_salt(id)
+        .default_open(default_open)
+        .show(ui, add);
+}
+
+/// Title, undo/redo and the validation message.
+pub fn header_ui(ui: &mut Ui, state: &mut EditorState) {
+    ui.horizontal(|ui| {
+        ui.heading(RichText::new("ignis").strong().color(Color32::from_rgb(255, 150, 60)));
+        ui.label(RichText::new(&state.effect.name).strong());
+        ui.weak(&state.source);
+    });
+    ui.horizontal(|ui| {
+        let undo = ui
+            .add_enabled(state.history.undo_len() > 0, egui::Button::new("Undo"))
+            .on_hover_text("Undo the last edit (Ctrl+Z)");
+        if undo.clicked() {
+            state.undo();
+        }
+        let redo = ui
+            .add_enabled(state.history.redo_len() > 0, egui::Button::new("Redo"))
+            .on_hover_text("Redo (Ctrl+Shift+Z)");
+        if redo.clicked() {
+            state.redo();
+        }
+        ui.weak(format!(
+            "{} undo · {} redo",
+            state.history.undo_len(),
+            state.history.redo_len()
+        ));
+    });
+    if !state.validation_errors.is_empty() {
+        error_box_ui(ui, |ui| {
+            ui.label(
+                RichText::new("Not applied: the last valid effect keeps running.").strong(),
+            );
+            for e in state.validation_errors.iter().take(6) {
+                ui.label(e.to_string());
+            }
+            if state.validation_errors.len() > 6 {
+                ui.label(format!("… and {} more", state.validation_errors.len() - 6));
+            }
+        });
+    }
+    if let Some((_, reason)) = &state.gpu_rejected {
+        error_box_ui(ui, |ui| {
+            ui.label(RichText::new("The GPU refused this effect; the last one keeps running.").strong());
+            ui.label(reason);
+        });
+    }
+}
+
+fn error_box_ui(ui: &mut Ui, add: impl FnOnce(&mut Ui)) {
+    egui::Frame::group(ui.style())
+        .fill(Color32::from_rgb(70, 24, 24))
+        .stroke(egui::Stroke::new(1.0, Color32::from_rgb(200, 80, 70)))
+        .show(ui, |ui| {
+            ui.set_width(ui.available_width());
+            add(ui);
+        });
+}
+
+// ---------------------------------------------------------------------------------------
+// Small widget helpers.
+
+/// A labelled grid row: the label names the widget for accessibility (and tests) and
+/// both carry the tooltip.
+fn row(ui: &mut Ui, label: &str, tip: &str, add: impl FnOnce(&mut Ui) -> Response) -> Response {
+    let label = ui.label(label).on_hover_text(tip);
+    let response = add(ui).labelled_by(label.id).on_hover_text(tip);
+    ui.end_row();
+    response
+}
+
+/// A float drag value clamped to `range`.
+fn drag<'a>(v: &'a mut f32, range: RangeInclusive<f32>, speed: f64, suffix: &str) -> DragValue<'a> {
+    DragValue::new(v)
+        .range(range)
+        .speed(speed)
+        .suffix(suffix.to_owned())
+        .max_decimals(4)
+}
+
+/// Three drag values side by side (x, y, z) in one row; the returned response is their
+/// union (changed when any changed).
+fn vec3_ui(
+    ui: &mut Ui,
+    label: &str,
+    tip: &str,
+    v: &mut [f32; 3],
+    range: RangeInclusive<f32>,
+    speed: f64,
+    suffix: &str,
+) -> Response {
+    let label = ui.label(label).on_hover_text(tip);
+    let response = ui
+        .horizontal(|ui| {
+            let mut union: Option<Response> = None;
+            for (c, axis) in v.iter_mut().zip(["x ", "y ", "z "]) {
+                let r = ui
+                    .add(
+                        drag(c, range.clone(), speed, suffix)
+                            .prefix(axis)
+                            .min_decimals(2),
+                    )
+                    .labelled_by(label.id);
+                union = Some(match union {
+                    Some(u) => u | r,
+                    None => r,
+                });
+            }
+            union
+        })
+        .inner;
+    ui.end_row();
+    response.unwrap_or(label)
+}
+
+/// A `[min, max]` pair whose widgets keep min ≤ max.
+fn range_ui(
+    ui: &mut Ui,
+    label: &str,
+    tip: &str,
+    r: &mut Range,
+    limits: RangeInclusive<f32>,
+    speed: f64,
+    suffix: &str,
+) -> Response {
+    let label = ui.label(label).on_hover_text(tip);
+    let response = ui
+        .horizontal(|ui| {
+            let max = r.max;
+            let a = ui
+                .add(
+                    drag(&mut r.min, *limits.start()..=max, speed, suffix)
+                        .prefix("min ")
+                        .min_decimals(2),
+                )
+                .labelled_by(label.id);
+            let min = r.min;
+            let b = ui
+                .add(
+                    drag(&mut r.max, min..=*limits.end(), speed, suffix)
+                        .prefix("max ")
+                        .min_decimals(2),
+                )
+                .labelled_by(label.id);
+            a | b
+        })
+        .inner
+        .on_hover_text(tip);
+    ui.end_row();
+    response
+}
+
+fn grid(id: &str) -> egui::Grid {
+    egui::Grid::new(id)
+        .num_columns(2)
+        .spacing([10.0, 5.0])
+        .min_col_width(96.0)
+}
+
+/// A name not used by any emitter of `effect`, starting from `base`.
+pub fn unique_name(effect: &Effect, base: &str) -> String {
+    if !effect.emitters.iter().any(|e| e.name == base) {
+        return base.to_owned();
+    }
+    (2..)
+        .map(|k| format!("{base} {k}"))
+        .find(|n| !effect.emitters.iter().any(|e| e.name == *n))
+        .unwrap_or_else(|| base.to_owned())
+}
+
+// ---------------------------------------------------------------------------------------
+// Emitter.
+
+/// The emitter list (select, mute, solo, add, duplicate, remove, reorder) and the
+/// selected emitter's spawning parameters.
+pub fn emitter_ui(ui: &mut Ui, effect: &mut Effect, selected: &mut usize) {
+    emitter_list_ui(ui, effect, selected);
+    ui.separator();
+    let Some(e) = effect.emitters.get_mut(*selected) else {
+        ui.label("No emitter: add one.");
+        return;
+    };
+    grid("emitter_grid").show(ui, |ui| {
+        row(ui, "Name", "Unique name of this layer", |ui| {
+            ui.add(egui::TextEdit::singleline(&mut e.name).desired_width(180.0))
+        });
+        shape_ui(ui, &mut e.shape);
+        vec3_ui(
+            ui,
+            "Position",
+            "Emitter origin in the world, metres",
+            &mut e.transform.position_m,
+            -100.0..=100.0,
+            0.01,
+            " m",
+        );
+        vec3_ui(
+            ui,
+            "Rotation",
+            "Emitter rotation, degrees (applied X, then Y, then Z)",
+            &mut e.transform.rotation_deg,
+            -360.0..=360.0,
+            0.5,
+            "°",
+        );
+        row(
+            ui,
+            "Spawn rate",
+            "Continuous emission, particles per second",
+            |ui| ui.add(drag(&mut e.spawn_rate_per_sec, 0.0..=1.0e6, 5.0, " /s")),
+        );
+        row(
+            ui,
+            "Max spawn / step",
+            "At most this many spawns per step, so a long step cannot cause a burst. 0 = automatic (the rate at a 1/15 s step)",
+            |ui| ui.add(DragValue::new(&mut e.max_spawn_per_step).range(0..=UI_MAX_CAPACITY).speed(1.0)),
+        );
+        row(
+            ui,
+            "Capacity",
+            "Particle slots in this emitter's ring. Keep it above rate × max lifetime, or living particles are recycled. Changing it keeps the particles that fit",
+            |ui| {
+                ui.add(
+                    DragValue::new(&mut e.capacity)
+                        .range(1..=UI_MAX_CAPACITY)
+                        .speed(16.0)
+                        .suffix(" slots"),
+                )
+            },
+        );
+        let needed = e.spawn_rate_per_sec * e.lifetime_secs.max;
+        if needed > e.capacity as f32 * 1.02 {
+            ui.label("");
+            ui.colored_label(
+                ui.visuals().warn_fg_color,
+                format!("rate × max lifetime ≈ {needed:.0} > capacity"),
+            );
+            ui.end_row();
+        }
+        range_ui(
+            ui,
+            "Lifetime",
+            "Each particle draws its lifetime from this range, seconds",
+            &mut e.lifetime_secs,
+            0.001..=1000.0,
+            0.01,
+            " s",
+        );
+        vec3_ui(
+            ui,
+            "Direction",
+            "Initial direction in emitter space (normalised on use; must not be zero)",
+            &mut e.direction,
+            -1.0..=1.0,
+            0.01,
+            "",
+        );
+        row(
+            ui,
+            "Spread",
+            "Half-angle of the cone of initial directions, degrees (a Cone shape uses its own angle)",
+            |ui| ui.add(drag(&mut e.spread_deg, 0.0..=180.0, 0.2, "°")),
+        );
+        range_ui(
+            ui,
+            "Speed",
+            "Initial speed range, metres per second",
+            &mut e.speed_m_per_s,
+            0.0..=1000.0,
+            0.01,
+            " m/s",
+        );
+    });
+    bursts_ui(ui, &mut e.bursts);
+}
+
+fn emitter_list_ui(ui: &mut Ui, effect: &mut Effect, selected: &mut usize) {
+    let n = effect.emitters.len();
+    for i in 0..n {
+        ui.horizontal(|ui| {
+            let e = &mut effect.emitters[i];
+            ui.checkbox(&mut e.enabled, "")
+                .on_hover_text("Enabled (unchecked = muted: neither simulated nor drawn)");
+            let text = if e.enabled {
+                RichText::new(&e.name)
+            } else {
+                RichText::new(&e.name).weak().strikethrough()
+            };
+            if ui.selectable_label(*selected == i, text).clicked() {
+                *selected = i;
+            }
+            ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+                ui.weak(format!("{} · {}", sprite_label(e.look.sprite), e.shape.label()));
+            });
+        });
+    }
+    ui.horizontal_wrapped(|ui| {
+        if ui
+            .small_button("Add")
+            .on_hover_text("Add a default emitter after the selected one")
+            .clicked()
+        {
+            let mut e = Emitter::default();
+            e.name = unique_name(effect, "emitter");
+            let at = (*selected + 1).min(n);
+            effect.emitters.insert(at, e);
+            *selected = at;
+        }
+        if ui
+            .add_enabled(n > 0, egui::Button::new("Duplicate").small())
+            .on_hover_text("Copy the selected emitter")
+            .clicked()
+            && let Some(src) = effect.emitters.get(*selected)
+        {
+            let mut e = src.clone();
+            e.name = unique_name(effect, &format!("{} copy", src.name));
+            effect.emitters.insert(*selected + 1, e);
+            *selected += 1;
+        }
+        if ui
+            .add_enabled(n > 1, egui::Button::new("Remove").small())
+            .on_hover_text("Remove the selected emitter (an effect keeps at least one)")
+            .clicked()
+            && *selected < n
+        {
+            effect.emitters.remove(*selected);
+            *selected = selected.saturating_sub(1).min(n - 2);
+        }
+        if ui
+            .add_enabled(*selected > 0, egui::Button::new("Up").small())
+            .on_hover_text("Draw earlier (layers are drawn in order within a blend mode)")
+            .clicked()
+        {
+            effect.emitters.swap(*selected, *selected - 1);
+            *selected -= 1;
+        }
+        if ui
+            .add_enabled(*selected + 1 < n, egui::Button::new("Down").small())
+            .on_hover_text("Draw later")
+            .clicked()
+        {
+            effect.emitters.swap(*selected, *selected + 1);
+            *selected += 1;
+        }
+        if ui
+            .small_button("Solo")
+            .on_hover_text("Enable only the selected emitter")
+            .clicked()
+        {
+            for (i, e) in effect.emitters.iter_mut().enumerate() {
+                e.enabled = i == *selected;
+            }
+        }
+        if ui
+            .small_button("All on")
+            .on_hover_text("Enable every emitter")
+            .clicked()
+        {
+            for e in &mut effect.emitters {
+                e.enabled = true;
+            }
+        }
+    });
+}
+
+/// Shape picker and the selected shape's dimensions (grid rows).
+fn shape_ui(ui: &mut Ui, shape: &mut Shape) {
+    let label = ui.label("Shape").on_hover_text("Where particles are born, in emitter space");
+    egui::ComboBox::from_id_salt("shape_kind")
+        .selected_text(shape.label())
+        .width(120.0)
+        .show_ui(ui, |ui| {
+            for s in Shape::all_defaults() {
+                let is_current = s.kind_index() == shape.kind_index();
+                if ui.selectable_label(is_current, s.label()).clicked() && !is_current {
+                    *shape = carry_size(shape, s);
+                }
+            }
+        })
+        .response
+        .labelled_by(label.id);
+    ui.end_row();
+    match shape {
+        Shape::Point => {}
+        Shape::Sphere {
+            radius_m,
+            surface_only,
+        } => {
+            row(ui, "Radius", "Sphere radius, metres", |ui| {
+                ui.add(drag(radius_m, 0.0..=100.0, 0.005, " m"))
+            });
+            row(ui, "Surface only", "Spawn on the surface instead of the volume", |ui| {
+                ui.checkbox(surface_only, "")
+            });
+        }
+        Shape::Disc { radius_m, normal } => {
+            row(ui, "Radius", "Disc radius, metres", |ui| {
+                ui.add(drag(radius_m, 0.0..=100.0, 0.005, " m"))
+            });
+            vec3_ui(
+                ui,
+                "Normal",
+                "Disc normal in emitter space (normalised on use; must not be zero)",
+                normal,
+                -1.0..=1.0,
+                0.01,
+                "",
+            );
+        }
+        Shape::Box { half_extents_m } => {
+            vec3_ui(
+                ui,
+                "Half extents",
+                "Half the box size along each axis, metres",
+                half_extents_m,
+                0.0..=100.0,
+                0.005,
+                " m",
+            );
+        }
+        Shape::Cone {
+            angle_deg,
+            radius_m,
+        } => {
+            row(ui, "Cone angle", "Half-angle of the directions, degrees (replaces Spread)", |ui| {
+                ui.add(drag(angle_deg, 0.0..=180.0, 0.2, "°"))
+            });
+            row(ui, "Base radius", "Radius of the base disc, metres", |ui| {
+                ui.add(drag(radius_m, 0.0..=100.0, 0.005, " m"))
+            });
+        }
+        Shape::Line { a_m, b_m } => {
+            vec3_ui(ui, "Start", "First endpoint, metres", a_m, -100.0..=100.0, 0.01, " m");
+            vec3_ui(ui, "End", "Second endpoint, metres", b_m, -100.0..=100.0, 0.01, " m");
+        }
+    }
+}
+
+/// Switches shape kind keeping the size when both kinds have a radius.
+fn carry_size(old: &Shape, mut new: Shape) -> Shape {
+    let old_radius = match old {
+        Shape::Sphere { radius_m, .. }
+        | Shape::Disc { radius_m, .. }
+        | Shape::Cone { radius_m, .. } => Some(*radius_m),
+        _ => None,
+    };
+    if let Some(r) = old_radius {
+        match &mut new {
+            Shape::Sphere { radius_m, .. }
+            | Shape::Disc { radius_m, .. }
+            | Shape::Cone { radius_m, .. } => *radius_m = r,
+            _ => {}
+        }
+    }
+    new
+}
+
+fn bursts_ui(ui: &mut Ui, bursts: &mut Vec<Burst>) {
+    ui.horizontal(|ui| {
+        ui.label("Bursts")
+            .on_hover_text("One-shot bursts at a simulated time (they fire again after a restart)");
+        if ui.small_button("Add burst").clicked() {
+            let t = bursts.last().map_or(0.0, |b| b.time_secs + 0.5);
+            bursts.push(Burst {
+                time_secs: t,
+                count: 200,
+            });
+        }
+    });
+    let mut remove = None;
+    for (k, b) in bursts.iter_mut().enumerate() {
+        ui.horizontal(|ui| {
+            ui.add_space(12.0);
+            ui.add(
+                drag(&mut b.time_secs, 0.0..=1.0e5, 0.01, " s")
+                    .prefix("at ")
+                    .min_decimals(2),
+            );
+            ui.add(
+                DragValue::new(&mut b.count)
+                    .range(0..=UI_MAX_CAPACITY)
+                    .speed(1.0)
+                    .suffix(" particles"),
+            );
+            if ui.small_button("✖").on_hover_text("Remove this burst").clicked() {
+                remove = Some(k);
+            }
+        });
+    }
+    if let Some(k) = remove {
+        bursts.remove(k);
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Randomness.
+
+/// A new seed derived from the old one (deterministic, so a session can be replayed).
+pub fn next_seed(seed: u32) -> u32 {
+    crate::rng::pcg4d([seed, 0x9E37_79B9, 0x7F4A_7C15, 1])[0]
+}
+
+/// The effect seed, the emitter's seed offset and its spawn noise.
+pub fn randomness_ui(ui: &mut Ui, effect: &mut Effect, selected: usize) {
+    grid("randomness_grid").show(ui, |ui| {
+        let label = ui
+            .label("Seed")
+            .on_hover_text("Master seed: every random number is a hash of the seed, the emitter, the slot and the spawn counter");
+        ui.horizontal(|ui| {
+            ui.add(DragValue::new(&mut effect.seed).speed(1.0))
+                .labelled_by(label.id);
+            if ui
+                .button("New seed")
+                .on_hover_text("Derive a new seed from this one")
+                .clicked()
+            {
+                effect.seed = next_seed(effect.seed);
+            }
+        });
+        ui.end_row();
+        let Some(e) = effect.emitters.get_mut(selected) else {
+            return;
+        };
+        row(
+            ui,
+            "Seed offset",
+            "Added to the seed for this emitter's stream (two emitters with the same settings differ by it)",
+            |ui| ui.add(DragValue::new(&mut e.seed_offset).speed(1.0)),
+        );
+        let n = &mut e.spawn_noise;
+        row(
+            ui,
+            "Noise frequency",
+            "Spatial frequency of the noise that moves spawn positions and tilts directions, per metre",
+            |ui| ui.add(drag(&mut n.frequency_per_m, 0.0..=100.0, 0.02, " /m")),
+        );
+        row(
+            ui,
+            "Position amplitude",
+            "How far the noise moves spawn positions, metres",
+            |ui| ui.add(drag(&mut n.position_amplitude_m, 0.0..=10.0, 0.002, " m")),
+        );
+        row(
+            ui,
+            "Direction amplitude",
+            "How far the noise tilts the initial direction (fraction of the direction vector)",
+            |ui| ui.add(drag(&mut n.direction_amplitude, 0.0..=10.0, 0.005, "")),
+        );
+        row(
+            ui,
+            "Scroll speed",
+            "How fast the noise field scrolls in time (flicker rate), per second",
+            |ui| ui.add(drag(&mut n.scroll_per_sec, -100.0..=100.0, 0.02, " /s")),
+        );
+    });
+}
+
+// ---------------------------------------------------------------------------------------
+// Forces.
+
+/// Gravity, buoyancy, drag and wind of the selected emitter.
+pub fn forces_ui(ui: &mut Ui, effect: &mut Effect, selected: usize) {
+    let Some(e) = effect.emitters.get_mut(selected) else {
+        return;
+    };
+    let f = &mut e.forces;
+    grid("forces_grid").show(ui, |ui| {
+        row(
+            ui,
+            "Buoyancy",
+            "Upward acceleration of hot gas along +Y, m/s² (the 2006 thesis's negative gravity)",
+            |ui| ui.add(drag(&mut f.buoyancy_m_per_s2, -1000.0..=1000.0, 0.05, " m/s²")),
+        );
+        vec3_ui(
+            ui,
+            "Gravity",
+            "Gravity, m/s²",
+            &mut f.gravity_m_per_s2,
+            -1000.0..=1000.0,
+            0.05,
+            "",
+        );
+        row(
+            ui,
+            "Drag",
+            "Linear drag rate k, per second: the velocity relaxes toward the wind with time constant 1/k",
+            |ui| ui.add(drag(&mut f.drag_per_sec, 0.0..=1000.0, 0.01, " /s")),
+        );
+        vec3_ui(
+            ui,
+            "Wind",
+            "The flow velocity drag pulls toward, m/s",
+            &mut f.wind_m_per_s,
+            -100.0..=100.0,
+            0.01,
+            "",
+        );
+    });
+    let accel = f.constant_acceleration();
+    let text = if f.drag_per_sec > 0.0 {
+        let terminal = accel / f.drag_per_sec + glam::Vec3::from(f.wind_m_per_s);
+        format!(
+            "Net constant acceleration {:+.2} m/s² up; terminal velocity ({:.2}, {:.2}, {:.2}) m/s",
+            accel.y, terminal.x, terminal.y, terminal.z
+        )
+    } else {
+        format!("Net constant acceleration {:+.2} m/s² up; no drag", accel.y)
+    };
+    ui.weak(text);
+}
+
+// ---------------------------------------------------------------------------------------
+// Time.
+
+/// Time stepping, playback and the integrator of each emitter with its stability hint.
+pub fn time_ui(ui: &mut Ui, effect: &mut Effect, playback: &mut Playback, selected: usize) {
+    ui.horizontal(|ui| {
+        let pause_text = if playback.is_paused { "Play" } else { "Pause" };
+        if ui
+            .button(pause_text)
+            .on_hover_text("Pause or resume the simulation (Space)")
+            .clicked()
+        {
+            playback.is_paused = !playback.is_paused;
+        }
+        if ui
+            .button("Step")
+            .on_hover_text("Run one step and pause (.)")
+            .clicked()
+        {
+            playback.step_requested = true;
+        }
+        if ui
+            .button("Restart")
+            .on_hover_text("Kill every particle and restart time (R)")
+            .clicked()
+        {
+            playback.restart_requested = true;
+        }
+        if playback.is_paused {
+            ui.colored_label(Color32::from_rgb(240, 200, 90), "paused");
+        }
+    });
+    let t = &mut effect.time;
+    grid("time_grid").show(ui, |ui| {
+        let label = ui.label("Mode").on_hover_text(
+            "Fixed step: an accumulator runs whole steps, so the result does not depend on the frame rate. Frame delta: one step per frame of the frame's duration (the 2006 thesis's mode)",
+        );
+        ui.horizontal(|ui| {
+            ui.radio_value(&mut t.mode, TimeMode::FixedStep, "Fixed step")
+                .labelled_by(label.id);
+            ui.radio_value(&mut t.mode, TimeMode::FrameDelta, "Frame delta")
+                .labelled_by(label.id);
+        });
+        ui.end_row();
+        let is_fixed = t.mode == TimeMode::FixedStep;
+        let label = ui
+            .label("Step size")
+            .on_hover_text("Fixed step size, seconds");
+        ui.horizontal(|ui| {
+            ui.add_enabled(
+                is_fixed,
+                drag(&mut t.step_secs, 0.0001..=0.1, 0.0002, " s").min_decimals(4),
+            )
+            .labelled_by(label.id);
+            if t.step_secs > 0.0 {
+                ui.weak(format!("{:.0} Hz", 1.0 / t.step_secs));
+            }
+        });
+        ui.end_row();
+        row(
+            ui,
+            "Max substeps",
+            "At most this many fixed steps per frame; the rest of the time is dropped and counted (Stats)",
+            |ui| ui.add_enabled(is_fixed, DragValue::new(&mut t.max_substeps).range(1..=256).speed(0.1)),
+        );
+        row(
+            ui,
+            "Max frame dt",
+            "Frame-delta mode: a longer frame is clamped to this step, seconds",
+            |ui| {
+                ui.add_enabled(
+                    !is_fixed,
+                    drag(&mut t.max_frame_dt_secs, 0.001..=0.5, 0.001, " s").min_decimals(3),
+                )
+            },
+        );
+        row(
+            ui,
+            "Speed",
+            "Simulation speed multiplier (1 = real time)",
+            |ui| ui.add(drag(&mut t.speed, 0.0..=10.0, 0.01, "×").min_decimals(2)),
+        );
+        if let Some(e) = effect.emitters.get_mut(selected) {
+            let label = ui
+                .label("Integrator")
+                .on_hover_text("Integration method of the selected emitter");
+            egui::ComboBox::from_id_salt("integrator")
+                .selected_text(e.integrator.label())
+                .width(150.0)
+                .show_ui(ui, |ui| {
+                    for i in Integrator::ALL {
+                        ui.selectable_value(&mut e.integrator, i, i.label());
+                    }
+                })
+                .response
+                .labelled_by(label.id);
+            ui.end_row();
+        }
+    });
+    stability_ui(ui, effect);
+}
+
+/// k·dt of the step the integrator sees (the worst case in frame-delta mode).
+pub fn drag_times_dt(effect: &Effect, emitter: &Emitter) -> f32 {
+    let dt = match effect.time.mode {
+        TimeMode::FixedStep => effect.time.step_secs,
+        TimeMode::FrameDelta => effect.time.max_frame_dt_secs,
+    };
+    emitter.forces.drag_per_sec * dt
+}
+
+/// The drag stability hint for every emitter: k·dt against the integrator's limit.
+fn stability_ui(ui: &mut Ui, effect: &Effect) {
+    egui::Grid::new("stability_grid")
+        .num_columns(3)
+        .spacing([10.0, 2.0])
+        .show(ui, |ui| {
+            ui.weak("emitter");
+            ui.weak("integrator");
+            ui.weak("drag·dt / limit")
+                .on_hover_text("Linear drag v' = −k·v is stable for k·dt below the method's limit; above it the velocity oscillates and grows");
+            ui.end_row();
+            for e in &effect.emitters {
+                let kdt = drag_times_dt(effect, e);
+                ui.label(&e.name);
+                ui.label(e.integrator.label());
+                match e.integrator.drag_stability_limit() {
+                    Some(limit) if kdt > limit => {
+                        ui.colored_label(
+                            ui.visuals().error_fg_color,
+                            format!("{kdt:.3} > {limit:.3}: unstable"),
+                        );
+                    }
+                    Some(limit) => {
+                        ui.label(format!("{kdt:.3} / {limit:.3}"));
+                    }
+                    None => {
+                        ui.label(format!("{kdt:.3} / ∞"));
+                    }
+                }
+                ui.end_row();
+            }
+        });
+}
+
+// ---------------------------------------------------------------------------------------
+// View.
+
+/// Viewport options: grid, gizmos, render scale, camera.
+pub fn view_ui(ui: &mut Ui, view: &mut ViewSettings, frame_requested: &mut bool) {
+    grid("view_grid").show(ui, |ui| {
+        row(ui, "Ground grid", "Draw the y = 0 grid (0.5 m cells)", |ui| {
+            ui.checkbox(&mut view.show_grid, "")
+        });
+        row(ui, "Shape gizmos", "Draw every emitter's spawn shape as a wireframe", |ui| {
+            ui.checkbox(&mut view.show_gizmos, "")
+        });
+        row(
+            ui,
+            "Render scale",
+            "Render the viewport at this fraction of its pixel size and upscale it (faster on slow GPUs)",
+            |ui| ui.add(egui::Slider::new(&mut view.render_scale, 0.25..=1.0).fixed_decimals(2)),
+        );
+    });
+    ui.horizontal(|ui| {
+        if ui
+            .button("Frame effect")
+            .on_hover_text("Centre the camera on the particles (F, or double-click the viewport)")
+            .clicked()
+        {
+            *frame_requested = true;
+        }
+    });
+    ui.weak("Drag: orbit · Shift/middle/right-drag: pan · Wheel: zoom · Double-click: frame");
+}
+
+/// UI name of a sprite.
+pub fn sprite_label(s: Sprite) -> &'static str {
+    match s {
+        Sprite::SoftDisc => "soft disc",
+        Sprite::Point => "point",
+        Sprite::Spark => "spark",
+    }
+}
+
+/// UI name of a blend mode.
+pub fn blend_label(b: BlendMode) -> &'static str {
+    match b {
+        BlendMode::Additive => "additive",
+        BlendMode::Alpha => "alpha",
+    }
+}

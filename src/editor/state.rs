@@ -1,0 +1,198 @@
+//! Everything the editor UI edits or shows, without any GPU object: the panel and its
+//! tests drive this struct with a plain `egui::Context`.
+
+use crate::effect::{Effect, ValidationError};
+
+use super::stats::Stats;
+use super::undo::UndoHistory;
+
+/// Viewing options that are not part of the effect (they do not change the fire, only
+/// how the editor shows it).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ViewSettings {
+    /// Exposure multiplier applied before tonemapping.
+    pub exposure: f32,
+    /// Draw the ground grid (y = 0, 0.5 m spacing).
+    pub show_grid: bool,
+    /// Draw the wireframe of every emitter's spawn shape.
+    pub show_gizmos: bool,
+    /// Render the viewport at this fraction of its pixel size (upscaled when shown).
+    pub render_scale: f32,
+}
+
+impl Default for ViewSettings {
+    fn default() -> Self {
+        Self {
+            exposure: 1.0,
+            show_grid: true,
+            show_gizmos: true,
+            render_scale: 1.0,
+        }
+    }
+}
+
+/// Playback requests from the panel and the keyboard, consumed by the frame loop.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Playback {
+    /// The simulation is frozen (rendering goes on).
+    pub is_paused: bool,
+    /// Run exactly one step on the next frame (pauses).
+    pub step_requested: bool,
+    /// Kill every particle and restart time on the next frame.
+    pub restart_requested: bool,
+}
+
+/// The editor's model: the effect under edit, the last valid one that runs, undo
+/// history, playback and statistics.
+pub struct EditorState {
+    /// The effect the widgets edit.
+    pub effect: Effect,
+    /// The last valid effect: what the simulation runs.
+    pub running: Effect,
+    /// Why `effect` is not running (validation errors), empty when it is.
+    pub validation_errors: Vec<ValidationError>,
+    /// An effect the GPU refused (e.g. a capacity over a device limit) and why; not
+    /// offered again until it changes.
+    pub gpu_rejected: Option<(Effect, String)>,
+    /// Index of the emitter shown in the emitter-specific sections.
+    pub selected: usize,
+    /// Undo/redo of `effect`.
+    pub history: UndoHistory,
+    /// Pause, single step, restart.
+    pub playback: Playback,
+    /// Exposure, grid, gizmos.
+    pub view: ViewSettings,
+    /// Frame and simulation statistics.
+    pub stats: Stats,
+    /// Set by the viewport (double-click) or the F key: frame the camera on the effect.
+    pub frame_requested: bool,
+    /// Where the effect was loaded from, for the title.
+    pub source: String,
+}
+
+impl EditorState {
+    /// A state editing `effect` (assumed valid; if not, the errors show at once and the
+    /// simulation runs the effect anyway only once it is fixed).
+    pub fn new(effect: Effect, source: impl Into<String>) -> Self {
+        let validation_errors = effect.validate().err().unwrap_or_default();
+        Self {
+            running: effect.clone(),
+            history: UndoHistory::new(&effect),
+            effect,
+            validation_errors,
+            gpu_rejected: None,
+            selected: 0,
+            playback: Playback::default(),
+            view: ViewSettings::default(),
+            stats: Stats::default(),
+            frame_requested: false,
+            source: source.into(),
+        }
+    }
+
+    /// End-of-frame bookkeeping after the UI ran: handles the undo/redo and playback
+    /// shortcuts, records an undo step when a gesture ended, validates the edited effect
+    /// and promotes it to `running` when valid. Returns true when `running` changed.
+    pub fn end_frame(&mut self, ctx: &egui::Context) -> bool {
+        self.handle_shortcuts(ctx);
+        let is_interacting =
+            ctx.input(|i| i.pointer.any_down()) || ctx.text_edit_focused();
+        self.history.observe(&self.effect, is_interacting);
+        self.apply()
+    }
+
+    /// Validates `effect` and makes it the running effect when valid. Returns true when
+    /// `running` changed.
+    pub fn apply(&mut self) -> bool {
+        self.clamp_selection();
+        if self.effect == self.running {
+            self.validation_errors.clear();
+            return false;
+        }
+        match self.effect.validate() {
+            Ok(()) => {
+                self.validation_errors.clear();
+                let refused = self
+                    .gpu_rejected
+                    .as_ref()
+                    .is_some_and(|(e, _)| *e == self.effect);
+                if refused {
+                    return false;
+                }
+                self.gpu_rejected = None;
+                self.running.clone_from(&self.effect);
+                true
+            }
+            Err(errors) => {
+                self.validation_errors = errors;
+                false
+            }
+        }
+    }
+
+    /// The GPU refused `running`: go back to `last_good` and remember why.
+    pub fn reject_running(&mut self, last_good: &Effect, reason: String) {
+        self.gpu_rejected = Some((self.running.clone(), reason));
+        self.running.clone_from(last_good);
+    }
+
+    /// Undoes the last edit. Returns false when there was nothing to undo.
+    pub fn undo(&mut self) -> bool {
+        let done = self.history.undo(&mut self.effect);
+        self.clamp_selection();
+        done
+    }
+
+    /// Redoes the last undone edit. Returns false when there was nothing to redo.
+    pub fn redo(&mut self) -> bool {
+        let done = self.history.redo(&mut self.effect);
+        self.clamp_selection();
+        done
+    }
+
+    fn clamp_selection(&mut self) {
+        self.selected = self.selected.min(self.effect.emitters.len().saturating_sub(1));
+    }
+
+    fn handle_shortcuts(&mut self, ctx: &egui::Context) {
+        use egui::{Key, KeyboardShortcut, Modifiers};
+        // A focused text field has its own undo and takes every key.
+        if ctx.text_edit_focused() {
+            return;
+        }
+        let redo = KeyboardShortcut::new(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+        let redo_y = KeyboardShortcut::new(Modifiers::COMMAND, Key::Y);
+        let undo = KeyboardShortcut::new(Modifiers::COMMAND, Key::Z);
+        // Shift+Z first: `consume_shortcut` matches logically, so Ctrl+Z would also
+        // match Ctrl+Shift+Z.
+        let (do_redo, do_undo, pause, step, restart, frame) = ctx.input_mut(|i| {
+            let do_redo = i.consume_shortcut(&redo) || i.consume_shortcut(&redo_y);
+            let do_undo = i.consume_shortcut(&undo);
+            (
+                do_redo,
+                do_undo,
+                i.consume_key(Modifiers::NONE, Key::Space),
+                i.consume_key(Modifiers::NONE, Key::Period),
+                i.consume_key(Modifiers::NONE, Key::R),
+                i.consume_key(Modifiers::NONE, Key::F),
+            )
+        });
+        if do_redo {
+            self.redo();
+        } else if do_undo {
+            self.undo();
+        }
+        if pause {
+            self.playback.is_paused = !self.playback.is_paused;
+        }
+        if step {
+            self.playback.step_requested = true;
+        }
+        if restart {
+            self.playback.restart_requested = true;
+        }
+        if frame {
+            self.frame_requested = true;
+        }
+    }
+}

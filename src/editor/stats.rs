@@ -1,0 +1,231 @@
+//! Frame timing and simulation statistics, and the Stats section of the panel.
+
+use std::collections::VecDeque;
+
+use egui_plot::{Line, Plot};
+
+use crate::effect::Effect;
+use crate::sim::SpawnStats;
+
+/// Frames kept for the plot and the averages.
+const HISTORY_FRAMES: usize = 300;
+
+/// Counters of one emitter, read back from the GPU now and then.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EmitterStats {
+    /// Alive particles after the last step (GPU counter).
+    pub alive: u32,
+    /// Particles killed for a non-finite position or velocity, since the start.
+    pub nonfinite: u32,
+    /// Slots in the pool.
+    pub capacity: u32,
+    /// Spawn accounting from the CPU planner.
+    pub spawn: SpawnStats,
+}
+
+/// What the Stats section shows.
+#[derive(Clone, Debug, Default)]
+pub struct Stats {
+    frame_secs: VecDeque<f32>,
+    cpu_secs: VecDeque<f32>,
+    /// Steps simulated in the last frame.
+    pub steps_last_frame: u32,
+    /// Step size of the last frame, seconds.
+    pub dt_secs: f32,
+    /// Steps dropped by the max-substeps cap since the start.
+    pub dropped_steps: u64,
+    /// Simulated time, seconds.
+    pub sim_time_secs: f64,
+    /// Per-emitter counters (refreshed every few frames).
+    pub emitters: Vec<EmitterStats>,
+    /// Frames since the GPU counters were read.
+    pub counters_age_frames: u32,
+    /// The adapter's name.
+    pub adapter: String,
+    /// Size of the viewport's render target, pixels.
+    pub viewport_px: (u32, u32),
+}
+
+impl Stats {
+    /// Records one frame: its wall-clock interval and the CPU wall time spent recording
+    /// the simulation and the render.
+    pub fn push_frame(&mut self, frame_secs: f32, cpu_secs: f32) {
+        for (queue, v) in [
+            (&mut self.frame_secs, frame_secs),
+            (&mut self.cpu_secs, cpu_secs),
+        ] {
+            if queue.len() == HISTORY_FRAMES {
+                queue.pop_front();
+            }
+            queue.push_back(v);
+        }
+        self.counters_age_frames += 1;
+    }
+
+    /// Mean frame interval over the history, seconds (0 before the first frame).
+    pub fn mean_frame_secs(&self) -> f32 {
+        mean(&self.frame_secs)
+    }
+
+    /// Frames per second over the history.
+    pub fn fps(&self) -> f32 {
+        let m = self.mean_frame_secs();
+        if m > 0.0 { 1.0 / m } else { 0.0 }
+    }
+
+    /// Mean CPU wall time of the simulation + render recording, seconds.
+    pub fn mean_cpu_secs(&self) -> f32 {
+        mean(&self.cpu_secs)
+    }
+
+    /// Alive particles over all emitters (as of the last readback).
+    pub fn total_alive(&self) -> u64 {
+        self.emitters.iter().map(|e| e.alive as u64).sum()
+    }
+}
+
+fn mean(v: &VecDeque<f32>) -> f32 {
+    if v.is_empty() {
+        0.0
+    } else {
+        v.iter().sum::<f32>() / v.len() as f32
+    }
+}
+
+/// Median of `values` (NaN-free), 0 when empty.
+pub fn median(values: &[f32]) -> f32 {
+    let mut v: Vec<f32> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f32::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// The Stats section: timings, counters per emitter and a frame-time plot.
+pub fn stats_ui(ui: &mut egui::Ui, stats: &Stats, effect: &Effect) {
+    egui::Grid::new("stats_grid")
+        .num_columns(2)
+        .spacing([12.0, 4.0])
+        .show(ui, |ui| {
+            ui.label("Frame rate");
+            ui.label(format!(
+                "{:.1} fps ({:.2} ms)",
+                stats.fps(),
+                stats.mean_frame_secs() * 1e3
+            ));
+            ui.end_row();
+            ui.label("CPU wall time").on_hover_text(
+                "Wall-clock time spent on the CPU recording and submitting the simulation \
+                 steps and the viewport render, mean over the plotted frames. On a software \
+                 adapter this includes much of the GPU work.",
+            );
+            ui.label(format!("{:.2} ms", stats.mean_cpu_secs() * 1e3));
+            ui.end_row();
+            ui.label("Steps / frame");
+            ui.label(format!(
+                "{} × {:.2} ms",
+                stats.steps_last_frame,
+                stats.dt_secs * 1e3
+            ));
+            ui.end_row();
+            ui.label("Dropped steps").on_hover_text(
+                "Steps skipped because a frame needed more than the max substeps: \
+                 the simulation ran slower than real time.",
+            );
+            ui.label(stats.dropped_steps.to_string());
+            ui.end_row();
+            ui.label("Simulated time");
+            ui.label(format!("{:.2} s", stats.sim_time_secs));
+            ui.end_row();
+            ui.label("Viewport");
+            ui.label(format!("{} × {} px", stats.viewport_px.0, stats.viewport_px.1));
+            ui.end_row();
+            ui.label("Adapter");
+            ui.label(&stats.adapter);
+            ui.end_row();
+        });
+    ui.add_space(4.0);
+    for (i, e) in effect.emitters.iter().enumerate() {
+        let Some(s) = stats.emitters.get(i) else {
+            continue;
+        };
+        let fill = if s.capacity > 0 {
+            s.alive as f32 / s.capacity as f32
+        } else {
+            0.0
+        };
+        ui.horizontal(|ui| {
+            ui.add_sized([80.0, 18.0], egui::Label::new(&e.name).truncate());
+            ui.add(
+                egui::ProgressBar::new(fill)
+                    .desired_width(ui.available_width())
+                    .text(format!("{} / {} alive", s.alive, s.capacity)),
+            )
+            .on_hover_text(format!(
+                "spawned {}\ndropped by the per-step cap {}\ndropped over capacity {}\n\
+                 recycled while alive {}\nkilled as non-finite {}",
+                s.spawn.spawned,
+                s.spawn.dropped_by_cap,
+                s.spawn.dropped_over_capacity,
+                s.spawn.recycled_alive,
+                s.nonfinite
+            ));
+        });
+        let dropped = s.spawn.dropped_by_cap + s.spawn.dropped_over_capacity;
+        if dropped > 0 || s.spawn.recycled_alive > 0 || s.nonfinite > 0 {
+            ui.horizontal(|ui| {
+                ui.add_space(84.0);
+                ui.colored_label(
+                    ui.visuals().warn_fg_color,
+                    format!(
+                        "{dropped} spawns dropped, {} recycled alive, {} non-finite",
+                        s.spawn.recycled_alive, s.nonfinite
+                    ),
+                )
+                .on_hover_text(
+                    "Recycled: the ring of slots wrapped onto particles still alive — raise \
+                     the capacity above rate × max lifetime. Dropped: a step asked for more \
+                     spawns than the per-step cap or the capacity.",
+                );
+            });
+        }
+    }
+    ui.add_space(4.0);
+    let frame_ms: Vec<[f64; 2]> = stats
+        .frame_secs
+        .iter()
+        .enumerate()
+        .map(|(i, s)| [i as f64, *s as f64 * 1e3])
+        .collect();
+    let cpu_ms: Vec<[f64; 2]> = stats
+        .cpu_secs
+        .iter()
+        .enumerate()
+        .map(|(i, s)| [i as f64, *s as f64 * 1e3])
+        .collect();
+    Plot::new("frame_time_plot")
+        .height(110.0)
+        .allow_drag(false)
+        .allow_zoom(false)
+        .allow_scroll(false)
+        .allow_boxed_zoom(false)
+        .show_x(false)
+        .include_y(0.0)
+        .include_y(33.4)
+        .include_x(0.0)
+        .include_x(HISTORY_FRAMES as f64)
+        .y_axis_label("ms")
+        .legend(egui_plot::Legend::default())
+        .show(ui, |plot| {
+            plot.line(Line::new("frame", frame_ms).color(egui::Color32::from_rgb(255, 170, 60)));
+            plot.line(
+                Line::new("CPU wall time", cpu_ms).color(egui::Color32::from_rgb(110, 170, 255)),
+            );
+        });
+}
