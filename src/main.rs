@@ -7,6 +7,7 @@ use anyhow::{Context as _, bail};
 use clap::{Parser, Subcommand};
 
 use ignis::editor::EditOptions;
+use ignis::editor::ui_painter::UiPainterKind;
 use ignis::effect::Effect;
 use ignis::gpu::GpuContext;
 use ignis::headless::Headless;
@@ -38,6 +39,13 @@ enum Command {
         /// Shader folder (default: ./shaders if present, else the embedded copies).
         #[arg(long)]
         shader_dir: Option<PathBuf>,
+        /// egui painter: auto (lean on software adapters), egui-wgpu or lean.
+        #[arg(long, default_value = "auto")]
+        ui_painter: UiPainterKind,
+        /// Render the viewport at this fraction of its size, 0.1..=1 (default: 1, or 0.5
+        /// on software adapters).
+        #[arg(long)]
+        render_scale: Option<f32>,
     },
     /// Render PNG frames of an effect headless.
     Render {
@@ -104,12 +112,16 @@ fn main() {
             screenshot,
             size,
             shader_dir,
+            ui_painter,
+            render_scale,
         }) => edit(EditOptions {
             frames: frames.or(screenshot.as_ref().map(|_| 60)),
             preset,
             screenshot,
             shader_dir,
             window_size: size,
+            ui_painter,
+            render_scale,
         }),
         Some(Command::Render {
             preset,
@@ -141,6 +153,11 @@ fn main() {
 fn edit(options: EditOptions) -> anyhow::Result<()> {
     if options.frames == Some(0) {
         bail!("--frames must be at least 1");
+    }
+    if let Some(s) = options.render_scale
+        && !(s.is_finite() && (0.1..=1.0).contains(&s))
+    {
+        bail!("--render-scale must be between 0.1 and 1, got {s}");
     }
     if let Some(report) = ignis::editor::run(options)? {
         println!("{report}");

@@ -26,6 +26,7 @@ use super::remap::emitter_sources;
 use super::screenshot::{Screenshot, read_back};
 use super::state::EditorState;
 use super::stats::{EmitterStats, median};
+use super::ui_painter::{UiPainter, UiPainterKind};
 use super::viewport::{ViewportOutput, emitter_bounds, frame_bounds, viewport_ui};
 
 /// Read the GPU's alive counters every this many frames (a blocking readback).
@@ -33,6 +34,14 @@ const COUNTER_INTERVAL_FRAMES: u64 = 15;
 
 /// Frames left out of the reported median (start-up: pipeline creation, first present).
 const WARMUP_FRAMES: usize = 3;
+
+/// The viewport's background colour (gamma-encoded, as egui's colours are).
+const VIEWPORT_BACKGROUND: wgpu::Color = wgpu::Color {
+    r: 9.0 / 255.0,
+    g: 9.0 / 255.0,
+    b: 11.0 / 255.0,
+    a: 1.0,
+};
 
 /// Extra frames `--screenshot` waits for the window to hand out a frame.
 const MAX_EXTRA_FRAMES: u64 = 120;
@@ -50,6 +59,10 @@ pub struct EditOptions {
     pub shader_dir: Option<PathBuf>,
     /// Initial window size in logical pixels.
     pub window_size: (u32, u32),
+    /// Which egui painter to use.
+    pub ui_painter: UiPainterKind,
+    /// Viewport render scale (default: 1, or 0.5 on software adapters).
+    pub render_scale: Option<f32>,
 }
 
 /// What a run with `--frames` measured.
@@ -98,20 +111,15 @@ impl std::fmt::Display for RunReport {
 /// Opens the editor window and runs until it is closed (or `--frames` are done).
 pub fn run(options: EditOptions) -> anyhow::Result<Option<RunReport>> {
     let (effect, source) = match &options.preset {
-        Some(path) => (
-            crate::preset::load(path)?,
-            path.display().to_string(),
-        ),
+        Some(path) => (crate::preset::load(path)?, path.display().to_string()),
         None => (Effect::default_campfire(), "embedded default".to_owned()),
     };
     let event_loop = EventLoop::new().context(
         "cannot open a window (no display?): set DISPLAY/WAYLAND_DISPLAY, or run under xvfb-run",
     )?;
-    let instance = wgpu::Instance::new(
-        wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(
-            event_loop.owned_display_handle(),
-        )),
-    );
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(
+        Box::new(event_loop.owned_display_handle()),
+    ));
     let mut app = App {
         camera: OrbitCamera::from_hint(&effect.camera),
         state: EditorState::new(effect, source),
@@ -154,7 +162,7 @@ struct Gfx {
     gpu_effect: Effect,
     egui_ctx: egui::Context,
     egui_state: egui_winit::State,
-    egui_renderer: egui_wgpu::Renderer,
+    ui_painter: UiPainter,
     viewport_texture: Option<egui::TextureId>,
     registered_size: Option<(u32, u32)>,
     last_alpha: f32,
@@ -173,6 +181,15 @@ impl ApplicationHandler for App {
         match Gfx::new(event_loop, &self.instance, &self.options, &self.state) {
             Ok(gfx) => {
                 self.state.stats.adapter = gfx.ctx.info.name.clone();
+                self.state.stats.ui_painter = gfx.ui_painter.name();
+                // Software rasterisers pay for every pixel of every billboard: render the
+                // soft fire at half resolution there unless asked otherwise.
+                let default_scale = if gfx.ctx.is_cpu_adapter() { 0.5 } else { 1.0 };
+                self.state.view.render_scale = self
+                    .options
+                    .render_scale
+                    .unwrap_or(default_scale)
+                    .clamp(0.1, 1.0);
                 gfx.window.request_redraw();
                 self.gfx = Some(gfx);
             }
@@ -275,17 +292,19 @@ impl Gfx {
             window.theme(),
             Some(max_texture_side),
         );
-        let egui_renderer = egui_wgpu::Renderer::new(
+        let ui_painter = UiPainter::new(
             &ctx.device,
             format,
-            egui_wgpu::RendererOptions::default(),
+            options.ui_painter,
+            ctx.is_cpu_adapter(),
         );
         log::info!(
-            "editor: {}x{} surface {:?}, COPY_SRC {}",
+            "editor: {}x{} surface {:?}, COPY_SRC {}, UI painter {}",
             config.width,
             config.height,
             config.format,
-            surface_can_copy
+            surface_can_copy,
+            ui_painter.name()
         );
         Ok(Self {
             window,
@@ -299,7 +318,7 @@ impl Gfx {
             stepper: Stepper::default(),
             egui_ctx,
             egui_state,
-            egui_renderer,
+            ui_painter,
             viewport_texture: None,
             registered_size: None,
             last_alpha: 1.0,
@@ -454,21 +473,11 @@ impl Gfx {
             format: Some(LDR_GAMMA_VIEW_FORMAT),
             ..Default::default()
         });
-        match self.viewport_texture {
-            Some(id) => self.egui_renderer.update_egui_texture_from_wgpu_texture(
-                &self.ctx.device,
-                &view,
-                wgpu::FilterMode::Linear,
-                id,
-            ),
-            None => {
-                self.viewport_texture = Some(self.egui_renderer.register_native_texture(
-                    &self.ctx.device,
-                    &view,
-                    wgpu::FilterMode::Linear,
-                ));
-            }
-        }
+        self.viewport_texture = Some(self.ui_painter.set_native_texture(
+            &self.ctx.device,
+            &view,
+            self.viewport_texture,
+        ));
         self.registered_size = Some(size);
     }
 
@@ -488,7 +497,8 @@ impl Gfx {
                     depth_slice: None,
                     resolve_target: None,
                     ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        // The viewport's background: egui paints only the panel and overlays.
+                        load: wgpu::LoadOp::Clear(VIEWPORT_BACKGROUND),
                         store: wgpu::StoreOp::Store,
                     },
                 })],
@@ -498,7 +508,7 @@ impl Gfx {
                 multiview_mask: None,
             })
             .forget_lifetime();
-        self.egui_renderer.render(&mut pass, paint_jobs, screen);
+        self.ui_painter.render(&mut pass, paint_jobs, screen);
     }
 }
 
@@ -580,7 +590,7 @@ impl App {
         let paint_jobs = gfx.egui_ctx.tessellate(full_output.shapes, ppp);
         for (id, deltas) in &full_output.textures_delta.set {
             for delta in deltas {
-                gfx.egui_renderer
+                gfx.ui_painter
                     .update_texture(&gfx.ctx.device, &gfx.ctx.queue, *id, delta);
             }
         }
@@ -588,7 +598,7 @@ impl App {
             size_in_pixels: [gfx.config.width, gfx.config.height],
             pixels_per_point: ppp,
         };
-        let callbacks = gfx.egui_renderer.update_buffers(
+        let callbacks = gfx.ui_painter.prepare(
             &gfx.ctx.device,
             &gfx.ctx.queue,
             &mut encoder,
@@ -671,7 +681,7 @@ impl App {
             gfx.ctx.queue.present(frame);
         }
         for id in &full_output.textures_delta.free {
-            gfx.egui_renderer.free_texture(id);
+            gfx.ui_painter.free_texture(id);
         }
 
         if !is_last {

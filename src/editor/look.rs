@@ -173,7 +173,10 @@ fn gradient_preview_ui(ui: &mut Ui, stops: &[ColorStop]) {
     for s in stops {
         let x = rect.left() + s.t.clamp(0.0, 1.0) * rect.width();
         painter.line_segment(
-            [egui::pos2(x, rect.bottom() - 5.0), egui::pos2(x, rect.bottom())],
+            [
+                egui::pos2(x, rect.bottom() - 5.0),
+                egui::pos2(x, rect.bottom()),
+            ],
             egui::Stroke::new(1.5, Color32::WHITE),
         );
     }
@@ -247,7 +250,10 @@ pub fn add_stop(stops: &mut Vec<ColorStop>) {
         .windows(2)
         .enumerate()
         .map(|(i, w)| (i, w[1] - w[0]))
-        .fold((0, -1.0), |best, cur| if cur.1 > best.1 { cur } else { best });
+        .fold(
+            (0, -1.0),
+            |best, cur| if cur.1 > best.1 { cur } else { best },
+        );
     let t = 0.5 * (edges[gap] + edges[gap + 1]);
     let rgba = sample_gradient(stops, t);
     // `gap` is the index of the first stop after the insertion point.
@@ -266,7 +272,11 @@ pub fn sample_gradient(stops: &[ColorStop], t: f32) -> [f32; 4] {
     for pair in stops.windows(2) {
         let (a, b) = (pair[0], pair[1]);
         if t <= b.t {
-            let f = if b.t > a.t { (t - a.t) / (b.t - a.t) } else { 1.0 };
+            let f = if b.t > a.t {
+                (t - a.t) / (b.t - a.t)
+            } else {
+                1.0
+            };
             let mut out = [0.0; 4];
             for (k, o) in out.iter_mut().enumerate() {
                 *o = a.rgba[k] + (b.rgba[k] - a.rgba[k]) * f;

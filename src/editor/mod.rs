@@ -11,6 +11,7 @@ pub mod remap;
 pub mod screenshot;
 pub mod state;
 pub mod stats;
+pub mod ui_painter;
 pub mod undo;
 pub mod viewport;
 

@@ -83,7 +83,11 @@ fn section_ui(
 /// Title, undo/redo and the validation message.
 pub fn header_ui(ui: &mut Ui, state: &mut EditorState) {
     ui.horizontal(|ui| {
-        ui.heading(RichText::new("ignis").strong().color(Color32::from_rgb(255, 150, 60)));
+        ui.heading(
+            RichText::new("ignis")
+                .strong()
+                .color(Color32::from_rgb(255, 150, 60)),
+        );
         ui.label(RichText::new(&state.effect.name).strong());
         ui.weak(&state.source);
     });
@@ -108,9 +112,7 @@ pub fn header_ui(ui: &mut Ui, state: &mut EditorState) {
     });
     if !state.validation_errors.is_empty() {
         error_box_ui(ui, |ui| {
-            ui.label(
-                RichText::new("Not applied: the last valid effect keeps running.").strong(),
-            );
+            ui.label(RichText::new("Not applied: the last valid effect keeps running.").strong());
             for e in state.validation_errors.iter().take(6) {
                 ui.label(e.to_string());
             }
@@ -121,7 +123,9 @@ pub fn header_ui(ui: &mut Ui, state: &mut EditorState) {
     }
     if let Some((_, reason)) = &state.gpu_rejected {
         error_box_ui(ui, |ui| {
-            ui.label(RichText::new("The GPU refused this effect; the last one keeps running.").strong());
+            ui.label(
+                RichText::new("The GPU refused this effect; the last one keeps running.").strong(),
+            );
             ui.label(reason);
         });
     }
@@ -370,7 +374,11 @@ fn emitter_list_ui(ui: &mut Ui, effect: &mut Effect, selected: &mut usize) {
                 *selected = i;
             }
             ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
-                ui.weak(format!("{} · {}", sprite_label(e.look.sprite), e.shape.label()));
+                ui.weak(format!(
+                    "{} · {}",
+                    sprite_label(e.look.sprite),
+                    e.shape.label()
+                ));
             });
         });
     }
@@ -445,7 +453,9 @@ fn emitter_list_ui(ui: &mut Ui, effect: &mut Effect, selected: &mut usize) {
 
 /// Shape picker and the selected shape's dimensions (grid rows).
 fn shape_ui(ui: &mut Ui, shape: &mut Shape) {
-    let label = ui.label("Shape").on_hover_text("Where particles are born, in emitter space");
+    let label = ui
+        .label("Shape")
+        .on_hover_text("Where particles are born, in emitter space");
     egui::ComboBox::from_id_salt("shape_kind")
         .selected_text(shape.label())
         .width(120.0)
@@ -469,9 +479,12 @@ fn shape_ui(ui: &mut Ui, shape: &mut Shape) {
             row(ui, "Radius", "Sphere radius, metres", |ui| {
                 ui.add(drag(radius_m, 0.0..=100.0, 0.005, " m"))
             });
-            row(ui, "Surface only", "Spawn on the surface instead of the volume", |ui| {
-                ui.checkbox(surface_only, "")
-            });
+            row(
+                ui,
+                "Surface only",
+                "Spawn on the surface instead of the volume",
+                |ui| ui.checkbox(surface_only, ""),
+            );
         }
         Shape::Disc { radius_m, normal } => {
             row(ui, "Radius", "Disc radius, metres", |ui| {
@@ -502,16 +515,35 @@ fn shape_ui(ui: &mut Ui, shape: &mut Shape) {
             angle_deg,
             radius_m,
         } => {
-            row(ui, "Cone angle", "Half-angle of the directions, degrees (replaces Spread)", |ui| {
-                ui.add(drag(angle_deg, 0.0..=180.0, 0.2, "°"))
-            });
+            row(
+                ui,
+                "Cone angle",
+                "Half-angle of the directions, degrees (replaces Spread)",
+                |ui| ui.add(drag(angle_deg, 0.0..=180.0, 0.2, "°")),
+            );
             row(ui, "Base radius", "Radius of the base disc, metres", |ui| {
                 ui.add(drag(radius_m, 0.0..=100.0, 0.005, " m"))
             });
         }
         Shape::Line { a_m, b_m } => {
-            vec3_ui(ui, "Start", "First endpoint, metres", a_m, -100.0..=100.0, 0.01, " m");
-            vec3_ui(ui, "End", "Second endpoint, metres", b_m, -100.0..=100.0, 0.01, " m");
+            vec3_ui(
+                ui,
+                "Start",
+                "First endpoint, metres",
+                a_m,
+                -100.0..=100.0,
+                0.01,
+                " m",
+            );
+            vec3_ui(
+                ui,
+                "End",
+                "Second endpoint, metres",
+                b_m,
+                -100.0..=100.0,
+                0.01,
+                " m",
+            );
         }
     }
 }
@@ -562,7 +594,11 @@ fn bursts_ui(ui: &mut Ui, bursts: &mut Vec<Burst>) {
                     .speed(1.0)
                     .suffix(" particles"),
             );
-            if ui.small_button("✖").on_hover_text("Remove this burst").clicked() {
+            if ui
+                .small_button("✖")
+                .on_hover_text("Remove this burst")
+                .clicked()
+            {
                 remove = Some(k);
             }
         });

@@ -95,8 +95,7 @@ impl EditorState {
     /// and promotes it to `running` when valid. Returns true when `running` changed.
     pub fn end_frame(&mut self, ctx: &egui::Context) -> bool {
         self.handle_shortcuts(ctx);
-        let is_interacting =
-            ctx.input(|i| i.pointer.any_down()) || ctx.text_edit_focused();
+        let is_interacting = ctx.input(|i| i.pointer.any_down()) || ctx.text_edit_focused();
         self.history.observe(&self.effect, is_interacting);
         self.apply()
     }
@@ -151,7 +150,9 @@ impl EditorState {
     }
 
     fn clamp_selection(&mut self) {
-        self.selected = self.selected.min(self.effect.emitters.len().saturating_sub(1));
+        self.selected = self
+            .selected
+            .min(self.effect.emitters.len().saturating_sub(1));
     }
 
     fn handle_shortcuts(&mut self, ctx: &egui::Context) {

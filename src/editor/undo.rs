@@ -58,7 +58,8 @@ impl UndoHistory {
         let Some(previous) = self.undo.pop() else {
             return false;
         };
-        self.redo.push(std::mem::replace(&mut self.baseline, previous));
+        self.redo
+            .push(std::mem::replace(&mut self.baseline, previous));
         current.clone_from(&self.baseline);
         true
     }

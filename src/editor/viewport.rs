@@ -31,7 +31,8 @@ pub fn viewport_ui(
     camera_input(ui, &response, rect, camera, state);
 
     let painter = ui.painter_at(rect);
-    painter.rect_filled(rect, 0.0, Color32::from_rgb(9, 9, 11));
+    // The background is the frame's clear colour: painting it here would shade every
+    // viewport pixel once more in egui's pass.
     let aspect = rect.width() / rect.height().max(1.0);
     let projector = Projector::new(camera.clip_from_world(aspect), rect);
     if state.view.show_grid {
@@ -292,8 +293,8 @@ fn draw_gizmo(
     }
     if is_selected {
         let origin = world_from_emitter.transform_point3(Vec3::ZERO);
-        let dir = world_from_emitter
-            .transform_vector3(Vec3::from(e.direction).normalize_or(Vec3::Y));
+        let dir =
+            world_from_emitter.transform_vector3(Vec3::from(e.direction).normalize_or(Vec3::Y));
         let tip = origin + dir * 0.3;
         projector.polyline(painter, &[origin, tip], stroke);
         if let Some([_, t]) = projector.segment(origin, tip) {
@@ -387,13 +388,18 @@ mod tests {
         assert!((s[0].x - 100.0).abs() < 1e-3 && (s[0].y - 50.0).abs() < 1e-3);
         let eye = camera.eye();
         let behind = eye + (eye - camera.target);
-        assert!(p.segment(behind, eye + (eye - camera.target) * 2.0).is_none());
+        assert!(
+            p.segment(behind, eye + (eye - camera.target) * 2.0)
+                .is_none()
+        );
         assert!(p.segment(behind, camera.target).is_some());
     }
 
     #[test]
     fn framing_ignores_outliers() {
-        let mut pts: Vec<Vec3> = (0..100).map(|i| Vec3::new(0.0, i as f32 * 0.01, 0.0)).collect();
+        let mut pts: Vec<Vec3> = (0..100)
+            .map(|i| Vec3::new(0.0, i as f32 * 0.01, 0.0))
+            .collect();
         pts.push(Vec3::new(0.0, 1000.0, 0.0));
         let (c, r) = frame_bounds(&pts).expect("points");
         assert!(c.y < 1.0 && r < 1.0, "{c} {r}");

@@ -413,8 +413,10 @@ impl GpuSim {
     /// dropped. Call it before the next [`GpuSim::step`] with the edited effect, which then
     /// sizes the new pools.
     pub fn remap_emitters(&mut self, sources: &[Option<usize>]) {
-        let mut old_pools: Vec<Option<EmitterState>> =
-            std::mem::take(&mut self.emitters).into_iter().map(Some).collect();
+        let mut old_pools: Vec<Option<EmitterState>> = std::mem::take(&mut self.emitters)
+            .into_iter()
+            .map(Some)
+            .collect();
         let mut old_planners: Vec<Option<crate::sim::EmitterPlanner>> =
             std::mem::take(&mut self.planner.emitters)
                 .into_iter()
