@@ -49,13 +49,12 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
                 .response
                 .labelled_by(label.id);
             ui.end_row();
-            let label = ui.label("Blend").on_hover_text(
-                "Additive: light adds up, order-independent (fire, sparks). Alpha: premultiplied over, darkens what is behind (smoke); alpha layers are drawn first",
-            );
+            let label_tip = "Additive: light adds up, order-independent (fire, sparks). Alpha: premultiplied over, darkens what is behind (smoke); alpha layers are drawn first";
+            ui.label("Blend").on_hover_text(label_tip);
             ui.horizontal(|ui| {
                 for b in [BlendMode::Additive, BlendMode::Alpha] {
                     ui.radio_value(&mut look.blend, b, blend_label(b))
-                        .labelled_by(label.id);
+                        .on_hover_text(label_tip);
                 }
             });
             ui.end_row();
@@ -207,7 +206,7 @@ pub fn color_stops_ui(ui: &mut Ui, stops: &mut Vec<ColorStop>) {
                 .on_hover_text("Colour (linear RGB) and alpha");
             ui.weak(format!("α {:.2}", stop.rgba[3]));
             if ui
-                .add_enabled(n > 1, egui::Button::new("✖").small())
+                .add_enabled(n > 1, egui::Button::new("x").small())
                 .on_hover_text("Remove this stop")
                 .clicked()
             {

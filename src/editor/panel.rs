@@ -388,8 +388,10 @@ fn emitter_list_ui(ui: &mut Ui, effect: &mut Effect, selected: &mut usize) {
             .on_hover_text("Add a default emitter after the selected one")
             .clicked()
         {
-            let mut e = Emitter::default();
-            e.name = unique_name(effect, "emitter");
+            let e = Emitter {
+                name: unique_name(effect, "emitter"),
+                ..Emitter::default()
+            };
             let at = (*selected + 1).min(n);
             effect.emitters.insert(at, e);
             *selected = at;
@@ -595,7 +597,7 @@ fn bursts_ui(ui: &mut Ui, bursts: &mut Vec<Burst>) {
                     .suffix(" particles"),
             );
             if ui
-                .small_button("✖")
+                .small_button("x")
                 .on_hover_text("Remove this burst")
                 .clicked()
             {
@@ -759,14 +761,12 @@ pub fn time_ui(ui: &mut Ui, effect: &mut Effect, playback: &mut Playback, select
     });
     let t = &mut effect.time;
     grid("time_grid").show(ui, |ui| {
-        let label = ui.label("Mode").on_hover_text(
+        ui.label("Mode").on_hover_text(
             "Fixed step: an accumulator runs whole steps, so the result does not depend on the frame rate. Frame delta: one step per frame of the frame's duration (the 2006 thesis's mode)",
         );
         ui.horizontal(|ui| {
-            ui.radio_value(&mut t.mode, TimeMode::FixedStep, "Fixed step")
-                .labelled_by(label.id);
-            ui.radio_value(&mut t.mode, TimeMode::FrameDelta, "Frame delta")
-                .labelled_by(label.id);
+            ui.radio_value(&mut t.mode, TimeMode::FixedStep, "Fixed step");
+            ui.radio_value(&mut t.mode, TimeMode::FrameDelta, "Frame delta");
         });
         ui.end_row();
         let is_fixed = t.mode == TimeMode::FixedStep;
@@ -803,7 +803,7 @@ pub fn time_ui(ui: &mut Ui, effect: &mut Effect, playback: &mut Playback, select
         );
         row(
             ui,
-            "Speed",
+            "Sim speed",
             "Simulation speed multiplier (1 = real time)",
             |ui| ui.add(drag(&mut t.speed, 0.0..=10.0, 0.01, "×").min_decimals(2)),
         );

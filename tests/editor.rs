@@ -1,0 +1,477 @@
+//! The editor's UI logic, driven through egui_kittest (no window, no GPU for the UI), and
+//! the path from a widget to the GPU simulation (headless `GpuSim`).
+
+use egui::{Key, Modifiers, Role};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable as _;
+
+use ignis::editor::EditorState;
+use ignis::editor::panel::panel_ui;
+use ignis::editor::remap::emitter_sources;
+use ignis::effect::Effect;
+use ignis::gpu::GpuContext;
+use ignis::gpu::types::Particle;
+use ignis::shaders::ShaderLibrary;
+use ignis::sim::GpuSim;
+
+/// The side panel over an editor state, as the window runs it (UI, then end of frame).
+fn panel_harness(state: EditorState) -> Harness<'static, EditorState> {
+    Harness::builder()
+        .with_size(egui::vec2(440.0, 1800.0))
+        .build_ui_state(
+            |ui, state: &mut EditorState| {
+                panel_ui(ui, state);
+                state.end_frame(ui.ctx());
+            },
+            state,
+        )
+}
+
+fn campfire_state() -> EditorState {
+    EditorState::new(Effect::default_campfire(), "test")
+}
+
+/// Index of the emitter called `name` in the default campfire.
+fn emitter_index(effect: &Effect, name: &str) -> usize {
+    effect
+        .emitters
+        .iter()
+        .position(|e| e.name == name)
+        .unwrap_or_else(|| panic!("no emitter {name}"))
+}
+
+fn open_section(harness: &mut Harness<'_, EditorState>, title: &str) {
+    harness.get_by_label_contains(title).click_accesskit();
+    harness.run();
+}
+
+#[test]
+fn a_widget_edits_the_effect_and_the_running_copy() {
+    let mut harness = panel_harness(campfire_state());
+    assert_eq!(harness.state().selected, 0);
+    let before = harness.state().effect.emitters[0].spawn_rate_per_sec;
+    assert_eq!(before, 90.0);
+
+    harness
+        .get_by_label("Spawn rate")
+        .set_value_accesskit(500.0);
+    harness.run();
+
+    let state = harness.state();
+    assert_eq!(state.effect.emitters[0].spawn_rate_per_sec, 500.0);
+    assert_eq!(state.running.emitters[0].spawn_rate_per_sec, 500.0);
+    assert!(state.validation_errors.is_empty());
+    assert_eq!(state.history.undo_len(), 1);
+}
+
+#[test]
+fn undo_and_redo_restore_the_effect_with_the_keyboard() {
+    let mut harness = panel_harness(campfire_state());
+    let original = harness.state().effect.clone();
+    harness
+        .get_by_label("Spawn rate")
+        .set_value_accesskit(500.0);
+    harness.run();
+    harness.get_by_label("Capacity").set_value_accesskit(4096.0);
+    harness.run();
+    assert_eq!(harness.state().history.undo_len(), 2);
+
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    harness.run();
+    assert_eq!(harness.state().effect.emitters[0].capacity, 2048);
+    assert_eq!(harness.state().effect.emitters[0].spawn_rate_per_sec, 500.0);
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    harness.run();
+    assert_eq!(harness.state().effect, original);
+    assert_eq!(
+        harness.state().running,
+        original,
+        "undo reaches the simulation"
+    );
+
+    harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+    harness.run();
+    assert_eq!(harness.state().effect.emitters[0].spawn_rate_per_sec, 500.0);
+    assert_eq!(harness.state().effect.emitters[0].capacity, 2048);
+    assert_eq!(harness.state().history.redo_len(), 1);
+}
+
+#[test]
+fn one_drag_is_one_undo_step() {
+    let mut harness = panel_harness(campfire_state());
+    let original = harness.state().effect.clone();
+    let rect = harness.get_by_label("Spawn rate").rect();
+    let start = rect.center();
+    harness.hover_at(start);
+    harness.run();
+    harness.drag_at(start);
+    harness.run();
+    for k in 1..=10 {
+        harness.hover_at(start + egui::vec2(8.0 * k as f32, 0.0));
+        harness.run();
+        // Nothing is recorded while the button is down.
+        assert_eq!(harness.state().history.undo_len(), 0);
+    }
+    harness.drop_at(start + egui::vec2(80.0, 0.0));
+    harness.run();
+    let rate = harness.state().effect.emitters[0].spawn_rate_per_sec;
+    assert!(rate > 90.0, "the drag changed the rate ({rate})");
+    assert_eq!(harness.state().history.undo_len(), 1, "one drag, one step");
+    assert!(harness.state_mut().undo());
+    harness.run();
+    assert_eq!(harness.state().effect, original);
+}
+
+#[test]
+fn an_invalid_effect_is_shown_and_the_last_valid_one_keeps_running() {
+    let mut harness = panel_harness(campfire_state());
+    // Each component is in range on its own; together they make a zero direction.
+    for node in harness.get_all_by_label("Direction") {
+        node.set_value_accesskit(0.0);
+    }
+    harness.run();
+    let state = harness.state();
+    assert_eq!(state.effect.emitters[0].direction, [0.0, 0.0, 0.0]);
+    assert!(
+        state
+            .validation_errors
+            .iter()
+            .any(|e| e.path == "emitters[0].direction"),
+        "{:?}",
+        state.validation_errors
+    );
+    assert_eq!(state.running.emitters[0].direction, [0.0, 1.0, 0.0]);
+    harness
+        .get_by_label_contains("the last valid effect keeps running")
+        .hover();
+
+    // Fixing it applies it again.
+    harness
+        .get_all_by_label("Direction")
+        .next()
+        .expect("x")
+        .set_value_accesskit(1.0);
+    harness.run();
+    assert!(harness.state().validation_errors.is_empty());
+    assert_eq!(
+        harness.state().running.emitters[0].direction,
+        [1.0, 0.0, 0.0]
+    );
+}
+
+#[test]
+fn widgets_clamp_out_of_range_values() {
+    let mut harness = panel_harness(campfire_state());
+    harness.get_by_label("Spread").set_value_accesskit(1.0e9);
+    harness.run();
+    harness.get_by_label("Spawn rate").set_value_accesskit(-5.0);
+    harness.run();
+    harness.get_by_label("Spread").set_value_accesskit(f64::NAN);
+    harness.run();
+    let state = harness.state();
+    let e = &state.effect.emitters[0];
+    assert_eq!(e.spawn_rate_per_sec, 0.0);
+    assert!(e.spread_deg.is_finite() && (0.0..=180.0).contains(&e.spread_deg));
+    assert!(state.effect.validate().is_ok());
+}
+
+#[test]
+fn new_seed_and_noise_are_bound_to_the_effect() {
+    let mut harness = panel_harness(campfire_state());
+    open_section(&mut harness, "Randomness");
+    let seed = harness.state().effect.seed;
+    harness.get_by_label("New seed").click_accesskit();
+    harness.run();
+    assert_ne!(harness.state().effect.seed, seed);
+    assert_eq!(harness.state().running.seed, harness.state().effect.seed);
+    harness
+        .get_by_label("Scroll speed")
+        .set_value_accesskit(4.0);
+    harness.run();
+    assert_eq!(
+        harness.state().effect.emitters[0]
+            .spawn_noise
+            .scroll_per_sec,
+        4.0
+    );
+}
+
+#[test]
+fn emitters_can_be_added_duplicated_reordered_and_removed() {
+    let mut harness = panel_harness(campfire_state());
+    harness.get_by_label("Duplicate").click_accesskit();
+    harness.run();
+    let names: Vec<String> = harness
+        .state()
+        .effect
+        .emitters
+        .iter()
+        .map(|e| e.name.clone())
+        .collect();
+    assert_eq!(names, ["smoke", "smoke copy", "flames", "embers"]);
+    assert_eq!(harness.state().selected, 1);
+    assert!(harness.state().validation_errors.is_empty());
+
+    harness.get_by_label("Down").click_accesskit();
+    harness.run();
+    assert_eq!(harness.state().effect.emitters[2].name, "smoke copy");
+    assert_eq!(harness.state().selected, 2);
+
+    harness.get_by_label("Solo").click_accesskit();
+    harness.run();
+    let enabled: Vec<bool> = harness
+        .state()
+        .effect
+        .emitters
+        .iter()
+        .map(|e| e.enabled)
+        .collect();
+    assert_eq!(enabled, [false, false, true, false]);
+
+    harness.get_by_label("Remove").click_accesskit();
+    harness.run();
+    assert_eq!(harness.state().effect.emitters.len(), 3);
+    harness.get_by_label("All on").click_accesskit();
+    harness.run();
+    assert!(harness.state().effect.emitters.iter().all(|e| e.enabled));
+    assert!(harness.state().effect.validate().is_ok());
+}
+
+#[test]
+fn colour_stops_can_be_added_and_removed_and_stay_sorted() {
+    let mut harness = panel_harness(campfire_state());
+    open_section(&mut harness, "Look");
+    let count = harness.state().effect.emitters[0]
+        .look
+        .color_over_life
+        .len();
+    harness.get_by_label("Add stop").click_accesskit();
+    harness.run();
+    let stops = &harness.state().effect.emitters[0].look.color_over_life;
+    assert_eq!(stops.len(), count + 1);
+    assert!(stops.windows(2).all(|w| w[0].t <= w[1].t));
+    // A stop's t cannot pass its neighbour.
+    harness
+        .get_all_by_label("Stop 1")
+        .next()
+        .expect("t")
+        .set_value_accesskit(0.99);
+    harness.run();
+    let stops = &harness.state().effect.emitters[0].look.color_over_life;
+    assert!(stops[0].t <= stops[1].t);
+    assert!(harness.state().validation_errors.is_empty());
+    // The slider comes first, then its number field.
+    harness
+        .get_all_by_label("Exposure")
+        .next()
+        .expect("slider")
+        .set_value_accesskit(2.0);
+    harness.run();
+    assert_eq!(harness.state().view.exposure, 2.0);
+}
+
+#[test]
+fn time_settings_and_the_drag_stability_hint() {
+    let mut harness = panel_harness(campfire_state());
+    harness.get_by_label("Frame delta").click_accesskit();
+    harness.run();
+    assert_eq!(
+        harness.state().effect.time.mode,
+        ignis::effect::TimeMode::FrameDelta
+    );
+    harness.get_by_label("Sim speed").set_value_accesskit(0.5);
+    harness.run();
+    assert_eq!(harness.state().running.time.speed, 0.5);
+    assert!(harness.query_by_label_contains("unstable").is_none());
+
+    // k·dt = 300 /s × 0.1 s = 30, far past explicit Euler's limit of 2.
+    open_section(&mut harness, "Forces");
+    harness.get_by_label("Drag").set_value_accesskit(300.0);
+    harness.run();
+    assert!(harness.query_by_label_contains("unstable").is_some());
+    harness.get_by_label("Pause").click_accesskit();
+    harness.run();
+    assert!(harness.state().playback.is_paused);
+}
+
+#[test]
+fn playback_keys_work_only_when_no_text_field_has_focus() {
+    let mut harness = panel_harness(campfire_state());
+    harness.key_press(Key::Space);
+    harness.key_press(Key::Period);
+    harness.key_press(Key::R);
+    harness.key_press(Key::F);
+    harness.run();
+    let p = harness.state().playback.clone();
+    assert!(p.is_paused && p.step_requested && p.restart_requested);
+    assert!(harness.state().frame_requested);
+
+    let mut harness = panel_harness(campfire_state());
+    harness.get_by_label("Name").focus();
+    harness.run();
+    harness.key_press(Key::Space);
+    harness.run();
+    assert!(!harness.state().playback.is_paused);
+}
+
+// ---------------------------------------------------------------------------------------
+// From a widget to the GPU.
+
+struct Twin {
+    edited: GpuSim,
+    reference: GpuSim,
+}
+
+const DT_SECS: f32 = 1.0 / 120.0;
+
+fn twin_sims(ctx: &GpuContext, effect: &Effect, steps: u32) -> Twin {
+    let make = || {
+        let mut sim = GpuSim::new(ctx, ShaderLibrary::discover(None), effect).expect("sim");
+        sim.step(effect, DT_SECS, steps).expect("step");
+        sim
+    };
+    Twin {
+        edited: make(),
+        reference: make(),
+    }
+}
+
+fn alive(particles: &[Particle]) -> usize {
+    particles.iter().filter(|p| p.is_alive()).count()
+}
+
+#[test]
+fn a_panel_edit_reaches_the_gpu_on_the_next_step_without_a_reset() {
+    let ctx = GpuContext::headless().expect("a GPU adapter (lavapipe is fine)");
+    let state = campfire_state();
+    let flames = emitter_index(&state.effect, "flames");
+    let mut twin = twin_sims(&ctx, &state.running, 90);
+    let before = twin.edited.read_particles(flames).expect("read");
+    assert!(alive(&before) > 500);
+
+    // Select the flames and set their buoyancy to 0 through the panel.
+    let mut harness = panel_harness(state);
+    harness
+        .get_by_role_and_label(Role::Button, "flames")
+        .click_accesskit();
+    harness.run();
+    open_section(&mut harness, "Forces");
+    harness.get_by_label("Buoyancy").set_value_accesskit(0.0);
+    harness.run();
+    let state = harness.into_state();
+    assert_eq!(state.running.emitters[flames].forces.buoyancy_m_per_s2, 0.0);
+    let reference_effect = Effect::default_campfire();
+    assert_eq!(
+        reference_effect.emitters[flames].forces.buoyancy_m_per_s2,
+        11.6
+    );
+
+    // The very next step uses it: particles alive before and after differ in vertical
+    // velocity by exactly buoyancy × dt (same state, same drag, same step).
+    twin.edited.step(&state.running, DT_SECS, 1).expect("step");
+    twin.reference
+        .step(&reference_effect, DT_SECS, 1)
+        .expect("step");
+    let edited = twin.edited.read_particles(flames).expect("read");
+    let reference = twin.reference.read_particles(flames).expect("read");
+    let mut dv = Vec::new();
+    for ((b, e), r) in before.iter().zip(&edited).zip(&reference) {
+        if b.is_alive() && e.is_alive() && r.is_alive() && e.pos_age[3] > b.pos_age[3] {
+            dv.push(r.velocity().y - e.velocity().y);
+        }
+    }
+    assert!(dv.len() > 500, "{} particles compared", dv.len());
+    let expected = 11.6 * DT_SECS;
+    for d in &dv {
+        assert!((d - expected).abs() < 1e-3, "Δv_y {d}, expected {expected}");
+    }
+    // No reset: the particles that were alive are still there.
+    assert!(alive(&edited) as f32 > 0.9 * alive(&before) as f32);
+
+    // And the flame stops rising: lower mean height after half a second.
+    twin.edited.step(&state.running, DT_SECS, 60).expect("step");
+    twin.reference
+        .step(&reference_effect, DT_SECS, 60)
+        .expect("step");
+    let mean_y = |ps: &[Particle]| {
+        let alive: Vec<f32> = ps
+            .iter()
+            .filter(|p| p.is_alive())
+            .map(|p| p.position().y)
+            .collect();
+        alive.iter().sum::<f32>() / alive.len().max(1) as f32
+    };
+    let (y_edited, y_reference) = (
+        mean_y(&twin.edited.read_particles(flames).expect("read")),
+        mean_y(&twin.reference.read_particles(flames).expect("read")),
+    );
+    assert!(
+        y_edited + 0.1 < y_reference,
+        "mean height {y_edited} m without buoyancy vs {y_reference} m with"
+    );
+}
+
+#[test]
+fn a_smaller_capacity_keeps_the_particles_that_fit() {
+    let ctx = GpuContext::headless().expect("a GPU adapter (lavapipe is fine)");
+    let state = campfire_state();
+    let flames = emitter_index(&state.effect, "flames");
+    let mut sim = GpuSim::new(&ctx, ShaderLibrary::discover(None), &state.running).expect("sim");
+    sim.step(&state.running, DT_SECS, 90).expect("step");
+    let before = sim.read_particles(flames).expect("read");
+
+    let mut harness = panel_harness(state);
+    harness
+        .get_by_role_and_label(Role::Button, "flames")
+        .click_accesskit();
+    harness.run();
+    harness.get_by_label("Capacity").set_value_accesskit(1024.0);
+    harness.run();
+    let state = harness.into_state();
+    assert_eq!(state.running.emitters[flames].capacity, 1024);
+    sim.sync(&state.running).expect("sync");
+    let after = sim.read_particles(flames).expect("read");
+    assert_eq!(after.len(), 1024);
+    assert_eq!(&after[..], &before[..1024]);
+}
+
+#[test]
+fn reordering_emitters_moves_their_particles_along() {
+    let ctx = GpuContext::headless().expect("a GPU adapter (lavapipe is fine)");
+    let state = campfire_state();
+    let gpu_effect = state.running.clone();
+    let mut sim = GpuSim::new(&ctx, ShaderLibrary::discover(None), &gpu_effect).expect("sim");
+    sim.step(&gpu_effect, DT_SECS, 60).expect("step");
+    let smoke = sim.read_particles(0).expect("read");
+    let flames = sim.read_particles(1).expect("read");
+    let spawned_smoke = sim.planner.emitters[0].stats.spawned;
+
+    // Move the smoke down one place, then duplicate the flames.
+    let mut harness = panel_harness(state);
+    harness.get_by_label("Down").click_accesskit();
+    harness.run();
+    harness.get_by_label("Duplicate").click_accesskit();
+    harness.run();
+    let state = harness.into_state();
+    let names: Vec<&str> = state
+        .running
+        .emitters
+        .iter()
+        .map(|e| e.name.as_str())
+        .collect();
+    assert_eq!(names, ["flames", "smoke", "smoke copy", "embers"]);
+
+    let sources = emitter_sources(&gpu_effect, &state.running).expect("a structural edit");
+    assert_eq!(sources, [Some(1), Some(0), None, Some(2)]);
+    sim.remap_emitters(&sources);
+    sim.sync(&state.running).expect("sync");
+    assert_eq!(sim.read_particles(0).expect("read"), flames);
+    assert_eq!(sim.read_particles(1).expect("read"), smoke);
+    assert_eq!(alive(&sim.read_particles(2).expect("read")), 0);
+    assert_eq!(sim.planner.emitters[1].stats.spawned, spawned_smoke);
+    sim.step(&state.running, DT_SECS, 30).expect("step");
+    assert!(
+        alive(&sim.read_particles(2).expect("read")) > 0,
+        "the copy spawns"
+    );
+}
