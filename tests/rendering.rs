@@ -11,7 +11,11 @@ use ignis::shaders::ShaderLibrary;
 
 const SIZE: (u32, u32) = (320, 240);
 
-fn campfire_after(ctx: &ignis::gpu::GpuContext, secs: f64, seed: u32) -> (Headless, image::RgbaImage) {
+fn campfire_after(
+    ctx: &ignis::gpu::GpuContext,
+    secs: f64,
+    seed: u32,
+) -> (Headless, image::RgbaImage) {
     let mut effect = Effect::default_campfire();
     effect.seed = seed;
     let mut run = Headless::new(ctx, effect, ShaderLibrary::embedded()).expect("headless");
@@ -26,7 +30,10 @@ fn campfire_after(ctx: &ignis::gpu::GpuContext, secs: f64, seed: u32) -> (Headle
 fn project(run: &Headless, p: Vec3) -> (f32, f32) {
     let clip = run.camera.clip_from_world(SIZE.0 as f32 / SIZE.1 as f32) * p.extend(1.0);
     let ndc = clip.truncate() / clip.w;
-    ((ndc.x * 0.5 + 0.5) * SIZE.0 as f32, (0.5 - ndc.y * 0.5) * SIZE.1 as f32)
+    (
+        (ndc.x * 0.5 + 0.5) * SIZE.0 as f32,
+        (0.5 - ndc.y * 0.5) * SIZE.1 as f32,
+    )
 }
 
 fn mean_rgb(img: &image::RgbaImage, x0: u32, y0: u32, x1: u32, y1: u32) -> [f32; 3] {
@@ -54,16 +61,34 @@ fn default_frame_is_warm_above_the_emitter_and_black_far_away() {
     let (ex, ey) = (ex as u32, ey as u32);
     let warm = mean_rgb(&img, ex - 12, ey - 12, ex + 12, ey + 12);
     assert!(warm[0] > 150.0, "flame not bright: {warm:?}");
-    assert!(warm[0] > warm[1] && warm[1] > warm[2], "flame not warm: {warm:?}");
-    for (x0, y0) in [(0, 0), (SIZE.0 - 24, 0), (0, SIZE.1 - 24), (SIZE.0 - 24, SIZE.1 - 24)] {
+    assert!(
+        warm[0] > warm[1] && warm[1] > warm[2],
+        "flame not warm: {warm:?}"
+    );
+    for (x0, y0) in [
+        (0, 0),
+        (SIZE.0 - 24, 0),
+        (0, SIZE.1 - 24),
+        (SIZE.0 - 24, SIZE.1 - 24),
+    ] {
         let c = mean_rgb(&img, x0, y0, x0 + 24, y0 + 24);
-        assert!(c.iter().all(|&v| v < 3.0), "corner ({x0},{y0}) not black: {c:?}");
+        assert!(
+            c.iter().all(|&v| v < 3.0),
+            "corner ({x0},{y0}) not black: {c:?}"
+        );
     }
     // Below the emitter (the ground) stays black.
     let (bx, by) = project(&run, Vec3::new(0.0, -0.6, 0.0));
-    let below = mean_rgb(&img, bx as u32 - 10, by as u32 - 10, bx as u32 + 10, (by as u32 + 10).min(SIZE.1));
+    let below = mean_rgb(
+        &img,
+        bx as u32 - 10,
+        by as u32 - 10,
+        bx as u32 + 10,
+        (by as u32 + 10).min(SIZE.1),
+    );
     assert!(below.iter().all(|&v| v < 10.0), "below the fire: {below:?}");
-    img.save(std::env::temp_dir().join("ignis_test_campfire.png")).expect("save");
+    img.save(std::env::temp_dir().join("ignis_test_campfire.png"))
+        .expect("save");
 }
 
 /// Nothing alive ⇒ a fully black frame (dead slots produce no fragments — unlike the
@@ -72,9 +97,13 @@ fn default_frame_is_warm_above_the_emitter_and_black_far_away() {
 fn all_dead_frame_is_black() {
     let ctx = gpu();
     // Before any step: every slot is zero (dead).
-    let mut run = Headless::new(&ctx, Effect::default_campfire(), ShaderLibrary::embedded()).expect("headless");
+    let mut run = Headless::new(&ctx, Effect::default_campfire(), ShaderLibrary::embedded())
+        .expect("headless");
     let img = run.render(SIZE).expect("render");
-    assert!(img.pixels().all(|p| p[0] == 0 && p[1] == 0 && p[2] == 0), "fresh pools drew something");
+    assert!(
+        img.pixels().all(|p| p[0] == 0 && p[1] == 0 && p[2] == 0),
+        "fresh pools drew something"
+    );
     // After every particle died: lifetimes ≤ 4 s, spawning stopped.
     for _ in 0..60 {
         run.advance(1.0 / 60.0).expect("advance");
@@ -87,7 +116,10 @@ fn all_dead_frame_is_black() {
     }
     assert_eq!(run.alive().expect("alive"), 0);
     let img = run.render(SIZE).expect("render");
-    let lit = img.pixels().filter(|p| p[0] > 0 || p[1] > 0 || p[2] > 0).count();
+    let lit = img
+        .pixels()
+        .filter(|p| p[0] > 0 || p[1] > 0 || p[2] > 0)
+        .count();
     assert_eq!(lit, 0, "{lit} pixels lit with no particle alive");
 }
 
@@ -99,7 +131,12 @@ fn deterministic_frames_for_a_seed() {
     let (_, b) = campfire_after(&ctx, 1.0, 3);
     let (_, c) = campfire_after(&ctx, 1.0, 4);
     assert!(a.as_raw() == b.as_raw(), "same seed, different pixels");
-    let diff = a.as_raw().iter().zip(c.as_raw()).filter(|(x, y)| x != y).count();
+    let diff = a
+        .as_raw()
+        .iter()
+        .zip(c.as_raw())
+        .filter(|(x, y)| x != y)
+        .count();
     assert!(diff > 1000, "different seeds differ in only {diff} bytes");
 }
 
@@ -108,12 +145,18 @@ fn deterministic_frames_for_a_seed() {
 fn render_command_writes_pngs() {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_ignis"))
-        .args(["render", "--frames", "5", "--size", "160x120", "--fps", "30", "--out"])
+        .args([
+            "render", "--frames", "5", "--size", "160x120", "--fps", "30", "--out",
+        ])
         .arg(dir.path())
         .output()
         .expect("run ignis");
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "ignis render failed: {}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "ignis render failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(stdout.contains("rendered 5 frames"), "{stdout}");
     for f in 0..5 {
         let path = dir.path().join(format!("frame_{f:04}.png"));
@@ -122,8 +165,13 @@ fn render_command_writes_pngs() {
     }
     assert!(!dir.path().join("frame_0005.png").exists());
     // The last frame shows fire.
-    let img = image::open(dir.path().join("frame_0004.png")).expect("png").to_rgba8();
-    assert!(img.pixels().any(|p| p[0] > 200), "no bright pixel in the last frame");
+    let img = image::open(dir.path().join("frame_0004.png"))
+        .expect("png")
+        .to_rgba8();
+    assert!(
+        img.pixels().any(|p| p[0] > 200),
+        "no bright pixel in the last frame"
+    );
 }
 
 /// Bad arguments: a clear error and a non-zero exit, no panic.

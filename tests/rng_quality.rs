@@ -28,7 +28,10 @@ fn unit_interval_outputs_are_uniform() {
                 bins[(*x * 100.0) as usize] += 1;
             }
             let expected = N as f64 / 100.0;
-            let chi2: f64 = bins.iter().map(|&b| (b as f64 - expected).powi(2) / expected).sum();
+            let chi2: f64 = bins
+                .iter()
+                .map(|&b| (b as f64 - expected).powi(2) / expected)
+                .sum();
             assert!(chi2 < 148.2, "block {block} lane {lane}: chi² = {chi2:.1}");
             let mean = xs.iter().map(|&x| x as f64).sum::<f64>() / N as f64;
             assert!((mean - 0.5).abs() < 0.005, "mean {mean}");
@@ -40,7 +43,11 @@ fn correlation(a: &[f32], b: &[f32]) -> f64 {
     let n = a.len() as f64;
     let ma = a.iter().map(|&x| x as f64).sum::<f64>() / n;
     let mb = b.iter().map(|&x| x as f64).sum::<f64>() / n;
-    let cov: f64 = a.iter().zip(b).map(|(&x, &y)| (x as f64 - ma) * (y as f64 - mb)).sum();
+    let cov: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(&x, &y)| (x as f64 - ma) * (y as f64 - mb))
+        .sum();
     let va: f64 = a.iter().map(|&x| (x as f64 - ma).powi(2)).sum();
     let vb: f64 = b.iter().map(|&y| (y as f64 - mb).powi(2)).sum();
     cov / (va * vb).sqrt()
@@ -54,7 +61,10 @@ fn no_correlation_between_neighbouring_slots_or_lanes() {
     let r_next = correlation(&x[..x.len() - 1], &x[1..]);
     assert!(r_next.abs() < 0.01, "slot i vs i+1: r = {r_next}");
     let r_far = correlation(&x[..x.len() - 4096], &x[4096..]);
-    assert!(r_far.abs() < 0.01, "same slot, next lap of the ring: r = {r_far}");
+    assert!(
+        r_far.abs() < 0.01,
+        "same slot, next lap of the ring: r = {r_far}"
+    );
     let y = samples(0, 1);
     let z = samples(1, 0);
     assert!(correlation(&x, &y).abs() < 0.01);

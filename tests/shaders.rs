@@ -2,7 +2,7 @@
 //! layouts agree, errors point at the right file, line and column.
 
 use ignis::gpu::types::{CameraUniform, LookUniform, Particle, SimParams, ToneUniform};
-use ignis::shaders::{ENTRY_FILES, EMBEDDED, ShaderError, ShaderLibrary};
+use ignis::shaders::{EMBEDDED, ENTRY_FILES, ShaderError, ShaderLibrary};
 
 fn project_shaders() -> ShaderLibrary {
     ShaderLibrary::from_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/shaders"))
@@ -27,8 +27,14 @@ fn every_entry_validates() {
     for f in std::fs::read_dir(dir).expect("shaders/") {
         let name = f.expect("entry").file_name().to_string_lossy().into_owned();
         if name.ends_with(".wgsl") {
-            assert!(EMBEDDED.iter().any(|(n, _)| *n == name), "{name} is not embedded");
-            assert!(reached.contains(&name), "{name} is not imported by any pipeline");
+            assert!(
+                EMBEDDED.iter().any(|(n, _)| *n == name),
+                "{name} is not embedded"
+            );
+            assert!(
+                reached.contains(&name),
+                "{name} is not imported by any pipeline"
+            );
         }
     }
 }
@@ -48,8 +54,13 @@ fn rust_and_wgsl_struct_sizes_agree() {
         (&tonemap, "ToneUniform", size_of::<ToneUniform>()),
     ];
     for (composed, name, rust) in cases {
-        let wgsl = composed.struct_size(name).unwrap_or_else(|| panic!("{name} not found"));
-        assert_eq!(wgsl as usize, rust, "{name}: WGSL {wgsl} bytes, Rust {rust} bytes");
+        let wgsl = composed
+            .struct_size(name)
+            .unwrap_or_else(|| panic!("{name} not found"));
+        assert_eq!(
+            wgsl as usize, rust,
+            "{name}: WGSL {wgsl} bytes, Rust {rust} bytes"
+        );
     }
 }
 
@@ -81,14 +92,23 @@ fn errors_point_at_the_imported_file() {
     );
     assert_ne!(text, broken);
     std::fs::write(&path, &broken).expect("write");
-    let line = broken.lines().position(|l| l.contains("wind_time.xyz;")).expect("line") as u32 + 1;
-    let err = ShaderLibrary::from_dir(dir.path()).compose("update.wgsl").expect_err("must fail");
+    let line = broken
+        .lines()
+        .position(|l| l.contains("wind_time.xyz;"))
+        .expect("line") as u32
+        + 1;
+    let err = ShaderLibrary::from_dir(dir.path())
+        .compose("update.wgsl")
+        .expect_err("must fail");
     let (file, l, col) = located(&err);
     assert!(file.ends_with("forces.wgsl"), "{file}");
     assert_eq!(l, line, "{err}");
     assert!(col > 1);
     let shown = err.to_string();
-    assert!(shown.contains(&format!("forces.wgsl:{line}:{col}")), "{shown}");
+    assert!(
+        shown.contains(&format!("forces.wgsl:{line}:{col}")),
+        "{shown}"
+    );
     assert!(shown.contains('^'), "no caret: {shown}");
 }
 
@@ -101,16 +121,31 @@ fn validation_and_import_errors_are_located() {
     let original = std::fs::read_to_string(&forces).expect("read");
 
     // A type error: vec3 returned where f32 expected.
-    std::fs::write(&forces, original.replace("fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age_secs: f32) -> vec3<f32> {", "fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age_secs: f32) -> f32 {")).expect("write");
+    std::fs::write(
+        &forces,
+        original.replace(
+            "fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age_secs: f32) -> vec3<f32> {",
+            "fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age_secs: f32) -> f32 {",
+        ),
+    )
+    .expect("write");
     let err = lib.compose("update.wgsl").expect_err("type error");
     assert!(located(&err).0.ends_with("forces.wgsl"), "{err}");
 
     // A missing import is reported at the #import line.
-    std::fs::write(&forces, original.replace("#import \"common.wgsl\"", "#import \"nope.wgsl\"")).expect("write");
+    std::fs::write(
+        &forces,
+        original.replace("#import \"common.wgsl\"", "#import \"nope.wgsl\""),
+    )
+    .expect("write");
     let err = lib.compose("update.wgsl").expect_err("missing import");
     let (file, line, _) = located(&err);
     assert!(file.ends_with("forces.wgsl"), "{err}");
-    let want = original.lines().position(|l| l.contains("#import \"common.wgsl\"")).expect("import") as u32 + 1;
+    let want = original
+        .lines()
+        .position(|l| l.contains("#import \"common.wgsl\""))
+        .expect("import") as u32
+        + 1;
     assert_eq!(line, want);
     assert!(err.to_string().contains("nope.wgsl"));
 

@@ -6,6 +6,7 @@ use crate::effect::{Effect, Integrator};
 use crate::gpu::types::{PARAMS_STRIDE, Particle, SimParams};
 use crate::gpu::{GpuContext, GpuError};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
+use crate::sim::modules::Modules;
 use crate::sim::planner::EffectPlanner;
 
 /// Steps recorded per submission (the per-step params blocks live side by side).
@@ -25,11 +26,19 @@ pub enum SimError {
     Readback(String),
 }
 
-/// The update pipelines (one per integrator, built on demand) and their layout.
+/// What specialises an update pipeline: the integrator and the modules compiled in.
+pub type PipelineKey = (Integrator, Modules);
+
+/// The pipeline key an emitter needs.
+pub fn pipeline_key(e: &crate::effect::Emitter) -> PipelineKey {
+    (e.integrator, Modules::of(e))
+}
+
+/// The update pipelines (one per integrator × module set, built on demand) and their layout.
 pub struct UpdatePass {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
-    pipelines: HashMap<Integrator, wgpu::ComputePipeline>,
+    pipelines: HashMap<PipelineKey, wgpu::ComputePipeline>,
     /// Files the current pipelines were built from.
     pub files: Vec<String>,
 }
@@ -88,11 +97,13 @@ impl UpdatePass {
         &mut self,
         ctx: &GpuContext,
         lib: &ShaderLibrary,
-        integrators: &[Integrator],
+        keys: &[PipelineKey],
     ) -> Result<(), ShaderError> {
         let composed = lib.compose("update.wgsl")?;
         let mut fresh = HashMap::new();
-        for &integrator in integrators {
+        for &(integrator, modules) in keys {
+            let mut constants = modules.constants();
+            constants.push(("INTEGRATOR", integrator.index() as f64));
             let pipeline = create_checked(&ctx.device, &composed, lib, |module| {
                 ctx.device
                     .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -101,13 +112,13 @@ impl UpdatePass {
                         module,
                         entry_point: Some("main"),
                         compilation_options: wgpu::PipelineCompilationOptions {
-                            constants: &[("INTEGRATOR", integrator.index() as f64)],
+                            constants: &constants,
                             zero_initialize_workgroup_memory: true,
                         },
                         cache: None,
                     })
             })?;
-            fresh.insert(integrator, pipeline);
+            fresh.insert((integrator, modules), pipeline);
         }
         self.pipelines = fresh;
         self.files = composed.files;
@@ -118,13 +129,13 @@ impl UpdatePass {
         &mut self,
         ctx: &GpuContext,
         lib: &ShaderLibrary,
-        integrator: Integrator,
+        key: PipelineKey,
     ) -> Result<(), ShaderError> {
-        if self.pipelines.contains_key(&integrator) {
+        if self.pipelines.contains_key(&key) {
             return Ok(());
         }
-        let mut wanted: Vec<Integrator> = self.pipelines.keys().copied().collect();
-        wanted.push(integrator);
+        let mut wanted: Vec<PipelineKey> = self.pipelines.keys().copied().collect();
+        wanted.push(key);
         self.rebuild(ctx, lib, &wanted)
     }
 }
@@ -175,8 +186,7 @@ impl GpuSim {
         effect: &Effect,
     ) -> Result<Self, SimError> {
         let mut update = UpdatePass::new(ctx);
-        let integrators = used_integrators(effect);
-        update.rebuild(ctx, &library, &integrators)?;
+        update.rebuild(ctx, &library, &used_keys(effect))?;
         let mut sim = Self {
             ctx: ctx.clone(),
             library,
@@ -214,7 +224,7 @@ impl GpuSim {
         effect: &Effect,
     ) -> Result<(), ShaderError> {
         self.update
-            .rebuild(&self.ctx, &library, &used_integrators(effect))?;
+            .rebuild(&self.ctx, &library, &used_keys(effect))?;
         self.library = library;
         Ok(())
     }
@@ -267,8 +277,8 @@ impl GpuSim {
                     self.bind_groups(&self.emitters[i].buffers, &self.emitters[i].counters);
             }
         }
-        for integrator in used_integrators(effect) {
-            self.update.ensure(&self.ctx, &self.library, integrator)?;
+        for key in used_keys(effect) {
+            self.update.ensure(&self.ctx, &self.library, key)?;
         }
         Ok(())
     }
@@ -385,7 +395,10 @@ impl GpuSim {
                 let (Some(p), Some(em)) = (params, self.emitters.get_mut(e)) else {
                     continue;
                 };
-                let Some(pipeline) = self.update.pipelines.get(&effect.emitters[e].integrator)
+                let Some(pipeline) = self
+                    .update
+                    .pipelines
+                    .get(&pipeline_key(&effect.emitters[e]))
                 else {
                     continue;
                 };
@@ -470,13 +483,13 @@ pub fn dispatch_size(slots: u32) -> (u32, u32) {
     (x, groups.div_ceil(x))
 }
 
-/// Every integrator the effect uses (so only those pipelines are built).
-pub fn used_integrators(effect: &Effect) -> Vec<Integrator> {
-    let mut v: Vec<Integrator> = effect.emitters.iter().map(|e| e.integrator).collect();
-    v.sort_by_key(|i| i.index());
+/// Every pipeline key the effect uses (so only those pipelines are built).
+pub fn used_keys(effect: &Effect) -> Vec<PipelineKey> {
+    let mut v: Vec<PipelineKey> = effect.emitters.iter().map(pipeline_key).collect();
+    v.sort_by_key(|(i, m)| (i.index(), *m));
     v.dedup();
     if v.is_empty() {
-        v.push(Integrator::SemiImplicitEuler);
+        v.push((Integrator::SemiImplicitEuler, Modules::DRAG));
     }
     v
 }

@@ -39,6 +39,7 @@ pub fn plain_emitter() -> Emitter {
             buoyancy_m_per_s2: 0.0,
             drag_per_sec: 0.0,
             wind_m_per_s: [0.0; 3],
+            ..Forces::default()
         },
         spawn_noise: SpawnNoise {
             position_amplitude_m: 0.0,
@@ -51,11 +52,16 @@ pub fn plain_emitter() -> Emitter {
 
 /// Plans `steps` steps and runs them on the GPU and on the CPU reference with the very
 /// same parameter blocks. Returns (GPU state, CPU state) of emitter 0.
-pub fn run_gpu_and_cpu(ctx: &GpuContext, effect: &Effect, dt: f32, steps: usize) -> (Vec<Particle>, CpuSim) {
+pub fn run_gpu_and_cpu(
+    ctx: &GpuContext,
+    effect: &Effect,
+    dt: f32,
+    steps: usize,
+) -> (Vec<Particle>, CpuSim) {
     let mut sim = GpuSim::new(ctx, ShaderLibrary::embedded(), effect).expect("sim");
     let mut planner = EffectPlanner::default();
     let e = &effect.emitters[0];
-    let mut cpu = CpuSim::new(e.capacity, e.integrator);
+    let mut cpu = CpuSim::for_emitter(e);
     let mut chunk: Vec<Vec<Option<SimParams>>> = Vec::new();
     for s in 0..steps {
         let plan = planner.plan_step(effect, dt);
