@@ -262,10 +262,18 @@ fn capacity_beyond_device_limit_names_the_limit() {
 
 fn spawn_once(ctx: &ignis::gpu::GpuContext, e: Emitter) -> Vec<ignis::gpu::types::Particle> {
     let sim = run_gpu(ctx, &bare_effect(e), 1.0 / 120.0, 1);
+    // Positions are stored relative to the emitter's simulation origin.
+    let origin = sim.planner.emitters[0].origin().as_vec3();
     sim.read_particles(0)
         .expect("read")
         .into_iter()
         .filter(|p| p.is_alive())
+        .map(|mut p| {
+            for k in 0..3 {
+                p.pos_age[k] += origin[k];
+            }
+            p
+        })
         .collect()
 }
 

@@ -117,6 +117,8 @@ pub struct CameraUniform {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct LookUniform {
+    /// Emitter simulation space → clip (camera-relative, composed in f64).
+    pub clip_from_sim: [[f32; 4]; 4],
     /// Gradient colours (linear RGBA).
     pub colors: [[f32; 4]; 8],
     /// Gradient stop positions, four per vec4.
