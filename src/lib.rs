@@ -14,3 +14,4 @@ pub mod shaders;
 pub mod sim;
 
 pub use effect::Effect;
+pub mod bench;

@@ -286,7 +286,8 @@ fn every_shape_spawns_inside_itself() {
         rotation_deg: [20.0, 45.0, -10.0],
     };
     let emitter_from_world = transform.world_from_emitter().inverse();
-    let cases: Vec<(Shape, Box<dyn Fn(Vec3) -> bool>)> = vec![
+    type Inside = Box<dyn Fn(Vec3) -> bool>;
+    let cases: Vec<(Shape, Inside)> = vec![
         (Shape::Point, Box::new(|p: Vec3| p.length() < 1e-5)),
         (
             Shape::Sphere {

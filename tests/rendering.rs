@@ -77,16 +77,25 @@ fn default_frame_is_warm_above_the_emitter_and_black_far_away() {
             "corner ({x0},{y0}) not black: {c:?}"
         );
     }
-    // Below the emitter (the ground) stays black.
-    let (bx, by) = project(&run, Vec3::new(0.0, -0.6, 0.0));
-    let below = mean_rgb(
-        &img,
-        bx as u32 - 10,
-        by as u32 - 10,
-        bx as u32 + 10,
-        (by as u32 + 10).min(SIZE.1),
-    );
-    assert!(below.iter().all(|&v| v < 10.0), "below the fire: {below:?}");
+    // Beside the fire, 1.3 m to either side at flame height, stays black.
+    for side in [-1.3f32, 1.3] {
+        let (sx, sy) = project(&run, Vec3::new(side, 0.3, 0.0));
+        assert!(
+            sx > 10.0 && sx + 10.0 < SIZE.0 as f32,
+            "the side probe is off-screen"
+        );
+        let c = mean_rgb(
+            &img,
+            sx as u32 - 10,
+            sy as u32 - 10,
+            sx as u32 + 10,
+            sy as u32 + 10,
+        );
+        assert!(
+            c.iter().all(|&v| v < 3.0),
+            "beside the fire ({side} m): {c:?}"
+        );
+    }
     img.save(std::env::temp_dir().join("ignis_test_campfire.png"))
         .expect("save");
 }

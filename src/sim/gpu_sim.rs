@@ -372,6 +372,36 @@ impl GpuSim {
 
     /// Records the planned steps (one `SimParams` per enabled emitter and step) and submits.
     pub fn record_and_submit(&mut self, effect: &Effect, plans: &[Vec<Option<SimParams>>]) {
+        let mut enc = self
+            .ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("GpuSim::step"),
+            });
+        self.record(&mut enc, effect, plans);
+        self.ctx.queue.submit([enc.finish()]);
+    }
+
+    /// Plans `steps` steps of `dt_secs` (at most 32: the params ring holds that many).
+    pub fn plan(
+        &mut self,
+        effect: &Effect,
+        dt_secs: f32,
+        steps: usize,
+    ) -> Vec<Vec<Option<SimParams>>> {
+        (0..steps.min(STEPS_PER_SUBMIT))
+            .map(|_| self.planner.plan_step(effect, dt_secs))
+            .collect()
+    }
+
+    /// Uploads the planned blocks and records their dispatches into `enc`. Submit `enc`
+    /// before the next call (the blocks share one buffer).
+    pub fn record(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        effect: &Effect,
+        plans: &[Vec<Option<SimParams>>],
+    ) {
         let n_emitters = self.emitters.len();
         let mut blocks = vec![0u8; plans.len() * n_emitters * PARAMS_STRIDE as usize];
         for (s, plan) in plans.iter().enumerate() {
@@ -383,12 +413,6 @@ impl GpuSim {
             }
         }
         self.ctx.queue.write_buffer(&self.params_buffer, 0, &blocks);
-        let mut enc = self
-            .ctx
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("GpuSim::step"),
-            });
         enc.push_debug_group("update particles");
         for (s, plan) in plans.iter().enumerate() {
             for (e, params) in plan.iter().enumerate() {
@@ -417,7 +441,6 @@ impl GpuSim {
             }
         }
         enc.pop_debug_group();
-        self.ctx.queue.submit([enc.finish()]);
     }
 
     /// Buffers of emitter `index` for drawing.
@@ -434,6 +457,26 @@ impl GpuSim {
     /// Number of emitter pools.
     pub fn emitter_count(&self) -> usize {
         self.emitters.len()
+    }
+
+    /// Overwrites emitter `index`'s current (and previous) state (benches and tests that
+    /// need an exact initial condition). `particles` is truncated to the capacity.
+    pub fn write_particles(
+        &mut self,
+        index: usize,
+        particles: &[Particle],
+    ) -> Result<(), SimError> {
+        let s = self
+            .emitters
+            .get(index)
+            .ok_or_else(|| SimError::Readback(format!("no emitter {index}")))?;
+        let n = particles.len().min(s.capacity as usize);
+        for b in &s.buffers {
+            self.ctx
+                .queue
+                .write_buffer(b, 0, bytemuck::cast_slice(&particles[..n]));
+        }
+        Ok(())
     }
 
     /// Reads emitter `index`'s current state back (blocking; tests and tools).
