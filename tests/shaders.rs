@@ -87,14 +87,14 @@ fn errors_point_at_the_imported_file() {
     let path = dir.path().join("forces.wgsl");
     let text = std::fs::read_to_string(&path).expect("read");
     let broken = text.replace(
-        "return params.accel_drag.xyz - k * (vel - params.wind_time.xyz);",
-        "return params.accel_drag.xyz - k * (vel - params.wind_time.xyz;",
+        "a -= params.accel_drag.w * (vel - wind);",
+        "a -= params.accel_drag.w * (vel - wind;",
     );
     assert_ne!(text, broken);
     std::fs::write(&path, &broken).expect("write");
     let line = broken
         .lines()
-        .position(|l| l.contains("wind_time.xyz;"))
+        .position(|l| l.contains("(vel - wind;"))
         .expect("line") as u32
         + 1;
     let err = ShaderLibrary::from_dir(dir.path())
@@ -124,8 +124,8 @@ fn validation_and_import_errors_are_located() {
     std::fs::write(
         &forces,
         original.replace(
-            "fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age_secs: f32) -> vec3<f32> {",
-            "fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age_secs: f32) -> f32 {",
+            "fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age: f32, life: f32, time: f32) -> vec3<f32> {",
+            "fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age: f32, life: f32, time: f32) -> f32 {",
         ),
     )
     .expect("write");
