@@ -20,6 +20,9 @@ struct CameraUniform {
 }
 
 struct LookUniform {
+    // The emitter's simulation space → clip, composed in f64 on the CPU so effects far
+    // from the world origin render without f32 jitter.
+    clip_from_sim: mat4x4<f32>,
     colors: array<vec4<f32>, 8>,
     // Stop positions, four per vec4.
     stops: array<vec4<f32>, 2>,
@@ -94,7 +97,7 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) slot: u32) -
     let corner_index = array<u32, 6>(0u, 1u, 2u, 2u, 1u, 3u)[vi];
     let corner = vec2<f32>(f32(corner_index & 1u), f32(corner_index >> 1u)) * 2.0 - 1.0;
     let world = pos + (camera.right_alpha.xyz * corner.x + camera.up.xyz * corner.y) * (0.5 * size);
-    out.clip = camera.clip_from_world * vec4<f32>(world, 1.0);
+    out.clip = look.clip_from_sim * vec4<f32>(world, 1.0);
     out.uv = corner;
     out.color = particle_color(t);
     return out;

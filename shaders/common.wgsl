@@ -41,6 +41,31 @@ struct SimParams {
     // spawn_frac0 + k * spawn_frac_step (sub-step emission: no puffs at low frame rates).
     spawn_frac0: f32,
     spawn_frac_step: f32,
+    // Optional force modules (each compiled in only when on; see forces.wgsl).
+    // strength (m/s²), frequency (1/m), octaves, scroll (m/s).
+    turbulence: vec4<f32>,
+    // gust strength (fraction of wind), gust frequency (Hz), quadratic drag (1/m),
+    // flame pull strength (1/s²).
+    gusts_qdrag_pull: vec4<f32>,
+    // xyz: vortex centre (m), w: falloff radius (m).
+    vortex_center: vec4<f32>,
+    // xyz: unit vortex axis, w: swirl acceleration (m/s²) at the axis.
+    vortex_axis: vec4<f32>,
+    // xyz: attractor position (m), w: strength (m/s², negative repels).
+    attractor: vec4<f32>,
+    // x: attractor radius (m), y: falloff (0 softened inverse square, 1 constant within
+    // radius), z: flame pull exponent, w: unused.
+    attractor_b: vec4<f32>,
+    // xyz: emitter origin (world), the flame pull's axis passes through it.
+    axis_origin: vec4<f32>,
+    // xyz: emitter direction (world, unit).
+    axis_dir: vec4<f32>,
+    // Ground plane: height (m), elasticity, friction, kill on contact (0/1).
+    ground: vec4<f32>,
+    // rest speed (m/s), sphere count, kill on contact with spheres (0/1), ground on (0/1).
+    collide_b: vec4<f32>,
+    // Sphere colliders: xyz centre (m), w radius (m).
+    spheres: array<vec4<f32>, 4>,
 }
 
 const SHAPE_POINT: u32 = 0u;

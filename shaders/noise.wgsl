@@ -36,3 +36,59 @@ fn value_noise3_vec(p: vec3<f32>, seed: u32) -> vec3<f32> {
         value_noise3(p + vec3<f32>(-17.231, 5.117, 63.941), seed),
     ) * 2.0 - 1.0;
 }
+
+fn fade3_deriv(t: vec3<f32>) -> vec3<f32> {
+    return 30.0 * t * t * (t * (t - 2.0) + 1.0);
+}
+
+// Value noise and its analytic gradient: xyz = ∇n, w = n.
+fn value_noise3_grad(p: vec3<f32>, seed: u32) -> vec4<f32> {
+    let cell = floor(p);
+    let f = p - cell;
+    let c = vec3<i32>(cell);
+    let u = fade3(f);
+    let du = fade3_deriv(f);
+    let a = hash_cell(c + vec3<i32>(0, 0, 0), seed);
+    let b = hash_cell(c + vec3<i32>(1, 0, 0), seed);
+    let cc = hash_cell(c + vec3<i32>(0, 1, 0), seed);
+    let d = hash_cell(c + vec3<i32>(1, 1, 0), seed);
+    let e = hash_cell(c + vec3<i32>(0, 0, 1), seed);
+    let ff = hash_cell(c + vec3<i32>(1, 0, 1), seed);
+    let g = hash_cell(c + vec3<i32>(0, 1, 1), seed);
+    let h = hash_cell(c + vec3<i32>(1, 1, 1), seed);
+    let k1 = b - a;
+    let k2 = cc - a;
+    let k3 = e - a;
+    let k4 = a - b - cc + d;
+    let k5 = a - cc - e + g;
+    let k6 = a - b - e + ff;
+    let k7 = -a + b + cc - d + e - ff - g + h;
+    let n = a + k1 * u.x + k2 * u.y + k3 * u.z + k4 * u.x * u.y + k5 * u.y * u.z + k6 * u.z * u.x
+        + k7 * u.x * u.y * u.z;
+    let grad = du * vec3<f32>(
+        k1 + k4 * u.y + k6 * u.z + k7 * u.y * u.z,
+        k2 + k4 * u.x + k5 * u.z + k7 * u.x * u.z,
+        k3 + k5 * u.y + k6 * u.x + k7 * u.x * u.y,
+    );
+    return vec4<f32>(grad, n);
+}
+
+// Curl noise (Bridson et al. 2007): the curl of a vector potential of three decorrelated
+// value-noise channels, summed over octaves. Divergence-free by construction. The result
+// is in units of the potential per unit length (frequency is applied by the caller).
+fn curl_noise(p: vec3<f32>, seed: u32, octaves: u32) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    var freq = 1.0;
+    var amp = 1.0;
+    for (var o = 0u; o < octaves; o++) {
+        let q = p * freq;
+        let gx = value_noise3_grad(q, seed + o * 3u).xyz;
+        let gy = value_noise3_grad(q + vec3<f32>(31.416, 47.853, 12.793), seed + o * 3u + 1u).xyz;
+        let gz = value_noise3_grad(q + vec3<f32>(-17.231, 5.117, 63.941), seed + o * 3u + 2u).xyz;
+        // curl ψ = (∂ψz/∂y − ∂ψy/∂z, ∂ψx/∂z − ∂ψz/∂x, ∂ψy/∂x − ∂ψx/∂y), chain rule × freq.
+        sum += amp * freq * vec3<f32>(gz.y - gy.z, gx.z - gz.x, gy.x - gx.y);
+        freq *= 2.0;
+        amp *= 0.5;
+    }
+    return sum;
+}

@@ -16,6 +16,7 @@
 
 #import "spawn.wgsl"
 #import "integrators.wgsl"
+#import "collide.wgsl"
 
 override COUNT_ALIVE: bool = true;
 
@@ -45,11 +46,20 @@ fn main(
             p.pos_age = vec4<f32>(p.pos_age.xyz + p.vel_life.xyz * age0, age0);
             alive = is_alive(p);
         } else if is_alive(p) {
-            let s = integrate(p.pos_age.xyz, p.vel_life.xyz, p.pos_age.w, params.dt_secs);
-            let age = p.pos_age.w + params.dt_secs;
+            let life = p.vel_life.w;
+            var s = integrate(p.pos_age.xyz, p.vel_life.xyz, p.pos_age.w, life, params.wind_time.w, params.dt_secs);
+            var age = p.pos_age.w + params.dt_secs;
+            if MOD_COLLISIONS {
+                let c = collide(p.pos_age.xyz, s.pos, s.vel);
+                s = State(c.pos, c.vel);
+                if c.killed {
+                    // Killed on contact: dead, and its age says so.
+                    age = life;
+                }
+            }
             if finite_vec3(s.pos) && finite_vec3(s.vel) {
-                p = Particle(vec4<f32>(s.pos, age), vec4<f32>(s.vel, p.vel_life.w));
-                alive = age < p.vel_life.w;
+                p = Particle(vec4<f32>(s.pos, age), vec4<f32>(s.vel, life));
+                alive = age < life;
             } else {
                 // Non-finite guard: kill and count, never let NaN reach the draw.
                 p = Particle(vec4<f32>(0.0), vec4<f32>(0.0));

@@ -103,6 +103,8 @@ pub struct Emitter {
     pub spawn_noise: SpawnNoise,
     /// Integration method.
     pub integrator: Integrator,
+    /// Ground and sphere colliders.
+    pub collisions: Collisions,
     /// Added to the effect seed for this emitter's stream.
     pub seed_offset: u32,
     /// How the particles are drawn.
@@ -259,6 +261,210 @@ pub struct Forces {
     pub drag_per_sec: f32,
     /// The flow velocity drag pulls toward, m/s.
     pub wind_m_per_s: [f32; 3],
+    /// Quadratic drag c, 1/m: a = −c·|v − wind|·(v − wind). 0 = off.
+    pub quadratic_drag_per_m: f32,
+    /// Noise-modulated wind strength (off when absent).
+    pub gusts: Option<Gusts>,
+    /// Curl-noise turbulence (off when absent).
+    pub turbulence: Option<Turbulence>,
+    /// Swirl around an axis (off when absent).
+    pub vortex: Option<Vortex>,
+    /// Point attractor / repulsor (off when absent).
+    pub attractor: Option<Attractor>,
+    /// Pull toward the emitter axis growing with age, so flames taper (off when absent).
+    pub flame_pull: Option<FlamePull>,
+}
+
+/// Wind gusts: the wind is scaled by 1 + strength·n(t), n a smooth noise in [−1, 1].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Gusts {
+    /// Gust strength as a fraction of the wind (0..).
+    pub strength: f32,
+    /// How often gusts change, Hz.
+    pub frequency_hz: f32,
+}
+
+/// Curl-noise turbulence: divergence-free, seeded, scrolling upward.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Turbulence {
+    /// Typical acceleration, m/s².
+    pub strength_m_per_s2: f32,
+    /// Spatial frequency, 1/m.
+    pub frequency_per_m: f32,
+    /// Octaves (1..=4), each twice the frequency and half the amplitude.
+    pub octaves: u32,
+    /// Upward scroll of the field, m/s.
+    pub scroll_m_per_s: f32,
+}
+
+/// A vortex: tangential acceleration around an axis with a Gaussian falloff.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Vortex {
+    /// A point on the axis, world metres.
+    pub center_m: [f32; 3],
+    /// Axis direction (normalised on use).
+    pub axis: [f32; 3],
+    /// Tangential acceleration near the axis, m/s² (sign = direction of spin).
+    pub swirl_m_per_s2: f32,
+    /// Falloff radius, metres: a·exp(−d²/R²).
+    pub radius_m: f32,
+}
+
+/// How an attractor's pull falls off with distance (Latta's two choices).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Falloff {
+    /// a = s·d/(|d|² + ε²)^{3/2}, s in m³/s², ε = radius (Plummer softening).
+    InverseSquare,
+    /// |a| = s (m/s²) within the radius, zero outside.
+    ConstantWithinRadius,
+}
+
+/// A point attractor (positive strength) or repulsor (negative).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Attractor {
+    /// Position, world metres.
+    pub position_m: [f32; 3],
+    /// Strength (see [`Falloff`] for units); negative repels.
+    pub strength: f32,
+    /// Softening radius (inverse square) or range (constant), metres.
+    pub radius_m: f32,
+    /// Falloff law.
+    pub falloff: Falloff,
+}
+
+/// Pull toward the emitter axis: a = −strength·(age/life)^exponent·(radial offset).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FlamePull {
+    /// Pull strength, 1/s².
+    pub strength_per_s2: f32,
+    /// Growth with normalised age (1 = linear).
+    pub exponent: f32,
+}
+
+/// Colliders an emitter's particles bounce off (or die on).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Collisions {
+    /// An infinite horizontal ground plane.
+    pub ground: Option<GroundPlane>,
+    /// Up to four spheres.
+    pub spheres: Vec<SphereCollider>,
+    /// Normal restitution, 0 (stop) ..= 1 (perfect bounce).
+    pub elasticity: f32,
+    /// Tangential loss per contact, 0..=1.
+    pub friction: f32,
+    /// Below this normal speed after a bounce, the particle rests (no hovering, no jitter).
+    pub rest_speed_m_per_s: f32,
+    /// Kill particles that touch a sphere (smoke into a wall).
+    pub kill_on_sphere_contact: bool,
+}
+
+/// A horizontal plane y = height.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GroundPlane {
+    /// Height of the plane, metres.
+    pub height_m: f32,
+    /// Kill particles that touch it.
+    pub kill_on_contact: bool,
+}
+
+/// A sphere collider.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SphereCollider {
+    /// Centre, world metres.
+    pub center_m: [f32; 3],
+    /// Radius, metres.
+    pub radius_m: f32,
+}
+
+/// The maximum number of sphere colliders per emitter.
+pub const MAX_SPHERES: usize = 4;
+
+impl Default for Gusts {
+    fn default() -> Self {
+        Self {
+            strength: 0.6,
+            frequency_hz: 0.7,
+        }
+    }
+}
+
+impl Default for Turbulence {
+    fn default() -> Self {
+        Self {
+            strength_m_per_s2: 2.0,
+            frequency_per_m: 2.5,
+            octaves: 2,
+            scroll_m_per_s: 0.8,
+        }
+    }
+}
+
+impl Default for Vortex {
+    fn default() -> Self {
+        Self {
+            center_m: [0.0; 3],
+            axis: [0.0, 1.0, 0.0],
+            swirl_m_per_s2: 2.0,
+            radius_m: 0.5,
+        }
+    }
+}
+
+impl Default for Attractor {
+    fn default() -> Self {
+        Self {
+            position_m: [0.0, 1.5, 0.0],
+            strength: 1.0,
+            radius_m: 0.2,
+            falloff: Falloff::InverseSquare,
+        }
+    }
+}
+
+impl Default for FlamePull {
+    fn default() -> Self {
+        Self {
+            strength_per_s2: 6.0,
+            exponent: 1.0,
+        }
+    }
+}
+
+impl Default for Collisions {
+    fn default() -> Self {
+        Self {
+            ground: None,
+            spheres: Vec::new(),
+            elasticity: 0.4,
+            friction: 0.2,
+            rest_speed_m_per_s: 0.05,
+            kill_on_sphere_contact: false,
+        }
+    }
+}
+
+impl Collisions {
+    /// True when any collider is present.
+    pub fn any(&self) -> bool {
+        self.ground.is_some() || !self.spheres.is_empty()
+    }
+}
+
+impl Default for SphereCollider {
+    fn default() -> Self {
+        Self {
+            center_m: [0.0, 1.0, 0.0],
+            radius_m: 0.3,
+        }
+    }
 }
 
 impl Forces {
@@ -471,6 +677,7 @@ impl Default for Emitter {
             forces: Forces::default(),
             spawn_noise: SpawnNoise::default(),
             integrator: Integrator::SemiImplicitEuler,
+            collisions: Collisions::default(),
             seed_offset: 0,
             look: Look::default(),
         }
@@ -493,6 +700,12 @@ impl Default for Forces {
             buoyancy_m_per_s2: 11.5,
             drag_per_sec: 1.2,
             wind_m_per_s: [0.1, 0.0, 0.0],
+            quadratic_drag_per_m: 0.0,
+            gusts: None,
+            turbulence: None,
+            vortex: None,
+            attractor: None,
+            flame_pull: None,
         }
     }
 }
@@ -728,6 +941,105 @@ impl Effect {
             );
             c.num(|| p("forces.drag_per_sec"), f.drag_per_sec, 0.0, 1e4);
             c.vec3(|| p("forces.wind_m_per_s"), f.wind_m_per_s, 1e5);
+            c.num(
+                || p("forces.quadratic_drag_per_m"),
+                f.quadratic_drag_per_m,
+                0.0,
+                1e4,
+            );
+            if let Some(g) = &f.gusts {
+                c.num(|| p("forces.gusts.strength"), g.strength, 0.0, 10.0);
+                c.num(
+                    || p("forces.gusts.frequency_hz"),
+                    g.frequency_hz,
+                    0.0,
+                    100.0,
+                );
+            }
+            if let Some(t) = &f.turbulence {
+                c.num(
+                    || p("forces.turbulence.strength_m_per_s2"),
+                    t.strength_m_per_s2,
+                    0.0,
+                    1e4,
+                );
+                c.num(
+                    || p("forces.turbulence.frequency_per_m"),
+                    t.frequency_per_m,
+                    0.0,
+                    1e3,
+                );
+                c.num(
+                    || p("forces.turbulence.scroll_m_per_s"),
+                    t.scroll_m_per_s,
+                    -1e3,
+                    1e3,
+                );
+                if !(1..=4).contains(&t.octaves) {
+                    c.push(
+                        p("forces.turbulence.octaves"),
+                        t.octaves,
+                        "must be in 1..=4",
+                    );
+                }
+            }
+            if let Some(v) = &f.vortex {
+                c.vec3(|| p("forces.vortex.center_m"), v.center_m, 1e7);
+                c.nonzero_vec3(|| p("forces.vortex.axis"), v.axis);
+                c.num(
+                    || p("forces.vortex.swirl_m_per_s2"),
+                    v.swirl_m_per_s2,
+                    -1e4,
+                    1e4,
+                );
+                c.num(|| p("forces.vortex.radius_m"), v.radius_m, 1e-3, 1e4);
+            }
+            if let Some(a) = &f.attractor {
+                c.vec3(|| p("forces.attractor.position_m"), a.position_m, 1e7);
+                c.num(|| p("forces.attractor.strength"), a.strength, -1e5, 1e5);
+                c.num(|| p("forces.attractor.radius_m"), a.radius_m, 1e-3, 1e4);
+            }
+            if let Some(fp) = &f.flame_pull {
+                c.num(
+                    || p("forces.flame_pull.strength_per_s2"),
+                    fp.strength_per_s2,
+                    0.0,
+                    1e4,
+                );
+                c.num(|| p("forces.flame_pull.exponent"), fp.exponent, 0.0, 16.0);
+            }
+            let col = &e.collisions;
+            c.num(|| p("collisions.elasticity"), col.elasticity, 0.0, 1.0);
+            c.num(|| p("collisions.friction"), col.friction, 0.0, 1.0);
+            c.num(
+                || p("collisions.rest_speed_m_per_s"),
+                col.rest_speed_m_per_s,
+                0.0,
+                1e3,
+            );
+            if let Some(g) = &col.ground {
+                c.num(|| p("collisions.ground.height_m"), g.height_m, -1e7, 1e7);
+            }
+            if col.spheres.len() > MAX_SPHERES {
+                c.push(
+                    p("collisions.spheres"),
+                    format!("{} spheres", col.spheres.len()),
+                    &format!("at most {MAX_SPHERES}"),
+                );
+            }
+            for (k, sp) in col.spheres.iter().enumerate() {
+                c.vec3(
+                    || p(&format!("collisions.spheres[{k}].center_m")),
+                    sp.center_m,
+                    1e7,
+                );
+                c.num(
+                    || p(&format!("collisions.spheres[{k}].radius_m")),
+                    sp.radius_m,
+                    1e-3,
+                    1e4,
+                );
+            }
             let n = &e.spawn_noise;
             c.num(
                 || p("spawn_noise.frequency_per_m"),

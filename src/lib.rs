@@ -15,3 +15,4 @@ pub mod shaders;
 pub mod sim;
 
 pub use effect::Effect;
+pub mod bench;

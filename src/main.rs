@@ -73,10 +73,37 @@ enum Command {
         #[arg(long)]
         shader_dir: Option<PathBuf>,
     },
+    /// Measure: `accuracy` (integrators' error vs cost) or `perf` (throughput).
+    Bench {
+        #[command(subcommand)]
+        kind: BenchKind,
+    },
     /// Validate presets and shaders without opening a window.
     Check {
         /// Files or folders (.ron presets, .wgsl shaders). Default: presets/ and shaders/.
         paths: Vec<PathBuf>,
+    },
+}
+
+#[derive(Subcommand)]
+enum BenchKind {
+    /// Error against exact / high-precision references, next to GPU cost, per integrator and dt.
+    Accuracy {
+        /// Particles per error run.
+        #[arg(long, default_value_t = 2048)]
+        particles: u32,
+        /// Particles for the cost runs (0 = 1M on a CPU adapter, 16M on a GPU).
+        #[arg(long, default_value_t = 0)]
+        cost_capacity: u32,
+        /// Timed repeats per cost point (the median is reported).
+        #[arg(long, default_value_t = 5)]
+        repeats: usize,
+        /// Output folder for the Markdown, JSON, CSV and SVG files.
+        #[arg(long, default_value = "bench/results")]
+        out: PathBuf,
+        /// File name stem (default: accuracy-<adapter>).
+        #[arg(long)]
+        name: Option<String>,
     },
 }
 
@@ -143,6 +170,7 @@ fn main() {
             shader_dir.as_deref(),
         ),
         Some(Command::Check { paths }) => check(&paths),
+        Some(Command::Bench { kind }) => bench(kind),
     };
     if let Err(err) = result {
         eprintln!("error: {err:#}");
@@ -218,6 +246,50 @@ fn render(
         elapsed * 1000.0 / frames.max(1) as f64,
         ctx.info.name
     );
+    Ok(())
+}
+
+/// A file-name-safe tag for the adapter ("llvmpipe", "nvidia-h100-…").
+fn adapter_tag(ctx: &GpuContext) -> String {
+    let name: String = ctx
+        .info
+        .name
+        .to_lowercase()
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
+        .collect();
+    name.split('-')
+        .filter(|s| !s.is_empty())
+        .take(3)
+        .collect::<Vec<_>>()
+        .join("-")
+}
+
+fn bench(kind: BenchKind) -> anyhow::Result<()> {
+    let ctx = GpuContext::headless()?;
+    match kind {
+        BenchKind::Accuracy {
+            particles,
+            cost_capacity,
+            repeats,
+            out,
+            name,
+        } => {
+            let opts = ignis::bench::accuracy::AccuracyOptions {
+                particles: particles.max(16),
+                cost_capacity,
+                repeats: repeats.max(1),
+            };
+            let report = ignis::bench::accuracy::run(&ctx, &opts, &out)?;
+            let name = name.unwrap_or_else(|| format!("accuracy-{}", adapter_tag(&ctx)));
+            report.save(&out, &name)?;
+            println!("{}", report.markdown);
+            println!(
+                "wrote {}/{name}.md, .json, accuracy.csv, accuracy.svg",
+                out.display()
+            );
+        }
+    }
     Ok(())
 }
 

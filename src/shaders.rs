@@ -20,6 +20,7 @@ pub const EMBEDDED: &[(&str, &str)] = &[
         "integrators.wgsl",
         include_str!("../shaders/integrators.wgsl"),
     ),
+    ("collide.wgsl", include_str!("../shaders/collide.wgsl")),
     ("update.wgsl", include_str!("../shaders/update.wgsl")),
     ("billboard.wgsl", include_str!("../shaders/billboard.wgsl")),
     ("tonemap.wgsl", include_str!("../shaders/tonemap.wgsl")),

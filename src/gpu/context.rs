@@ -66,7 +66,7 @@ impl GpuContext {
         let mut limits = wgpu::Limits::default().using_resolution(supported.clone());
         limits.max_storage_buffer_binding_size = supported.max_storage_buffer_binding_size;
         limits.max_buffer_size = supported.max_buffer_size;
-        let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
+        let features = crate::gpu::timer::timing_features(&adapter);
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("ignis device"),
             required_features: features,
@@ -103,7 +103,10 @@ impl GpuContext {
     pub fn max_capacity(&self) -> u64 {
         let limits = self.device.limits();
         let per = std::mem::size_of::<crate::gpu::types::Particle>() as u64;
-        (limits.max_storage_buffer_binding_size as u64).min(limits.max_buffer_size) / per
+        limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size)
+            / per
     }
 
     /// Checks that `capacity` slots fit in one storage binding, naming the limit if not.
@@ -112,10 +115,10 @@ impl GpuContext {
         let per = std::mem::size_of::<crate::gpu::types::Particle>() as u64;
         let needed = capacity as u64 * per;
         let (limit, limit_bytes) =
-            if (limits.max_storage_buffer_binding_size as u64) < limits.max_buffer_size {
+            if limits.max_storage_buffer_binding_size < limits.max_buffer_size {
                 (
                     "max_storage_buffer_binding_size",
-                    limits.max_storage_buffer_binding_size as u64,
+                    limits.max_storage_buffer_binding_size,
                 )
             } else {
                 ("max_buffer_size", limits.max_buffer_size)

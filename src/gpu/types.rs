@@ -75,6 +75,28 @@ pub struct SimParams {
     pub spawn_frac0: f32,
     /// Birth fraction increment per spawn.
     pub spawn_frac_step: f32,
+    /// strength, frequency, octaves, scroll.
+    pub turbulence: [f32; 4],
+    /// gust strength, gust frequency, quadratic drag, flame pull strength.
+    pub gusts_qdrag_pull: [f32; 4],
+    /// xyz: vortex centre, w: falloff radius.
+    pub vortex_center: [f32; 4],
+    /// xyz: unit vortex axis, w: swirl acceleration.
+    pub vortex_axis: [f32; 4],
+    /// xyz: attractor position, w: strength.
+    pub attractor: [f32; 4],
+    /// radius, falloff mode, flame pull exponent, unused.
+    pub attractor_b: [f32; 4],
+    /// Emitter origin in world space.
+    pub axis_origin: [f32; 4],
+    /// Emitter direction in world space.
+    pub axis_dir: [f32; 4],
+    /// Ground: height, elasticity, friction, kill.
+    pub ground: [f32; 4],
+    /// rest speed, sphere count, kill on spheres, ground on.
+    pub collide_b: [f32; 4],
+    /// Sphere colliders: centre, radius.
+    pub spheres: [[f32; 4]; 4],
 }
 
 /// Camera data for the billboard pass (keep in sync with `CameraUniform` in
@@ -95,6 +117,8 @@ pub struct CameraUniform {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct LookUniform {
+    /// Emitter simulation space → clip (camera-relative, composed in f64).
+    pub clip_from_sim: [[f32; 4]; 4],
     /// Gradient colours (linear RGBA).
     pub colors: [[f32; 4]; 8],
     /// Gradient stop positions, four per vec4.
@@ -114,7 +138,7 @@ pub struct ToneUniform {
 }
 
 /// Byte stride between per-step `SimParams` blocks (the dynamic-offset alignment).
-pub const PARAMS_STRIDE: u64 = 256;
+pub const PARAMS_STRIDE: u64 = 512;
 
 const _: () = assert!(std::mem::size_of::<SimParams>() as u64 <= PARAMS_STRIDE);
 const _: () = assert!(std::mem::size_of::<Particle>() == 32);

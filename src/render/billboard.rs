@@ -241,8 +241,15 @@ impl BillboardPass {
         let mut blocks = vec![0u8; n * PARAMS_STRIDE as usize];
         for (i, e) in effect.emitters.iter().enumerate() {
             let at = i * PARAMS_STRIDE as usize;
-            blocks[at..at + size_of::<LookUniform>()]
-                .copy_from_slice(bytemuck::bytes_of(&look_uniform(&e.look)));
+            let mut u = look_uniform(&e.look);
+            let origin = sim
+                .planner
+                .emitters
+                .get(i)
+                .map(|p| p.origin())
+                .unwrap_or_default();
+            u.clip_from_sim = camera.clip_from_sim(aspect, origin).to_cols_array_2d();
+            blocks[at..at + size_of::<LookUniform>()].copy_from_slice(bytemuck::bytes_of(&u));
         }
         if !blocks.is_empty() {
             ctx.queue.write_buffer(&self.looks, 0, &blocks);

@@ -53,6 +53,31 @@ impl OrbitCamera {
             * self.view_from_world()
     }
 
+    /// World → clip in f64, for composing with far-away simulation origins.
+    pub fn clip_from_world_f64(&self, aspect: f32) -> glam::DMat4 {
+        let eye = self.eye().as_dvec3();
+        let view =
+            glam::dcamera::rh::view::look_at_mat4(eye, self.target.as_dvec3(), glam::DVec3::Y);
+        let near = (self.distance as f64 * 0.01).max(1e-3);
+        let far = self.distance as f64 * 100.0 + 100.0;
+        let f = 1.0 / (0.5 * self.fov_y as f64).tan();
+        let aspect = aspect.max(1e-3) as f64;
+        // Right-handed, depth 0..1 (wgpu), like `clip_from_world`.
+        let r = far / (near - far);
+        let proj = glam::DMat4::from_cols(
+            glam::DVec4::new(f / aspect, 0.0, 0.0, 0.0),
+            glam::DVec4::new(0.0, f, 0.0, 0.0),
+            glam::DVec4::new(0.0, 0.0, r, -1.0),
+            glam::DVec4::new(0.0, 0.0, r * near, 0.0),
+        );
+        proj * view
+    }
+
+    /// Simulation space with origin `origin` → clip, composed in f64 and rounded once.
+    pub fn clip_from_sim(&self, aspect: f32, origin: glam::DVec3) -> Mat4 {
+        (self.clip_from_world_f64(aspect) * glam::DMat4::from_translation(origin)).as_mat4()
+    }
+
     /// The uniform block for the billboard pass.
     pub fn uniform(&self, aspect: f32, alpha: f32) -> CameraUniform {
         let view = self.view_from_world();

@@ -124,6 +124,7 @@ impl Renderer {
 
     /// Records the frame into `enc`: particles into the HDR target, then the tonemap
     /// into the display texture.
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
         ctx: &GpuContext,

@@ -2,11 +2,12 @@
 //! Keep in sync with `shaders/update.wgsl`, `spawn.wgsl`, `forces.wgsl`,
 //! `integrators.wgsl` and `noise.wgsl`.
 
-use glam::{Mat3, Mat4, Vec3, Vec4};
+use glam::{DVec3, Mat3, Mat4, Vec3, Vec4};
 
-use crate::effect::Integrator;
+use crate::effect::{Emitter, Integrator};
 use crate::gpu::types::{Particle, SimParams};
 use crate::rng;
+use crate::sim::modules::Modules;
 use crate::sim::planner::mix;
 
 /// A CPU particle pool stepped with exactly the GPU's inputs.
@@ -18,6 +19,8 @@ pub struct CpuSim {
     pub integrator: Integrator,
     /// Particles killed by the non-finite guard.
     pub nonfinite_killed: u64,
+    /// Modules compiled in (the GPU's `MOD_*` constants).
+    pub modules: Modules,
 }
 
 impl CpuSim {
@@ -27,6 +30,15 @@ impl CpuSim {
             particles: vec![Particle::default(); capacity as usize],
             integrator,
             nonfinite_killed: 0,
+            modules: Modules::DRAG,
+        }
+    }
+
+    /// A pool configured like the GPU pipeline for emitter `e`.
+    pub fn for_emitter(e: &Emitter) -> Self {
+        Self {
+            modules: Modules::of(e),
+            ..Self::new(e.capacity, e.integrator)
         }
     }
 
@@ -47,19 +59,34 @@ impl CpuSim {
                 q.pos_age = [pos.x, pos.y, pos.z, age0];
                 *p = q;
             } else if p.is_alive() {
-                let (x, v) = integrate(
-                    self.integrator,
+                let life = p.vel_life[3];
+                let forces = Forces {
                     params,
+                    modules: self.modules,
+                };
+                let (mut x, mut v) = integrate(
+                    self.integrator,
+                    &forces,
                     p.position(),
                     p.velocity(),
                     p.pos_age[3],
+                    life,
+                    params.wind_time[3],
                     params.dt_secs,
                 );
-                let age = p.pos_age[3] + params.dt_secs;
+                let mut age = p.pos_age[3] + params.dt_secs;
+                if self.modules.contains(Modules::COLLISIONS) {
+                    let c = collide(params, p.position(), x, v);
+                    x = c.0;
+                    v = c.1;
+                    if c.2 {
+                        age = life;
+                    }
+                }
                 if x.is_finite() && v.is_finite() {
                     *p = Particle {
                         pos_age: [x.x, x.y, x.z, age],
-                        vel_life: [v.x, v.y, v.z, p.vel_life[3]],
+                        vel_life: [v.x, v.y, v.z, life],
                     };
                 } else {
                     *p = Particle::default();
@@ -187,10 +214,223 @@ pub fn spawn_particle(params: &SimParams, key: [u32; 4]) -> Particle {
     }
 }
 
-/// `acceleration` in forces.wgsl.
-pub fn acceleration(params: &SimParams, _pos: Vec3, vel: Vec3, _age: f32) -> Vec3 {
-    let k = params.accel_drag[3];
-    Vec3::from_slice(&params.accel_drag[..3]) - k * (vel - Vec3::from_slice(&params.wind_time[..3]))
+/// The force model of forces.wgsl for one step's parameters and module set, evaluated in
+/// f64 (the f32 reference rounds the result; the accuracy bench uses it as is).
+pub struct Forces<'a> {
+    /// The step's parameter block.
+    pub params: &'a SimParams,
+    /// Modules compiled in.
+    pub modules: Modules,
+}
+
+fn d3(v: [f32; 4]) -> DVec3 {
+    DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64)
+}
+
+impl Forces<'_> {
+    /// The linear drag rate k the exponential integrator uses.
+    pub fn linear_drag_k(&self) -> f64 {
+        if self.modules.contains(Modules::DRAG) {
+            self.params.accel_drag[3] as f64
+        } else {
+            0.0
+        }
+    }
+
+    /// `acceleration` in forces.wgsl, in f64.
+    pub fn acceleration(&self, pos: DVec3, vel: DVec3, age: f64, life: f64, time: f64) -> DVec3 {
+        let p = self.params;
+        let m = self.modules;
+        let mut a = d3(p.accel_drag);
+        let mut wind = d3(p.wind_time);
+        if m.contains(Modules::GUSTS) {
+            let g = p.gusts_qdrag_pull;
+            let n = value_noise3_f64(DVec3::new(time * g[1] as f64, 0.5, 0.5), p.seed ^ 0x6057)
+                * 2.0
+                - 1.0;
+            wind *= 1.0 + g[0] as f64 * n;
+        }
+        if m.contains(Modules::DRAG) {
+            a -= p.accel_drag[3] as f64 * (vel - wind);
+        }
+        if m.contains(Modules::QUADRATIC_DRAG) {
+            let rel = vel - wind;
+            a -= p.gusts_qdrag_pull[2] as f64 * rel.length() * rel;
+        }
+        if m.contains(Modules::TURBULENCE) {
+            let t = p.turbulence;
+            let q = (pos - DVec3::new(0.0, t[3] as f64 * time, 0.0)) * t[1] as f64;
+            a += t[0] as f64 * curl_noise(q, p.seed ^ p.emitter_salt, t[2] as u32) / 1.5;
+        }
+        if m.contains(Modules::VORTEX) {
+            let axis = d3(p.vortex_axis);
+            let r = pos - d3(p.vortex_center);
+            let radial = r - axis * r.dot(axis);
+            let d = radial.length();
+            if d >= 1e-6 {
+                let rr = p.vortex_center[3] as f64;
+                let falloff = (-(d * d) / (rr * rr).max(1e-6)).exp();
+                a += p.vortex_axis[3] as f64 * falloff * axis.cross(radial / d);
+            }
+        }
+        if m.contains(Modules::ATTRACTOR) {
+            let to = d3(p.attractor) - pos;
+            let r2 = to.length_squared();
+            let radius = p.attractor_b[0] as f64;
+            let s = p.attractor[3] as f64;
+            if p.attractor_b[1] > 0.5 {
+                if r2 <= radius * radius && r2 >= 1e-12 {
+                    a += s * to / r2.sqrt();
+                }
+            } else {
+                let soft = r2 + radius * radius;
+                a += s * to / (soft * soft.sqrt());
+            }
+        }
+        if m.contains(Modules::FLAME_PULL) {
+            let r = pos - d3(p.axis_origin);
+            let axis = d3(p.axis_dir);
+            let radial = r - axis * r.dot(axis);
+            let t = (age / life.max(1e-6)).clamp(0.0, 1.0);
+            a -= p.gusts_qdrag_pull[3] as f64 * t.powf(p.attractor_b[2] as f64) * radial;
+        }
+        a
+    }
+
+    fn acc32(&self, x: Vec3, v: Vec3, age: f32, life: f32, time: f32) -> Vec3 {
+        self.acceleration(
+            x.as_dvec3(),
+            v.as_dvec3(),
+            age as f64,
+            life as f64,
+            time as f64,
+        )
+        .as_vec3()
+    }
+}
+
+/// `value_noise3` in noise.wgsl, in f64.
+pub fn value_noise3_f64(p: DVec3, seed: u32) -> f64 {
+    value_noise3_grad(p, seed).1
+}
+
+fn fade64(t: f64) -> f64 {
+    t * t * t * (t * (t * 6.0 - 15.0) + 10.0)
+}
+
+fn fade64_deriv(t: f64) -> f64 {
+    30.0 * t * t * (t * (t - 2.0) + 1.0)
+}
+
+/// `value_noise3_grad` in noise.wgsl: (∇n, n), in f64.
+pub fn value_noise3_grad(p: DVec3, seed: u32) -> (DVec3, f64) {
+    let cell = p.floor();
+    let f = p - cell;
+    let c = [cell.x as i32, cell.y as i32, cell.z as i32];
+    let h =
+        |dx: i32, dy: i32, dz: i32| rng::hash_cell([c[0] + dx, c[1] + dy, c[2] + dz], seed) as f64;
+    let u = DVec3::new(fade64(f.x), fade64(f.y), fade64(f.z));
+    let du = DVec3::new(fade64_deriv(f.x), fade64_deriv(f.y), fade64_deriv(f.z));
+    let (a, b, cc, d) = (h(0, 0, 0), h(1, 0, 0), h(0, 1, 0), h(1, 1, 0));
+    let (e, ff, g, hh) = (h(0, 0, 1), h(1, 0, 1), h(0, 1, 1), h(1, 1, 1));
+    let k1 = b - a;
+    let k2 = cc - a;
+    let k3 = e - a;
+    let k4 = a - b - cc + d;
+    let k5 = a - cc - e + g;
+    let k6 = a - b - e + ff;
+    let k7 = -a + b + cc - d + e - ff - g + hh;
+    let n = a
+        + k1 * u.x
+        + k2 * u.y
+        + k3 * u.z
+        + k4 * u.x * u.y
+        + k5 * u.y * u.z
+        + k6 * u.z * u.x
+        + k7 * u.x * u.y * u.z;
+    let grad = du
+        * DVec3::new(
+            k1 + k4 * u.y + k6 * u.z + k7 * u.y * u.z,
+            k2 + k4 * u.x + k5 * u.z + k7 * u.x * u.z,
+            k3 + k5 * u.y + k6 * u.x + k7 * u.x * u.y,
+        );
+    (grad, n)
+}
+
+/// `curl_noise` in noise.wgsl, in f64.
+pub fn curl_noise(p: DVec3, seed: u32, octaves: u32) -> DVec3 {
+    let mut sum = DVec3::ZERO;
+    let mut freq = 1.0;
+    let mut amp = 1.0;
+    for o in 0..octaves {
+        let q = p * freq;
+        let s = seed.wrapping_add(o * 3);
+        let gx = value_noise3_grad(q, s).0;
+        let gy = value_noise3_grad(q + DVec3::new(31.416, 47.853, 12.793), s.wrapping_add(1)).0;
+        let gz = value_noise3_grad(q + DVec3::new(-17.231, 5.117, 63.941), s.wrapping_add(2)).0;
+        sum += amp * freq * DVec3::new(gz.y - gy.z, gx.z - gz.x, gy.x - gx.y);
+        freq *= 2.0;
+        amp *= 0.5;
+    }
+    sum
+}
+
+/// `collide` in collide.wgsl: (position, velocity, killed).
+pub fn collide(params: &SimParams, old: Vec3, pos_in: Vec3, vel_in: Vec3) -> (Vec3, Vec3, bool) {
+    let bounce = |vel: Vec3, n: Vec3| -> Vec3 {
+        let vn = vel.dot(n);
+        if vn >= 0.0 {
+            return vel;
+        }
+        let tangent = (vel - vn * n) * (1.0 - params.ground[2]).max(0.0);
+        let mut out_n = -vn * params.ground[1];
+        if out_n < params.collide_b[0] {
+            out_n = 0.0;
+        }
+        tangent + out_n * n
+    };
+    let (mut pos, mut vel) = (pos_in, vel_in);
+    let count = (params.collide_b[1] as u32).min(4);
+    for s in &params.spheres[..count as usize] {
+        let center = Vec3::new(s[0], s[1], s[2]);
+        let d = pos - old;
+        let f = old - center;
+        let r2 = s[3] * s[3];
+        let a = d.dot(d);
+        let b = f.dot(d);
+        let c = f.dot(f) - r2;
+        let mut hit = (pos - center).length_squared() < r2;
+        let mut t_hit = 1.0;
+        if a > 1e-12 && c > 0.0 {
+            let disc = b * b - a * c;
+            if disc >= 0.0 {
+                let t = (-b - disc.sqrt()) / a;
+                if (0.0..=1.0).contains(&t) {
+                    hit = true;
+                    t_hit = t;
+                }
+            }
+        }
+        if hit {
+            if params.collide_b[2] > 0.5 {
+                return (pos, vel, true);
+            }
+            let contact = if c > 0.0 { old + d * t_hit } else { pos };
+            let n = contact - center;
+            let len = n.length();
+            let n = if len > 1e-6 { n / len } else { Vec3::Y };
+            pos = center + n * (s[3] * 1.0001);
+            vel = bounce(vel, n);
+        }
+    }
+    if params.collide_b[3] > 0.5 && pos.y < params.ground[0] {
+        if params.ground[3] > 0.5 {
+            return (pos, vel, true);
+        }
+        pos.y = params.ground[0];
+        vel = bounce(vel, Vec3::Y);
+    }
+    (pos, vel, false)
 }
 
 /// `exp_phi_psi` in integrators.wgsl: phi = (1 − e^{−k dt})/k, psi = (dt − phi)/k.
@@ -218,16 +458,20 @@ pub fn exp_phi_psi(k: f32, dt: f32) -> (f32, f32) {
     (phi, (dt - phi) / k)
 }
 
-/// `integrate` in integrators.wgsl.
+/// `integrate` in integrators.wgsl (f32 state, forces evaluated as the GPU does).
+#[allow(clippy::too_many_arguments)]
 pub fn integrate(
     method: Integrator,
-    params: &SimParams,
+    forces: &Forces<'_>,
     x: Vec3,
     v: Vec3,
     age: f32,
+    life: f32,
+    time: f32,
     dt: f32,
 ) -> (Vec3, Vec3) {
-    let acc = |x: Vec3, v: Vec3, age: f32| acceleration(params, x, v, age);
+    // Ages and times advance together within a step, as in the shader.
+    let acc = |x: Vec3, v: Vec3, a: f32| forces.acc32(x, v, a, life, time + (a - age));
     match method {
         Integrator::ExplicitEuler => {
             let a = acc(x, v, age);
@@ -266,7 +510,7 @@ pub fn integrate(
             )
         }
         Integrator::Exponential => {
-            let k = params.accel_drag[3];
+            let k = forces.linear_drag_k() as f32;
             let f = acc(x, v, age) + k * v;
             let (phi, psi) = exp_phi_psi(k, dt);
             let e = 1.0 - k * phi;

@@ -6,6 +6,7 @@ use crate::effect::{Effect, Integrator};
 use crate::gpu::types::{PARAMS_STRIDE, Particle, SimParams};
 use crate::gpu::{GpuContext, GpuError};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
+use crate::sim::modules::Modules;
 use crate::sim::planner::EffectPlanner;
 
 /// Steps recorded per submission (the per-step params blocks live side by side).
@@ -25,11 +26,19 @@ pub enum SimError {
     Readback(String),
 }
 
-/// The update pipelines (one per integrator, built on demand) and their layout.
+/// What specialises an update pipeline: the integrator and the modules compiled in.
+pub type PipelineKey = (Integrator, Modules);
+
+/// The pipeline key an emitter needs.
+pub fn pipeline_key(e: &crate::effect::Emitter) -> PipelineKey {
+    (e.integrator, Modules::of(e))
+}
+
+/// The update pipelines (one per integrator × module set, built on demand) and their layout.
 pub struct UpdatePass {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
-    pipelines: HashMap<Integrator, wgpu::ComputePipeline>,
+    pipelines: HashMap<PipelineKey, wgpu::ComputePipeline>,
     /// Files the current pipelines were built from.
     pub files: Vec<String>,
 }
@@ -88,11 +97,13 @@ impl UpdatePass {
         &mut self,
         ctx: &GpuContext,
         lib: &ShaderLibrary,
-        integrators: &[Integrator],
+        keys: &[PipelineKey],
     ) -> Result<(), ShaderError> {
         let composed = lib.compose("update.wgsl")?;
         let mut fresh = HashMap::new();
-        for &integrator in integrators {
+        for &(integrator, modules) in keys {
+            let mut constants = modules.constants();
+            constants.push(("INTEGRATOR", integrator.index() as f64));
             let pipeline = create_checked(&ctx.device, &composed, lib, |module| {
                 ctx.device
                     .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -101,13 +112,13 @@ impl UpdatePass {
                         module,
                         entry_point: Some("main"),
                         compilation_options: wgpu::PipelineCompilationOptions {
-                            constants: &[("INTEGRATOR", integrator.index() as f64)],
+                            constants: &constants,
                             zero_initialize_workgroup_memory: true,
                         },
                         cache: None,
                     })
             })?;
-            fresh.insert(integrator, pipeline);
+            fresh.insert((integrator, modules), pipeline);
         }
         self.pipelines = fresh;
         self.files = composed.files;
@@ -118,13 +129,13 @@ impl UpdatePass {
         &mut self,
         ctx: &GpuContext,
         lib: &ShaderLibrary,
-        integrator: Integrator,
+        key: PipelineKey,
     ) -> Result<(), ShaderError> {
-        if self.pipelines.contains_key(&integrator) {
+        if self.pipelines.contains_key(&key) {
             return Ok(());
         }
-        let mut wanted: Vec<Integrator> = self.pipelines.keys().copied().collect();
-        wanted.push(integrator);
+        let mut wanted: Vec<PipelineKey> = self.pipelines.keys().copied().collect();
+        wanted.push(key);
         self.rebuild(ctx, lib, &wanted)
     }
 }
@@ -175,8 +186,7 @@ impl GpuSim {
         effect: &Effect,
     ) -> Result<Self, SimError> {
         let mut update = UpdatePass::new(ctx);
-        let integrators = used_integrators(effect);
-        update.rebuild(ctx, &library, &integrators)?;
+        update.rebuild(ctx, &library, &used_keys(effect))?;
         let mut sim = Self {
             ctx: ctx.clone(),
             library,
@@ -214,7 +224,7 @@ impl GpuSim {
         effect: &Effect,
     ) -> Result<(), ShaderError> {
         self.update
-            .rebuild(&self.ctx, &library, &used_integrators(effect))?;
+            .rebuild(&self.ctx, &library, &used_keys(effect))?;
         self.library = library;
         Ok(())
     }
@@ -267,8 +277,8 @@ impl GpuSim {
                     self.bind_groups(&self.emitters[i].buffers, &self.emitters[i].counters);
             }
         }
-        for integrator in used_integrators(effect) {
-            self.update.ensure(&self.ctx, &self.library, integrator)?;
+        for key in used_keys(effect) {
+            self.update.ensure(&self.ctx, &self.library, key)?;
         }
         Ok(())
     }
@@ -362,6 +372,36 @@ impl GpuSim {
 
     /// Records the planned steps (one `SimParams` per enabled emitter and step) and submits.
     pub fn record_and_submit(&mut self, effect: &Effect, plans: &[Vec<Option<SimParams>>]) {
+        let mut enc = self
+            .ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("GpuSim::step"),
+            });
+        self.record(&mut enc, effect, plans);
+        self.ctx.queue.submit([enc.finish()]);
+    }
+
+    /// Plans `steps` steps of `dt_secs` (at most 32: the params ring holds that many).
+    pub fn plan(
+        &mut self,
+        effect: &Effect,
+        dt_secs: f32,
+        steps: usize,
+    ) -> Vec<Vec<Option<SimParams>>> {
+        (0..steps.min(STEPS_PER_SUBMIT))
+            .map(|_| self.planner.plan_step(effect, dt_secs))
+            .collect()
+    }
+
+    /// Uploads the planned blocks and records their dispatches into `enc`. Submit `enc`
+    /// before the next call (the blocks share one buffer).
+    pub fn record(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        effect: &Effect,
+        plans: &[Vec<Option<SimParams>>],
+    ) {
         let n_emitters = self.emitters.len();
         let mut blocks = vec![0u8; plans.len() * n_emitters * PARAMS_STRIDE as usize];
         for (s, plan) in plans.iter().enumerate() {
@@ -373,19 +413,16 @@ impl GpuSim {
             }
         }
         self.ctx.queue.write_buffer(&self.params_buffer, 0, &blocks);
-        let mut enc = self
-            .ctx
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("GpuSim::step"),
-            });
         enc.push_debug_group("update particles");
         for (s, plan) in plans.iter().enumerate() {
             for (e, params) in plan.iter().enumerate() {
                 let (Some(p), Some(em)) = (params, self.emitters.get_mut(e)) else {
                     continue;
                 };
-                let Some(pipeline) = self.update.pipelines.get(&effect.emitters[e].integrator)
+                let Some(pipeline) = self
+                    .update
+                    .pipelines
+                    .get(&pipeline_key(&effect.emitters[e]))
                 else {
                     continue;
                 };
@@ -404,7 +441,6 @@ impl GpuSim {
             }
         }
         enc.pop_debug_group();
-        self.ctx.queue.submit([enc.finish()]);
     }
 
     /// Follows a structural edit of the effect's emitter list (reorder, insert, remove):
@@ -451,6 +487,26 @@ impl GpuSim {
     /// Number of emitter pools.
     pub fn emitter_count(&self) -> usize {
         self.emitters.len()
+    }
+
+    /// Overwrites emitter `index`'s current (and previous) state (benches and tests that
+    /// need an exact initial condition). `particles` is truncated to the capacity.
+    pub fn write_particles(
+        &mut self,
+        index: usize,
+        particles: &[Particle],
+    ) -> Result<(), SimError> {
+        let s = self
+            .emitters
+            .get(index)
+            .ok_or_else(|| SimError::Readback(format!("no emitter {index}")))?;
+        let n = particles.len().min(s.capacity as usize);
+        for b in &s.buffers {
+            self.ctx
+                .queue
+                .write_buffer(b, 0, bytemuck::cast_slice(&particles[..n]));
+        }
+        Ok(())
     }
 
     /// Reads emitter `index`'s current state back (blocking; tests and tools).
@@ -500,13 +556,13 @@ pub fn dispatch_size(slots: u32) -> (u32, u32) {
     (x, groups.div_ceil(x))
 }
 
-/// Every integrator the effect uses (so only those pipelines are built).
-pub fn used_integrators(effect: &Effect) -> Vec<Integrator> {
-    let mut v: Vec<Integrator> = effect.emitters.iter().map(|e| e.integrator).collect();
-    v.sort_by_key(|i| i.index());
+/// Every pipeline key the effect uses (so only those pipelines are built).
+pub fn used_keys(effect: &Effect) -> Vec<PipelineKey> {
+    let mut v: Vec<PipelineKey> = effect.emitters.iter().map(pipeline_key).collect();
+    v.sort_by_key(|(i, m)| (i.index(), *m));
     v.dedup();
     if v.is_empty() {
-        v.push(Integrator::SemiImplicitEuler);
+        v.push((Integrator::SemiImplicitEuler, Modules::DRAG));
     }
     v
 }

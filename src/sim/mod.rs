@@ -3,10 +3,12 @@
 
 pub mod cpu_reference;
 pub mod gpu_sim;
+pub mod modules;
 pub mod planner;
 pub mod stepper;
 
 pub use cpu_reference::CpuSim;
 pub use gpu_sim::{GpuSim, SimError};
+pub use modules::Modules;
 pub use planner::{EffectPlanner, EmitterPlanner, SpawnStats};
 pub use stepper::{StepPlan, Stepper};

@@ -36,6 +36,8 @@ pub struct EmitterPlanner {
     /// Running statistics.
     pub stats: SpawnStats,
     history: VecDeque<Batch>,
+    /// The origin of this emitter's simulation space, fixed at its first step.
+    origin: Option<glam::DVec3>,
 }
 
 /// Plans every emitter of an effect, step after step.
@@ -138,8 +140,10 @@ impl EmitterPlanner {
         self.spawned_total += count;
         self.stats.spawned += count;
 
+        let origin = *self.origin.get_or_insert_with(|| sim_origin_for(e));
         build_params(
             e,
+            origin,
             seed,
             salt,
             dt_secs,
@@ -188,6 +192,14 @@ impl EmitterPlanner {
         }
     }
 
+    /// The world position of this emitter's simulation space (particle positions are
+    /// stored relative to it, so an effect far from the world origin keeps full f32
+    /// precision). Fixed at the first step; world-space behaviour is kept when the
+    /// emitter moves later.
+    pub fn origin(&self) -> glam::DVec3 {
+        self.origin.unwrap_or_default()
+    }
+
     /// The spawn counter: how many particles this emitter has started.
     pub fn spawned_total(&self) -> u64 {
         self.spawned_total
@@ -207,10 +219,17 @@ impl SimParams {
     }
 }
 
-/// Builds the uniform block for one emitter and one step.
+/// The simulation-space origin an emitter gets: its position, in f64.
+pub fn sim_origin_for(e: &Emitter) -> glam::DVec3 {
+    glam::Vec3::from(e.transform.position_m).as_dvec3()
+}
+
+/// Builds the uniform block for one emitter and one step. Every position in it is
+/// relative to `origin` (the emitter's simulation space).
 #[allow(clippy::too_many_arguments)]
 pub fn build_params(
     e: &Emitter,
+    origin: glam::DVec3,
     seed: u32,
     salt: u32,
     dt_secs: f32,
@@ -240,13 +259,69 @@ pub fn build_params(
         Shape::Line { a_m, b_m } => ([a_m[0], a_m[1], a_m[2], 0.0], [b_m[0], b_m[1], b_m[2], 0.0]),
     };
     let dir = glam::Vec3::from(e.direction).normalize_or(glam::Vec3::Y);
+    // Translation relative to the simulation origin, computed in f64.
+    let mut world = e.transform.world_from_emitter();
+    let rel = (glam::Vec3::from(e.transform.position_m).as_dvec3() - origin).as_vec3();
+    world.w_axis = rel.extend(1.0);
+    let local = |p: [f32; 3]| (glam::Vec3::from(p).as_dvec3() - origin).as_vec3();
+    let axis_origin = rel;
+    let world_dir = world.transform_vector3(dir).normalize_or(glam::Vec3::Y);
+    let f = &e.forces;
+    let turbulence = f.turbulence.as_ref().map_or([0.0; 4], |t| {
+        [
+            t.strength_m_per_s2,
+            t.frequency_per_m,
+            t.octaves.clamp(1, 4) as f32,
+            t.scroll_m_per_s,
+        ]
+    });
+    let (gust_strength, gust_hz) = f
+        .gusts
+        .as_ref()
+        .map_or((0.0, 0.0), |g| (g.strength, g.frequency_hz));
+    let (pull, pull_exp) = f
+        .flame_pull
+        .as_ref()
+        .map_or((0.0, 1.0), |p| (p.strength_per_s2, p.exponent));
+    let (vortex_center, vortex_axis) =
+        f.vortex
+            .as_ref()
+            .map_or(([0.0; 4], [0.0, 1.0, 0.0, 0.0]), |v| {
+                let a = glam::Vec3::from(v.axis).normalize_or(glam::Vec3::Y);
+                (
+                    [v.center_m[0], v.center_m[1], v.center_m[2], v.radius_m],
+                    [a.x, a.y, a.z, v.swirl_m_per_s2],
+                )
+            });
+    let (attractor, attractor_mode, attractor_radius) =
+        f.attractor.as_ref().map_or(([0.0; 4], 0.0, 1.0), |a| {
+            (
+                [
+                    a.position_m[0],
+                    a.position_m[1],
+                    a.position_m[2],
+                    a.strength,
+                ],
+                match a.falloff {
+                    crate::effect::Falloff::InverseSquare => 0.0,
+                    crate::effect::Falloff::ConstantWithinRadius => 1.0,
+                },
+                a.radius_m,
+            )
+        });
+    let col = &e.collisions;
+    let mut spheres = [[0.0f32; 4]; 4];
+    for (slot, s) in spheres.iter_mut().zip(&col.spheres) {
+        *slot = local(s.center_m).extend(s.radius_m).to_array();
+    }
+    let ground = col.ground.as_ref();
     let accel = e.forces.constant_acceleration();
     let wind = e.forces.wind_m_per_s;
     let n = &e.spawn_noise;
     // Noise time wraps every 4096 s so the f32 never grows large.
     let noise_time = t0_secs.rem_euclid(4096.0) as f32;
     SimParams {
-        world_from_emitter: e.transform.world_from_emitter().to_cols_array_2d(),
+        world_from_emitter: world.to_cols_array_2d(),
         shape_a,
         shape_b,
         direction_spread: [dir.x, dir.y, dir.z, e.spread_deg.to_radians()],
@@ -276,5 +351,30 @@ pub fn build_params(
         flags: 0,
         spawn_frac0: 0.0,
         spawn_frac_step: 0.0,
+        turbulence,
+        gusts_qdrag_pull: [gust_strength, gust_hz, f.quadratic_drag_per_m, pull],
+        vortex_center,
+        vortex_axis,
+        attractor,
+        attractor_b: [attractor_radius, attractor_mode, pull_exp, 0.0],
+        axis_origin: axis_origin.extend(0.0).to_array(),
+        axis_dir: [world_dir.x, world_dir.y, world_dir.z, 0.0],
+        ground: [
+            ground.map_or(0.0, |g| (g.height_m as f64 - origin.y) as f32),
+            col.elasticity,
+            col.friction,
+            if ground.is_some_and(|g| g.kill_on_contact) {
+                1.0
+            } else {
+                0.0
+            },
+        ],
+        collide_b: [
+            col.rest_speed_m_per_s,
+            col.spheres.len().min(4) as f32,
+            if col.kill_on_sphere_contact { 1.0 } else { 0.0 },
+            if ground.is_some() { 1.0 } else { 0.0 },
+        ],
+        spheres,
     }
 }

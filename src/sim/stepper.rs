@@ -32,8 +32,9 @@ impl Stepper {
             TimeMode::FixedStep => {
                 let dt = time.step_secs as f64;
                 self.accumulator_secs += scaled;
-                let wanted = (self.accumulator_secs / dt).floor();
-                self.accumulator_secs -= wanted * dt;
+                // A hair of tolerance so 2 s of 1/144 s frames is exactly 240 steps of 1/120 s.
+                let wanted = (self.accumulator_secs / dt + 1e-9).floor();
+                self.accumulator_secs = (self.accumulator_secs - wanted * dt).max(0.0);
                 let mut steps = wanted as u64;
                 if steps > time.max_substeps as u64 {
                     // Drop the excess: a hitch must not snowball into a spiral of death.

@@ -1,0 +1,663 @@
+//! `ignis bench accuracy`: the speed/accuracy trade of every integrator, measured.
+//!
+//! Scene 1 (closed form): constant acceleration with linear drag toward a wind; the exact
+//! solution is known. Scene 2 (turbulent): scene 1 plus curl-noise turbulence; the
+//! reference is RK4 in f64 on the CPU at dt/64. Each run spawns one burst, reads the state
+//! after the spawn step as the initial condition, runs T = 2 s on the GPU and compares.
+
+use glam::DVec3;
+use serde::Serialize;
+
+use crate::effect::{
+    Burst, Effect, Emitter, Integrator, Range, Shape, SpawnNoise, TimeMode, Turbulence,
+};
+use crate::gpu::GpuContext;
+use crate::gpu::timer::{GpuTimer, median};
+use crate::gpu::types::Particle;
+use crate::headless::Headless;
+use crate::shaders::ShaderLibrary;
+use crate::sim::cpu_reference::Forces;
+use crate::sim::{GpuSim, Modules, SimError};
+
+/// The step sizes measured (seconds).
+pub const DTS: [f64; 6] = [
+    1.0 / 480.0,
+    1.0 / 240.0,
+    1.0 / 120.0,
+    1.0 / 60.0,
+    1.0 / 30.0,
+    1.0 / 15.0,
+];
+/// Simulated duration of each run (seconds).
+pub const T_SECS: f64 = 2.0;
+
+/// The two scenes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum Scene {
+    /// Constant acceleration + linear drag: exact solution.
+    ClosedForm,
+    /// Plus curl-noise turbulence: f64 RK4 reference at dt/64.
+    Turbulent,
+}
+
+impl Scene {
+    /// Table label.
+    pub fn label(self) -> &'static str {
+        match self {
+            Scene::ClosedForm => "scene 1: gravity + buoyancy + linear drag (exact)",
+            Scene::Turbulent => "scene 2: + curl-noise turbulence (f64 RK4 at dt/64)",
+        }
+    }
+}
+
+/// The emitter of a scene: one burst of `n` particles with random velocities.
+pub fn scene_emitter(scene: Scene, integrator: Integrator, n: u32) -> Emitter {
+    let mut e = Emitter {
+        name: "bench".into(),
+        capacity: n,
+        spawn_rate_per_sec: 0.0,
+        max_spawn_per_step: n,
+        bursts: vec![Burst {
+            time_secs: 0.0,
+            count: n,
+        }],
+        lifetime_secs: Range::new(1000.0, 1000.0),
+        shape: Shape::Sphere {
+            radius_m: 0.2,
+            surface_only: false,
+        },
+        spread_deg: 60.0,
+        speed_m_per_s: Range::new(0.5, 3.0),
+        spawn_noise: SpawnNoise {
+            position_amplitude_m: 0.0,
+            direction_amplitude: 0.0,
+            ..SpawnNoise::default()
+        },
+        integrator,
+        ..Emitter::default()
+    };
+    e.forces.gravity_m_per_s2 = [0.0, -9.81, 0.0];
+    e.forces.buoyancy_m_per_s2 = 11.0;
+    e.forces.drag_per_sec = 1.5;
+    e.forces.wind_m_per_s = [0.5, 0.0, 0.2];
+    if scene == Scene::Turbulent {
+        e.forces.turbulence = Some(Turbulence {
+            strength_m_per_s2: 3.0,
+            frequency_per_m: 1.5,
+            octaves: 2,
+            scroll_m_per_s: 0.5,
+        });
+    }
+    e
+}
+
+/// The exact solution of x'' = c − k x' from (x0, v0) after t (c = a + k·wind).
+pub fn exact_state(x0: DVec3, v0: DVec3, a: DVec3, k: f64, wind: DVec3, t: f64) -> (DVec3, DVec3) {
+    let c = a + k * wind;
+    if k == 0.0 {
+        return (x0 + v0 * t + 0.5 * a * t * t, v0 + a * t);
+    }
+    let vt = c / k;
+    let e = (-k * t).exp();
+    (x0 + vt * t + (v0 - vt) * (1.0 - e) / k, vt + (v0 - vt) * e)
+}
+
+/// RK4 in f64 on the CPU from `t0` over `t` with `substeps` steps.
+#[allow(clippy::too_many_arguments)]
+pub fn reference_rk4(
+    forces: &Forces<'_>,
+    x0: DVec3,
+    v0: DVec3,
+    age0: f64,
+    life: f64,
+    t0: f64,
+    t: f64,
+    substeps: u32,
+) -> DVec3 {
+    let h = t / substeps as f64;
+    let (mut x, mut v) = (x0, v0);
+    for i in 0..substeps {
+        let time = t0 + i as f64 * h;
+        let age = age0 + i as f64 * h;
+        let acc =
+            |x: DVec3, v: DVec3, dt: f64| forces.acceleration(x, v, age + dt, life, time + dt);
+        let k1v = acc(x, v, 0.0);
+        let k1x = v;
+        let k2x = v + 0.5 * h * k1v;
+        let k2v = acc(x + 0.5 * h * k1x, k2x, 0.5 * h);
+        let k3x = v + 0.5 * h * k2v;
+        let k3v = acc(x + 0.5 * h * k2x, k3x, 0.5 * h);
+        let k4x = v + h * k3v;
+        let k4v = acc(x + h * k3x, k4x, h);
+        x += h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
+        v += h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
+    }
+    x
+}
+
+/// One measured (scene, integrator, dt) point.
+#[derive(Clone, Debug, Serialize)]
+pub struct ErrorPoint {
+    /// Scene.
+    pub scene: Scene,
+    /// Integrator label.
+    pub integrator: &'static str,
+    /// Step size, seconds.
+    pub dt_secs: f64,
+    /// RMS over particles of |x − x_ref| / |x_ref − x0|.
+    pub rms_rel_error: f64,
+    /// Max over particles of the same.
+    pub max_rel_error: f64,
+}
+
+/// A scene's fixed initial condition and its reference solution at T.
+pub struct SceneSetup {
+    /// The scene.
+    pub scene: Scene,
+    /// Initial particles (born by the GPU spawn code, then frozen).
+    pub initial: Vec<Particle>,
+    /// Reference positions at `T_SECS`.
+    pub reference: Vec<DVec3>,
+}
+
+/// Spawns the scene's particles once and computes the reference: the closed form for
+/// scene 1, RK4 in f64 at (smallest dt)/64 for scene 2 (so at dt/64 or finer for every
+/// measured dt), on all CPU cores.
+pub fn setup_scene(ctx: &GpuContext, scene: Scene, n: u32) -> Result<SceneSetup, SimError> {
+    let e = scene_emitter(scene, Integrator::Rk4, n);
+    let effect = Effect {
+        emitters: vec![e.clone()],
+        ..Effect::default()
+    };
+    let mut sim = GpuSim::new(ctx, ShaderLibrary::embedded(), &effect)?;
+    sim.step(&effect, 1e-4, 1)?;
+    let mut initial = sim.read_particles(0)?;
+    for p in &mut initial {
+        p.pos_age[3] = 0.0;
+    }
+    let mut probe = sim.planner.clone();
+    let params = probe.plan_step(&effect, 1e-4)[0].unwrap_or_default();
+    let forces = Forces {
+        params: &params,
+        modules: Modules::of(&e),
+    };
+    let a = e.forces.constant_acceleration().as_dvec3();
+    let wind = glam::Vec3::from(e.forces.wind_m_per_s).as_dvec3();
+    let k = e.forces.drag_per_sec as f64;
+    let fine = (T_SECS / DTS[0]).round() as u32 * 64;
+    let solve = |p: &Particle| -> DVec3 {
+        let x0 = p.position().as_dvec3();
+        let v0 = p.velocity().as_dvec3();
+        match scene {
+            Scene::ClosedForm => exact_state(x0, v0, a, k, wind, T_SECS).0,
+            Scene::Turbulent => reference_rk4(
+                &forces,
+                x0,
+                v0,
+                0.0,
+                p.vel_life[3] as f64,
+                0.0,
+                T_SECS,
+                fine,
+            ),
+        }
+    };
+    let threads = std::thread::available_parallelism().map_or(2, |n| n.get());
+    let chunk = initial.len().div_ceil(threads).max(1);
+    let reference = std::thread::scope(|s| {
+        let handles: Vec<_> = initial
+            .chunks(chunk)
+            .map(|c| s.spawn(move || c.iter().map(solve).collect::<Vec<_>>()))
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().unwrap_or_default())
+            .collect::<Vec<_>>()
+    });
+    Ok(SceneSetup {
+        scene,
+        initial,
+        reference,
+    })
+}
+
+/// Runs `integrator` at `dt` from the scene's initial state for T = 2 s on the GPU and
+/// measures the error against the reference.
+pub fn measure_error(
+    ctx: &GpuContext,
+    setup: &SceneSetup,
+    integrator: Integrator,
+    dt: f64,
+) -> Result<ErrorPoint, SimError> {
+    let mut e = scene_emitter(setup.scene, integrator, setup.initial.len() as u32);
+    e.bursts.clear();
+    let effect = Effect {
+        emitters: vec![e],
+        ..Effect::default()
+    };
+    let mut sim = GpuSim::new(ctx, ShaderLibrary::embedded(), &effect)?;
+    sim.write_particles(0, &setup.initial)?;
+    let steps = (T_SECS / dt).round() as u32;
+    sim.step(&effect, dt as f32, steps)?;
+    let fin = sim.read_particles(0)?;
+    let mut sum = 0.0;
+    let mut max: f64 = 0.0;
+    for ((p0, p1), x_ref) in setup.initial.iter().zip(&fin).zip(&setup.reference) {
+        let x0 = p0.position().as_dvec3();
+        let travelled = (*x_ref - x0).length().max(1e-9);
+        let err = (p1.position().as_dvec3() - *x_ref).length() / travelled;
+        let err = if err.is_finite() && p1.is_alive() {
+            err
+        } else {
+            f64::INFINITY
+        };
+        sum += err * err;
+        max = max.max(err);
+    }
+    Ok(ErrorPoint {
+        scene: setup.scene,
+        integrator: integrator.label(),
+        dt_secs: dt,
+        rms_rel_error: (sum / setup.initial.len().max(1) as f64).sqrt(),
+        max_rel_error: max,
+    })
+}
+
+/// Least-squares slope of log(error) against log(dt) over the points in the asymptotic
+/// range (1e-5 < error < 0.3: above the f32 floor, below the pre-asymptotic regime).
+pub fn convergence_order(points: &[(f64, f64)]) -> Option<f64> {
+    let pts: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|(_, e)| *e > 1e-5 && *e < 0.3 && e.is_finite())
+        .map(|(dt, e)| (dt.ln(), e.ln()))
+        .collect();
+    if pts.len() < 2 {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let mx = pts.iter().map(|p| p.0).sum::<f64>() / n;
+    let my = pts.iter().map(|p| p.1).sum::<f64>() / n;
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    Some(sxy / sxx)
+}
+
+/// Cost of one update step per particle, in nanoseconds (median of `repeats`).
+pub fn measure_cost(
+    ctx: &GpuContext,
+    scene: Scene,
+    integrator: Integrator,
+    capacity: u32,
+    repeats: usize,
+) -> Result<f64, SimError> {
+    let e = scene_emitter(scene, integrator, capacity);
+    let effect = Effect {
+        emitters: vec![e],
+        ..Effect::default()
+    };
+    let mut sim = GpuSim::new(ctx, ShaderLibrary::embedded(), &effect)?;
+    sim.step(&effect, 1.0 / 60.0, 2)?;
+    let timer = GpuTimer::new(ctx);
+    let steps = 8;
+    let mut samples = Vec::new();
+    for _ in 0..repeats {
+        let plans = sim.plan(&effect, 1.0 / 60.0, steps);
+        let ms = timer.time(ctx, |enc| sim.record(enc, &effect, &plans));
+        samples.push(ms * 1e6 / (steps as f64 * capacity as f64));
+    }
+    Ok(median(&mut samples))
+}
+
+/// Frame-rate (in)dependence: final states after 2 s for several frame-time sequences.
+#[derive(Clone, Debug, Serialize)]
+pub struct FrameRateRow {
+    /// The frame sequence.
+    pub frames: String,
+    /// Time mode.
+    pub mode: &'static str,
+    /// FNV-1a hash of the final state bytes (fixed step) — equal means bit-identical.
+    pub state_hash: String,
+    /// RMS relative error against the exact solution (frame delta, scene 1).
+    pub rms_rel_error_vs_exact: Option<f64>,
+    /// RMS relative divergence from the 240 fps run (frame delta, scene 1).
+    pub rms_rel_divergence_vs_240fps: Option<f64>,
+}
+
+/// The frame sequences: constant 30, 60, 144, 240 fps and a jittered one, each 2 s long.
+pub fn frame_sequences() -> Vec<(String, Vec<f64>)> {
+    let mut v: Vec<(String, Vec<f64>)> = [30.0, 60.0, 144.0, 240.0]
+        .iter()
+        .map(|fps| {
+            (
+                format!("{fps} fps"),
+                vec![1.0 / fps; (T_SECS * fps).round() as usize],
+            )
+        })
+        .collect();
+    // Jitter: frame times in [1/240, 1/30] from a fixed LCG, trimmed to sum to 2 s.
+    let mut state = 0x2545_F491_u64;
+    let mut frames = Vec::new();
+    let mut total = 0.0;
+    while total < T_SECS {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        let u = (state >> 11) as f64 / (1u64 << 53) as f64;
+        let dt = (1.0 / 240.0 + u * (1.0 / 30.0 - 1.0 / 240.0)).min(T_SECS - total);
+        frames.push(dt);
+        total += dt;
+    }
+    v.push(("jittered 30–240 fps".into(), frames));
+    v
+}
+
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ *b as u64).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+/// The default campfire in fixed-step mode over every frame sequence: state hashes.
+pub fn fixed_step_hashes(ctx: &GpuContext) -> Result<Vec<(String, u64, u64)>, SimError> {
+    let mut out = Vec::new();
+    for (name, frames) in frame_sequences() {
+        let mut effect = Effect::default_campfire();
+        effect.time.mode = TimeMode::FixedStep;
+        let mut run = Headless::new(ctx, effect, ShaderLibrary::embedded())?;
+        for dt in &frames {
+            run.advance(*dt)?;
+        }
+        let mut bytes = Vec::new();
+        for i in 0..run.sim.emitter_count() {
+            bytes.extend_from_slice(bytemuck::cast_slice(&run.sim.read_particles(i)?));
+        }
+        out.push((name, fnv1a(&bytes), run.sim.planner.step_index));
+    }
+    Ok(out)
+}
+
+/// Scene 1 with explicit Euler in frame-delta mode (the 2006 thesis's setup) for every
+/// frame sequence: error against the exact solution and divergence between frame rates.
+pub fn frame_delta_divergence(
+    ctx: &GpuContext,
+    n: u32,
+) -> Result<Vec<(String, f64, Vec<DVec3>)>, SimError> {
+    let e = scene_emitter(Scene::ClosedForm, Integrator::ExplicitEuler, n);
+    let a = e.forces.constant_acceleration().as_dvec3();
+    let wind = glam::Vec3::from(e.forces.wind_m_per_s).as_dvec3();
+    let k = e.forces.drag_per_sec as f64;
+    let mut out = Vec::new();
+    for (name, frames) in frame_sequences() {
+        let effect = Effect {
+            emitters: vec![e.clone()],
+            ..Effect::default()
+        };
+        let mut sim = GpuSim::new(ctx, ShaderLibrary::embedded(), &effect)?;
+        // The burst is born in the first frame's step; measure from its end.
+        sim.step(&effect, frames[0] as f32, 1)?;
+        let initial = sim.read_particles(0)?;
+        let mut t = 0.0;
+        for dt in &frames[1..] {
+            sim.step(&effect, *dt as f32, 1)?;
+            t += dt;
+        }
+        let fin = sim.read_particles(0)?;
+        let mut sum = 0.0;
+        let mut count = 0;
+        let mut positions = Vec::new();
+        for (p0, p1) in initial.iter().zip(&fin) {
+            let x0 = p0.position().as_dvec3();
+            let x_ref = exact_state(x0, p0.velocity().as_dvec3(), a, k, wind, t).0;
+            let err = (p1.position().as_dvec3() - x_ref).length() / (x_ref - x0).length().max(1e-9);
+            sum += err * err;
+            count += 1;
+            positions.push(p1.position().as_dvec3());
+        }
+        out.push((name, (sum / count.max(1) as f64).sqrt(), positions));
+    }
+    Ok(out)
+}
+
+/// Options of `ignis bench accuracy`.
+pub struct AccuracyOptions {
+    /// Particles per error run.
+    pub particles: u32,
+    /// Capacity for the cost runs (0 = automatic: 1M on a CPU adapter, 16M otherwise).
+    pub cost_capacity: u32,
+    /// Timed repeats per cost point.
+    pub repeats: usize,
+}
+
+/// Runs the whole accuracy bench and returns its report (also writes CSV and SVG into
+/// `out_dir`).
+pub fn run(
+    ctx: &GpuContext,
+    opts: &AccuracyOptions,
+    out_dir: &std::path::Path,
+) -> anyhow::Result<crate::bench::Report> {
+    use crate::bench::report::sci;
+    let mut report = crate::bench::Report::new("ignis bench accuracy", ctx);
+    let timer = GpuTimer::new(ctx);
+    let cost_capacity = if opts.cost_capacity > 0 {
+        opts.cost_capacity
+    } else if ctx.is_cpu_adapter() {
+        1 << 20
+    } else {
+        1 << 24
+    }
+    .min(ctx.max_capacity() as u32);
+    report.para(&format!(
+        "Error: RMS and max over {} particles (scene 2: at most 512) of |x − x_ref| / |x_ref − x0| at T = {T_SECS} s, \
+         all runs from the same initial state. \
+         Cost: update pass, ns per particle-step at {} particles, median of {} runs of 8 steps, \
+         measured with **{}**. Order: least-squares slope of log RMS error vs log dt over the \
+         points with 1e-5 < error < 0.3.",
+        opts.particles,
+        cost_capacity,
+        opts.repeats,
+        timer.source.label()
+    ));
+    let mut points = Vec::new();
+    let mut costs = Vec::new();
+    let mut csv = String::from(
+        "scene,integrator,dt_secs,rms_rel_error,max_rel_error,cost_ns_per_particle_step\n",
+    );
+    let mut json_scenes = Vec::new();
+    for scene in [Scene::ClosedForm, Scene::Turbulent] {
+        report.heading(scene.label());
+        eprintln!("bench accuracy: {}: reference solution", scene.label());
+        let n = if scene == Scene::Turbulent {
+            opts.particles.min(512)
+        } else {
+            opts.particles
+        };
+        let setup = setup_scene(ctx, scene, n)?;
+        let mut rows = Vec::new();
+        let mut frontier = Vec::new();
+        for integrator in Integrator::ALL {
+            eprintln!("bench accuracy: {} / {}", scene.label(), integrator.label());
+            let cost = measure_cost(ctx, scene, integrator, cost_capacity, opts.repeats)?;
+            costs.push((scene, integrator, cost));
+            let mut errs = Vec::new();
+            let mut row = vec![integrator.label().to_owned()];
+            for dt in DTS {
+                let p = measure_error(ctx, &setup, integrator, dt)?;
+                row.push(format!(
+                    "{} / {}",
+                    sci(p.rms_rel_error),
+                    sci(p.max_rel_error)
+                ));
+                csv.push_str(&format!(
+                    "{:?},{},{},{},{},{}\n",
+                    scene, p.integrator, dt, p.rms_rel_error, p.max_rel_error, cost
+                ));
+                errs.push((dt, p.rms_rel_error));
+                points.push(p);
+            }
+            let order = convergence_order(&errs);
+            row.push(order.map_or("—".into(), |o| format!("{o:.2}")));
+            row.push(format!("{cost:.3}"));
+            frontier.push((integrator, errs, cost));
+            rows.push(row);
+        }
+        let mut header = vec!["integrator"];
+        let dt_labels: Vec<String> = DTS.iter().map(|d| format!("dt=1/{:.0}", 1.0 / d)).collect();
+        header.extend(dt_labels.iter().map(|s| s.as_str()));
+        header.push("order");
+        header.push("ns/particle-step");
+        report.para("Each cell: RMS / max relative position error.");
+        report.table(&header, &rows);
+        let mut lines = Vec::new();
+        for target in [1e-2, 1e-3, 1e-4] {
+            let best = frontier
+                .iter()
+                .filter(|(_, errs, _)| {
+                    errs.iter()
+                        .any(|(dt, e)| (*dt - 1.0 / 60.0).abs() < 1e-9 && *e <= target)
+                })
+                .min_by(|a, b| a.2.total_cmp(&b.2));
+            lines.push(format!(
+                "- ≤ {:.2}% error at 60 Hz: **{}**",
+                target * 100.0,
+                best.map_or("none of them".to_owned(), |b| format!(
+                    "{} ({:.3} ns/particle-step)",
+                    b.0.label(),
+                    b.2
+                ))
+            ));
+        }
+        report.para(&format!(
+            "Cheapest integrator meeting each error bound at dt = 1/60 s:\n\n{}",
+            lines.join("\n")
+        ));
+        json_scenes.push(serde_json::json!({
+            "scene": scene,
+            "frontier": lines,
+        }));
+    }
+
+    // Frame-rate (in)dependence.
+    report.heading("Frame-rate (in)dependence (2 s)");
+    eprintln!("bench accuracy: frame-rate independence");
+    let hashes = fixed_step_hashes(ctx)?;
+    let all_equal = hashes.windows(2).all(|w| w[0].1 == w[1].1);
+    let deltas = frame_delta_divergence(ctx, opts.particles)?;
+    let reference = deltas
+        .iter()
+        .find(|d| d.0 == "240 fps")
+        .map(|d| d.2.clone())
+        .unwrap_or_default();
+    let mut rows = Vec::new();
+    let mut fr_json = Vec::new();
+    for ((name, hash, steps), (_, err, positions)) in hashes.iter().zip(&deltas) {
+        let div = (positions
+            .iter()
+            .zip(&reference)
+            .map(|(a, b)| (*a - *b).length_squared())
+            .sum::<f64>()
+            / positions.len().max(1) as f64)
+            .sqrt();
+        rows.push(vec![
+            name.clone(),
+            format!("{hash:016x} ({steps} steps)"),
+            sci(*err),
+            format!("{div:.4} m"),
+        ]);
+        fr_json.push(serde_json::json!({"frames": name, "fixed_step_state_hash": format!("{hash:016x}"), "fixed_steps": steps, "frame_delta_rms_rel_error": err, "frame_delta_rms_divergence_vs_240fps_m": div}));
+    }
+    report.para(&format!(
+        "Fixed step (default campfire, all three emitters, 1/120 s steps): final state **{}** across every frame sequence. \
+         Frame delta (scene 1, explicit Euler — the 2006 thesis's setup): error against the exact solution and RMS distance \
+         of the final positions from the 240 fps run.",
+        if all_equal { "bit-identical" } else { "NOT identical" }
+    ));
+    report.table(
+        &[
+            "frames",
+            "fixed step: state hash",
+            "frame delta: RMS rel. error vs exact",
+            "frame delta: RMS divergence vs 240 fps",
+        ],
+        &rows,
+    );
+
+    report.json["points"] = serde_json::to_value(&points)?;
+    report.json["costs_ns_per_particle_step"] = serde_json::to_value(
+        costs
+            .iter()
+            .map(|(s, i, c)| serde_json::json!({"scene": s, "integrator": i.label(), "ns": c}))
+            .collect::<Vec<_>>(),
+    )?;
+    report.json["frontier"] = serde_json::Value::Array(json_scenes);
+    report.json["frame_rate"] = serde_json::Value::Array(fr_json);
+    report.json["fixed_step_bit_identical"] = serde_json::Value::Bool(all_equal);
+    report.json["timing"] = serde_json::Value::String(timer.source.label().into());
+
+    std::fs::create_dir_all(out_dir)?;
+    crate::preset::write_atomic(&out_dir.join("accuracy.csv"), csv.as_bytes())?;
+    plot_frontier(&out_dir.join("accuracy.svg"), &points, &costs)?;
+    report.para("Plot: `accuracy.svg` — error vs cost, one line per integrator, one point per dt.");
+    Ok(report)
+}
+
+/// Error (y, log) against cost per simulated second (x, log): one line per integrator and
+/// scene, a point per dt.
+fn plot_frontier(
+    path: &std::path::Path,
+    points: &[ErrorPoint],
+    costs: &[(Scene, Integrator, f64)],
+) -> anyhow::Result<()> {
+    use plotters::prelude::*;
+    let root = SVGBackend::new(path, (960, 540)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let series: Vec<(String, Vec<(f64, f64)>)> = costs
+        .iter()
+        .map(|(scene, integrator, ns)| {
+            let pts = points
+                .iter()
+                .filter(|p| p.scene == *scene && p.integrator == integrator.label())
+                .map(|p| (ns / p.dt_secs, p.rms_rel_error.clamp(1e-9, 10.0)))
+                .collect();
+            let tag = if *scene == Scene::ClosedForm {
+                "s1"
+            } else {
+                "s2"
+            };
+            (format!("{} ({tag})", integrator.label()), pts)
+        })
+        .collect();
+    let xs = series.iter().flat_map(|s| s.1.iter().map(|p| p.0));
+    let (xmin, xmax) = xs.fold((f64::MAX, f64::MIN), |(a, b), x| (a.min(x), b.max(x)));
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            "ignis: error vs cost (ns per particle per simulated second)",
+            ("sans-serif", 20),
+        )
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(
+            (xmin * 0.8..xmax * 1.25).log_scale(),
+            (1e-9f64..10.0).log_scale(),
+        )?;
+    chart
+        .configure_mesh()
+        .x_desc("cost: ns per particle per simulated second")
+        .y_desc("RMS relative position error at T = 2 s")
+        .draw()?;
+    for (i, (name, pts)) in series.iter().enumerate() {
+        let color = Palette99::pick(i).to_rgba();
+        chart
+            .draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))?
+            .label(name.clone())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color));
+        chart.draw_series(pts.iter().map(|p| Circle::new(*p, 3, color.filled())))?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    root.present()?;
+    Ok(())
+}

@@ -1,0 +1,7 @@
+//! Benchmarks as commands: they print tables and write Markdown + JSON (+ CSV, SVG)
+//! under `bench/results/`, with the adapter, driver and command line that produced them.
+
+pub mod accuracy;
+pub mod report;
+
+pub use report::Report;

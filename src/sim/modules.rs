@@ -1,0 +1,105 @@
+//! Optional modules: which parts of the update shader an emitter needs. Each maps to a
+//! WGSL `override` constant (keep in sync with `MOD_*` in `shaders/forces.wgsl` and
+//! `shaders/collide.wgsl`), so a module that is off is compiled out of the pipeline.
+
+use crate::effect::Emitter;
+
+/// A set of modules, as bits.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Modules(pub u32);
+
+impl Modules {
+    /// Linear drag toward the wind.
+    pub const DRAG: Modules = Modules(1);
+    /// Noise-modulated wind.
+    pub const GUSTS: Modules = Modules(2);
+    /// Quadratic drag.
+    pub const QUADRATIC_DRAG: Modules = Modules(4);
+    /// Curl-noise turbulence.
+    pub const TURBULENCE: Modules = Modules(8);
+    /// Vortex.
+    pub const VORTEX: Modules = Modules(16);
+    /// Attractor.
+    pub const ATTRACTOR: Modules = Modules(32);
+    /// Flame-closing pull.
+    pub const FLAME_PULL: Modules = Modules(64);
+    /// Ground and sphere colliders.
+    pub const COLLISIONS: Modules = Modules(128);
+
+    /// Every module with its override-constant name.
+    pub const ALL: [(Modules, &'static str); 8] = [
+        (Self::DRAG, "MOD_DRAG"),
+        (Self::GUSTS, "MOD_GUSTS"),
+        (Self::QUADRATIC_DRAG, "MOD_QUADRATIC_DRAG"),
+        (Self::TURBULENCE, "MOD_TURBULENCE"),
+        (Self::VORTEX, "MOD_VORTEX"),
+        (Self::ATTRACTOR, "MOD_ATTRACTOR"),
+        (Self::FLAME_PULL, "MOD_FLAME_PULL"),
+        (Self::COLLISIONS, "MOD_COLLISIONS"),
+    ];
+
+    /// The modules an emitter's settings need.
+    pub fn of(e: &Emitter) -> Modules {
+        let f = &e.forces;
+        let mut m = Modules(0);
+        let wind = f.wind_m_per_s.iter().any(|w| *w != 0.0);
+        if f.drag_per_sec > 0.0 {
+            m.0 |= Self::DRAG.0;
+        }
+        if f.gusts.is_some() && wind && (f.drag_per_sec > 0.0 || f.quadratic_drag_per_m > 0.0) {
+            m.0 |= Self::GUSTS.0;
+        }
+        if f.quadratic_drag_per_m > 0.0 {
+            m.0 |= Self::QUADRATIC_DRAG.0;
+        }
+        if f.turbulence
+            .as_ref()
+            .is_some_and(|t| t.strength_m_per_s2 != 0.0)
+        {
+            m.0 |= Self::TURBULENCE.0;
+        }
+        if f.vortex.as_ref().is_some_and(|v| v.swirl_m_per_s2 != 0.0) {
+            m.0 |= Self::VORTEX.0;
+        }
+        if f.attractor.as_ref().is_some_and(|a| a.strength != 0.0) {
+            m.0 |= Self::ATTRACTOR.0;
+        }
+        if f.flame_pull
+            .as_ref()
+            .is_some_and(|p| p.strength_per_s2 != 0.0)
+        {
+            m.0 |= Self::FLAME_PULL.0;
+        }
+        if e.collisions.any() {
+            m.0 |= Self::COLLISIONS.0;
+        }
+        m
+    }
+
+    /// True when every module of `other` is in `self`.
+    pub fn contains(self, other: Modules) -> bool {
+        self.0 & other.0 == other.0
+    }
+
+    /// The union.
+    pub fn with(self, other: Modules) -> Modules {
+        Modules(self.0 | other.0)
+    }
+
+    /// The pipeline override constants for this set.
+    pub fn constants(self) -> Vec<(&'static str, f64)> {
+        Self::ALL
+            .iter()
+            .map(|(m, name)| (*name, if self.contains(*m) { 1.0 } else { 0.0 }))
+            .collect()
+    }
+
+    /// Names of the modules that are on.
+    pub fn names(self) -> Vec<&'static str> {
+        Self::ALL
+            .iter()
+            .filter(|(m, _)| self.contains(*m))
+            .map(|(_, n)| &n[4..])
+            .collect()
+    }
+}

@@ -1,0 +1,487 @@
+//! The core simulation on a real adapter: GPU against the CPU reference, exact spawn
+//! counts, shapes, determinism, capacity limits.
+
+mod common;
+
+use common::*;
+use glam::{Mat4, Vec3};
+use ignis::effect::{Burst, Effect, Emitter, Integrator, Range, Shape, TimeMode, Transform};
+use ignis::gpu::GpuError;
+use ignis::shaders::ShaderLibrary;
+use ignis::sim::{GpuSim, SimError, Stepper};
+
+/// GPU and CPU agree after 240 steps for every integrator, with spawning, noise, drag,
+/// wind and a transformed disc emitter. Tolerance: 2e-5 absolute + 2e-5 relative on
+/// positions and velocities (GPU sin/cos/exp/pow differ from Rust's in the last bits).
+#[test]
+fn gpu_matches_cpu_reference_for_every_integrator() {
+    let ctx = gpu();
+    for integrator in Integrator::ALL {
+        let mut e = Emitter {
+            capacity: 1500,
+            spawn_rate_per_sec: 700.0,
+            lifetime_secs: Range::new(0.5, 1.6),
+            integrator,
+            transform: Transform {
+                position_m: [0.3, 0.1, -0.2],
+                rotation_deg: [10.0, 30.0, 0.0],
+            },
+            ..Emitter::default()
+        };
+        e.forces.wind_m_per_s = [0.4, 0.0, 0.2];
+        let effect = bare_effect(e);
+        let (gpu_state, cpu) = run_gpu_and_cpu(&ctx, &effect, 1.0 / 120.0, 240);
+        assert_eq!(gpu_state.len(), cpu.particles.len());
+        let mut alive = 0;
+        let mut max_err: f32 = 0.0;
+        for (slot, (g, c)) in gpu_state.iter().zip(&cpu.particles).enumerate() {
+            assert_eq!(
+                g.is_alive(),
+                c.is_alive(),
+                "{integrator:?}: slot {slot} alive differs: gpu {g:?} cpu {c:?}"
+            );
+            if !c.is_alive() {
+                continue;
+            }
+            alive += 1;
+            for (a, b) in g
+                .pos_age
+                .iter()
+                .chain(&g.vel_life)
+                .zip(c.pos_age.iter().chain(&c.vel_life))
+            {
+                let err = (a - b).abs();
+                max_err = max_err.max(err);
+                assert!(
+                    err <= 2e-5 + 2e-5 * b.abs(),
+                    "{integrator:?}: slot {slot}: gpu {g:?} vs cpu {c:?}"
+                );
+            }
+        }
+        assert!(alive > 500, "{integrator:?}: only {alive} alive");
+        eprintln!("{integrator:?}: {alive} alive, max |gpu - cpu| = {max_err:e}");
+    }
+}
+
+/// Every optional module at once (turbulence, vortex, attractor, flame pull, gusts,
+/// quadratic drag, ground and sphere colliders): GPU and CPU still agree. The tolerance is
+/// looser (2e-4) because the CPU evaluates the noise in f64 and rounds, while the GPU
+/// works in f32 throughout; bounces amplify small differences at the contact.
+#[test]
+fn gpu_matches_cpu_reference_with_every_module() {
+    use ignis::effect::*;
+    let ctx = gpu();
+    for integrator in [
+        Integrator::SemiImplicitEuler,
+        Integrator::Rk4,
+        Integrator::Exponential,
+    ] {
+        let mut e = Emitter {
+            capacity: 1200,
+            spawn_rate_per_sec: 600.0,
+            lifetime_secs: Range::new(0.5, 1.6),
+            integrator,
+            ..Emitter::default()
+        };
+        let f = &mut e.forces;
+        f.quadratic_drag_per_m = 0.3;
+        f.gusts = Some(Gusts::default());
+        f.turbulence = Some(Turbulence::default());
+        f.vortex = Some(Vortex::default());
+        f.attractor = Some(Attractor {
+            falloff: Falloff::ConstantWithinRadius,
+            radius_m: 0.8,
+            ..Attractor::default()
+        });
+        f.flame_pull = Some(FlamePull::default());
+        e.collisions.ground = Some(GroundPlane {
+            height_m: -0.05,
+            kill_on_contact: false,
+        });
+        e.collisions.spheres = vec![SphereCollider {
+            center_m: [0.0, 1.0, 0.0],
+            radius_m: 0.2,
+        }];
+        e.forces.gravity_m_per_s2 = [0.0, -9.81, 0.0];
+        e.forces.buoyancy_m_per_s2 = 9.0;
+        let effect = bare_effect(e);
+        let (gpu_state, cpu) = run_gpu_and_cpu(&ctx, &effect, 1.0 / 120.0, 180);
+        let mut worst: f32 = 0.0;
+        let mut alive = 0;
+        let mut bad = 0;
+        for (g, c) in gpu_state.iter().zip(&cpu.particles) {
+            assert_eq!(g.is_alive(), c.is_alive());
+            if !c.is_alive() {
+                continue;
+            }
+            alive += 1;
+            let err = (g.position() - c.position()).length();
+            worst = worst.max(err);
+            if err > 2e-4 {
+                bad += 1;
+            }
+        }
+        eprintln!(
+            "{integrator:?}: {alive} alive, worst position error {worst:e}, {bad} beyond 2e-4"
+        );
+        assert!(alive > 300);
+        // Allow a handful of contact-amplified outliers, never a systematic mismatch.
+        assert!(
+            bad * 100 <= alive,
+            "{integrator:?}: {bad} of {alive} beyond 2e-4 (worst {worst})"
+        );
+    }
+}
+
+/// After t seconds, alive = rate × min(t, lifetime) within ±1 (sub-step emission makes
+/// this exact even when rate × dt is not an integer), and the GPU's own alive counter
+/// agrees with the readback.
+#[test]
+fn exact_spawn_counts_over_time() {
+    let ctx = gpu();
+    for (rate, dt) in [
+        (1000.0f32, 1.0f32 / 120.0),
+        (333.0, 1.0 / 60.0),
+        (50.0, 1.0 / 240.0),
+    ] {
+        let e = Emitter {
+            spawn_rate_per_sec: rate,
+            lifetime_secs: Range::new(1.0, 1.0),
+            ..plain_emitter()
+        };
+        let effect = bare_effect(e);
+        let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
+        let mut steps_done = 0u32;
+        for t in [0.25f64, 0.5, 1.0, 1.5, 3.0] {
+            let target = (t / dt as f64).round() as u32;
+            sim.step(&effect, dt, target - steps_done).expect("step");
+            steps_done = target;
+            let t_sim = sim.planner.time_secs;
+            let expected = rate as f64 * t_sim.min(1.0);
+            let state = sim.read_particles(0).expect("read");
+            let alive = alive_of(&state) as f64;
+            let counter = sim.read_counters(0).expect("counters")[0] as f64;
+            assert_eq!(alive, counter, "GPU alive counter disagrees with the state");
+            assert!(
+                (alive - expected).abs() <= 1.0,
+                "rate {rate} dt {dt} t {t_sim}: alive {alive}, expected {expected} ± 1"
+            );
+            let spawned = sim.planner.emitters[0].stats.spawned as f64;
+            assert!(
+                (spawned - rate as f64 * t_sim).abs() <= 1.0,
+                "spawned {spawned} at t {t_sim}"
+            );
+        }
+    }
+}
+
+/// The per-step cap drops the excess and counts it; a huge frame-delta step cannot burst.
+#[test]
+fn spawn_cap_per_step_is_enforced_and_counted() {
+    let ctx = gpu();
+    let e = Emitter {
+        spawn_rate_per_sec: 12_000.0,
+        max_spawn_per_step: 40,
+        ..plain_emitter()
+    };
+    let mut effect = bare_effect(e);
+    let sim = run_gpu(&ctx, &effect, 1.0 / 60.0, 10);
+    let stats = sim.planner.emitters[0].stats;
+    assert_eq!(stats.spawned, 400, "10 steps × cap 40");
+    assert_eq!(
+        stats.dropped_by_cap,
+        2000 - 400,
+        "12000/s × 10/60 s requested"
+    );
+    assert_eq!(alive_of(&sim.read_particles(0).expect("read")), 400);
+
+    // Frame-delta mode with a one-second hitch: dt is clamped to max_frame_dt_secs and the
+    // automatic cap (rate / 15 per step) bounds the burst.
+    effect.emitters[0].max_spawn_per_step = 0;
+    effect.time.mode = TimeMode::FrameDelta;
+    effect.time.max_frame_dt_secs = 0.1;
+    let mut stepper = Stepper::default();
+    let plan = stepper.advance(1.0, &effect.time);
+    assert_eq!((plan.steps, plan.dt_secs), (1, 0.1));
+    let sim = run_gpu(&ctx, &effect, plan.dt_secs, plan.steps);
+    assert_eq!(
+        sim.planner.emitters[0].stats.spawned, 800,
+        "automatic cap = 12000/15"
+    );
+}
+
+/// Too small a pool: the overwrite of still-alive particles is counted, never silent.
+#[test]
+fn capacity_exhaustion_is_reported() {
+    let ctx = gpu();
+    let e = Emitter {
+        capacity: 100,
+        spawn_rate_per_sec: 1000.0,
+        ..plain_emitter()
+    };
+    let sim = run_gpu(&ctx, &bare_effect(e), 1.0 / 120.0, 120);
+    let stats = sim.planner.emitters[0].stats;
+    assert_eq!(stats.spawned, 1000);
+    // Everything beyond the first 100 spawns overwrote a particle younger than 1 s.
+    assert_eq!(stats.recycled_alive, 900, "{stats:?}");
+    assert_eq!(alive_of(&sim.read_particles(0).expect("read")), 100);
+    // Enough capacity: nothing recycled.
+    let ok = Emitter {
+        capacity: 1200,
+        ..plain_emitter()
+    };
+    let sim = run_gpu(&ctx, &bare_effect(ok), 1.0 / 120.0, 240);
+    assert_eq!(sim.planner.emitters[0].stats.recycled_alive, 0);
+}
+
+/// A capacity beyond the device's storage-binding limit fails with the limit's name.
+#[test]
+fn capacity_beyond_device_limit_names_the_limit() {
+    let ctx = gpu();
+    let too_big = (ctx.max_capacity() + 1).min(ignis::effect::MAX_CAPACITY as u64) as u32;
+    let e = Emitter {
+        capacity: too_big.max(ctx.max_capacity() as u32 + 1),
+        ..plain_emitter()
+    };
+    if (e.capacity as u64) <= ctx.max_capacity() {
+        panic!("device allows more than MAX_CAPACITY; test needs a larger capacity");
+    }
+    match GpuSim::new(&ctx, ShaderLibrary::embedded(), &bare_effect(e)) {
+        Err(SimError::Gpu(err @ GpuError::CapacityTooLarge { .. })) => {
+            let msg = err.to_string();
+            assert!(
+                msg.contains("max_storage_buffer_binding_size") || msg.contains("max_buffer_size"),
+                "{msg}"
+            );
+            assert!(msg.contains("lower the capacity"), "{msg}");
+        }
+        Err(other) => panic!("wrong error: {other}"),
+        Ok(_) => panic!("capacity {} accepted beyond the limit", too_big),
+    }
+}
+
+fn spawn_once(ctx: &ignis::gpu::GpuContext, e: Emitter) -> Vec<ignis::gpu::types::Particle> {
+    let sim = run_gpu(ctx, &bare_effect(e), 1.0 / 120.0, 1);
+    // Positions are stored relative to the emitter's simulation origin.
+    let origin = sim.planner.emitters[0].origin().as_vec3();
+    sim.read_particles(0)
+        .expect("read")
+        .into_iter()
+        .filter(|p| p.is_alive())
+        .map(|mut p| {
+            for k in 0..3 {
+                p.pos_age[k] += origin[k];
+            }
+            p
+        })
+        .collect()
+}
+
+/// Every shape: all spawned positions lie inside/on the shape under its transform.
+#[test]
+fn every_shape_spawns_inside_itself() {
+    let ctx = gpu();
+    let transform = Transform {
+        position_m: [1.0, 2.0, -3.0],
+        rotation_deg: [20.0, 45.0, -10.0],
+    };
+    let emitter_from_world = transform.world_from_emitter().inverse();
+    type Inside = Box<dyn Fn(Vec3) -> bool>;
+    let cases: Vec<(Shape, Inside)> = vec![
+        (Shape::Point, Box::new(|p: Vec3| p.length() < 1e-5)),
+        (
+            Shape::Sphere {
+                radius_m: 0.5,
+                surface_only: false,
+            },
+            Box::new(|p: Vec3| p.length() <= 0.5 + 1e-5),
+        ),
+        (
+            Shape::Sphere {
+                radius_m: 0.5,
+                surface_only: true,
+            },
+            Box::new(|p: Vec3| (p.length() - 0.5).abs() < 1e-5),
+        ),
+        (
+            Shape::Disc {
+                radius_m: 0.4,
+                normal: [0.0, 0.0, 1.0],
+            },
+            Box::new(|p: Vec3| p.z.abs() < 1e-5 && p.truncate().length() <= 0.4 + 1e-5),
+        ),
+        (
+            Shape::Box {
+                half_extents_m: [0.1, 0.2, 0.3],
+            },
+            Box::new(|p: Vec3| {
+                p.x.abs() <= 0.1 + 1e-5 && p.y.abs() <= 0.2 + 1e-5 && p.z.abs() <= 0.3 + 1e-5
+            }),
+        ),
+        (
+            Shape::Cone {
+                angle_deg: 20.0,
+                radius_m: 0.25,
+            },
+            // Base disc normal to the direction (+Y here).
+            Box::new(|p: Vec3| {
+                p.y.abs() < 1e-5 && Vec3::new(p.x, 0.0, p.z).length() <= 0.25 + 1e-5
+            }),
+        ),
+        (
+            Shape::Line {
+                a_m: [-0.5, 0.0, 0.0],
+                b_m: [0.5, 0.2, 0.0],
+            },
+            Box::new(|p: Vec3| {
+                let a = Vec3::new(-0.5, 0.0, 0.0);
+                let d = Vec3::new(1.0, 0.2, 0.0);
+                let t = (p - a).dot(d) / d.length_squared();
+                (-1e-5..=1.0 + 1e-5).contains(&t) && (a + d * t - p).length() < 1e-5
+            }),
+        ),
+    ];
+    for (shape, inside) in cases {
+        let e = Emitter {
+            capacity: 4000,
+            spawn_rate_per_sec: 3000.0 * 120.0,
+            max_spawn_per_step: 3000,
+            shape: shape.clone(),
+            transform: transform.clone(),
+            ..plain_emitter()
+        };
+        let born = spawn_once(&ctx, e);
+        assert_eq!(born.len(), 3000, "{shape:?}");
+        let mut extent: f32 = 0.0;
+        for p in &born {
+            let local = emitter_from_world.transform_point3(p.position());
+            assert!(inside(local), "{shape:?}: {local} is outside");
+            extent = extent.max(local.length());
+        }
+        if !matches!(shape, Shape::Point) {
+            assert!(
+                extent > 0.2,
+                "{shape:?}: spawns do not cover the shape (max extent {extent})"
+            );
+        }
+    }
+}
+
+/// Directions stay within the spread cone and fill it; a cone shape uses its own angle.
+#[test]
+fn direction_spread_is_respected() {
+    let ctx = gpu();
+    for (shape, spread, direction) in [
+        (Shape::Point, 20.0f32, [0.0, 1.0, 0.0]),
+        (Shape::Point, 60.0, [1.0, 1.0, 0.0]),
+        (
+            Shape::Cone {
+                angle_deg: 35.0,
+                radius_m: 0.1,
+            },
+            35.0,
+            [0.0, 0.0, 1.0],
+        ),
+    ] {
+        let e = Emitter {
+            capacity: 4000,
+            spawn_rate_per_sec: 3000.0 * 120.0,
+            max_spawn_per_step: 3000,
+            shape: shape.clone(),
+            direction,
+            spread_deg: if matches!(shape, Shape::Cone { .. }) {
+                5.0
+            } else {
+                spread
+            },
+            speed_m_per_s: Range::new(1.0, 2.0),
+            ..plain_emitter()
+        };
+        let axis = Vec3::from(direction).normalize();
+        let born = spawn_once(&ctx, e);
+        let mut max_angle: f32 = 0.0;
+        for p in &born {
+            let v = p.velocity();
+            let speed = v.length();
+            assert!((0.999..=2.001).contains(&speed), "speed {speed}");
+            let angle = v.normalize().dot(axis).clamp(-1.0, 1.0).acos().to_degrees();
+            assert!(angle <= spread + 0.01, "{shape:?}: {angle}° > {spread}°");
+            max_angle = max_angle.max(angle);
+        }
+        assert!(
+            max_angle > spread * 0.95,
+            "{shape:?}: cone not filled (max {max_angle}°)"
+        );
+    }
+}
+
+/// Same seed ⇒ byte-identical state; another seed ⇒ different state.
+#[test]
+fn deterministic_state_for_a_seed() {
+    let ctx = gpu();
+    let effect = Effect::default_campfire();
+    let run = |seed: u32| {
+        let mut e = effect.clone();
+        e.seed = seed;
+        let sim = run_gpu(&ctx, &e, 1.0 / 120.0, 150);
+        (0..e.emitters.len())
+            .flat_map(|i| {
+                bytemuck::cast_slice::<_, u8>(&sim.read_particles(i).expect("read")).to_vec()
+            })
+            .collect::<Vec<u8>>()
+    };
+    let a = run(7);
+    let b = run(7);
+    let c = run(8);
+    assert!(a == b, "same seed gave different bytes");
+    assert!(a != c, "different seeds gave the same bytes");
+}
+
+/// Bursts fire once at their time, in full.
+#[test]
+fn bursts_fire_once() {
+    let ctx = gpu();
+    let e = Emitter {
+        spawn_rate_per_sec: 0.0,
+        bursts: vec![
+            Burst {
+                time_secs: 0.1,
+                count: 500,
+            },
+            Burst {
+                time_secs: 0.5,
+                count: 200,
+            },
+        ],
+        ..plain_emitter()
+    };
+    let sim = run_gpu(&ctx, &bare_effect(e), 1.0 / 120.0, 120);
+    assert_eq!(sim.planner.emitters[0].stats.spawned, 700);
+    // Lifetime 1 s: at t = 1 s the first burst (t = 0.1) is still alive, all 700 are.
+    assert_eq!(alive_of(&sim.read_particles(0).expect("read")), 700);
+}
+
+/// The world transform maps the local spawn point to the emitter's position.
+#[test]
+fn point_emitter_spawns_at_its_transform() {
+    let ctx = gpu();
+    let e = Emitter {
+        transform: Transform {
+            position_m: [5.0, -2.0, 1.5],
+            rotation_deg: [0.0, 90.0, 0.0],
+        },
+        ..plain_emitter()
+    };
+    let born = spawn_once(&ctx, e);
+    assert!(!born.is_empty());
+    for p in born {
+        assert!((p.position() - Vec3::new(5.0, -2.0, 1.5)).length() < 1e-5);
+    }
+    let m = Transform {
+        position_m: [0.0; 3],
+        rotation_deg: [0.0, 90.0, 0.0],
+    }
+    .world_from_emitter();
+    assert!((m.transform_vector3(Vec3::X) - Vec3::new(0.0, 0.0, -1.0)).length() < 1e-6);
+    let _ = Mat4::IDENTITY;
+}

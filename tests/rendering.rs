@@ -1,0 +1,203 @@
+//! Rendering on a real adapter: warm fire above the emitter, black elsewhere, dead
+//! particles invisible, deterministic PNGs, `ignis render` end to end.
+
+mod common;
+
+use common::*;
+use glam::Vec3;
+use ignis::effect::Effect;
+use ignis::headless::Headless;
+use ignis::shaders::ShaderLibrary;
+
+const SIZE: (u32, u32) = (320, 240);
+
+fn campfire_after(
+    ctx: &ignis::gpu::GpuContext,
+    secs: f64,
+    seed: u32,
+) -> (Headless, image::RgbaImage) {
+    let mut effect = Effect::default_campfire();
+    effect.seed = seed;
+    let mut run = Headless::new(ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    let frames = (secs * 60.0) as u32;
+    for _ in 0..frames {
+        run.advance(1.0 / 60.0).expect("advance");
+    }
+    let img = run.render(SIZE).expect("render");
+    (run, img)
+}
+
+fn project(run: &Headless, p: Vec3) -> (f32, f32) {
+    let clip = run.camera.clip_from_world(SIZE.0 as f32 / SIZE.1 as f32) * p.extend(1.0);
+    let ndc = clip.truncate() / clip.w;
+    (
+        (ndc.x * 0.5 + 0.5) * SIZE.0 as f32,
+        (0.5 - ndc.y * 0.5) * SIZE.1 as f32,
+    )
+}
+
+fn mean_rgb(img: &image::RgbaImage, x0: u32, y0: u32, x1: u32, y1: u32) -> [f32; 3] {
+    let mut s = [0.0f32; 3];
+    let mut n = 0.0;
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let p = img.get_pixel(x, y);
+            for c in 0..3 {
+                s[c] += p[c] as f32;
+            }
+            n += 1.0;
+        }
+    }
+    s.map(|v| v / n)
+}
+
+/// The default campfire: warm (red > green > blue, bright) just above the emitter,
+/// black in the top corners far from it.
+#[test]
+fn default_frame_is_warm_above_the_emitter_and_black_far_away() {
+    let ctx = gpu();
+    let (run, img) = campfire_after(&ctx, 2.0, 1);
+    let (ex, ey) = project(&run, Vec3::new(0.0, 0.35, 0.0));
+    let (ex, ey) = (ex as u32, ey as u32);
+    let warm = mean_rgb(&img, ex - 12, ey - 12, ex + 12, ey + 12);
+    assert!(warm[0] > 150.0, "flame not bright: {warm:?}");
+    assert!(
+        warm[0] > warm[1] && warm[1] > warm[2],
+        "flame not warm: {warm:?}"
+    );
+    for (x0, y0) in [
+        (0, 0),
+        (SIZE.0 - 24, 0),
+        (0, SIZE.1 - 24),
+        (SIZE.0 - 24, SIZE.1 - 24),
+    ] {
+        let c = mean_rgb(&img, x0, y0, x0 + 24, y0 + 24);
+        assert!(
+            c.iter().all(|&v| v < 3.0),
+            "corner ({x0},{y0}) not black: {c:?}"
+        );
+    }
+    // Beside the fire, 1.3 m to either side at flame height, stays black.
+    for side in [-1.3f32, 1.3] {
+        let (sx, sy) = project(&run, Vec3::new(side, 0.3, 0.0));
+        assert!(
+            sx > 10.0 && sx + 10.0 < SIZE.0 as f32,
+            "the side probe is off-screen"
+        );
+        let c = mean_rgb(
+            &img,
+            sx as u32 - 10,
+            sy as u32 - 10,
+            sx as u32 + 10,
+            sy as u32 + 10,
+        );
+        assert!(
+            c.iter().all(|&v| v < 3.0),
+            "beside the fire ({side} m): {c:?}"
+        );
+    }
+    img.save(std::env::temp_dir().join("ignis_test_campfire.png"))
+        .expect("save");
+}
+
+/// Nothing alive ⇒ a fully black frame (dead slots produce no fragments — unlike the
+/// 2006 thesis, whose dead particles piled up at the origin).
+#[test]
+fn all_dead_frame_is_black() {
+    let ctx = gpu();
+    // Before any step: every slot is zero (dead).
+    let mut run = Headless::new(&ctx, Effect::default_campfire(), ShaderLibrary::embedded())
+        .expect("headless");
+    let img = run.render(SIZE).expect("render");
+    assert!(
+        img.pixels().all(|p| p[0] == 0 && p[1] == 0 && p[2] == 0),
+        "fresh pools drew something"
+    );
+    // After every particle died: lifetimes ≤ 4 s, spawning stopped.
+    for _ in 0..60 {
+        run.advance(1.0 / 60.0).expect("advance");
+    }
+    for e in &mut run.effect.emitters {
+        e.spawn_rate_per_sec = 0.0;
+    }
+    for _ in 0..(5 * 60) {
+        run.advance(1.0 / 60.0).expect("advance");
+    }
+    assert_eq!(run.alive().expect("alive"), 0);
+    let img = run.render(SIZE).expect("render");
+    let lit = img
+        .pixels()
+        .filter(|p| p[0] > 0 || p[1] > 0 || p[2] > 0)
+        .count();
+    assert_eq!(lit, 0, "{lit} pixels lit with no particle alive");
+}
+
+/// Same seed ⇒ identical PNG bytes; a different seed ⇒ a different image.
+#[test]
+fn deterministic_frames_for_a_seed() {
+    let ctx = gpu();
+    let (_, a) = campfire_after(&ctx, 1.0, 3);
+    let (_, b) = campfire_after(&ctx, 1.0, 3);
+    let (_, c) = campfire_after(&ctx, 1.0, 4);
+    assert!(a.as_raw() == b.as_raw(), "same seed, different pixels");
+    let diff = a
+        .as_raw()
+        .iter()
+        .zip(c.as_raw())
+        .filter(|(x, y)| x != y)
+        .count();
+    assert!(diff > 1000, "different seeds differ in only {diff} bytes");
+}
+
+/// `ignis render` writes the requested PNG frames and prints its summary.
+#[test]
+fn render_command_writes_pngs() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_ignis"))
+        .args([
+            "render", "--frames", "5", "--size", "160x120", "--fps", "30", "--out",
+        ])
+        .arg(dir.path())
+        .output()
+        .expect("run ignis");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "ignis render failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("rendered 5 frames"), "{stdout}");
+    for f in 0..5 {
+        let path = dir.path().join(format!("frame_{f:04}.png"));
+        let img = image::open(&path).expect("png").to_rgba8();
+        assert_eq!(img.dimensions(), (160, 120));
+    }
+    assert!(!dir.path().join("frame_0005.png").exists());
+    // The last frame shows fire.
+    let img = image::open(dir.path().join("frame_0004.png"))
+        .expect("png")
+        .to_rgba8();
+    assert!(
+        img.pixels().any(|p| p[0] > 200),
+        "no bright pixel in the last frame"
+    );
+}
+
+/// Bad arguments: a clear error and a non-zero exit, no panic.
+#[test]
+fn render_command_rejects_bad_input() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_ignis"))
+        .args(["render", "--size", "0x10"])
+        .output()
+        .expect("run ignis");
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("size"));
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_ignis"))
+        .args(["render", "no/such/preset.ron"])
+        .output()
+        .expect("run ignis");
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no/such/preset.ron"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}
