@@ -361,9 +361,10 @@ fn a_panel_edit_reaches_the_gpu_on_the_next_step_without_a_reset() {
     let state = harness.into_state();
     assert_eq!(state.running.emitters[flames].forces.buoyancy_m_per_s2, 0.0);
     let reference_effect = Effect::default_campfire();
-    assert_eq!(
-        reference_effect.emitters[flames].forces.buoyancy_m_per_s2,
-        11.6
+    let buoyancy = reference_effect.emitters[flames].forces.buoyancy_m_per_s2;
+    assert!(
+        buoyancy > 5.0,
+        "the campfire's flames rise ({buoyancy} m/s²)"
     );
 
     // The very next step uses it: particles alive before and after differ in vertical
@@ -381,7 +382,7 @@ fn a_panel_edit_reaches_the_gpu_on_the_next_step_without_a_reset() {
         }
     }
     assert!(dv.len() > 500, "{} particles compared", dv.len());
-    let expected = 11.6 * DT_SECS;
+    let expected = buoyancy * DT_SECS;
     for d in &dv {
         assert!((d - expected).abs() < 1e-3, "Δv_y {d}, expected {expected}");
     }

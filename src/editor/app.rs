@@ -446,12 +446,19 @@ impl Gfx {
             if !e.enabled {
                 continue;
             }
+            // Particles live in their emitter's simulation space (relative to its origin).
+            let origin = self
+                .sim
+                .planner
+                .emitters
+                .get(i)
+                .map_or(glam::Vec3::ZERO, |p| p.origin().as_vec3());
             match self.sim.read_particles(i) {
                 Ok(particles) => positions.extend(
                     particles
                         .iter()
                         .filter(|p| p.is_alive())
-                        .map(|p| p.position()),
+                        .map(|p| p.position() + origin),
                 ),
                 Err(err) => log::warn!("reading particles for framing: {err}"),
             }
