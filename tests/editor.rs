@@ -476,3 +476,55 @@ fn reordering_emitters_moves_their_particles_along() {
         "the copy spawns"
     );
 }
+
+#[test]
+fn force_modules_and_colliders_are_switched_and_edited_in_the_panel() {
+    let mut harness = panel_harness(campfire_state());
+    open_section(&mut harness, "Forces");
+    assert!(
+        harness.state().effect.emitters[0]
+            .forces
+            .turbulence
+            .is_none()
+    );
+    harness.get_by_label("Turbulence").click_accesskit();
+    harness.run();
+    assert!(
+        harness.state().running.emitters[0]
+            .forces
+            .turbulence
+            .is_some()
+    );
+    harness.get_by_label("Octaves").set_value_accesskit(9.0);
+    harness.run();
+    let t = harness.state().effect.emitters[0]
+        .forces
+        .turbulence
+        .clone()
+        .expect("on");
+    assert_eq!(t.octaves, 4, "clamped to the 1..=4 the shader supports");
+
+    harness.get_by_label("Add sphere").click_accesskit();
+    harness.run();
+    harness.get_by_label("Ground plane").click_accesskit();
+    harness.run();
+    let col = &harness.state().running.emitters[0].collisions;
+    assert_eq!(col.spheres.len(), 1);
+    assert!(col.ground.is_some());
+    harness.get_by_label("Elasticity").set_value_accesskit(0.9);
+    harness.run();
+    assert_eq!(
+        harness.state().running.emitters[0].collisions.elasticity,
+        0.9
+    );
+
+    harness.get_by_label("Turbulence").click_accesskit();
+    harness.run();
+    assert!(
+        harness.state().running.emitters[0]
+            .forces
+            .turbulence
+            .is_none()
+    );
+    assert!(harness.state().validation_errors.is_empty());
+}

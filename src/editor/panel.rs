@@ -10,7 +10,8 @@ use std::ops::RangeInclusive;
 use egui::{Color32, DragValue, Response, RichText, Ui};
 
 use crate::effect::{
-    BlendMode, Burst, Effect, Emitter, Integrator, Range, Shape, Sprite, TimeMode,
+    BlendMode, Burst, Collisions, Effect, Emitter, Falloff, Integrator, MAX_SPHERES, Range, Shape,
+    SphereCollider, Sprite, TimeMode,
 };
 
 use super::look::look_ui;
@@ -691,7 +692,7 @@ pub fn forces_ui(ui: &mut Ui, effect: &mut Effect, selected: usize) {
         );
         vec3_ui(
             ui,
-            "Gravity",
+            "Gravity m/s²",
             "Gravity, m/s²",
             &mut f.gravity_m_per_s2,
             -1000.0..=1000.0,
@@ -706,7 +707,7 @@ pub fn forces_ui(ui: &mut Ui, effect: &mut Effect, selected: usize) {
         );
         vec3_ui(
             ui,
-            "Wind",
+            "Wind m/s",
             "The flow velocity drag pulls toward, m/s",
             &mut f.wind_m_per_s,
             -100.0..=100.0,
@@ -725,6 +726,278 @@ pub fn forces_ui(ui: &mut Ui, effect: &mut Effect, selected: usize) {
         format!("Net constant acceleration {:+.2} m/s² up; no drag", accel.y)
     };
     ui.weak(text);
+    ui.add_space(4.0);
+    force_modules_ui(ui, f);
+    ui.add_space(4.0);
+    collisions_ui(ui, &mut e.collisions);
+}
+
+/// An optional module: a checkbox that creates it with its defaults or removes it, and
+/// its fields when present.
+fn module_ui<T: Default>(
+    ui: &mut Ui,
+    id: &str,
+    label: &str,
+    tip: &str,
+    slot: &mut Option<T>,
+    body: impl FnOnce(&mut Ui, &mut T),
+) {
+    let mut is_on = slot.is_some();
+    if ui.checkbox(&mut is_on, label).on_hover_text(tip).changed() {
+        *slot = is_on.then(T::default);
+    }
+    if let Some(module) = slot {
+        ui.indent(id, |ui| grid(id).show(ui, |ui| body(ui, module)));
+    }
+}
+
+/// Quadratic drag and the optional force modules (each costs nothing when off).
+fn force_modules_ui(ui: &mut Ui, f: &mut crate::effect::Forces) {
+    grid("quadratic_drag_grid").show(ui, |ui| {
+        row(
+            ui,
+            "Quadratic drag",
+            "a = −c·|v − wind|·(v − wind), per metre; 0 = off",
+            |ui| ui.add(drag(&mut f.quadratic_drag_per_m, 0.0..=100.0, 0.005, " /m")),
+        );
+    });
+    module_ui(
+        ui,
+        "gusts",
+        "Gusts",
+        "Noise-modulated wind strength",
+        &mut f.gusts,
+        |ui, g| {
+            row(ui, "Gust strength", "Fraction of the wind", |ui| {
+                ui.add(drag(&mut g.strength, 0.0..=10.0, 0.01, "×"))
+            });
+            row(ui, "Gust frequency", "How often gusts change, Hz", |ui| {
+                ui.add(drag(&mut g.frequency_hz, 0.0..=100.0, 0.01, " Hz"))
+            });
+        },
+    );
+    module_ui(
+        ui,
+        "turbulence",
+        "Turbulence",
+        "Curl-noise turbulence (divergence-free swirls)",
+        &mut f.turbulence,
+        |ui, t| {
+            row(ui, "Turb. strength", "Typical acceleration, m/s²", |ui| {
+                ui.add(drag(&mut t.strength_m_per_s2, 0.0..=1000.0, 0.02, " m/s²"))
+            });
+            row(
+                ui,
+                "Turb. frequency",
+                "Spatial frequency, per metre",
+                |ui| ui.add(drag(&mut t.frequency_per_m, 0.0..=100.0, 0.02, " /m")),
+            );
+            row(
+                ui,
+                "Octaves",
+                "Each octave doubles the frequency and halves the amplitude",
+                |ui| ui.add(DragValue::new(&mut t.octaves).range(1..=4).speed(0.05)),
+            );
+            row(
+                ui,
+                "Turb. scroll",
+                "Upward scroll of the field, m/s",
+                |ui| ui.add(drag(&mut t.scroll_m_per_s, -100.0..=100.0, 0.01, " m/s")),
+            );
+        },
+    );
+    module_ui(
+        ui,
+        "vortex",
+        "Vortex",
+        "Swirl around an axis through a point",
+        &mut f.vortex,
+        |ui, v| {
+            vec3_ui(
+                ui,
+                "Vortex centre",
+                "A point on the axis, world metres",
+                &mut v.center_m,
+                -1000.0..=1000.0,
+                0.01,
+                " m",
+            );
+            vec3_ui(
+                ui,
+                "Vortex axis",
+                "Axis direction (normalised on use; not zero)",
+                &mut v.axis,
+                -1.0..=1.0,
+                0.01,
+                "",
+            );
+            row(
+                ui,
+                "Swirl",
+                "Tangential acceleration near the axis, m/s² (sign = spin)",
+                |ui| ui.add(drag(&mut v.swirl_m_per_s2, -1000.0..=1000.0, 0.02, " m/s²")),
+            );
+            row(
+                ui,
+                "Vortex radius",
+                "Falloff radius R: a·exp(−d²/R²), metres",
+                |ui| ui.add(drag(&mut v.radius_m, 0.001..=1000.0, 0.005, " m")),
+            );
+        },
+    );
+    module_ui(
+        ui,
+        "attractor",
+        "Attractor",
+        "Point attractor (negative strength repels)",
+        &mut f.attractor,
+        |ui, a| {
+            vec3_ui(
+                ui,
+                "Attractor position",
+                "World metres",
+                &mut a.position_m,
+                -1000.0..=1000.0,
+                0.01,
+                " m",
+            );
+            row(
+                ui,
+                "Attractor strength",
+                "m³/s² (inverse square) or m/s² (constant); negative repels",
+                |ui| ui.add(drag(&mut a.strength, -1000.0..=1000.0, 0.01, "")),
+            );
+            row(
+                ui,
+                "Attractor radius",
+                "Softening radius (inverse square) or range (constant), metres",
+                |ui| ui.add(drag(&mut a.radius_m, 0.001..=1000.0, 0.005, " m")),
+            );
+            let label = ui.label("Falloff");
+            egui::ComboBox::from_id_salt("attractor_falloff")
+                .selected_text(falloff_label(a.falloff))
+                .show_ui(ui, |ui| {
+                    for f in [Falloff::InverseSquare, Falloff::ConstantWithinRadius] {
+                        ui.selectable_value(&mut a.falloff, f, falloff_label(f));
+                    }
+                })
+                .response
+                .labelled_by(label.id);
+            ui.end_row();
+        },
+    );
+    module_ui(
+        ui,
+        "flame_pull",
+        "Flame pull",
+        "Pull toward the emitter axis, growing with age, so flames taper",
+        &mut f.flame_pull,
+        |ui, p| {
+            row(ui, "Pull strength", "Per second squared", |ui| {
+                ui.add(drag(&mut p.strength_per_s2, 0.0..=1000.0, 0.05, " /s²"))
+            });
+            row(
+                ui,
+                "Pull exponent",
+                "Growth with normalised age (1 = linear)",
+                |ui| ui.add(drag(&mut p.exponent, 0.0..=16.0, 0.01, "")),
+            );
+        },
+    );
+}
+
+fn falloff_label(f: Falloff) -> &'static str {
+    match f {
+        Falloff::InverseSquare => "inverse square",
+        Falloff::ConstantWithinRadius => "constant within radius",
+    }
+}
+
+/// Ground plane and sphere colliders of the selected emitter.
+fn collisions_ui(ui: &mut Ui, col: &mut Collisions) {
+    ui.label(RichText::new("Collisions").strong());
+    module_ui(
+        ui,
+        "ground",
+        "Ground plane",
+        "An infinite horizontal plane particles bounce on",
+        &mut col.ground,
+        |ui, g| {
+            row(ui, "Ground height", "Height of the plane, metres", |ui| {
+                ui.add(drag(&mut g.height_m, -1000.0..=1000.0, 0.01, " m"))
+            });
+            row(
+                ui,
+                "Kill on ground",
+                "Particles that touch the ground die",
+                |ui| ui.checkbox(&mut g.kill_on_contact, ""),
+            );
+        },
+    );
+    let mut remove = None;
+    for (k, sphere) in col.spheres.iter_mut().enumerate() {
+        ui.horizontal(|ui| {
+            ui.label(format!("Sphere {}", k + 1));
+            for (c, axis) in sphere.center_m.iter_mut().zip(["x ", "y ", "z "]) {
+                ui.add(
+                    drag(c, -1000.0..=1000.0, 0.01, "")
+                        .prefix(axis)
+                        .min_decimals(2),
+                );
+            }
+            ui.add(drag(&mut sphere.radius_m, 0.001..=1000.0, 0.005, " m").prefix("r "));
+            if ui
+                .small_button("x")
+                .on_hover_text("Remove this sphere")
+                .clicked()
+            {
+                remove = Some(k);
+            }
+        });
+    }
+    if let Some(k) = remove {
+        col.spheres.remove(k);
+    }
+    ui.horizontal(|ui| {
+        if ui
+            .add_enabled(
+                col.spheres.len() < MAX_SPHERES,
+                egui::Button::new("Add sphere").small(),
+            )
+            .on_hover_text(format!("A sphere collider (at most {MAX_SPHERES})"))
+            .clicked()
+        {
+            col.spheres.push(SphereCollider::default());
+        }
+        ui.checkbox(&mut col.kill_on_sphere_contact, "kill on contact")
+            .on_hover_text("Particles that touch a sphere die (smoke into a wall)");
+    });
+    if col.any() {
+        grid("collision_grid").show(ui, |ui| {
+            row(
+                ui,
+                "Elasticity",
+                "Normal restitution: 0 stops, 1 bounces perfectly",
+                |ui| ui.add(drag(&mut col.elasticity, 0.0..=1.0, 0.005, "")),
+            );
+            row(ui, "Friction", "Tangential loss per contact, 0..1", |ui| {
+                ui.add(drag(&mut col.friction, 0.0..=1.0, 0.005, ""))
+            });
+            row(
+                ui,
+                "Rest speed",
+                "Below this normal speed after a bounce the particle rests, m/s",
+                |ui| {
+                    ui.add(drag(
+                        &mut col.rest_speed_m_per_s,
+                        0.0..=100.0,
+                        0.001,
+                        " m/s",
+                    ))
+                },
+            );
+        });
+    }
 }
 
 // ---------------------------------------------------------------------------------------

@@ -292,6 +292,7 @@ fn draw_gizmo(
         projector.polyline(painter, &world, stroke);
     }
     if is_selected {
+        draw_force_gizmos(painter, projector, e);
         let origin = world_from_emitter.transform_point3(Vec3::ZERO);
         let dir =
             world_from_emitter.transform_vector3(Vec3::from(e.direction).normalize_or(Vec3::Y));
@@ -300,6 +301,45 @@ fn draw_gizmo(
         if let Some([_, t]) = projector.segment(origin, tip) {
             painter.circle_filled(t, 2.5, color);
         }
+    }
+}
+
+/// Colliders, the attractor and the vortex axis of an emitter (all in world space).
+fn draw_force_gizmos(painter: &egui::Painter, projector: &Projector, e: &Emitter) {
+    let collider = Stroke::new(1.0, Color32::from_rgb(230, 150, 70));
+    for sphere in &e.collisions.spheres {
+        let c = Vec3::from(sphere.center_m);
+        for (u, v) in [(Vec3::X, Vec3::Y), (Vec3::Y, Vec3::Z), (Vec3::X, Vec3::Z)] {
+            projector.polyline(painter, &circle(c, u, v, sphere.radius_m), collider);
+        }
+    }
+    if let Some(ground) = &e.collisions.ground {
+        let h = ground.height_m;
+        let s = 2.0;
+        let corners = [
+            Vec3::new(-s, h, -s),
+            Vec3::new(s, h, -s),
+            Vec3::new(s, h, s),
+            Vec3::new(-s, h, s),
+            Vec3::new(-s, h, -s),
+        ];
+        projector.polyline(painter, &corners, collider);
+    }
+    let force = Stroke::new(1.0, Color32::from_rgb(190, 120, 255));
+    if let Some(a) = &e.forces.attractor {
+        let p = Vec3::from(a.position_m);
+        for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
+            projector.polyline(painter, &[p - axis * 0.08, p + axis * 0.08], force);
+        }
+        let (u, v) = basis(Vec3::Y);
+        projector.polyline(painter, &circle(p, u, v, a.radius_m), force);
+    }
+    if let Some(vortex) = &e.forces.vortex {
+        let c = Vec3::from(vortex.center_m);
+        let axis = Vec3::from(vortex.axis).normalize_or(Vec3::Y);
+        projector.polyline(painter, &[c - axis * 1.5, c + axis * 1.5], force);
+        let (u, v) = basis(axis);
+        projector.polyline(painter, &circle(c, u, v, vortex.radius_m), force);
     }
 }
 
