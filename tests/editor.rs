@@ -528,3 +528,20 @@ fn force_modules_and_colliders_are_switched_and_edited_in_the_panel() {
     );
     assert!(harness.state().validation_errors.is_empty());
 }
+
+#[test]
+fn an_effect_the_gpu_refused_is_not_offered_again_until_it_changes() {
+    let mut state = campfire_state();
+    let good = state.running.clone();
+    state.effect.emitters[0].capacity = 4_000_000;
+    assert!(state.apply());
+    // The frame loop's sync failed (say, a device limit): back to the last good effect.
+    state.reject_running(&good, "capacity over the device limit".into());
+    assert_eq!(state.running, good);
+    assert!(!state.apply(), "the same effect is not retried every frame");
+    assert!(state.gpu_rejected.is_some());
+    state.effect.emitters[0].capacity = 8192;
+    assert!(state.apply());
+    assert!(state.gpu_rejected.is_none());
+    assert_eq!(state.running.emitters[0].capacity, 8192);
+}

@@ -555,7 +555,12 @@ impl App {
         // 2. The simulation follows the running effect and steps.
         gfx.apply_running(&mut self.state);
         let cpu_start = Instant::now();
-        gfx.simulate(&mut self.state, frame_dt_secs)?;
+        if let Err(err) = gfx.simulate(&mut self.state, frame_dt_secs) {
+            // Keep the editor alive: pause and show why, the user can fix and resume.
+            log::error!("{err:#}");
+            self.state.playback.is_paused = true;
+            self.state.sim_error = Some(format!("{err:#}"));
+        }
 
         // 3. The viewport image: particles → HDR → tonemap, in this frame's encoder.
         gfx.viewport_px = viewport.size_px;

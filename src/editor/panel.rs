@@ -122,6 +122,12 @@ pub fn header_ui(ui: &mut Ui, state: &mut EditorState) {
             }
         });
     }
+    if let Some(err) = &state.sim_error {
+        error_box_ui(ui, |ui| {
+            ui.label(RichText::new("The simulation stopped (paused).").strong());
+            ui.label(err);
+        });
+    }
     if let Some((_, reason)) = &state.gpu_rejected {
         error_box_ui(ui, |ui| {
             ui.label(

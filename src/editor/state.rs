@@ -54,6 +54,8 @@ pub struct EditorState {
     /// An effect the GPU refused (e.g. a capacity over a device limit) and why; not
     /// offered again until it changes.
     pub gpu_rejected: Option<(Effect, String)>,
+    /// The last simulation failure (the simulation pauses), until playback resumes.
+    pub sim_error: Option<String>,
     /// Index of the emitter shown in the emitter-specific sections.
     pub selected: usize,
     /// Undo/redo of `effect`.
@@ -81,6 +83,7 @@ impl EditorState {
             effect,
             validation_errors,
             gpu_rejected: None,
+            sim_error: None,
             selected: 0,
             playback: Playback::default(),
             view: ViewSettings::default(),
@@ -95,6 +98,9 @@ impl EditorState {
     /// and promotes it to `running` when valid. Returns true when `running` changed.
     pub fn end_frame(&mut self, ctx: &egui::Context) -> bool {
         self.handle_shortcuts(ctx);
+        if !self.playback.is_paused {
+            self.sim_error = None;
+        }
         let is_interacting = ctx.input(|i| i.pointer.any_down()) || ctx.text_edit_focused();
         self.history.observe(&self.effect, is_interacting);
         self.apply()
