@@ -94,7 +94,7 @@ fn mean(v: &VecDeque<f32>) -> f32 {
     }
 }
 
-/// Median of `values` (NaN-free), 0 when empty.
+/// Median of `values` (non-finite values ignored), 0 when empty.
 pub fn median(values: &[f32]) -> f32 {
     let mut v: Vec<f32> = values.iter().copied().filter(|x| x.is_finite()).collect();
     if v.is_empty() {
@@ -107,6 +107,17 @@ pub fn median(values: &[f32]) -> f32 {
     } else {
         0.5 * (v[n / 2 - 1] + v[n / 2])
     }
+}
+
+/// The `q` quantile (0..=1, nearest rank) of `values`, 0 when empty.
+pub fn percentile(values: &[f32], q: f32) -> f32 {
+    let mut v: Vec<f32> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f32::total_cmp);
+    let rank = ((v.len() - 1) as f32 * q.clamp(0.0, 1.0)).round() as usize;
+    v[rank]
 }
 
 /// The Stats section: timings, counters per emitter and a frame-time plot.
@@ -208,18 +219,17 @@ pub fn stats_ui(ui: &mut egui::Ui, stats: &Stats, effect: &Effect) {
         }
     }
     ui.add_space(4.0);
-    let frame_ms: Vec<[f64; 2]> = stats
-        .frame_secs
-        .iter()
-        .enumerate()
-        .map(|(i, s)| [i as f64, *s as f64 * 1e3])
-        .collect();
-    let cpu_ms: Vec<[f64; 2]> = stats
-        .cpu_secs
-        .iter()
-        .enumerate()
-        .map(|(i, s)| [i as f64, *s as f64 * 1e3])
-        .collect();
+    // Spikes (start-up, a resize) are clipped so they do not flatten the rest.
+    let frames: Vec<f32> = stats.frame_secs.iter().map(|s| s * 1e3).collect();
+    let y_max = (percentile(&frames, 0.95) * 1.5).max(34.0) as f64;
+    let series = |v: &VecDeque<f32>| -> Vec<[f64; 2]> {
+        v.iter()
+            .enumerate()
+            .map(|(i, s)| [i as f64, (*s as f64 * 1e3).min(y_max)])
+            .collect()
+    };
+    let frame_ms = series(&stats.frame_secs);
+    let cpu_ms = series(&stats.cpu_secs);
     Plot::new("frame_time_plot")
         .height(110.0)
         .allow_drag(false)
@@ -228,7 +238,7 @@ pub fn stats_ui(ui: &mut egui::Ui, stats: &Stats, effect: &Effect) {
         .allow_boxed_zoom(false)
         .show_x(false)
         .include_y(0.0)
-        .include_y(33.4)
+        .include_y(y_max)
         .include_x(0.0)
         .include_x(HISTORY_FRAMES as f64)
         .y_axis_label("ms")
