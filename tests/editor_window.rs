@@ -15,8 +15,9 @@ fn on_path(program: &str) -> Option<PathBuf> {
     })
 }
 
-#[test]
-fn the_editor_window_shows_the_panel_and_the_fire() {
+/// Runs `ignis edit --frames N --screenshot … EXTRA…` under Xvfb; returns the frame
+/// report line and the screenshot.
+fn run_editor(frames: u32, extra: &[&str]) -> (String, image::RgbaImage) {
     let xvfb_run = on_path("xvfb-run").unwrap_or_else(|| {
         panic!(
             "xvfb-run is not on PATH: this test opens a real window under a virtual X server; \
@@ -28,8 +29,9 @@ fn the_editor_window_shows_the_panel_and_the_fire() {
     let output = Command::new(xvfb_run)
         .args(["-a", "-s", "-screen 0 1280x720x24"])
         .arg(env!("CARGO_BIN_EXE_ignis"))
-        .args(["edit", "--frames", "60", "--screenshot"])
+        .args(["edit", "--frames", &frames.to_string(), "--screenshot"])
         .arg(&png)
+        .args(extra)
         .output()
         .expect("running xvfb-run");
     let stdout = String::from_utf8_lossy(&output.stdout);
@@ -39,15 +41,20 @@ fn the_editor_window_shows_the_panel_and_the_fire() {
         "ignis edit failed ({}):\n{stdout}\n{stderr}",
         output.status
     );
+    let prefix = format!("edit: {frames} frames, median frame");
     let report = stdout
         .lines()
-        .find(|l| l.starts_with("edit: 60 frames, median frame"))
-        .unwrap_or_else(|| panic!("no frame report in the output:\n{stdout}\n{stderr}"));
-    println!("{report}");
-
+        .find(|l| l.starts_with(&prefix))
+        .unwrap_or_else(|| panic!("no frame report in the output:\n{stdout}\n{stderr}"))
+        .to_owned();
     let image = image::open(&png)
         .expect("the screenshot is a PNG")
         .to_rgba8();
+    (report, image)
+}
+
+/// Checks the screenshot: egui's panel on the right, a fire on a dark viewport.
+fn assert_panel_and_fire(image: &image::RgbaImage, min_warm_pixels: usize) {
     assert_eq!(image.dimensions(), (1280, 720));
 
     // egui's dark panel fill (grey 27) covers most of the rightmost 300 pixels.
@@ -81,9 +88,28 @@ fn the_editor_window_shows_the_panel_and_the_fire() {
             }
         }
     }
-    assert!(warm > 3000, "only {warm} warm pixels in the viewport");
+    assert!(
+        warm > min_warm_pixels,
+        "only {warm} warm pixels in the viewport"
+    );
     assert!(
         dark > 880 * 720 / 3,
         "the viewport background should be dark ({dark} dark pixels)"
     );
+}
+
+#[test]
+fn the_editor_window_shows_the_panel_and_the_fire() {
+    let (report, image) = run_editor(60, &[]);
+    println!("{report}");
+    assert_panel_and_fire(&image, 3000);
+}
+
+#[test]
+fn egui_wgpus_own_painter_draws_the_same_window() {
+    // The default painter on a software adapter is the lean one; egui-wgpu's must work
+    // too (it is the default on hardware GPUs). Few frames: it is slow on llvmpipe.
+    let (report, image) = run_editor(12, &["--ui-painter", "egui-wgpu"]);
+    println!("{report}");
+    assert_panel_and_fire(&image, 1000);
 }

@@ -17,7 +17,7 @@ use winit::window::{Window, WindowId};
 
 use crate::effect::{Effect, TimeMode};
 use crate::gpu::GpuContext;
-use crate::render::{LDR_GAMMA_VIEW_FORMAT, OrbitCamera, Renderer};
+use crate::render::{OrbitCamera, Renderer};
 use crate::shaders::ShaderLibrary;
 use crate::sim::{GpuSim, Stepper};
 
@@ -164,7 +164,8 @@ struct Gfx {
     egui_state: egui_winit::State,
     ui_painter: UiPainter,
     viewport_texture: Option<egui::TextureId>,
-    registered_size: Option<(u32, u32)>,
+    /// The viewport image egui shows (a gamma-encoded copy of the display image).
+    viewport_image: Option<wgpu::Texture>,
     last_alpha: f32,
     frame_index: u64,
     last_frame: Option<Instant>,
@@ -320,7 +321,7 @@ impl Gfx {
             egui_state,
             ui_painter,
             viewport_texture: None,
-            registered_size: None,
+            viewport_image: None,
             last_alpha: 1.0,
             frame_index: 0,
             last_frame: None,
@@ -468,24 +469,52 @@ impl Gfx {
         camera.frame(center, radius);
     }
 
-    /// Points the egui texture at the renderer's display image (again after a resize).
-    fn register_viewport_texture(&mut self) {
+    /// Copies the renderer's display image into the texture egui shows (recreated and
+    /// re-registered after a resize).
+    ///
+    /// egui samples textures as gamma-encoded bytes, while the display image is
+    /// `Rgba8UnormSrgb` (sampling would decode it). A copy into an `Rgba8Unorm` texture of
+    /// the same bytes is legal between sRGB and non-sRGB twins and, unlike a
+    /// reinterpreting view, needs no `VIEW_FORMATS` support (the GL backend lacks it).
+    fn copy_viewport_image(&mut self, encoder: &mut wgpu::CommandEncoder) {
         let size = self.viewport_px;
-        if self.registered_size == Some(size) && self.viewport_texture.is_some() {
-            return;
+        let stale = self
+            .viewport_image
+            .as_ref()
+            .is_none_or(|t| (t.width(), t.height()) != size);
+        if stale || self.viewport_texture.is_none() {
+            let image = self.ctx.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("editor::viewport_image"),
+                size: wgpu::Extent3d {
+                    width: size.0,
+                    height: size.1,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba8Unorm,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            });
+            let view = image.create_view(&wgpu::TextureViewDescriptor::default());
+            self.viewport_texture = Some(self.ui_painter.set_native_texture(
+                &self.ctx.device,
+                &view,
+                self.viewport_texture,
+            ));
+            self.viewport_image = Some(image);
         }
         let targets = self.renderer.targets(&self.ctx, size);
-        let view = targets.ldr.create_view(&wgpu::TextureViewDescriptor {
-            label: Some("editor::viewport_view"),
-            format: Some(LDR_GAMMA_VIEW_FORMAT),
-            ..Default::default()
-        });
-        self.viewport_texture = Some(self.ui_painter.set_native_texture(
-            &self.ctx.device,
-            &view,
-            self.viewport_texture,
-        ));
-        self.registered_size = Some(size);
+        if let Some(image) = &self.viewport_image
+            && targets.size == size
+        {
+            encoder.copy_texture_to_texture(
+                targets.ldr.as_image_copy(),
+                image.as_image_copy(),
+                image.size(),
+            );
+        }
     }
 
     /// Draws egui's paint jobs into `target`.
@@ -583,7 +612,7 @@ impl App {
         );
         encoder.pop_debug_group();
         let cpu_secs = cpu_start.elapsed().as_secs_f32();
-        gfx.register_viewport_texture();
+        gfx.copy_viewport_image(&mut encoder);
 
         if self.state.frame_requested {
             self.state.frame_requested = false;

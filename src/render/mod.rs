@@ -18,10 +18,6 @@ pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// The display format of headless frames.
 pub const LDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 
-/// A view format of the display target that reads the sRGB-encoded bytes as they are
-/// (no decode on sampling), for compositors that expect gamma-space textures, like egui.
-pub const LDR_GAMMA_VIEW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
-
 /// Offscreen HDR and display targets of one size.
 pub struct Targets {
     /// Width and height in pixels.
@@ -43,7 +39,7 @@ impl Targets {
             height: size.1,
             depth_or_array_layers: 1,
         };
-        let make = |label, format, usage, view_formats| {
+        let make = |label, format, usage| {
             ctx.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
                 size: extent,
@@ -52,24 +48,20 @@ impl Targets {
                 dimension: wgpu::TextureDimension::D2,
                 format,
                 usage,
-                view_formats,
+                view_formats: &[],
             })
         };
         let hdr = make(
             "Targets::hdr",
             HDR_FORMAT,
             wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            &[],
         );
-        // The editor samples the display image through a non-sRGB view: egui's shader
-        // expects gamma-encoded texels (see `LDR_GAMMA_VIEW_FORMAT`).
         let ldr = make(
             "Targets::ldr",
             LDR_FORMAT,
             wgpu::TextureUsages::RENDER_ATTACHMENT
                 | wgpu::TextureUsages::TEXTURE_BINDING
                 | wgpu::TextureUsages::COPY_SRC,
-            &[LDR_GAMMA_VIEW_FORMAT],
         );
         Self {
             size,
