@@ -573,7 +573,26 @@ pub struct Look {
     pub intensity: f32,
     /// How particles are blended.
     pub blend: BlendMode,
+    /// Which draw path renders them.
+    pub draw_path: DrawPath,
 }
+
+/// The two draw paths; both render the same look.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum DrawPath {
+    /// Splat when the particles project smaller than [`SPLAT_BELOW_PX`] and blend
+    /// additively; billboards otherwise.
+    #[default]
+    Auto,
+    /// Always instanced billboards (textured quads through the rasteriser).
+    Billboard,
+    /// Always the compute splat (additive emitters only; alpha emitters fall back to
+    /// billboards, which they need for ordering).
+    Splat,
+}
+
+/// Auto draw path: below this projected particle size (pixels), splat.
+pub const SPLAT_BELOW_PX: f32 = 2.0;
 
 /// Built-in procedural sprites.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -751,6 +770,7 @@ impl Default for Look {
             ],
             intensity: 1.6,
             blend: BlendMode::Additive,
+            draw_path: DrawPath::Auto,
         }
     }
 }

@@ -22,12 +22,19 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ),
     ("collide.wgsl", include_str!("../shaders/collide.wgsl")),
     ("update.wgsl", include_str!("../shaders/update.wgsl")),
+    ("look.wgsl", include_str!("../shaders/look.wgsl")),
     ("billboard.wgsl", include_str!("../shaders/billboard.wgsl")),
+    ("splat.wgsl", include_str!("../shaders/splat.wgsl")),
     ("tonemap.wgsl", include_str!("../shaders/tonemap.wgsl")),
 ];
 
 /// The entry files, one per pipeline family; the others are imported by them.
-pub const ENTRY_FILES: &[&str] = &["update.wgsl", "billboard.wgsl", "tonemap.wgsl"];
+pub const ENTRY_FILES: &[&str] = &[
+    "update.wgsl",
+    "billboard.wgsl",
+    "splat.wgsl",
+    "tonemap.wgsl",
+];
 
 /// A shader problem, located in the file the user edits.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]

@@ -201,3 +201,66 @@ fn render_command_rejects_bad_input() {
     assert!(err.contains("no/such/preset.ron"), "{err}");
     assert!(!err.contains("panicked"), "{err}");
 }
+
+/// Both draw paths render the same look: flames of 3-px particles drawn as billboards and
+/// as compute splats agree in total light (within 10 %) and, block-averaged over 8×8
+/// pixels, in where the light is.
+#[test]
+fn billboard_and_splat_paths_agree() {
+    use ignis::effect::DrawPath;
+    let ctx = gpu();
+    let render = |path: DrawPath| {
+        let mut effect = Effect::default_campfire();
+        effect.emitters.retain(|e| e.name == "flames");
+        let e = &mut effect.emitters[0];
+        e.look.size_start_m = 0.03;
+        e.look.size_end_m = 0.02;
+        e.look.intensity = 0.6;
+        e.look.draw_path = path;
+        let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+        run.renderer.exposure = 0.5;
+        for _ in 0..60 {
+            run.advance(1.0 / 60.0).expect("advance");
+        }
+        run.render(SIZE).expect("render")
+    };
+    let a = render(DrawPath::Billboard);
+    let b = render(DrawPath::Splat);
+    let light = |img: &image::RgbaImage| {
+        img.pixels()
+            .map(|p| p[0] as f64 + p[1] as f64 + p[2] as f64)
+            .sum::<f64>()
+    };
+    let (la, lb) = (light(&a), light(&b));
+    assert!(la > 1e5, "billboards drew almost nothing: {la}");
+    assert!(
+        (la - lb).abs() / la < 0.10,
+        "total light differs: billboard {la}, splat {lb}"
+    );
+    let blocks = |img: &image::RgbaImage| -> Vec<f64> {
+        let mut v = Vec::new();
+        for by in 0..SIZE.1 / 8 {
+            for bx in 0..SIZE.0 / 8 {
+                v.push(
+                    mean_rgb(img, bx * 8, by * 8, bx * 8 + 8, by * 8 + 8)
+                        .iter()
+                        .map(|c| *c as f64)
+                        .sum::<f64>(),
+                );
+            }
+        }
+        v
+    };
+    let (ba, bb) = (blocks(&a), blocks(&b));
+    let diff: f64 = ba.iter().zip(&bb).map(|(x, y)| (x - y).abs()).sum::<f64>();
+    let total: f64 = ba.iter().sum();
+    assert!(
+        diff / total < 0.15,
+        "block-averaged images differ by {:.1} %",
+        100.0 * diff / total
+    );
+    a.save(std::env::temp_dir().join("ignis_path_billboard.png"))
+        .expect("save");
+    b.save(std::env::temp_dir().join("ignis_path_splat.png"))
+        .expect("save");
+}

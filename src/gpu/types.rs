@@ -110,6 +110,8 @@ pub struct CameraUniform {
     pub right_alpha: [f32; 4],
     /// xyz: camera up.
     pub up: [f32; 4],
+    /// xy: target size in pixels, z: pixels per unit of size / clip w.
+    pub viewport: [f32; 4],
 }
 
 /// Look data for the billboard pass (keep in sync with `LookUniform` in
@@ -127,6 +129,8 @@ pub struct LookUniform {
     pub size_intensity: [f32; 4],
     /// sprite kind, blend (0 additive, 1 alpha), unused, unused.
     pub sprite_blend: [u32; 4],
+    /// x: ∫ sprite coverage over the unit quad, yzw: unused.
+    pub extra: [f32; 4],
 }
 
 /// Tonemap settings (keep in sync with `ToneUniform` in `shaders/tonemap.wgsl`).

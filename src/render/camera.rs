@@ -79,7 +79,8 @@ impl OrbitCamera {
     }
 
     /// The uniform block for the billboard pass.
-    pub fn uniform(&self, aspect: f32, alpha: f32) -> CameraUniform {
+    pub fn uniform(&self, size: (u32, u32), alpha: f32) -> CameraUniform {
+        let aspect = size.0 as f32 / size.1.max(1) as f32;
         let view = self.view_from_world();
         // The camera's right and up axes in world space are the rows of the view rotation.
         let right = Vec3::new(view.x_axis.x, view.y_axis.x, view.z_axis.x);
@@ -88,6 +89,13 @@ impl OrbitCamera {
             clip_from_world: self.clip_from_world(aspect).to_cols_array_2d(),
             right_alpha: [right.x, right.y, right.z, alpha],
             up: [up.x, up.y, up.z, 0.0],
+            viewport: [
+                size.0 as f32,
+                size.1 as f32,
+                // Pixels per (metre / clip w): half the height times the focal factor.
+                0.5 * size.1 as f32 / (0.5 * self.fov_y).tan(),
+                0.0,
+            ],
         }
     }
 

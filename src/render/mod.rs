@@ -2,10 +2,14 @@
 
 pub mod billboard;
 pub mod camera;
+pub mod frame;
+pub mod splat;
 pub mod tonemap;
 
 pub use billboard::BillboardPass;
 pub use camera::OrbitCamera;
+pub use frame::{DrawItem, FrameResources};
+pub use splat::SplatPass;
 pub use tonemap::TonemapPass;
 
 use crate::effect::Effect;
@@ -72,10 +76,37 @@ impl Targets {
     }
 }
 
-/// Draws a simulation: billboards → HDR → tonemap → display texture.
+/// Opens a render pass that clears the HDR target to transparent black.
+pub fn begin_hdr_pass<'a>(
+    enc: &'a mut wgpu::CommandEncoder,
+    hdr: &'a wgpu::TextureView,
+) -> wgpu::RenderPass<'a> {
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("Renderer::hdr_pass"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: hdr,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}
+
+/// Draws a simulation: billboards and splats → HDR → tonemap → display texture.
 pub struct Renderer {
+    /// Uniforms and bind groups shared by the draw paths.
+    pub frame: FrameResources,
     /// The billboard pass.
     pub billboard: BillboardPass,
+    /// The compute splat pass.
+    pub splat: SplatPass,
     /// The tonemap pass.
     pub tonemap: TonemapPass,
     targets: Option<Targets>,
@@ -86,8 +117,11 @@ pub struct Renderer {
 impl Renderer {
     /// Builds the pipelines from `lib`.
     pub fn new(ctx: &GpuContext, lib: &ShaderLibrary) -> Result<Self, ShaderError> {
+        let frame = FrameResources::new(ctx);
         Ok(Self {
-            billboard: BillboardPass::new(ctx, lib)?,
+            billboard: BillboardPass::new(ctx, lib, &frame)?,
+            splat: SplatPass::new(ctx, lib, &frame)?,
+            frame,
             tonemap: TonemapPass::new(ctx, lib, LDR_FORMAT)?,
             targets: None,
             exposure: 1.0,
@@ -101,6 +135,7 @@ impl Renderer {
         lib: &ShaderLibrary,
     ) -> Result<(), ShaderError> {
         self.billboard.rebuild(ctx, lib)?;
+        self.splat.rebuild(ctx, lib)?;
         self.tonemap.rebuild(ctx, lib)?;
         Ok(())
     }
@@ -131,17 +166,15 @@ impl Renderer {
         let Some(targets) = self.targets.as_ref() else {
             return;
         };
-        let aspect = size.0 as f32 / size.1.max(1) as f32;
-        self.billboard.record(
-            ctx,
-            enc,
-            &targets.hdr_view,
-            sim,
-            effect,
-            camera,
-            aspect,
-            alpha,
-        );
+        let items = self.frame.prepare(ctx, sim, effect, camera, size, alpha);
+        let splatted = self.splat.splat(ctx, enc, &self.frame, &items, size);
+        {
+            let mut pass = begin_hdr_pass(enc, &targets.hdr_view);
+            self.billboard.draw(&mut pass, &self.frame, &items);
+            if splatted {
+                self.splat.resolve(&mut pass, &self.frame);
+            }
+        }
         self.tonemap.record(
             ctx,
             enc,

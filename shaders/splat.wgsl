@@ -1,0 +1,95 @@
+// splat.wgsl — pass 2, small particles: a compute splat. Each alive slot projects its
+// particle and adds its light, as the billboard would have integrated it
+// (colour · alpha · intensity · ∫coverage · (size in px / 2)²), into a fixed-point
+// accumulation buffer spread bilinearly over the 2×2 nearest pixels; `resolve` turns the
+// buffer into HDR light. Order-independent, so additive fire needs no sort; alpha-blended
+// emitters always use billboards.
+//
+// Contract:
+// - group 0: 0 `camera`, 1 `look` (dynamic offset per emitter), as billboard.wgsl.
+// - group 1: 0 `prev`, 1 `cur` (state buffers).
+// - group 2: 0 `accum` (3 × u32 per pixel: R, G, B in units of 1/FIXED_SCALE).
+#import "common.wgsl"
+#import "rng.wgsl"
+#import "look.wgsl"
+
+@group(0) @binding(0) var<uniform> camera: CameraUniform;
+@group(0) @binding(1) var<uniform> look: LookUniform;
+@group(1) @binding(0) var<storage, read> prev: array<Particle>;
+@group(1) @binding(1) var<storage, read> cur: array<Particle>;
+@group(2) @binding(0) var<storage, read_write> accum: array<atomic<u32>>;
+
+// Keep in sync with `SPLAT_FIXED_SCALE` in src/render/splat.rs.
+const FIXED_SCALE: f32 = 4096.0;
+
+fn add_light(x: i32, y: i32, rgb: vec3<f32>, dither: f32) {
+    let w = i32(camera.viewport.x);
+    let h = i32(camera.viewport.y);
+    if x < 0 || y < 0 || x >= w || y >= h {
+        return;
+    }
+    let base = u32(y * w + x) * 3u;
+    // Dithered rounding keeps the expected energy of faint contributions.
+    let q = vec3<u32>(rgb * FIXED_SCALE + dither);
+    if q.r > 0u {
+        atomicAdd(&accum[base], q.r);
+    }
+    if q.g > 0u {
+        atomicAdd(&accum[base + 1u], q.g);
+    }
+    if q.b > 0u {
+        atomicAdd(&accum[base + 2u], q.b);
+    }
+}
+
+@compute @workgroup_size(256)
+fn splat(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let slot = (wg.y * nwg.x + wg.x) * 256u + lid;
+    if slot >= arrayLength(&cur) {
+        return;
+    }
+    let p = cur[slot];
+    if !is_alive(p) {
+        return;
+    }
+    let s = draw_state(p, prev[slot]);
+    let clip = look.clip_from_sim * vec4<f32>(s.xyz, 1.0);
+    if clip.w <= 1e-4 || any(abs(clip.xy) > vec2<f32>(clip.w * 1.01)) || clip.z < 0.0 || clip.z > clip.w {
+        return;
+    }
+    let t = age_fraction(s.w, p.vel_life.w);
+    let color = particle_color(t);
+    let size_px = size_at(t) * camera.viewport.z / clip.w;
+    let half = 0.5 * size_px;
+    let energy = color.rgb * (color.a * look.size_intensity.z * look.extra.x * half * half);
+    let ndc = clip.xy / clip.w;
+    let px = vec2<f32>((ndc.x * 0.5 + 0.5) * camera.viewport.x, (0.5 - ndc.y * 0.5) * camera.viewport.y) - 0.5;
+    let base = floor(px);
+    let f = px - base;
+    let b = vec2<i32>(base);
+    let dither = unorm4(pcg4d(vec4<u32>(slot, bitcast<u32>(s.w), 0x5EEDu, 0u)));
+    add_light(b.x, b.y, energy * ((1.0 - f.x) * (1.0 - f.y)), dither.x);
+    add_light(b.x + 1, b.y, energy * (f.x * (1.0 - f.y)), dither.y);
+    add_light(b.x, b.y + 1, energy * ((1.0 - f.x) * f.y), dither.z);
+    add_light(b.x + 1, b.y + 1, energy * (f.x * f.y), dither.w);
+}
+
+// The resolve: a full-screen triangle reading the accumulated light into the HDR target
+// (additive blending on top of the billboards).
+@vertex
+fn vs_resolve(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
+    let uv = vec2<f32>(f32((vi << 1u) & 2u), f32(vi & 2u));
+    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+}
+
+@fragment
+fn fs_resolve(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let w = u32(camera.viewport.x);
+    let i = (u32(frag.y) * w + u32(frag.x)) * 3u;
+    let rgb = vec3<f32>(f32(atomicLoad(&accum[i])), f32(atomicLoad(&accum[i + 1u])), f32(atomicLoad(&accum[i + 2u])));
+    return vec4<f32>(rgb / FIXED_SCALE, 0.0);
+}
