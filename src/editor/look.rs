@@ -2,7 +2,9 @@
 
 use egui::{Color32, DragValue, Rgba, RichText, Sense, Ui};
 
-use crate::effect::{BlendMode, ColorStop, Effect, Look, MAX_COLOR_STOPS, Sprite};
+use crate::effect::{
+    BlendMode, ColorStop, DrawPath, Effect, Look, MAX_COLOR_STOPS, SPLAT_BELOW_PX, Sprite,
+};
 
 use super::panel::{blend_label, sprite_label};
 use super::state::ViewSettings;
@@ -58,6 +60,19 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
                 }
             });
             ui.end_row();
+            let label = ui.label("Draw path").on_hover_text(format!(
+                "auto: compute splat when particles project below {SPLAT_BELOW_PX} px and blend additively, billboards otherwise. billboard: instanced quads. splat: compute splat (additive only; alpha falls back to billboards)"
+            ));
+            egui::ComboBox::from_id_salt("draw_path")
+                .selected_text(draw_path_label(look.draw_path))
+                .show_ui(ui, |ui| {
+                    for d in [DrawPath::Auto, DrawPath::Billboard, DrawPath::Splat] {
+                        ui.selectable_value(&mut look.draw_path, d, draw_path_label(d));
+                    }
+                })
+                .response
+                .labelled_by(label.id);
+            ui.end_row();
             let label = ui
                 .label("Size")
                 .on_hover_text("Billboard diameter at birth and at death, metres (linear in between)");
@@ -100,6 +115,14 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
     );
     gradient_preview_ui(ui, &look.color_over_life);
     color_stops_ui(ui, &mut look.color_over_life);
+}
+
+fn draw_path_label(d: DrawPath) -> &'static str {
+    match d {
+        DrawPath::Auto => "auto",
+        DrawPath::Billboard => "billboard",
+        DrawPath::Splat => "splat",
+    }
 }
 
 /// Linear RGBA → egui colour (egui's `Rgba` is linear, premultiplied).
