@@ -540,6 +540,10 @@ fn an_effect_the_gpu_refused_is_not_offered_again_until_it_changes() {
     assert_eq!(state.running, good);
     assert!(!state.apply(), "the same effect is not retried every frame");
     assert!(state.gpu_rejected.is_some());
+    // Undoing to what runs clears the message.
+    assert!(state.undo());
+    assert!(!state.apply());
+    assert!(state.gpu_rejected.is_none());
     state.effect.emitters[0].capacity = 8192;
     assert!(state.apply());
     assert!(state.gpu_rejected.is_none());

@@ -111,7 +111,9 @@ impl EditorState {
     pub fn apply(&mut self) -> bool {
         self.clamp_selection();
         if self.effect == self.running {
+            // Back to what runs (e.g. after an undo): nothing to report any more.
             self.validation_errors.clear();
+            self.gpu_rejected = None;
             return false;
         }
         match self.effect.validate() {
