@@ -46,6 +46,10 @@ enum Command {
         /// on software adapters).
         #[arg(long)]
         render_scale: Option<f32>,
+        /// With --frames: drain the GPU after each frame stage and print the median time
+        /// of each (slower; for finding where the time goes).
+        #[arg(long)]
+        profile: bool,
     },
     /// Render PNG frames of an effect headless.
     Render {
@@ -141,6 +145,7 @@ fn main() {
             shader_dir,
             ui_painter,
             render_scale,
+            profile,
         }) => edit(EditOptions {
             frames: frames.or(screenshot.as_ref().map(|_| 60)),
             preset,
@@ -149,6 +154,7 @@ fn main() {
             window_size: size,
             ui_painter,
             render_scale,
+            profile,
         }),
         Some(Command::Render {
             preset,

@@ -22,6 +22,7 @@ use crate::shaders::ShaderLibrary;
 use crate::sim::{GpuSim, Stepper};
 
 use super::panel::{PANEL_WIDTH, panel_ui};
+use super::profile::StageProfiler;
 use super::remap::emitter_sources;
 use super::screenshot::{Screenshot, read_back};
 use super::state::EditorState;
@@ -63,6 +64,8 @@ pub struct EditOptions {
     pub ui_painter: UiPainterKind,
     /// Viewport render scale (default: 1, or 0.5 on software adapters).
     pub render_scale: Option<f32>,
+    /// Drain the GPU after each frame stage and report where the time goes.
+    pub profile: bool,
 }
 
 /// What a run with `--frames` measured.
@@ -82,6 +85,8 @@ pub struct RunReport {
     pub window_px: (u32, u32),
     /// The adapter.
     pub adapter: String,
+    /// The per-stage breakdown (`--profile`).
+    pub profile: Option<String>,
 }
 
 impl std::fmt::Display for RunReport {
@@ -104,7 +109,11 @@ impl std::fmt::Display for RunReport {
             self.viewport_px.1,
             self.alive,
             self.adapter
-        )
+        )?;
+        if let Some(profile) = &self.profile {
+            write!(f, "\n{profile}")?;
+        }
+        Ok(())
     }
 }
 
@@ -172,6 +181,7 @@ struct Gfx {
     frame_log: Vec<f32>,
     cpu_log: Vec<f32>,
     viewport_px: (u32, u32),
+    profiler: StageProfiler,
 }
 
 impl ApplicationHandler for App {
@@ -328,6 +338,7 @@ impl Gfx {
             frame_log: Vec::new(),
             cpu_log: Vec::new(),
             viewport_px: (1, 1),
+            profiler: StageProfiler::new(options.profile),
         })
     }
 
@@ -562,6 +573,7 @@ impl App {
         gfx.frame_index += 1;
 
         // 1. The UI: edits, camera, the viewport's size.
+        gfx.profiler.begin(&gfx.ctx);
         let raw_input = gfx.egui_state.take_egui_input(&gfx.window);
         let state = &mut self.state;
         let camera = &mut self.camera;
@@ -582,6 +594,7 @@ impl App {
             .handle_platform_output(&gfx.window, full_output.platform_output);
 
         // 2. The simulation follows the running effect and steps.
+        gfx.profiler.end_stage(&gfx.ctx);
         gfx.apply_running(&mut self.state);
         let cpu_start = Instant::now();
         if let Err(err) = gfx.simulate(&mut self.state, frame_dt_secs) {
@@ -591,16 +604,16 @@ impl App {
             self.state.sim_error = Some(format!("{err:#}"));
         }
 
-        // 3. The viewport image: particles → HDR → tonemap, in this frame's encoder.
+        // 3. The viewport image: particles → HDR → tonemap, then a copy egui can show.
+        gfx.profiler.end_stage(&gfx.ctx);
         gfx.viewport_px = viewport.size_px;
         gfx.renderer.exposure = self.state.view.exposure;
         let mut encoder = gfx
             .ctx
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("editor::frame"),
+                label: Some("editor::viewport"),
             });
-        encoder.push_debug_group("viewport");
         gfx.renderer.record(
             &gfx.ctx,
             &mut encoder,
@@ -610,9 +623,9 @@ impl App {
             gfx.last_alpha,
             gfx.viewport_px,
         );
-        encoder.pop_debug_group();
         let cpu_secs = cpu_start.elapsed().as_secs_f32();
         gfx.copy_viewport_image(&mut encoder);
+        gfx.ctx.queue.submit([encoder.finish()]);
 
         if self.state.frame_requested {
             self.state.frame_requested = false;
@@ -625,8 +638,15 @@ impl App {
             gfx.cpu_log.push(cpu_secs);
         }
         self.state.stats.viewport_px = gfx.viewport_px;
+        gfx.profiler.end_stage(&gfx.ctx);
 
         // 4. egui: textures first (always, even when no frame can be drawn), then paint.
+        let mut encoder = gfx
+            .ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("editor::ui"),
+            });
         let ppp = full_output.pixels_per_point;
         let paint_jobs = gfx.egui_ctx.tessellate(full_output.shapes, ppp);
         for (id, deltas) in &full_output.textures_delta.set {
@@ -717,10 +737,12 @@ impl App {
         gfx.ctx
             .queue
             .submit(callbacks.into_iter().chain([encoder.finish()]));
+        gfx.profiler.end_stage(&gfx.ctx);
         if let Some(frame) = frame {
             gfx.window.pre_present_notify();
             gfx.ctx.queue.present(frame);
         }
+        gfx.profiler.end_stage(&gfx.ctx);
         for id in &full_output.textures_delta.free {
             gfx.ui_painter.free_texture(id);
         }
@@ -753,6 +775,7 @@ impl App {
             viewport_px: gfx.viewport_px,
             window_px: (gfx.config.width, gfx.config.height),
             adapter: gfx.ctx.info.name.clone(),
+            profile: gfx.profiler.report(WARMUP_FRAMES),
         });
         Ok(true)
     }

@@ -7,6 +7,7 @@
 pub mod app;
 pub mod look;
 pub mod panel;
+pub mod profile;
 pub mod remap;
 pub mod screenshot;
 pub mod state;
