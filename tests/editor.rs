@@ -8,9 +8,11 @@ use egui_kittest::kittest::Queryable as _;
 use ignis::editor::EditorState;
 use ignis::editor::panel::panel_ui;
 use ignis::editor::remap::emitter_sources;
+use ignis::editor::viewport::viewport_ui;
 use ignis::effect::Effect;
 use ignis::gpu::GpuContext;
 use ignis::gpu::types::Particle;
+use ignis::render::OrbitCamera;
 use ignis::shaders::ShaderLibrary;
 use ignis::sim::GpuSim;
 
@@ -548,4 +550,130 @@ fn an_effect_the_gpu_refused_is_not_offered_again_until_it_changes() {
     assert!(state.apply());
     assert!(state.gpu_rejected.is_none());
     assert_eq!(state.running.emitters[0].capacity, 8192);
+}
+
+// ---------------------------------------------------------------------------------------
+// The viewport's camera input.
+
+struct ViewportHarnessState {
+    editor: EditorState,
+    camera: OrbitCamera,
+    size_px: (u32, u32),
+}
+
+fn viewport_harness() -> Harness<'static, ViewportHarnessState> {
+    let editor = campfire_state();
+    let camera = OrbitCamera::from_hint(&editor.effect.camera);
+    Harness::builder()
+        .with_size(egui::vec2(800.0, 450.0))
+        // Frames 1/60 s apart, so two clicks can make a double-click (kittest's default
+        // step is 0.25 s).
+        .with_step_dt(1.0 / 60.0)
+        .with_max_steps(120)
+        .build_ui_state(
+            |ui, s: &mut ViewportHarnessState| {
+                let out = viewport_ui(ui, &mut s.camera, &mut s.editor, None);
+                s.size_px = out.size_px;
+                s.editor.end_frame(ui.ctx());
+            },
+            ViewportHarnessState {
+                editor,
+                camera,
+                size_px: (0, 0),
+            },
+        )
+}
+
+fn drag(
+    harness: &mut Harness<'_, ViewportHarnessState>,
+    button: egui::PointerButton,
+    modifiers: Modifiers,
+) {
+    let start = egui::pos2(400.0, 225.0);
+    // As egui-winit reports held modifiers.
+    harness.event(egui::Event::ModifiersChanged(modifiers));
+    harness.hover_at(start);
+    harness.run();
+    harness.event(egui::Event::PointerButton {
+        pos: start,
+        button,
+        pressed: true,
+        modifiers,
+    });
+    harness.run();
+    for k in 1..=5 {
+        harness.hover_at(start + egui::vec2(10.0 * k as f32, 6.0 * k as f32));
+        harness.run();
+    }
+    harness.event(egui::Event::PointerButton {
+        pos: start + egui::vec2(50.0, 30.0),
+        button,
+        pressed: false,
+        modifiers,
+    });
+    harness.run();
+    harness.event(egui::Event::ModifiersChanged(Modifiers::NONE));
+    harness.run();
+}
+
+#[test]
+fn the_viewport_orbits_pans_zooms_and_frames() {
+    let mut harness = viewport_harness();
+    harness.run();
+    // The render target follows the viewport's size (render scale 1 here; the harness
+    // keeps an 8-point margin).
+    assert_eq!(harness.state().size_px, (784, 434));
+    let start = harness.state().camera.clone();
+
+    drag(&mut harness, egui::PointerButton::Primary, Modifiers::NONE);
+    let orbited = harness.state().camera.clone();
+    assert_ne!(orbited.yaw, start.yaw, "drag orbits");
+    assert_ne!(orbited.pitch, start.pitch);
+    assert_eq!(orbited.target, start.target);
+
+    drag(&mut harness, egui::PointerButton::Middle, Modifiers::NONE);
+    let panned = harness.state().camera.clone();
+    assert_ne!(panned.target, orbited.target, "middle-drag pans");
+    assert_eq!(panned.yaw, orbited.yaw);
+
+    drag(&mut harness, egui::PointerButton::Primary, Modifiers::SHIFT);
+    let shift_panned = harness.state().camera.clone();
+    assert_ne!(shift_panned.target, panned.target, "shift-drag pans");
+    assert_eq!(shift_panned.yaw, panned.yaw);
+
+    harness.hover_at(egui::pos2(400.0, 225.0));
+    harness.event(egui::Event::MouseWheel {
+        unit: egui::MouseWheelUnit::Line,
+        delta: egui::vec2(0.0, 3.0),
+        phase: egui::TouchPhase::Move,
+        source: egui::MouseWheelSource::Unknown,
+        modifiers: Modifiers::NONE,
+    });
+    harness.run();
+    assert!(
+        harness.state().camera.distance < shift_panned.distance,
+        "scrolling up zooms in"
+    );
+    // Nothing here touched the effect.
+    assert_eq!(harness.state().editor.history.undo_len(), 0);
+
+    let center = egui::pos2(400.0, 225.0);
+    harness.hover_at(center);
+    harness.run();
+    for _ in 0..2 {
+        for pressed in [true, false] {
+            harness.event(egui::Event::PointerButton {
+                pos: center,
+                button: egui::PointerButton::Primary,
+                pressed,
+                modifiers: Modifiers::NONE,
+            });
+            harness.step();
+        }
+    }
+    harness.run();
+    assert!(
+        harness.state().editor.frame_requested,
+        "double-click frames"
+    );
 }
