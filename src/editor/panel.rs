@@ -153,7 +153,7 @@ fn error_box_ui(ui: &mut Ui, add: impl FnOnce(&mut Ui)) {
 
 /// A labelled grid row: the label names the widget for accessibility (and tests) and
 /// both carry the tooltip.
-fn row(ui: &mut Ui, label: &str, tip: &str, add: impl FnOnce(&mut Ui) -> Response) -> Response {
+fn row_ui(ui: &mut Ui, label: &str, tip: &str, add: impl FnOnce(&mut Ui) -> Response) -> Response {
     let label = ui.label(label).on_hover_text(tip);
     let response = add(ui).labelled_by(label.id).on_hover_text(tip);
     ui.end_row();
@@ -272,7 +272,8 @@ pub fn emitter_ui(ui: &mut Ui, effect: &mut Effect, selected: &mut usize) {
         return;
     };
     grid("emitter_grid").show(ui, |ui| {
-        row(ui, "Name", "Unique name of this layer", |ui| {
+        row_ui(
+ui, "Name", "Unique name of this layer", |ui| {
             ui.add(egui::TextEdit::singleline(&mut e.name).desired_width(180.0))
         });
         shape_ui(ui, &mut e.shape);
@@ -294,20 +295,20 @@ pub fn emitter_ui(ui: &mut Ui, effect: &mut Effect, selected: &mut usize) {
             0.5,
             "°",
         );
-        row(
-            ui,
+        row_ui(
+ui,
             "Spawn rate",
             "Continuous emission, particles per second",
             |ui| ui.add(drag(&mut e.spawn_rate_per_sec, 0.0..=1.0e6, 5.0, " /s")),
         );
-        row(
-            ui,
+        row_ui(
+ui,
             "Max spawn / step",
             "At most this many spawns per step, so a long step cannot cause a burst. 0 = automatic (the rate at a 1/15 s step)",
             |ui| ui.add(DragValue::new(&mut e.max_spawn_per_step).range(0..=UI_MAX_CAPACITY).speed(1.0)),
         );
-        row(
-            ui,
+        row_ui(
+ui,
             "Capacity",
             "Particle slots in this emitter's ring. Keep it above rate × max lifetime, or living particles are recycled. Changing it keeps the particles that fit",
             |ui| {
@@ -346,8 +347,8 @@ pub fn emitter_ui(ui: &mut Ui, effect: &mut Effect, selected: &mut usize) {
             0.01,
             "",
         );
-        row(
-            ui,
+        row_ui(
+ui,
             "Spread",
             "Half-angle of the cone of initial directions, degrees (a Cone shape uses its own angle)",
             |ui| ui.add(drag(&mut e.spread_deg, 0.0..=180.0, 0.2, "°")),
@@ -485,10 +486,10 @@ fn shape_ui(ui: &mut Ui, shape: &mut Shape) {
             radius_m,
             surface_only,
         } => {
-            row(ui, "Radius", "Sphere radius, metres", |ui| {
+            row_ui(ui, "Radius", "Sphere radius, metres", |ui| {
                 ui.add(drag(radius_m, 0.0..=100.0, 0.005, " m"))
             });
-            row(
+            row_ui(
                 ui,
                 "Surface only",
                 "Spawn on the surface instead of the volume",
@@ -496,7 +497,7 @@ fn shape_ui(ui: &mut Ui, shape: &mut Shape) {
             );
         }
         Shape::Disc { radius_m, normal } => {
-            row(ui, "Radius", "Disc radius, metres", |ui| {
+            row_ui(ui, "Radius", "Disc radius, metres", |ui| {
                 ui.add(drag(radius_m, 0.0..=100.0, 0.005, " m"))
             });
             vec3_ui(
@@ -524,13 +525,13 @@ fn shape_ui(ui: &mut Ui, shape: &mut Shape) {
             angle_deg,
             radius_m,
         } => {
-            row(
+            row_ui(
                 ui,
                 "Cone angle",
                 "Half-angle of the directions, degrees (replaces Spread)",
                 |ui| ui.add(drag(angle_deg, 0.0..=180.0, 0.2, "°")),
             );
-            row(ui, "Base radius", "Radius of the base disc, metres", |ui| {
+            row_ui(ui, "Base radius", "Radius of the base disc, metres", |ui| {
                 ui.add(drag(radius_m, 0.0..=100.0, 0.005, " m"))
             });
         }
@@ -646,33 +647,33 @@ pub fn randomness_ui(ui: &mut Ui, effect: &mut Effect, selected: usize) {
         let Some(e) = effect.emitters.get_mut(selected) else {
             return;
         };
-        row(
-            ui,
+        row_ui(
+ui,
             "Seed offset",
             "Added to the seed for this emitter's stream (two emitters with the same settings differ by it)",
             |ui| ui.add(DragValue::new(&mut e.seed_offset).speed(1.0)),
         );
         let n = &mut e.spawn_noise;
-        row(
-            ui,
+        row_ui(
+ui,
             "Noise frequency",
             "Spatial frequency of the noise that moves spawn positions and tilts directions, per metre",
             |ui| ui.add(drag(&mut n.frequency_per_m, 0.0..=100.0, 0.02, " /m")),
         );
-        row(
-            ui,
+        row_ui(
+ui,
             "Position amplitude",
             "How far the noise moves spawn positions, metres",
             |ui| ui.add(drag(&mut n.position_amplitude_m, 0.0..=10.0, 0.002, " m")),
         );
-        row(
-            ui,
+        row_ui(
+ui,
             "Direction amplitude",
             "How far the noise tilts the initial direction (fraction of the direction vector)",
             |ui| ui.add(drag(&mut n.direction_amplitude, 0.0..=10.0, 0.005, "")),
         );
-        row(
-            ui,
+        row_ui(
+ui,
             "Scroll speed",
             "How fast the noise field scrolls in time (flicker rate), per second",
             |ui| ui.add(drag(&mut n.scroll_per_sec, -100.0..=100.0, 0.02, " /s")),
@@ -690,8 +691,8 @@ pub fn forces_ui(ui: &mut Ui, effect: &mut Effect, selected: usize) {
     };
     let f = &mut e.forces;
     grid("forces_grid").show(ui, |ui| {
-        row(
-            ui,
+        row_ui(
+ui,
             "Buoyancy",
             "Upward acceleration of hot gas along +Y, m/s² (the 2006 thesis's negative gravity)",
             |ui| ui.add(drag(&mut f.buoyancy_m_per_s2, -1000.0..=1000.0, 0.05, " m/s²")),
@@ -705,8 +706,8 @@ pub fn forces_ui(ui: &mut Ui, effect: &mut Effect, selected: usize) {
             0.05,
             "",
         );
-        row(
-            ui,
+        row_ui(
+ui,
             "Drag",
             "Linear drag rate k, per second: the velocity relaxes toward the wind with time constant 1/k",
             |ui| ui.add(drag(&mut f.drag_per_sec, 0.0..=1000.0, 0.01, " /s")),
@@ -760,7 +761,7 @@ fn module_ui<T: Default>(
 /// Quadratic drag and the optional force modules (each costs nothing when off).
 fn force_modules_ui(ui: &mut Ui, f: &mut crate::effect::Forces) {
     grid("quadratic_drag_grid").show(ui, |ui| {
-        row(
+        row_ui(
             ui,
             "Quadratic drag",
             "a = −c·|v − wind|·(v − wind), per metre; 0 = off",
@@ -774,10 +775,10 @@ fn force_modules_ui(ui: &mut Ui, f: &mut crate::effect::Forces) {
         "Noise-modulated wind strength",
         &mut f.gusts,
         |ui, g| {
-            row(ui, "Gust strength", "Fraction of the wind", |ui| {
+            row_ui(ui, "Gust strength", "Fraction of the wind", |ui| {
                 ui.add(drag(&mut g.strength, 0.0..=10.0, 0.01, "×"))
             });
-            row(ui, "Gust frequency", "How often gusts change, Hz", |ui| {
+            row_ui(ui, "Gust frequency", "How often gusts change, Hz", |ui| {
                 ui.add(drag(&mut g.frequency_hz, 0.0..=100.0, 0.01, " Hz"))
             });
         },
@@ -789,22 +790,22 @@ fn force_modules_ui(ui: &mut Ui, f: &mut crate::effect::Forces) {
         "Curl-noise turbulence (divergence-free swirls)",
         &mut f.turbulence,
         |ui, t| {
-            row(ui, "Turb. strength", "Typical acceleration, m/s²", |ui| {
+            row_ui(ui, "Turb. strength", "Typical acceleration, m/s²", |ui| {
                 ui.add(drag(&mut t.strength_m_per_s2, 0.0..=1000.0, 0.02, " m/s²"))
             });
-            row(
+            row_ui(
                 ui,
                 "Turb. frequency",
                 "Spatial frequency, per metre",
                 |ui| ui.add(drag(&mut t.frequency_per_m, 0.0..=100.0, 0.02, " /m")),
             );
-            row(
+            row_ui(
                 ui,
                 "Octaves",
                 "Each octave doubles the frequency and halves the amplitude",
                 |ui| ui.add(DragValue::new(&mut t.octaves).range(1..=4).speed(0.05)),
             );
-            row(
+            row_ui(
                 ui,
                 "Turb. scroll",
                 "Upward scroll of the field, m/s",
@@ -837,13 +838,13 @@ fn force_modules_ui(ui: &mut Ui, f: &mut crate::effect::Forces) {
                 0.01,
                 "",
             );
-            row(
+            row_ui(
                 ui,
                 "Swirl",
                 "Tangential acceleration near the axis, m/s² (sign = spin)",
                 |ui| ui.add(drag(&mut v.swirl_m_per_s2, -1000.0..=1000.0, 0.02, " m/s²")),
             );
-            row(
+            row_ui(
                 ui,
                 "Vortex radius",
                 "Falloff radius R: a·exp(−d²/R²), metres",
@@ -867,13 +868,13 @@ fn force_modules_ui(ui: &mut Ui, f: &mut crate::effect::Forces) {
                 0.01,
                 " m",
             );
-            row(
+            row_ui(
                 ui,
                 "Attractor strength",
                 "m³/s² (inverse square) or m/s² (constant); negative repels",
                 |ui| ui.add(drag(&mut a.strength, -1000.0..=1000.0, 0.01, "")),
             );
-            row(
+            row_ui(
                 ui,
                 "Attractor radius",
                 "Softening radius (inverse square) or range (constant), metres",
@@ -899,10 +900,10 @@ fn force_modules_ui(ui: &mut Ui, f: &mut crate::effect::Forces) {
         "Pull toward the emitter axis, growing with age, so flames taper",
         &mut f.flame_pull,
         |ui, p| {
-            row(ui, "Pull strength", "Per second squared", |ui| {
+            row_ui(ui, "Pull strength", "Per second squared", |ui| {
                 ui.add(drag(&mut p.strength_per_s2, 0.0..=1000.0, 0.05, " /s²"))
             });
-            row(
+            row_ui(
                 ui,
                 "Pull exponent",
                 "Growth with normalised age (1 = linear)",
@@ -929,10 +930,10 @@ fn collisions_ui(ui: &mut Ui, col: &mut Collisions) {
         "An infinite horizontal plane particles bounce on",
         &mut col.ground,
         |ui, g| {
-            row(ui, "Ground height", "Height of the plane, metres", |ui| {
+            row_ui(ui, "Ground height", "Height of the plane, metres", |ui| {
                 ui.add(drag(&mut g.height_m, -1000.0..=1000.0, 0.01, " m"))
             });
-            row(
+            row_ui(
                 ui,
                 "Kill on ground",
                 "Particles that touch the ground die",
@@ -980,16 +981,16 @@ fn collisions_ui(ui: &mut Ui, col: &mut Collisions) {
     });
     if col.any() {
         grid("collision_grid").show(ui, |ui| {
-            row(
+            row_ui(
                 ui,
                 "Elasticity",
                 "Normal restitution: 0 stops, 1 bounces perfectly",
                 |ui| ui.add(drag(&mut col.elasticity, 0.0..=1.0, 0.005, "")),
             );
-            row(ui, "Friction", "Tangential loss per contact, 0..1", |ui| {
+            row_ui(ui, "Friction", "Tangential loss per contact, 0..1", |ui| {
                 ui.add(drag(&mut col.friction, 0.0..=1.0, 0.005, ""))
             });
-            row(
+            row_ui(
                 ui,
                 "Rest speed",
                 "Below this normal speed after a bounce the particle rests, m/s",
@@ -1063,14 +1064,14 @@ pub fn time_ui(ui: &mut Ui, effect: &mut Effect, playback: &mut Playback, select
             }
         });
         ui.end_row();
-        row(
-            ui,
+        row_ui(
+ui,
             "Max substeps",
             "At most this many fixed steps per frame; the rest of the time is dropped and counted (Stats)",
             |ui| ui.add_enabled(is_fixed, DragValue::new(&mut t.max_substeps).range(1..=256).speed(0.1)),
         );
-        row(
-            ui,
+        row_ui(
+ui,
             "Max frame dt",
             "Frame-delta mode: a longer frame is clamped to this step, seconds",
             |ui| {
@@ -1080,8 +1081,8 @@ pub fn time_ui(ui: &mut Ui, effect: &mut Effect, playback: &mut Playback, select
                 )
             },
         );
-        row(
-            ui,
+        row_ui(
+ui,
             "Sim speed",
             "Simulation speed multiplier (1 = real time)",
             |ui| ui.add(drag(&mut t.speed, 0.0..=10.0, 0.01, "×").min_decimals(2)),
@@ -1155,14 +1156,16 @@ fn stability_ui(ui: &mut Ui, effect: &Effect) {
 /// Viewport options: grid, gizmos, render scale, camera.
 pub fn view_ui(ui: &mut Ui, view: &mut ViewSettings, frame_requested: &mut bool) {
     grid("view_grid").show(ui, |ui| {
-        row(ui, "Ground grid", "Draw the y = 0 grid (0.5 m cells)", |ui| {
+        row_ui(
+ui, "Ground grid", "Draw the y = 0 grid (0.5 m cells)", |ui| {
             ui.checkbox(&mut view.show_grid, "")
         });
-        row(ui, "Shape gizmos", "Draw every emitter's spawn shape as a wireframe", |ui| {
+        row_ui(
+ui, "Shape gizmos", "Draw every emitter's spawn shape as a wireframe", |ui| {
             ui.checkbox(&mut view.show_gizmos, "")
         });
-        row(
-            ui,
+        row_ui(
+ui,
             "Render scale",
             "Render the viewport at this fraction of its pixel size and upscale it (faster on slow GPUs)",
             |ui| ui.add(egui::Slider::new(&mut view.render_scale, 0.25..=1.0).fixed_decimals(2)),
