@@ -49,6 +49,7 @@ fn main(
             let life = p.vel_life.w;
             var s = integrate(p.pos_age.xyz, p.vel_life.xyz, p.pos_age.w, life, params.wind_time.w, params.dt_secs);
             var age = p.pos_age.w + params.dt_secs;
+            // module-begin
             if MOD_COLLISIONS {
                 let c = collide(p.pos_age.xyz, s.pos, s.vel);
                 s = State(c.pos, c.vel);
@@ -57,6 +58,7 @@ fn main(
                     age = life;
                 }
             }
+            // module-end
             if finite_vec3(s.pos) && finite_vec3(s.vel) {
                 p = Particle(vec4<f32>(s.pos, age), vec4<f32>(s.vel, life));
                 alive = age < life;

@@ -592,7 +592,7 @@ pub enum DrawPath {
 }
 
 /// Auto draw path: below this projected particle size (pixels), splat.
-pub const SPLAT_BELOW_PX: f32 = 2.0;
+pub const SPLAT_BELOW_PX: f32 = 4.0;
 
 /// Built-in procedural sprites.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

@@ -108,6 +108,8 @@ pub enum ShaderSourceDir {
 #[derive(Clone, Debug)]
 pub struct ShaderLibrary {
     source: ShaderSourceDir,
+    /// Files replaced in memory (the bench's bare variant).
+    overrides: Vec<(String, String)>,
 }
 
 /// A composed, validated shader: one WGSL string for one pipeline.
@@ -130,6 +132,7 @@ impl ShaderLibrary {
     pub fn embedded() -> Self {
         Self {
             source: ShaderSourceDir::Embedded,
+            overrides: Vec::new(),
         }
     }
 
@@ -137,6 +140,7 @@ impl ShaderLibrary {
     pub fn from_dir(dir: impl Into<PathBuf>) -> Self {
         Self {
             source: ShaderSourceDir::Dir(dir.into()),
+            overrides: Vec::new(),
         }
     }
 
@@ -166,8 +170,39 @@ impl ShaderLibrary {
         }
     }
 
+    /// The same library with every optional module's code removed (the lines between
+    /// `// module-begin` and `// module-end`): the reference pipeline the perf bench
+    /// compares "module compiled out by its override constant" against.
+    pub fn without_modules(&self) -> Result<ShaderLibrary, ShaderError> {
+        let mut bare = self.clone();
+        for (name, _) in EMBEDDED {
+            let text = self.read(name)?;
+            let mut keep = true;
+            let stripped: Vec<&str> = text
+                .lines()
+                .filter(|l| {
+                    let t = l.trim_start();
+                    if t.starts_with("// module-begin") {
+                        keep = false;
+                    }
+                    let k = keep;
+                    if t.starts_with("// module-end") {
+                        keep = true;
+                    }
+                    k
+                })
+                .collect();
+            bare.overrides
+                .push(((*name).to_owned(), stripped.join("\n")));
+        }
+        Ok(bare)
+    }
+
     /// Reads one file's text.
     pub fn read(&self, name: &str) -> Result<String, ShaderError> {
+        if let Some((_, text)) = self.overrides.iter().find(|(n, _)| n == name) {
+            return Ok(text.clone());
+        }
         match &self.source {
             ShaderSourceDir::Embedded => EMBEDDED
                 .iter()

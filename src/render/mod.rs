@@ -149,6 +149,11 @@ impl Renderer {
         self.targets.get_or_insert_with(|| Targets::new(ctx, size))
     }
 
+    /// The targets of the last frame, if any.
+    pub fn targets_ref(&self) -> Option<&Targets> {
+        self.targets.as_ref()
+    }
+
     /// Records the frame into `enc`: particles into the HDR target, then the tonemap
     /// into the display texture.
     #[allow(clippy::too_many_arguments)]
@@ -171,14 +176,18 @@ impl Renderer {
         {
             let mut pass = begin_hdr_pass(enc, &targets.hdr_view);
             self.billboard.draw(&mut pass, &self.frame, &items);
-            if splatted {
-                self.splat.resolve(&mut pass, &self.frame);
-            }
         }
+        // The splat's light is resolved inside the tonemap (one full-screen pass less).
+        let accum = if splatted {
+            self.splat.accum_buffer()
+        } else {
+            None
+        };
         self.tonemap.record(
             ctx,
             enc,
             &targets.hdr_view,
+            accum,
             &targets.ldr_view,
             self.exposure,
         );

@@ -205,7 +205,14 @@ impl SplatPass {
         true
     }
 
-    /// Adds the accumulated light into the HDR target (inside an open render pass).
+    /// The accumulation buffer of the last splat (the tonemap reads it directly).
+    pub fn accum_buffer(&self) -> Option<&wgpu::Buffer> {
+        self.accum.as_ref().map(|a| &a.1)
+    }
+
+    /// Adds the accumulated light into the HDR target (inside an open render pass). The
+    /// renderer fuses this into the tonemap instead; kept for the bench and for targets
+    /// without a tonemap.
     pub fn resolve(&self, pass: &mut wgpu::RenderPass<'_>, frame: &FrameResources) {
         let Some((_, _, group)) = self.accum.as_ref() else {
             return;
