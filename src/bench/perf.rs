@@ -321,7 +321,8 @@ fn module_costs(ctx: &GpuContext, opts: &PerfOptions) -> Result<Vec<(String, f64
             ShaderLibrary::embedded(),
         ),
     ];
-    let on: Vec<(&str, Box<dyn Fn(&mut Emitter)>)> = vec![
+    type Switch = Box<dyn Fn(&mut Emitter)>;
+    let on: Vec<(&str, Switch)> = vec![
         (
             "gusts on",
             Box::new(|e: &mut Emitter| e.forces.gusts = Some(Default::default())),
