@@ -18,7 +18,11 @@
 #import "integrators.wgsl"
 #import "collide.wgsl"
 
-override COUNT_ALIVE: bool = true;
+// How alive particles are counted: 1 = a workgroup reduction, one global atomic per
+// workgroup (GPUs); 2 = one global atomic per alive particle, no barrier (CPU adapters,
+// where a workgroup barrier forces each invocation onto its own coroutine and costs ~10×).
+// Keep in sync with `AliveCount` in src/sim/gpu_sim.rs.
+override ALIVE_COUNT_MODE: u32 = 1u;
 
 var<workgroup> wg_alive: atomic<u32>;
 
@@ -70,7 +74,11 @@ fn main(
         }
         dst[slot] = p;
     }
-    if COUNT_ALIVE {
+    if ALIVE_COUNT_MODE == 2u {
+        if alive {
+            atomicAdd(&counters[0], 1u);
+        }
+    } else {
         if alive {
             atomicAdd(&wg_alive, 1u);
         }

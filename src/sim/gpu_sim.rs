@@ -104,6 +104,10 @@ impl UpdatePass {
         for &(integrator, modules) in keys {
             let mut constants = modules.constants();
             constants.push(("INTEGRATOR", integrator.index() as f64));
+            // Workgroup barriers are very expensive on CPU adapters (lavapipe runs each
+            // invocation of a barrier-split shader separately): count with plain atomics there.
+            let alive_mode = if ctx.is_cpu_adapter() { 2.0 } else { 1.0 };
+            constants.push(("ALIVE_COUNT_MODE", alive_mode));
             let pipeline = create_checked(&ctx.device, &composed, lib, |module| {
                 ctx.device
                     .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
