@@ -26,6 +26,25 @@ override ALIVE_COUNT_MODE: u32 = 1u;
 
 var<workgroup> wg_alive: atomic<u32>;
 
+// Stateless mode: this pass only writes the spawn records of this step's window (one
+// invocation per spawn, no other slot is touched); the draw passes evaluate positions in
+// closed form (look.wgsl). The record keeps the spawn position and velocity, and in
+// pos_age.w the birth time on the 4096 s clock.
+override MOD_STATELESS: bool = false;
+
+fn stateless_spawn(i: u32) {
+    if i >= params.spawn_count {
+        return;
+    }
+    let slot = (params.spawn_head + i) % params.capacity;
+    let lo = params.spawn_base_lo + i;
+    let hi = params.spawn_base_hi + select(0u, 1u, lo < i);
+    var p = spawn_particle(slot, spawn_key(params.seed, params.emitter_salt, slot, lo, hi));
+    let f = clamp(params.spawn_frac0 + f32(i) * params.spawn_frac_step, 0.0, 1.0);
+    p.pos_age.w = (params.wind_time.w + f * params.dt_secs) % 4096.0;
+    dst[slot] = p;
+}
+
 @compute @workgroup_size(256)
 fn main(
     @builtin(workgroup_id) wg: vec3<u32>,
@@ -33,6 +52,10 @@ fn main(
     @builtin(local_invocation_index) lid: u32,
 ) {
     let slot = (wg.y * nwg.x + wg.x) * 256u + lid;
+    if MOD_STATELESS {
+        stateless_spawn(slot);
+        return;
+    }
     var alive = false;
     if slot < params.capacity {
         var p = src[slot];
@@ -44,10 +67,11 @@ fn main(
             let hi = params.spawn_base_hi + select(0u, 1u, lo < rel);
             p = spawn_particle(slot, spawn_key(params.seed, params.emitter_salt, slot, lo, hi));
             // Sub-step emission: a particle born at fraction f of the step is (1 - f)·dt old
-            // at its end and has drifted that far.
+            // at its end, integrated over that partial step with the emitter's integrator.
             let f = clamp(params.spawn_frac0 + f32(rel) * params.spawn_frac_step, 0.0, 1.0);
             let age0 = (1.0 - f) * params.dt_secs;
-            p.pos_age = vec4<f32>(p.pos_age.xyz + p.vel_life.xyz * age0, age0);
+            let s0 = integrate(p.pos_age.xyz, p.vel_life.xyz, 0.0, p.vel_life.w, params.wind_time.w + f * params.dt_secs, age0);
+            p = Particle(vec4<f32>(s0.pos, age0), vec4<f32>(s0.vel, p.vel_life.w));
             alive = is_alive(p);
         } else if is_alive(p) {
             let life = p.vel_life.w;

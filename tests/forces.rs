@@ -404,3 +404,62 @@ fn modules_off_are_bit_identical_to_a_pipeline_without_them() {
         );
     }
 }
+
+/// Stateless mode (closed form from spawn records) and the stateful exponential integrator
+/// (exact for the same forces) give the same particles within f32 rounding; stateless is
+/// refused, with the reason, when a module needs state.
+#[test]
+fn stateless_matches_stateful_and_is_refused_when_ineligible() {
+    let ctx = gpu();
+    let mut base = Emitter {
+        capacity: 3000,
+        spawn_rate_per_sec: 1500.0,
+        lifetime_secs: Range::new(0.8, 1.6),
+        integrator: Integrator::Exponential,
+        ..Emitter::default()
+    };
+    base.forces.wind_m_per_s = [0.6, 0.0, -0.2];
+    let stateful = bare_effect(base.clone());
+    let stateless = bare_effect(Emitter {
+        stateless: true,
+        ..base.clone()
+    });
+    assert!(Modules::of(&stateless.emitters[0]).contains(Modules::STATELESS));
+    let mut a = GpuSim::new(&ctx, ShaderLibrary::embedded(), &stateful).expect("sim");
+    let mut b = GpuSim::new(&ctx, ShaderLibrary::embedded(), &stateless).expect("sim");
+    a.step(&stateful, 1.0 / 120.0, 150).expect("step");
+    b.step(&stateless, 1.0 / 120.0, 150).expect("step");
+    let now = b.planner.time_secs.rem_euclid(4096.0) as f32;
+    let full = a.read_particles(0).expect("read");
+    let records = b.read_particles(0).expect("read");
+    let mut compared = 0;
+    let mut worst: f32 = 0.0;
+    for (s, r) in full.iter().zip(&records) {
+        let e = ignis::sim::cpu_reference::evaluate_stateless(r, &stateless.emitters[0], now);
+        assert_eq!(s.is_alive(), e.is_alive(), "{s:?} vs {e:?}");
+        if s.is_alive() {
+            worst = worst.max((s.position() - e.position()).length());
+            compared += 1;
+        }
+    }
+    assert!(compared > 1000, "{compared}");
+    assert!(
+        worst < 2e-5,
+        "stateless vs stateful: worst position difference {worst} m"
+    );
+
+    // Not eligible with turbulence: validation names the blocker, and the pipeline stays
+    // stateful.
+    let mut bad = Emitter {
+        stateless: true,
+        ..base
+    };
+    bad.forces.turbulence = Some(Turbulence::default());
+    assert!(!Modules::of(&bad).contains(Modules::STATELESS));
+    let err = bare_effect(bad).validate().expect_err("refused");
+    assert!(
+        err.iter()
+            .any(|e| e.path.ends_with("stateless") && e.problem.contains("turbulence")),
+        "{err:?}"
+    );
+}

@@ -348,6 +348,10 @@ fn module_costs(ctx: &GpuContext, opts: &PerfOptions) -> Result<Vec<(String, f64
             Box::new(|e: &mut Emitter| e.forces.flame_pull = Some(Default::default())),
         ),
         (
+            "stateless mode (spawn records only, closed form when drawn)",
+            Box::new(|e: &mut Emitter| e.stateless = true),
+        ),
+        (
             "collisions on (ground + 1 sphere)",
             Box::new(|e: &mut Emitter| {
                 e.collisions.ground = Some(Default::default());

@@ -55,8 +55,22 @@ impl CpuSim {
                 let mut q = spawn_particle(params, key);
                 let f = (params.spawn_frac0 + rel as f32 * params.spawn_frac_step).clamp(0.0, 1.0);
                 let age0 = (1.0 - f) * params.dt_secs;
-                let pos = q.position() + q.velocity() * age0;
-                q.pos_age = [pos.x, pos.y, pos.z, age0];
+                let forces = Forces {
+                    params,
+                    modules: self.modules,
+                };
+                let (x, v) = integrate(
+                    self.integrator,
+                    &forces,
+                    q.position(),
+                    q.velocity(),
+                    0.0,
+                    q.vel_life[3],
+                    params.wind_time[3] + f * params.dt_secs,
+                    age0,
+                );
+                q.pos_age = [x.x, x.y, x.z, age0];
+                q.vel_life = [v.x, v.y, v.z, q.vel_life[3]];
                 *p = q;
             } else if p.is_alive() {
                 let life = p.vel_life[3];
@@ -516,5 +530,26 @@ pub fn integrate(
             let e = 1.0 - k * phi;
             (x + v * phi + f * psi, v * e + f * phi)
         }
+    }
+}
+
+/// A stateless emitter's spawn record evaluated at `now` (seconds on the 4096 s clock),
+/// as `drawn` in look.wgsl does: the particle's current position, age and velocity.
+pub fn evaluate_stateless(record: &Particle, e: &Emitter, now: f32) -> Particle {
+    let life = record.vel_life[3];
+    let mut age = now - record.pos_age[3];
+    if age < 0.0 {
+        age += 4096.0;
+    }
+    let k = e.forces.drag_per_sec;
+    let (phi, psi) = exp_phi_psi(k, age);
+    let c = e.forces.constant_acceleration() + k * Vec3::from(e.forces.wind_m_per_s);
+    let x = record.position() + record.velocity() * phi + c * psi;
+    // v(t) = v0·e^{−kt} + c·φ, with e^{−kt} = 1 − k·φ.
+    let v = record.velocity() * (1.0 - k * phi) + c * phi;
+    let alive_age = if life > 0.0 && age < life { age } else { life };
+    Particle {
+        pos_age: [x.x, x.y, x.z, alive_age],
+        vel_life: [v.x, v.y, v.z, life],
     }
 }

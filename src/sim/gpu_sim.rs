@@ -153,6 +153,8 @@ struct EmitterState {
     /// Which buffer holds the current state (the thesis's `mFlip`).
     current: usize,
     generation: u64,
+    /// Holds stateless spawn records (no ping-pong: buffer 0 only).
+    stateless: bool,
 }
 
 /// The GPU simulation of an effect.
@@ -267,6 +269,24 @@ impl GpuSim {
                 }
             }
         }
+        // Switching an emitter between stateless records and stateful particles restarts
+        // its pool: the two layouts mean different things.
+        let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+        let mut cleared = false;
+        for (s, e) in self.emitters.iter_mut().zip(&effect.emitters) {
+            let stateless = Modules::of(e).contains(Modules::STATELESS);
+            if s.stateless != stateless {
+                for b in &s.buffers {
+                    enc.clear_buffer(b, 0, None);
+                }
+                s.current = 0;
+                s.stateless = stateless;
+                cleared = true;
+            }
+        }
+        if cleared {
+            self.ctx.queue.submit([enc.finish()]);
+        }
         let slots = STEPS_PER_SUBMIT * effect.emitters.len().max(1);
         if slots > self.params_slots {
             self.params_slots = slots;
@@ -318,6 +338,7 @@ impl GpuSim {
             bind_groups,
             current: 0,
             generation,
+            stateless: false,
         }
     }
 
@@ -430,13 +451,28 @@ impl GpuSim {
                 else {
                     continue;
                 };
+                let offset = ((s * n_emitters + e) as u64 * PARAMS_STRIDE) as u32;
+                if em.stateless {
+                    // Spawn records only, written in place into buffer 0 (group 1 reads
+                    // buffer 1 and writes buffer 0); nothing else is touched.
+                    if p.spawn_count > 0 {
+                        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                            label: Some("GpuSim::stateless_spawn"),
+                            timestamp_writes: None,
+                        });
+                        pass.set_pipeline(pipeline);
+                        pass.set_bind_group(0, &em.bind_groups[1], &[offset]);
+                        let (x, y) = dispatch_size(p.spawn_count);
+                        pass.dispatch_workgroups(x, y, 1);
+                    }
+                    continue;
+                }
                 enc.clear_buffer(&em.counters, 0, Some(4));
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("GpuSim::update"),
                     timestamp_writes: None,
                 });
                 pass.set_pipeline(pipeline);
-                let offset = ((s * n_emitters + e) as u64 * PARAMS_STRIDE) as u32;
                 pass.set_bind_group(0, &em.bind_groups[em.current], &[offset]);
                 let (x, y) = dispatch_size(p.capacity.min(em.capacity));
                 pass.dispatch_workgroups(x, y, 1);
