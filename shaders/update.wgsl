@@ -2,7 +2,9 @@
 //
 // Contract (plumbing; designers change spawn.wgsl, forces.wgsl, integrators.wgsl):
 // - group 0: binding 0 `params` (SimParams, dynamic offset per step), 1 `src` (read),
-//   2 `dst` (write), 3 `counters` ([0] alive after this step, [1] non-finite kills, total).
+//   2 `dst` (write), 3 `counters` ([0] alive, written by count.wgsl on demand, [1] non-finite
+//   kills, total). Counting alive particles is not this pass's job: it costs a workgroup
+//   barrier or an atomic per particle every step, and only the stats need it.
 // - Slots in the spawn window [spawn_head, spawn_head + spawn_count) (mod capacity) are
 //   born; alive slots integrate and age; every slot is written, so B never holds stale
 //   data from two steps ago.
@@ -17,14 +19,6 @@
 #import "spawn.wgsl"
 #import "integrators.wgsl"
 #import "collide.wgsl"
-
-// How alive particles are counted: 1 = a workgroup reduction, one global atomic per
-// workgroup (GPUs); 2 = one global atomic per alive particle, no barrier (CPU adapters,
-// where a workgroup barrier forces each invocation onto its own coroutine and costs ~10×).
-// Keep in sync with `AliveCount` in src/sim/gpu_sim.rs.
-override ALIVE_COUNT_MODE: u32 = 1u;
-
-var<workgroup> wg_alive: atomic<u32>;
 
 // Stateless mode: this pass only writes the spawn records of this step's window (one
 // invocation per spawn, no other slot is touched); the draw passes evaluate positions in
@@ -56,7 +50,6 @@ fn main(
         stateless_spawn(slot);
         return;
     }
-    var alive = false;
     if slot < params.capacity {
         var p = src[slot];
         // Position of this slot in the ring relative to the spawn head (capacity ≤ 2^28).
@@ -72,7 +65,6 @@ fn main(
             let age0 = (1.0 - f) * params.dt_secs;
             let s0 = integrate(p.pos_age.xyz, p.vel_life.xyz, 0.0, p.vel_life.w, params.wind_time.w + f * params.dt_secs, age0);
             p = Particle(vec4<f32>(s0.pos, age0), vec4<f32>(s0.vel, p.vel_life.w));
-            alive = is_alive(p);
         } else if is_alive(p) {
             let life = p.vel_life.w;
             var s = integrate(p.pos_age.xyz, p.vel_life.xyz, p.pos_age.w, life, params.wind_time.w, params.dt_secs);
@@ -89,7 +81,6 @@ fn main(
             // module-end
             if finite_vec3(s.pos) && finite_vec3(s.vel) {
                 p = Particle(vec4<f32>(s.pos, age), vec4<f32>(s.vel, life));
-                alive = age < life;
             } else {
                 // Non-finite guard: kill and count, never let NaN reach the draw.
                 p = Particle(vec4<f32>(0.0), vec4<f32>(0.0));
@@ -97,21 +88,5 @@ fn main(
             }
         }
         dst[slot] = p;
-    }
-    if ALIVE_COUNT_MODE == 2u {
-        if alive {
-            atomicAdd(&counters[0], 1u);
-        }
-    } else {
-        if alive {
-            atomicAdd(&wg_alive, 1u);
-        }
-        workgroupBarrier();
-        if lid == 0u {
-            let n = atomicLoad(&wg_alive);
-            if n > 0u {
-                atomicAdd(&counters[0], n);
-            }
-        }
     }
 }

@@ -149,7 +149,7 @@ impl ShaderReloader {
         let mut report = ReloadReport::default();
         for entry in self.affected(changed) {
             let result = match entry {
-                "update.wgsl" => sim.reload_shaders(lib.clone(), effect),
+                "update.wgsl" | "count.wgsl" => sim.reload_shaders(lib.clone(), effect),
                 "billboard.wgsl" => renderer.billboard.rebuild(ctx, lib),
                 "splat.wgsl" => renderer.splat.rebuild(ctx, lib),
                 "tonemap.wgsl" => renderer.tonemap.rebuild(ctx, lib),

@@ -22,6 +22,7 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ),
     ("collide.wgsl", include_str!("../shaders/collide.wgsl")),
     ("update.wgsl", include_str!("../shaders/update.wgsl")),
+    ("count.wgsl", include_str!("../shaders/count.wgsl")),
     ("look.wgsl", include_str!("../shaders/look.wgsl")),
     ("billboard.wgsl", include_str!("../shaders/billboard.wgsl")),
     ("splat.wgsl", include_str!("../shaders/splat.wgsl")),
@@ -31,6 +32,7 @@ pub const EMBEDDED: &[(&str, &str)] = &[
 /// The entry files, one per pipeline family; the others are imported by them.
 pub const ENTRY_FILES: &[&str] = &[
     "update.wgsl",
+    "count.wgsl",
     "billboard.wgsl",
     "splat.wgsl",
     "tonemap.wgsl",

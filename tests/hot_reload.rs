@@ -269,12 +269,16 @@ fn only_dependent_pipelines_rebuild() {
     let mut rig = Rig::new();
     assert_eq!(rig.reload(&["forces.wgsl"]).rebuilt, vec!["update.wgsl"]);
     assert_eq!(rig.reload(&["tonemap.wgsl"]).rebuilt, vec!["tonemap.wgsl"]);
+    assert_eq!(rig.reload(&["count.wgsl"]).rebuilt, vec!["count.wgsl"]);
     let mut look = rig.reload(&["look.wgsl"]).rebuilt;
     look.sort();
     assert_eq!(look, vec!["billboard.wgsl", "splat.wgsl"]);
     let mut all = rig.reload(&["common.wgsl"]).rebuilt;
     all.sort();
-    assert_eq!(all, vec!["billboard.wgsl", "splat.wgsl", "update.wgsl"]);
+    assert_eq!(
+        all,
+        vec!["billboard.wgsl", "count.wgsl", "splat.wgsl", "update.wgsl"]
+    );
 }
 
 fn wait_for(w: &FileWatcher, name: &str) -> Duration {

@@ -39,6 +39,9 @@ pub struct UpdatePass {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
     pipelines: HashMap<PipelineKey, wgpu::ComputePipeline>,
+    count_layout: wgpu::BindGroupLayout,
+    count_pipeline_layout: wgpu::PipelineLayout,
+    count: Option<wgpu::ComputePipeline>,
     /// Files the current pipelines were built from.
     pub files: Vec<String>,
 }
@@ -84,10 +87,26 @@ impl UpdatePass {
                 bind_group_layouts: &[Some(&layout)],
                 immediate_size: 0,
             });
+        let count_layout = ctx
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("UpdatePass::count_layout"),
+                entries: &[storage(0, true), storage(1, false)],
+            });
+        let count_pipeline_layout =
+            ctx.device
+                .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("UpdatePass::count_pipeline_layout"),
+                    bind_group_layouts: &[Some(&count_layout)],
+                    immediate_size: 0,
+                });
         Self {
             layout,
             pipeline_layout,
             pipelines: HashMap::new(),
+            count_layout,
+            count_pipeline_layout,
+            count: None,
             files: Vec::new(),
         }
     }
@@ -104,10 +123,6 @@ impl UpdatePass {
         for &(integrator, modules) in keys {
             let mut constants = modules.constants();
             constants.push(("INTEGRATOR", integrator.index() as f64));
-            // Workgroup barriers are very expensive on CPU adapters (lavapipe runs each
-            // invocation of a barrier-split shader separately): count with plain atomics there.
-            let alive_mode = if ctx.is_cpu_adapter() { 2.0 } else { 1.0 };
-            constants.push(("ALIVE_COUNT_MODE", alive_mode));
             let pipeline = create_checked(&ctx.device, &composed, lib, |module| {
                 ctx.device
                     .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -124,8 +139,36 @@ impl UpdatePass {
             })?;
             fresh.insert((integrator, modules), pipeline);
         }
+        // The on-demand alive count. Workgroup barriers are very expensive on CPU adapters
+        // (lavapipe runs each invocation of a barrier-split shader separately): plain
+        // atomics there.
+        let count_src = lib.compose("count.wgsl")?;
+        let direct = [(
+            "DIRECT_ATOMICS",
+            if ctx.is_cpu_adapter() { 1.0 } else { 0.0 },
+        )];
+        let count = create_checked(&ctx.device, &count_src, lib, |module| {
+            ctx.device
+                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some("UpdatePass::count"),
+                    layout: Some(&self.count_pipeline_layout),
+                    module,
+                    entry_point: Some("main"),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &direct,
+                        zero_initialize_workgroup_memory: true,
+                    },
+                    cache: None,
+                })
+        })?;
         self.pipelines = fresh;
+        self.count = Some(count);
         self.files = composed.files;
+        for f in count_src.files {
+            if !self.files.contains(&f) {
+                self.files.push(f);
+            }
+        }
         Ok(())
     }
 
@@ -467,7 +510,6 @@ impl GpuSim {
                     }
                     continue;
                 }
-                enc.clear_buffer(&em.counters, 0, Some(4));
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("GpuSim::update"),
                     timestamp_writes: None,
@@ -534,11 +576,62 @@ impl GpuSim {
     }
 
     /// `[alive after the last step, non-finite kills so far]` of emitter `index` (blocking).
+    ///
+    /// The alive count is computed now, by a counting pass over the current state (the
+    /// update pass does not count: only the stats need it). Stateless emitters are counted
+    /// on the CPU from their spawn records' ages.
     pub fn read_counters(&self, index: usize) -> Result<[u32; 2], SimError> {
         let s = self
             .emitters
             .get(index)
             .ok_or_else(|| SimError::Readback(format!("no emitter {index}")))?;
+        if s.stateless {
+            let now = self.planner.time_secs.rem_euclid(4096.0) as f32;
+            let alive = self
+                .read_particles(index)?
+                .iter()
+                .filter(|r| {
+                    let mut age = now - r.pos_age[3];
+                    if age < 0.0 {
+                        age += 4096.0;
+                    }
+                    r.vel_life[3] > 0.0 && age < r.vel_life[3]
+                })
+                .count() as u32;
+            return Ok([alive, 0]);
+        }
+        if let Some(count) = &self.update.count {
+            let group = self
+                .ctx
+                .device
+                .create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("GpuSim::count_group"),
+                    layout: &self.update.count_layout,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: s.buffers[s.current].as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: s.counters.as_entire_binding(),
+                        },
+                    ],
+                });
+            let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+            enc.clear_buffer(&s.counters, 0, Some(4));
+            {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("GpuSim::count"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(count);
+                pass.set_bind_group(0, &group, &[]);
+                let (x, y) = dispatch_size(s.capacity);
+                pass.dispatch_workgroups(x, y, 1);
+            }
+            self.ctx.queue.submit([enc.finish()]);
+        }
         let bytes = read_buffer(&self.ctx, &s.counters, 8)?;
         let v: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
         Ok([v[0], v[1]])
