@@ -60,11 +60,19 @@ fn main(
             let hi = params.spawn_base_hi + select(0u, 1u, lo < rel);
             p = spawn_particle(slot, spawn_key(params.seed, params.emitter_salt, slot, lo, hi));
             // Sub-step emission: a particle born at fraction f of the step is (1 - f)·dt old
-            // at its end, integrated over that partial step with the emitter's integrator.
+            // at its end, moved over that partial step in closed form under the constant
+            // acceleration and linear drag (cheap, and exact where stateless mode applies;
+            // the other modules act from its first full step).
             let f = clamp(params.spawn_frac0 + f32(rel) * params.spawn_frac_step, 0.0, 1.0);
             let age0 = (1.0 - f) * params.dt_secs;
-            let s0 = integrate(p.pos_age.xyz, p.vel_life.xyz, 0.0, p.vel_life.w, params.wind_time.w + f * params.dt_secs, age0);
-            p = Particle(vec4<f32>(s0.pos, age0), vec4<f32>(s0.vel, p.vel_life.w));
+            let k = linear_drag_k();
+            let pp = exp_phi_psi(k, age0);
+            let c = params.accel_drag.xyz + k * params.wind_time.xyz;
+            let v0 = p.vel_life.xyz;
+            p = Particle(
+                vec4<f32>(p.pos_age.xyz + v0 * pp.x + c * pp.y, age0),
+                vec4<f32>(v0 * (1.0 - k * pp.x) + c * pp.x, p.vel_life.w),
+            );
         } else if is_alive(p) {
             let life = p.vel_life.w;
             var s = integrate(p.pos_age.xyz, p.vel_life.xyz, p.pos_age.w, life, params.wind_time.w, params.dt_secs);

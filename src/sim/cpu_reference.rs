@@ -59,16 +59,13 @@ impl CpuSim {
                     params,
                     modules: self.modules,
                 };
-                let (x, v) = integrate(
-                    self.integrator,
-                    &forces,
-                    q.position(),
-                    q.velocity(),
-                    0.0,
-                    q.vel_life[3],
-                    params.wind_time[3] + f * params.dt_secs,
-                    age0,
-                );
+                let k = forces.linear_drag_k() as f32;
+                let (phi, psi) = exp_phi_psi(k, age0);
+                let c = Vec3::from_slice(&params.accel_drag[..3])
+                    + k * Vec3::from_slice(&params.wind_time[..3]);
+                let v0 = q.velocity();
+                let x = q.position() + v0 * phi + c * psi;
+                let v = v0 * (1.0 - k * phi) + c * phi;
                 q.pos_age = [x.x, x.y, x.z, age0];
                 q.vel_life = [v.x, v.y, v.z, q.vel_life[3]];
                 *p = q;
