@@ -123,6 +123,7 @@ impl UpdatePass {
         for &(integrator, modules) in keys {
             let mut constants = modules.constants();
             constants.push(("INTEGRATOR", integrator.index() as f64));
+            constants.push(("COUNT_ALIVE", if ctx.is_cpu_adapter() { 0.0 } else { 1.0 }));
             let pipeline = create_checked(&ctx.device, &composed, lib, |module| {
                 ctx.device
                     .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -510,6 +511,10 @@ impl GpuSim {
                     }
                     continue;
                 }
+                if !self.ctx.is_cpu_adapter() {
+                    // The update counts alive particles (COUNT_ALIVE) into a cleared slot.
+                    enc.clear_buffer(&em.counters, 0, Some(4));
+                }
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("GpuSim::update"),
                     timestamp_writes: None,
@@ -600,7 +605,13 @@ impl GpuSim {
                 .count() as u32;
             return Ok([alive, 0]);
         }
-        if let Some(count) = &self.update.count {
+        // GPUs count in the update pass itself; CPU adapters count here, on demand.
+        if let Some(count) = self
+            .update
+            .count
+            .as_ref()
+            .filter(|_| self.ctx.is_cpu_adapter())
+        {
             let group = self
                 .ctx
                 .device
