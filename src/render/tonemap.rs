@@ -102,35 +102,19 @@ impl TonemapPass {
         create_checked(&ctx.device, &composed, lib, |module| {
             let make = |splat: bool| {
                 let constants = [("SPLAT", if splat { 1.0 } else { 0.0 })];
-                ctx.device
-                    .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                        label: Some(if splat {
-                            "TonemapPass::with_splat"
-                        } else {
-                            "TonemapPass::plain"
-                        }),
-                        layout: Some(layout),
-                        vertex: wgpu::VertexState {
-                            module,
-                            entry_point: Some("vs_main"),
-                            compilation_options: Default::default(),
-                            buffers: &[],
-                        },
-                        primitive: wgpu::PrimitiveState::default(),
-                        depth_stencil: None,
-                        multisample: wgpu::MultisampleState::default(),
-                        fragment: Some(wgpu::FragmentState {
-                            module,
-                            entry_point: Some("fs_main"),
-                            compilation_options: wgpu::PipelineCompilationOptions {
-                                constants: &constants,
-                                zero_initialize_workgroup_memory: true,
-                            },
-                            targets: &[Some(format.into())],
-                        }),
-                        multiview_mask: None,
-                        cache: None,
-                    })
+                crate::render::simple_pipeline(
+                    ctx,
+                    if splat {
+                        "TonemapPass::with_splat"
+                    } else {
+                        "TonemapPass::plain"
+                    },
+                    layout,
+                    module,
+                    ("vs_main", "fs_main"),
+                    format.into(),
+                    &constants,
+                )
             };
             (make(false), make(true))
         })

@@ -177,11 +177,20 @@ pub fn value_noise3(p: Vec3, seed: u32) -> f32 {
     let c = [cell.x as i32, cell.y as i32, cell.z as i32];
     let h = |dx: i32, dy: i32, dz: i32| rng::hash_cell([c[0] + dx, c[1] + dy, c[2] + dz], seed);
     let (ux, uy, uz) = (fade(f.x), fade(f.y), fade(f.z));
-    let x00 = mix(h(0, 0, 0), h(1, 0, 0), ux);
-    let x10 = mix(h(0, 1, 0), h(1, 1, 0), ux);
-    let x01 = mix(h(0, 0, 1), h(1, 0, 1), ux);
-    let x11 = mix(h(0, 1, 1), h(1, 1, 1), ux);
-    mix(mix(x00, x10, uy), mix(x01, x11, uy), uz)
+    // The same polynomial form as `value_noise3_grad` in noise.wgsl, in f32.
+    let (a, b, cc, d) = (h(0, 0, 0), h(1, 0, 0), h(0, 1, 0), h(1, 1, 0));
+    let (e, ff, g, hh) = (h(0, 0, 1), h(1, 0, 1), h(0, 1, 1), h(1, 1, 1));
+    let k4 = a - b - cc + d;
+    let k5 = a - cc - e + g;
+    let k6 = a - b - e + ff;
+    let k7 = -a + b + cc - d + e - ff - g + hh;
+    a + (b - a) * ux
+        + (cc - a) * uy
+        + (e - a) * uz
+        + k4 * ux * uy
+        + k5 * uy * uz
+        + k6 * uz * ux
+        + k7 * ux * uy * uz
 }
 
 /// `value_noise3_vec` in noise.wgsl.
