@@ -26,20 +26,19 @@ struct VsOut {
 @vertex
 fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) slot: u32) -> VsOut {
     var out: VsOut;
-    let p = cur[slot];
-    if !is_alive(p) {
+    let d = drawn(cur[slot], prev[slot]);
+    if !d.alive {
         out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
         out.uv = vec2<f32>(0.0);
         out.color = vec4<f32>(0.0);
         return out;
     }
-    let s = draw_state(p, prev[slot]);
-    let t = age_fraction(s.w, p.vel_life.w);
+    let t = age_fraction(d.age, d.life);
     let size = size_at(t);
     // Two triangles: 0 1 2, 2 1 3 over the corners (-1,-1) (1,-1) (-1,1) (1,1).
     let corner_index = array<u32, 6>(0u, 1u, 2u, 2u, 1u, 3u)[vi];
     let corner = vec2<f32>(f32(corner_index & 1u), f32(corner_index >> 1u)) * 2.0 - 1.0;
-    let world = s.xyz + (camera.right_alpha.xyz * corner.x + camera.up.xyz * corner.y) * (0.5 * size);
+    let world = d.pos + (camera.right_alpha.xyz * corner.x + camera.up.xyz * corner.y) * (0.5 * size);
     out.clip = look.clip_from_sim * vec4<f32>(world, 1.0);
     out.uv = corner;
     out.color = particle_color(t);

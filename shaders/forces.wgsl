@@ -31,11 +31,13 @@ fn linear_drag_k() -> f32 {
 // Wind, optionally modulated by smooth 1-D noise in time (gusts).
 fn wind_at(time: f32) -> vec3<f32> {
     var wind = params.wind_time.xyz;
+    // module-begin (lines up to module-end are removed for the bench's bare pipeline)
     if MOD_GUSTS {
         let g = params.gusts_qdrag_pull;
         let n = value_noise3(vec3<f32>(time * g.y, 0.5, 0.5), params.seed ^ 0x6057u) * 2.0 - 1.0;
         wind = wind * (1.0 + g.x * n);
     }
+    // module-end
     return wind;
 }
 
@@ -92,6 +94,7 @@ fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age: f32, life: f32, time: f32) 
     if MOD_DRAG {
         a -= params.accel_drag.w * (vel - wind);
     }
+    // module-begin
     if MOD_QUADRATIC_DRAG {
         let rel = vel - wind;
         a -= params.gusts_qdrag_pull.z * length(rel) * rel;
@@ -108,5 +111,6 @@ fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age: f32, life: f32, time: f32) 
     if MOD_FLAME_PULL {
         a += flame_pull_accel(pos, age, life);
     }
+    // module-end
     return a;
 }

@@ -21,21 +21,6 @@ struct State {
     vel: vec3<f32>,
 }
 
-// phi = (1 - e^{-z})/k · … and psi = (dt - phi)/k, with series below z = 0.5 so that
-// neither loses digits to cancellation (truncation < 1e-7 relative).
-fn exp_phi_psi(k: f32, dt: f32) -> vec2<f32> {
-    let z = k * dt;
-    if z < 0.5 {
-        let phi = dt * (1.0 + z * (-1.0 / 2.0 + z * (1.0 / 6.0 + z * (-1.0 / 24.0 + z * (1.0 / 120.0
-            + z * (-1.0 / 720.0 + z * (1.0 / 5040.0 - z / 40320.0)))))));
-        let psi = dt * dt * (1.0 / 2.0 + z * (-1.0 / 6.0 + z * (1.0 / 24.0 + z * (-1.0 / 120.0
-            + z * (1.0 / 720.0 + z * (-1.0 / 5040.0 + z * (1.0 / 40320.0 - z / 362880.0)))))));
-        return vec2<f32>(phi, psi);
-    }
-    let phi = (1.0 - exp(-z)) / k;
-    return vec2<f32>(phi, (dt - phi) / k);
-}
-
 fn integrate(pos: vec3<f32>, vel: vec3<f32>, age: f32, life: f32, time: f32, dt: f32) -> State {
     switch INTEGRATOR {
         case INTEGRATOR_EXPLICIT_EULER: {

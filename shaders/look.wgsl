@@ -26,8 +26,13 @@ struct LookUniform {
     size_intensity: vec4<f32>,
     // x: sprite kind, y: blend (0 additive, 1 alpha), zw: unused.
     sprite_blend: vec4<u32>,
-    // x: ∫ sprite coverage over the unit quad (for the splat's energy), yzw: unused.
+    // x: ∫ sprite coverage over the unit quad (for the splat's energy), y: 1 for a
+    // stateless emitter, zw: unused.
     extra: vec4<f32>,
+    // Stateless emitters: xyz constant acceleration, w linear drag k.
+    motion_a: vec4<f32>,
+    // Stateless emitters: xyz wind, w render time on the 4096 s clock.
+    motion_b: vec4<f32>,
 }
 
 override INTERPOLATE: bool = true;
@@ -91,6 +96,35 @@ fn draw_state(p: Particle, q: Particle) -> vec4<f32> {
         }
     }
     return vec4<f32>(pos, age);
+}
+
+// A particle as drawn: position, age, lifetime, alive.
+struct Drawn {
+    pos: vec3<f32>,
+    age: f32,
+    life: f32,
+    alive: bool,
+}
+
+// The particle in slot state `p` (previous state `q`) as drawn. Stateless emitters store
+// spawn records (x0, birth time; v0, lifetime) and are evaluated here in closed form:
+// x(t) = x0 + v0·φ + (a + k·wind)·ψ, φ = (1 − e^{−kt})/k, ψ = (t − φ)/k (exact for constant
+// acceleration with linear drag, the only forces stateless mode allows).
+fn drawn(p: Particle, q: Particle) -> Drawn {
+    if look.extra.y > 0.5 {
+        let life = p.vel_life.w;
+        var age = look.motion_b.w - p.pos_age.w;
+        if age < 0.0 {
+            age += 4096.0;
+        }
+        let k = look.motion_a.w;
+        let pp = exp_phi_psi(k, age);
+        let c = look.motion_a.xyz + k * look.motion_b.xyz;
+        let pos = p.pos_age.xyz + p.vel_life.xyz * pp.x + c * pp.y;
+        return Drawn(pos, age, life, life > 0.0 && age < life);
+    }
+    let s = draw_state(p, q);
+    return Drawn(s.xyz, s.w, p.vel_life.w, is_alive(p));
 }
 
 // Normalised age and billboard size of a drawn state.

@@ -1,7 +1,7 @@
 // splat.wgsl — pass 2, small particles: a compute splat. Each alive slot projects its
 // particle and adds its light, as the billboard would have integrated it
 // (colour · alpha · intensity · ∫coverage · (size in px / 2)²), into a fixed-point
-// accumulation buffer spread bilinearly over the 2×2 nearest pixels; `resolve` turns the
+// accumulation buffer, spread bilinearly over the 2×2 nearest pixels (one pixel below 2 px); `resolve` turns the
 // buffer into HDR light. Order-independent, so additive fire needs no sort; alpha-blended
 // emitters always use billboards.
 //
@@ -52,26 +52,32 @@ fn splat(
     if slot >= arrayLength(&cur) {
         return;
     }
-    let p = cur[slot];
-    if !is_alive(p) {
+    let d = drawn(cur[slot], prev[slot]);
+    if !d.alive {
         return;
     }
-    let s = draw_state(p, prev[slot]);
-    let clip = look.clip_from_sim * vec4<f32>(s.xyz, 1.0);
+    let clip = look.clip_from_sim * vec4<f32>(d.pos, 1.0);
     if clip.w <= 1e-4 || any(abs(clip.xy) > vec2<f32>(clip.w * 1.01)) || clip.z < 0.0 || clip.z > clip.w {
         return;
     }
-    let t = age_fraction(s.w, p.vel_life.w);
+    let t = age_fraction(d.age, d.life);
     let color = particle_color(t);
     let size_px = size_at(t) * camera.viewport.z / clip.w;
     let half = 0.5 * size_px;
     let energy = color.rgb * (color.a * look.size_intensity.z * look.extra.x * half * half);
     let ndc = clip.xy / clip.w;
     let px = vec2<f32>((ndc.x * 0.5 + 0.5) * camera.viewport.x, (0.5 - ndc.y * 0.5) * camera.viewport.y) - 0.5;
+    let dither = unorm4(pcg4d(vec4<u32>(slot, bitcast<u32>(d.age), 0x5EEDu, 0u)));
+    if size_px < 2.0 {
+        // Below two pixels one tap (3 atomics) suffices: the footprint is sub-pixel anyway,
+        // and atomics are the splat's cost.
+        let c = vec2<i32>(floor(px + 0.5));
+        add_light(c.x, c.y, energy, dither.x);
+        return;
+    }
     let base = floor(px);
     let f = px - base;
     let b = vec2<i32>(base);
-    let dither = unorm4(pcg4d(vec4<u32>(slot, bitcast<u32>(s.w), 0x5EEDu, 0u)));
     add_light(b.x, b.y, energy * ((1.0 - f.x) * (1.0 - f.y)), dither.x);
     add_light(b.x + 1, b.y, energy * (f.x * (1.0 - f.y)), dither.y);
     add_light(b.x, b.y + 1, energy * ((1.0 - f.x) * f.y), dither.z);

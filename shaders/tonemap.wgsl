@@ -1,6 +1,8 @@
 // tonemap.wgsl — HDR (linear, Rgba16Float) → display (sRGB target does the encoding).
 //
-// Contract: group 0 binding 0 `hdr` texture, binding 1 `tone` (x: exposure).
+// Contract: group 0 binding 0 `hdr` texture, binding 1 `tone` (x: exposure), binding 2
+// `accum` (the compute splat's fixed-point light, read only when SPLAT is on — the splat
+// resolve is fused into this pass, saving a full-screen pass).
 // A full-screen triangle; the ACES fit by Krzysztof Narkowicz maps HDR to [0, 1].
 
 struct ToneUniform {
@@ -10,6 +12,11 @@ struct ToneUniform {
 
 @group(0) @binding(0) var hdr: texture_2d<f32>;
 @group(0) @binding(1) var<uniform> tone: ToneUniform;
+@group(0) @binding(2) var<storage, read> accum: array<u32>;
+
+override SPLAT: bool = false;
+// Keep in sync with `FIXED_SCALE` in splat.wgsl.
+const SPLAT_FIXED_SCALE: f32 = 4096.0;
 
 @vertex
 fn vs_main(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
@@ -28,6 +35,10 @@ fn aces(x: vec3<f32>) -> vec3<f32> {
 
 @fragment
 fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let c = textureLoad(hdr, vec2<i32>(frag.xy), 0).rgb;
+    var c = textureLoad(hdr, vec2<i32>(frag.xy), 0).rgb;
+    if SPLAT {
+        let i = (u32(frag.y) * textureDimensions(hdr).x + u32(frag.x)) * 3u;
+        c += vec3<f32>(f32(accum[i]), f32(accum[i + 1u]), f32(accum[i + 2u])) / SPLAT_FIXED_SCALE;
+    }
     return vec4<f32>(aces(c * tone.exposure.x), 1.0);
 }

@@ -103,6 +103,11 @@ pub struct Emitter {
     pub spawn_noise: SpawnNoise,
     /// Integration method.
     pub integrator: Integrator,
+    /// Stateless mode (Latta; the 2012 blog's closed-form fountain): no per-step update,
+    /// positions evaluated in closed form from each particle's spawn record and age.
+    /// Cheaper and exact, but only for constant acceleration + linear drag: see
+    /// [`Emitter::stateless_blockers`].
+    pub stateless: bool,
     /// Ground and sphere colliders.
     pub collisions: Collisions,
     /// Added to the effect seed for this emitter's stream.
@@ -592,7 +597,7 @@ pub enum DrawPath {
 }
 
 /// Auto draw path: below this projected particle size (pixels), splat.
-pub const SPLAT_BELOW_PX: f32 = 2.0;
+pub const SPLAT_BELOW_PX: f32 = 4.0;
 
 /// Built-in procedural sprites.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -696,6 +701,7 @@ impl Default for Emitter {
             forces: Forces::default(),
             spawn_noise: SpawnNoise::default(),
             integrator: Integrator::SemiImplicitEuler,
+            stateless: false,
             collisions: Collisions::default(),
             seed_offset: 0,
             look: Look::default(),
@@ -1028,6 +1034,16 @@ impl Effect {
                 );
                 c.num(|| p("forces.flame_pull.exponent"), fp.exponent, 0.0, 16.0);
             }
+            if e.stateless && !e.stateless_blockers().is_empty() {
+                c.push(
+                    p("stateless"),
+                    "true",
+                    &format!(
+                        "stateless mode needs constant acceleration and linear drag only; turn off: {}",
+                        e.stateless_blockers().join(", ")
+                    ),
+                );
+            }
             let col = &e.collisions;
             c.num(|| p("collisions.elasticity"), col.elasticity, 0.0, 1.0);
             c.num(|| p("collisions.friction"), col.friction, 0.0, 1.0);
@@ -1133,6 +1149,35 @@ impl Effect {
 pub const DEFAULT_PRESET_RON: &str = include_str!("../presets/campfire.ron");
 
 impl Emitter {
+    /// Why this emitter cannot run stateless (empty = it can): every module beyond
+    /// constant acceleration and linear drag needs per-step state.
+    pub fn stateless_blockers(&self) -> Vec<&'static str> {
+        let f = &self.forces;
+        let mut v = Vec::new();
+        if f.quadratic_drag_per_m > 0.0 {
+            v.push("quadratic drag");
+        }
+        if f.gusts.is_some() {
+            v.push("gusts");
+        }
+        if f.turbulence.is_some() {
+            v.push("turbulence");
+        }
+        if f.vortex.is_some() {
+            v.push("vortex");
+        }
+        if f.attractor.is_some() {
+            v.push("attractor");
+        }
+        if f.flame_pull.is_some() {
+            v.push("flame pull");
+        }
+        if self.collisions.any() {
+            v.push("collisions");
+        }
+        v
+    }
+
     /// The spawn cap per step actually used (see [`Emitter::max_spawn_per_step`]).
     pub fn effective_spawn_cap(&self) -> u32 {
         if self.max_spawn_per_step > 0 {

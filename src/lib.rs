@@ -16,3 +16,4 @@ pub mod sim;
 
 pub use effect::Effect;
 pub mod bench;
+pub mod hot_reload;

@@ -109,6 +109,27 @@ enum BenchKind {
         #[arg(long)]
         name: Option<String>,
     },
+    /// Update / draw / composite throughput from 64² particles to the device's limit.
+    Perf {
+        /// Texture sides (capacity = side²); default: the thesis's 64…4096, and beyond on a GPU.
+        #[arg(long, value_delimiter = ',')]
+        sides: Vec<u32>,
+        /// Render resolution, WxH.
+        #[arg(long, default_value = "1920x1080", value_parser = parse_size)]
+        size: (u32, u32),
+        /// Timed repeats (the median is reported).
+        #[arg(long, default_value_t = 7)]
+        repeats: usize,
+        /// Particles for the module-cost table (0 = 1M on a CPU adapter, 16M on a GPU).
+        #[arg(long, default_value_t = 0)]
+        module_capacity: u32,
+        /// Output folder.
+        #[arg(long, default_value = "bench/results")]
+        out: PathBuf,
+        /// File name stem (default: perf-<adapter>).
+        #[arg(long)]
+        name: Option<String>,
+    },
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -294,6 +315,43 @@ fn bench(kind: BenchKind) -> anyhow::Result<()> {
                 "wrote {}/{name}.md, .json, accuracy.csv, accuracy.svg",
                 out.display()
             );
+        }
+        BenchKind::Perf {
+            sides,
+            size,
+            repeats,
+            module_capacity,
+            out,
+            name,
+        } => {
+            let cpu = ctx.is_cpu_adapter();
+            let sides = if sides.is_empty() {
+                let mut s = vec![64, 128, 256, 512, 1024, 2048];
+                if !cpu {
+                    s.extend([4096, 8192, 11586]);
+                }
+                s
+            } else {
+                sides
+            };
+            let opts = ignis::bench::perf::PerfOptions {
+                sides,
+                size,
+                repeats: repeats.max(1),
+                billboard_limit: if cpu { 1 << 20 } else { 1 << 26 },
+                module_capacity: if module_capacity > 0 {
+                    module_capacity
+                } else if cpu {
+                    1 << 20
+                } else {
+                    1 << 24
+                },
+            };
+            let report = ignis::bench::perf::run(&ctx, &opts)?;
+            let name = name.unwrap_or_else(|| format!("perf-{}", adapter_tag(&ctx)));
+            report.save(&out, &name)?;
+            println!("{}", report.markdown);
+            println!("wrote {}/{name}.md and .json", out.display());
         }
     }
     Ok(())

@@ -22,6 +22,7 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ),
     ("collide.wgsl", include_str!("../shaders/collide.wgsl")),
     ("update.wgsl", include_str!("../shaders/update.wgsl")),
+    ("count.wgsl", include_str!("../shaders/count.wgsl")),
     ("look.wgsl", include_str!("../shaders/look.wgsl")),
     ("billboard.wgsl", include_str!("../shaders/billboard.wgsl")),
     ("splat.wgsl", include_str!("../shaders/splat.wgsl")),
@@ -31,6 +32,7 @@ pub const EMBEDDED: &[(&str, &str)] = &[
 /// The entry files, one per pipeline family; the others are imported by them.
 pub const ENTRY_FILES: &[&str] = &[
     "update.wgsl",
+    "count.wgsl",
     "billboard.wgsl",
     "splat.wgsl",
     "tonemap.wgsl",
@@ -108,6 +110,8 @@ pub enum ShaderSourceDir {
 #[derive(Clone, Debug)]
 pub struct ShaderLibrary {
     source: ShaderSourceDir,
+    /// Files replaced in memory (the bench's bare variant).
+    overrides: Vec<(String, String)>,
 }
 
 /// A composed, validated shader: one WGSL string for one pipeline.
@@ -130,6 +134,7 @@ impl ShaderLibrary {
     pub fn embedded() -> Self {
         Self {
             source: ShaderSourceDir::Embedded,
+            overrides: Vec::new(),
         }
     }
 
@@ -137,6 +142,7 @@ impl ShaderLibrary {
     pub fn from_dir(dir: impl Into<PathBuf>) -> Self {
         Self {
             source: ShaderSourceDir::Dir(dir.into()),
+            overrides: Vec::new(),
         }
     }
 
@@ -166,8 +172,39 @@ impl ShaderLibrary {
         }
     }
 
+    /// The same library with every optional module's code removed (the lines between
+    /// `// module-begin` and `// module-end`): the reference pipeline the perf bench
+    /// compares "module compiled out by its override constant" against.
+    pub fn without_modules(&self) -> Result<ShaderLibrary, ShaderError> {
+        let mut bare = self.clone();
+        for (name, _) in EMBEDDED {
+            let text = self.read(name)?;
+            let mut keep = true;
+            let stripped: Vec<&str> = text
+                .lines()
+                .filter(|l| {
+                    let t = l.trim_start();
+                    if t.starts_with("// module-begin") {
+                        keep = false;
+                    }
+                    let k = keep;
+                    if t.starts_with("// module-end") {
+                        keep = true;
+                    }
+                    k
+                })
+                .collect();
+            bare.overrides
+                .push(((*name).to_owned(), stripped.join("\n")));
+        }
+        Ok(bare)
+    }
+
     /// Reads one file's text.
     pub fn read(&self, name: &str) -> Result<String, ShaderError> {
+        if let Some((_, text)) = self.overrides.iter().find(|(n, _)| n == name) {
+            return Ok(text.clone());
+        }
         match &self.source {
             ShaderSourceDir::Embedded => EMBEDDED
                 .iter()

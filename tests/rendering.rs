@@ -264,3 +264,32 @@ fn billboard_and_splat_paths_agree() {
     b.save(std::env::temp_dir().join("ignis_path_splat.png"))
         .expect("save");
 }
+
+/// A stateless emitter draws the same fire as the stateful exponential integrator (exact
+/// for the same forces): the draw passes evaluate its spawn records in closed form.
+#[test]
+fn stateless_emitter_renders_like_the_stateful_one() {
+    let ctx = gpu();
+    let render = |stateless: bool| {
+        let mut effect = Effect::default_campfire();
+        effect.emitters.retain(|e| e.name == "flames");
+        effect.emitters[0].integrator = ignis::effect::Integrator::Exponential;
+        effect.emitters[0].stateless = stateless;
+        let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+        for _ in 0..45 {
+            run.advance(1.0 / 60.0).expect("advance");
+        }
+        run.render(SIZE).expect("render")
+    };
+    let (a, b) = (render(false), render(true));
+    let lit = a.pixels().filter(|p| p[0] > 50).count();
+    assert!(lit > 500, "stateful frame nearly empty");
+    let diff: f64 = a
+        .as_raw()
+        .iter()
+        .zip(b.as_raw())
+        .map(|(x, y)| (*x as f64 - *y as f64).abs())
+        .sum::<f64>()
+        / a.as_raw().len() as f64;
+    assert!(diff < 1.0, "mean pixel difference {diff}");
+}

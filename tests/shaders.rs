@@ -153,3 +153,22 @@ fn validation_and_import_errors_are_located() {
     std::fs::write(dir.path().join("tonemap.wgsl"), "").expect("write");
     assert!(lib.compose("tonemap.wgsl").is_err());
 }
+
+/// The bench's bare variant (module code removed) still validates, and really lacks the
+/// module code.
+#[test]
+fn bare_variant_validates_without_module_code() {
+    let bare = project_shaders().without_modules().expect("bare");
+    for entry in ENTRY_FILES {
+        if let Err(e) = bare.compose(entry) {
+            panic!("bare {entry}: {e}");
+        }
+    }
+    let update = bare.compose("update.wgsl").expect("update").source;
+    assert!(!update.contains("if MOD_COLLISIONS"));
+    assert!(!update.contains("if MOD_TURBULENCE"));
+    assert!(
+        update.contains("if MOD_DRAG"),
+        "drag is not an optional-module block"
+    );
+}

@@ -129,8 +129,12 @@ pub struct LookUniform {
     pub size_intensity: [f32; 4],
     /// sprite kind, blend (0 additive, 1 alpha), unused, unused.
     pub sprite_blend: [u32; 4],
-    /// x: ∫ sprite coverage over the unit quad, yzw: unused.
+    /// x: ∫ sprite coverage over the unit quad, y: 1 for a stateless emitter.
     pub extra: [f32; 4],
+    /// Stateless: constant acceleration xyz, drag k.
+    pub motion_a: [f32; 4],
+    /// Stateless: wind xyz, render time on the 4096 s clock.
+    pub motion_b: [f32; 4],
 }
 
 /// Tonemap settings (keep in sync with `ToneUniform` in `shaders/tonemap.wgsl`).

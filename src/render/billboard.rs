@@ -3,7 +3,6 @@
 
 use crate::effect::BlendMode;
 use crate::gpu::GpuContext;
-use crate::render::HDR_FORMAT;
 use crate::render::frame::{DrawItem, FrameResources};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 
@@ -43,32 +42,15 @@ impl BillboardPass {
     ) -> Result<(wgpu::RenderPipeline, wgpu::RenderPipeline), ShaderError> {
         let composed = lib.compose("billboard.wgsl")?;
         let make = |module: &wgpu::ShaderModule, blend: wgpu::BlendState, label| {
-            ctx.device
-                .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some(label),
-                    layout: Some(layout),
-                    vertex: wgpu::VertexState {
-                        module,
-                        entry_point: Some("vs_main"),
-                        compilation_options: Default::default(),
-                        buffers: &[],
-                    },
-                    primitive: wgpu::PrimitiveState::default(),
-                    depth_stencil: None,
-                    multisample: wgpu::MultisampleState::default(),
-                    fragment: Some(wgpu::FragmentState {
-                        module,
-                        entry_point: Some("fs_main"),
-                        compilation_options: Default::default(),
-                        targets: &[Some(wgpu::ColorTargetState {
-                            format: HDR_FORMAT,
-                            blend: Some(blend),
-                            write_mask: wgpu::ColorWrites::ALL,
-                        })],
-                    }),
-                    multiview_mask: None,
-                    cache: None,
-                })
+            crate::render::simple_pipeline(
+                ctx,
+                label,
+                layout,
+                module,
+                ("vs_main", "fs_main"),
+                crate::render::hdr_target(blend),
+                &[],
+            )
         };
         create_checked(&ctx.device, &composed, lib, |module| {
             (

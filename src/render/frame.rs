@@ -8,7 +8,7 @@ use crate::effect::{BlendMode, DrawPath, Effect, Look, MAX_COLOR_STOPS, SPLAT_BE
 use crate::gpu::GpuContext;
 use crate::gpu::types::{CameraUniform, LookUniform, PARAMS_STRIDE};
 use crate::render::OrbitCamera;
-use crate::sim::GpuSim;
+use crate::sim::{GpuSim, Modules};
 
 /// One emitter to draw this frame.
 #[derive(Clone, Copy, Debug)]
@@ -222,6 +222,16 @@ impl FrameResources {
                 .unwrap_or_default();
             let mut u = look_uniform(&e.look);
             u.clip_from_sim = camera.clip_from_sim(aspect, origin).to_cols_array_2d();
+            if Modules::of(e).contains(Modules::STATELESS) {
+                // Closed-form evaluation at the render time (between the last two steps).
+                let t =
+                    sim.planner.time_secs - (1.0 - alpha as f64) * sim.planner.last_dt_secs as f64;
+                let a = e.forces.constant_acceleration();
+                let w = e.forces.wind_m_per_s;
+                u.extra[1] = 1.0;
+                u.motion_a = [a.x, a.y, a.z, e.forces.drag_per_sec];
+                u.motion_b = [w[0], w[1], w[2], t.rem_euclid(4096.0) as f32];
+            }
             let at = i * PARAMS_STRIDE as usize;
             blocks[at..at + size_of::<LookUniform>()].copy_from_slice(bytemuck::bytes_of(&u));
             let Some(b) = sim.emitter_buffers(i) else {

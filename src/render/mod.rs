@@ -76,6 +76,53 @@ impl Targets {
     }
 }
 
+/// A render pipeline without vertex buffers: `vs` and `fs` of one module, one colour
+/// target, and the fragment stage's override constants.
+pub fn simple_pipeline(
+    ctx: &GpuContext,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    (vs, fs): (&str, &str),
+    target: wgpu::ColorTargetState,
+    constants: &[(&str, f64)],
+) -> wgpu::RenderPipeline {
+    ctx.device
+        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(layout),
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some(vs),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: None,
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module,
+                entry_point: Some(fs),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants,
+                    zero_initialize_workgroup_memory: true,
+                },
+                targets: &[Some(target)],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+}
+
+/// A colour target on the HDR format with `blend`.
+pub fn hdr_target(blend: wgpu::BlendState) -> wgpu::ColorTargetState {
+    wgpu::ColorTargetState {
+        format: HDR_FORMAT,
+        blend: Some(blend),
+        write_mask: wgpu::ColorWrites::ALL,
+    }
+}
+
 /// Opens a render pass that clears the HDR target to transparent black.
 pub fn begin_hdr_pass<'a>(
     enc: &'a mut wgpu::CommandEncoder,
@@ -149,6 +196,11 @@ impl Renderer {
         self.targets.get_or_insert_with(|| Targets::new(ctx, size))
     }
 
+    /// The targets of the last frame, if any.
+    pub fn targets_ref(&self) -> Option<&Targets> {
+        self.targets.as_ref()
+    }
+
     /// Records the frame into `enc`: particles into the HDR target, then the tonemap
     /// into the display texture.
     #[allow(clippy::too_many_arguments)]
@@ -171,14 +223,18 @@ impl Renderer {
         {
             let mut pass = begin_hdr_pass(enc, &targets.hdr_view);
             self.billboard.draw(&mut pass, &self.frame, &items);
-            if splatted {
-                self.splat.resolve(&mut pass, &self.frame);
-            }
         }
+        // The splat's light is resolved inside the tonemap (one full-screen pass less).
+        let accum = if splatted {
+            self.splat.accum_buffer()
+        } else {
+            None
+        };
         self.tonemap.record(
             ctx,
             enc,
             &targets.hdr_view,
+            accum,
             &targets.ldr_view,
             self.exposure,
         );

@@ -3,7 +3,6 @@
 //! quads on GPUs whose rasteriser runs on a few SMs (see the perf bench).
 
 use crate::gpu::GpuContext;
-use crate::render::HDR_FORMAT;
 use crate::render::billboard::ADDITIVE;
 use crate::render::frame::{DrawItem, FrameResources};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
@@ -110,33 +109,15 @@ impl SplatPass {
                     compilation_options: Default::default(),
                     cache: None,
                 });
-            let resolve = ctx
-                .device
-                .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some("SplatPass::resolve"),
-                    layout: Some(resolve_layout),
-                    vertex: wgpu::VertexState {
-                        module,
-                        entry_point: Some("vs_resolve"),
-                        compilation_options: Default::default(),
-                        buffers: &[],
-                    },
-                    primitive: wgpu::PrimitiveState::default(),
-                    depth_stencil: None,
-                    multisample: wgpu::MultisampleState::default(),
-                    fragment: Some(wgpu::FragmentState {
-                        module,
-                        entry_point: Some("fs_resolve"),
-                        compilation_options: Default::default(),
-                        targets: &[Some(wgpu::ColorTargetState {
-                            format: HDR_FORMAT,
-                            blend: Some(ADDITIVE),
-                            write_mask: wgpu::ColorWrites::ALL,
-                        })],
-                    }),
-                    multiview_mask: None,
-                    cache: None,
-                });
+            let resolve = crate::render::simple_pipeline(
+                ctx,
+                "SplatPass::resolve",
+                resolve_layout,
+                module,
+                ("vs_resolve", "fs_resolve"),
+                crate::render::hdr_target(ADDITIVE),
+                &[],
+            );
             (splat, resolve)
         })
     }
@@ -205,7 +186,14 @@ impl SplatPass {
         true
     }
 
-    /// Adds the accumulated light into the HDR target (inside an open render pass).
+    /// The accumulation buffer of the last splat (the tonemap reads it directly).
+    pub fn accum_buffer(&self) -> Option<&wgpu::Buffer> {
+        self.accum.as_ref().map(|a| &a.1)
+    }
+
+    /// Adds the accumulated light into the HDR target (inside an open render pass). The
+    /// renderer fuses this into the tonemap instead; kept for the bench and for targets
+    /// without a tonemap.
     pub fn resolve(&self, pass: &mut wgpu::RenderPass<'_>, frame: &FrameResources) {
         let Some((_, _, group)) = self.accum.as_ref() else {
             return;

@@ -1,15 +1,19 @@
-//! The composite: HDR → exposure → ACES fit → sRGB display target.
+//! The composite: HDR (+ the compute splat's light, fused here) → exposure → ACES fit →
+//! sRGB display target.
 
 use crate::gpu::GpuContext;
 use crate::gpu::types::ToneUniform;
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 
-/// A full-screen tonemap pass.
+/// A full-screen tonemap pass, in two variants: with and without the splat's light.
 pub struct TonemapPass {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
-    pipeline: wgpu::RenderPipeline,
+    plain: wgpu::RenderPipeline,
+    with_splat: wgpu::RenderPipeline,
     uniform: wgpu::Buffer,
+    /// Bound in place of the splat buffer when nothing was splatted.
+    no_splat: wgpu::Buffer,
     format: wgpu::TextureFormat,
 }
 
@@ -45,6 +49,16 @@ impl TonemapPass {
                         },
                         count: None,
                     },
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 2,
+                        visibility: wgpu::ShaderStages::FRAGMENT,
+                        ty: wgpu::BindingType::Buffer {
+                            ty: wgpu::BufferBindingType::Storage { read_only: true },
+                            has_dynamic_offset: false,
+                            min_binding_size: None,
+                        },
+                        count: None,
+                    },
                 ],
             });
         let pipeline_layout = ctx
@@ -54,18 +68,26 @@ impl TonemapPass {
                 bind_group_layouts: &[Some(&layout)],
                 immediate_size: 0,
             });
-        let pipeline = Self::build(ctx, lib, &pipeline_layout, format)?;
+        let (plain, with_splat) = Self::build(ctx, lib, &pipeline_layout, format)?;
         let uniform = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("TonemapPass::uniform"),
             size: size_of::<ToneUniform>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        let no_splat = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("TonemapPass::no_splat"),
+            size: 16,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
         Ok(Self {
             layout,
             pipeline_layout,
-            pipeline,
+            plain,
+            with_splat,
             uniform,
+            no_splat,
             format,
         })
     }
@@ -75,46 +97,45 @@ impl TonemapPass {
         lib: &ShaderLibrary,
         layout: &wgpu::PipelineLayout,
         format: wgpu::TextureFormat,
-    ) -> Result<wgpu::RenderPipeline, ShaderError> {
+    ) -> Result<(wgpu::RenderPipeline, wgpu::RenderPipeline), ShaderError> {
         let composed = lib.compose("tonemap.wgsl")?;
         create_checked(&ctx.device, &composed, lib, |module| {
-            ctx.device
-                .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some("TonemapPass::pipeline"),
-                    layout: Some(layout),
-                    vertex: wgpu::VertexState {
-                        module,
-                        entry_point: Some("vs_main"),
-                        compilation_options: Default::default(),
-                        buffers: &[],
+            let make = |splat: bool| {
+                let constants = [("SPLAT", if splat { 1.0 } else { 0.0 })];
+                crate::render::simple_pipeline(
+                    ctx,
+                    if splat {
+                        "TonemapPass::with_splat"
+                    } else {
+                        "TonemapPass::plain"
                     },
-                    primitive: wgpu::PrimitiveState::default(),
-                    depth_stencil: None,
-                    multisample: wgpu::MultisampleState::default(),
-                    fragment: Some(wgpu::FragmentState {
-                        module,
-                        entry_point: Some("fs_main"),
-                        compilation_options: Default::default(),
-                        targets: &[Some(format.into())],
-                    }),
-                    multiview_mask: None,
-                    cache: None,
-                })
+                    layout,
+                    module,
+                    ("vs_main", "fs_main"),
+                    format.into(),
+                    &constants,
+                )
+            };
+            (make(false), make(true))
         })
     }
 
-    /// Rebuilds the pipeline; keeps the old one on error.
+    /// Rebuilds the pipelines; keeps the old ones on error.
     pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
-        self.pipeline = Self::build(ctx, lib, &self.pipeline_layout, self.format)?;
+        let (plain, with_splat) = Self::build(ctx, lib, &self.pipeline_layout, self.format)?;
+        self.plain = plain;
+        self.with_splat = with_splat;
         Ok(())
     }
 
-    /// Records the tonemap from `hdr` into `out`.
+    /// Records the tonemap from `hdr` (plus `splat`'s accumulated light, when given) into
+    /// `out`.
     pub fn record(
         &self,
         ctx: &GpuContext,
         enc: &mut wgpu::CommandEncoder,
         hdr: &wgpu::TextureView,
+        splat: Option<&wgpu::Buffer>,
         out: &wgpu::TextureView,
         exposure: f32,
     ) {
@@ -137,6 +158,10 @@ impl TonemapPass {
                     binding: 1,
                     resource: self.uniform.as_entire_binding(),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: splat.unwrap_or(&self.no_splat).as_entire_binding(),
+                },
             ],
         });
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -155,7 +180,11 @@ impl TonemapPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.pipeline);
+        pass.set_pipeline(if splat.is_some() {
+            &self.with_splat
+        } else {
+            &self.plain
+        });
         pass.set_bind_group(0, &bind_group, &[]);
         pass.draw(0..3, 0..1);
     }

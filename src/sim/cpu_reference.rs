@@ -55,8 +55,19 @@ impl CpuSim {
                 let mut q = spawn_particle(params, key);
                 let f = (params.spawn_frac0 + rel as f32 * params.spawn_frac_step).clamp(0.0, 1.0);
                 let age0 = (1.0 - f) * params.dt_secs;
-                let pos = q.position() + q.velocity() * age0;
-                q.pos_age = [pos.x, pos.y, pos.z, age0];
+                let forces = Forces {
+                    params,
+                    modules: self.modules,
+                };
+                let k = forces.linear_drag_k() as f32;
+                let (phi, psi) = exp_phi_psi(k, age0);
+                let c = Vec3::from_slice(&params.accel_drag[..3])
+                    + k * Vec3::from_slice(&params.wind_time[..3]);
+                let v0 = q.velocity();
+                let x = q.position() + v0 * phi + c * psi;
+                let v = v0 * (1.0 - k * phi) + c * phi;
+                q.pos_age = [x.x, x.y, x.z, age0];
+                q.vel_life = [v.x, v.y, v.z, q.vel_life[3]];
                 *p = q;
             } else if p.is_alive() {
                 let life = p.vel_life[3];
@@ -166,11 +177,20 @@ pub fn value_noise3(p: Vec3, seed: u32) -> f32 {
     let c = [cell.x as i32, cell.y as i32, cell.z as i32];
     let h = |dx: i32, dy: i32, dz: i32| rng::hash_cell([c[0] + dx, c[1] + dy, c[2] + dz], seed);
     let (ux, uy, uz) = (fade(f.x), fade(f.y), fade(f.z));
-    let x00 = mix(h(0, 0, 0), h(1, 0, 0), ux);
-    let x10 = mix(h(0, 1, 0), h(1, 1, 0), ux);
-    let x01 = mix(h(0, 0, 1), h(1, 0, 1), ux);
-    let x11 = mix(h(0, 1, 1), h(1, 1, 1), ux);
-    mix(mix(x00, x10, uy), mix(x01, x11, uy), uz)
+    // The same polynomial form as `value_noise3_grad` in noise.wgsl, in f32.
+    let (a, b, cc, d) = (h(0, 0, 0), h(1, 0, 0), h(0, 1, 0), h(1, 1, 0));
+    let (e, ff, g, hh) = (h(0, 0, 1), h(1, 0, 1), h(0, 1, 1), h(1, 1, 1));
+    let k4 = a - b - cc + d;
+    let k5 = a - cc - e + g;
+    let k6 = a - b - e + ff;
+    let k7 = -a + b + cc - d + e - ff - g + hh;
+    a + (b - a) * ux
+        + (cc - a) * uy
+        + (e - a) * uz
+        + k4 * ux * uy
+        + k5 * uy * uz
+        + k6 * uz * ux
+        + k7 * ux * uy * uz
 }
 
 /// `value_noise3_vec` in noise.wgsl.
@@ -516,5 +536,26 @@ pub fn integrate(
             let e = 1.0 - k * phi;
             (x + v * phi + f * psi, v * e + f * phi)
         }
+    }
+}
+
+/// A stateless emitter's spawn record evaluated at `now` (seconds on the 4096 s clock),
+/// as `drawn` in look.wgsl does: the particle's current position, age and velocity.
+pub fn evaluate_stateless(record: &Particle, e: &Emitter, now: f32) -> Particle {
+    let life = record.vel_life[3];
+    let mut age = now - record.pos_age[3];
+    if age < 0.0 {
+        age += 4096.0;
+    }
+    let k = e.forces.drag_per_sec;
+    let (phi, psi) = exp_phi_psi(k, age);
+    let c = e.forces.constant_acceleration() + k * Vec3::from(e.forces.wind_m_per_s);
+    let x = record.position() + record.velocity() * phi + c * psi;
+    // v(t) = v0·e^{−kt} + c·φ, with e^{−kt} = 1 − k·φ.
+    let v = record.velocity() * (1.0 - k * phi) + c * phi;
+    let alive_age = if life > 0.0 && age < life { age } else { life };
+    Particle {
+        pos_age: [x.x, x.y, x.z, alive_age],
+        vel_life: [v.x, v.y, v.z, life],
     }
 }

@@ -39,6 +39,9 @@ pub struct UpdatePass {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
     pipelines: HashMap<PipelineKey, wgpu::ComputePipeline>,
+    count_layout: wgpu::BindGroupLayout,
+    count_pipeline_layout: wgpu::PipelineLayout,
+    count: Option<wgpu::ComputePipeline>,
     /// Files the current pipelines were built from.
     pub files: Vec<String>,
 }
@@ -84,10 +87,26 @@ impl UpdatePass {
                 bind_group_layouts: &[Some(&layout)],
                 immediate_size: 0,
             });
+        let count_layout = ctx
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("UpdatePass::count_layout"),
+                entries: &[storage(0, true), storage(1, false)],
+            });
+        let count_pipeline_layout =
+            ctx.device
+                .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("UpdatePass::count_pipeline_layout"),
+                    bind_group_layouts: &[Some(&count_layout)],
+                    immediate_size: 0,
+                });
         Self {
             layout,
             pipeline_layout,
             pipelines: HashMap::new(),
+            count_layout,
+            count_pipeline_layout,
+            count: None,
             files: Vec::new(),
         }
     }
@@ -104,6 +123,7 @@ impl UpdatePass {
         for &(integrator, modules) in keys {
             let mut constants = modules.constants();
             constants.push(("INTEGRATOR", integrator.index() as f64));
+            constants.push(("COUNT_ALIVE", if ctx.is_cpu_adapter() { 0.0 } else { 1.0 }));
             let pipeline = create_checked(&ctx.device, &composed, lib, |module| {
                 ctx.device
                     .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -120,8 +140,36 @@ impl UpdatePass {
             })?;
             fresh.insert((integrator, modules), pipeline);
         }
+        // The on-demand alive count. Workgroup barriers are very expensive on CPU adapters
+        // (lavapipe runs each invocation of a barrier-split shader separately): plain
+        // atomics there.
+        let count_src = lib.compose("count.wgsl")?;
+        let direct = [(
+            "DIRECT_ATOMICS",
+            if ctx.is_cpu_adapter() { 1.0 } else { 0.0 },
+        )];
+        let count = create_checked(&ctx.device, &count_src, lib, |module| {
+            ctx.device
+                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some("UpdatePass::count"),
+                    layout: Some(&self.count_pipeline_layout),
+                    module,
+                    entry_point: Some("main"),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &direct,
+                        zero_initialize_workgroup_memory: true,
+                    },
+                    cache: None,
+                })
+        })?;
         self.pipelines = fresh;
+        self.count = Some(count);
         self.files = composed.files;
+        for f in count_src.files {
+            if !self.files.contains(&f) {
+                self.files.push(f);
+            }
+        }
         Ok(())
     }
 
@@ -149,6 +197,8 @@ struct EmitterState {
     /// Which buffer holds the current state (the thesis's `mFlip`).
     current: usize,
     generation: u64,
+    /// Holds stateless spawn records (no ping-pong: buffer 0 only).
+    stateless: bool,
 }
 
 /// The GPU simulation of an effect.
@@ -263,6 +313,24 @@ impl GpuSim {
                 }
             }
         }
+        // Switching an emitter between stateless records and stateful particles restarts
+        // its pool: the two layouts mean different things.
+        let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+        let mut cleared = false;
+        for (s, e) in self.emitters.iter_mut().zip(&effect.emitters) {
+            let stateless = Modules::of(e).contains(Modules::STATELESS);
+            if s.stateless != stateless {
+                for b in &s.buffers {
+                    enc.clear_buffer(b, 0, None);
+                }
+                s.current = 0;
+                s.stateless = stateless;
+                cleared = true;
+            }
+        }
+        if cleared {
+            self.ctx.queue.submit([enc.finish()]);
+        }
         let slots = STEPS_PER_SUBMIT * effect.emitters.len().max(1);
         if slots > self.params_slots {
             self.params_slots = slots;
@@ -314,6 +382,7 @@ impl GpuSim {
             bind_groups,
             current: 0,
             generation,
+            stateless: false,
         }
     }
 
@@ -426,13 +495,31 @@ impl GpuSim {
                 else {
                     continue;
                 };
-                enc.clear_buffer(&em.counters, 0, Some(4));
+                let offset = ((s * n_emitters + e) as u64 * PARAMS_STRIDE) as u32;
+                if em.stateless {
+                    // Spawn records only, written in place into buffer 0 (group 1 reads
+                    // buffer 1 and writes buffer 0); nothing else is touched.
+                    if p.spawn_count > 0 {
+                        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                            label: Some("GpuSim::stateless_spawn"),
+                            timestamp_writes: None,
+                        });
+                        pass.set_pipeline(pipeline);
+                        pass.set_bind_group(0, &em.bind_groups[1], &[offset]);
+                        let (x, y) = dispatch_size(p.spawn_count);
+                        pass.dispatch_workgroups(x, y, 1);
+                    }
+                    continue;
+                }
+                if !self.ctx.is_cpu_adapter() {
+                    // The update counts alive particles (COUNT_ALIVE) into a cleared slot.
+                    enc.clear_buffer(&em.counters, 0, Some(4));
+                }
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("GpuSim::update"),
                     timestamp_writes: None,
                 });
                 pass.set_pipeline(pipeline);
-                let offset = ((s * n_emitters + e) as u64 * PARAMS_STRIDE) as u32;
                 pass.set_bind_group(0, &em.bind_groups[em.current], &[offset]);
                 let (x, y) = dispatch_size(p.capacity.min(em.capacity));
                 pass.dispatch_workgroups(x, y, 1);
@@ -524,11 +611,68 @@ impl GpuSim {
     }
 
     /// `[alive after the last step, non-finite kills so far]` of emitter `index` (blocking).
+    ///
+    /// The alive count is computed now, by a counting pass over the current state (the
+    /// update pass does not count: only the stats need it). Stateless emitters are counted
+    /// on the CPU from their spawn records' ages.
     pub fn read_counters(&self, index: usize) -> Result<[u32; 2], SimError> {
         let s = self
             .emitters
             .get(index)
             .ok_or_else(|| SimError::Readback(format!("no emitter {index}")))?;
+        if s.stateless {
+            let now = self.planner.time_secs.rem_euclid(4096.0) as f32;
+            let alive = self
+                .read_particles(index)?
+                .iter()
+                .filter(|r| {
+                    let mut age = now - r.pos_age[3];
+                    if age < 0.0 {
+                        age += 4096.0;
+                    }
+                    r.vel_life[3] > 0.0 && age < r.vel_life[3]
+                })
+                .count() as u32;
+            return Ok([alive, 0]);
+        }
+        // GPUs count in the update pass itself; CPU adapters count here, on demand.
+        if let Some(count) = self
+            .update
+            .count
+            .as_ref()
+            .filter(|_| self.ctx.is_cpu_adapter())
+        {
+            let group = self
+                .ctx
+                .device
+                .create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("GpuSim::count_group"),
+                    layout: &self.update.count_layout,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: s.buffers[s.current].as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: s.counters.as_entire_binding(),
+                        },
+                    ],
+                });
+            let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+            enc.clear_buffer(&s.counters, 0, Some(4));
+            {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("GpuSim::count"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(count);
+                pass.set_bind_group(0, &group, &[]);
+                let (x, y) = dispatch_size(s.capacity);
+                pass.dispatch_workgroups(x, y, 1);
+            }
+            self.ctx.queue.submit([enc.finish()]);
+        }
         let bytes = read_buffer(&self.ctx, &s.counters, 8)?;
         let v: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
         Ok([v[0], v[1]])

@@ -25,9 +25,11 @@ impl Modules {
     pub const FLAME_PULL: Modules = Modules(64);
     /// Ground and sphere colliders.
     pub const COLLISIONS: Modules = Modules(128);
+    /// Stateless mode: spawn records only, positions in closed form when drawn.
+    pub const STATELESS: Modules = Modules(256);
 
     /// Every module with its override-constant name.
-    pub const ALL: [(Modules, &'static str); 8] = [
+    pub const ALL: [(Modules, &'static str); 9] = [
         (Self::DRAG, "MOD_DRAG"),
         (Self::GUSTS, "MOD_GUSTS"),
         (Self::QUADRATIC_DRAG, "MOD_QUADRATIC_DRAG"),
@@ -36,6 +38,7 @@ impl Modules {
         (Self::ATTRACTOR, "MOD_ATTRACTOR"),
         (Self::FLAME_PULL, "MOD_FLAME_PULL"),
         (Self::COLLISIONS, "MOD_COLLISIONS"),
+        (Self::STATELESS, "MOD_STATELESS"),
     ];
 
     /// The modules an emitter's settings need.
@@ -72,6 +75,9 @@ impl Modules {
         }
         if e.collisions.any() {
             m.0 |= Self::COLLISIONS.0;
+        }
+        if e.stateless && e.stateless_blockers().is_empty() {
+            m.0 |= Self::STATELESS.0;
         }
         m
     }

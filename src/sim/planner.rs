@@ -49,6 +49,8 @@ pub struct EffectPlanner {
     pub time_secs: f64,
     /// Steps planned so far.
     pub step_index: u64,
+    /// Size of the last planned step, seconds.
+    pub last_dt_secs: f32,
 }
 
 impl EffectPlanner {
@@ -69,6 +71,7 @@ impl EffectPlanner {
             .collect();
         self.time_secs += dt_secs as f64;
         self.step_index += 1;
+        self.last_dt_secs = dt_secs;
         params
     }
 

@@ -1,0 +1,39 @@
+// count.wgsl — counts alive particles on demand (the stats panel, tests): one invocation
+// per slot, a workgroup reduction (GPUs) or one atomic per alive particle (CPU adapters,
+// where a workgroup barrier splits the shader per invocation). Plumbing, not a hook.
+//
+// Contract: group 0 binding 0 `state` (read), binding 1 `counters` ([0] += alive).
+#import "common.wgsl"
+
+@group(0) @binding(0) var<storage, read> state: array<Particle>;
+@group(0) @binding(1) var<storage, read_write> counters: array<atomic<u32>, 2>;
+
+override DIRECT_ATOMICS: bool = false;
+
+var<workgroup> wg_alive: atomic<u32>;
+
+@compute @workgroup_size(256)
+fn main(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let slot = (wg.y * nwg.x + wg.x) * 256u + lid;
+    let alive = slot < arrayLength(&state) && is_alive(state[slot]);
+    if DIRECT_ATOMICS {
+        if alive {
+            atomicAdd(&counters[0], 1u);
+        }
+    } else {
+        if alive {
+            atomicAdd(&wg_alive, 1u);
+        }
+        workgroupBarrier();
+        if lid == 0u {
+            let n = atomicLoad(&wg_alive);
+            if n > 0u {
+                atomicAdd(&counters[0], n);
+            }
+        }
+    }
+}

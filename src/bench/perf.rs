@@ -1,0 +1,525 @@
+//! `ignis bench perf`: update, draw (both paths) and composite cost from 64² to the
+//! device's limit, the update pass's bandwidth against a compute copy of the same bytes
+//! in the same run, the 2006 thesis's frame rates next to its sizes, and what optional
+//! modules cost on and off.
+
+use crate::bench::Report;
+use crate::bench::report::sci;
+use crate::effect::{DrawPath, Effect, Emitter, Range};
+use crate::gpu::GpuContext;
+use crate::gpu::timer::{GpuTimer, median};
+use crate::render::{OrbitCamera, Renderer, begin_hdr_pass};
+use crate::shaders::ShaderLibrary;
+use crate::sim::{GpuSim, Modules, SimError};
+
+/// The 2006 thesis's measurements (GeForce 8800, points only): texture side → fps.
+pub const THESIS_FPS: [(u32, f64); 7] = [
+    (64, 5300.0),
+    (128, 5300.0),
+    (256, 2500.0),
+    (512, 700.0),
+    (1024, 180.0),
+    (2048, 46.0),
+    (4096, 12.0),
+];
+
+/// Options of `ignis bench perf`.
+pub struct PerfOptions {
+    /// Texture sides: capacity = side².
+    pub sides: Vec<u32>,
+    /// Render resolution.
+    pub size: (u32, u32),
+    /// Timed repeats (median reported).
+    pub repeats: usize,
+    /// Skip the billboard path above this many particles (it is ~100× slower).
+    pub billboard_limit: u64,
+    /// Particles for the module-cost table.
+    pub module_capacity: u32,
+}
+
+/// The default campfire's flames, scaled to `n` particles: sizes shrink with √n so the
+/// lit area (and the total light) stays that of the 4096-particle original. Pools larger
+/// than one storage binding are split into several emitters.
+pub fn scaled_campfire(n: u64, max_pool: u64) -> Effect {
+    let base = Effect::default_campfire();
+    let flames = base
+        .emitters
+        .iter()
+        .find(|e| e.name == "flames")
+        .cloned()
+        .unwrap_or_default();
+    let scale = (4096.0 / n as f64).sqrt() as f32;
+    let pools = n.div_ceil(max_pool).max(1);
+    let per_pool = (n / pools) as u32;
+    let emitters = (0..pools)
+        .map(|i| {
+            let mut e = Emitter {
+                name: format!("flames {i}"),
+                capacity: per_pool,
+                lifetime_secs: Range::new(1.0, 1.0),
+                spawn_rate_per_sec: per_pool as f32,
+                seed_offset: i as u32,
+                ..flames.clone()
+            };
+            e.max_spawn_per_step = 0;
+            e.look.size_start_m *= scale.min(1.0);
+            e.look.size_end_m *= scale.min(1.0);
+            e
+        })
+        .collect();
+    Effect {
+        name: format!("campfire × {n}"),
+        emitters,
+        ..base
+    }
+}
+
+/// One row of the throughput table.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct PerfRow {
+    /// Particles.
+    pub particles: u64,
+    /// Pools (emitters) the particles were split into.
+    pub pools: u64,
+    /// Update pass, ms.
+    pub update_ms: f64,
+    /// Compute copy of the same bytes, ms.
+    pub copy_ms: f64,
+    /// Billboard draw, ms (None when skipped).
+    pub billboard_ms: Option<f64>,
+    /// Splat draw (clear + splat + resolve), ms.
+    pub splat_ms: f64,
+    /// Tonemap composite, ms.
+    pub composite_ms: f64,
+    /// The path Auto picks for this scene.
+    pub auto_path: &'static str,
+    /// update + auto draw + composite, ms.
+    pub frame_ms: f64,
+}
+
+fn copy_pipeline(ctx: &GpuContext) -> (wgpu::ComputePipeline, wgpu::BindGroupLayout) {
+    let module = ctx
+        .device
+        .create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("bench copy"),
+            source: wgpu::ShaderSource::Wgsl(COPY_WGSL.into()),
+        });
+    let layout = ctx
+        .device
+        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("bench copy layout"),
+            entries: &[storage_entry(0, true), storage_entry(1, false)],
+        });
+    let pl = ctx
+        .device
+        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("bench copy pipeline layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+    let pipeline = ctx
+        .device
+        .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("bench copy"),
+            layout: Some(&pl),
+            module: &module,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+    (pipeline, layout)
+}
+
+fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// A plain compute copy, 32 bytes per invocation: the same bytes the update moves.
+const COPY_WGSL: &str = "
+struct P { a: vec4<f32>, b: vec4<f32> }
+@group(0) @binding(0) var<storage, read> src: array<P>;
+@group(0) @binding(1) var<storage, read_write> dst: array<P>;
+@compute @workgroup_size(256)
+fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) n: vec3<u32>, @builtin(local_invocation_index) l: u32) {
+    let i = (wg.y * n.x + wg.x) * 256u + l;
+    if i < arrayLength(&src) { dst[i] = src[i]; }
+}
+";
+
+fn time_median(
+    timer: &GpuTimer,
+    ctx: &GpuContext,
+    repeats: usize,
+    mut work: impl FnMut(&mut wgpu::CommandEncoder),
+) -> f64 {
+    let mut samples: Vec<f64> = (0..repeats).map(|_| timer.time(ctx, &mut work)).collect();
+    median(&mut samples)
+}
+
+/// Measures one capacity.
+fn measure_row(
+    ctx: &GpuContext,
+    opts: &PerfOptions,
+    n: u64,
+    copy: &(wgpu::ComputePipeline, wgpu::BindGroupLayout),
+) -> Result<PerfRow, SimError> {
+    let max_pool = ctx.max_capacity().min(1 << 24);
+    let effect = scaled_campfire(n, max_pool);
+    let mut sim = GpuSim::new(ctx, ShaderLibrary::embedded(), &effect)?;
+    // Fill the pools: 1.1 s of simulation.
+    for _ in 0..3 {
+        sim.step(&effect, 1.0 / 60.0, 22)?;
+    }
+    let timer = GpuTimer::new(ctx);
+    let update_ms = time_median(&timer, ctx, opts.repeats, |enc| {
+        let plans = sim.plan(&effect, 1.0 / 60.0, 1);
+        sim.record(enc, &effect, &plans);
+    });
+    // The copy: the same bytes as every pool's read + write, in one run.
+    let mut copy_groups = Vec::new();
+    for i in 0..sim.emitter_count() {
+        if let Some(b) = sim.emitter_buffers(i) {
+            let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("bench copy group"),
+                layout: &copy.1,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: b.current.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: b.previous.as_entire_binding(),
+                    },
+                ],
+            });
+            copy_groups.push((group, b.capacity));
+        }
+    }
+    let copy_ms = time_median(&timer, ctx, opts.repeats, |enc| {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&copy.0);
+        for (g, cap) in &copy_groups {
+            pass.set_bind_group(0, g, &[]);
+            let (x, y) = crate::sim::gpu_sim::dispatch_size(*cap);
+            pass.dispatch_workgroups(x, y, 1);
+        }
+    });
+    drop(copy_groups);
+    // Re-run one step so the state is a real one again (the copy wrote into `previous`).
+    sim.step(&effect, 1.0 / 60.0, 1)?;
+
+    let mut renderer = Renderer::new(ctx, &ShaderLibrary::embedded())?;
+    let camera = OrbitCamera::from_hint(&effect.camera);
+    let size = opts.size;
+    renderer.targets(ctx, size);
+    let items = renderer
+        .frame
+        .prepare(ctx, &sim, &effect, &camera, size, 1.0);
+    let auto_splat = items.iter().all(|d| d.splat);
+    let all_billboard: Vec<_> = items
+        .iter()
+        .map(|d| crate::render::DrawItem { splat: false, ..*d })
+        .collect();
+    let all_splat: Vec<_> = items
+        .iter()
+        .map(|d| crate::render::DrawItem { splat: true, ..*d })
+        .collect();
+    let billboard_ms = if n <= opts.billboard_limit {
+        let r = &renderer;
+        let Some(t) = r_targets(r) else {
+            return Err(SimError::Readback("no targets".into()));
+        };
+        Some(time_median(&timer, ctx, opts.repeats.min(3), |enc| {
+            let mut pass = begin_hdr_pass(enc, t);
+            r.billboard.draw(&mut pass, &r.frame, &all_billboard);
+        }))
+    } else {
+        None
+    };
+    // Splat: clear + compute splat (its resolve is fused into the composite below).
+    let splat_ms = {
+        let mut samples = Vec::new();
+        for _ in 0..opts.repeats {
+            let Renderer { frame, splat, .. } = &mut renderer;
+            samples.push(timer.time(ctx, |enc| {
+                splat.splat(ctx, enc, frame, &all_splat, size);
+            }));
+        }
+        median(&mut samples)
+    };
+    // Composite: the tonemap, reading the splat's light when the auto path splats.
+    let composite_ms = {
+        let r = &renderer;
+        let Some(targets) = r.targets_ref() else {
+            return Err(SimError::Readback("no targets".into()));
+        };
+        let accum = if auto_splat {
+            r.splat.accum_buffer()
+        } else {
+            None
+        };
+        time_median(&timer, ctx, opts.repeats, |enc| {
+            r.tonemap
+                .record(ctx, enc, &targets.hdr_view, accum, &targets.ldr_view, 1.0);
+        })
+    };
+    let draw = if auto_splat {
+        splat_ms
+    } else {
+        billboard_ms.unwrap_or(f64::NAN)
+    };
+    Ok(PerfRow {
+        particles: n,
+        pools: effect.emitters.len() as u64,
+        update_ms,
+        copy_ms,
+        billboard_ms,
+        splat_ms,
+        composite_ms,
+        auto_path: if auto_splat { "splat" } else { "billboard" },
+        frame_ms: update_ms + draw + composite_ms,
+    })
+}
+
+fn r_targets(r: &Renderer) -> Option<&wgpu::TextureView> {
+    r.targets_ref().map(|t| &t.hdr_view)
+}
+
+/// Update cost with each optional module on, with every module compiled out by its
+/// override constant, and with the module code removed from the source.
+fn module_costs(ctx: &GpuContext, opts: &PerfOptions) -> Result<Vec<(String, f64)>, SimError> {
+    let n = opts.module_capacity.min(ctx.max_capacity() as u32);
+    let base = scaled_campfire(n as u64, n as u64);
+    let timer = GpuTimer::new(ctx);
+    let mut plain = base.clone();
+    for e in &mut plain.emitters {
+        e.spawn_noise.position_amplitude_m = 0.0;
+        e.spawn_noise.direction_amplitude = 0.0;
+    }
+    let bare_lib = ShaderLibrary::embedded()
+        .without_modules()
+        .map_err(SimError::Shader)?;
+    let mut variants: Vec<(String, Effect, ShaderLibrary)> = vec![
+        (
+            "bare: module code removed from the source".to_owned(),
+            plain.clone(),
+            bare_lib,
+        ),
+        (
+            "every optional module compiled out (override constants)".to_owned(),
+            plain.clone(),
+            ShaderLibrary::embedded(),
+        ),
+    ];
+    type Switch = Box<dyn Fn(&mut Emitter)>;
+    let on: Vec<(&str, Switch)> = vec![
+        (
+            "gusts on",
+            Box::new(|e: &mut Emitter| e.forces.gusts = Some(Default::default())),
+        ),
+        (
+            "quadratic drag on",
+            Box::new(|e: &mut Emitter| e.forces.quadratic_drag_per_m = 0.2),
+        ),
+        (
+            "turbulence on (2 octaves)",
+            Box::new(|e: &mut Emitter| e.forces.turbulence = Some(Default::default())),
+        ),
+        (
+            "vortex on",
+            Box::new(|e: &mut Emitter| e.forces.vortex = Some(Default::default())),
+        ),
+        (
+            "attractor on",
+            Box::new(|e: &mut Emitter| e.forces.attractor = Some(Default::default())),
+        ),
+        (
+            "flame pull on",
+            Box::new(|e: &mut Emitter| e.forces.flame_pull = Some(Default::default())),
+        ),
+        (
+            "stateless mode (spawn records only, closed form when drawn)",
+            Box::new(|e: &mut Emitter| e.stateless = true),
+        ),
+        (
+            "collisions on (ground + 1 sphere)",
+            Box::new(|e: &mut Emitter| {
+                e.collisions.ground = Some(Default::default());
+                e.collisions.spheres = vec![Default::default()];
+            }),
+        ),
+    ];
+    for (name, apply) in on {
+        let mut effect = plain.clone();
+        for e in &mut effect.emitters {
+            apply(e);
+        }
+        let mods = Modules::of(&effect.emitters[0]);
+        variants.push((
+            format!("{name} [{}]", mods.names().join(", ")),
+            effect,
+            ShaderLibrary::embedded(),
+        ));
+    }
+    // Two pools: one with the bare pipeline, one whose pipeline cache holds every other
+    // variant (so no compile happens inside the loop). Before each timed sample the GPU
+    // runs 10 untimed steps of the same variant: a GPU idling between submissions
+    // downclocks, and that — not the code — dominated earlier attempts at this table.
+    let mut sims = Vec::new();
+    for lib in [&variants[0].2, &variants[1].2] {
+        let mut sim = GpuSim::new(ctx, lib.clone(), &plain)?;
+        sim.step(&plain, 1.0 / 60.0, 66)?;
+        sims.push(sim);
+    }
+    for (_, effect, _) in &variants[2..] {
+        sims[1].step(effect, 1.0 / 60.0, 1)?;
+    }
+    // Round-robin over the variants, so slow drifts of a shared machine hit all alike.
+    let mut samples = vec![Vec::new(); variants.len()];
+    for _ in 0..opts.repeats * 3 {
+        for (i, (_, effect, _)) in variants.iter().enumerate() {
+            let sim = &mut sims[i.min(1)];
+            sim.step(effect, 1.0 / 60.0, 10)?;
+            for _ in 0..3 {
+                let ms = timer.time(ctx, |enc| {
+                    let plans = sim.plan(effect, 1.0 / 60.0, 1);
+                    sim.record(enc, effect, &plans);
+                });
+                samples[i].push(ms);
+            }
+        }
+    }
+    let rows = variants
+        .iter()
+        .zip(samples.iter_mut())
+        .map(|((name, _, _), s)| (name.clone(), median(s)))
+        .collect();
+    Ok(rows)
+}
+
+/// Runs the perf bench.
+pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
+    let mut report = Report::new("ignis bench perf", ctx);
+    let timer = GpuTimer::new(ctx);
+    report.para(&format!(
+        "Resolution {}×{}; the default campfire's flames scaled to N particles (sizes ∝ 1/√N, so the fire's \
+         footprint and light stay those of the original); medians of {} runs measured with **{}**. \
+         Bandwidth = 64 B per particle-step (32 read + 32 written) / update time; the copy is a compute shader \
+         moving the same bytes, in the same run. Pools larger than {} particles are split into several emitters \
+         (one storage binding each).",
+        opts.size.0,
+        opts.size.1,
+        opts.repeats,
+        timer.source.label(),
+        ctx.max_capacity().min(1 << 24)
+    ));
+    // Modules first: measured on a fresh device, before the large pools of the throughput
+    // rows have been allocated and freed.
+    eprintln!("bench perf: module costs");
+    let costs = module_costs(ctx, opts)?;
+    let copy = copy_pipeline(ctx);
+    let mut rows = Vec::new();
+    let mut table = Vec::new();
+    let limit = ctx.max_capacity() * 8;
+    for &side in &opts.sides {
+        let n = side as u64 * side as u64;
+        if n > limit {
+            report.para(&format!(
+                "{side}² = {n}: beyond this device's memory budget for the bench, skipped."
+            ));
+            continue;
+        }
+        eprintln!("bench perf: {side}² = {n} particles");
+        let row = match measure_row(ctx, opts, n, &copy) {
+            Ok(r) => r,
+            Err(e) => {
+                report.para(&format!("{side}² = {n}: {e}"));
+                continue;
+            }
+        };
+        let gbps = n as f64 * 64.0 / (row.update_ms * 1e-3) / 1e9;
+        let copy_gbps = n as f64 * 64.0 / (row.copy_ms * 1e-3) / 1e9;
+        let thesis = THESIS_FPS.iter().find(|(s, _)| *s == side).map(|(_, f)| *f);
+        let fps = 1000.0 / row.frame_ms;
+        table.push(vec![
+            format!("{side}² = {n}"),
+            format!("{:.3}", row.update_ms),
+            format!("{:.3}", row.copy_ms),
+            format!(
+                "{gbps:.3} GB/s ({:.0} % of the copy's {copy_gbps:.3})",
+                100.0 * row.copy_ms / row.update_ms
+            ),
+            row.billboard_ms
+                .map_or("skipped".into(), |m| format!("{m:.3}")),
+            format!("{:.3}", row.splat_ms),
+            format!("{:.3}", row.composite_ms),
+            format!("{:.3} ({})", row.frame_ms, row.auto_path),
+            format!("{fps:.0}"),
+            thesis.map_or("—".into(), |t| format!("{t:.0} (ours: {:.2}×)", fps / t)),
+            sci(n as f64 * fps),
+        ]);
+        rows.push(serde_json::json!({
+            "side": side, "row": row, "update_gb_per_s": gbps, "copy_gb_per_s": copy_gbps,
+            "update_vs_copy": row.copy_ms / row.update_ms, "fps": fps, "thesis_fps": thesis,
+        }));
+    }
+    report.heading("Throughput");
+    report.table(
+        &[
+            "particles",
+            "update ms",
+            "copy ms",
+            "update bandwidth (vs copy)",
+            "billboard draw ms",
+            "splat draw ms (clear + splat)",
+            "composite ms (tonemap + splat resolve)",
+            "frame ms (auto path)",
+            "fps",
+            "2006 thesis fps (ours ×)",
+            "particles/s",
+        ],
+        &table,
+    );
+    report.heading("Optional modules");
+    let bare = costs.first().map_or(f64::NAN, |c| c.1);
+    let mcap = opts.module_capacity.min(ctx.max_capacity() as u32);
+    report.para(&format!(
+        "Update pass at {mcap} particles, ms per step (median of {} one-step submissions, variants interleaved round-robin, \
+         each sample preceded by 10 untimed steps so the GPU is at its working clock). \
+         The first two rows are the \"off costs nothing\" check: the pipeline with every module compiled out \
+         by its override constant against one built from source with the module code deleted.",
+        opts.repeats * 9
+    ));
+    let mrows: Vec<Vec<String>> = costs
+        .iter()
+        .map(|(name, ms)| {
+            vec![
+                name.clone(),
+                format!("{ms:.4}"),
+                format!("{:+.1} %", 100.0 * (ms / bare - 1.0)),
+            ]
+        })
+        .collect();
+    report.table(&["variant", "update ms/step", "vs bare"], &mrows);
+    report.json["rows"] = serde_json::Value::Array(rows);
+    report.json["modules"] = serde_json::to_value(
+        costs
+            .iter()
+            .map(|(n, ms)| serde_json::json!({"variant": n, "ms": ms}))
+            .collect::<Vec<_>>(),
+    )?;
+    report.json["resolution"] = serde_json::json!([opts.size.0, opts.size.1]);
+    report.json["timing"] = serde_json::Value::String(timer.source.label().into());
+    let _ = DrawPath::Auto;
+    Ok(report)
+}
