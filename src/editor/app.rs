@@ -17,8 +17,9 @@ use winit::window::{Window, WindowId};
 
 use crate::effect::{Effect, TimeMode};
 use crate::gpu::GpuContext;
+use crate::hot_reload::{FileWatcher, ShaderReloader, wgsl_names};
 use crate::render::{OrbitCamera, Renderer};
-use crate::shaders::ShaderLibrary;
+use crate::shaders::{ShaderLibrary, ShaderSourceDir};
 use crate::sim::{GpuSim, Stepper};
 
 use super::panel::{PANEL_WIDTH, panel_ui};
@@ -26,7 +27,7 @@ use super::profile::StageProfiler;
 use super::remap::emitter_sources;
 use super::screenshot::{Screenshot, read_back};
 use super::state::EditorState;
-use super::stats::{EmitterStats, median};
+use super::stats::{EmitterStats, ShaderReloadStats, median};
 use super::ui_painter::{UiPainter, UiPainterKind};
 use super::viewport::{ViewportOutput, emitter_bounds, frame_bounds, viewport_ui};
 
@@ -182,6 +183,35 @@ struct Gfx {
     cpu_log: Vec<f32>,
     viewport_px: (u32, u32),
     profiler: StageProfiler,
+    /// Hot reload of `shaders/` (absent with the embedded shaders).
+    shader_watch: Option<ShaderWatch>,
+}
+
+/// The shader folder's watcher and the reloader that rebuilds affected pipelines.
+struct ShaderWatch {
+    dir: PathBuf,
+    watcher: FileWatcher,
+    reloader: ShaderReloader,
+}
+
+impl ShaderWatch {
+    /// Watches `lib`'s folder; `None` for embedded shaders or when watching fails.
+    fn new(lib: &ShaderLibrary) -> Option<Self> {
+        let ShaderSourceDir::Dir(dir) = lib.source() else {
+            return None;
+        };
+        match FileWatcher::new(&[dir.as_path()]) {
+            Ok(watcher) => Some(Self {
+                dir: dir.clone(),
+                watcher,
+                reloader: ShaderReloader::new(lib),
+            }),
+            Err(err) => {
+                log::warn!("not watching {} for shader changes: {err}", dir.display());
+                None
+            }
+        }
+    }
 }
 
 impl ApplicationHandler for App {
@@ -290,6 +320,7 @@ impl Gfx {
 
         let lib = ShaderLibrary::discover(options.shader_dir.as_deref());
         let renderer = Renderer::new(&ctx, &lib)?;
+        let shader_watch = ShaderWatch::new(&lib);
         let sim = GpuSim::new(&ctx, lib, &state.running)?;
 
         let egui_ctx = egui::Context::default();
@@ -339,6 +370,7 @@ impl Gfx {
             cpu_log: Vec::new(),
             viewport_px: (1, 1),
             profiler: StageProfiler::new(options.profile),
+            shader_watch,
         })
     }
 
@@ -373,6 +405,51 @@ impl Gfx {
                 state.reject_running(&self.gpu_effect, err.to_string());
             }
         }
+    }
+
+    /// Rebuilds the pipelines whose shaders changed on disk; a failure keeps the last
+    /// good pipeline and shows the error (file, line, caret) in the panel.
+    fn reload_changed_shaders(&mut self, state: &mut EditorState) {
+        let Some(watch) = &mut self.shader_watch else {
+            return;
+        };
+        let changed = wgsl_names(&watch.watcher.poll());
+        if changed.is_empty() {
+            return;
+        }
+        let noticed = Instant::now();
+        let lib = ShaderLibrary::from_dir(watch.dir.clone());
+        let report = watch.reloader.reload(
+            &self.ctx,
+            &lib,
+            &mut self.sim,
+            &mut self.renderer,
+            &self.gpu_effect,
+            &changed,
+            noticed,
+        );
+        log::info!(
+            "shaders changed ({}): rebuilt {:?}, failed {:?}",
+            changed.join(", "),
+            report.rebuilt,
+            report.failed
+        );
+        state.shader_errors = watch
+            .reloader
+            .errors
+            .values()
+            .map(|e| e.to_string())
+            .collect();
+        let succeeded = report.failed.is_empty() && !report.rebuilt.is_empty();
+        state.stats.shader_reload = Some(ShaderReloadStats {
+            changed,
+            latency_secs: succeeded
+                .then_some(watch.reloader.last_latency)
+                .flatten()
+                .map(|d| d.as_secs_f32()),
+            rebuilt: report.rebuilt,
+            failed: report.failed,
+        });
     }
 
     /// Runs this frame's simulation steps.
@@ -595,6 +672,7 @@ impl App {
 
         // 2. The simulation follows the running effect and steps.
         gfx.profiler.end_stage(&gfx.ctx);
+        gfx.reload_changed_shaders(&mut self.state);
         gfx.apply_running(&mut self.state);
         let cpu_start = Instant::now();
         if let Err(err) = gfx.simulate(&mut self.state, frame_dt_secs) {

@@ -122,6 +122,14 @@ pub fn header_ui(ui: &mut Ui, state: &mut EditorState) {
             }
         });
     }
+    if !state.shader_errors.is_empty() {
+        error_box_ui(ui, |ui| {
+            ui.label(RichText::new("Shader error: the last good pipeline keeps running.").strong());
+            for e in &state.shader_errors {
+                ui.label(RichText::new(e).monospace().size(11.0));
+            }
+        });
+    }
     if let Some(err) = &state.sim_error {
         error_box_ui(ui, |ui| {
             ui.label(RichText::new("The simulation stopped (paused).").strong());

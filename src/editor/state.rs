@@ -54,6 +54,8 @@ pub struct EditorState {
     /// An effect the GPU refused (e.g. a capacity over a device limit) and why; not
     /// offered again until it changes.
     pub gpu_rejected: Option<(Effect, String)>,
+    /// Shader errors from the last hot reload (the last good pipelines keep running).
+    pub shader_errors: Vec<String>,
     /// The last simulation failure (the simulation pauses), until playback resumes.
     pub sim_error: Option<String>,
     /// Index of the emitter shown in the emitter-specific sections.
@@ -84,6 +86,7 @@ impl EditorState {
             validation_errors,
             gpu_rejected: None,
             sim_error: None,
+            shader_errors: Vec::new(),
             selected: 0,
             playback: Playback::default(),
             view: ViewSettings::default(),

@@ -23,6 +23,19 @@ pub struct EmitterStats {
     pub spawn: SpawnStats,
 }
 
+/// The last shader hot reload.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ShaderReloadStats {
+    /// Files that changed.
+    pub changed: Vec<String>,
+    /// Entry files whose pipelines were rebuilt.
+    pub rebuilt: Vec<&'static str>,
+    /// Entry files whose rebuild failed (their last good pipelines keep running).
+    pub failed: Vec<&'static str>,
+    /// File change noticed → new pipelines in use, seconds (when nothing failed).
+    pub latency_secs: Option<f32>,
+}
+
 /// What the Stats section shows.
 #[derive(Clone, Debug, Default)]
 pub struct Stats {
@@ -44,6 +57,8 @@ pub struct Stats {
     pub adapter: String,
     /// Which egui painter draws the UI.
     pub ui_painter: &'static str,
+    /// The last shader hot reload, if any.
+    pub shader_reload: Option<ShaderReloadStats>,
     /// Size of the viewport's render target, pixels.
     pub viewport_px: (u32, u32),
 }
@@ -171,6 +186,20 @@ pub fn stats_ui(ui: &mut egui::Ui, stats: &Stats, effect: &Effect) {
             );
             ui.label(stats.ui_painter);
             ui.end_row();
+            if let Some(r) = &stats.shader_reload {
+                ui.label("Shader reload").on_hover_text(format!(
+                    "changed: {}\nrebuilt: {}",
+                    r.changed.join(", "),
+                    r.rebuilt.join(", ")
+                ));
+                ui.label(match (r.failed.is_empty(), r.latency_secs) {
+                    (true, Some(s)) => {
+                        format!("{} rebuilt in {:.0} ms", r.rebuilt.join(", "), s * 1e3)
+                    }
+                    _ => format!("{} failed: last good kept", r.failed.join(", ")),
+                });
+                ui.end_row();
+            }
         });
     ui.add_space(4.0);
     for (i, e) in effect.emitters.iter().enumerate() {
