@@ -677,3 +677,31 @@ fn the_viewport_orbits_pans_zooms_and_frames() {
         "double-click frames"
     );
 }
+
+#[test]
+fn stateless_mode_is_offered_and_its_blockers_are_named() {
+    let mut harness = panel_harness(campfire_state());
+    harness.get_by_label("Stateless").click_accesskit();
+    harness.run();
+    assert!(harness.state().running.emitters[0].stateless);
+    assert!(harness.query_by_label_contains("turn off:").is_none());
+
+    // Turbulence needs per-step state: the panel says so and validation refuses it.
+    open_section(&mut harness, "Forces");
+    harness.get_by_label("Turbulence").click_accesskit();
+    harness.run();
+    // Named next to the checkbox and in the validation message.
+    assert_eq!(
+        harness
+            .query_all_by_label_contains("turn off: turbulence")
+            .count(),
+        2
+    );
+    assert!(!harness.state().validation_errors.is_empty());
+    assert!(
+        harness.state().running.emitters[0]
+            .forces
+            .turbulence
+            .is_none()
+    );
+}

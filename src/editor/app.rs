@@ -532,7 +532,8 @@ impl Gfx {
     fn frame_camera(&self, camera: &mut OrbitCamera) {
         let mut positions = Vec::new();
         for (i, e) in self.gpu_effect.emitters.iter().enumerate() {
-            if !e.enabled {
+            // Stateless pools hold spawn records, not positions.
+            if !e.enabled || e.stateless {
                 continue;
             }
             // Particles live in their emitter's simulation space (relative to its origin).

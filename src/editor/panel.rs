@@ -1110,6 +1110,21 @@ ui,
                 .response
                 .labelled_by(label.id);
             ui.end_row();
+            row_ui(
+                ui,
+                "Stateless",
+                "Closed form instead of steps: each particle's position is evaluated from its spawn record and age (exact, cheaper). Only for constant acceleration and linear drag",
+                |ui| ui.checkbox(&mut e.stateless, "closed form"),
+            );
+            let blockers = e.stateless_blockers();
+            if e.stateless && !blockers.is_empty() {
+                ui.label("");
+                ui.colored_label(
+                    ui.visuals().warn_fg_color,
+                    format!("turn off: {}", blockers.join(", ")),
+                );
+                ui.end_row();
+            }
         }
     });
     stability_ui(ui, effect);
