@@ -705,3 +705,44 @@ fn stateless_mode_is_offered_and_its_blockers_are_named() {
             .is_none()
     );
 }
+
+#[test]
+fn presets_are_saved_and_loaded_from_the_header() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("my_fire.ron");
+    let mut harness = panel_harness(campfire_state());
+    harness
+        .get_by_label("Spawn rate")
+        .set_value_accesskit(321.0);
+    harness.run();
+    harness.state_mut().preset_path = path.display().to_string();
+    harness.get_by_label("Save").click_accesskit();
+    harness.run();
+    assert!(
+        matches!(harness.state().preset_message, Some(Ok(_))),
+        "{:?}",
+        harness.state().preset_message
+    );
+    let saved = ignis::preset::load(&path).expect("a valid preset on disk");
+    assert_eq!(saved, harness.state().effect);
+
+    // Change it, then load the file back: one undo step, and the running effect follows.
+    harness.get_by_label("Spawn rate").set_value_accesskit(7.0);
+    harness.run();
+    let undo_before = harness.state().history.undo_len();
+    harness.get_by_label("Load").click_accesskit();
+    harness.run();
+    assert_eq!(harness.state().effect.emitters[0].spawn_rate_per_sec, 321.0);
+    assert_eq!(
+        harness.state().running.emitters[0].spawn_rate_per_sec,
+        321.0
+    );
+    assert_eq!(harness.state().history.undo_len(), undo_before + 1);
+
+    // A missing file is reported, not fatal.
+    harness.state_mut().preset_path = dir.path().join("nope.ron").display().to_string();
+    harness.get_by_label("Load").click_accesskit();
+    harness.run();
+    assert!(matches!(harness.state().preset_message, Some(Err(_))));
+    assert_eq!(harness.state().effect.emitters[0].spawn_rate_per_sec, 321.0);
+}

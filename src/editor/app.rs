@@ -132,7 +132,13 @@ pub fn run(options: EditOptions) -> anyhow::Result<Option<RunReport>> {
     ));
     let mut app = App {
         camera: OrbitCamera::from_hint(&effect.camera),
-        state: EditorState::new(effect, source),
+        state: {
+            let mut state = EditorState::new(effect, source);
+            if let Some(path) = &options.preset {
+                state.preset_path = path.display().to_string();
+            }
+            state
+        },
         options,
         instance,
         gfx: None,

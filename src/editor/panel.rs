@@ -111,6 +111,39 @@ pub fn header_ui(ui: &mut Ui, state: &mut EditorState) {
             state.history.redo_len()
         ));
     });
+    ui.horizontal(|ui| {
+        let label = ui.label("Preset");
+        ui.add(
+            egui::TextEdit::singleline(&mut state.preset_path)
+                .desired_width(ui.available_width() - 104.0)
+                .hint_text("presets/name.ron"),
+        )
+        .labelled_by(label.id)
+        .on_hover_text("The RON preset file Save writes and Load reads");
+        if ui
+            .button("Save")
+            .on_hover_text("Write the edited effect (valid effects only; atomic: a crash never leaves half a file)")
+            .clicked()
+        {
+            state.save_preset();
+        }
+        if ui
+            .button("Load")
+            .on_hover_text("Replace the effect with this preset (undoable)")
+            .clicked()
+        {
+            state.load_preset();
+        }
+    });
+    match &state.preset_message {
+        Some(Ok(msg)) => {
+            ui.colored_label(Color32::from_rgb(130, 200, 130), msg);
+        }
+        Some(Err(msg)) => {
+            ui.colored_label(ui.visuals().error_fg_color, msg);
+        }
+        None => {}
+    }
     if !state.validation_errors.is_empty() {
         error_box_ui(ui, |ui| {
             ui.label(RichText::new("Not applied: the last valid effect keeps running.").strong());

@@ -72,6 +72,10 @@ pub struct EditorState {
     pub frame_requested: bool,
     /// Where the effect was loaded from, for the title.
     pub source: String,
+    /// The preset file Save writes and Load reads (edited in the header).
+    pub preset_path: String,
+    /// The outcome of the last save or load: `Ok(message)` or `Err(message)`.
+    pub preset_message: Option<Result<String, String>>,
 }
 
 impl EditorState {
@@ -79,6 +83,7 @@ impl EditorState {
     /// simulation runs the effect anyway only once it is fixed).
     pub fn new(effect: Effect, source: impl Into<String>) -> Self {
         let validation_errors = effect.validate().err().unwrap_or_default();
+        let effect_name = effect.name.clone();
         Self {
             running: effect.clone(),
             history: UndoHistory::new(&effect),
@@ -92,8 +97,36 @@ impl EditorState {
             view: ViewSettings::default(),
             stats: Stats::default(),
             frame_requested: false,
+            preset_path: format!("presets/my_{}.ron", file_stem(&effect_name)),
+            preset_message: None,
             source: source.into(),
         }
+    }
+
+    /// Saves the edited effect to `preset_path` (atomically; only a valid effect).
+    pub fn save_preset(&mut self) {
+        let path = std::path::PathBuf::from(self.preset_path.trim());
+        self.preset_message = Some(match crate::preset::save(&self.effect, &path) {
+            Ok(()) => Ok(format!("saved {}", path.display())),
+            Err(err) => Err(err.to_string()),
+        });
+    }
+
+    /// Replaces the edited effect with the preset at `preset_path` (one undo step; the
+    /// particles of emitters with the same names keep burning).
+    pub fn load_preset(&mut self) {
+        let path = std::path::PathBuf::from(self.preset_path.trim());
+        self.preset_message = Some(match crate::preset::load(&path) {
+            Ok(effect) => {
+                self.history.observe(&self.effect, false);
+                self.effect = effect;
+                self.history.observe(&self.effect, false);
+                self.source = path.display().to_string();
+                self.clamp_selection();
+                Ok(format!("loaded {}", path.display()))
+            }
+            Err(err) => Err(err.to_string()),
+        });
     }
 
     /// End-of-frame bookkeeping after the UI ran: handles the undo/redo and playback
@@ -206,5 +239,24 @@ impl EditorState {
         if frame {
             self.frame_requested = true;
         }
+    }
+}
+
+/// A file-name-safe version of an effect name.
+fn file_stem(name: &str) -> String {
+    let stem: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' {
+                c.to_ascii_lowercase()
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if stem.is_empty() {
+        "effect".to_owned()
+    } else {
+        stem
     }
 }
