@@ -436,6 +436,10 @@ fn explain(
         }
         E::UnclosedBlockComment => "a `/*` comment is never closed".to_owned(),
         _ if end_of_text => {
+            // Point just after the last thing in the file.
+            if let Some(last) = tokens.last() {
+                pos = last.end_pos;
+            }
             let unclosed = unclosed_bracket(tokens);
             match unclosed {
                 Some(t) => format!(
@@ -482,7 +486,10 @@ fn explain(
         ),
         E::Eof => "unexpected end of file".to_owned(),
         E::ExpectedDifferentLength { expected, found } => {
-            format!("expected {expected}, found {found} values")
+            match expected.strip_prefix("an array of length ") {
+                Some(n) => format!("expected {n} values, found {found}"),
+                None => format!("expected {expected}, found {found} values"),
+            }
         }
         E::InvalidValueForType { expected, found } => format!("expected {expected}, found {found}"),
         E::NoSuchEnumVariant {
@@ -661,7 +668,8 @@ fn brackets(open: u8) -> (char, char) {
 /// when it does not fit.
 fn write_node(node: &Node, text: &str, indent: usize, col: usize, out: &mut String, force: bool) {
     let one_line = inline(node, text);
-    let fits = col + one_line.chars().count() + 1 <= LINE_WIDTH;
+    // One column for the trailing comma.
+    let fits = col + one_line.chars().count() < LINE_WIDTH;
     let children = match &node.body {
         Body::Atom(_) => 0,
         Body::Fields(f) => f.len(),
@@ -776,7 +784,7 @@ static TMP_COUNTER: AtomicU64 = AtomicU64::new(0);
 /// file in the same folder, which is then flushed, fsynced and renamed over `path` (and the
 /// folder fsynced, so the rename itself survives a crash). If `fill` or any later step fails
 /// (a full disk, a crash before the rename), `path` keeps its previous content and the
-/// temporary file is removed. A symlink at `path` is followed: its target is replaced. An
+/// temporary file is removed (also when `fill` panics). A symlink at `path` is followed: its target is replaced. An
 /// existing file's permissions are kept.
 pub fn write_atomic_with(
     path: &Path,
@@ -794,35 +802,47 @@ pub fn write_atomic_with(
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "preset".into());
-    let tmp = dir.join(format!(
-        ".{name}.tmp-{}-{}",
-        std::process::id(),
-        TMP_COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    let result = (|| {
-        let file = std::fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&tmp)?;
-        let mut w = std::io::BufWriter::new(file);
-        fill(&mut w)?;
-        let file = w.into_inner().map_err(|e| e.into_error())?;
-        if let Ok(old) = std::fs::metadata(&target) {
-            file.set_permissions(old.permissions())?;
-        }
-        file.sync_all()?;
-        drop(file);
-        std::fs::rename(&tmp, &target)?;
-        // Persist the rename itself (not possible on every platform; best effort).
-        if let Ok(d) = std::fs::File::open(dir) {
-            let _ = d.sync_all();
-        }
-        Ok(())
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
+    let mut tmp = TempFile {
+        path: dir.join(format!(
+            ".{name}.tmp-{}-{}",
+            std::process::id(),
+            TMP_COUNTER.fetch_add(1, Ordering::Relaxed)
+        )),
+        renamed: false,
+    };
+    let file = std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&tmp.path)?;
+    let mut w = std::io::BufWriter::new(file);
+    fill(&mut w)?;
+    let file = w.into_inner().map_err(|e| e.into_error())?;
+    if let Ok(old) = std::fs::metadata(&target) {
+        file.set_permissions(old.permissions())?;
     }
-    result
+    file.sync_all()?;
+    drop(file);
+    std::fs::rename(&tmp.path, &target)?;
+    tmp.renamed = true;
+    // Persist the rename itself (not possible on every platform; best effort).
+    if let Ok(d) = std::fs::File::open(dir) {
+        let _ = d.sync_all();
+    }
+    Ok(())
+}
+
+/// Removes the temporary file when a write fails or panics before the rename.
+struct TempFile {
+    path: PathBuf,
+    renamed: bool,
+}
+
+impl Drop for TempFile {
+    fn drop(&mut self) {
+        if !self.renamed {
+            let _ = std::fs::remove_file(&self.path);
+        }
+    }
 }
 
 /// Every `.ron` file in `dir`, sorted by name.
