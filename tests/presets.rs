@@ -1385,3 +1385,82 @@ proptest! {
         prop_assert!(!text.contains("Some("));
     }
 }
+
+/// The ```ron blocks of docs/presets.md, in order.
+fn doc_ron_blocks() -> Vec<String> {
+    let doc =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/presets.md"))
+            .expect("docs/presets.md");
+    doc.split("```ron\n")
+        .skip(1)
+        .filter_map(|b| b.split_once("\n```").map(|(code, _)| code.to_owned()))
+        .collect()
+}
+
+/// The documentation's examples load: the minimal preset takes the documented defaults, and
+/// the "every field and its default" block is exactly the code's defaults.
+#[test]
+fn documented_examples_and_defaults_match_the_code() {
+    let blocks = doc_ron_blocks();
+    assert_eq!(blocks.len(), 2, "two ```ron blocks in docs/presets.md");
+    let minimal =
+        preset::parse_str(&blocks[0], "docs/presets.md").unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(minimal.emitters[0], Emitter::default());
+    assert_eq!(minimal.time, TimeSettings::default());
+    let sparks = &minimal.emitters[1];
+    let turbulence = sparks.forces.turbulence.clone().expect("turbulence on");
+    assert_eq!(turbulence.strength_m_per_s2, 3.0);
+    assert_eq!(
+        turbulence.frequency_per_m,
+        Turbulence::default().frequency_per_m
+    );
+    assert_eq!(sparks.look.sprite, Sprite::Spark);
+    assert_eq!(sparks.look.intensity, Look::default().intensity);
+
+    let documented =
+        preset::parse_str(&blocks[1], "docs/presets.md").unwrap_or_else(|e| panic!("{e}"));
+    let mut expected = Effect::default();
+    let e = &mut expected.emitters[0];
+    e.bursts = vec![ignis::effect::Burst::default()];
+    e.forces.gusts = Some(Gusts::default());
+    e.forces.turbulence = Some(Turbulence::default());
+    e.forces.vortex = Some(Vortex::default());
+    e.forces.attractor = Some(Attractor::default());
+    e.forces.flame_pull = Some(FlamePull::default());
+    e.collisions.ground = Some(GroundPlane::default());
+    e.collisions.spheres = vec![SphereCollider::default()];
+    assert_eq!(documented, expected);
+}
+
+/// Optional modules: left out or `None` = off, `()` = on with defaults, `Some(…)` accepted.
+#[test]
+fn optional_modules_are_written_as_groups() {
+    let load = |forces: &str| {
+        let text = format!("(version: 1, emitters: [(name: \"a\", forces: ({forces}))])");
+        preset::parse_str(&text, "modules.ron")
+            .unwrap_or_else(|e| panic!("{e}"))
+            .emitters[0]
+            .forces
+            .clone()
+    };
+    assert_eq!(load("").turbulence, None);
+    assert_eq!(load("turbulence: None").turbulence, None);
+    assert_eq!(
+        load("turbulence: ()").turbulence,
+        Some(Turbulence::default())
+    );
+    assert_eq!(
+        load("turbulence: Some((octaves: 3))").turbulence,
+        Some(Turbulence {
+            octaves: 3,
+            ..Turbulence::default()
+        })
+    );
+    assert_eq!(
+        load("flame_pull: (exponent: 2.0)").flame_pull,
+        Some(FlamePull {
+            exponent: 2.0,
+            ..FlamePull::default()
+        })
+    );
+}
