@@ -435,6 +435,7 @@ fn explain(
             "a string is never closed (a `\"` is missing)".to_owned()
         }
         E::UnclosedBlockComment => "a `/*` comment is never closed".to_owned(),
+        E::ExceededRecursionLimit => "nested too deeply (more than 128 levels of brackets)".into(),
         _ if end_of_text => {
             // Point just after the last thing in the file.
             if let Some(last) = tokens.last() {

@@ -669,6 +669,20 @@ fn malformed_cases() -> Vec<Case> {
         )],
     ));
 
+    let t = format!(
+        "(version: 1, emitters: [(name: \"deep\", bursts: {}",
+        "[".repeat(100_000)
+    );
+    cases.push(case(
+        "deep_nesting.ron",
+        t.clone(),
+        // No stack overflow: the typed reader stops at the first bracket too many.
+        &[
+            "deep_nesting.ron:1:49: emitters[0].bursts[0]: expected `(` opening a group of \
+             fields, found `[`",
+        ],
+    ));
+
     cases.push(case("empty.ron", "", &["empty.ron:1:1: the file is empty"]));
     cases.push(case(
         "only_comments.ron",
@@ -1463,4 +1477,26 @@ fn optional_modules_are_written_as_groups() {
             ..FlamePull::default()
         })
     );
+}
+
+/// Files that are not presets at all are refused before parsing: a folder, a huge file.
+#[test]
+fn non_preset_files_are_refused_up_front() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let err = preset::load(dir.path()).expect_err("a folder");
+    assert!(
+        err.to_string().contains("is a folder, not a preset file"),
+        "{err}"
+    );
+    let huge = dir.path().join("huge.ron");
+    let f = std::fs::File::create(&huge).expect("create");
+    f.set_len(preset::MAX_PRESET_BYTES + 1)
+        .expect("sparse file");
+    let err = preset::load(&huge).expect_err("too large");
+    assert!(
+        err.to_string().contains("is too large for a preset"),
+        "{err}"
+    );
+    let err = preset::load(&dir.path().join("missing.ron")).expect_err("missing");
+    assert!(err.to_string().contains("missing.ron: "), "{err}");
 }
