@@ -1116,11 +1116,7 @@ fn scan_version(tokens: &[Token], text: &str) -> Option<(Option<u64>, TextPos)> 
                 let v = tokens.get(i + 2)?;
                 let word = &text[v.start..v.end];
                 let n = if v.kind == Tok::Word {
-                    word.replace('_', "")
-                        .trim_end_matches("u32")
-                        .trim_end_matches("u64")
-                        .parse::<u64>()
-                        .ok()
+                    parse_integer(word)
                 } else {
                     None
                 };
@@ -1131,6 +1127,20 @@ fn scan_version(tokens: &[Token], text: &str) -> Option<(Option<u64>, TextPos)> 
         i += 1;
     }
     None
+}
+
+/// A RON unsigned integer literal: decimal, `0x`/`0o`/`0b`, `_` separators, optional
+/// `u32`/`u64` suffix.
+fn parse_integer(word: &str) -> Option<u64> {
+    let w = word.replace('_', "");
+    let w = w.trim_end_matches("u32").trim_end_matches("u64");
+    let w = w.strip_prefix('+').unwrap_or(w);
+    match w.get(..2) {
+        Some("0x") => u64::from_str_radix(&w[2..], 16).ok(),
+        Some("0o") => u64::from_str_radix(&w[2..], 8).ok(),
+        Some("0b") => u64::from_str_radix(&w[2..], 2).ok(),
+        _ => w.parse().ok(),
+    }
 }
 
 /// The innermost bracket still open at the end of the text.
@@ -1435,6 +1445,11 @@ mod tests {
             }
         );
         assert_eq!(scan_version(&tokenize("(name: 1)"), "(name: 1)"), None);
+        for (word, n) in [("7", 7), ("0x3E7", 999), ("0b11", 3), ("1_000u32", 1000)] {
+            assert_eq!(parse_integer(word), Some(n), "{word}");
+        }
+        assert_eq!(parse_integer("1.5"), None);
+        assert_eq!(parse_integer("\"1\""), None);
     }
 
     #[test]
