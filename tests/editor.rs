@@ -746,3 +746,42 @@ fn presets_are_saved_and_loaded_from_the_header() {
     assert!(matches!(harness.state().preset_message, Some(Err(_))));
     assert_eq!(harness.state().effect.emitters[0].spawn_rate_per_sec, 321.0);
 }
+
+#[test]
+fn the_library_opens_the_shipped_presets() {
+    let mut harness = panel_harness(campfire_state());
+    harness.state_mut().preset_path = "presets/campfire.ron".into();
+    harness.run();
+    harness.get_by_label("Library").click_accesskit();
+    harness.run();
+    harness
+        .get_by_role_and_label(Role::Button, "torch")
+        .click_accesskit();
+    harness.run();
+    let state = harness.state();
+    assert!(
+        state.preset_path.ends_with("torch.ron"),
+        "{}",
+        state.preset_path
+    );
+    let torch = ignis::preset::load(std::path::Path::new("presets/torch.ron")).expect("torch");
+    assert_eq!(state.effect, torch);
+    assert_eq!(state.running, torch);
+}
+
+#[test]
+fn the_time_section_shows_the_measured_accuracy_of_the_integrator() {
+    let harness = panel_harness(campfire_state());
+    assert!(
+        harness
+            .query_by_label_contains("as measured (H100")
+            .is_some()
+    );
+    // One line per measured scene (closed form, turbulent).
+    assert_eq!(
+        harness
+            .query_all_by_label_contains("ns/particle-step")
+            .count(),
+        2
+    );
+}

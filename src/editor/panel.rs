@@ -135,6 +135,7 @@ pub fn header_ui(ui: &mut Ui, state: &mut EditorState) {
             state.load_preset();
         }
     });
+    preset_library_ui(ui, state);
     match &state.preset_message {
         Some(Ok(msg)) => {
             ui.colored_label(Color32::from_rgb(130, 200, 130), msg);
@@ -176,6 +177,45 @@ pub fn header_ui(ui: &mut Ui, state: &mut EditorState) {
             );
             ui.label(reason);
         });
+    }
+}
+
+/// Opens a preset from the folder of the current preset path (or `presets/`); the
+/// folder is listed only while the list is open.
+fn preset_library_ui(ui: &mut Ui, state: &mut EditorState) {
+    let path = std::path::PathBuf::from(state.preset_path.trim());
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .map_or_else(|| std::path::PathBuf::from("presets"), |d| d.to_path_buf());
+    let mut chosen = None;
+    ui.horizontal(|ui| {
+        let label = ui.label("Library");
+        egui::ComboBox::from_id_salt("preset_library")
+            .selected_text(format!("{}/", dir.display()))
+            .width(ui.available_width() - 8.0)
+            .show_ui(ui, |ui| {
+                let files = crate::preset::list(&dir);
+                if files.is_empty() {
+                    ui.weak("no .ron presets here");
+                }
+                for file in files {
+                    let name = file
+                        .file_stem()
+                        .map(|n| n.to_string_lossy().into_owned())
+                        .unwrap_or_default();
+                    if ui.selectable_label(file == path, name).clicked() {
+                        chosen = Some(file);
+                    }
+                }
+            })
+            .response
+            .labelled_by(label.id)
+            .on_hover_text("Open a preset from this folder (undoable)");
+    });
+    if let Some(file) = chosen {
+        state.preset_path = file.display().to_string();
+        state.load_preset();
     }
 }
 
@@ -1160,16 +1200,59 @@ ui,
             }
         }
     });
+    if let Some(e) = effect.emitters.get(selected) {
+        measured_ui(ui, e.integrator, step_secs(effect));
+    }
     stability_ui(ui, effect);
+}
+
+/// The step the integrators see: the fixed step, or the largest frame-delta step.
+pub fn step_secs(effect: &Effect) -> f32 {
+    match effect.time.mode {
+        TimeMode::FixedStep => effect.time.step_secs,
+        TimeMode::FrameDelta => effect.time.max_frame_dt_secs,
+    }
+}
+
+/// What the accuracy bench measured for `integrator` near `dt_secs` (the committed H100
+/// results embedded in the binary), cached because the figures are parsed from JSON.
+fn measured_ui(ui: &mut Ui, integrator: Integrator, dt_secs: f32) {
+    type Cache = Option<((Integrator, u32), Vec<crate::bench::accuracy::Measured>)>;
+    static CACHE: std::sync::Mutex<Cache> = std::sync::Mutex::new(None);
+    let key = (integrator, dt_secs.to_bits());
+    let figures = match CACHE.lock() {
+        Ok(mut cache) => {
+            if cache.as_ref().is_none_or(|(k, _)| *k != key) {
+                let figures = crate::bench::accuracy::measured_for(integrator, dt_secs as f64);
+                *cache = Some((key, figures));
+            }
+            cache.as_ref().map(|(_, f)| f.clone()).unwrap_or_default()
+        }
+        Err(_) => Vec::new(),
+    };
+    if figures.is_empty() {
+        return;
+    }
+    ui.weak(format!(
+        "{} as measured (H100, T = 2 s):",
+        integrator.label()
+    ))
+    .on_hover_text(
+        "From the committed accuracy bench (bench/results/accuracy-nvidia-h100-80gb.json): \
+             RMS position error relative to the reference solution after 2 s, and the update \
+             cost per particle and step, at the measured step nearest to this one",
+    );
+    for m in figures {
+        ui.weak(format!(
+            "  {}: error {:.1e} at dt {:.4} s, {:.2} ns/particle-step",
+            m.scene, m.rms_rel_error, m.dt_secs, m.cost_ns
+        ));
+    }
 }
 
 /// k·dt of the step the integrator sees (the worst case in frame-delta mode).
 pub fn drag_times_dt(effect: &Effect, emitter: &Emitter) -> f32 {
-    let dt = match effect.time.mode {
-        TimeMode::FixedStep => effect.time.step_secs,
-        TimeMode::FrameDelta => effect.time.max_frame_dt_secs,
-    };
-    emitter.forces.drag_per_sec * dt
+    emitter.forces.drag_per_sec * step_secs(effect)
 }
 
 /// The drag stability hint for every emitter: k·dt against the integrator's limit.
