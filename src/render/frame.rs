@@ -198,6 +198,7 @@ impl FrameResources {
     }
 
     /// Uploads this frame's uniforms and returns what to draw, with each emitter's path.
+    #[allow(clippy::too_many_arguments)]
     pub fn prepare(
         &mut self,
         ctx: &GpuContext,
