@@ -16,6 +16,10 @@
 @group(0) @binding(1) var<uniform> look: LookUniform;
 @group(1) @binding(0) var<storage, read> prev: array<Particle>;
 @group(1) @binding(1) var<storage, read> cur: array<Particle>;
+// Back-to-front slot order (sort.wgsl), read only by the alpha-blended pipeline.
+@group(1) @binding(2) var<storage, read> order: array<u32>;
+
+override SORTED: bool = false;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -24,8 +28,12 @@ struct VsOut {
 }
 
 @vertex
-fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) slot: u32) -> VsOut {
+fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) instance: u32) -> VsOut {
     var out: VsOut;
+    var slot = instance;
+    if SORTED {
+        slot = order[instance];
+    }
     let d = drawn(cur[slot], prev[slot]);
     if !d.alive {
         out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);

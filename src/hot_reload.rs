@@ -152,6 +152,7 @@ impl ShaderReloader {
                 "update.wgsl" | "count.wgsl" => sim.reload_shaders(lib.clone(), effect),
                 "billboard.wgsl" => renderer.billboard.rebuild(ctx, lib),
                 "splat.wgsl" => renderer.splat.rebuild(ctx, lib),
+                "sort.wgsl" => renderer.sort.rebuild(ctx, lib),
                 "tonemap.wgsl" => renderer.tonemap.rebuild(ctx, lib),
                 _ => Ok(()),
             };

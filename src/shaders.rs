@@ -26,6 +26,7 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ("look.wgsl", include_str!("../shaders/look.wgsl")),
     ("billboard.wgsl", include_str!("../shaders/billboard.wgsl")),
     ("splat.wgsl", include_str!("../shaders/splat.wgsl")),
+    ("sort.wgsl", include_str!("../shaders/sort.wgsl")),
     ("tonemap.wgsl", include_str!("../shaders/tonemap.wgsl")),
 ];
 
@@ -35,6 +36,7 @@ pub const ENTRY_FILES: &[&str] = &[
     "count.wgsl",
     "billboard.wgsl",
     "splat.wgsl",
+    "sort.wgsl",
     "tonemap.wgsl",
 ];
 

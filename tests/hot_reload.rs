@@ -277,7 +277,13 @@ fn only_dependent_pipelines_rebuild() {
     all.sort();
     assert_eq!(
         all,
-        vec!["billboard.wgsl", "count.wgsl", "splat.wgsl", "update.wgsl"]
+        vec![
+            "billboard.wgsl",
+            "count.wgsl",
+            "sort.wgsl",
+            "splat.wgsl",
+            "update.wgsl"
+        ]
     );
 }
 

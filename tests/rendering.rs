@@ -293,3 +293,49 @@ fn stateless_emitter_renders_like_the_stateful_one() {
         / a.as_raw().len() as f64;
     assert!(diff < 1.0, "mean pixel difference {diff}");
 }
+
+/// The GPU bitonic sort equals a CPU sort of the same keys: random keys, sizes that are
+/// not powers of two, many equal keys, and the extremes.
+#[test]
+fn gpu_sort_equals_cpu_sort() {
+    let ctx = gpu();
+    let mut sort =
+        ignis::render::sort::SortPass::new(&ctx, &ShaderLibrary::embedded()).expect("sort");
+    let mut state = 0x9E37_79B9u32;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        state
+    };
+    for (n, modulo) in [
+        (1usize, 0u32),
+        (2, 0),
+        (3, 0),
+        (1000, 0),
+        (1023, 7),
+        (4096, 0),
+        (5000, 3),
+        (77_777, 1000),
+    ] {
+        let keys: Vec<u32> = (0..n)
+            .map(|_| if modulo > 0 { next() % modulo } else { next() })
+            .collect();
+        let (gpu_keys, gpu_idx) = sort.sort_keys(&ctx, &keys).expect("sort");
+        let mut cpu = keys.clone();
+        cpu.sort_unstable();
+        assert_eq!(gpu_keys, cpu, "n = {n}");
+        // The indices are a permutation that carries each key with it.
+        let mut seen = vec![false; n];
+        for (k, i) in gpu_keys.iter().zip(&gpu_idx) {
+            assert_eq!(keys[*i as usize], *k);
+            assert!(!seen[*i as usize], "index {i} twice");
+            seen[*i as usize] = true;
+        }
+    }
+    let extremes = vec![u32::MAX, 0, u32::MAX - 1, 1, 0];
+    assert_eq!(
+        sort.sort_keys(&ctx, &extremes).expect("sort").0,
+        vec![0, 0, 1, u32::MAX - 1, u32::MAX]
+    );
+}

@@ -222,9 +222,10 @@ fn measure_row(
     let camera = OrbitCamera::from_hint(&effect.camera);
     let size = opts.size;
     renderer.targets(ctx, size);
-    let items = renderer
-        .frame
-        .prepare(ctx, &sim, &effect, &camera, size, 1.0);
+    let items = {
+        let Renderer { frame, sort, .. } = &mut renderer;
+        frame.prepare(ctx, &sim, &effect, &camera, size, 1.0, sort)
+    };
     let auto_splat = items.iter().all(|d| d.splat);
     let all_billboard: Vec<_> = items
         .iter()

@@ -42,6 +42,8 @@ impl BillboardPass {
     ) -> Result<(wgpu::RenderPipeline, wgpu::RenderPipeline), ShaderError> {
         let composed = lib.compose("billboard.wgsl")?;
         let make = |module: &wgpu::ShaderModule, blend: wgpu::BlendState, label| {
+            // The alpha pipeline draws through the back-to-front order.
+            let sorted = blend != ADDITIVE;
             crate::render::simple_pipeline(
                 ctx,
                 label,
@@ -49,7 +51,7 @@ impl BillboardPass {
                 module,
                 ("vs_main", "fs_main"),
                 crate::render::hdr_target(blend),
-                &[],
+                &[("SORTED", if sorted { 1.0 } else { 0.0 })],
             )
         };
         create_checked(&ctx.device, &composed, lib, |module| {

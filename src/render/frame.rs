@@ -16,7 +16,7 @@ pub struct DrawItem {
     /// Emitter index (the look uniform's slot).
     pub index: usize,
     /// Key of the cached particle bind group.
-    pub key: (u64, usize),
+    pub key: (u64, usize, bool),
     /// Slots (instances / invocations).
     pub capacity: u32,
     /// Blend mode.
@@ -36,7 +36,9 @@ pub struct FrameResources {
     look_slots: usize,
     /// The group-0 bind group.
     pub frame_group: wgpu::BindGroup,
-    particle_groups: HashMap<(u64, usize), wgpu::BindGroup>,
+    particle_groups: HashMap<(u64, usize, bool), wgpu::BindGroup>,
+    /// Bound as the draw order of emitters that are not sorted.
+    no_order: wgpu::Buffer,
 }
 
 /// ∫ sprite coverage over the unit quad [-1, 1]² (keep in sync with `sprite_coverage`
@@ -126,7 +128,7 @@ impl FrameResources {
         });
         let particle_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("FrameResources::particle_layout"),
-            entries: &[storage(0), storage(1)],
+            entries: &[storage(0), storage(1), storage(2)],
         });
         let camera = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some("FrameResources::camera"),
@@ -143,6 +145,12 @@ impl FrameResources {
             look_slots: 4,
             frame_group,
             particle_groups: HashMap::new(),
+            no_order: d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("FrameResources::no_order"),
+                size: 16,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            }),
         }
     }
 
@@ -185,11 +193,12 @@ impl FrameResources {
     }
 
     /// The particle bind group for a draw item.
-    pub fn particle_group(&self, key: (u64, usize)) -> Option<&wgpu::BindGroup> {
+    pub fn particle_group(&self, key: (u64, usize, bool)) -> Option<&wgpu::BindGroup> {
         self.particle_groups.get(&key)
     }
 
     /// Uploads this frame's uniforms and returns what to draw, with each emitter's path.
+    #[allow(clippy::too_many_arguments)]
     pub fn prepare(
         &mut self,
         ctx: &GpuContext,
@@ -198,6 +207,7 @@ impl FrameResources {
         camera: &OrbitCamera,
         size: (u32, u32),
         alpha: f32,
+        sort: &mut crate::render::sort::SortPass,
     ) -> Vec<DrawItem> {
         let aspect = size.0 as f32 / size.1.max(1) as f32;
         let cam = camera.uniform(size, alpha);
@@ -240,7 +250,14 @@ impl FrameResources {
             if !e.enabled {
                 continue;
             }
-            let key = (b.generation, b.parity);
+            // Alpha-blended emitters are drawn back to front through the sort's order.
+            let sorted = e.look.blend == BlendMode::Alpha;
+            let order = if sorted {
+                &sort.buffers(ctx, b.generation, b.capacity).values
+            } else {
+                &self.no_order
+            };
+            let key = (b.generation, b.parity, sorted);
             self.particle_groups.entry(key).or_insert_with(|| {
                 ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("FrameResources::particle_group"),
@@ -253,6 +270,10 @@ impl FrameResources {
                         wgpu::BindGroupEntry {
                             binding: 1,
                             resource: b.current.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 2,
+                            resource: order.as_entire_binding(),
                         },
                     ],
                 })

@@ -3,6 +3,7 @@
 pub mod billboard;
 pub mod camera;
 pub mod frame;
+pub mod sort;
 pub mod splat;
 pub mod tonemap;
 
@@ -77,7 +78,7 @@ impl Targets {
 }
 
 /// A render pipeline without vertex buffers: `vs` and `fs` of one module, one colour
-/// target, and the fragment stage's override constants.
+/// target, and override constants (given to both stages).
 pub fn simple_pipeline(
     ctx: &GpuContext,
     label: &str,
@@ -94,7 +95,10 @@ pub fn simple_pipeline(
             vertex: wgpu::VertexState {
                 module,
                 entry_point: Some(vs),
-                compilation_options: Default::default(),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants,
+                    zero_initialize_workgroup_memory: true,
+                },
                 buffers: &[],
             },
             primitive: wgpu::PrimitiveState::default(),
@@ -154,6 +158,8 @@ pub struct Renderer {
     pub billboard: BillboardPass,
     /// The compute splat pass.
     pub splat: SplatPass,
+    /// Back-to-front sorting of alpha-blended emitters.
+    pub sort: sort::SortPass,
     /// The tonemap pass.
     pub tonemap: TonemapPass,
     targets: Option<Targets>,
@@ -168,6 +174,7 @@ impl Renderer {
         Ok(Self {
             billboard: BillboardPass::new(ctx, lib, &frame)?,
             splat: SplatPass::new(ctx, lib, &frame)?,
+            sort: sort::SortPass::new(ctx, lib)?,
             frame,
             tonemap: TonemapPass::new(ctx, lib, LDR_FORMAT)?,
             targets: None,
@@ -183,6 +190,7 @@ impl Renderer {
     ) -> Result<(), ShaderError> {
         self.billboard.rebuild(ctx, lib)?;
         self.splat.rebuild(ctx, lib)?;
+        self.sort.rebuild(ctx, lib)?;
         self.tonemap.rebuild(ctx, lib)?;
         Ok(())
     }
@@ -218,7 +226,26 @@ impl Renderer {
         let Some(targets) = self.targets.as_ref() else {
             return;
         };
-        let items = self.frame.prepare(ctx, sim, effect, camera, size, alpha);
+        let items = self
+            .frame
+            .prepare(ctx, sim, effect, camera, size, alpha, &mut self.sort);
+        // Sort the alpha-blended emitters back to front (nothing runs when there is none).
+        for d in items.iter().filter(|d| d.key.2) {
+            if let Some(b) = sim.emitter_buffers(d.index) {
+                let origin = sim
+                    .planner
+                    .emitters
+                    .get(d.index)
+                    .map(|p| p.origin())
+                    .unwrap_or_default();
+                let eye = (camera.eye().as_dvec3() - origin).as_vec3();
+                let forward = (camera.target - camera.eye()).normalize_or(glam::Vec3::NEG_Z);
+                self.sort
+                    .record(ctx, enc, b.generation, b.current, b.capacity, eye, forward);
+            }
+        }
+        let live: std::collections::HashSet<u64> = items.iter().map(|d| d.key.0).collect();
+        self.sort.retain(&live);
         let splatted = self.splat.splat(ctx, enc, &self.frame, &items, size);
         {
             let mut pass = begin_hdr_pass(enc, &targets.hdr_view);

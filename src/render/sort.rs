@@ -1,0 +1,380 @@
+//! Back-to-front ordering of alpha-blended emitters on the GPU: depth keys, then a
+//! bitonic sort of (key, slot) pairs. The billboard pass draws alpha emitters through the
+//! sorted slot order; nothing is sorted when no emitter blends with alpha.
+
+use std::collections::HashMap;
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::gpu::GpuContext;
+use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
+use crate::sim::gpu_sim::{dispatch_size, map_read};
+
+/// Keep in sync with `SortStep` in `shaders/sort.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct SortStep {
+    /// Bitonic stage size.
+    pub k: u32,
+    /// Compare distance.
+    pub j: u32,
+    /// Power-of-two element count.
+    pub count: u32,
+    /// Slots that hold particles.
+    pub capacity: u32,
+    /// Camera position in the emitter's simulation space.
+    pub eye: [f32; 4],
+    /// Camera forward axis.
+    pub forward: [f32; 4],
+}
+
+const STRIDE: u64 = 256;
+
+/// The (k, j) stages of a bitonic sort of `n` (a power of two) elements.
+pub fn bitonic_stages(n: u32) -> Vec<(u32, u32)> {
+    let mut v = Vec::new();
+    let mut k = 2;
+    while k <= n {
+        let mut j = k / 2;
+        while j > 0 {
+            v.push((k, j));
+            j /= 2;
+        }
+        k *= 2;
+    }
+    v
+}
+
+/// Sort buffers of one emitter.
+pub struct SortBuffers {
+    count: u32,
+    capacity: u32,
+    /// Sorted slot indices (farthest first), bound by the billboard pass.
+    pub values: wgpu::Buffer,
+    steps: wgpu::Buffer,
+    group: wgpu::BindGroup,
+}
+
+/// The depth-key and bitonic pipelines, and per-emitter sort buffers.
+pub struct SortPass {
+    layout: wgpu::BindGroupLayout,
+    state_layout: wgpu::BindGroupLayout,
+    pipeline_layout: wgpu::PipelineLayout,
+    keys: wgpu::ComputePipeline,
+    bitonic: wgpu::ComputePipeline,
+    buffers: HashMap<u64, SortBuffers>,
+}
+
+impl SortPass {
+    /// Builds the pipelines from `lib`.
+    pub fn new(ctx: &GpuContext, lib: &ShaderLibrary) -> Result<Self, ShaderError> {
+        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty,
+            count: None,
+        };
+        let storage = |read_only| wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        };
+        let layout = ctx
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("SortPass::layout"),
+                entries: &[
+                    entry(
+                        0,
+                        wgpu::BindingType::Buffer {
+                            ty: wgpu::BufferBindingType::Uniform,
+                            has_dynamic_offset: true,
+                            min_binding_size: wgpu::BufferSize::new(size_of::<SortStep>() as u64),
+                        },
+                    ),
+                    entry(1, storage(false)),
+                    entry(2, storage(false)),
+                ],
+            });
+        let state_layout = ctx
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("SortPass::state_layout"),
+                entries: &[entry(0, storage(true))],
+            });
+        let pipeline_layout = ctx
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("SortPass::pipeline_layout"),
+                bind_group_layouts: &[Some(&layout), Some(&state_layout)],
+                immediate_size: 0,
+            });
+        let (keys, bitonic) = Self::build(ctx, lib, &pipeline_layout)?;
+        Ok(Self {
+            layout,
+            state_layout,
+            pipeline_layout,
+            keys,
+            bitonic,
+            buffers: HashMap::new(),
+        })
+    }
+
+    fn build(
+        ctx: &GpuContext,
+        lib: &ShaderLibrary,
+        layout: &wgpu::PipelineLayout,
+    ) -> Result<(wgpu::ComputePipeline, wgpu::ComputePipeline), ShaderError> {
+        let composed = lib.compose("sort.wgsl")?;
+        create_checked(&ctx.device, &composed, lib, |module| {
+            let make = |entry: &str| {
+                ctx.device
+                    .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                        label: Some(entry),
+                        layout: Some(layout),
+                        module,
+                        entry_point: Some(entry),
+                        compilation_options: Default::default(),
+                        cache: None,
+                    })
+            };
+            (make("depth_keys"), make("bitonic"))
+        })
+    }
+
+    /// Rebuilds the pipelines; keeps the old ones on error.
+    pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
+        let (keys, bitonic) = Self::build(ctx, lib, &self.pipeline_layout)?;
+        self.keys = keys;
+        self.bitonic = bitonic;
+        Ok(())
+    }
+
+    /// The sort buffers for a pool (`generation` identifies it), created on first use.
+    pub fn buffers(&mut self, ctx: &GpuContext, generation: u64, capacity: u32) -> &SortBuffers {
+        let stale = self
+            .buffers
+            .get(&generation)
+            .is_none_or(|b| b.capacity != capacity);
+        if stale {
+            let b = self.create(ctx, capacity);
+            self.buffers.insert(generation, b);
+        }
+        &self.buffers[&generation]
+    }
+
+    /// Forgets the buffers of pools that no longer exist.
+    pub fn retain(&mut self, live: &std::collections::HashSet<u64>) {
+        self.buffers.retain(|g, _| live.contains(g));
+    }
+
+    fn create(&self, ctx: &GpuContext, capacity: u32) -> SortBuffers {
+        let count = capacity.max(2).next_power_of_two();
+        let stages = bitonic_stages(count);
+        let make = |label| {
+            ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: count as u64 * 4,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let keys = make("SortPass::keys");
+        let values = make("SortPass::values");
+        let steps = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("SortPass::steps"),
+            size: (stages.len() as u64 + 1) * STRIDE,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut blocks = vec![0u8; (stages.len() + 1) * STRIDE as usize];
+        for (i, (k, j)) in stages.iter().enumerate() {
+            let s = SortStep {
+                k: *k,
+                j: *j,
+                count,
+                capacity,
+                ..Default::default()
+            };
+            let at = (i + 1) * STRIDE as usize;
+            blocks[at..at + size_of::<SortStep>()].copy_from_slice(bytemuck::bytes_of(&s));
+        }
+        ctx.queue.write_buffer(&steps, 0, &blocks);
+        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("SortPass::group"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &steps,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(size_of::<SortStep>() as u64),
+                    }),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: keys.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: values.as_entire_binding(),
+                },
+            ],
+        });
+        // `keys` lives on through the bind group.
+        drop(keys);
+        SortBuffers {
+            count,
+            capacity,
+            values,
+            steps,
+            group,
+        }
+    }
+
+    fn record_stages(&self, pass: &mut wgpu::ComputePass<'_>, b: &SortBuffers) {
+        pass.set_pipeline(&self.bitonic);
+        let (x, y) = dispatch_size(b.count);
+        for i in 0..bitonic_stages(b.count).len() {
+            pass.set_bind_group(0, &b.group, &[((i as u64 + 1) * STRIDE) as u32]);
+            pass.dispatch_workgroups(x, y, 1);
+        }
+    }
+
+    /// Records depth keys for `state` seen from `eye` along `forward` (simulation space)
+    /// and the sort; afterwards `values` holds slots farthest first.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &mut self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        generation: u64,
+        state: &wgpu::Buffer,
+        capacity: u32,
+        eye: glam::Vec3,
+        forward: glam::Vec3,
+    ) {
+        self.buffers(ctx, generation, capacity);
+        let Some(b) = self.buffers.get(&generation) else {
+            return;
+        };
+        let head = SortStep {
+            k: 0,
+            j: 0,
+            count: b.count,
+            capacity,
+            eye: eye.extend(0.0).to_array(),
+            forward: forward.extend(0.0).to_array(),
+        };
+        ctx.queue
+            .write_buffer(&b.steps, 0, bytemuck::bytes_of(&head));
+        let state_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("SortPass::state_group"),
+            layout: &self.state_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: state.as_entire_binding(),
+            }],
+        });
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("SortPass::sort"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.keys);
+        pass.set_bind_group(0, &b.group, &[0]);
+        pass.set_bind_group(1, &state_group, &[]);
+        let (x, y) = dispatch_size(b.count);
+        pass.dispatch_workgroups(x, y, 1);
+        self.record_stages(&mut pass, b);
+    }
+
+    /// Sorts arbitrary keys on the GPU (tests): returns (sorted keys, their original
+    /// indices). Sizes need not be powers of two: padding keys are 0xFFFFFFFF.
+    pub fn sort_keys(
+        &mut self,
+        ctx: &GpuContext,
+        keys: &[u32],
+    ) -> Result<(Vec<u32>, Vec<u32>), crate::sim::SimError> {
+        let b = self.create(ctx, keys.len().max(1) as u32);
+        let mut padded = keys.to_vec();
+        padded.resize(b.count as usize, u32::MAX);
+        let iota: Vec<u32> = (0..b.count).collect();
+        let keys_buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("SortPass::test_keys"),
+            size: b.count as u64 * 4,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        ctx.queue
+            .write_buffer(&keys_buffer, 0, bytemuck::cast_slice(&padded));
+        ctx.queue
+            .write_buffer(&b.values, 0, bytemuck::cast_slice(&iota));
+        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("SortPass::test_group"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &b.steps,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(size_of::<SortStep>() as u64),
+                    }),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: keys_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: b.values.as_entire_binding(),
+                },
+            ],
+        });
+        let test = SortBuffers { group, ..b };
+        // The pipeline layout has the particle group; the bitonic stages do not read it.
+        let dummy = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("SortPass::no_state"),
+            size: 32,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let state_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("SortPass::no_state_group"),
+            layout: &self.state_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: dummy.as_entire_binding(),
+            }],
+        });
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_bind_group(1, &state_group, &[]);
+            self.record_stages(&mut pass, &test);
+        }
+        ctx.queue.submit([enc.finish()]);
+        let read = |buffer: &wgpu::Buffer| -> Result<Vec<u32>, crate::sim::SimError> {
+            let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("SortPass::readback"),
+                size: test.count as u64 * 4,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let mut enc = ctx.device.create_command_encoder(&Default::default());
+            enc.copy_buffer_to_buffer(buffer, 0, &staging, 0, test.count as u64 * 4);
+            ctx.queue.submit([enc.finish()]);
+            Ok(bytemuck::pod_collect_to_vec(&map_read(ctx, &staging)?))
+        };
+        let mut k = read(&keys_buffer)?;
+        let mut v = read(&test.values)?;
+        k.truncate(keys.len());
+        v.truncate(keys.len());
+        Ok((k, v))
+    }
+}
