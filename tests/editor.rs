@@ -785,3 +785,79 @@ fn the_time_section_shows_the_measured_accuracy_of_the_integrator() {
         2
     );
 }
+
+/// The preset workflow: a dirty marker after an edit, Revert back to the saved effect,
+/// Save-as name validation, a confirm before a load discards edits, and an external edit
+/// of the loaded preset re-applied (or held for confirmation while there are edits).
+#[test]
+fn preset_workflow_dirty_revert_confirm_and_external_reload() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("fire.ron");
+    let mut state = campfire_state();
+    assert!(!state.is_dirty());
+
+    // Save-as validation.
+    state.preset_path = dir.path().join("bad name!.ron").display().to_string();
+    state.save_preset();
+    assert!(matches!(&state.preset_message, Some(Err(m)) if m.contains("letters, digits")));
+    state.preset_path = dir.path().join("fire.txt").display().to_string();
+    state.save_preset();
+    assert!(matches!(&state.preset_message, Some(Err(m)) if m.contains(".ron")));
+
+    // Edit → dirty → save → clean.
+    state.effect.seed = 77;
+    assert!(state.is_dirty());
+    state.preset_path = path.display().to_string();
+    state.save_preset();
+    assert!(
+        matches!(&state.preset_message, Some(Ok(_))),
+        "{:?}",
+        state.preset_message
+    );
+    assert!(!state.is_dirty());
+    assert_eq!(state.loaded_path.as_deref(), Some(path.as_path()));
+
+    // Edit → revert.
+    state.effect.seed = 78;
+    state.revert();
+    assert_eq!(state.effect.seed, 77);
+    assert!(!state.is_dirty());
+
+    // A load with unsaved edits asks first; "keep editing" keeps them.
+    state.effect.seed = 79;
+    state.request_load();
+    assert_eq!(
+        state.pending,
+        Some(ignis::editor::state::PendingAction::Load)
+    );
+    assert_eq!(state.effect.seed, 79);
+    state.pending = None;
+
+    // External edit while clean: re-applied at once.
+    state.revert();
+    let mut on_disk = state.effect.clone();
+    on_disk.seed = 1234;
+    ignis::preset::save(&on_disk, &path).expect("external save");
+    state.preset_changed_on_disk();
+    assert_eq!(state.effect.seed, 1234);
+    assert!(!state.is_dirty());
+
+    // External edit while dirty: held until confirmed.
+    state.effect.seed = 5;
+    on_disk.seed = 4321;
+    ignis::preset::save(&on_disk, &path).expect("external save");
+    state.preset_changed_on_disk();
+    assert_eq!(
+        state.pending,
+        Some(ignis::editor::state::PendingAction::ExternalReload)
+    );
+    assert_eq!(state.effect.seed, 5);
+    state.confirm_pending();
+    assert_eq!(state.effect.seed, 4321);
+
+    // A broken external edit loses nothing: an error, the effect stays.
+    std::fs::write(&path, "(version: 1, emitters: [").expect("write");
+    state.preset_changed_on_disk();
+    assert_eq!(state.effect.seed, 4321);
+    assert!(matches!(&state.preset_message, Some(Err(m)) if m.contains("fire.ron")));
+}

@@ -136,12 +136,14 @@ pub fn run(options: EditOptions) -> anyhow::Result<Option<RunReport>> {
             let mut state = EditorState::new(effect, source);
             if let Some(path) = &options.preset {
                 state.preset_path = path.display().to_string();
+                state.loaded_path = Some(path.clone());
             }
             state
         },
         options,
         instance,
         gfx: None,
+        preset_watch: None,
         fatal: None,
         report: None,
     };
@@ -160,6 +162,8 @@ struct App {
     state: EditorState,
     camera: OrbitCamera,
     gfx: Option<Gfx>,
+    /// Watches the loaded preset's folder: an external edit re-applies the preset.
+    preset_watch: Option<(std::path::PathBuf, FileWatcher)>,
     fatal: Option<anyhow::Error>,
     report: Option<RunReport>,
 }
@@ -644,8 +648,44 @@ impl Gfx {
 }
 
 impl App {
+    /// Re-applies the loaded preset when another program changed it (asking first when
+    /// the panel has unsaved edits). Our own saves are recognised and ignored.
+    fn reload_changed_preset(&mut self) {
+        let Some(path) = self.state.loaded_path.clone() else {
+            return;
+        };
+        let dir = path
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .map_or_else(|| std::path::PathBuf::from("."), |d| d.to_path_buf());
+        if self.preset_watch.as_ref().is_none_or(|(d, _)| *d != dir) {
+            self.preset_watch = match FileWatcher::new(&[dir.as_path()]) {
+                Ok(w) => Some((dir, w)),
+                Err(e) => {
+                    log::warn!("not watching {} for preset edits: {e}", dir.display());
+                    None
+                }
+            };
+        }
+        let Some((_, watcher)) = &self.preset_watch else {
+            return;
+        };
+        let changed = watcher.poll();
+        if !changed.iter().any(|p| p.file_name() == path.file_name()) {
+            return;
+        }
+        match crate::preset::load(&path) {
+            Ok(effect) if effect == self.state.saved => {}
+            _ => {
+                log::info!("{} changed on disk", path.display());
+                self.state.preset_changed_on_disk();
+            }
+        }
+    }
+
     /// One frame. Returns true when the editor should exit (`--frames` done).
     fn frame(&mut self) -> anyhow::Result<bool> {
+        self.reload_changed_preset();
         let Some(gfx) = self.gfx.as_mut() else {
             return Ok(false);
         };

@@ -91,6 +91,10 @@ pub fn header_ui(ui: &mut Ui, state: &mut EditorState) {
         );
         ui.label(RichText::new(&state.effect.name).strong());
         ui.weak(&state.source);
+        if state.is_dirty() {
+            ui.colored_label(Color32::from_rgb(255, 190, 90), "● unsaved")
+                .on_hover_text("The effect differs from the last loaded or saved preset");
+        }
     });
     ui.horizontal(|ui| {
         let undo = ui
@@ -129,12 +133,45 @@ pub fn header_ui(ui: &mut Ui, state: &mut EditorState) {
         }
         if ui
             .button("Load")
-            .on_hover_text("Replace the effect with this preset (undoable)")
+            .on_hover_text("Replace the effect with this preset (undoable; asks first when there are unsaved edits)")
             .clicked()
         {
-            state.load_preset();
+            state.request_load();
         }
     });
+    ui.horizontal(|ui| {
+        if ui
+            .add_enabled(state.is_dirty(), egui::Button::new("Revert"))
+            .on_hover_text("Back to the last loaded or saved preset (undoable)")
+            .clicked()
+        {
+            state.revert();
+        }
+        ui.weak("Save writes the path above: edit it to save as a new preset");
+    });
+    if let Some(pending) = state.pending.clone() {
+        error_box_ui(ui, |ui| {
+            ui.label(
+                RichText::new(match pending {
+                    super::state::PendingAction::Load => {
+                        "Discard the unsaved edits and load the preset?"
+                    }
+                    super::state::PendingAction::ExternalReload => {
+                        "The preset changed on disk. Reload it and discard the unsaved edits?"
+                    }
+                })
+                .strong(),
+            );
+            ui.horizontal(|ui| {
+                if ui.button("Discard edits").clicked() {
+                    state.confirm_pending();
+                }
+                if ui.button("Keep editing").clicked() {
+                    state.pending = None;
+                }
+            });
+        });
+    }
     preset_library_ui(ui, state);
     match &state.preset_message {
         Some(Ok(msg)) => {
@@ -215,7 +252,7 @@ fn preset_library_ui(ui: &mut Ui, state: &mut EditorState) {
     });
     if let Some(file) = chosen {
         state.preset_path = file.display().to_string();
-        state.load_preset();
+        state.request_load();
     }
 }
 

@@ -76,6 +76,21 @@ pub struct EditorState {
     pub preset_path: String,
     /// The outcome of the last save or load: `Ok(message)` or `Err(message)`.
     pub preset_message: Option<Result<String, String>>,
+    /// The effect as last loaded or saved: the edited effect differs from it ⇒ unsaved.
+    pub saved: Effect,
+    /// The file the effect was loaded from or saved to (watched for external edits).
+    pub loaded_path: Option<std::path::PathBuf>,
+    /// An action that would discard unsaved edits, waiting for the user's confirmation.
+    pub pending: Option<PendingAction>,
+}
+
+/// Actions that discard unsaved edits, so they ask first.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PendingAction {
+    /// Load the preset at `preset_path`.
+    Load,
+    /// The loaded preset changed on disk: re-apply it.
+    ExternalReload,
 }
 
 impl EditorState {
@@ -84,6 +99,7 @@ impl EditorState {
     pub fn new(effect: Effect, source: impl Into<String>) -> Self {
         let validation_errors = effect.validate().err().unwrap_or_default();
         let effect_name = effect.name.clone();
+        let effect_for_saved = effect.clone();
         Self {
             running: effect.clone(),
             history: UndoHistory::new(&effect),
@@ -99,15 +115,74 @@ impl EditorState {
             frame_requested: false,
             preset_path: format!("presets/my_{}.ron", file_stem(&effect_name)),
             preset_message: None,
+            saved: effect_for_saved,
+            loaded_path: None,
+            pending: None,
             source: source.into(),
+        }
+    }
+
+    /// True when the edited effect differs from the last loaded or saved one.
+    pub fn is_dirty(&self) -> bool {
+        self.effect != self.saved
+    }
+
+    /// Load requested from the UI: asks first when there are unsaved edits.
+    pub fn request_load(&mut self) {
+        if self.is_dirty() {
+            self.pending = Some(PendingAction::Load);
+        } else {
+            self.load_preset();
+        }
+    }
+
+    /// Back to the last loaded or saved effect (one undo step).
+    pub fn revert(&mut self) {
+        self.history.observe(&self.effect, false);
+        self.effect = self.saved.clone();
+        self.history.observe(&self.effect, false);
+        self.clamp_selection();
+    }
+
+    /// The loaded preset file changed on disk (an external editor saved it): re-apply it,
+    /// or ask first when the panel has unsaved edits.
+    pub fn preset_changed_on_disk(&mut self) {
+        if self.is_dirty() {
+            self.pending = Some(PendingAction::ExternalReload);
+        } else {
+            self.reload_from_disk();
+        }
+    }
+
+    /// Carries out the pending action (the user confirmed discarding the edits).
+    pub fn confirm_pending(&mut self) {
+        match self.pending.take() {
+            Some(PendingAction::Load) => self.load_preset(),
+            Some(PendingAction::ExternalReload) => self.reload_from_disk(),
+            None => {}
+        }
+    }
+
+    fn reload_from_disk(&mut self) {
+        if let Some(path) = &self.loaded_path {
+            self.preset_path = path.display().to_string();
+            self.load_preset();
         }
     }
 
     /// Saves the edited effect to `preset_path` (atomically; only a valid effect).
     pub fn save_preset(&mut self) {
         let path = std::path::PathBuf::from(self.preset_path.trim());
+        if let Err(why) = check_preset_name(&path) {
+            self.preset_message = Some(Err(format!("{}: {why}", path.display())));
+            return;
+        }
         self.preset_message = Some(match crate::preset::save(&self.effect, &path) {
-            Ok(()) => Ok(format!("saved {}", path.display())),
+            Ok(()) => {
+                self.saved = self.effect.clone();
+                self.loaded_path = Some(path.clone());
+                Ok(format!("saved {}", path.display()))
+            }
             Err(err) => Err(err.to_string()),
         });
     }
@@ -119,6 +194,9 @@ impl EditorState {
         self.preset_message = Some(match crate::preset::load(&path) {
             Ok(effect) => {
                 self.history.observe(&self.effect, false);
+                self.saved = effect.clone();
+                self.loaded_path = Some(path.clone());
+                self.pending = None;
                 self.effect = effect;
                 self.history.observe(&self.effect, false);
                 self.source = path.display().to_string();
@@ -259,4 +337,25 @@ fn file_stem(name: &str) -> String {
     } else {
         stem
     }
+}
+
+/// "Save as" names: a `.ron` file whose stem is letters, digits, `_` or `-`.
+pub fn check_preset_name(path: &std::path::Path) -> Result<(), String> {
+    if path.extension().is_none_or(|x| x != "ron") {
+        return Err("a preset file name must end in .ron".into());
+    }
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    if stem.is_empty()
+        || !stem
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+    {
+        return Err(format!(
+            "the name \"{stem}\" may use only letters, digits, _ and -"
+        ));
+    }
+    Ok(())
 }
