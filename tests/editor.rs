@@ -732,6 +732,10 @@ fn presets_are_saved_and_loaded_from_the_header() {
     let undo_before = harness.state().history.undo_len();
     harness.get_by_label("Load").click_accesskit();
     harness.run();
+    // Unsaved edits: the load asks first.
+    assert_eq!(harness.state().effect.emitters[0].spawn_rate_per_sec, 7.0);
+    harness.get_by_label("Discard edits").click_accesskit();
+    harness.run();
     assert_eq!(harness.state().effect.emitters[0].spawn_rate_per_sec, 321.0);
     assert_eq!(
         harness.state().running.emitters[0].spawn_rate_per_sec,

@@ -92,7 +92,7 @@ pub fn header_ui(ui: &mut Ui, state: &mut EditorState) {
         ui.label(RichText::new(&state.effect.name).strong());
         ui.weak(&state.source);
         if state.is_dirty() {
-            ui.colored_label(Color32::from_rgb(255, 190, 90), "● unsaved")
+            ui.colored_label(Color32::from_rgb(255, 190, 90), "* unsaved")
                 .on_hover_text("The effect differs from the last loaded or saved preset");
         }
     });
