@@ -370,6 +370,19 @@ fn hud_ui(painter: &egui::Painter, rect: Rect, state: &EditorState) {
         font,
         Color32::from_gray(200),
     );
+    // A red badge while a shader fails to build (the last good pipeline keeps running;
+    // the panel shows file:line:col and the caret).
+    if !state.shader_errors.is_empty() {
+        let badge = format!(
+            "SHADER ERROR ({}): last good pipeline running, see the panel",
+            state.shader_errors.len()
+        );
+        let at = rect.left_bottom() + egui::vec2(10.0, -28.0);
+        let galley = painter.layout_no_wrap(badge, egui::FontId::monospace(12.0), Color32::WHITE);
+        let bg = Rect::from_min_size(at, galley.size()).expand(5.0);
+        painter.rect_filled(bg, 4.0, Color32::from_rgb(190, 30, 30));
+        painter.galley(at, galley, Color32::WHITE);
+    }
 }
 
 /// A sphere around the bulk of `positions` for framing the camera: the centre of the
