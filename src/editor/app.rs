@@ -193,6 +193,10 @@ struct Gfx {
     cpu_log: Vec<f32>,
     viewport_px: (u32, u32),
     profiler: StageProfiler,
+    /// Per-pass GPU timestamps (None on CPU adapters: their timestamps are not trusted).
+    pass_timer: Option<crate::gpu::timer::PassTimer>,
+    /// Steps planned for this frame, recorded into the viewport encoder.
+    pending_steps: (u32, f32),
     /// Hot reload of `shaders/` (absent with the embedded shaders).
     shader_watch: Option<ShaderWatch>,
 }
@@ -305,6 +309,7 @@ impl Gfx {
         ))
         .map_err(|e| anyhow!("no GPU adapter can draw to this window: {e}"))?;
         let ctx = GpuContext::from_adapter(adapter)?;
+        let pass_timer = crate::gpu::timer::PassTimer::new(&ctx);
 
         let size = window.inner_size();
         let caps = surface.get_capabilities(&ctx.adapter);
@@ -379,6 +384,8 @@ impl Gfx {
             frame_log: Vec::new(),
             cpu_log: Vec::new(),
             viewport_px: (1, 1),
+            pass_timer,
+            pending_steps: (0, 0.0),
             profiler: StageProfiler::new(options.profile),
             shader_watch,
         })
@@ -487,10 +494,16 @@ impl Gfx {
             self.last_alpha = plan.alpha;
             (plan.steps, plan.dt_secs)
         };
-        if steps > 0 {
+        // Up to 32 steps are recorded into the frame's encoder (timed per pass when the
+        // adapter has timestamps); more go through their own submissions.
+        self.pending_steps = (0, dt_secs);
+        if steps > 32 {
             self.sim
                 .step(effect, dt_secs, steps)
                 .context("simulation step")?;
+        } else if steps > 0 {
+            self.sim.sync(effect).context("simulation step")?;
+            self.pending_steps = (steps, dt_secs);
         }
         let stats = &mut state.stats;
         stats.steps_last_frame = steps;
@@ -739,18 +752,63 @@ impl App {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("editor::viewport"),
             });
-        gfx.renderer.record(
-            &gfx.ctx,
-            &mut encoder,
-            &gfx.sim,
-            &gfx.gpu_effect,
-            &self.camera,
-            gfx.last_alpha,
-            gfx.viewport_px,
-        );
+        let timing = gfx.pass_timer.as_mut().is_some_and(|t| t.begin_frame());
+        let (steps, dt_secs) = gfx.pending_steps;
+        if steps > 0 {
+            let plans = gfx.sim.plan(&gfx.gpu_effect, dt_secs, steps as usize);
+            let Gfx {
+                sim,
+                gpu_effect,
+                pass_timer,
+                ..
+            } = &mut *gfx;
+            match pass_timer.as_mut().filter(|_| timing) {
+                Some(t) => t.scope(&mut encoder, "update", |enc| {
+                    sim.record(enc, gpu_effect, &plans)
+                }),
+                None => sim.record(&mut encoder, gpu_effect, &plans),
+            }
+        }
+        {
+            let Gfx {
+                renderer,
+                ctx,
+                sim,
+                gpu_effect,
+                pass_timer,
+                last_alpha,
+                viewport_px,
+                ..
+            } = &mut *gfx;
+            let mut draw = |enc: &mut wgpu::CommandEncoder| {
+                renderer.record(
+                    ctx,
+                    enc,
+                    sim,
+                    gpu_effect,
+                    &self.camera,
+                    *last_alpha,
+                    *viewport_px,
+                );
+            };
+            match pass_timer.as_mut().filter(|_| timing) {
+                Some(t) => t.scope(&mut encoder, "draw + composite", draw),
+                None => draw(&mut encoder),
+            }
+        }
+        if let Some(t) = gfx.pass_timer.as_mut().filter(|_| timing) {
+            t.end_frame(&mut encoder);
+        }
         let cpu_secs = cpu_start.elapsed().as_secs_f32();
         gfx.copy_viewport_image(&mut encoder);
         gfx.ctx.queue.submit([encoder.finish()]);
+        if let Some(t) = gfx.pass_timer.as_mut() {
+            if timing {
+                t.after_submit();
+            }
+            t.poll(&gfx.ctx);
+            self.state.stats.gpu_pass_ms = t.latest.clone();
+        }
 
         if self.state.frame_requested {
             self.state.frame_requested = false;

@@ -41,6 +41,9 @@ pub struct ShaderReloadStats {
 pub struct Stats {
     frame_secs: VecDeque<f32>,
     cpu_secs: VecDeque<f32>,
+    /// GPU time per pass from timestamp queries (empty on adapters without trustworthy
+    /// timestamps, e.g. software ones).
+    pub gpu_pass_ms: Vec<(&'static str, f64)>,
     /// Steps simulated in the last frame.
     pub steps_last_frame: u32,
     /// Step size of the last frame, seconds.
@@ -155,6 +158,13 @@ pub fn stats_ui(ui: &mut egui::Ui, stats: &Stats, effect: &Effect) {
             );
             ui.label(format!("{:.2} ms", stats.mean_cpu_secs() * 1e3));
             ui.end_row();
+            for (pass, ms) in &stats.gpu_pass_ms {
+                ui.label(format!("GPU {pass}")).on_hover_text(
+                    "GPU timestamp queries around the pass, read back a frame or two later",
+                );
+                ui.label(format!("{ms:.3} ms (timestamps)"));
+                ui.end_row();
+            }
             ui.label("Steps / frame");
             ui.label(format!(
                 "{} × {:.2} ms",
