@@ -17,6 +17,10 @@ struct Collided {
 }
 
 fn bounce(vel: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    if params.collide_c.x > 0.5 {
+        // Stick: stop at the contact.
+        return vec3<f32>(0.0);
+    }
     let elasticity = params.ground.y;
     let friction = params.ground.z;
     let vn = dot(vel, n);

@@ -66,6 +66,8 @@ struct SimParams {
     collide_b: vec4<f32>,
     // Sphere colliders: xyz centre (m), w radius (m).
     spheres: array<vec4<f32>, 4>,
+    // x: stick on contact (0/1): the particle stops where it touches, yzw: unused.
+    collide_c: vec4<f32>,
 }
 
 const SHAPE_POINT: u32 = 0u;

@@ -367,6 +367,10 @@ pub struct Collisions {
     pub rest_speed_m_per_s: f32,
     /// Kill particles that touch a sphere (smoke into a wall).
     pub kill_on_sphere_contact: bool,
+    /// Particles lose all velocity where they touch a collider (embers settling on the
+    /// ground). Forces still act afterwards: on the ground a stuck particle stays; on a
+    /// sphere's side, gravity can pull it off again.
+    pub stick_on_contact: bool,
 }
 
 /// A horizontal plane y = height.
@@ -452,6 +456,7 @@ impl Default for Collisions {
             friction: 0.2,
             rest_speed_m_per_s: 0.05,
             kill_on_sphere_contact: false,
+            stick_on_contact: false,
         }
     }
 }

@@ -463,3 +463,37 @@ fn stateless_matches_stateful_and_is_refused_when_ineligible() {
         "{err:?}"
     );
 }
+
+/// Stick on contact: a particle that reaches the ground (under gravity) or a sphere (no
+/// forces) stops where it touches and stays there.
+#[test]
+fn stick_on_contact_stops_particles_where_they_touch() {
+    let mut e = quiet(Integrator::SemiImplicitEuler);
+    e.collisions = Collisions {
+        ground: Some(GroundPlane {
+            height_m: 0.0,
+            kill_on_contact: false,
+        }),
+        spheres: vec![SphereCollider {
+            center_m: [2.0, 0.5, 0.0],
+            radius_m: 0.3,
+        }],
+        stick_on_contact: true,
+        ..Collisions::default()
+    };
+    let initial = [
+        particle(Vec3::new(0.0, 0.05, 0.0), Vec3::new(1.0, -2.0, 0.0)),
+        particle(Vec3::new(1.0, 0.5, 0.0), Vec3::new(10.0, 0.0, 0.0)),
+    ];
+    let out = run_from(&e, &initial, 1.0 / 60.0, 30);
+    let d = (out[1].position() - Vec3::new(2.0, 0.5, 0.0)).length();
+    assert!(
+        (d - 0.3).abs() < 1e-3 && out[1].velocity() == Vec3::ZERO,
+        "{:?} at {d}",
+        out[1]
+    );
+    e.forces.gravity_m_per_s2 = [0.0, -9.81, 0.0];
+    let out = run_from(&e, &initial, 1.0 / 60.0, 30);
+    assert_eq!(out[0].position().y, 0.0, "{:?}", out[0]);
+    assert_eq!(out[0].velocity(), Vec3::ZERO);
+}

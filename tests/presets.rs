@@ -1190,15 +1190,17 @@ fn collisions() -> BoxedStrategy<Collisions> {
         fl(0.0, 1.0),
         fl(0.0, 1e3),
         any::<bool>(),
+        any::<bool>(),
     )
         .prop_map(
-            |(ground, spheres, elasticity, friction, rest, kill)| Collisions {
+            |(ground, spheres, elasticity, friction, rest, kill, stick)| Collisions {
                 ground,
                 spheres,
                 elasticity,
                 friction,
                 rest_speed_m_per_s: rest,
                 kill_on_sphere_contact: kill,
+                stick_on_contact: stick,
             },
         )
         .boxed()

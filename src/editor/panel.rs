@@ -1096,6 +1096,8 @@ fn collisions_ui(ui: &mut Ui, col: &mut Collisions) {
         }
         ui.checkbox(&mut col.kill_on_sphere_contact, "kill on contact")
             .on_hover_text("Particles that touch a sphere die (smoke into a wall)");
+        ui.checkbox(&mut col.stick_on_contact, "stick")
+            .on_hover_text("Particles stop where they touch a collider and stay there");
     });
     if col.any() {
         grid("collision_grid").show(ui, |ui| {

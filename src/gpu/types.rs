@@ -97,6 +97,8 @@ pub struct SimParams {
     pub collide_b: [f32; 4],
     /// Sphere colliders: centre, radius.
     pub spheres: [[f32; 4]; 4],
+    /// x: stick on contact.
+    pub collide_c: [f32; 4],
 }
 
 /// Camera data for the billboard pass (keep in sync with `CameraUniform` in

@@ -398,6 +398,9 @@ pub fn curl_noise(p: DVec3, seed: u32, octaves: u32) -> DVec3 {
 /// `collide` in collide.wgsl: (position, velocity, killed).
 pub fn collide(params: &SimParams, old: Vec3, pos_in: Vec3, vel_in: Vec3) -> (Vec3, Vec3, bool) {
     let bounce = |vel: Vec3, n: Vec3| -> Vec3 {
+        if params.collide_c[0] > 0.5 {
+            return Vec3::ZERO;
+        }
         let vn = vel.dot(n);
         if vn >= 0.0 {
             return vel;

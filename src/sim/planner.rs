@@ -379,5 +379,6 @@ pub fn build_params(
             if ground.is_some() { 1.0 } else { 0.0 },
         ],
         spheres,
+        collide_c: [if col.stick_on_contact { 1.0 } else { 0.0 }, 0.0, 0.0, 0.0],
     }
 }
