@@ -865,3 +865,79 @@ fn preset_workflow_dirty_revert_confirm_and_external_reload() {
     assert_eq!(state.effect.seed, 4321);
     assert!(matches!(&state.preset_message, Some(Err(m)) if m.contains("fire.ron")));
 }
+
+/// The mouse collider: with the toggle on, hovering the viewport puts a sphere under the
+/// pointer (on the plane through the orbit target facing the camera); the simulated copy of
+/// the effect gets it, the edited effect does not; off, nothing.
+#[test]
+fn mouse_collider_follows_the_pointer() {
+    let mut harness = viewport_harness();
+    harness.hover_at(egui::pos2(400.0, 225.0));
+    harness.run();
+    assert_eq!(harness.state().editor.mouse_point, None, "off by default");
+    harness.state_mut().editor.view.mouse_collider = true;
+    harness.hover_at(egui::pos2(400.0, 225.0));
+    harness.run();
+    let centre = harness
+        .state()
+        .editor
+        .mouse_point
+        .expect("a point under the pointer");
+    // The viewport's centre looks at the orbit target.
+    assert!(
+        (centre - harness.state().camera.target).length() < 0.05,
+        "{centre}"
+    );
+    harness.hover_at(egui::pos2(600.0, 225.0));
+    harness.run();
+    let right = harness.state().editor.mouse_point.expect("point");
+    assert!(right.x > centre.x + 0.2, "{right} vs {centre}");
+    let state = &harness.state().editor;
+    let simulated = ignis::editor::state::with_mouse_collider(&state.effect, state.mouse_point);
+    for (e, s) in state.effect.emitters.iter().zip(&simulated.emitters) {
+        assert_eq!(s.collisions.spheres.len(), e.collisions.spheres.len() + 1);
+        assert_eq!(
+            s.collisions.spheres.last().expect("sphere").center_m,
+            right.to_array()
+        );
+    }
+    assert!(
+        state
+            .effect
+            .emitters
+            .iter()
+            .all(|e| e.collisions.spheres.is_empty())
+    );
+}
+
+/// Ctrl+drag in the viewport moves the selected emitter's sphere collider with the pointer
+/// (rightwards drag → +x for the default camera), and the camera does not orbit.
+#[test]
+fn ctrl_drag_moves_a_sphere_collider() {
+    let mut harness = viewport_harness();
+    let before_camera = harness.state().camera.clone();
+    {
+        let s = &mut harness.state_mut().editor;
+        let target = s.effect.camera.target_m;
+        s.effect.emitters[s.selected].collisions.spheres = vec![ignis::effect::SphereCollider {
+            center_m: target,
+            radius_m: 0.2,
+        }];
+    }
+    let start_x = harness.state().editor.effect.emitters[harness.state().editor.selected]
+        .collisions
+        .spheres[0]
+        .center_m[0];
+    drag(
+        &mut harness,
+        egui::PointerButton::Primary,
+        Modifiers::COMMAND,
+    );
+    let s = &harness.state().editor;
+    let moved = s.effect.emitters[s.selected].collisions.spheres[0].center_m;
+    assert!(
+        moved[0] > start_x + 0.1,
+        "collider did not follow the drag: {moved:?}"
+    );
+    assert_eq!(harness.state().camera, before_camera, "the camera orbited");
+}

@@ -180,6 +180,8 @@ struct Gfx {
     stepper: Stepper,
     /// The effect the GPU pools currently match.
     gpu_effect: Effect,
+    /// What is simulated and drawn this frame: `gpu_effect` plus the mouse collider.
+    frame_effect: Effect,
     egui_ctx: egui::Context,
     egui_state: egui_winit::State,
     ui_painter: UiPainter,
@@ -369,6 +371,7 @@ impl Gfx {
             config,
             surface_can_copy,
             gpu_effect: state.running.clone(),
+            frame_effect: state.running.clone(),
             ctx,
             sim,
             renderer,
@@ -477,7 +480,8 @@ impl Gfx {
             self.sim.restart();
             self.stepper.reset();
         }
-        let effect = &self.gpu_effect;
+        self.frame_effect = super::state::with_mouse_collider(&self.gpu_effect, state.mouse_point);
+        let effect = &self.frame_effect;
         let (steps, dt_secs) = if playback.step_requested {
             playback.step_requested = false;
             playback.is_paused = true;
@@ -755,18 +759,18 @@ impl App {
         let timing = gfx.pass_timer.as_mut().is_some_and(|t| t.begin_frame());
         let (steps, dt_secs) = gfx.pending_steps;
         if steps > 0 {
-            let plans = gfx.sim.plan(&gfx.gpu_effect, dt_secs, steps as usize);
+            let plans = gfx.sim.plan(&gfx.frame_effect, dt_secs, steps as usize);
             let Gfx {
                 sim,
-                gpu_effect,
+                frame_effect,
                 pass_timer,
                 ..
             } = &mut *gfx;
             match pass_timer.as_mut().filter(|_| timing) {
                 Some(t) => t.scope(&mut encoder, "update", |enc| {
-                    sim.record(enc, gpu_effect, &plans)
+                    sim.record(enc, frame_effect, &plans)
                 }),
-                None => sim.record(&mut encoder, gpu_effect, &plans),
+                None => sim.record(&mut encoder, frame_effect, &plans),
             }
         }
         {
@@ -774,7 +778,7 @@ impl App {
                 renderer,
                 ctx,
                 sim,
-                gpu_effect,
+                frame_effect,
                 pass_timer,
                 last_alpha,
                 viewport_px,
@@ -785,7 +789,7 @@ impl App {
                     ctx,
                     enc,
                     sim,
-                    gpu_effect,
+                    frame_effect,
                     &self.camera,
                     *last_alpha,
                     *viewport_px,

@@ -1339,6 +1339,12 @@ ui, "Ground grid", "Draw the y = 0 grid (0.5 m cells)", |ui| {
             ui.checkbox(&mut view.show_grid, "")
         });
         row_ui(
+            ui,
+            "Mouse collider",
+            "A sphere collider follows the pointer over the viewport: push the fire around",
+            |ui| ui.checkbox(&mut view.mouse_collider, ""),
+        );
+        row_ui(
 ui, "Shape gizmos", "Draw every emitter's spawn shape as a wireframe", |ui| {
             ui.checkbox(&mut view.show_gizmos, "")
         });

@@ -18,6 +18,8 @@ pub struct ViewSettings {
     pub show_gizmos: bool,
     /// Render the viewport at this fraction of its pixel size (upscaled when shown).
     pub render_scale: f32,
+    /// A sphere collider follows the pointer over the viewport: push the fire around.
+    pub mouse_collider: bool,
 }
 
 impl Default for ViewSettings {
@@ -27,6 +29,7 @@ impl Default for ViewSettings {
             show_grid: true,
             show_gizmos: true,
             render_scale: 1.0,
+            mouse_collider: false,
         }
     }
 }
@@ -70,6 +73,9 @@ pub struct EditorState {
     pub stats: Stats,
     /// Set by the viewport (double-click) or the F key: frame the camera on the effect.
     pub frame_requested: bool,
+    /// Where the mouse collider is (world metres), while it is on and the pointer is over
+    /// the viewport. Not part of the effect: it is added to the simulated copy each frame.
+    pub mouse_point: Option<glam::Vec3>,
     /// Where the effect was loaded from, for the title.
     pub source: String,
     /// The preset file Save writes and Load reads (edited in the header).
@@ -113,6 +119,7 @@ impl EditorState {
             view: ViewSettings::default(),
             stats: Stats::default(),
             frame_requested: false,
+            mouse_point: None,
             preset_path: format!("presets/my_{}.ron", file_stem(&effect_name)),
             preset_message: None,
             saved: effect_for_saved,
@@ -358,4 +365,24 @@ pub fn check_preset_name(path: &std::path::Path) -> Result<(), String> {
         ));
     }
     Ok(())
+}
+
+/// Radius of the mouse collider, metres.
+pub const MOUSE_COLLIDER_RADIUS_M: f32 = 0.25;
+
+/// `effect` with the mouse collider (a sphere at `point`) added to every enabled emitter
+/// that has room for one more sphere.
+pub fn with_mouse_collider(effect: &Effect, point: Option<glam::Vec3>) -> Effect {
+    let mut out = effect.clone();
+    if let Some(p) = point {
+        for e in out.emitters.iter_mut().filter(|e| e.enabled) {
+            if e.collisions.spheres.len() < crate::effect::MAX_SPHERES {
+                e.collisions.spheres.push(crate::effect::SphereCollider {
+                    center_m: p.to_array(),
+                    radius_m: MOUSE_COLLIDER_RADIUS_M,
+                });
+            }
+        }
+    }
+    out
 }

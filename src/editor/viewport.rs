@@ -56,6 +56,34 @@ pub fn viewport_ui(
             }
         }
     }
+    // The mouse collider: a sphere under the pointer, on the plane through the orbit
+    // target facing the camera.
+    state.mouse_point = None;
+    if state.view.mouse_collider
+        && let Some(pointer) = response.hover_pos()
+    {
+        let ndc = glam::Vec2::new(
+            (pointer.x - rect.left()) / rect.width().max(1.0) * 2.0 - 1.0,
+            1.0 - (pointer.y - rect.top()) / rect.height().max(1.0) * 2.0,
+        );
+        let inv = camera.clip_from_world(aspect).inverse();
+        let near = inv.project_point3(ndc.extend(0.0));
+        let far = inv.project_point3(ndc.extend(1.0));
+        let dir = (far - near).normalize_or_zero();
+        let normal = (camera.target - camera.eye()).normalize_or_zero();
+        let denom = dir.dot(normal);
+        if denom.abs() > 1e-6 {
+            let t = (camera.target - near).dot(normal) / denom;
+            let p = near + dir * t;
+            state.mouse_point = Some(p);
+            let (u, v) = basis(normal);
+            projector.polyline(
+                &painter,
+                &circle(p, u, v, super::state::MOUSE_COLLIDER_RADIUS_M),
+                egui::Stroke::new(1.5, Color32::from_rgb(255, 120, 80)),
+            );
+        }
+    }
     hud_ui(&painter, rect, state);
 
     let ppp = ui.ctx().pixels_per_point();
@@ -72,8 +100,16 @@ fn camera_input(
     camera: &mut OrbitCamera,
     state: &mut EditorState,
 ) {
-    let shift = ui.input(|i| i.modifiers.shift);
+    let (shift, ctrl) = ui.input(|i| (i.modifiers.shift, i.modifiers.command));
     let delta = response.drag_delta();
+    // Ctrl+drag moves the selected emitter's sphere collider nearest the pointer, in the
+    // plane facing the camera (one drag is one undo step).
+    if ctrl && response.dragged_by(egui::PointerButton::Primary) {
+        if let Some(pointer) = response.interact_pointer_pos() {
+            drag_collider(camera, rect, state, pointer, delta);
+        }
+        return;
+    }
     let is_pan = response.dragged_by(egui::PointerButton::Middle)
         || response.dragged_by(egui::PointerButton::Secondary)
         || (shift && response.dragged_by(egui::PointerButton::Primary));
@@ -96,6 +132,45 @@ fn camera_input(
     }
     if response.double_clicked() {
         state.frame_requested = true;
+    }
+}
+
+fn drag_collider(
+    camera: &OrbitCamera,
+    rect: Rect,
+    state: &mut EditorState,
+    pointer: Pos2,
+    delta: egui::Vec2,
+) {
+    let aspect = rect.width() / rect.height().max(1.0);
+    let clip_from_world = camera.clip_from_world(aspect);
+    let to_screen = |p: Vec3| -> Option<Pos2> {
+        let c = clip_from_world * p.extend(1.0);
+        (c.w > 1e-4).then(|| {
+            let n = c.truncate() / c.w;
+            egui::pos2(
+                rect.left() + (n.x * 0.5 + 0.5) * rect.width(),
+                rect.top() + (0.5 - n.y * 0.5) * rect.height(),
+            )
+        })
+    };
+    let Some(e) = state.effect.emitters.get_mut(state.selected) else {
+        return;
+    };
+    let nearest = e
+        .collisions
+        .spheres
+        .iter_mut()
+        .filter_map(|s| to_screen(Vec3::from(s.center_m)).map(|q| (q.distance(pointer), s)))
+        .min_by(|a, b| a.0.total_cmp(&b.0));
+    if let Some((_, sphere)) = nearest {
+        let center = Vec3::from(sphere.center_m);
+        let distance = (center - camera.eye()).length();
+        let per_point = 2.0 * (0.5 * camera.fov_y).tan() / rect.height().max(1.0) * distance;
+        let view = camera.view_from_world();
+        let right = Vec3::new(view.x_axis.x, view.y_axis.x, view.z_axis.x);
+        let up = Vec3::new(view.x_axis.y, view.y_axis.y, view.z_axis.y);
+        sphere.center_m = (center + (right * delta.x - up * delta.y) * per_point).to_array();
     }
 }
 
