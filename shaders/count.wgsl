@@ -8,9 +8,9 @@
 @group(0) @binding(0) var<storage, read> state: array<Particle>;
 @group(0) @binding(1) var<storage, read_write> counters: array<atomic<u32>, 2>;
 
-override DIRECT_ATOMICS: bool = false;
+#import "alive_count.wgsl"
 
-var<workgroup> wg_alive: atomic<u32>;
+override DIRECT_ATOMICS: bool = false;
 
 @compute @workgroup_size(256)
 fn main(
@@ -25,15 +25,6 @@ fn main(
             atomicAdd(&counters[0], 1u);
         }
     } else {
-        if alive {
-            atomicAdd(&wg_alive, 1u);
-        }
-        workgroupBarrier();
-        if lid == 0u {
-            let n = atomicLoad(&wg_alive);
-            if n > 0u {
-                atomicAdd(&counters[0], n);
-            }
-        }
+        add_alive_in_workgroup(alive, lid);
     }
 }

@@ -22,6 +22,7 @@
 #import "spawn.wgsl"
 #import "integrators.wgsl"
 #import "collide.wgsl"
+#import "alive_count.wgsl"
 
 // Stateless mode: this pass only writes the spawn records of this step's window (one
 // invocation per spawn, no other slot is touched); the draw passes evaluate positions in
@@ -29,8 +30,6 @@
 // pos_age.w the birth time on the 4096 s clock.
 override MOD_STATELESS: bool = false;
 override COUNT_ALIVE: bool = true;
-
-var<workgroup> wg_alive: atomic<u32>;
 
 fn stateless_spawn(i: u32) {
     if i >= params.spawn_count {
@@ -107,15 +106,6 @@ fn main(
         dst[slot] = p;
     }
     if COUNT_ALIVE {
-        if alive {
-            atomicAdd(&wg_alive, 1u);
-        }
-        workgroupBarrier();
-        if lid == 0u {
-            let n = atomicLoad(&wg_alive);
-            if n > 0u {
-                atomicAdd(&counters[0], n);
-            }
-        }
+        add_alive_in_workgroup(alive, lid);
     }
 }

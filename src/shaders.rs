@@ -21,6 +21,10 @@ pub const EMBEDDED: &[(&str, &str)] = &[
         include_str!("../shaders/integrators.wgsl"),
     ),
     ("collide.wgsl", include_str!("../shaders/collide.wgsl")),
+    (
+        "alive_count.wgsl",
+        include_str!("../shaders/alive_count.wgsl"),
+    ),
     ("update.wgsl", include_str!("../shaders/update.wgsl")),
     ("count.wgsl", include_str!("../shaders/count.wgsl")),
     ("look.wgsl", include_str!("../shaders/look.wgsl")),
