@@ -108,7 +108,10 @@ fn copy_pipeline(ctx: &GpuContext) -> (wgpu::ComputePipeline, wgpu::BindGroupLay
         .device
         .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("bench copy layout"),
-            entries: &[storage_entry(0, true), storage_entry(1, false)],
+            entries: &[
+                crate::gpu::compute_storage_entry(0, true),
+                crate::gpu::compute_storage_entry(1, false),
+            ],
         });
     let pl = ctx
         .device
@@ -128,19 +131,6 @@ fn copy_pipeline(ctx: &GpuContext) -> (wgpu::ComputePipeline, wgpu::BindGroupLay
             cache: None,
         });
     (pipeline, layout)
-}
-
-fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
 }
 
 /// A plain compute copy, 32 bytes per invocation: the same bytes the update moves.
