@@ -14,17 +14,30 @@
 
 @group(0) @binding(0) var<uniform> camera: CameraUniform;
 @group(0) @binding(1) var<uniform> look: LookUniform;
+@group(0) @binding(2) var ramps: texture_2d<f32>;
 @group(1) @binding(0) var<storage, read> prev: array<Particle>;
 @group(1) @binding(1) var<storage, read> cur: array<Particle>;
 // Back-to-front slot order (sort.wgsl), read only by the alpha-blended pipeline.
 @group(1) @binding(2) var<storage, read> order: array<u32>;
+// The sprite: linear, premultiplied, mipmapped (src/render/sprites.rs).
+@group(2) @binding(0) var sprite_tex: texture_2d<f32>;
+@group(2) @binding(1) var sprite_sampler: sampler;
 
+// Pipeline variants: each look module is compiled in only when an emitter uses it.
 override SORTED: bool = false;
+override FLIPBOOK: bool = false;
+override FLIP_BLEND: bool = false;
+override STREAK: bool = false;
+override SOFT: bool = false;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
-    @location(0) uv: vec2<f32>,
-    @location(1) color: vec4<f32>,
+    // Atlas coordinates of this frame and of the next (flipbook blending).
+    @location(0) uv0: vec2<f32>,
+    @location(1) uv1: vec2<f32>,
+    @location(2) color: vec4<f32>,
+    // x: weight of the next frame, y: height above the ground plane (m).
+    @location(3) blend_height: vec2<f32>,
 }
 
 @vertex
@@ -37,28 +50,76 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) instance: u3
     let d = drawn(cur[slot], prev[slot]);
     if !d.alive {
         out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
-        out.uv = vec2<f32>(0.0);
-        out.color = vec4<f32>(0.0);
         return out;
     }
     let t = age_fraction(d.age, d.life);
-    let size = size_at(t);
+    let rnd = particle_random(slot, d.life);
+    let size = size_at(t, rnd.x);
     // Two triangles: 0 1 2, 2 1 3 over the corners (-1,-1) (1,-1) (-1,1) (1,1).
     let corner_index = array<u32, 6>(0u, 1u, 2u, 2u, 1u, 3u)[vi];
     let corner = vec2<f32>(f32(corner_index & 1u), f32(corner_index >> 1u)) * 2.0 - 1.0;
-    let world = d.pos + (camera.right_alpha.xyz * corner.x + camera.up.xyz * corner.y) * (0.5 * size);
-    out.clip = look.clip_from_sim * vec4<f32>(world, 1.0);
-    out.uv = corner;
+    var world = d.pos;
+    if STREAK {
+        // Stretched from where the particle was `length` seconds ago (tail, corner.x = -1)
+        // to where it is (head), `size` wide on screen.
+        var tail = d.vel * look.spin_streak.z;
+        let len = length(tail);
+        if len > look.spin_streak.w {
+            tail *= look.spin_streak.w / len;
+        }
+        let head_clip = look.clip_from_sim * vec4<f32>(d.pos, 1.0);
+        var tail_clip = look.clip_from_sim * vec4<f32>(d.pos - tail, 1.0);
+        if tail_clip.w <= 1e-4 || head_clip.w <= 1e-4 {
+            tail_clip = head_clip;
+        }
+        let half_vp = 0.5 * camera.viewport.xy;
+        let dir_px = (head_clip.xy / head_clip.w - tail_clip.xy / tail_clip.w) * half_vp;
+        let l = length(dir_px);
+        let dir = select(vec2<f32>(1.0, 0.0), dir_px / l, l > 1e-3);
+        let perp = vec2<f32>(-dir.y, dir.x);
+        let end = select(tail_clip, head_clip, corner.x > 0.0);
+        // The half-width in pixels is 0.5·size·viewport.z / w; in clip units the w cancels.
+        let off_px = (dir * corner.x + perp * corner.y) * (0.5 * size * camera.viewport.z);
+        out.clip = vec4<f32>(end.xy + off_px / half_vp, end.z, end.w);
+        world = select(d.pos - tail, d.pos, corner.x > 0.0);
+    } else {
+        // Random initial rotation plus spin over the particle's age.
+        let angle = (rnd.y - 0.5) * look.extra.z + mix(look.spin_streak.x, look.spin_streak.y, rnd.z) * d.age;
+        let cs = vec2<f32>(cos(angle), sin(angle));
+        let c = vec2<f32>(corner.x * cs.x - corner.y * cs.y, corner.x * cs.y + corner.y * cs.x);
+        world = d.pos + (camera.right_alpha.xyz * c.x + camera.up.xyz * c.y) * (0.5 * size);
+        out.clip = look.clip_from_sim * vec4<f32>(world, 1.0);
+    }
+    if FLIPBOOK {
+        let f = flipbook_frames(d.age, d.life, rnd.w, FLIP_BLEND);
+        out.uv0 = atlas_uv(f.x, corner);
+        out.uv1 = atlas_uv(f.y, corner);
+        out.blend_height.x = f.z;
+    } else {
+        out.uv0 = vec2<f32>(corner.x * 0.5 + 0.5, 0.5 - corner.y * 0.5);
+        out.uv1 = out.uv0;
+    }
+    out.blend_height.y = world.y - look.soft.x;
     out.color = particle_color(t);
     return out;
 }
 
 @fragment
 fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
-    let cov = sprite_coverage(in.uv);
-    let a = in.color.a * cov;
-    var rgb = in.color.rgb * a;
-    if look.sprite_blend.y == 0u {
+    var tex = textureSample(sprite_tex, sprite_sampler, in.uv0);
+    if FLIPBOOK && FLIP_BLEND {
+        tex = mix(tex, textureSample(sprite_tex, sprite_sampler, in.uv1), in.blend_height.x);
+    }
+    // The sprite is premultiplied: its rgb already carries its alpha.
+    var a = in.color.a * tex.a;
+    var rgb = in.color.rgb * tex.rgb * in.color.a;
+    if SOFT {
+        // Soft particles: fade out towards the ground plane instead of a hard cut.
+        let fade = clamp(in.blend_height.y * look.soft.y, 0.0, 1.0);
+        a *= fade;
+        rgb *= fade;
+    }
+    if look.ids.y == 0u {
         rgb = rgb * look.size_intensity.z;
     }
     return vec4<f32>(rgb, a);

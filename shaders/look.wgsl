@@ -1,9 +1,11 @@
 // look.wgsl — how a particle looks, shared by both draw paths (billboards and the
 // compute splat) so they render the same fire. A designer hook: `particle_color`.
 //
-// Contract: the including file declares `camera: CameraUniform` and `look: LookUniform`
-// (keep both in sync with `src/gpu/types.rs`).
+// Contract: the including file declares `camera: CameraUniform`, `look: LookUniform`
+// (keep both in sync with `src/gpu/types.rs`) and `ramps: texture_2d<f32>` (one
+// Rgba32Float colour ramp row per emitter).
 #import "common.wgsl"
+#import "rng.wgsl"
 
 struct CameraUniform {
     clip_from_world: mat4x4<f32>,
@@ -19,16 +21,20 @@ struct LookUniform {
     // The emitter's simulation space → clip, composed in f64 on the CPU so effects far
     // from the world origin render without f32 jitter.
     clip_from_sim: mat4x4<f32>,
-    colors: array<vec4<f32>, 8>,
-    // Stop positions, four per vec4.
-    stops: array<vec4<f32>, 2>,
-    // size start (m), size end (m), intensity, stop count.
+    // size start (m), size end (m), intensity, per-particle random size (fraction).
     size_intensity: vec4<f32>,
-    // x: sprite kind, y: blend (0 additive, 1 alpha), zw: unused.
-    sprite_blend: vec4<u32>,
-    // x: ∫ sprite coverage over the unit quad (for the splat's energy), y: 1 for a
-    // stateless emitter, zw: unused.
+    // x: colour ramp row, y: blend (0 additive, 1 alpha), z: flipbook rows, w: columns.
+    ids: vec4<u32>,
+    // x: flipbook mode (0 over life, 1 frame rate), y: random start frame (0/1),
+    // z: per-emitter random salt, w: unused.
+    flags: vec4<u32>,
+    // x: ∫ sprite brightness over the quad (the splat's energy), y: 1 for a stateless
+    // emitter, z: random rotation spread (rad), w: flipbook frames per second.
     extra: vec4<f32>,
+    // x, y: angular velocity range (rad/s), z: streak length (s), w: longest streak (m).
+    spin_streak: vec4<f32>,
+    // x: ground height in simulation space (m), y: 1 / soft-edge distance (1/m), zw: unused.
+    soft: vec4<f32>,
     // Stateless emitters: xyz constant acceleration, w linear drag k.
     motion_a: vec4<f32>,
     // Stateless emitters: xyz wind, w render time on the 4096 s clock.
@@ -37,50 +43,63 @@ struct LookUniform {
 
 override INTERPOLATE: bool = true;
 
-const SPRITE_SOFT_DISC: u32 = 0u;
-const SPRITE_POINT: u32 = 1u;
-const SPRITE_SPARK: u32 = 2u;
+// Texels per colour ramp row (keep in sync with `RAMP_WIDTH` in src/render/look.rs).
+const RAMP_WIDTH: u32 = 1024u;
 
-fn stop_t(i: u32) -> f32 {
-    return look.stops[i / 4u][i % 4u];
-}
-
-// Colour and alpha at normalised age t (piecewise-linear gradient, clamped at the ends).
+// Colour and alpha at normalised age t: the emitter's gradient baked into a ramp row
+// (exact at the texel centres, t = i / (RAMP_WIDTH - 1); linear in between).
 fn particle_color(t: f32) -> vec4<f32> {
-    let count = u32(look.size_intensity.w);
-    if t <= stop_t(0u) {
-        return look.colors[0];
-    }
-    for (var i = 1u; i < count; i++) {
-        let t1 = stop_t(i);
-        if t <= t1 {
-            let t0 = stop_t(i - 1u);
-            let f = select(1.0, (t - t0) / (t1 - t0), t1 > t0);
-            return mix(look.colors[i - 1u], look.colors[i], f);
-        }
-    }
-    return look.colors[count - 1u];
+    let x = clamp(t, 0.0, 1.0) * f32(RAMP_WIDTH - 1u);
+    let i = min(u32(x), RAMP_WIDTH - 1u);
+    let j = min(i + 1u, RAMP_WIDTH - 1u);
+    let row = i32(look.ids.x);
+    let c0 = textureLoad(ramps, vec2<i32>(i32(i), row), 0);
+    let c1 = textureLoad(ramps, vec2<i32>(i32(j), row), 0);
+    return mix(c0, c1, x - f32(i));
 }
 
-// Coverage of the sprite at uv ∈ [-1, 1]² (keep in sync with `sprite_integral` in
-// `src/render/billboard.rs`).
-fn sprite_coverage(uv: vec2<f32>) -> f32 {
-    let r2 = dot(uv, uv);
-    if r2 >= 1.0 {
-        return 0.0;
+// Four random numbers in [0, 1) fixed for one particle's life: a hash of the slot and
+// its lifetime bits (each spawn draws a fresh lifetime) with the emitter's salt.
+fn particle_random(slot: u32, life: f32) -> vec4<f32> {
+    return unorm4(pcg4d(vec4<u32>(slot, bitcast<u32>(life), look.flags.z, 0x1007u)));
+}
+
+// Flipbook frame selection: x = frame, y = next frame, z = weight of y (0 without
+// blending). Over life: frame 0 at birth, the last frame at death. Frame rate: loops.
+fn flipbook_frames(age: f32, life: f32, start01: f32, blend: bool) -> vec3<f32> {
+    let count = max(look.ids.z * look.ids.w, 1u);
+    let n = f32(count);
+    var start = 0u;
+    if look.flags.y != 0u {
+        start = min(u32(start01 * n), count - 1u);
     }
-    switch look.sprite_blend.x {
-        case SPRITE_POINT: {
-            return select(0.0, 1.0, r2 < 0.25);
+    if look.flags.x == 0u {
+        let t = age_fraction(age, life);
+        if blend {
+            let pos = t * (n - 1.0);
+            let f0 = min(u32(pos), count - 1u);
+            let f1 = min(f0 + 1u, count - 1u);
+            return vec3<f32>(f32((f0 + start) % count), f32((f1 + start) % count), pos - f32(f0));
         }
-        case SPRITE_SPARK: {
-            return min(1.0, exp(-r2 * 14.0) * 1.5 + 0.25 * (1.0 - r2) * (1.0 - r2));
-        }
-        default: {
-            let f = 1.0 - r2;
-            return f * f;
-        }
+        let f = min(u32(t * n), count - 1u);
+        return vec3<f32>(f32((f + start) % count), f32((f + start) % count), 0.0);
     }
+    let pos = max(age, 0.0) * look.extra.w;
+    let whole = floor(pos);
+    let f0 = (u32(whole) + start) % count;
+    let f1 = (f0 + 1u) % count;
+    return vec3<f32>(f32(f0), f32(f1), select(0.0, pos - whole, blend));
+}
+
+// Atlas coordinates of frame `frame` at quad uv ∈ [-1, 1]² (y up; frames row-major from
+// the top-left).
+fn atlas_uv(frame: f32, uv: vec2<f32>) -> vec2<f32> {
+    let cols = max(look.ids.w, 1u);
+    let rows = max(look.ids.z, 1u);
+    let f = u32(frame);
+    let cell = vec2<f32>(f32(f % cols), f32(f / cols));
+    let local = vec2<f32>(uv.x * 0.5 + 0.5, 0.5 - uv.y * 0.5);
+    return (cell + local) / vec2<f32>(f32(cols), f32(rows));
 }
 
 // Position and age to draw: between the last two steps when interpolating, and only when
@@ -98,9 +117,10 @@ fn draw_state(p: Particle, q: Particle) -> vec4<f32> {
     return vec4<f32>(pos, age);
 }
 
-// A particle as drawn: position, age, lifetime, alive.
+// A particle as drawn: position, velocity, age, lifetime, alive.
 struct Drawn {
     pos: vec3<f32>,
+    vel: vec3<f32>,
     age: f32,
     life: f32,
     alive: bool,
@@ -121,10 +141,12 @@ fn drawn(p: Particle, q: Particle) -> Drawn {
         let pp = exp_phi_psi(k, age);
         let c = look.motion_a.xyz + k * look.motion_b.xyz;
         let pos = p.pos_age.xyz + p.vel_life.xyz * pp.x + c * pp.y;
-        return Drawn(pos, age, life, life > 0.0 && age < life);
+        // v(t) = v0·e^{−kt} + c·φ, with e^{−kt} = 1 − kφ.
+        let vel = p.vel_life.xyz * (1.0 - k * pp.x) + c * pp.x;
+        return Drawn(pos, vel, age, life, life > 0.0 && age < life);
     }
     let s = draw_state(p, q);
-    return Drawn(s.xyz, s.w, p.vel_life.w, is_alive(p));
+    return Drawn(s.xyz, p.vel_life.xyz, s.w, p.vel_life.w, is_alive(p));
 }
 
 // Normalised age and billboard size of a drawn state.
@@ -132,6 +154,9 @@ fn age_fraction(age: f32, life: f32) -> f32 {
     return clamp(age / life, 0.0, 1.0);
 }
 
-fn size_at(t: f32) -> f32 {
-    return mix(look.size_intensity.x, look.size_intensity.y, t);
+// Billboard diameter at normalised age t, scaled by the particle's random factor
+// `r` ∈ [0, 1) (size × [1 − random, 1 + random]).
+fn size_at(t: f32, r: f32) -> f32 {
+    let scale = 1.0 + look.size_intensity.w * (2.0 * r - 1.0);
+    return mix(look.size_intensity.x, look.size_intensity.y, t) * scale;
 }

@@ -15,6 +15,7 @@
 
 @group(0) @binding(0) var<uniform> camera: CameraUniform;
 @group(0) @binding(1) var<uniform> look: LookUniform;
+@group(0) @binding(2) var ramps: texture_2d<f32>;
 @group(1) @binding(0) var<storage, read> prev: array<Particle>;
 @group(1) @binding(1) var<storage, read> cur: array<Particle>;
 @group(2) @binding(0) var<storage, read_write> accum: array<atomic<u32>>;
@@ -62,7 +63,8 @@ fn splat(
     }
     let t = age_fraction(d.age, d.life);
     let color = particle_color(t);
-    let size_px = size_at(t) * camera.viewport.z / clip.w;
+    let rnd = particle_random(slot, d.life);
+    let size_px = size_at(t, rnd.x) * camera.viewport.z / clip.w;
     let half = 0.5 * size_px;
     let energy = color.rgb * (color.a * look.size_intensity.z * look.extra.x * half * half);
     let ndc = clip.xy / clip.w;

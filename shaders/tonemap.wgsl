@@ -1,20 +1,25 @@
 // tonemap.wgsl — HDR (linear, Rgba16Float) → display (sRGB target does the encoding).
 //
-// Contract: group 0 binding 0 `hdr` texture, binding 1 `tone` (x: exposure), binding 2
-// `accum` (the compute splat's fixed-point light, read only when SPLAT is on — the splat
-// resolve is fused into this pass, saving a full-screen pass).
+// Contract: group 0 binding 0 `hdr` texture, binding 1 `tone` (x: exposure, y: bloom
+// intensity), binding 2 `accum` (the compute splat's fixed-point light, read only when
+// SPLAT is on — the splat resolve is fused into this pass, saving a full-screen pass),
+// binding 3 `bloom_tex` + 4 `bloom_samp` (level 0 of the bloom chain, read only when
+// BLOOM is on).
 // A full-screen triangle; the ACES fit by Krzysztof Narkowicz maps HDR to [0, 1].
 
 struct ToneUniform {
-    // x: exposure multiplier, yzw: unused.
+    // x: exposure multiplier, y: bloom intensity, zw: unused.
     exposure: vec4<f32>,
 }
 
 @group(0) @binding(0) var hdr: texture_2d<f32>;
 @group(0) @binding(1) var<uniform> tone: ToneUniform;
 @group(0) @binding(2) var<storage, read> accum: array<u32>;
+@group(0) @binding(3) var bloom_tex: texture_2d<f32>;
+@group(0) @binding(4) var bloom_samp: sampler;
 
 override SPLAT: bool = false;
+override BLOOM: bool = false;
 // Keep in sync with `FIXED_SCALE` in splat.wgsl.
 const SPLAT_FIXED_SCALE: f32 = 4096.0;
 
@@ -39,6 +44,10 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     if SPLAT {
         let i = (u32(frag.y) * textureDimensions(hdr).x + u32(frag.x)) * 3u;
         c += vec3<f32>(f32(accum[i]), f32(accum[i + 1u]), f32(accum[i + 2u])) / SPLAT_FIXED_SCALE;
+    }
+    if BLOOM {
+        let uv = frag.xy / vec2<f32>(textureDimensions(hdr));
+        c += tone.exposure.y * textureSampleLevel(bloom_tex, bloom_samp, uv, 0.0).rgb;
     }
     return vec4<f32>(aces(c * tone.exposure.x), 1.0);
 }

@@ -25,6 +25,49 @@ pub struct Effect {
     pub camera: CameraHint,
     /// Emitter layers (flame, embers, smoke…), drawn in order.
     pub emitters: Vec<Emitter>,
+    /// The HDR composite: exposure and bloom.
+    pub post: Post,
+}
+
+/// The HDR composite applied to the whole image: exposure, optional bloom, ACES tonemap.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Post {
+    /// Multiplies the HDR image before the tonemap (1 = unchanged).
+    pub exposure: f32,
+    /// Glow around bright light; `None` costs nothing (the passes are not recorded).
+    pub bloom: Option<Bloom>,
+}
+
+impl Default for Post {
+    fn default() -> Self {
+        Self {
+            exposure: 1.0,
+            bloom: None,
+        }
+    }
+}
+
+/// Bloom: light above `threshold` is blurred over a mip chain and added back.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Bloom {
+    /// HDR luminance where the glow starts (soft knee below it).
+    pub threshold: f32,
+    /// How much of the blurred light is added back.
+    pub intensity: f32,
+    /// Blur levels (each halves the resolution; more = wider glow), 1..=8.
+    pub levels: u32,
+}
+
+impl Default for Bloom {
+    fn default() -> Self {
+        Self {
+            threshold: 1.0,
+            intensity: 0.35,
+            levels: 6,
+        }
+    }
 }
 
 /// How simulated time advances relative to wall-clock frames.
@@ -571,12 +614,26 @@ impl Integrator {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Look {
-    /// Procedural sprite.
+    /// The sprite texture: a built-in procedural one or a PNG.
     pub sprite: Sprite,
+    /// Animate the sprite as an atlas of frames (`None`: the whole texture is one sprite).
+    pub flipbook: Option<Flipbook>,
     /// Billboard size (diameter) at birth, metres.
     pub size_start_m: f32,
     /// Billboard size at death, metres.
     pub size_end_m: f32,
+    /// Per-particle random size: each particle's size is scaled by a factor in
+    /// [1 − r, 1 + r] (0 = all the same).
+    pub size_random: f32,
+    /// Per-particle random initial rotation, 0..=360 degrees of spread.
+    pub rotation_random_deg: f32,
+    /// Per-particle angular velocity, degrees per second (uniform in the range).
+    pub spin_deg_per_s: Range,
+    /// Stretch the billboard along the screen-space velocity (sparks).
+    pub streak: Option<Streak>,
+    /// Fade the sprite where it meets the ground plane over this distance, metres (0 =
+    /// off; the plane is the emitter's ground collider, or y = 0 without one).
+    pub soft_ground_m: f32,
     /// Colour and alpha over normalised age (0 = birth, 1 = death); linear RGB.
     pub color_over_life: Vec<ColorStop>,
     /// Multiplies the colour (HDR brightness).
@@ -604,24 +661,106 @@ pub enum DrawPath {
 /// Auto draw path: below this projected particle size (pixels), splat.
 pub const SPLAT_BELOW_PX: f32 = 4.0;
 
-/// Built-in procedural sprites.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+/// A sprite texture: one of the procedural set generated at start, or a PNG with alpha.
+#[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum Sprite {
-    /// A soft round disc (Gaussian-like falloff).
+    /// A soft round disc.
     SoftDisc,
     /// A hard-edged point (the thesis's look).
     Point,
     /// A bright core with a soft halo (sparks).
     Spark,
+    /// A teardrop flame tongue, brighter at the base.
+    FlameWisp,
+    /// A lumpy, noisy puff (smoke).
+    SmokePuff,
+    /// A built-in 4 × 4 flipbook of licking flame tongues (use with a 4 × 4 flipbook).
+    FlameSheet,
+    /// A PNG (straight alpha) at this path, relative to the preset file.
+    Image(String),
 }
 
 impl Sprite {
-    /// Stable index used on the GPU (keep in sync with `SPRITE_*` in `shaders/billboard.wgsl`).
-    pub fn index(self) -> u32 {
+    /// The built-in sprites, in menu order.
+    pub const BUILT_IN: [Sprite; 6] = [
+        Sprite::SoftDisc,
+        Sprite::Point,
+        Sprite::Spark,
+        Sprite::FlameWisp,
+        Sprite::SmokePuff,
+        Sprite::FlameSheet,
+    ];
+
+    /// A short name for menus and messages.
+    pub fn label(&self) -> &str {
         match self {
-            Sprite::SoftDisc => 0,
-            Sprite::Point => 1,
-            Sprite::Spark => 2,
+            Sprite::SoftDisc => "soft disc",
+            Sprite::Point => "point",
+            Sprite::Spark => "spark",
+            Sprite::FlameWisp => "flame wisp",
+            Sprite::SmokePuff => "smoke puff",
+            Sprite::FlameSheet => "flame sheet (4×4)",
+            Sprite::Image(path) => path,
+        }
+    }
+}
+
+/// A sprite atlas of `rows` × `cols` frames (row-major, top-left first), animated.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Flipbook {
+    /// Frame rows in the atlas.
+    pub rows: u32,
+    /// Frame columns in the atlas.
+    pub cols: u32,
+    /// How the frame advances.
+    pub mode: FlipbookMode,
+    /// Cross-fade between consecutive frames (two texture samples) instead of cutting.
+    pub blend_frames: bool,
+    /// Start each particle on a random frame.
+    pub random_start: bool,
+}
+
+impl Default for Flipbook {
+    fn default() -> Self {
+        Self {
+            rows: 4,
+            cols: 4,
+            mode: FlipbookMode::OverLife,
+            blend_frames: true,
+            random_start: false,
+        }
+    }
+}
+
+/// How a flipbook's frame advances.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum FlipbookMode {
+    /// Frame 0 at birth to the last frame at death.
+    OverLife,
+    /// A fixed rate, looping.
+    FrameRate {
+        /// Frames per second.
+        fps: f32,
+    },
+}
+
+/// Spark streaks: the billboard runs from the particle back along its velocity.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Streak {
+    /// The tail is where the particle was this many seconds ago (at its current
+    /// velocity), like the thesis's old-to-new interpolation.
+    pub length_secs: f32,
+    /// Longest tail, metres (keeps very fast sparks from crossing the screen).
+    pub max_length_m: f32,
+}
+
+impl Default for Streak {
+    fn default() -> Self {
+        Self {
+            length_secs: 0.03,
+            max_length_m: 0.5,
         }
     }
 }
@@ -645,8 +784,9 @@ pub struct ColorStop {
     pub rgba: [f32; 4],
 }
 
-/// The maximum number of gradient stops the GPU uniform holds.
-pub const MAX_COLOR_STOPS: usize = 8;
+/// The most gradient stops a look may have (the ramp baking handles any number; this
+/// only keeps files sane).
+pub const MAX_COLOR_STOPS: usize = 256;
 
 impl Default for Effect {
     fn default() -> Self {
@@ -657,6 +797,7 @@ impl Default for Effect {
             time: TimeSettings::default(),
             camera: CameraHint::default(),
             emitters: vec![Emitter::default()],
+            post: Post::default(),
         }
     }
 }
@@ -755,8 +896,14 @@ impl Default for Look {
     fn default() -> Self {
         Self {
             sprite: Sprite::SoftDisc,
+            flipbook: None,
             size_start_m: 0.22,
             size_end_m: 0.06,
+            size_random: 0.0,
+            rotation_random_deg: 0.0,
+            spin_deg_per_s: Range::new(0.0, 0.0),
+            streak: None,
+            soft_ground_m: 0.0,
             color_over_life: vec![
                 ColorStop {
                     t: 0.0,
@@ -897,6 +1044,14 @@ impl Effect {
         c.num(|| "camera.yaw_deg".into(), cam.yaw_deg, -3600.0, 3600.0);
         c.num(|| "camera.pitch_deg".into(), cam.pitch_deg, -89.9, 89.9);
         c.num(|| "camera.fov_y_deg".into(), cam.fov_y_deg, 1.0, 170.0);
+        c.num(|| "post.exposure".into(), self.post.exposure, 1e-3, 1e3);
+        if let Some(b) = &self.post.bloom {
+            c.num(|| "post.bloom.threshold".into(), b.threshold, 0.0, 1e3);
+            c.num(|| "post.bloom.intensity".into(), b.intensity, 0.0, 100.0);
+            if !(1..=8).contains(&b.levels) {
+                c.push("post.bloom.levels".into(), b.levels, "must be 1..=8");
+            }
+        }
         if self.emitters.is_empty() {
             c.push("emitters".into(), "[]", "must list at least one emitter");
         }
@@ -1110,6 +1265,38 @@ impl Effect {
             c.num(|| p("look.size_start_m"), l.size_start_m, 0.0, 1e3);
             c.num(|| p("look.size_end_m"), l.size_end_m, 0.0, 1e3);
             c.num(|| p("look.intensity"), l.intensity, 0.0, 1e4);
+            c.num(|| p("look.size_random"), l.size_random, 0.0, 1.0);
+            c.num(
+                || p("look.rotation_random_deg"),
+                l.rotation_random_deg,
+                0.0,
+                360.0,
+            );
+            c.range(|| p("look.spin_deg_per_s"), l.spin_deg_per_s, -1e5, 1e5);
+            c.num(|| p("look.soft_ground_m"), l.soft_ground_m, 0.0, 100.0);
+            if let Sprite::Image(path) = &l.sprite
+                && path.trim().is_empty()
+            {
+                c.push(
+                    p("look.sprite"),
+                    "Image(\"\")",
+                    "needs a PNG path, relative to the preset file",
+                );
+            }
+            if let Some(f) = &l.flipbook {
+                for (name, v) in [("rows", f.rows), ("cols", f.cols)] {
+                    if !(1..=64).contains(&v) {
+                        c.push(p(&format!("look.flipbook.{name}")), v, "must be 1..=64");
+                    }
+                }
+                if let FlipbookMode::FrameRate { fps } = f.mode {
+                    c.num(|| p("look.flipbook.mode.fps"), fps, 0.0, 1000.0);
+                }
+            }
+            if let Some(s) = &l.streak {
+                c.num(|| p("look.streak.length_secs"), s.length_secs, 0.0, 10.0);
+                c.num(|| p("look.streak.max_length_m"), s.max_length_m, 0.0, 1e3);
+            }
             if l.color_over_life.is_empty() || l.color_over_life.len() > MAX_COLOR_STOPS {
                 c.push(
                     p("look.color_over_life"),

@@ -154,6 +154,7 @@ impl ShaderReloader {
                 "splat.wgsl" => renderer.splat.rebuild(ctx, lib),
                 "sort.wgsl" => renderer.sort.rebuild(ctx, lib),
                 "tonemap.wgsl" => renderer.tonemap.rebuild(ctx, lib),
+                "bloom.wgsl" => renderer.bloom.rebuild(ctx, lib),
                 _ => Ok(()),
             };
             match result {

@@ -248,6 +248,8 @@ fn render(
     let ctx = GpuContext::headless()?;
     let lib = ShaderLibrary::discover(shader_dir);
     let mut run = Headless::new(&ctx, effect, lib)?;
+    // PNG sprites are relative to the preset file.
+    run.renderer.asset_dir = preset.and_then(Path::parent).map(Path::to_path_buf);
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let start = Instant::now();
     let mut written = 0;

@@ -32,6 +32,7 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ("splat.wgsl", include_str!("../shaders/splat.wgsl")),
     ("sort.wgsl", include_str!("../shaders/sort.wgsl")),
     ("tonemap.wgsl", include_str!("../shaders/tonemap.wgsl")),
+    ("bloom.wgsl", include_str!("../shaders/bloom.wgsl")),
 ];
 
 /// The entry files, one per pipeline family; the others are imported by them.
@@ -42,6 +43,7 @@ pub const ENTRY_FILES: &[&str] = &[
     "splat.wgsl",
     "sort.wgsl",
     "tonemap.wgsl",
+    "bloom.wgsl",
 ];
 
 /// A shader problem, located in the file the user edits.

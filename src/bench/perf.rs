@@ -214,17 +214,29 @@ fn measure_row(
     renderer.targets(ctx, size);
     let items = {
         let Renderer { frame, sort, .. } = &mut renderer;
-        frame.prepare(ctx, &sim, &effect, &camera, size, 1.0, sort)
+        frame.prepare(ctx, &sim, &effect, &camera, size, 1.0, sort, None)
     };
     let auto_splat = items.iter().all(|d| d.splat);
     let all_billboard: Vec<_> = items
         .iter()
-        .map(|d| crate::render::DrawItem { splat: false, ..*d })
+        .map(|d| crate::render::DrawItem {
+            splat: false,
+            ..d.clone()
+        })
         .collect();
     let all_splat: Vec<_> = items
         .iter()
-        .map(|d| crate::render::DrawItem { splat: true, ..*d })
+        .map(|d| crate::render::DrawItem {
+            splat: true,
+            ..d.clone()
+        })
         .collect();
+    {
+        let Renderer {
+            frame, billboard, ..
+        } = &mut renderer;
+        billboard.prepare(ctx, &all_billboard, &frame.sprites.sampler);
+    }
     let billboard_ms = if n <= opts.billboard_limit {
         let r = &renderer;
         let Some(t) = r_targets(r) else {
@@ -260,8 +272,15 @@ fn measure_row(
             None
         };
         time_median(&timer, ctx, opts.repeats, |enc| {
-            r.tonemap
-                .record(ctx, enc, &targets.hdr_view, accum, &targets.ldr_view, 1.0);
+            r.tonemap.record(
+                ctx,
+                enc,
+                &targets.hdr_view,
+                accum,
+                None,
+                &targets.ldr_view,
+                1.0,
+            );
         })
     };
     let draw = if auto_splat {

@@ -201,6 +201,8 @@ struct Gfx {
     pending_steps: (u32, f32),
     /// Hot reload of `shaders/` (absent with the embedded shaders).
     shader_watch: Option<ShaderWatch>,
+    /// Watches the folders of the PNG sprites in use: a changed file is reloaded.
+    sprite_watch: Option<(Vec<PathBuf>, FileWatcher)>,
 }
 
 /// The shader folder's watcher and the reloader that rebuilds affected pipelines.
@@ -391,6 +393,7 @@ impl Gfx {
             pending_steps: (0, 0.0),
             profiler: StageProfiler::new(options.profile),
             shader_watch,
+            sprite_watch: None,
         })
     }
 
@@ -700,9 +703,40 @@ impl App {
         }
     }
 
+    /// Drops PNG sprites that changed on disk (they reload on the next frame) and
+    /// keeps the watcher on the folders of the sprites in use.
+    fn reload_changed_sprites(&mut self) {
+        let Some(gfx) = self.gfx.as_mut() else {
+            return;
+        };
+        let dirs = gfx.renderer.frame.sprites.watched_dirs();
+        if dirs.is_empty() {
+            gfx.sprite_watch = None;
+            return;
+        }
+        if gfx.sprite_watch.as_ref().is_none_or(|(d, _)| *d != dirs) {
+            let paths: Vec<&std::path::Path> = dirs.iter().map(PathBuf::as_path).collect();
+            gfx.sprite_watch = match FileWatcher::new(&paths) {
+                Ok(w) => Some((dirs, w)),
+                Err(e) => {
+                    log::warn!("not watching sprite folders for changes: {e}");
+                    None
+                }
+            };
+        }
+        let Some((_, watcher)) = &gfx.sprite_watch else {
+            return;
+        };
+        let changed = watcher.poll();
+        if !changed.is_empty() && gfx.renderer.frame.sprites.invalidate(&changed) {
+            log::info!("sprite changed on disk, reloading");
+        }
+    }
+
     /// One frame. Returns true when the editor should exit (`--frames` done).
     fn frame(&mut self) -> anyhow::Result<bool> {
         self.reload_changed_preset();
+        self.reload_changed_sprites();
         let Some(gfx) = self.gfx.as_mut() else {
             return Ok(false);
         };
@@ -750,6 +784,12 @@ impl App {
         gfx.profiler.end_stage(&gfx.ctx);
         gfx.viewport_px = viewport.size_px;
         gfx.renderer.exposure = self.state.view.exposure;
+        gfx.renderer.asset_dir = self
+            .state
+            .loaded_path
+            .as_deref()
+            .and_then(std::path::Path::parent)
+            .map(std::path::Path::to_path_buf);
         let mut encoder = gfx
             .ctx
             .device
@@ -800,6 +840,13 @@ impl App {
                 None => draw(&mut encoder),
             }
         }
+        self.state.sprite_errors = gfx
+            .renderer
+            .frame
+            .sprite_errors
+            .iter()
+            .map(|(i, e)| (*i, e.to_string()))
+            .collect();
         if let Some(t) = gfx.pass_timer.as_mut().filter(|_| timing) {
             t.end_frame(&mut encoder);
         }

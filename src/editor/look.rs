@@ -3,14 +3,23 @@
 use egui::{Color32, DragValue, Rgba, RichText, Sense, Ui};
 
 use crate::effect::{
-    BlendMode, ColorStop, DrawPath, Effect, Look, MAX_COLOR_STOPS, SPLAT_BELOW_PX, Sprite,
+    BlendMode, Bloom, ColorStop, DrawPath, Effect, Flipbook, FlipbookMode, Look, MAX_COLOR_STOPS,
+    Post, SPLAT_BELOW_PX, Sprite, Streak,
 };
+pub use crate::render::look::sample_gradient;
 
-use super::panel::{blend_label, sprite_label};
+use super::panel::blend_label;
 use super::state::ViewSettings;
 
-/// The selected emitter's look and the viewport exposure.
-pub fn look_ui(ui: &mut Ui, effect: &mut Effect, selected: usize, view: &mut ViewSettings) {
+/// The selected emitter's look, the effect's composite (exposure, bloom) and the
+/// viewport exposure. `sprite_error` is the selected emitter's sprite load error.
+pub fn look_ui(
+    ui: &mut Ui,
+    effect: &mut Effect,
+    selected: usize,
+    view: &mut ViewSettings,
+    sprite_error: Option<&str>,
+) {
     egui::Grid::new("exposure_grid")
         .num_columns(2)
         .spacing([10.0, 5.0])
@@ -26,32 +35,78 @@ pub fn look_ui(ui: &mut Ui, effect: &mut Effect, selected: usize, view: &mut Vie
             )
             .labelled_by(label.id);
             ui.end_row();
+            post_ui(ui, &mut effect.post);
         });
+    ui.separator();
     let Some(e) = effect.emitters.get_mut(selected) else {
         return;
     };
     look_fields_ui(ui, &mut e.look);
+    if let Some(err) = sprite_error {
+        ui.colored_label(Color32::from_rgb(255, 110, 90), err);
+    }
 }
 
-/// Sprite, blend, sizes, intensity and the colour gradient of one look.
+/// The effect's composite settings (rows of an open grid).
+fn post_ui(ui: &mut Ui, post: &mut Post) {
+    let label = ui
+        .label("Preset exposure")
+        .on_hover_text("Saved with the preset: multiplies the HDR image before bloom and tonemap");
+    ui.add(
+        egui::Slider::new(&mut post.exposure, 0.05..=8.0)
+            .logarithmic(true)
+            .fixed_decimals(2),
+    )
+    .labelled_by(label.id);
+    ui.end_row();
+    let label = ui.label("Bloom").on_hover_text(
+        "Light above the threshold is blurred over a mip chain and added back (off: no passes run)",
+    );
+    let mut on = post.bloom.is_some();
+    if ui.checkbox(&mut on, "glow").labelled_by(label.id).changed() {
+        post.bloom = on.then(Bloom::default);
+    }
+    ui.end_row();
+    if let Some(b) = &mut post.bloom {
+        let label = ui
+            .label("Bloom threshold")
+            .on_hover_text("HDR brightness where the glow starts");
+        ui.add(
+            DragValue::new(&mut b.threshold)
+                .range(0.0..=100.0)
+                .speed(0.01),
+        )
+        .labelled_by(label.id);
+        ui.end_row();
+        let label = ui
+            .label("Bloom intensity")
+            .on_hover_text("How much blurred light is added");
+        ui.add(
+            DragValue::new(&mut b.intensity)
+                .range(0.0..=10.0)
+                .speed(0.01),
+        )
+        .labelled_by(label.id);
+        ui.end_row();
+        let label = ui
+            .label("Bloom levels")
+            .on_hover_text("Blur levels: each halves the resolution (more = wider glow)");
+        ui.add(DragValue::new(&mut b.levels).range(1..=8))
+            .labelled_by(label.id);
+        ui.end_row();
+    }
+}
+
+/// Sprite, flipbook, blend, sizes, randomness, streaks, soft edges, intensity and the
+/// colour gradient of one look.
 pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
     egui::Grid::new("look_grid")
         .num_columns(2)
         .spacing([10.0, 5.0])
         .min_col_width(96.0)
         .show(ui, |ui| {
-            let label = ui.label("Sprite").on_hover_text("Procedural sprite of each billboard");
-            egui::ComboBox::from_id_salt("sprite")
-                .selected_text(sprite_label(look.sprite))
-                .show_ui(ui, |ui| {
-                    for s in [Sprite::SoftDisc, Sprite::Point, Sprite::Spark] {
-                        ui.selectable_value(&mut look.sprite, s, sprite_label(s));
-                    }
-                })
-                .response
-                .labelled_by(label.id);
-            ui.end_row();
-            let label_tip = "Additive: light adds up, order-independent (fire, sparks). Alpha: premultiplied over, darkens what is behind (smoke); alpha layers are drawn first";
+            sprite_rows_ui(ui, look);
+            let label_tip = "Additive: light adds up, order-independent (fire, sparks). Alpha: premultiplied over, darkens what is behind (smoke); alpha layers are drawn first, sorted back to front";
             ui.label("Blend").on_hover_text(label_tip);
             ui.horizontal(|ui| {
                 for b in [BlendMode::Additive, BlendMode::Alpha] {
@@ -61,7 +116,7 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
             });
             ui.end_row();
             let label = ui.label("Draw path").on_hover_text(format!(
-                "auto: compute splat when particles project below {SPLAT_BELOW_PX} px and blend additively, billboards otherwise. billboard: instanced quads. splat: compute splat (additive only; alpha falls back to billboards)"
+                "auto: compute splat when particles project below {SPLAT_BELOW_PX} px, blend additively and have no streak; billboards otherwise. billboard: instanced quads. splat: compute splat (additive only; alpha falls back to billboards)"
             ));
             egui::ComboBox::from_id_salt("draw_path")
                 .selected_text(draw_path_label(look.draw_path))
@@ -98,6 +153,53 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
             });
             ui.end_row();
             let label = ui
+                .label("Random size")
+                .on_hover_text("Each particle's size is scaled by a random factor in [1 − r, 1 + r]");
+            ui.add(DragValue::new(&mut look.size_random).range(0.0..=1.0).speed(0.005).prefix("± "))
+                .labelled_by(label.id);
+            ui.end_row();
+            let label = ui
+                .label("Rotation")
+                .on_hover_text("Random initial rotation spread (degrees) and angular velocity range (degrees per second)");
+            ui.horizontal(|ui| {
+                ui.add(
+                    DragValue::new(&mut look.rotation_random_deg)
+                        .range(0.0..=360.0)
+                        .speed(1.0)
+                        .prefix("random ")
+                        .suffix("°"),
+                )
+                .labelled_by(label.id);
+                let spin = &mut look.spin_deg_per_s;
+                ui.add(DragValue::new(&mut spin.min).range(-3600.0..=spin.max).speed(1.0).prefix("spin "))
+                    .labelled_by(label.id);
+                ui.add(DragValue::new(&mut spin.max).range(spin.min..=3600.0).speed(1.0).prefix("… ").suffix(" °/s"))
+                    .labelled_by(label.id);
+            });
+            ui.end_row();
+            let label = ui
+                .label("Streak")
+                .on_hover_text("Stretch each billboard from where the particle was (length seconds ago) to where it is: spark trails");
+            ui.horizontal(|ui| {
+                let mut on = look.streak.is_some();
+                if ui.checkbox(&mut on, "").labelled_by(label.id).changed() {
+                    look.streak = on.then(Streak::default);
+                }
+                if let Some(s) = &mut look.streak {
+                    ui.add(DragValue::new(&mut s.length_secs).range(0.0..=1.0).speed(0.001).suffix(" s"))
+                        .labelled_by(label.id);
+                    ui.add(DragValue::new(&mut s.max_length_m).range(0.0..=100.0).speed(0.01).prefix("≤ ").suffix(" m"))
+                        .labelled_by(label.id);
+                }
+            });
+            ui.end_row();
+            let label = ui
+                .label("Soft ground")
+                .on_hover_text("Fade sprites over this distance above the ground plane (the emitter's ground collider, else y = 0) instead of cutting them: soft particles. 0 = off");
+            ui.add(DragValue::new(&mut look.soft_ground_m).range(0.0..=10.0).speed(0.002).suffix(" m"))
+                .labelled_by(label.id);
+            ui.end_row();
+            let label = ui
                 .label("Intensity")
                 .on_hover_text("Multiplies the colour: HDR brightness before exposure and tonemap");
             ui.add(
@@ -111,10 +213,174 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
         });
     ui.add_space(4.0);
     ui.label("Colour over life").on_hover_text(
-        "Colour (linear RGB) and alpha over the normalised age: 0 = birth, 1 = death",
+        "Colour (linear RGB) and alpha over the normalised age: 0 = birth, 1 = death. Click the bar to add a stop, drag a handle to move it, right-click a handle to remove it",
     );
-    gradient_preview_ui(ui, &look.color_over_life);
+    gradient_editor_ui(ui, &mut look.color_over_life);
     color_stops_ui(ui, &mut look.color_over_life);
+}
+
+/// The sprite picker, the PNG path and the flipbook (rows of an open grid).
+fn sprite_rows_ui(ui: &mut Ui, look: &mut Look) {
+    let label = ui
+        .label("Sprite")
+        .on_hover_text("Built-in procedural sprites, or a PNG with alpha (path relative to the preset file; reloads when the file changes)");
+    let is_image = matches!(look.sprite, Sprite::Image(_));
+    egui::ComboBox::from_id_salt("sprite")
+        .selected_text(if is_image {
+            "PNG file"
+        } else {
+            look.sprite.label()
+        })
+        .show_ui(ui, |ui| {
+            for s in Sprite::BUILT_IN {
+                let text = s.label().to_owned();
+                ui.selectable_value(&mut look.sprite, s, text);
+            }
+            if ui.selectable_label(is_image, "PNG file").clicked() && !is_image {
+                look.sprite = Sprite::Image("textures/flame_sheet.png".to_owned());
+            }
+        })
+        .response
+        .labelled_by(label.id);
+    ui.end_row();
+    if let Sprite::Image(path) = &mut look.sprite {
+        let label = ui
+            .label("PNG path")
+            .on_hover_text("Relative to the preset file");
+        ui.text_edit_singleline(path).labelled_by(label.id);
+        ui.end_row();
+    }
+    let label = ui
+        .label("Flipbook")
+        .on_hover_text("Treat the sprite as an atlas of rows × columns frames (row-major from the top left) and animate it");
+    let mut on = look.flipbook.is_some();
+    if ui
+        .checkbox(&mut on, "animate")
+        .labelled_by(label.id)
+        .changed()
+    {
+        look.flipbook = on.then(|| {
+            let mut f = Flipbook::default();
+            if look.sprite != Sprite::FlameSheet {
+                (f.rows, f.cols) = (1, 1);
+            }
+            f
+        });
+    }
+    ui.end_row();
+    let Some(f) = &mut look.flipbook else {
+        return;
+    };
+    let label = ui
+        .label("Frames")
+        .on_hover_text("Rows × columns of the atlas");
+    ui.horizontal(|ui| {
+        ui.add(DragValue::new(&mut f.rows).range(1..=64).suffix(" rows"))
+            .labelled_by(label.id);
+        ui.add(DragValue::new(&mut f.cols).range(1..=64).suffix(" cols"))
+            .labelled_by(label.id);
+    });
+    ui.end_row();
+    let label = ui.label("Frame timing").on_hover_text(
+        "Over life: first frame at birth, last at death. Frame rate: a fixed rate, looping",
+    );
+    ui.horizontal(|ui| {
+        let mut fps = match f.mode {
+            FlipbookMode::FrameRate { fps } => Some(fps),
+            FlipbookMode::OverLife => None,
+        };
+        if ui
+            .radio(fps.is_none(), "over life")
+            .labelled_by(label.id)
+            .clicked()
+        {
+            fps = None;
+        }
+        if ui
+            .radio(fps.is_some(), "fps")
+            .labelled_by(label.id)
+            .clicked()
+            && fps.is_none()
+        {
+            fps = Some(24.0);
+        }
+        if let Some(v) = &mut fps {
+            ui.add(DragValue::new(v).range(0.0..=240.0).speed(0.1))
+                .labelled_by(label.id);
+        }
+        f.mode = fps.map_or(FlipbookMode::OverLife, |fps| FlipbookMode::FrameRate {
+            fps,
+        });
+    });
+    ui.end_row();
+    ui.label("");
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut f.blend_frames, "blend frames")
+            .on_hover_text("Cross-fade consecutive frames (two texture samples)");
+        ui.checkbox(&mut f.random_start, "random start")
+            .on_hover_text("Each particle starts on a random frame");
+    });
+    ui.end_row();
+}
+
+/// An interactive gradient bar: click to add a stop (coloured as the gradient there),
+/// drag a handle to move a stop between its neighbours, right-click a handle to remove it
+/// (one stop always remains). Any number of stops.
+pub fn gradient_editor_ui(ui: &mut Ui, stops: &mut Vec<ColorStop>) {
+    let width = ui.available_width().min(330.0);
+    let (rect, bar) = ui.allocate_exact_size(egui::vec2(width, 26.0), Sense::click());
+    paint_gradient(ui, rect, stops);
+    let (handles, _) = ui.allocate_exact_size(egui::vec2(width, 12.0), Sense::hover());
+    let id = bar.id;
+    let x_of = |t: f32| rect.left() + t.clamp(0.0, 1.0) * rect.width();
+    let mut remove = None;
+    for k in 0..stops.len() {
+        let x = x_of(stops[k].t);
+        let hit =
+            egui::Rect::from_center_size(egui::pos2(x, handles.center().y), egui::vec2(10.0, 12.0));
+        let r = ui
+            .interact(hit, id.with(("stop", k)), Sense::click_and_drag())
+            .on_hover_text(format!(
+                "t {:.3} · drag to move · right-click to remove",
+                stops[k].t
+            ));
+        if r.dragged() {
+            let lo = if k == 0 { 0.0 } else { stops[k - 1].t };
+            let hi = stops.get(k + 1).map_or(1.0, |s| s.t);
+            let t = stops[k].t + r.drag_delta().x / rect.width();
+            stops[k].t = t.clamp(lo, hi);
+        }
+        if r.secondary_clicked() && stops.len() > 1 {
+            remove = Some(k);
+        }
+        let fill = to_color32([stops[k].rgba[0], stops[k].rgba[1], stops[k].rgba[2], 1.0]);
+        let stroke = if r.hovered() || r.dragged() {
+            egui::Stroke::new(2.0, Color32::WHITE)
+        } else {
+            egui::Stroke::new(1.0, Color32::GRAY)
+        };
+        let top = egui::pos2(x, handles.top());
+        ui.painter().add(egui::Shape::convex_polygon(
+            vec![
+                top,
+                egui::pos2(x + 5.0, handles.bottom()),
+                egui::pos2(x - 5.0, handles.bottom()),
+            ],
+            fill,
+            stroke,
+        ));
+    }
+    if let Some(k) = remove {
+        stops.remove(k);
+    }
+    if bar.clicked()
+        && let Some(pos) = bar.interact_pointer_pos()
+    {
+        let t = ((pos.x - rect.left()) / rect.width()).clamp(0.0, 1.0);
+        let rgba = sample_gradient(stops, t);
+        let at = stops.iter().position(|s| s.t > t).unwrap_or(stops.len());
+        stops.insert(at, ColorStop { t, rgba });
+    }
 }
 
 fn draw_path_label(d: DrawPath) -> &'static str {
@@ -133,9 +399,7 @@ fn to_color32(rgba: [f32; 4]) -> Color32 {
 
 /// The gradient as a strip: the upper half shows the colour over a dark checkerboard with
 /// its alpha, the lower half the opaque colour.
-fn gradient_preview_ui(ui: &mut Ui, stops: &[ColorStop]) {
-    let width = ui.available_width().min(330.0);
-    let (rect, _) = ui.allocate_exact_size(egui::vec2(width, 26.0), Sense::hover());
+fn paint_gradient(ui: &Ui, rect: egui::Rect, stops: &[ColorStop]) {
     let painter = ui.painter_at(rect);
     let cell = 6.5;
     let cols = (rect.width() / cell).ceil() as usize;
@@ -192,16 +456,6 @@ fn gradient_preview_ui(ui: &mut Ui, stops: &[ColorStop]) {
     add_band(rect.top(), mid, false);
     add_band(mid, rect.bottom(), true);
     painter.add(egui::Shape::mesh(mesh));
-    for s in stops {
-        let x = rect.left() + s.t.clamp(0.0, 1.0) * rect.width();
-        painter.line_segment(
-            [
-                egui::pos2(x, rect.bottom() - 5.0),
-                egui::pos2(x, rect.bottom()),
-            ],
-            egui::Stroke::new(1.5, Color32::WHITE),
-        );
-    }
 }
 
 /// One row per stop (t, colour with alpha, remove) and an add button. Each stop's t is
@@ -280,33 +534,6 @@ pub fn add_stop(stops: &mut Vec<ColorStop>) {
     let rgba = sample_gradient(stops, t);
     // `gap` is the index of the first stop after the insertion point.
     stops.insert(gap.min(stops.len()), ColorStop { t, rgba });
-}
-
-/// The gradient's value at `t` (linear interpolation, clamped at the ends), as the
-/// billboard shader evaluates it.
-pub fn sample_gradient(stops: &[ColorStop], t: f32) -> [f32; 4] {
-    let Some(first) = stops.first() else {
-        return [1.0; 4];
-    };
-    if t <= first.t {
-        return first.rgba;
-    }
-    for pair in stops.windows(2) {
-        let (a, b) = (pair[0], pair[1]);
-        if t <= b.t {
-            let f = if b.t > a.t {
-                (t - a.t) / (b.t - a.t)
-            } else {
-                1.0
-            };
-            let mut out = [0.0; 4];
-            for (k, o) in out.iter_mut().enumerate() {
-                *o = a.rgba[k] + (b.rgba[k] - a.rgba[k]) * f;
-            }
-            return out;
-        }
-    }
-    stops.last().map_or([1.0; 4], |s| s.rgba)
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@ use egui::{Color32, DragValue, Response, RichText, Ui};
 
 use crate::effect::{
     BlendMode, Burst, Collisions, Effect, Emitter, Falloff, Integrator, MAX_SPHERES, Range, Shape,
-    SphereCollider, Sprite, TimeMode,
+    SphereCollider, TimeMode,
 };
 
 use super::look::look_ui;
@@ -50,7 +50,18 @@ pub fn panel_ui(ui: &mut Ui, state: &mut EditorState) {
                 time_ui(ui, &mut state.effect, &mut state.playback, state.selected);
             });
             section_ui(ui, "look", "Look", &name, false, |ui| {
-                look_ui(ui, &mut state.effect, state.selected, &mut state.view);
+                let sprite_error = state
+                    .sprite_errors
+                    .iter()
+                    .find(|(i, _)| *i == state.selected)
+                    .map(|(_, e)| e.as_str());
+                look_ui(
+                    ui,
+                    &mut state.effect,
+                    state.selected,
+                    &mut state.view,
+                    sprite_error,
+                );
             });
             section_ui(ui, "view", "View", "", false, |ui| {
                 view_ui(ui, &mut state.view, &mut state.frame_requested);
@@ -500,11 +511,7 @@ fn emitter_list_ui(ui: &mut Ui, effect: &mut Effect, selected: &mut usize) {
                 *selected = i;
             }
             ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
-                ui.weak(format!(
-                    "{} · {}",
-                    sprite_label(e.look.sprite),
-                    e.shape.label()
-                ));
+                ui.weak(format!("{} · {}", e.look.sprite.label(), e.shape.label()));
             });
         });
     }
@@ -1365,15 +1372,6 @@ ui,
         }
     });
     ui.weak("Drag: orbit · Shift/middle/right-drag: pan · Wheel: zoom · Double-click: frame");
-}
-
-/// UI name of a sprite.
-pub fn sprite_label(s: Sprite) -> &'static str {
-    match s {
-        Sprite::SoftDisc => "soft disc",
-        Sprite::Point => "point",
-        Sprite::Spark => "spark",
-    }
 }
 
 /// UI name of a blend mode.

@@ -59,6 +59,8 @@ pub struct EditorState {
     pub gpu_rejected: Option<(Effect, String)>,
     /// Shader errors from the last hot reload (the last good pipelines keep running).
     pub shader_errors: Vec<String>,
+    /// Sprites that failed to load: (emitter index, message); the soft disc is drawn.
+    pub sprite_errors: Vec<(usize, String)>,
     /// The last simulation failure (the simulation pauses), until playback resumes.
     pub sim_error: Option<String>,
     /// Index of the emitter shown in the emitter-specific sections.
@@ -112,6 +114,7 @@ impl EditorState {
             effect,
             validation_errors,
             gpu_rejected: None,
+            sprite_errors: Vec::new(),
             sim_error: None,
             shader_errors: Vec::new(),
             selected: 0,

@@ -116,23 +116,26 @@ pub struct CameraUniform {
     pub viewport: [f32; 4],
 }
 
-/// Look data for the billboard pass (keep in sync with `LookUniform` in
-/// `shaders/billboard.wgsl`).
+/// Look data for both draw paths (keep in sync with `LookUniform` in
+/// `shaders/look.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct LookUniform {
     /// Emitter simulation space → clip (camera-relative, composed in f64).
     pub clip_from_sim: [[f32; 4]; 4],
-    /// Gradient colours (linear RGBA).
-    pub colors: [[f32; 4]; 8],
-    /// Gradient stop positions, four per vec4.
-    pub stops: [[f32; 4]; 2],
-    /// size start, size end, intensity, stop count.
+    /// size start, size end, intensity, random size fraction.
     pub size_intensity: [f32; 4],
-    /// sprite kind, blend (0 additive, 1 alpha), unused, unused.
-    pub sprite_blend: [u32; 4],
-    /// x: ∫ sprite coverage over the unit quad, y: 1 for a stateless emitter.
+    /// ramp row, blend (0 additive, 1 alpha), flipbook rows, flipbook columns.
+    pub ids: [u32; 4],
+    /// flipbook mode (0 over life, 1 frame rate), random start frame, random salt, unused.
+    pub flags: [u32; 4],
+    /// ∫ sprite brightness over the quad, stateless (0/1), rotation spread (rad),
+    /// flipbook fps.
     pub extra: [f32; 4],
+    /// spin min, spin max (rad/s), streak length (s), longest streak (m).
+    pub spin_streak: [f32; 4],
+    /// ground height in simulation space (m), 1 / soft-edge distance (1/m), unused ×2.
+    pub soft: [f32; 4],
     /// Stateless: constant acceleration xyz, drag k.
     pub motion_a: [f32; 4],
     /// Stateless: wind xyz, render time on the 4096 s clock.
@@ -143,7 +146,7 @@ pub struct LookUniform {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ToneUniform {
-    /// x: exposure.
+    /// x: exposure, y: bloom intensity, z: bloom threshold, w: unused.
     pub exposure: [f32; 4],
 }
 

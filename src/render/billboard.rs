@@ -1,81 +1,177 @@
 //! The billboard pass: one instanced draw of camera-facing quads per emitter, vertex
 //! pulling from the state buffer the update pass just wrote.
 
+use std::collections::HashMap;
+
 use crate::effect::BlendMode;
 use crate::gpu::GpuContext;
-use crate::render::frame::{DrawItem, FrameResources};
+use crate::render::frame::{DrawItem, FrameResources, LookVariant};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 
-/// Instanced billboards into the HDR target.
+/// Instanced billboards into the HDR target, one pipeline per look variant (built on
+/// first use), one sprite bind group per texture.
 pub struct BillboardPass {
     pipeline_layout: wgpu::PipelineLayout,
-    additive: wgpu::RenderPipeline,
-    alpha: wgpu::RenderPipeline,
+    sprite_layout: wgpu::BindGroupLayout,
+    module: wgpu::ShaderModule,
+    pipelines: HashMap<LookVariant, Option<wgpu::RenderPipeline>>,
+    sprite_groups: HashMap<u64, wgpu::BindGroup>,
 }
 
 impl BillboardPass {
-    /// Builds both blend pipelines from `lib`.
+    /// Builds the basic additive and alpha pipelines from `lib`.
     pub fn new(
         ctx: &GpuContext,
         lib: &ShaderLibrary,
         frame: &FrameResources,
     ) -> Result<Self, ShaderError> {
+        let sprite_layout = ctx
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("BillboardPass::sprite_layout"),
+                entries: &[
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 0,
+                        visibility: wgpu::ShaderStages::FRAGMENT,
+                        ty: wgpu::BindingType::Texture {
+                            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                            view_dimension: wgpu::TextureViewDimension::D2,
+                            multisampled: false,
+                        },
+                        count: None,
+                    },
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 1,
+                        visibility: wgpu::ShaderStages::FRAGMENT,
+                        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                        count: None,
+                    },
+                ],
+            });
         let pipeline_layout = ctx
             .device
             .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("BillboardPass::pipeline_layout"),
-                bind_group_layouts: &[Some(&frame.frame_layout), Some(&frame.particle_layout)],
+                bind_group_layouts: &[
+                    Some(&frame.frame_layout),
+                    Some(&frame.particle_layout),
+                    Some(&sprite_layout),
+                ],
                 immediate_size: 0,
             });
-        let (additive, alpha) = Self::build(ctx, lib, &pipeline_layout)?;
+        let (module, pipelines) = Self::build(ctx, lib, &pipeline_layout)?;
         Ok(Self {
             pipeline_layout,
-            additive,
-            alpha,
+            sprite_layout,
+            module,
+            pipelines,
+            sprite_groups: HashMap::new(),
         })
     }
 
+    fn pipeline(
+        ctx: &GpuContext,
+        layout: &wgpu::PipelineLayout,
+        module: &wgpu::ShaderModule,
+        v: LookVariant,
+    ) -> wgpu::RenderPipeline {
+        let blend = if v.alpha {
+            wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING
+        } else {
+            ADDITIVE
+        };
+        crate::render::simple_pipeline(
+            ctx,
+            &format!("BillboardPass {v:?}"),
+            layout,
+            module,
+            ("vs_main", "fs_main"),
+            crate::render::hdr_target(blend),
+            &v.constants(),
+        )
+    }
+
+    /// The two basic variants (validated together with the module).
+    #[allow(clippy::type_complexity)]
     fn build(
         ctx: &GpuContext,
         lib: &ShaderLibrary,
         layout: &wgpu::PipelineLayout,
-    ) -> Result<(wgpu::RenderPipeline, wgpu::RenderPipeline), ShaderError> {
+    ) -> Result<
+        (
+            wgpu::ShaderModule,
+            HashMap<LookVariant, Option<wgpu::RenderPipeline>>,
+        ),
+        ShaderError,
+    > {
         let composed = lib.compose("billboard.wgsl")?;
-        let make = |module: &wgpu::ShaderModule, blend: wgpu::BlendState, label| {
-            // The alpha pipeline draws through the back-to-front order.
-            let sorted = blend != ADDITIVE;
-            crate::render::simple_pipeline(
-                ctx,
-                label,
-                layout,
-                module,
-                ("vs_main", "fs_main"),
-                crate::render::hdr_target(blend),
-                &[("SORTED", if sorted { 1.0 } else { 0.0 })],
-            )
-        };
         create_checked(&ctx.device, &composed, lib, |module| {
-            (
-                make(module, ADDITIVE, "BillboardPass::additive"),
-                make(
-                    module,
-                    wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING,
-                    "BillboardPass::alpha",
-                ),
-            )
+            let mut pipelines = HashMap::new();
+            for alpha in [false, true] {
+                let v = LookVariant {
+                    alpha,
+                    flipbook: false,
+                    flip_blend: false,
+                    streak: false,
+                    soft: false,
+                };
+                pipelines.insert(v, Some(Self::pipeline(ctx, layout, module, v)));
+            }
+            (module.clone(), pipelines)
         })
     }
 
-    /// Rebuilds the pipelines; keeps the old ones on error.
+    /// Rebuilds the pipelines; keeps the old ones on error. Other variants are rebuilt
+    /// on first use.
     pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
-        let (additive, alpha) = Self::build(ctx, lib, &self.pipeline_layout)?;
-        self.additive = additive;
-        self.alpha = alpha;
+        let (module, pipelines) = Self::build(ctx, lib, &self.pipeline_layout)?;
+        self.module = module;
+        self.pipelines = pipelines;
         Ok(())
     }
 
+    /// Creates the pipelines and sprite bind groups `items` need (call before `draw`).
+    pub fn prepare(&mut self, ctx: &GpuContext, items: &[DrawItem], sampler: &wgpu::Sampler) {
+        for d in items.iter().filter(|d| !d.splat) {
+            if !self.pipelines.contains_key(&d.variant) {
+                let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
+                let p = Self::pipeline(ctx, &self.pipeline_layout, &self.module, d.variant);
+                let ok = match pollster::block_on(scope.pop()) {
+                    None => Some(p),
+                    Some(err) => {
+                        log::error!("billboard variant {:?} failed: {err}", d.variant);
+                        None
+                    }
+                };
+                self.pipelines.insert(d.variant, ok);
+            }
+            self.sprite_groups.entry(d.sprite.id).or_insert_with(|| {
+                ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("BillboardPass::sprite_group"),
+                    layout: &self.sprite_layout,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: wgpu::BindingResource::TextureView(&d.sprite.view),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: wgpu::BindingResource::Sampler(sampler),
+                        },
+                    ],
+                })
+            });
+        }
+        // Drop bind groups of textures no longer drawn (e.g. a reloaded PNG).
+        if self.sprite_groups.len() > 32 {
+            let live: std::collections::HashSet<u64> = items.iter().map(|d| d.sprite.id).collect();
+            self.sprite_groups.retain(|id, _| live.contains(id));
+        }
+    }
+
     /// Draws the billboard items into an open render pass (alpha-blended layers first,
-    /// then additive ones on top).
+    /// then additive ones on top). Items whose pipeline or sprite was not prepared are
+    /// skipped.
     pub fn draw(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
@@ -88,19 +184,21 @@ impl BillboardPass {
             BlendMode::Additive => 1,
         });
         for d in sorted {
-            let Some(group) = frame.particle_group(d.key) else {
+            let (Some(group), Some(Some(pipeline)), Some(sprite)) = (
+                frame.particle_group(d.key),
+                self.pipelines.get(&d.variant),
+                self.sprite_groups.get(&d.sprite.id),
+            ) else {
                 continue;
             };
-            pass.set_pipeline(match d.blend {
-                BlendMode::Additive => &self.additive,
-                BlendMode::Alpha => &self.alpha,
-            });
+            pass.set_pipeline(pipeline);
             pass.set_bind_group(
                 0,
                 &frame.frame_group,
                 &[FrameResources::look_offset(d.index)],
             );
             pass.set_bind_group(1, group, &[]);
+            pass.set_bind_group(2, sprite, &[]);
             pass.draw(0..6, 0..d.capacity);
         }
     }

@@ -4,14 +4,19 @@
 
 use std::collections::HashMap;
 
-use crate::effect::{BlendMode, DrawPath, Effect, Look, MAX_COLOR_STOPS, SPLAT_BELOW_PX, Sprite};
+use std::path::Path;
+use std::sync::Arc;
+
+use crate::effect::{BlendMode, DrawPath, Effect, FlipbookMode, Look, SPLAT_BELOW_PX, Streak};
 use crate::gpu::GpuContext;
 use crate::gpu::types::{CameraUniform, LookUniform, PARAMS_STRIDE};
 use crate::render::OrbitCamera;
+use crate::render::look::{RAMP_WIDTH, bake_ramp, gradient_key};
+use crate::render::sprites::{SpriteError, SpriteLibrary, SpriteTexture};
 use crate::sim::{GpuSim, Modules};
 
 /// One emitter to draw this frame.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct DrawItem {
     /// Emitter index (the look uniform's slot).
     pub index: usize,
@@ -23,6 +28,10 @@ pub struct DrawItem {
     pub blend: BlendMode,
     /// The path chosen for this frame.
     pub splat: bool,
+    /// The billboard pipeline variant.
+    pub variant: LookVariant,
+    /// The sprite texture.
+    pub sprite: Arc<SpriteTexture>,
 }
 
 /// Uniform buffers, layouts and bind groups for the draw passes.
@@ -34,6 +43,13 @@ pub struct FrameResources {
     camera: wgpu::Buffer,
     looks: wgpu::Buffer,
     look_slots: usize,
+    ramps: wgpu::Texture,
+    /// What each ramp row holds (`gradient_key`), to upload only changes.
+    ramp_keys: Vec<Option<u64>>,
+    /// Sprite textures (built-in and PNG).
+    pub sprites: SpriteLibrary,
+    /// Sprite load errors of the last `prepare`: (emitter index, error).
+    pub sprite_errors: Vec<(usize, SpriteError)>,
     /// The group-0 bind group.
     pub frame_group: wgpu::BindGroup,
     particle_groups: HashMap<(u64, usize, bool), wgpu::BindGroup>,
@@ -41,60 +57,103 @@ pub struct FrameResources {
     no_order: wgpu::Buffer,
 }
 
-/// ∫ sprite coverage over the unit quad [-1, 1]² (keep in sync with `sprite_coverage`
-/// in `shaders/look.wgsl`), by midpoint quadrature on a 256² grid.
-pub fn sprite_integral(sprite: Sprite) -> f32 {
-    let n = 256;
-    let h = 2.0 / n as f64;
-    let mut sum = 0.0;
-    for j in 0..n {
-        for i in 0..n {
-            let x = -1.0 + (i as f64 + 0.5) * h;
-            let y = -1.0 + (j as f64 + 0.5) * h;
-            let r2 = x * x + y * y;
-            if r2 >= 1.0 {
-                continue;
-            }
-            sum += match sprite {
-                Sprite::Point => f64::from(u8::from(r2 < 0.25)),
-                Sprite::Spark => {
-                    (1.5 * (-r2 * 14.0).exp() + 0.25 * (1.0 - r2) * (1.0 - r2)).min(1.0)
-                }
-                Sprite::SoftDisc => (1.0 - r2) * (1.0 - r2),
-            };
-        }
-    }
-    (sum * h * h) as f32
-}
-
-/// The look uniform of an emitter (gradient padded to `MAX_COLOR_STOPS`).
-pub fn look_uniform(look: &Look) -> LookUniform {
+/// The look uniform of an emitter (everything but the matrices, the ground height and
+/// stateless motion, which depend on the frame). `ramp_row` is the emitter's colour ramp
+/// row, `salt` its per-particle random salt, `sprite_integral` the sprite's ∫ brightness.
+pub fn look_uniform(look: &Look, ramp_row: u32, salt: u32, sprite_integral: f32) -> LookUniform {
     let mut u = LookUniform::default();
-    let stops = &look.color_over_life[..look.color_over_life.len().min(MAX_COLOR_STOPS)];
-    for (i, s) in stops.iter().enumerate() {
-        u.colors[i] = s.rgba;
-        u.stops[i / 4][i % 4] = s.t;
-    }
-    if stops.is_empty() {
-        u.colors[0] = [1.0; 4];
-    }
     u.size_intensity = [
         look.size_start_m,
         look.size_end_m,
         look.intensity,
-        stops.len().max(1) as f32,
+        look.size_random,
     ];
-    u.sprite_blend = [
-        look.sprite.index(),
-        match look.blend {
-            BlendMode::Additive => 0,
-            BlendMode::Alpha => 1,
-        },
-        0,
-        0,
+    let (rows, cols, mode, fps, random_start) = match &look.flipbook {
+        Some(f) => {
+            let (mode, fps) = match f.mode {
+                FlipbookMode::OverLife => (0, 0.0),
+                FlipbookMode::FrameRate { fps } => (1, fps),
+            };
+            (
+                f.rows.max(1),
+                f.cols.max(1),
+                mode,
+                fps,
+                u32::from(f.random_start),
+            )
+        }
+        None => (1, 1, 0, 0.0, 0),
+    };
+    let blend = match look.blend {
+        BlendMode::Additive => 0,
+        BlendMode::Alpha => 1,
+    };
+    u.ids = [ramp_row, blend, rows, cols];
+    u.flags = [mode, random_start, salt, 0];
+    u.extra = [
+        sprite_integral,
+        0.0,
+        look.rotation_random_deg.to_radians(),
+        fps,
     ];
-    u.extra = [sprite_integral(look.sprite), 0.0, 0.0, 0.0];
+    let streak = look.streak.unwrap_or(Streak {
+        length_secs: 0.0,
+        max_length_m: 0.0,
+    });
+    u.spin_streak = [
+        look.spin_deg_per_s.min.to_radians(),
+        look.spin_deg_per_s.max.to_radians(),
+        streak.length_secs,
+        streak.max_length_m,
+    ];
+    let inv_soft = if look.soft_ground_m > 0.0 {
+        1.0 / look.soft_ground_m
+    } else {
+        0.0
+    };
+    u.soft = [0.0, inv_soft, 0.0, 0.0];
     u
+}
+
+/// Which billboard pipeline variant draws an emitter: the look modules it uses (each is
+/// compiled out of the others).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct LookVariant {
+    /// Premultiplied alpha, drawn through the sort order (else additive).
+    pub alpha: bool,
+    /// Flipbook atlas lookup.
+    pub flipbook: bool,
+    /// Cross-fade between flipbook frames.
+    pub flip_blend: bool,
+    /// Velocity-stretched quads.
+    pub streak: bool,
+    /// Ground-plane depth fade.
+    pub soft: bool,
+}
+
+impl LookVariant {
+    /// The variant a look needs.
+    pub fn of(look: &Look) -> Self {
+        Self {
+            alpha: look.blend == BlendMode::Alpha,
+            flipbook: look.flipbook.is_some(),
+            flip_blend: look.flipbook.is_some_and(|f| f.blend_frames),
+            streak: look.streak.is_some(),
+            soft: look.soft_ground_m > 0.0,
+        }
+    }
+
+    /// The override constants of this variant.
+    pub fn constants(self) -> [(&'static str, f64); 5] {
+        let b = |v: bool| if v { 1.0 } else { 0.0 };
+        [
+            ("SORTED", b(self.alpha)),
+            ("FLIPBOOK", b(self.flipbook)),
+            ("FLIP_BLEND", b(self.flip_blend)),
+            ("STREAK", b(self.streak)),
+            ("SOFT", b(self.soft)),
+        ]
+    }
 }
 
 impl FrameResources {
@@ -124,7 +183,20 @@ impl FrameResources {
         };
         let frame_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("FrameResources::frame_layout"),
-            entries: &[uniform(0, false), uniform(1, true)],
+            entries: &[
+                uniform(0, false),
+                uniform(1, true),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: all,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+            ],
         });
         let particle_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("FrameResources::particle_layout"),
@@ -136,13 +208,17 @@ impl FrameResources {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let (looks, frame_group) = Self::look_buffer(ctx, &frame_layout, &camera, 4);
+        let (looks, ramps, frame_group) = Self::look_buffer(ctx, &frame_layout, &camera, 4);
         Self {
             frame_layout,
             particle_layout,
             camera,
             looks,
             look_slots: 4,
+            ramps,
+            ramp_keys: vec![None; 4],
+            sprites: SpriteLibrary::new(ctx),
+            sprite_errors: Vec::new(),
             frame_group,
             particle_groups: HashMap::new(),
             no_order: d.create_buffer(&wgpu::BufferDescriptor {
@@ -159,13 +235,28 @@ impl FrameResources {
         layout: &wgpu::BindGroupLayout,
         camera: &wgpu::Buffer,
         slots: usize,
-    ) -> (wgpu::Buffer, wgpu::BindGroup) {
+    ) -> (wgpu::Buffer, wgpu::Texture, wgpu::BindGroup) {
         let looks = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("FrameResources::looks"),
             size: slots as u64 * PARAMS_STRIDE,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        let ramps = ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("FrameResources::ramps"),
+            size: wgpu::Extent3d {
+                width: RAMP_WIDTH,
+                height: slots as u32,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let ramp_view = ramps.create_view(&Default::default());
         let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("FrameResources::frame_group"),
             layout,
@@ -182,9 +273,13 @@ impl FrameResources {
                         size: wgpu::BufferSize::new(size_of::<LookUniform>() as u64),
                     }),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&ramp_view),
+                },
             ],
         });
-        (looks, group)
+        (looks, ramps, group)
     }
 
     /// The dynamic offset of emitter `index`'s look uniform.
@@ -208,6 +303,7 @@ impl FrameResources {
         size: (u32, u32),
         alpha: f32,
         sort: &mut crate::render::sort::SortPass,
+        asset_dir: Option<&Path>,
     ) -> Vec<DrawItem> {
         let aspect = size.0 as f32 / size.1.max(1) as f32;
         let cam = camera.uniform(size, alpha);
@@ -216,11 +312,14 @@ impl FrameResources {
         let n = effect.emitters.len();
         if n > self.look_slots {
             self.look_slots = n.next_power_of_two();
-            let (looks, group) =
+            let (looks, ramps, group) =
                 Self::look_buffer(ctx, &self.frame_layout, &self.camera, self.look_slots);
             self.looks = looks;
+            self.ramps = ramps;
+            self.ramp_keys = vec![None; self.look_slots];
             self.frame_group = group;
         }
+        self.sprite_errors.clear();
         let mut blocks = vec![0u8; n * PARAMS_STRIDE as usize];
         let mut items = Vec::new();
         for (i, e) in effect.emitters.iter().enumerate() {
@@ -230,8 +329,45 @@ impl FrameResources {
                 .get(i)
                 .map(|p| p.origin())
                 .unwrap_or_default();
-            let mut u = look_uniform(&e.look);
+            let (sprite, error) = self.sprites.resolve(ctx, &e.look.sprite, asset_dir);
+            if let Some(err) = error {
+                self.sprite_errors.push((i, err));
+            }
+            let salt = crate::rng::pcg4d([effect.seed, i as u32, e.seed_offset, 0x5EED_100C])[0];
+            let mut u = look_uniform(&e.look, i as u32, salt, sprite.integral);
             u.clip_from_sim = camera.clip_from_sim(aspect, origin).to_cols_array_2d();
+            let ground = e.collisions.ground.as_ref().map_or(0.0, |g| g.height_m);
+            u.soft[0] = (f64::from(ground) - origin.y) as f32;
+            let key = gradient_key(&e.look);
+            if self.ramp_keys.get(i).copied().flatten() != Some(key) {
+                let row = bake_ramp(&e.look.color_over_life);
+                ctx.queue.write_texture(
+                    wgpu::TexelCopyTextureInfo {
+                        texture: &self.ramps,
+                        mip_level: 0,
+                        origin: wgpu::Origin3d {
+                            x: 0,
+                            y: i as u32,
+                            z: 0,
+                        },
+                        aspect: wgpu::TextureAspect::All,
+                    },
+                    bytemuck::cast_slice(&row),
+                    wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(RAMP_WIDTH * 16),
+                        rows_per_image: Some(1),
+                    },
+                    wgpu::Extent3d {
+                        width: RAMP_WIDTH,
+                        height: 1,
+                        depth_or_array_layers: 1,
+                    },
+                );
+                if let Some(k) = self.ramp_keys.get_mut(i) {
+                    *k = Some(key);
+                }
+            }
             if Modules::of(e).contains(Modules::STATELESS) {
                 // Closed-form evaluation at the render time (between the last two steps).
                 let t =
@@ -287,7 +423,8 @@ impl FrameResources {
             let additive = e.look.blend == BlendMode::Additive;
             let splat = additive
                 && match e.look.draw_path {
-                    DrawPath::Auto => size_px < SPLAT_BELOW_PX,
+                    // Streaks are long even when the particles are small.
+                    DrawPath::Auto => size_px < SPLAT_BELOW_PX && e.look.streak.is_none(),
                     DrawPath::Billboard => false,
                     DrawPath::Splat => true,
                 };
@@ -297,6 +434,8 @@ impl FrameResources {
                 capacity: b.capacity,
                 blend: e.look.blend,
                 splat,
+                variant: LookVariant::of(&e.look),
+                sprite,
             });
         }
         if !blocks.is_empty() {

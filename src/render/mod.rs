@@ -1,10 +1,13 @@
 //! Pass 2 and the composite: billboards into an HDR target, tonemapped to sRGB.
 
 pub mod billboard;
+pub mod bloom;
 pub mod camera;
 pub mod frame;
+pub mod look;
 pub mod sort;
 pub mod splat;
+pub mod sprites;
 pub mod tonemap;
 
 pub use billboard::BillboardPass;
@@ -162,9 +165,14 @@ pub struct Renderer {
     pub sort: sort::SortPass,
     /// The tonemap pass.
     pub tonemap: TonemapPass,
+    /// The bloom passes (recorded only when the effect has bloom).
+    pub bloom: bloom::BloomPass,
     targets: Option<Targets>,
-    /// Exposure multiplier applied before tonemapping.
+    /// Exposure multiplier applied before tonemapping (times the effect's own).
     pub exposure: f32,
+    /// The folder PNG sprite paths are relative to (the preset's; the working directory
+    /// when `None`).
+    pub asset_dir: Option<std::path::PathBuf>,
 }
 
 impl Renderer {
@@ -177,8 +185,10 @@ impl Renderer {
             sort: sort::SortPass::new(ctx, lib)?,
             frame,
             tonemap: TonemapPass::new(ctx, lib, LDR_FORMAT)?,
+            bloom: bloom::BloomPass::new(ctx, lib)?,
             targets: None,
             exposure: 1.0,
+            asset_dir: None,
         })
     }
 
@@ -192,6 +202,7 @@ impl Renderer {
         self.splat.rebuild(ctx, lib)?;
         self.sort.rebuild(ctx, lib)?;
         self.tonemap.rebuild(ctx, lib)?;
+        self.bloom.rebuild(ctx, lib)?;
         Ok(())
     }
 
@@ -226,9 +237,18 @@ impl Renderer {
         let Some(targets) = self.targets.as_ref() else {
             return;
         };
-        let items = self
-            .frame
-            .prepare(ctx, sim, effect, camera, size, alpha, &mut self.sort);
+        let items = self.frame.prepare(
+            ctx,
+            sim,
+            effect,
+            camera,
+            size,
+            alpha,
+            &mut self.sort,
+            self.asset_dir.as_deref(),
+        );
+        self.billboard
+            .prepare(ctx, &items, &self.frame.sprites.sampler);
         // Sort the alpha-blended emitters back to front (nothing runs when there is none).
         for d in items.iter().filter(|d| d.key.2) {
             if let Some(b) = sim.emitter_buffers(d.index) {
@@ -257,13 +277,21 @@ impl Renderer {
         } else {
             None
         };
+        let bloom = match &effect.post.bloom {
+            Some(b) => self
+                .bloom
+                .record(ctx, enc, &targets.hdr_view, accum, targets.size, b)
+                .map(|view| (view, b.intensity)),
+            None => None,
+        };
         self.tonemap.record(
             ctx,
             enc,
             &targets.hdr_view,
             accum,
+            bloom,
             &targets.ldr_view,
-            self.exposure,
+            self.exposure * effect.post.exposure,
         );
     }
 

@@ -5,15 +5,19 @@ use crate::gpu::GpuContext;
 use crate::gpu::types::ToneUniform;
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 
-/// A full-screen tonemap pass, in two variants: with and without the splat's light.
+/// A full-screen tonemap pass, in four variants: with and without the splat's light and
+/// the bloom.
 pub struct TonemapPass {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
-    plain: wgpu::RenderPipeline,
-    with_splat: wgpu::RenderPipeline,
+    /// Indexed by `splat as usize + 2 * bloom as usize`.
+    pipelines: [wgpu::RenderPipeline; 4],
     uniform: wgpu::Buffer,
     /// Bound in place of the splat buffer when nothing was splatted.
     no_splat: wgpu::Buffer,
+    /// Bound in place of the bloom chain when there is no bloom.
+    no_bloom: wgpu::TextureView,
+    sampler: wgpu::Sampler,
     format: wgpu::TextureFormat,
 }
 
@@ -59,6 +63,22 @@ impl TonemapPass {
                         },
                         count: None,
                     },
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 3,
+                        visibility: wgpu::ShaderStages::FRAGMENT,
+                        ty: wgpu::BindingType::Texture {
+                            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                            view_dimension: wgpu::TextureViewDimension::D2,
+                            multisampled: false,
+                        },
+                        count: None,
+                    },
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 4,
+                        visibility: wgpu::ShaderStages::FRAGMENT,
+                        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                        count: None,
+                    },
                 ],
             });
         let pipeline_layout = ctx
@@ -68,7 +88,7 @@ impl TonemapPass {
                 bind_group_layouts: &[Some(&layout)],
                 immediate_size: 0,
             });
-        let (plain, with_splat) = Self::build(ctx, lib, &pipeline_layout, format)?;
+        let pipelines = Self::build(ctx, lib, &pipeline_layout, format)?;
         let uniform = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("TonemapPass::uniform"),
             size: size_of::<ToneUniform>() as u64,
@@ -81,13 +101,37 @@ impl TonemapPass {
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
+        let no_bloom = ctx
+            .device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some("TonemapPass::no_bloom"),
+                size: wgpu::Extent3d {
+                    width: 1,
+                    height: 1,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: crate::render::HDR_FORMAT,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            })
+            .create_view(&Default::default());
+        let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("TonemapPass::sampler"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
         Ok(Self {
             layout,
             pipeline_layout,
-            plain,
-            with_splat,
+            pipelines,
             uniform,
             no_splat,
+            no_bloom,
+            sampler,
             format,
         })
     }
@@ -97,18 +141,16 @@ impl TonemapPass {
         lib: &ShaderLibrary,
         layout: &wgpu::PipelineLayout,
         format: wgpu::TextureFormat,
-    ) -> Result<(wgpu::RenderPipeline, wgpu::RenderPipeline), ShaderError> {
+    ) -> Result<[wgpu::RenderPipeline; 4], ShaderError> {
         let composed = lib.compose("tonemap.wgsl")?;
         create_checked(&ctx.device, &composed, lib, |module| {
-            let make = |splat: bool| {
-                let constants = [("SPLAT", if splat { 1.0 } else { 0.0 })];
+            let make = |i: usize| {
+                let (splat, bloom) = (i & 1 != 0, i & 2 != 0);
+                let b = |v: bool| if v { 1.0 } else { 0.0 };
+                let constants = [("SPLAT", b(splat)), ("BLOOM", b(bloom))];
                 crate::render::simple_pipeline(
                     ctx,
-                    if splat {
-                        "TonemapPass::with_splat"
-                    } else {
-                        "TonemapPass::plain"
-                    },
+                    &format!("TonemapPass splat={splat} bloom={bloom}"),
                     layout,
                     module,
                     ("vs_main", "fs_main"),
@@ -116,26 +158,26 @@ impl TonemapPass {
                     &constants,
                 )
             };
-            (make(false), make(true))
+            [make(0), make(1), make(2), make(3)]
         })
     }
 
     /// Rebuilds the pipelines; keeps the old ones on error.
     pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
-        let (plain, with_splat) = Self::build(ctx, lib, &self.pipeline_layout, self.format)?;
-        self.plain = plain;
-        self.with_splat = with_splat;
+        self.pipelines = Self::build(ctx, lib, &self.pipeline_layout, self.format)?;
         Ok(())
     }
 
-    /// Records the tonemap from `hdr` (plus `splat`'s accumulated light, when given) into
-    /// `out`.
+    /// Records the tonemap from `hdr` (plus `splat`'s accumulated light and `bloom`'s
+    /// glow × intensity, when given) into `out`.
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         ctx: &GpuContext,
         enc: &mut wgpu::CommandEncoder,
         hdr: &wgpu::TextureView,
         splat: Option<&wgpu::Buffer>,
+        bloom: Option<(&wgpu::TextureView, f32)>,
         out: &wgpu::TextureView,
         exposure: f32,
     ) {
@@ -143,7 +185,7 @@ impl TonemapPass {
             &self.uniform,
             0,
             bytemuck::bytes_of(&ToneUniform {
-                exposure: [exposure, 0.0, 0.0, 0.0],
+                exposure: [exposure, bloom.map_or(0.0, |b| b.1), 0.0, 0.0],
             }),
         );
         let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -161,6 +203,16 @@ impl TonemapPass {
                 wgpu::BindGroupEntry {
                     binding: 2,
                     resource: splat.unwrap_or(&self.no_splat).as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(
+                        bloom.map_or(&self.no_bloom, |b| b.0),
+                    ),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::Sampler(&self.sampler),
                 },
             ],
         });
@@ -180,11 +232,8 @@ impl TonemapPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(if splat.is_some() {
-            &self.with_splat
-        } else {
-            &self.plain
-        });
+        let variant = usize::from(splat.is_some()) + 2 * usize::from(bloom.is_some());
+        pass.set_pipeline(&self.pipelines[variant]);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.draw(0..3, 0..1);
     }

@@ -1,0 +1,90 @@
+// bloom.wgsl — the glow in the HDR composite: a soft threshold while halving the HDR
+// image (plus the compute splat's light), a chain of 2× downsamples, then tent-filtered
+// upsamples added back up the chain (Jimenez 2014, "Next Generation Post Processing in
+// Call of Duty: Advanced Warfare"). tonemap.wgsl adds the top of the chain to the image.
+//
+// Contract: group 0: 0 `src` (the level read: the HDR target for `prefilter`, a mip of
+// the bloom chain otherwise), 1 `samp` (linear, clamp), 2 `bloom` (BloomUniform, keep in
+// sync with src/render/bloom.rs), 3 `accum` (the splat's fixed-point light, read by
+// `prefilter` when SPLAT is on).
+
+struct BloomUniform {
+    // x: threshold, y: knee (soft range below the threshold), zw: unused.
+    params: vec4<f32>,
+}
+
+@group(0) @binding(0) var src: texture_2d<f32>;
+@group(0) @binding(1) var samp: sampler;
+@group(0) @binding(2) var<uniform> bloom: BloomUniform;
+@group(0) @binding(3) var<storage, read> accum: array<u32>;
+
+override SPLAT: bool = false;
+// Keep in sync with `FIXED_SCALE` in splat.wgsl.
+const BLOOM_FIXED_SCALE: f32 = 4096.0;
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+}
+
+@vertex
+fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
+    let uv = vec2<f32>(f32((vi << 1u) & 2u), f32(vi & 2u));
+    var out: VsOut;
+    out.clip = vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+    out.uv = vec2<f32>(uv.x, 1.0 - uv.y);
+    return out;
+}
+
+fn hdr_at(p: vec2<i32>) -> vec3<f32> {
+    let size = vec2<i32>(textureDimensions(src));
+    let q = clamp(p, vec2<i32>(0), size - 1);
+    var c = textureLoad(src, q, 0).rgb;
+    if SPLAT {
+        let i = u32(q.y * size.x + q.x) * 3u;
+        c += vec3<f32>(f32(accum[i]), f32(accum[i + 1u]), f32(accum[i + 2u])) / BLOOM_FIXED_SCALE;
+    }
+    return c;
+}
+
+// Full resolution → half: the 2×2 average, kept above a soft threshold (quadratic knee).
+@fragment
+fn prefilter(in: VsOut) -> @location(0) vec4<f32> {
+    let p = vec2<i32>(in.clip.xy) * 2;
+    let c = 0.25 * (hdr_at(p) + hdr_at(p + vec2<i32>(1, 0)) + hdr_at(p + vec2<i32>(0, 1)) + hdr_at(p + vec2<i32>(1, 1)));
+    let threshold = bloom.params.x;
+    let knee = max(bloom.params.y, 1e-5);
+    let l = max(c.r, max(c.g, c.b));
+    var soft = clamp(l - threshold + knee, 0.0, 2.0 * knee);
+    soft = soft * soft / (4.0 * knee);
+    let w = max(soft, l - threshold) / max(l, 1e-5);
+    return vec4<f32>(c * max(w, 0.0), 1.0);
+}
+
+// Halving with five bilinear taps (the dual-filter downsample).
+@fragment
+fn down(in: VsOut) -> @location(0) vec4<f32> {
+    let t = 1.0 / vec2<f32>(textureDimensions(src));
+    var c = textureSample(src, samp, in.uv).rgb * 4.0;
+    c += textureSample(src, samp, in.uv + vec2<f32>(-t.x, -t.y)).rgb;
+    c += textureSample(src, samp, in.uv + vec2<f32>(t.x, -t.y)).rgb;
+    c += textureSample(src, samp, in.uv + vec2<f32>(-t.x, t.y)).rgb;
+    c += textureSample(src, samp, in.uv + vec2<f32>(t.x, t.y)).rgb;
+    return vec4<f32>(c / 8.0, 1.0);
+}
+
+// Doubling with a 3×3 tent, added (blend One + One) onto the level above.
+@fragment
+fn up(in: VsOut) -> @location(0) vec4<f32> {
+    let t = 1.0 / vec2<f32>(textureDimensions(src));
+    var c = textureSample(src, samp, in.uv).rgb * 4.0;
+    c += (textureSample(src, samp, in.uv + vec2<f32>(-t.x, 0.0)).rgb
+        + textureSample(src, samp, in.uv + vec2<f32>(t.x, 0.0)).rgb
+        + textureSample(src, samp, in.uv + vec2<f32>(0.0, -t.y)).rgb
+        + textureSample(src, samp, in.uv + vec2<f32>(0.0, t.y)).rgb) * 2.0;
+    c += textureSample(src, samp, in.uv + vec2<f32>(-t.x, -t.y)).rgb
+        + textureSample(src, samp, in.uv + vec2<f32>(t.x, -t.y)).rgb
+        + textureSample(src, samp, in.uv + vec2<f32>(-t.x, t.y)).rgb
+        + textureSample(src, samp, in.uv + vec2<f32>(t.x, t.y)).rgb;
+    return vec4<f32>(c / 16.0, 1.0);
+}

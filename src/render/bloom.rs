@@ -1,0 +1,283 @@
+//! Bloom: the HDR image (and the splat's light) thresholded into a half-resolution mip
+//! chain, blurred down and back up (`shaders/bloom.wgsl`); the tonemap adds the result.
+//! Nothing is recorded when the effect has no bloom.
+
+use crate::effect::Bloom;
+use crate::gpu::GpuContext;
+use crate::render::HDR_FORMAT;
+use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
+
+/// The bloom passes and their mip chain.
+pub struct BloomPass {
+    layout: wgpu::BindGroupLayout,
+    pipeline_layout: wgpu::PipelineLayout,
+    pipelines: BloomPipelines,
+    sampler: wgpu::Sampler,
+    uniform: wgpu::Buffer,
+    no_splat: wgpu::Buffer,
+    chain: Option<Chain>,
+}
+
+struct BloomPipelines {
+    prefilter: wgpu::RenderPipeline,
+    prefilter_splat: wgpu::RenderPipeline,
+    down: wgpu::RenderPipeline,
+    up: wgpu::RenderPipeline,
+}
+
+/// The mip chain: level 0 is half the target size.
+struct Chain {
+    target_size: (u32, u32),
+    levels: u32,
+    views: Vec<wgpu::TextureView>,
+}
+
+impl BloomPass {
+    /// Builds the pipelines from `lib`.
+    pub fn new(ctx: &GpuContext, lib: &ShaderLibrary) -> Result<Self, ShaderError> {
+        let d = &ctx.device;
+        let frag = wgpu::ShaderStages::FRAGMENT;
+        let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("BloomPass::layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: frag,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: frag,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: frag,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: frag,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let pipeline_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("BloomPass::pipeline_layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipelines = Self::build(ctx, lib, &pipeline_layout)?;
+        Ok(Self {
+            layout,
+            pipeline_layout,
+            pipelines,
+            sampler: d.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("BloomPass::sampler"),
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                ..Default::default()
+            }),
+            uniform: d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("BloomPass::uniform"),
+                size: 16,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            no_splat: d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("BloomPass::no_splat"),
+                size: 16,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            }),
+            chain: None,
+        })
+    }
+
+    fn build(
+        ctx: &GpuContext,
+        lib: &ShaderLibrary,
+        layout: &wgpu::PipelineLayout,
+    ) -> Result<BloomPipelines, ShaderError> {
+        let composed = lib.compose("bloom.wgsl")?;
+        create_checked(&ctx.device, &composed, lib, |module| {
+            let make = |fs: &str, blend: Option<wgpu::BlendState>, splat: bool| {
+                let constants = [("SPLAT", if splat { 1.0 } else { 0.0 })];
+                crate::render::simple_pipeline(
+                    ctx,
+                    &format!("BloomPass::{fs}"),
+                    layout,
+                    module,
+                    ("vs_main", fs),
+                    wgpu::ColorTargetState {
+                        format: HDR_FORMAT,
+                        blend,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    },
+                    &constants,
+                )
+            };
+            BloomPipelines {
+                prefilter: make("prefilter", None, false),
+                prefilter_splat: make("prefilter", None, true),
+                down: make("down", None, false),
+                up: make("up", Some(crate::render::billboard::ADDITIVE), false),
+            }
+        })
+    }
+
+    /// Rebuilds the pipelines; keeps the old ones on error.
+    pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
+        self.pipelines = Self::build(ctx, lib, &self.pipeline_layout)?;
+        Ok(())
+    }
+
+    fn ensure_chain(&mut self, ctx: &GpuContext, target_size: (u32, u32), levels: u32) {
+        let (w, h) = ((target_size.0 / 2).max(1), (target_size.1 / 2).max(1));
+        // No level smaller than 1 × 1.
+        let levels = levels.clamp(1, 32 - w.min(h).leading_zeros());
+        let stale = self
+            .chain
+            .as_ref()
+            .is_none_or(|c| c.target_size != target_size || c.levels != levels);
+        if stale {
+            let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("BloomPass::chain"),
+                size: wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: levels,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: HDR_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            });
+            let views = (0..levels)
+                .map(|m| {
+                    texture.create_view(&wgpu::TextureViewDescriptor {
+                        label: Some("BloomPass::level"),
+                        base_mip_level: m,
+                        mip_level_count: Some(1),
+                        ..Default::default()
+                    })
+                })
+                .collect();
+            self.chain = Some(Chain {
+                target_size,
+                levels,
+                views,
+            });
+        }
+    }
+
+    /// Records the bloom of `hdr` (plus `splat`'s light) and returns the view the tonemap
+    /// adds (level 0 of the chain).
+    pub fn record(
+        &mut self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        hdr: &wgpu::TextureView,
+        splat: Option<&wgpu::Buffer>,
+        target_size: (u32, u32),
+        settings: &Bloom,
+    ) -> Option<&wgpu::TextureView> {
+        let params = [
+            settings.threshold,
+            0.5 * settings.threshold.max(1e-3),
+            0.0,
+            0.0,
+        ];
+        ctx.queue
+            .write_buffer(&self.uniform, 0, bytemuck::cast_slice(&params));
+        self.ensure_chain(ctx, target_size, settings.levels);
+        let chain = self.chain.as_ref()?;
+        let group = |src: &wgpu::TextureView| {
+            ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("BloomPass::group"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(src),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::Sampler(&self.sampler),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: self.uniform.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: splat.unwrap_or(&self.no_splat).as_entire_binding(),
+                    },
+                ],
+            })
+        };
+        let pass = |enc: &mut wgpu::CommandEncoder,
+                    pipeline: &wgpu::RenderPipeline,
+                    src: &wgpu::TextureView,
+                    dst: &wgpu::TextureView,
+                    load: bool| {
+            let bind = group(src);
+            let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("BloomPass::pass"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: dst,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: if load {
+                            wgpu::LoadOp::Load
+                        } else {
+                            wgpu::LoadOp::Clear(wgpu::Color::BLACK)
+                        },
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            rp.set_pipeline(pipeline);
+            rp.set_bind_group(0, &bind, &[]);
+            rp.draw(0..3, 0..1);
+        };
+        let p = &self.pipelines;
+        let prefilter = if splat.is_some() {
+            &p.prefilter_splat
+        } else {
+            &p.prefilter
+        };
+        pass(enc, prefilter, hdr, &chain.views[0], false);
+        for m in 1..chain.views.len() {
+            pass(enc, &p.down, &chain.views[m - 1], &chain.views[m], false);
+        }
+        for m in (1..chain.views.len()).rev() {
+            pass(enc, &p.up, &chain.views[m], &chain.views[m - 1], true);
+        }
+        chain.views.first()
+    }
+}

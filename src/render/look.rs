@@ -1,0 +1,120 @@
+//! The look's data as the GPU sees it, with CPU mirrors of the shader functions in
+//! `shaders/look.wgsl` (colour ramps, flipbook frame selection) for tests and tools.
+
+use crate::effect::{ColorStop, Flipbook, FlipbookMode, Look};
+
+/// Texels per colour ramp row (keep in sync with `RAMP_WIDTH` in `shaders/look.wgsl`).
+pub const RAMP_WIDTH: u32 = 1024;
+
+/// The gradient's value at `t`: linear between stops, clamped at the ends.
+pub fn sample_gradient(stops: &[ColorStop], t: f32) -> [f32; 4] {
+    let Some(first) = stops.first() else {
+        return [1.0; 4];
+    };
+    if t <= first.t {
+        return first.rgba;
+    }
+    for pair in stops.windows(2) {
+        let (a, b) = (pair[0], pair[1]);
+        if t <= b.t {
+            let f = if b.t > a.t {
+                (t - a.t) / (b.t - a.t)
+            } else {
+                1.0
+            };
+            let mut out = [0.0; 4];
+            for (k, o) in out.iter_mut().enumerate() {
+                *o = a.rgba[k] + (b.rgba[k] - a.rgba[k]) * f;
+            }
+            return out;
+        }
+    }
+    stops.last().map_or([1.0; 4], |s| s.rgba)
+}
+
+/// One ramp row: the gradient evaluated exactly at t = i / (RAMP_WIDTH − 1). Any number
+/// of stops bakes to the same 16 KiB; the shader does two loads and a lerp per vertex
+/// instead of a loop over the stops.
+pub fn bake_ramp(stops: &[ColorStop]) -> Vec<[f32; 4]> {
+    (0..RAMP_WIDTH)
+        .map(|i| sample_gradient(stops, i as f32 / (RAMP_WIDTH - 1) as f32))
+        .collect()
+}
+
+/// `particle_color` of look.wgsl on a baked row.
+pub fn ramp_lookup(ramp: &[[f32; 4]], t: f32) -> [f32; 4] {
+    let x = t.clamp(0.0, 1.0) * (RAMP_WIDTH - 1) as f32;
+    let i = (x as u32).min(RAMP_WIDTH - 1) as usize;
+    let j = (i + 1).min(RAMP_WIDTH as usize - 1);
+    let f = x - i as f32;
+    let (a, b) = (ramp[i], ramp[j]);
+    std::array::from_fn(|k| a[k] + (b[k] - a[k]) * f)
+}
+
+/// A flipbook frame choice: `frame`, the `next` frame and the weight of `next`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameChoice {
+    /// The frame shown.
+    pub frame: u32,
+    /// The frame blended in.
+    pub next: u32,
+    /// Weight of `next` (0 without frame blending).
+    pub weight: f32,
+}
+
+/// `flipbook_frames` of look.wgsl: `start01` is the particle's random number for its
+/// start frame.
+pub fn flipbook_frame(f: &Flipbook, age: f32, life: f32, start01: f32) -> FrameChoice {
+    let count = (f.rows * f.cols).max(1);
+    let n = count as f32;
+    let start = if f.random_start {
+        ((start01 * n) as u32).min(count - 1)
+    } else {
+        0
+    };
+    match f.mode {
+        FlipbookMode::OverLife => {
+            let t = (age / life).clamp(0.0, 1.0);
+            if f.blend_frames {
+                let pos = t * (n - 1.0);
+                let f0 = (pos as u32).min(count - 1);
+                let f1 = (f0 + 1).min(count - 1);
+                FrameChoice {
+                    frame: (f0 + start) % count,
+                    next: (f1 + start) % count,
+                    weight: pos - f0 as f32,
+                }
+            } else {
+                let fr = ((t * n) as u32).min(count - 1);
+                FrameChoice {
+                    frame: (fr + start) % count,
+                    next: (fr + start) % count,
+                    weight: 0.0,
+                }
+            }
+        }
+        FlipbookMode::FrameRate { fps } => {
+            let pos = age.max(0.0) * fps;
+            let whole = pos.floor();
+            let f0 = (whole as u32 + start) % count;
+            FrameChoice {
+                frame: f0,
+                next: (f0 + 1) % count,
+                weight: if f.blend_frames { pos - whole } else { 0.0 },
+            }
+        }
+    }
+}
+
+/// A stable 32-bit key of what a ramp row holds (rows are re-uploaded only on change).
+pub fn gradient_key(look: &Look) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for s in &look.color_over_life {
+        s.t.to_bits().hash(&mut h);
+        for c in s.rgba {
+            c.to_bits().hash(&mut h);
+        }
+    }
+    h.finish()
+}

@@ -1,0 +1,412 @@
+//! Sprite textures: the built-in procedural set (generated on first use) and PNGs from
+//! disk, each uploaded premultiplied and linear (`Rgba16Float`) with a full mip chain.
+//!
+//! A PNG that is missing or broken never stops the frame: [`SpriteLibrary::resolve`]
+//! returns the built-in soft disc and an error that names the file and the problem. A PNG
+//! that changes on disk is reloaded after [`SpriteLibrary::invalidate`].
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use image::{Rgba, Rgba32FImage};
+
+use crate::effect::Sprite;
+use crate::gpu::GpuContext;
+
+/// Side of a built-in sprite (one frame), pixels.
+pub const BUILT_IN_SIZE: u32 = 128;
+/// Frames per side of the built-in flame sheet.
+pub const FLAME_SHEET_GRID: u32 = 4;
+/// The texture format sprites are stored in (linear, premultiplied alpha).
+pub const SPRITE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// An uploaded sprite texture.
+#[derive(Debug)]
+pub struct SpriteTexture {
+    /// Unique id (bind groups are cached by it).
+    pub id: u64,
+    /// View over all mips.
+    pub view: wgpu::TextureView,
+    /// Width and height of mip 0.
+    pub size: (u32, u32),
+    /// ∫ premultiplied brightness over the sprite's quad [-1, 1]² (4 × the mean), the
+    /// splat's energy per unit of colour.
+    pub integral: f32,
+}
+
+/// A sprite that could not be loaded.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error(
+    "sprite {path}: {reason} — drawing the built-in soft disc instead; fix the file or the path (relative to the preset)"
+)]
+pub struct SpriteError {
+    /// The file as resolved.
+    pub path: String,
+    /// What went wrong.
+    pub reason: String,
+}
+
+/// Built-in and file sprites, uploaded once and shared by every emitter that uses them.
+pub struct SpriteLibrary {
+    built_in: HashMap<Sprite, Arc<SpriteTexture>>,
+    files: HashMap<PathBuf, Result<Arc<SpriteTexture>, SpriteError>>,
+    /// Trilinear, clamp-to-edge.
+    pub sampler: wgpu::Sampler,
+    next_id: u64,
+}
+
+impl SpriteLibrary {
+    /// An empty library (built-ins are generated on first use).
+    pub fn new(ctx: &GpuContext) -> Self {
+        let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("SpriteLibrary::sampler"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        Self {
+            built_in: HashMap::new(),
+            files: HashMap::new(),
+            sampler,
+            next_id: 1,
+        }
+    }
+
+    /// The texture for `sprite`; PNG paths are relative to `base_dir` (the preset's
+    /// folder; the working directory when `None`). A file that fails to load gives the
+    /// soft disc and the error.
+    pub fn resolve(
+        &mut self,
+        ctx: &GpuContext,
+        sprite: &Sprite,
+        base_dir: Option<&Path>,
+    ) -> (Arc<SpriteTexture>, Option<SpriteError>) {
+        let Sprite::Image(rel) = sprite else {
+            return (self.built_in(ctx, sprite), None);
+        };
+        let path = resolve_path(rel, base_dir);
+        if !self.files.contains_key(&path) {
+            let loaded = load_png(&path).map(|img| {
+                let id = self.take_id();
+                Arc::new(upload(ctx, &img, id, &path.display().to_string()))
+            });
+            if let Err(e) = &loaded {
+                log::warn!("{e}");
+            }
+            self.files.insert(path.clone(), loaded);
+        }
+        match self.files.get(&path) {
+            Some(Ok(t)) => (t.clone(), None),
+            Some(Err(e)) => {
+                let e = e.clone();
+                (self.built_in(ctx, &Sprite::SoftDisc), Some(e))
+            }
+            None => (self.built_in(ctx, &Sprite::SoftDisc), None),
+        }
+    }
+
+    /// Forgets cached files among `changed` (they reload on the next `resolve`). Returns
+    /// true when any was cached.
+    pub fn invalidate(&mut self, changed: &[PathBuf]) -> bool {
+        let before = self.files.len();
+        self.files.retain(|p, _| {
+            !changed
+                .iter()
+                .any(|c| c == p || (c.file_name() == p.file_name() && same_file(c, p)))
+        });
+        before != self.files.len()
+    }
+
+    /// Folders holding the file sprites in use (to watch for changes).
+    pub fn watched_dirs(&self) -> Vec<PathBuf> {
+        let mut dirs: Vec<PathBuf> = self
+            .files
+            .keys()
+            .filter_map(|p| p.parent().map(Path::to_path_buf))
+            .map(|d| {
+                if d.as_os_str().is_empty() {
+                    PathBuf::from(".")
+                } else {
+                    d
+                }
+            })
+            .collect();
+        dirs.sort();
+        dirs.dedup();
+        dirs
+    }
+
+    fn take_id(&mut self) -> u64 {
+        self.next_id += 1;
+        self.next_id
+    }
+
+    fn built_in(&mut self, ctx: &GpuContext, sprite: &Sprite) -> Arc<SpriteTexture> {
+        let key = match sprite {
+            Sprite::Image(_) => Sprite::SoftDisc,
+            s => s.clone(),
+        };
+        if let Some(t) = self.built_in.get(&key) {
+            return t.clone();
+        }
+        let id = self.take_id();
+        let img = generate(&key);
+        let tex = Arc::new(upload(ctx, &img, id, key.label()));
+        self.built_in.insert(key, tex.clone());
+        tex
+    }
+}
+
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
+/// `rel` against `base_dir` (absolute paths are kept).
+pub fn resolve_path(rel: &str, base_dir: Option<&Path>) -> PathBuf {
+    let rel = Path::new(rel);
+    match base_dir {
+        Some(dir) if rel.is_relative() => dir.join(rel),
+        _ => rel.to_path_buf(),
+    }
+}
+
+/// Loads a PNG as linear, premultiplied RGBA.
+pub fn load_png(path: &Path) -> Result<Rgba32FImage, SpriteError> {
+    let err = |reason: String| SpriteError {
+        path: path.display().to_string(),
+        reason,
+    };
+    let bytes = std::fs::read(path).map_err(|e| err(format!("cannot read it ({e})")))?;
+    let img = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
+        .map_err(|e| err(format!("not a readable PNG ({e})")))?;
+    let (w, h) = (img.width(), img.height());
+    if w == 0 || h == 0 || w > 8192 || h > 8192 {
+        return Err(err(format!(
+            "{w}×{h} pixels; sprites must be 1..=8192 a side"
+        )));
+    }
+    let rgba = img.to_rgba8();
+    let mut out = Rgba32FImage::new(w, h);
+    for (src, dst) in rgba.pixels().zip(out.pixels_mut()) {
+        let a = f32::from(src[3]) / 255.0;
+        let lin = |c: u8| srgb_to_linear(f32::from(c) / 255.0) * a;
+        *dst = Rgba([lin(src[0]), lin(src[1]), lin(src[2]), a]);
+    }
+    Ok(out)
+}
+
+fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// The mip chain of `img` (halving with a triangle filter down to 1 × 1).
+pub fn mip_chain(img: &Rgba32FImage) -> Vec<Rgba32FImage> {
+    let mut levels = vec![img.clone()];
+    while let Some(last) = levels.last() {
+        let (w, h) = last.dimensions();
+        if w == 1 && h == 1 {
+            break;
+        }
+        let next = image::imageops::resize(
+            last,
+            (w / 2).max(1),
+            (h / 2).max(1),
+            image::imageops::FilterType::Triangle,
+        );
+        levels.push(next);
+    }
+    levels
+}
+
+/// 4 × the mean premultiplied brightness ((r + g + b) / 3) — ∫ over the quad [-1, 1]².
+pub fn brightness_integral(img: &Rgba32FImage) -> f32 {
+    let n = (img.width() * img.height()).max(1) as f64;
+    let sum: f64 = img
+        .pixels()
+        .map(|p| f64::from(p[0] + p[1] + p[2]) / 3.0)
+        .sum();
+    (4.0 * sum / n) as f32
+}
+
+fn upload(ctx: &GpuContext, img: &Rgba32FImage, id: u64, label: &str) -> SpriteTexture {
+    let levels = mip_chain(img);
+    let (w, h) = img.dimensions();
+    let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(&format!("sprite {label}")),
+        size: wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: levels.len() as u32,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: SPRITE_FORMAT,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    for (mip, level) in levels.iter().enumerate() {
+        let (lw, lh) = level.dimensions();
+        let halfs: Vec<half::f16> = level
+            .as_raw()
+            .iter()
+            .map(|&v| half::f16::from_f32(v))
+            .collect();
+        ctx.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture,
+                mip_level: mip as u32,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            bytemuck::cast_slice(&halfs),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(lw * 8),
+                rows_per_image: Some(lh),
+            },
+            wgpu::Extent3d {
+                width: lw,
+                height: lh,
+                depth_or_array_layers: 1,
+            },
+        );
+    }
+    SpriteTexture {
+        id,
+        view: texture.create_view(&Default::default()),
+        size: (w, h),
+        integral: brightness_integral(img),
+    }
+}
+
+/// The built-in sprite `sprite` as a linear, premultiplied image (white light; the
+/// colour comes from the gradient). `Image` gives the soft disc.
+pub fn generate(sprite: &Sprite) -> Rgba32FImage {
+    let n = BUILT_IN_SIZE;
+    match sprite {
+        Sprite::FlameSheet => {
+            let g = FLAME_SHEET_GRID;
+            let mut sheet = Rgba32FImage::new(n * g, n * g);
+            for fy in 0..g {
+                for fx in 0..g {
+                    let phase = (fy * g + fx) as f32 / (g * g) as f32;
+                    let frame = paint(n, |x, y| flame(x, y, phase, 1.0));
+                    image::imageops::replace(
+                        &mut sheet,
+                        &frame,
+                        i64::from(fx * n),
+                        i64::from(fy * n),
+                    );
+                }
+            }
+            sheet
+        }
+        Sprite::Point => paint(n, |x, y| {
+            let r = (x * x + y * y).sqrt();
+            // 1.5-texel anti-aliased edge at r = 0.5.
+            (0.5 - r) * n as f32 / 3.0 + 0.5
+        }),
+        Sprite::Spark => paint(n, |x, y| {
+            let r2 = x * x + y * y;
+            if r2 >= 1.0 {
+                0.0
+            } else {
+                (1.5 * (-r2 * 14.0).exp() + 0.25 * (1.0 - r2) * (1.0 - r2)).min(1.0)
+            }
+        }),
+        Sprite::FlameWisp => paint(n, |x, y| flame(x, y, 0.0, 0.0)),
+        Sprite::SmokePuff => paint(n, |x, y| {
+            let r2 = x * x + y * y;
+            if r2 >= 1.0 {
+                return 0.0;
+            }
+            let body = (1.0 - r2) * (1.0 - r2);
+            let lumps = fbm(x * 2.5 + 7.1, y * 2.5 - 3.3, 4);
+            (body * (0.35 + 1.1 * lumps)).clamp(0.0, 1.0)
+        }),
+        Sprite::SoftDisc | Sprite::Image(_) => paint(n, |x, y| {
+            let r2 = x * x + y * y;
+            if r2 >= 1.0 {
+                0.0
+            } else {
+                (1.0 - r2) * (1.0 - r2)
+            }
+        }),
+    }
+}
+
+/// An `n`² image whose alpha is `alpha(x, y)` over [-1, 1]² (y up), white premultiplied.
+fn paint(n: u32, alpha: impl Fn(f32, f32) -> f32) -> Rgba32FImage {
+    Rgba32FImage::from_fn(n, n, |i, j| {
+        let x = (i as f32 + 0.5) / n as f32 * 2.0 - 1.0;
+        let y = 1.0 - (j as f32 + 0.5) / n as f32 * 2.0;
+        let a = alpha(x, y).clamp(0.0, 1.0);
+        Rgba([a, a, a, a])
+    })
+}
+
+/// A flame tongue: wide, dense base; a wavering tip. `phase` ∈ [0, 1) animates the
+/// waver (a loop), `amount` scales it.
+fn flame(x: f32, y: f32, phase: f32, amount: f32) -> f32 {
+    // v: 0 at the bottom edge, 1 at the top.
+    let v = (y + 1.0) * 0.5;
+    let tau = std::f32::consts::TAU;
+    let sway = amount * 0.18 * v * v * (tau * (phase + v * 0.8)).sin();
+    let lick = amount * 0.06 * v * (tau * (2.0 * phase + v * 2.3)).sin();
+    let xs = x - sway - lick;
+    // Half-width: round base, pointed tip.
+    let width = 0.62 * (1.0 - v).powf(0.85) * (v * 5.0).min(1.0).sqrt() + 1e-3;
+    let edge = 1.0 - (xs / width).abs();
+    if edge <= 0.0 {
+        return 0.0;
+    }
+    let detail = 0.75 + 0.5 * fbm(x * 3.0 + phase * 11.0, y * 3.0 - phase * 17.0, 3);
+    let fade = (1.0 - v).powf(0.6) * (v * 8.0).min(1.0);
+    (edge.powf(0.7) * fade * detail).clamp(0.0, 1.0)
+}
+
+/// Value-noise fbm in [0, 1] (a fixed hash: the built-ins are identical everywhere).
+fn fbm(x: f32, y: f32, octaves: u32) -> f32 {
+    let mut sum = 0.0;
+    let mut amp = 0.5;
+    let mut norm = 0.0;
+    let (mut fx, mut fy) = (x, y);
+    for _ in 0..octaves {
+        sum += amp * value_noise(fx, fy);
+        norm += amp;
+        amp *= 0.5;
+        fx = fx * 2.03 + 1.7;
+        fy = fy * 2.03 - 0.9;
+    }
+    sum / norm
+}
+
+fn value_noise(x: f32, y: f32) -> f32 {
+    let (ix, iy) = (x.floor(), y.floor());
+    let (fx, fy) = (x - ix, y - iy);
+    let s = |t: f32| t * t * (3.0 - 2.0 * t);
+    let h = |a: f32, b: f32| {
+        let mut v = (a as i32 as u32).wrapping_mul(0x9E37_79B1)
+            ^ (b as i32 as u32).wrapping_mul(0x85EB_CA77);
+        v ^= v >> 15;
+        v = v.wrapping_mul(0x2C1B_3C6D);
+        v ^= v >> 12;
+        (v & 0xffff) as f32 / 65535.0
+    };
+    let a = h(ix, iy);
+    let b = h(ix + 1.0, iy);
+    let c = h(ix, iy + 1.0);
+    let d = h(ix + 1.0, iy + 1.0);
+    let (sx, sy) = (s(fx), s(fy));
+    a + (b - a) * sx + (c - a) * sy + (a - b - c + d) * sx * sy
+}
