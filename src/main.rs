@@ -51,6 +51,13 @@ enum Command {
         #[arg(long)]
         profile: bool,
     },
+    /// Write the built-in procedural sprites as PNGs (straight alpha), to start a
+    /// texture from.
+    Sprites {
+        /// Output folder.
+        #[arg(long, default_value = "sprites")]
+        out: PathBuf,
+    },
     /// Render PNG frames of an effect headless.
     Render {
         /// Preset file (default: the embedded campfire).
@@ -197,6 +204,7 @@ fn main() {
             shader_dir.as_deref(),
         ),
         Some(Command::Check { paths }) => check(&paths),
+        Some(Command::Sprites { out }) => write_sprites(&out),
         Some(Command::Bench { kind }) => bench(kind),
     };
     if let Err(err) = result {
@@ -419,5 +427,27 @@ fn check(paths: &[PathBuf]) -> anyhow::Result<()> {
         presets.len(),
         shader_dirs.len()
     );
+    Ok(())
+}
+
+/// `ignis sprites`: the built-in sprites as straight-alpha sRGB PNGs.
+fn write_sprites(out: &Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    for sprite in ignis::effect::Sprite::BUILT_IN {
+        let img = ignis::render::sprites::to_png_rgba(&ignis::render::sprites::generate(&sprite));
+        let name = format!(
+            "{}.png",
+            sprite
+                .label()
+                .split(' ')
+                .take(2)
+                .collect::<Vec<_>>()
+                .join("_")
+        );
+        let path = out.join(name);
+        img.save(&path)
+            .with_context(|| format!("writing {}", path.display()))?;
+        println!("wrote {}", path.display());
+    }
     Ok(())
 }

@@ -200,6 +200,31 @@ pub fn load_png(path: &Path) -> Result<Rgba32FImage, SpriteError> {
     Ok(out)
 }
 
+/// A linear premultiplied image back to straight-alpha sRGB bytes (what `load_png` reads).
+pub fn to_png_rgba(img: &Rgba32FImage) -> image::RgbaImage {
+    image::RgbaImage::from_fn(img.width(), img.height(), |x, y| {
+        let p = img.get_pixel(x, y);
+        let a = p[3].clamp(0.0, 1.0);
+        let c = |v: f32| {
+            let straight = if a > 0.0 {
+                (v / a).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (linear_to_srgb(straight) * 255.0).round() as u8
+        };
+        Rgba([c(p[0]), c(p[1]), c(p[2]), (a * 255.0).round() as u8])
+    })
+}
+
+fn linear_to_srgb(c: f32) -> f32 {
+    if c <= 0.003_130_8 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
 fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 {
         c / 12.92
