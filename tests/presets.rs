@@ -9,9 +9,10 @@ use std::path::{Path, PathBuf};
 
 use common::*;
 use ignis::effect::{
-    Attractor, BlendMode, CURRENT_VERSION, CameraHint, Collisions, ColorStop, Effect, Emitter,
-    Falloff, FlamePull, Forces, GroundPlane, Gusts, Integrator, Look, MAX_CAPACITY, Range, Shape,
-    SpawnNoise, SphereCollider, Sprite, TimeMode, TimeSettings, Transform, Turbulence, Vortex,
+    Attractor, BlendMode, Bloom, CURRENT_VERSION, CameraHint, Collisions, ColorStop, Effect,
+    Emitter, Falloff, FlamePull, Flipbook, FlipbookMode, Forces, GroundPlane, Gusts, Integrator,
+    Look, MAX_CAPACITY, Post, Range, Shape, SpawnNoise, SphereCollider, Sprite, Streak, TimeMode,
+    TimeSettings, Transform, Turbulence, Vortex,
 };
 use ignis::headless::Headless;
 use ignis::preset::{self, PresetError};
@@ -1217,16 +1218,25 @@ fn look() -> BoxedStrategy<Look> {
         prop_oneof![
             Just(Sprite::SoftDisc),
             Just(Sprite::Point),
-            Just(Sprite::Spark)
+            Just(Sprite::Spark),
+            Just(Sprite::FlameSheet),
+            "[a-z]{1,8}(/[a-z]{1,8})?\\.png".prop_map(Sprite::Image),
         ],
         fl(0.0, 1e3),
         fl(0.0, 1e3),
         proptest::collection::vec(stop, 1..=8),
         fl(0.0, 1e4),
         prop_oneof![Just(BlendMode::Additive), Just(BlendMode::Alpha)],
+        (
+            proptest::option::of((1u32..=64, 1u32..=64, fl(0.0, 1000.0), any::<bool>())),
+            fl(0.0, 1.0),
+            fl(0.0, 360.0),
+            proptest::option::of((fl(0.0, 10.0), fl(0.0, 1e3))),
+        ),
     )
         .prop_map(
-            |(sprite, size_start_m, size_end_m, mut stops, intensity, blend)| {
+            |(sprite, size_start_m, size_end_m, mut stops, intensity, blend, extra)| {
+                let (flip, size_random, rotation_random_deg, streak) = extra;
                 stops.sort_by(|a, b| a.t.total_cmp(&b.t));
                 // -0.0 sorts before 0.0 but the validator compares with <, so both orders pass.
                 Look {
@@ -1236,6 +1246,23 @@ fn look() -> BoxedStrategy<Look> {
                     color_over_life: stops,
                     intensity,
                     blend,
+                    flipbook: flip.map(|(rows, cols, fps, over_life)| Flipbook {
+                        rows,
+                        cols,
+                        mode: if over_life {
+                            FlipbookMode::OverLife
+                        } else {
+                            FlipbookMode::FrameRate { fps }
+                        },
+                        blend_frames: over_life,
+                        random_start: !over_life,
+                    }),
+                    size_random,
+                    rotation_random_deg,
+                    streak: streak.map(|(length_secs, max_length_m)| Streak {
+                        length_secs,
+                        max_length_m,
+                    }),
                     // Fields added later keep their defaults here.
                     ..Look::default()
                 }
@@ -1378,6 +1405,10 @@ fn effect() -> BoxedStrategy<Effect> {
                 time,
                 camera,
                 emitters,
+                post: Post {
+                    exposure: 1.5,
+                    bloom: (seed % 2 == 0).then(Bloom::default),
+                },
             }
         })
         .boxed()

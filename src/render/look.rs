@@ -22,11 +22,8 @@ pub fn sample_gradient(stops: &[ColorStop], t: f32) -> [f32; 4] {
             } else {
                 1.0
             };
-            let mut out = [0.0; 4];
-            for (k, o) in out.iter_mut().enumerate() {
-                *o = a.rgba[k] + (b.rgba[k] - a.rgba[k]) * f;
-            }
-            return out;
+            // (1 − f)·a + f·b: exactly a at f = 0 and exactly b at f = 1.
+            return std::array::from_fn(|k| a.rgba[k] * (1.0 - f) + b.rgba[k] * f);
         }
     }
     stops.last().map_or([1.0; 4], |s| s.rgba)

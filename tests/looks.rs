@@ -1,0 +1,746 @@
+//! Looks on a real adapter: the WGSL flipbook and colour-ramp functions against
+//! hand-computed values, PNG sprites (missing, broken, reloaded), streaks, soft ground,
+//! bloom, and fixed-seed frames of presets against committed reference images.
+//!
+//! Reference images live in `tests/reference/`. They are regenerated only deliberately:
+//! `IGNIS_BLESS=1 cargo test --release --test looks reference_images` (then look at them
+//! and commit them with the change that moved them).
+
+mod common;
+
+use std::path::Path;
+
+use common::*;
+use glam::Vec3;
+use ignis::effect::{
+    BlendMode, ColorStop, DrawPath, Effect, Flipbook, FlipbookMode, GroundPlane, Look, Range,
+    Sprite, Streak,
+};
+use ignis::gpu::GpuContext;
+use ignis::gpu::types::{CameraUniform, LookUniform};
+use ignis::headless::Headless;
+use ignis::render::frame::look_uniform;
+use ignis::render::look::{RAMP_WIDTH, bake_ramp, flipbook_frame, sample_gradient};
+use ignis::render::sprites::SpriteLibrary;
+use ignis::shaders::{EMBEDDED, ShaderLibrary};
+use wgpu::util::DeviceExt;
+
+const PROBE: &str = r#"
+#import "look.wgsl"
+@group(0) @binding(0) var<uniform> camera: CameraUniform;
+@group(0) @binding(1) var<uniform> look: LookUniform;
+@group(0) @binding(2) var ramps: texture_2d<f32>;
+// x: age, y: life, z: random start number, w: blend frames (0/1).
+@group(0) @binding(3) var<storage, read> inputs: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read_write> outputs: array<vec4<f32>>;
+
+@compute @workgroup_size(1)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    _ = camera.viewport;
+    let v = inputs[i];
+    outputs[2u * i] = vec4<f32>(flipbook_frames(v.x, v.y, v.z, v.w > 0.5), 0.0);
+    outputs[2u * i + 1u] = particle_color(age_fraction(v.x, v.y));
+}
+"#;
+
+/// Runs look.wgsl's `flipbook_frames` and `particle_color` on the GPU for `inputs`
+/// (age, life, start01, blend) with `look`'s uniform and ramp. Returns per input
+/// (frame, next, weight) and the colour.
+fn probe(ctx: &GpuContext, look: &Look, inputs: &[[f32; 4]]) -> Vec<([f32; 3], [f32; 4])> {
+    let dir = tempfile::tempdir().expect("tempdir");
+    for (name, text) in EMBEDDED {
+        std::fs::write(dir.path().join(name), text).expect("write shader");
+    }
+    std::fs::write(dir.path().join("probe.wgsl"), PROBE).expect("write probe");
+    let lib = ShaderLibrary::from_dir(dir.path());
+    let composed = lib.compose("probe.wgsl").expect("probe composes");
+    let d = &ctx.device;
+    let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("probe"),
+        source: wgpu::ShaderSource::Wgsl(composed.source.as_str().into()),
+    });
+    let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("probe"),
+        layout: None,
+        module: &module,
+        entry_point: Some("main"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let uniform = look_uniform(look, 0, 1234, 1.0);
+    let camera = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: None,
+        contents: bytemuck::bytes_of(&CameraUniform::default()),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let look_buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: None,
+        contents: bytemuck::bytes_of::<LookUniform>(&uniform),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let ramp = bake_ramp(&look.color_over_life);
+    let ramps = d.create_texture_with_data(
+        &ctx.queue,
+        &wgpu::TextureDescriptor {
+            label: None,
+            size: wgpu::Extent3d {
+                width: RAMP_WIDTH,
+                height: 1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        bytemuck::cast_slice(&ramp),
+    );
+    let input_buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: None,
+        contents: bytemuck::cast_slice(inputs),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let out_size = (inputs.len() * 32) as u64;
+    let out = d.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: out_size,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let view = ramps.create_view(&Default::default());
+    let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: camera.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: look_buf.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::TextureView(&view),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: input_buf.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 4,
+                resource: out.as_entire_binding(),
+            },
+        ],
+    });
+    let staging = d.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: out_size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = d.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.dispatch_workgroups(inputs.len() as u32, 1, 1);
+    }
+    enc.copy_buffer_to_buffer(&out, 0, &staging, 0, out_size);
+    ctx.queue.submit([enc.finish()]);
+    let bytes = ignis::sim::gpu_sim::map_read(ctx, &staging).expect("readback");
+    let values: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+    values
+        .chunks(2)
+        .map(|c| ([c[0][0], c[0][1], c[0][2]], c[1]))
+        .collect()
+}
+
+fn flip_look(flipbook: Flipbook) -> Look {
+    Look {
+        flipbook: Some(flipbook),
+        ..Look::default()
+    }
+}
+
+#[test]
+fn flipbook_frames_match_hand_computed_values_at_the_ends_and_between() {
+    let ctx = gpu();
+    let life = 2.0;
+    // 4 × 4 over life: frame 0 at birth, frame 15 at death.
+    let over_life = Flipbook {
+        rows: 4,
+        cols: 4,
+        mode: FlipbookMode::OverLife,
+        blend_frames: true,
+        random_start: false,
+    };
+    let cases: Vec<(Flipbook, [f32; 4], [f32; 3])> = vec![
+        // Blending: position t·(16 − 1).
+        (over_life, [0.0, life, 0.0, 1.0], [0.0, 1.0, 0.0]),
+        (over_life, [life, life, 0.0, 1.0], [15.0, 15.0, 0.0]),
+        (over_life, [1.0, life, 0.0, 1.0], [7.0, 8.0, 0.5]),
+        // Cutting: each frame an equal share of life.
+        (
+            Flipbook {
+                blend_frames: false,
+                ..over_life
+            },
+            [0.0, life, 0.0, 0.0],
+            [0.0, 0.0, 0.0],
+        ),
+        (
+            Flipbook {
+                blend_frames: false,
+                ..over_life
+            },
+            [life, life, 0.0, 0.0],
+            [15.0, 15.0, 0.0],
+        ),
+        (
+            Flipbook {
+                blend_frames: false,
+                ..over_life
+            },
+            [1.0, life, 0.0, 0.0],
+            [8.0, 8.0, 0.0],
+        ),
+        // 2 × 3 at 10 fps from a random start: start01 0.5 → frame 3 of 6.
+        (
+            Flipbook {
+                rows: 2,
+                cols: 3,
+                mode: FlipbookMode::FrameRate { fps: 10.0 },
+                blend_frames: false,
+                random_start: true,
+            },
+            [0.0, life, 0.5, 0.0],
+            [3.0, 4.0, 0.0],
+        ),
+        (
+            Flipbook {
+                rows: 2,
+                cols: 3,
+                mode: FlipbookMode::FrameRate { fps: 10.0 },
+                blend_frames: false,
+                random_start: true,
+            },
+            [0.25, life, 0.5, 0.0],
+            [5.0, 0.0, 0.0],
+        ),
+        // Looping past the last frame, with blending: 0.35 s × 10 = 3.5 → frames 3, 4.
+        (
+            Flipbook {
+                rows: 2,
+                cols: 3,
+                mode: FlipbookMode::FrameRate { fps: 10.0 },
+                blend_frames: true,
+                random_start: false,
+            },
+            [0.35, life, 0.9, 1.0],
+            [3.0, 4.0, 0.5],
+        ),
+        (
+            Flipbook {
+                rows: 2,
+                cols: 3,
+                mode: FlipbookMode::FrameRate { fps: 10.0 },
+                blend_frames: true,
+                random_start: false,
+            },
+            [0.55, life, 0.0, 1.0],
+            [5.0, 0.0, 0.5],
+        ),
+    ];
+    for (flip, input, want) in cases {
+        let got = probe(&ctx, &flip_look(flip), &[input])[0].0;
+        for k in 0..3 {
+            assert!(
+                (got[k] - want[k]).abs() < 1e-4,
+                "{flip:?} at {input:?}: GPU {got:?}, hand-computed {want:?}"
+            );
+        }
+        let cpu = flipbook_frame(&flip, input[0], input[1], input[2]);
+        assert_eq!(
+            [cpu.frame as f32, cpu.next as f32],
+            [want[0], want[1]],
+            "CPU mirror"
+        );
+        assert!((cpu.weight - want[2]).abs() < 1e-4, "CPU mirror weight");
+    }
+}
+
+#[test]
+fn gradient_sampling_is_exact_at_birth_and_death_and_any_number_of_stops_works() {
+    let ctx = gpu();
+    let mut look = Look::default();
+    look.color_over_life = vec![
+        ColorStop {
+            t: 0.0,
+            rgba: [0.9, 0.8, 0.7, 0.0],
+        },
+        ColorStop {
+            t: 0.25,
+            rgba: [1.0, 0.5, 0.0, 1.0],
+        },
+        ColorStop {
+            t: 1.0,
+            rgba: [0.1, 0.2, 0.3, 0.4],
+        },
+    ];
+    let life = 1.5;
+    // Age 0, age = lifetime, and t = 0.625 (between stops: hand-computed midpoint of the
+    // second segment: (1.0+0.1)/2, (0.5+0.2)/2, (0.0+0.3)/2, (1.0+0.4)/2).
+    let out = probe(
+        &ctx,
+        &look,
+        &[
+            [0.0, life, 0.0, 0.0],
+            [life, life, 0.0, 0.0],
+            [0.625 * life, life, 0.0, 0.0],
+        ],
+    );
+    assert_eq!(out[0].1, [0.9, 0.8, 0.7, 0.0], "age 0 is the first stop");
+    assert_eq!(
+        out[1].1,
+        [0.1, 0.2, 0.3, 0.4],
+        "age = lifetime is the last stop"
+    );
+    let mid = [0.55, 0.35, 0.15, 0.7];
+    for k in 0..4 {
+        assert!(
+            (out[2].1[k] - mid[k]).abs() < 2e-3,
+            "{:?} vs {mid:?}",
+            out[2].1
+        );
+    }
+
+    // 40 stops (beyond the old 8-stop uniform): the ramp follows the CPU gradient.
+    let stops: Vec<ColorStop> = (0..40)
+        .map(|i| {
+            let t = i as f32 / 39.0;
+            ColorStop {
+                t,
+                rgba: [t, 1.0 - t, (i % 2) as f32, 0.5],
+            }
+        })
+        .collect();
+    look.color_over_life = stops.clone();
+    assert!(
+        Effect {
+            emitters: vec![ignis::effect::Emitter {
+                look: look.clone(),
+                ..plain_emitter()
+            }],
+            ..Effect::default()
+        }
+        .validate()
+        .is_ok()
+    );
+    let inputs: Vec<[f32; 4]> = (0..=64)
+        .map(|i| [i as f32 / 64.0 * life, life, 0.0, 0.0])
+        .collect();
+    let out = probe(&ctx, &look, &inputs);
+    let mut worst: f32 = 0.0;
+    for (input, (_, c)) in inputs.iter().zip(&out) {
+        let want = sample_gradient(&stops, input[0] / life);
+        for k in 0..4 {
+            worst = worst.max((c[k] - want[k]).abs());
+        }
+    }
+    // Ramp texels are 1/1023 apart: a zig-zag of 39 segments deviates by at most one
+    // texel's share of a segment's rise (39 / 1023 ≈ 0.04) near its corners.
+    assert!(worst < 0.04, "worst ramp deviation {worst}");
+    assert_eq!(out[0].1, stops[0].rgba);
+    assert_eq!(out[64].1, stops[39].rgba);
+}
+
+fn write_png(path: &Path, w: u32, h: u32, pixel: impl Fn(u32, u32) -> [u8; 4]) {
+    image::RgbaImage::from_fn(w, h, |x, y| image::Rgba(pixel(x, y)))
+        .save(path)
+        .expect("write png");
+}
+
+#[test]
+fn missing_or_broken_pngs_fall_back_with_a_clear_error_and_changed_files_reload() {
+    let ctx = gpu();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut lib = SpriteLibrary::new(&ctx);
+    let (disc, err) = lib.resolve(&ctx, &Sprite::SoftDisc, None);
+    assert!(err.is_none());
+
+    let (tex, err) = lib.resolve(&ctx, &Sprite::Image("nope.png".into()), Some(dir.path()));
+    let err = err.expect("missing file is an error");
+    assert_eq!(tex.id, disc.id, "falls back to the soft disc");
+    let msg = err.to_string();
+    assert!(
+        msg.contains("nope.png") && msg.contains("cannot read"),
+        "{msg}"
+    );
+    assert!(msg.contains("soft disc"), "{msg}");
+
+    std::fs::write(
+        dir.path().join("broken.png"),
+        b"\x89PNG\r\n\x1a\nnot really",
+    )
+    .expect("write");
+    let (tex, err) = lib.resolve(&ctx, &Sprite::Image("broken.png".into()), Some(dir.path()));
+    let msg = err.expect("broken file is an error").to_string();
+    assert_eq!(tex.id, disc.id);
+    assert!(
+        msg.contains("broken.png") && msg.contains("not a readable PNG"),
+        "{msg}"
+    );
+
+    // A good PNG, then a change on disk: invalidate → the new content is uploaded.
+    let path = dir.path().join("dot.png");
+    write_png(&path, 16, 16, |_, _| [255, 255, 255, 64]);
+    let (first, err) = lib.resolve(&ctx, &Sprite::Image("dot.png".into()), Some(dir.path()));
+    assert!(err.is_none());
+    assert!(
+        (first.integral - 4.0 * 64.0 / 255.0).abs() < 1e-3,
+        "{}",
+        first.integral
+    );
+    assert_eq!(first.size, (16, 16));
+    write_png(&path, 32, 8, |_, _| [255, 255, 255, 255]);
+    let (same, _) = lib.resolve(&ctx, &Sprite::Image("dot.png".into()), Some(dir.path()));
+    assert_eq!(same.id, first.id, "cached until invalidated");
+    assert!(lib.invalidate(std::slice::from_ref(&path)));
+    let (second, err) = lib.resolve(&ctx, &Sprite::Image("dot.png".into()), Some(dir.path()));
+    assert!(err.is_none());
+    assert_ne!(second.id, first.id);
+    assert_eq!(second.size, (32, 8));
+    assert!((second.integral - 4.0).abs() < 1e-3);
+    assert_eq!(lib.watched_dirs(), vec![dir.path().to_path_buf()]);
+
+    // A whole frame with a missing sprite: drawn with the fallback, error reported.
+    let mut e = bare_effect(plain_emitter());
+    e.emitters[0].look.sprite = Sprite::Image("missing/fire.png".into());
+    e.emitters[0].look.draw_path = DrawPath::Billboard;
+    let mut run = Headless::new(&ctx, e, ShaderLibrary::embedded()).expect("headless");
+    run.renderer.asset_dir = Some(dir.path().to_path_buf());
+    for _ in 0..30 {
+        run.advance(1.0 / 60.0).expect("advance");
+    }
+    let img = run.render((160, 120)).expect("render");
+    assert!(img.pixels().any(|p| p[0] > 40), "fallback sprite drawn");
+    let errors = &run.renderer.frame.sprite_errors;
+    assert_eq!(errors.len(), 1);
+    assert!(errors[0].1.to_string().contains("fire.png"));
+}
+
+/// One emitter of particles at rest at `pos` (or moving with `vel`), drawn as billboards.
+fn single(pos: Vec3, vel: Vec3, look: Look) -> Effect {
+    let mut em = plain_emitter();
+    em.capacity = 64;
+    em.spawn_rate_per_sec = 0.0;
+    em.bursts = vec![ignis::effect::Burst {
+        time_secs: 0.0,
+        count: 1,
+    }];
+    em.lifetime_secs = Range::new(10.0, 10.0);
+    em.transform.position_m = pos.into();
+    let speed = vel.length();
+    em.speed_m_per_s = Range::new(speed, speed);
+    if speed > 0.0 {
+        em.direction = vel.normalize().into();
+    }
+    em.look = Look {
+        draw_path: DrawPath::Billboard,
+        color_over_life: vec![ColorStop {
+            t: 0.0,
+            rgba: [1.0, 1.0, 1.0, 1.0],
+        }],
+        ..look
+    };
+    let mut e = bare_effect(em);
+    e.camera.target_m = [0.0, 0.0, 0.0];
+    e.camera.distance_m = 4.0;
+    e.camera.pitch_deg = 0.0;
+    e.camera.yaw_deg = 0.0;
+    e
+}
+
+fn render_after(ctx: &GpuContext, effect: Effect, frames: u32) -> image::RgbaImage {
+    let mut run = Headless::new(ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    for _ in 0..frames {
+        run.advance(1.0 / 60.0).expect("advance");
+    }
+    run.render((200, 200)).expect("render")
+}
+
+/// (width, height) of the lit pixels' bounding box.
+fn lit_extent(img: &image::RgbaImage, threshold: u8) -> (u32, u32) {
+    let (mut x0, mut y0, mut x1, mut y1) = (u32::MAX, u32::MAX, 0, 0);
+    for (x, y, p) in img.enumerate_pixels() {
+        if p[0] > threshold {
+            x0 = x0.min(x);
+            y0 = y0.min(y);
+            x1 = x1.max(x);
+            y1 = y1.max(y);
+        }
+    }
+    if x1 < x0 {
+        return (0, 0);
+    }
+    (x1 - x0 + 1, y1 - y0 + 1)
+}
+
+#[test]
+fn streaks_stretch_along_the_screen_velocity() {
+    let ctx = gpu();
+    let look = Look {
+        size_start_m: 0.05,
+        size_end_m: 0.05,
+        ..Look::default()
+    };
+    let still = render_after(&ctx, single(Vec3::ZERO, Vec3::ZERO, look.clone()), 2);
+    let (w0, h0) = lit_extent(&still, 20);
+    assert!(
+        w0 > 0 && (w0 as i32 - h0 as i32).abs() <= 1,
+        "round: {w0}×{h0}"
+    );
+    // Moving right at 2 m/s with a 0.2 s tail: 0.4 m long, 0.05 m wide.
+    let streak = Look {
+        streak: Some(Streak {
+            length_secs: 0.2,
+            max_length_m: 10.0,
+        }),
+        ..look
+    };
+    let moving = render_after(
+        &ctx,
+        single(Vec3::new(-0.5, 0.0, 0.0), Vec3::X * 2.0, streak.clone()),
+        2,
+    );
+    let (w, h) = lit_extent(&moving, 20);
+    assert!(w as f32 > 5.0 * h as f32, "a horizontal streak: {w}×{h}");
+    // Moving up: a vertical streak.
+    let up = render_after(
+        &ctx,
+        single(Vec3::new(0.0, -0.5, 0.0), Vec3::Y * 2.0, streak),
+        2,
+    );
+    let (w, h) = lit_extent(&up, 20);
+    assert!(h as f32 > 5.0 * w as f32, "a vertical streak: {w}×{h}");
+}
+
+#[test]
+fn soft_ground_fades_sprites_towards_the_ground_plane() {
+    let ctx = gpu();
+    let look = Look {
+        size_start_m: 0.8,
+        size_end_m: 0.8,
+        ..Look::default()
+    };
+    let mut hard = single(Vec3::ZERO, Vec3::ZERO, look.clone());
+    hard.emitters[0].collisions.ground = Some(GroundPlane {
+        height_m: -0.2,
+        kill_on_contact: false,
+    });
+    let mut soft = hard.clone();
+    soft.emitters[0].look.soft_ground_m = 0.3;
+    let a = render_after(&ctx, hard, 2);
+    let b = render_after(&ctx, soft, 2);
+    // Rows near the ground line (y = −0.2 m is below the centre) darken; the top half
+    // of the sprite (more than 0.3 m above the ground) is unchanged.
+    let row = |img: &image::RgbaImage, y: u32| -> u32 {
+        (0..200).map(|x| u32::from(img.get_pixel(x, y)[0])).sum()
+    };
+    let centre = 100;
+    let top = 85; // ≈ 0.15 m above the centre: 0.35 m above the ground.
+    assert_eq!(row(&a, top), row(&b, top), "no fade far above the ground");
+    let near = 112; // ≈ 0.12 m below the centre: 0.08 m above the ground.
+    assert!(
+        row(&b, near) * 2 < row(&a, near),
+        "faded near the ground: {} vs {}",
+        row(&b, near),
+        row(&a, near)
+    );
+    assert!(row(&b, centre) < row(&a, centre));
+}
+
+#[test]
+fn bloom_spreads_light_and_exposure_scales_it() {
+    let ctx = gpu();
+    let look = Look {
+        size_start_m: 0.1,
+        size_end_m: 0.1,
+        intensity: 8.0,
+        ..Look::default()
+    };
+    let plain = single(Vec3::ZERO, Vec3::ZERO, look);
+    let mut bloom = plain.clone();
+    bloom.post.bloom = Some(ignis::effect::Bloom {
+        threshold: 1.0,
+        intensity: 1.0,
+        levels: 6,
+    });
+    let a = render_after(&ctx, plain.clone(), 2);
+    let b = render_after(&ctx, bloom, 2);
+    // 14 px from the sprite (radius ≈ 6 px): dark without bloom, lit with it.
+    let far = |img: &image::RgbaImage| img.get_pixel(114, 100)[0];
+    println!("14 px away: {} without bloom, {} with", far(&a), far(&b));
+    assert!(
+        far(&a) < 3,
+        "no light 14 px away without bloom: {}",
+        far(&a)
+    );
+    assert!(
+        far(&b) > far(&a) + 8,
+        "bloom spreads light: {} vs {}",
+        far(&b),
+        far(&a)
+    );
+    let mut dim = plain;
+    dim.post.exposure = 0.05;
+    let c = render_after(&ctx, dim, 2);
+    let centre = |img: &image::RgbaImage| img.get_pixel(100, 100)[0];
+    assert!(
+        centre(&c) + 40 < centre(&a),
+        "exposure dims: {} vs {}",
+        centre(&c),
+        centre(&a)
+    );
+}
+
+#[test]
+fn random_size_rotation_and_spin_vary_per_particle_deterministically() {
+    let ctx = gpu();
+    // Many particles on a line, each with a random size: the lit widths differ.
+    let mut em = plain_emitter();
+    em.shape = ignis::effect::Shape::Line {
+        a_m: [-1.0, 0.0, 0.0],
+        b_m: [1.0, 0.0, 0.0],
+    };
+    em.spawn_rate_per_sec = 0.0;
+    em.bursts = vec![ignis::effect::Burst {
+        time_secs: 0.0,
+        count: 12,
+    }];
+    em.lifetime_secs = Range::new(5.0, 9.0);
+    em.look = Look {
+        draw_path: DrawPath::Billboard,
+        size_start_m: 0.12,
+        size_end_m: 0.12,
+        size_random: 0.6,
+        rotation_random_deg: 360.0,
+        spin_deg_per_s: Range::new(-90.0, 90.0),
+        blend: BlendMode::Additive,
+        sprite: Sprite::FlameWisp,
+        ..Look::default()
+    };
+    let mut e = bare_effect(em);
+    e.camera.target_m = [0.0, 0.0, 0.0];
+    e.camera.distance_m = 3.0;
+    e.camera.pitch_deg = 0.0;
+    let a = render_after(&ctx, e.clone(), 10);
+    let b = render_after(&ctx, e.clone(), 10);
+    assert_eq!(a.as_raw(), b.as_raw(), "same preset + seed ⇒ same frame");
+    let mut uniform = e.clone();
+    uniform.emitters[0].look.size_random = 0.0;
+    uniform.emitters[0].look.rotation_random_deg = 0.0;
+    uniform.emitters[0].look.spin_deg_per_s = Range::new(0.0, 0.0);
+    let c = render_after(&ctx, uniform, 10);
+    assert_ne!(a.as_raw(), c.as_raw(), "randomness changes the frame");
+    let mut reseeded = e;
+    reseeded.seed = 99;
+    let d = render_after(&ctx, reseeded, 10);
+    assert_ne!(a.as_raw(), d.as_raw(), "another seed, another frame");
+}
+
+/// Mean absolute difference per channel (0–255) of two equally sized images.
+fn mean_abs_diff(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
+    assert_eq!(a.dimensions(), b.dimensions());
+    let sum: u64 = a
+        .as_raw()
+        .iter()
+        .zip(b.as_raw())
+        .map(|(x, y)| u64::from(x.abs_diff(*y)))
+        .sum();
+    sum as f64 / a.as_raw().len() as f64
+}
+
+/// Fixed-seed frames of presets against committed references on the software adapter.
+/// Tolerance: mean absolute difference ≤ 1.0 of 255 per channel (lavapipe builds differ
+/// in the last bits of their maths; a real look change moves the mean by far more — the
+/// test checks that the references differ from each other by ≥ 5).
+#[test]
+fn reference_images() {
+    const TOLERANCE: f64 = 1.0;
+    let ctx = gpu();
+    let bless = std::env::var_os("IGNIS_BLESS").is_some();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut rendered = Vec::new();
+    for name in ["campfire", "torch", "spark_fountain", "candle"] {
+        let preset = root.join("presets").join(format!("{name}.ron"));
+        let effect = ignis::preset::load(&preset).expect("preset");
+        let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+        run.renderer.asset_dir = preset.parent().map(Path::to_path_buf);
+        for _ in 0..90 {
+            run.advance(1.0 / 60.0).expect("advance");
+        }
+        let img = run.render((240, 180)).expect("render");
+        assert!(
+            run.renderer.frame.sprite_errors.is_empty(),
+            "{name}: sprites load"
+        );
+        let reference = root.join("tests/reference").join(format!("{name}.png"));
+        if bless {
+            std::fs::create_dir_all(reference.parent().expect("dir")).expect("mkdir");
+            img.save(&reference).expect("write reference");
+        }
+        let want = image::open(&reference)
+            .unwrap_or_else(|e| {
+                panic!(
+                    "{}: {e} (regenerate with IGNIS_BLESS=1 cargo test --release --test looks reference_images)",
+                    reference.display()
+                )
+            })
+            .to_rgba8();
+        let diff = mean_abs_diff(&img, &want);
+        println!("{name}: mean |difference| {diff:.3} (tolerance {TOLERANCE})");
+        if diff > TOLERANCE {
+            let out = std::env::temp_dir().join(format!("ignis-{name}-actual.png"));
+            let _ = img.save(&out);
+            panic!(
+                "{name} differs from {} by {diff:.3} > {TOLERANCE} (actual frame: {}); if the change is deliberate, regenerate with IGNIS_BLESS=1 cargo test --release --test looks reference_images",
+                reference.display(),
+                out.display()
+            );
+        }
+        rendered.push(img);
+    }
+    // The metric catches a small look change: the campfire without its bloom.
+    let preset = root.join("presets/campfire.ron");
+    let mut effect = ignis::preset::load(&preset).expect("preset");
+    effect.post.bloom = None;
+    let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    for _ in 0..90 {
+        run.advance(1.0 / 60.0).expect("advance");
+    }
+    let no_bloom = run.render((240, 180)).expect("render");
+    let d = mean_abs_diff(&no_bloom, &rendered[0]);
+    println!("campfire without bloom: mean |difference| {d:.3}");
+    assert!(
+        d > 2.0 * TOLERANCE,
+        "turning bloom off moves the mean by only {d}"
+    );
+    // The metric discriminates: different presets are far apart.
+    for i in 0..rendered.len() {
+        for j in i + 1..rendered.len() {
+            let d = mean_abs_diff(&rendered[i], &rendered[j]);
+            println!("presets {i} and {j}: mean |difference| {d:.3}");
+            assert!(
+                d >= 5.0 * TOLERANCE,
+                "presets {i} and {j} differ by only {d}"
+            );
+        }
+    }
+}
