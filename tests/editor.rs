@@ -941,3 +941,45 @@ fn ctrl_drag_moves_a_sphere_collider() {
     );
     assert_eq!(harness.state().camera, before_camera, "the camera orbited");
 }
+
+#[test]
+fn look_controls_toggle_flipbook_streak_bloom_and_the_gradient_bar_adds_stops() {
+    let mut harness = panel_harness(campfire_state());
+    open_section(&mut harness, "Look");
+    let stops = harness.state().effect.emitters[0]
+        .look
+        .color_over_life
+        .clone();
+    // A click in the middle of the bar inserts a stop there, coloured as the gradient.
+    harness
+        .get_by_label("Gradient (click to add a stop)")
+        .click();
+    harness.run();
+    let after = &harness.state().effect.emitters[0].look.color_over_life;
+    assert_eq!(after.len(), stops.len() + 1);
+    assert!(after.windows(2).all(|w| w[0].t <= w[1].t));
+    let added = after
+        .iter()
+        .find(|s| !stops.contains(s))
+        .expect("a new stop");
+    assert!((added.t - 0.5).abs() < 0.05, "added at {}", added.t);
+    let want = ignis::render::look::sample_gradient(&stops, added.t);
+    for k in 0..4 {
+        assert!((added.rgba[k] - want[k]).abs() < 1e-5);
+    }
+
+    // Smoke (emitter 0) has no flipbook, streak or bloom yet.
+    assert!(harness.state().effect.emitters[0].look.flipbook.is_none());
+    harness.get_by_label("animate").click_accesskit();
+    harness.run();
+    assert!(harness.state().effect.emitters[0].look.flipbook.is_some());
+    harness.get_by_label("stretch").click_accesskit();
+    harness.run();
+    assert!(harness.state().effect.emitters[0].look.streak.is_some());
+    let had_bloom = harness.state().effect.post.bloom.is_some();
+    harness.get_by_label("glow").click_accesskit();
+    harness.run();
+    assert_eq!(harness.state().effect.post.bloom.is_some(), !had_bloom);
+    assert!(harness.state().validation_errors.is_empty());
+    assert!(harness.state().effect.validate().is_ok());
+}

@@ -59,11 +59,11 @@ fn post_ui(ui: &mut Ui, post: &mut Post) {
     )
     .labelled_by(label.id);
     ui.end_row();
-    let label = ui.label("Bloom").on_hover_text(
+    ui.label("Bloom").on_hover_text(
         "Light above the threshold is blurred over a mip chain and added back (off: no passes run)",
     );
     let mut on = post.bloom.is_some();
-    if ui.checkbox(&mut on, "glow").labelled_by(label.id).changed() {
+    if ui.checkbox(&mut on, "glow").changed() {
         post.bloom = on.then(Bloom::default);
     }
     ui.end_row();
@@ -182,7 +182,7 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
                 .on_hover_text("Stretch each billboard from where the particle was (length seconds ago) to where it is: spark trails");
             ui.horizontal(|ui| {
                 let mut on = look.streak.is_some();
-                if ui.checkbox(&mut on, "").labelled_by(label.id).changed() {
+                if ui.checkbox(&mut on, "stretch").changed() {
                     look.streak = on.then(Streak::default);
                 }
                 if let Some(s) = &mut look.streak {
@@ -250,15 +250,11 @@ fn sprite_rows_ui(ui: &mut Ui, look: &mut Look) {
         ui.text_edit_singleline(path).labelled_by(label.id);
         ui.end_row();
     }
-    let label = ui
+    ui
         .label("Flipbook")
         .on_hover_text("Treat the sprite as an atlas of rows × columns frames (row-major from the top left) and animate it");
     let mut on = look.flipbook.is_some();
-    if ui
-        .checkbox(&mut on, "animate")
-        .labelled_by(label.id)
-        .changed()
-    {
+    if ui.checkbox(&mut on, "animate").changed() {
         look.flipbook = on.then(|| {
             let mut f = Flipbook::default();
             if look.sprite != Sprite::FlameSheet {
@@ -329,6 +325,9 @@ fn sprite_rows_ui(ui: &mut Ui, look: &mut Look) {
 pub fn gradient_editor_ui(ui: &mut Ui, stops: &mut Vec<ColorStop>) {
     let width = ui.available_width().min(330.0);
     let (rect, bar) = ui.allocate_exact_size(egui::vec2(width, 26.0), Sense::click());
+    bar.widget_info(|| {
+        egui::WidgetInfo::labeled(egui::Role::Button, true, "Gradient (click to add a stop)")
+    });
     paint_gradient(ui, rect, stops);
     let (handles, _) = ui.allocate_exact_size(egui::vec2(width, 12.0), Sense::hover());
     let id = bar.id;
