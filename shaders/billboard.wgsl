@@ -19,6 +19,9 @@
 @group(1) @binding(1) var<storage, read> cur: array<Particle>;
 // Back-to-front slot order (sort.wgsl), read only by the alpha-blended pipeline.
 @group(1) @binding(2) var<storage, read> order: array<u32>;
+// The same state buffers seen as packed state (src/gpu/types.rs `PackedParticle`).
+@group(1) @binding(3) var<storage, read> prev_packed: array<PackedParticle>;
+@group(1) @binding(4) var<storage, read> cur_packed: array<PackedParticle>;
 // The sprite: linear, premultiplied, mipmapped (src/render/sprites.rs).
 @group(2) @binding(0) var sprite_tex: texture_2d<f32>;
 @group(2) @binding(1) var sprite_sampler: sampler;
@@ -47,7 +50,8 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) instance: u3
     if SORTED {
         slot = order[instance];
     }
-    let d = drawn(cur[slot], prev[slot]);
+    let pair = load_pair(slot);
+    let d = drawn(pair[0], pair[1]);
     if !d.alive {
         out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
         return out;

@@ -80,6 +80,71 @@ const SHAPE_LINE: u32 = 5u;
 const PI: f32 = 3.14159265358979;
 const TAU: f32 = 6.28318530717959;
 
+// Packed state (20 bytes, the `packed_state` option): the position as three f32; the
+// velocity as three f16; the remaining life fraction 1 − age/lifetime as unorm16 (zero is
+// dead, so a zeroed buffer is all dead). The lifetime is not stored: it is a pure
+// function of (seed, emitter, slot, spawn counter) — see `slot_counter` and `spawn_life`.
+// Keep in sync with `PackedParticle` in src/gpu/types.rs.
+struct PackedParticle {
+    px: f32,
+    py: f32,
+    pz: f32,
+    // f16 velocity x (low half) and y (high half).
+    vxy: u32,
+    // f16 velocity z (low half), unorm16 remaining life fraction (high half).
+    vz_rest: u32,
+}
+
+fn packed_alive(q: PackedParticle) -> bool {
+    return (q.vz_rest >> 16u) != 0u;
+}
+
+// Half an f16 step (ulp) of x, for dithering before rounding to f16.
+fn f16_ulp(x: f32) -> f32 {
+    let e = i32((bitcast<u32>(x) >> 23u) & 0xFFu) - 127;
+    return exp2(f32(max(e, -14) - 10));
+}
+
+// Packs with dithered rounding (`dither` ∈ [0, 1)⁴, a hash of the slot and step): the
+// rounding errors of successive steps average out instead of drifting one way.
+fn pack_particle(p: Particle, dither: vec4<f32>) -> PackedParticle {
+    var rest = 0.0;
+    if p.pos_age.w < p.vel_life.w {
+        rest = clamp(1.0 - p.pos_age.w / p.vel_life.w, 0.0, 1.0);
+    }
+    // An alive particle never rounds to dead.
+    var r = min(u32(rest * 65535.0 + dither.w), 65535u);
+    if rest > 0.0 {
+        r = max(r, 1u);
+    }
+    let v = p.vel_life.xyz;
+    let vd = v + (dither.xyz - 0.5) * vec3<f32>(f16_ulp(v.x), f16_ulp(v.y), f16_ulp(v.z));
+    let vz = pack2x16float(vec2<f32>(vd.z, 0.0)) & 0xFFFFu;
+    return PackedParticle(p.pos_age.x, p.pos_age.y, p.pos_age.z, pack2x16float(vd.xy), vz | (r << 16u));
+}
+
+// `life` is the particle's lifetime (re-derived by the caller).
+fn unpack_particle(q: PackedParticle, life: f32) -> Particle {
+    let r = f32(q.vz_rest >> 16u) / 65535.0;
+    let vxy = unpack2x16float(q.vxy);
+    let vz = unpack2x16float(q.vz_rest & 0xFFFFu).x;
+    if r <= 0.0 {
+        return Particle(vec4<f32>(0.0), vec4<f32>(0.0));
+    }
+    return Particle(vec4<f32>(q.px, q.py, q.pz, (1.0 - r) * life), vec4<f32>(vxy, vz, life));
+}
+
+// The spawn counter (lo, hi) of the particle now in `slot` of a ring of `capacity` slots
+// that has spawned `total` particles, the last into slot `head` − 1 (head = total mod
+// capacity): slots are filled in counter order, so it is total − 1 − ((head − 1 − slot)
+// mod capacity). Only meaningful for slots that were ever spawned.
+fn slot_counter(slot: u32, head: u32, total_lo: u32, total_hi: u32, capacity: u32) -> vec2<u32> {
+    let back = (head + capacity - 1u - slot) % capacity + 1u;
+    let lo = total_lo - back;
+    let hi = total_hi - select(0u, 1u, total_lo < back);
+    return vec2<u32>(lo, hi);
+}
+
 fn is_alive(p: Particle) -> bool {
     return p.pos_age.w < p.vel_life.w;
 }

@@ -2,15 +2,18 @@
 // per slot, a workgroup reduction (GPUs) or one atomic per alive particle (CPU adapters,
 // where a workgroup barrier splits the shader per invocation). Plumbing, not a hook.
 //
-// Contract: group 0 binding 0 `state` (read), binding 1 `counters` ([0] += alive).
+// Contract: group 0 binding 0 `state` (read), binding 1 `counters` ([0] += alive),
+// binding 2 `state_packed` (the same buffer as packed state, read when PACKED is on).
 #import "common.wgsl"
 
 @group(0) @binding(0) var<storage, read> state: array<Particle>;
 @group(0) @binding(1) var<storage, read_write> counters: array<atomic<u32>, 2>;
+@group(0) @binding(2) var<storage, read> state_packed: array<PackedParticle>;
 
 #import "alive_count.wgsl"
 
 override DIRECT_ATOMICS: bool = false;
+override PACKED: bool = false;
 
 @compute @workgroup_size(256)
 fn main(
@@ -19,7 +22,12 @@ fn main(
     @builtin(local_invocation_index) lid: u32,
 ) {
     let slot = (wg.y * nwg.x + wg.x) * 256u + lid;
-    let alive = slot < arrayLength(&state) && is_alive(state[slot]);
+    var alive = false;
+    if PACKED {
+        alive = slot < arrayLength(&state_packed) && packed_alive(state_packed[slot]);
+    } else {
+        alive = slot < arrayLength(&state) && is_alive(state[slot]);
+    }
     if DIRECT_ATOMICS {
         if alive {
             atomicAdd(&counters[0], 1u);

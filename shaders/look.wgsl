@@ -2,8 +2,10 @@
 // compute splat) so they render the same fire. A designer hook: `particle_color`.
 //
 // Contract: the including file declares `camera: CameraUniform`, `look: LookUniform`
-// (keep both in sync with `src/gpu/types.rs`) and `ramps: texture_2d<f32>` (one
-// Rgba32Float colour ramp row per emitter).
+// (keep both in sync with `src/gpu/types.rs`), `ramps: texture_2d<f32>` (one
+// Rgba32Float colour ramp row per emitter) and the state: `prev`, `cur`
+// (array<Particle>) and the same buffers as `prev_packed`, `cur_packed`
+// (array<PackedParticle>, read when `look.ring.w` says the state is packed).
 #import "common.wgsl"
 #import "rng.wgsl"
 
@@ -33,8 +35,14 @@ struct LookUniform {
     extra: vec4<f32>,
     // x, y: angular velocity range (rad/s), z: streak length (s), w: longest streak (m).
     spin_streak: vec4<f32>,
-    // x: ground height in simulation space (m), y: 1 / soft-edge distance (1/m), zw: unused.
+    // x: ground height in simulation space (m), y: 1 / soft-edge distance (1/m),
+    // z, w: lifetime range (s; packed state re-derives lifetimes from it).
     soft: vec4<f32>,
+    // Packed state: x: next spawn slot (head), y, z: spawned total (lo, hi), w: 1 when the
+    // state is packed.
+    ring: vec4<u32>,
+    // Packed state: x: effect seed, y: emitter salt, z: capacity, w: unused.
+    ring_b: vec4<u32>,
     // Stateless emitters: xyz constant acceleration, w linear drag k.
     motion_a: vec4<f32>,
     // Stateless emitters: xyz wind, w render time on the 4096 s clock.
@@ -115,6 +123,19 @@ fn draw_state(p: Particle, q: Particle) -> vec4<f32> {
         }
     }
     return vec4<f32>(pos, age);
+}
+
+// The particle in `slot`: (after the last step, before it), unpacked when packed.
+fn load_pair(slot: u32) -> array<Particle, 2> {
+    if look.ring.w != 0u {
+        let q = cur_packed[slot];
+        let c = slot_counter(slot, look.ring.x, look.ring.y, look.ring.z, look.ring_b.z);
+        let key = spawn_key(look.ring_b.x, look.ring_b.y, slot, c.x, c.y);
+        let life = spawn_life(key, look.soft.z, look.soft.w);
+        // The previous state is only used while it holds the same particle (younger).
+        return array<Particle, 2>(unpack_particle(q, life), unpack_particle(prev_packed[slot], life));
+    }
+    return array<Particle, 2>(cur[slot], prev[slot]);
 }
 
 // A particle as drawn: position, velocity, age, lifetime, alive.

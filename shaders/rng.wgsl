@@ -34,6 +34,12 @@ fn unorm4(x: vec4<u32>) -> vec4<f32> {
     return vec4<f32>(x >> vec4<u32>(8u)) * (1.0 / 16777216.0);
 }
 
+// The lifetime a spawn with stream `key` draws, in [lo, hi] (block 1, w). spawn.wgsl uses
+// it, and the packed state re-derives lifetimes with it instead of storing them.
+fn spawn_life(key: vec4<u32>, lo: f32, hi: f32) -> f32 {
+    return mix(lo, hi, unorm4(rand_block(key, 1u)).w);
+}
+
 // A lattice hash for noise: integer cell + seed → [0, 1).
 fn hash_cell(c: vec3<i32>, seed: u32) -> f32 {
     let h = pcg4d(vec4<u32>(bitcast<vec3<u32>>(c), seed));

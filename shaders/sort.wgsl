@@ -16,7 +16,8 @@ struct SortStep {
     // Power-of-two element count, and the emitter's capacity (slots beyond are padding).
     count: u32,
     capacity: u32,
-    // The camera position and forward axis in the emitter's simulation space.
+    // The camera position and forward axis in the emitter's simulation space; eye.w: 1
+    // when the state is packed (read through `cur_packed`).
     eye: vec4<f32>,
     forward: vec4<f32>,
 }
@@ -49,6 +50,7 @@ fn bitonic(
 }
 
 @group(1) @binding(0) var<storage, read> cur: array<Particle>;
+@group(1) @binding(1) var<storage, read> cur_packed: array<PackedParticle>;
 
 @compute @workgroup_size(256)
 fn depth_keys(
@@ -62,9 +64,19 @@ fn depth_keys(
     }
     var key = 0xFFFFFFFFu;
     if i < step.capacity {
-        let p = cur[i];
-        if is_alive(p) {
-            let depth = max(dot(p.pos_age.xyz - step.eye.xyz, step.forward.xyz), 0.0);
+        var alive = false;
+        var pos = vec3<f32>(0.0);
+        if step.eye.w > 0.5 {
+            let q = cur_packed[i];
+            alive = packed_alive(q);
+            pos = vec3<f32>(q.px, q.py, q.pz);
+        } else {
+            let p = cur[i];
+            alive = is_alive(p);
+            pos = p.pos_age.xyz;
+        }
+        if alive {
+            let depth = max(dot(pos - step.eye.xyz, step.forward.xyz), 0.0);
             // Non-negative floats order like their bits; inverted, the farthest comes first.
             key = ~bitcast<u32>(depth);
         }

@@ -94,7 +94,8 @@ fn spawn_particle(slot: u32, key: vec4<u32>) -> Particle {
 
     let dir = cap_direction(axis, half, r1.x, r1.y);
     let speed = mix(params.speed_life.x, params.speed_life.y, r1.z);
-    let life = mix(params.speed_life.z, params.speed_life.w, r1.w);
+    // (= mix(life min, life max, r1.w); the packed state re-derives it the same way.)
+    let life = spawn_life(key, params.speed_life.z, params.speed_life.w);
 
     let world_pos = (params.world_from_emitter * vec4<f32>(local_pos, 1.0)).xyz;
     let world_vel = (params.world_from_emitter * vec4<f32>(dir * speed, 0.0)).xyz;

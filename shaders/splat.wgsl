@@ -18,6 +18,8 @@
 @group(0) @binding(2) var ramps: texture_2d<f32>;
 @group(1) @binding(0) var<storage, read> prev: array<Particle>;
 @group(1) @binding(1) var<storage, read> cur: array<Particle>;
+@group(1) @binding(3) var<storage, read> prev_packed: array<PackedParticle>;
+@group(1) @binding(4) var<storage, read> cur_packed: array<PackedParticle>;
 @group(2) @binding(0) var<storage, read_write> accum: array<atomic<u32>>;
 
 // Keep in sync with `SPLAT_FIXED_SCALE` in src/render/splat.rs.
@@ -50,10 +52,11 @@ fn splat(
     @builtin(local_invocation_index) lid: u32,
 ) {
     let slot = (wg.y * nwg.x + wg.x) * 256u + lid;
-    if slot >= arrayLength(&cur) {
+    if slot >= look.ring_b.z {
         return;
     }
-    let d = drawn(cur[slot], prev[slot]);
+    let pair = load_pair(slot);
+    let d = drawn(pair[0], pair[1]);
     if !d.alive {
         return;
     }

@@ -18,6 +18,9 @@
 @group(0) @binding(1) var<storage, read> src: array<Particle>;
 @group(0) @binding(2) var<storage, read_write> dst: array<Particle>;
 @group(0) @binding(3) var<storage, read_write> counters: array<atomic<u32>, 2>;
+// The same buffers seen as packed state (read only when MOD_PACKED is on).
+@group(0) @binding(4) var<storage, read> src_packed: array<PackedParticle>;
+@group(0) @binding(5) var<storage, read_write> dst_packed: array<PackedParticle>;
 
 #import "spawn.wgsl"
 #import "integrators.wgsl"
@@ -30,6 +33,33 @@
 // pos_age.w the birth time on the 4096 s clock.
 override MOD_STATELESS: bool = false;
 override COUNT_ALIVE: bool = true;
+// Packed state: 20 bytes per particle instead of 32 (f16 velocity, unorm16 life fraction,
+// lifetime re-derived from the spawn hash).
+override MOD_PACKED: bool = false;
+
+// The state of `slot` before this step.
+fn load_state(slot: u32) -> Particle {
+    if MOD_PACKED {
+        let q = src_packed[slot];
+        if !packed_alive(q) {
+            return Particle(vec4<f32>(0.0), vec4<f32>(0.0));
+        }
+        // The ring before this step's spawns: `spawn_base` spawned, next slot `spawn_head`.
+        let c = slot_counter(slot, params.spawn_head, params.spawn_base_lo, params.spawn_base_hi, params.capacity);
+        let key = spawn_key(params.seed, params.emitter_salt, slot, c.x, c.y);
+        return unpack_particle(q, spawn_life(key, params.speed_life.z, params.speed_life.w));
+    }
+    return src[slot];
+}
+
+fn store_state(slot: u32, p: Particle) {
+    if MOD_PACKED {
+        let dither = unorm4(pcg4d(vec4<u32>(slot, params.spawn_base_lo, params.seed, 0xD1u)));
+        dst_packed[slot] = pack_particle(p, dither);
+    } else {
+        dst[slot] = p;
+    }
+}
 
 fn stateless_spawn(i: u32) {
     if i >= params.spawn_count {
@@ -57,7 +87,7 @@ fn main(
     }
     var alive = false;
     if slot < params.capacity {
-        var p = src[slot];
+        var p = Particle(vec4<f32>(0.0), vec4<f32>(0.0));
         // Position of this slot in the ring relative to the spawn head (capacity ≤ 2^28).
         let rel = (slot + params.capacity - params.spawn_head) % params.capacity;
         if rel < params.spawn_count {
@@ -80,7 +110,10 @@ fn main(
                 vec4<f32>(v0 * (1.0 - k * pp.x) + c * pp.x, p.vel_life.w),
             );
             alive = is_alive(p);
-        } else if is_alive(p) {
+        } else {
+            p = load_state(slot);
+        }
+        if rel >= params.spawn_count && is_alive(p) {
             let life = p.vel_life.w;
             var s = integrate(p.pos_age.xyz, p.vel_life.xyz, p.pos_age.w, life, params.wind_time.w, params.dt_secs);
             var age = p.pos_age.w + params.dt_secs;
@@ -103,7 +136,7 @@ fn main(
                 atomicAdd(&counters[1], 1u);
             }
         }
-        dst[slot] = p;
+        store_state(slot, p);
     }
     if COUNT_ALIVE {
         add_alive_in_workgroup(alive, lid);

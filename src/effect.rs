@@ -151,6 +151,11 @@ pub struct Emitter {
     /// Cheaper and exact, but only for constant acceleration + linear drag: see
     /// [`Emitter::stateless_blockers`].
     pub stateless: bool,
+    /// Store the state packed in 20 bytes per particle instead of 32 (f16 velocity, the
+    /// age as a 16-bit fraction of the lifetime, the lifetime re-derived from the spawn
+    /// hash): less memory traffic, at the accuracy cost `ignis bench accuracy` reports.
+    /// Not with `stateless`. Editing the lifetime range re-times living particles.
+    pub packed_state: bool,
     /// Ground and sphere colliders.
     pub collisions: Collisions,
     /// Added to the effect seed for this emitter's stream.
@@ -848,6 +853,7 @@ impl Default for Emitter {
             spawn_noise: SpawnNoise::default(),
             integrator: Integrator::SemiImplicitEuler,
             stateless: false,
+            packed_state: false,
             collisions: Collisions::default(),
             seed_offset: 0,
             look: Look::default(),
@@ -1265,6 +1271,13 @@ impl Effect {
             c.num(|| p("look.size_start_m"), l.size_start_m, 0.0, 1e3);
             c.num(|| p("look.size_end_m"), l.size_end_m, 0.0, 1e3);
             c.num(|| p("look.intensity"), l.intensity, 0.0, 1e4);
+            if e.packed_state && e.stateless {
+                c.push(
+                    p("packed_state"),
+                    true,
+                    "cannot be combined with `stateless` (stateless emitters store spawn records, not state); turn one off",
+                );
+            }
             c.num(|| p("look.size_random"), l.size_random, 0.0, 1.0);
             c.num(
                 || p("look.rotation_random_deg"),

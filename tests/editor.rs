@@ -964,8 +964,8 @@ fn look_controls_toggle_flipbook_streak_bloom_and_the_gradient_bar_adds_stops() 
         .expect("a new stop");
     assert!((added.t - 0.5).abs() < 0.05, "added at {}", added.t);
     let want = ignis::render::look::sample_gradient(&stops, added.t);
-    for k in 0..4 {
-        assert!((added.rgba[k] - want[k]).abs() < 1e-5);
+    for (got, want) in added.rgba.iter().zip(want) {
+        assert!((got - want).abs() < 1e-5);
     }
 
     // Smoke (emitter 0) has no flipbook, streak or bloom yet.

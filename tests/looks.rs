@@ -278,21 +278,23 @@ fn flipbook_frames_match_hand_computed_values_at_the_ends_and_between() {
 #[test]
 fn gradient_sampling_is_exact_at_birth_and_death_and_any_number_of_stops_works() {
     let ctx = gpu();
-    let mut look = Look::default();
-    look.color_over_life = vec![
-        ColorStop {
-            t: 0.0,
-            rgba: [0.9, 0.8, 0.7, 0.0],
-        },
-        ColorStop {
-            t: 0.25,
-            rgba: [1.0, 0.5, 0.0, 1.0],
-        },
-        ColorStop {
-            t: 1.0,
-            rgba: [0.1, 0.2, 0.3, 0.4],
-        },
-    ];
+    let mut look = Look {
+        color_over_life: vec![
+            ColorStop {
+                t: 0.0,
+                rgba: [0.9, 0.8, 0.7, 0.0],
+            },
+            ColorStop {
+                t: 0.25,
+                rgba: [1.0, 0.5, 0.0, 1.0],
+            },
+            ColorStop {
+                t: 1.0,
+                rgba: [0.1, 0.2, 0.3, 0.4],
+            },
+        ],
+        ..Look::default()
+    };
     let life = 1.5;
     // Age 0, age = lifetime, and t = 0.625 (between stops: hand-computed midpoint of the
     // second segment: (1.0+0.1)/2, (0.5+0.2)/2, (0.0+0.3)/2, (1.0+0.4)/2).

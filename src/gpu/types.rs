@@ -30,6 +30,48 @@ impl Particle {
     }
 }
 
+/// One particle slot in the packed layout, 20 bytes (keep in sync with `PackedParticle` in
+/// `shaders/common.wgsl`): f32 position, f16 velocity, the remaining life fraction as
+/// unorm16 (0 = dead); the lifetime is re-derived from the spawn hash.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct PackedParticle {
+    /// Position x, y, z (m).
+    pub pos: [f32; 3],
+    /// f16 velocity x (low half), y (high half).
+    pub vxy: u32,
+    /// f16 velocity z (low half), remaining life fraction as unorm16 (high half).
+    pub vz_rest: u32,
+}
+
+impl PackedParticle {
+    /// The particle, given its (re-derived) lifetime.
+    pub fn unpack(&self, life: f32) -> Particle {
+        let rest = (self.vz_rest >> 16) as f32 / 65535.0;
+        if rest <= 0.0 {
+            return Particle::default();
+        }
+        let h = |bits: u32| half::f16::from_bits(bits as u16).to_f32();
+        Particle {
+            pos_age: [self.pos[0], self.pos[1], self.pos[2], (1.0 - rest) * life],
+            vel_life: [
+                h(self.vxy & 0xFFFF),
+                h(self.vxy >> 16),
+                h(self.vz_rest & 0xFFFF),
+                life,
+            ],
+        }
+    }
+}
+
+/// The spawn counter of the particle in `slot` of a ring of `capacity` slots that has
+/// spawned `total` (mirror of `slot_counter` in `shaders/common.wgsl`).
+pub fn slot_counter(slot: u32, total: u64, capacity: u32) -> u64 {
+    let head = (total % u64::from(capacity)) as u32;
+    let back = (head + capacity - 1 - slot) % capacity + 1;
+    total.wrapping_sub(u64::from(back))
+}
+
 /// Per-step, per-emitter simulation parameters (keep in sync with `SimParams` in
 /// `shaders/common.wgsl`). Uploaded once per step at a 256-byte aligned dynamic offset.
 #[repr(C)]
@@ -134,8 +176,13 @@ pub struct LookUniform {
     pub extra: [f32; 4],
     /// spin min, spin max (rad/s), streak length (s), longest streak (m).
     pub spin_streak: [f32; 4],
-    /// ground height in simulation space (m), 1 / soft-edge distance (1/m), unused ×2.
+    /// ground height in simulation space (m), 1 / soft-edge distance (1/m), lifetime
+    /// range (s).
     pub soft: [f32; 4],
+    /// Packed state: next spawn slot, spawned total (lo, hi), packed (0/1).
+    pub ring: [u32; 4],
+    /// Packed state: effect seed, emitter salt, capacity, unused.
+    pub ring_b: [u32; 4],
     /// Stateless: constant acceleration xyz, drag k.
     pub motion_a: [f32; 4],
     /// Stateless: wind xyz, render time on the 4096 s clock.
@@ -155,3 +202,4 @@ pub const PARAMS_STRIDE: u64 = 512;
 
 const _: () = assert!(std::mem::size_of::<SimParams>() as u64 <= PARAMS_STRIDE);
 const _: () = assert!(std::mem::size_of::<Particle>() == 32);
+const _: () = assert!(std::mem::size_of::<PackedParticle>() == 20);

@@ -61,13 +61,6 @@ pub struct FrameResources {
 /// stateless motion, which depend on the frame). `ramp_row` is the emitter's colour ramp
 /// row, `salt` its per-particle random salt, `sprite_integral` the sprite's ∫ brightness.
 pub fn look_uniform(look: &Look, ramp_row: u32, salt: u32, sprite_integral: f32) -> LookUniform {
-    let mut u = LookUniform::default();
-    u.size_intensity = [
-        look.size_start_m,
-        look.size_end_m,
-        look.intensity,
-        look.size_random,
-    ];
     let (rows, cols, mode, fps, random_start) = match &look.flipbook {
         Some(f) => {
             let (mode, fps) = match f.mode {
@@ -88,31 +81,39 @@ pub fn look_uniform(look: &Look, ramp_row: u32, salt: u32, sprite_integral: f32)
         BlendMode::Additive => 0,
         BlendMode::Alpha => 1,
     };
-    u.ids = [ramp_row, blend, rows, cols];
-    u.flags = [mode, random_start, salt, 0];
-    u.extra = [
-        sprite_integral,
-        0.0,
-        look.rotation_random_deg.to_radians(),
-        fps,
-    ];
     let streak = look.streak.unwrap_or(Streak {
         length_secs: 0.0,
         max_length_m: 0.0,
     });
-    u.spin_streak = [
-        look.spin_deg_per_s.min.to_radians(),
-        look.spin_deg_per_s.max.to_radians(),
-        streak.length_secs,
-        streak.max_length_m,
-    ];
     let inv_soft = if look.soft_ground_m > 0.0 {
         1.0 / look.soft_ground_m
     } else {
         0.0
     };
-    u.soft = [0.0, inv_soft, 0.0, 0.0];
-    u
+    LookUniform {
+        size_intensity: [
+            look.size_start_m,
+            look.size_end_m,
+            look.intensity,
+            look.size_random,
+        ],
+        ids: [ramp_row, blend, rows, cols],
+        flags: [mode, random_start, salt, 0],
+        extra: [
+            sprite_integral,
+            0.0,
+            look.rotation_random_deg.to_radians(),
+            fps,
+        ],
+        spin_streak: [
+            look.spin_deg_per_s.min.to_radians(),
+            look.spin_deg_per_s.max.to_radians(),
+            streak.length_secs,
+            streak.max_length_m,
+        ],
+        soft: [0.0, inv_soft, 0.0, 0.0],
+        ..LookUniform::default()
+    }
 }
 
 /// Which billboard pipeline variant draws an emitter: the look modules it uses (each is
@@ -200,7 +201,8 @@ impl FrameResources {
         });
         let particle_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("FrameResources::particle_layout"),
-            entries: &[storage(0), storage(1), storage(2)],
+            // 3, 4: the same state buffers as 0, 1, seen as packed state.
+            entries: &[storage(0), storage(1), storage(2), storage(3), storage(4)],
         });
         let camera = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some("FrameResources::camera"),
@@ -378,11 +380,22 @@ impl FrameResources {
                 u.motion_a = [a.x, a.y, a.z, e.forces.drag_per_sec];
                 u.motion_b = [w[0], w[1], w[2], t.rem_euclid(4096.0) as f32];
             }
-            let at = i * PARAMS_STRIDE as usize;
-            blocks[at..at + size_of::<LookUniform>()].copy_from_slice(bytemuck::bytes_of(&u));
             let Some(b) = sim.emitter_buffers(i) else {
+                let at = i * PARAMS_STRIDE as usize;
+                blocks[at..at + size_of::<LookUniform>()].copy_from_slice(bytemuck::bytes_of(&u));
                 continue;
             };
+            u.soft[2] = b.life_range.0;
+            u.soft[3] = b.life_range.1;
+            u.ring = [
+                (b.spawned_total % u64::from(b.capacity.max(1))) as u32,
+                b.spawned_total as u32,
+                (b.spawned_total >> 32) as u32,
+                u32::from(b.packed),
+            ];
+            u.ring_b = [b.seed_salt.0, b.seed_salt.1, b.capacity, 0];
+            let at = i * PARAMS_STRIDE as usize;
+            blocks[at..at + size_of::<LookUniform>()].copy_from_slice(bytemuck::bytes_of(&u));
             if !e.enabled {
                 continue;
             }
@@ -410,6 +423,14 @@ impl FrameResources {
                         wgpu::BindGroupEntry {
                             binding: 2,
                             resource: order.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 3,
+                            resource: b.previous.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 4,
+                            resource: b.current.as_entire_binding(),
                         },
                     ],
                 })

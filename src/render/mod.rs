@@ -260,8 +260,16 @@ impl Renderer {
                     .unwrap_or_default();
                 let eye = (camera.eye().as_dvec3() - origin).as_vec3();
                 let forward = (camera.target - camera.eye()).normalize_or(glam::Vec3::NEG_Z);
-                self.sort
-                    .record(ctx, enc, b.generation, b.current, b.capacity, eye, forward);
+                self.sort.record(
+                    ctx,
+                    enc,
+                    b.generation,
+                    b.current,
+                    b.capacity,
+                    eye,
+                    forward,
+                    b.packed,
+                );
             }
         }
         let live: std::collections::HashSet<u64> = items.iter().map(|d| d.key.0).collect();

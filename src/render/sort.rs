@@ -100,7 +100,7 @@ impl SortPass {
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("SortPass::state_layout"),
-                entries: &[entry(0, storage(true))],
+                entries: &[entry(0, storage(true)), entry(1, storage(true))],
             });
         let pipeline_layout = ctx
             .device
@@ -256,6 +256,7 @@ impl SortPass {
         capacity: u32,
         eye: glam::Vec3,
         forward: glam::Vec3,
+        packed: bool,
     ) {
         self.buffers(ctx, generation, capacity);
         let Some(b) = self.buffers.get(&generation) else {
@@ -266,7 +267,7 @@ impl SortPass {
             j: 0,
             count: b.count,
             capacity,
-            eye: eye.extend(0.0).to_array(),
+            eye: eye.extend(if packed { 1.0 } else { 0.0 }).to_array(),
             forward: forward.extend(0.0).to_array(),
         };
         ctx.queue
@@ -274,10 +275,16 @@ impl SortPass {
         let state_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("SortPass::state_group"),
             layout: &self.state_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: state.as_entire_binding(),
-            }],
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: state.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: state.as_entire_binding(),
+                },
+            ],
         });
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("SortPass::sort"),

@@ -3,7 +3,7 @@
 use std::collections::HashMap;
 
 use crate::effect::{Effect, Integrator};
-use crate::gpu::types::{PARAMS_STRIDE, Particle, SimParams};
+use crate::gpu::types::{PARAMS_STRIDE, PackedParticle, Particle, SimParams, slot_counter};
 use crate::gpu::{GpuContext, GpuError};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 use crate::sim::modules::Modules;
@@ -41,7 +41,8 @@ pub struct UpdatePass {
     pipelines: HashMap<PipelineKey, wgpu::ComputePipeline>,
     count_layout: wgpu::BindGroupLayout,
     count_pipeline_layout: wgpu::PipelineLayout,
-    count: Option<wgpu::ComputePipeline>,
+    /// The on-demand counts for full and packed state.
+    count: Option<[wgpu::ComputePipeline; 2]>,
     /// Files the current pipelines were built from.
     pub files: Vec<String>,
 }
@@ -69,6 +70,9 @@ impl UpdatePass {
                     storage(1, true),
                     storage(2, false),
                     storage(3, false),
+                    // The same state buffers as packed state.
+                    storage(4, true),
+                    storage(5, false),
                 ],
             });
         let pipeline_layout = ctx
@@ -82,7 +86,7 @@ impl UpdatePass {
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("UpdatePass::count_layout"),
-                entries: &[storage(0, true), storage(1, false)],
+                entries: &[storage(0, true), storage(1, false), storage(2, true)],
             });
         let count_pipeline_layout =
             ctx.device
@@ -135,23 +139,22 @@ impl UpdatePass {
         // (lavapipe runs each invocation of a barrier-split shader separately): plain
         // atomics there.
         let count_src = lib.compose("count.wgsl")?;
-        let direct = [(
-            "DIRECT_ATOMICS",
-            if ctx.is_cpu_adapter() { 1.0 } else { 0.0 },
-        )];
+        let direct = if ctx.is_cpu_adapter() { 1.0 } else { 0.0 };
         let count = create_checked(&ctx.device, &count_src, lib, |module| {
-            ctx.device
-                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some("UpdatePass::count"),
-                    layout: Some(&self.count_pipeline_layout),
-                    module,
-                    entry_point: Some("main"),
-                    compilation_options: wgpu::PipelineCompilationOptions {
-                        constants: &direct,
-                        zero_initialize_workgroup_memory: true,
-                    },
-                    cache: None,
-                })
+            [0.0, 1.0].map(|packed| {
+                ctx.device
+                    .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                        label: Some("UpdatePass::count"),
+                        layout: Some(&self.count_pipeline_layout),
+                        module,
+                        entry_point: Some("main"),
+                        compilation_options: wgpu::PipelineCompilationOptions {
+                            constants: &[("DIRECT_ATOMICS", direct), ("PACKED", packed)],
+                            zero_initialize_workgroup_memory: true,
+                        },
+                        cache: None,
+                    })
+            })
         })?;
         self.pipelines = fresh;
         self.count = Some(count);
@@ -190,6 +193,12 @@ struct EmitterState {
     generation: u64,
     /// Holds stateless spawn records (no ping-pong: buffer 0 only).
     stateless: bool,
+    /// Holds packed 20-byte state.
+    packed: bool,
+    /// Lifetime range, seed and salt of the last sync (packed state re-derives lifetimes).
+    life_range: (f32, f32),
+    seed: u32,
+    salt: u32,
 }
 
 /// The GPU simulation of an effect.
@@ -217,6 +226,14 @@ pub struct EmitterBuffers<'a> {
     pub generation: u64,
     /// Which of the pair is current (0 or 1).
     pub parity: usize,
+    /// The state is packed (`PackedParticle`, 20 bytes a slot).
+    pub packed: bool,
+    /// Particles spawned so far (the ring's position: packed state re-derives lifetimes).
+    pub spawned_total: u64,
+    /// Lifetime range of the emitter.
+    pub life_range: (f32, f32),
+    /// Effect seed and emitter salt.
+    pub seed_salt: (u32, u32),
 }
 
 impl GpuSim {
@@ -279,13 +296,19 @@ impl GpuSim {
         self.emitters.truncate(effect.emitters.len());
         for (i, e) in effect.emitters.iter().enumerate() {
             let capacity = e.capacity.max(1);
+            let packed = Modules::of(e).contains(Modules::PACKED);
             match self.emitters.get(i) {
-                Some(s) if s.capacity == capacity => {}
+                Some(s) if s.capacity == capacity && s.packed == packed => {}
+                // Switching the layout restarts the pool (nothing to convert in place).
+                Some(s) if s.packed != packed => {
+                    self.emitters[i] = self.create_state(capacity, packed);
+                }
                 _ => {
-                    let fresh = self.create_state(capacity);
+                    let fresh = self.create_state(capacity, packed);
                     if let Some(old) = self.emitters.get(i) {
-                        // Keep the particles that fit.
-                        let keep = old.capacity.min(capacity) as u64 * size_of::<Particle>() as u64;
+                        // Keep the particles that fit (packed ones get the lifetimes of
+                        // their new ring positions).
+                        let keep = old.capacity.min(capacity) as u64 * state_stride(packed);
                         let mut enc = self.ctx.device.create_command_encoder(&Default::default());
                         for b in 0..2 {
                             enc.copy_buffer_to_buffer(
@@ -308,7 +331,10 @@ impl GpuSim {
         // its pool: the two layouts mean different things.
         let mut enc = self.ctx.device.create_command_encoder(&Default::default());
         let mut cleared = false;
-        for (s, e) in self.emitters.iter_mut().zip(&effect.emitters) {
+        for (i, (s, e)) in self.emitters.iter_mut().zip(&effect.emitters).enumerate() {
+            s.life_range = (e.lifetime_secs.min, e.lifetime_secs.max);
+            s.seed = effect.seed;
+            s.salt = crate::rng::emitter_salt(i as u32, e.seed_offset);
             let stateless = Modules::of(e).contains(Modules::STATELESS);
             if s.stateless != stateless {
                 for b in &s.buffers {
@@ -342,8 +368,9 @@ impl GpuSim {
         Ok(())
     }
 
-    fn create_state(&mut self, capacity: u32) -> EmitterState {
-        let size = capacity as u64 * size_of::<Particle>() as u64;
+    fn create_state(&mut self, capacity: u32, packed: bool) -> EmitterState {
+        // At least one full `Particle`: the full-state bindings see the same buffer.
+        let size = (capacity as u64 * state_stride(packed)).max(size_of::<Particle>() as u64);
         let make = |label| {
             self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -374,6 +401,10 @@ impl GpuSim {
             current: 0,
             generation,
             stateless: false,
+            packed,
+            life_range: (0.0, 0.0),
+            seed: 0,
+            salt: 0,
         }
     }
 
@@ -408,6 +439,14 @@ impl GpuSim {
                         wgpu::BindGroupEntry {
                             binding: 3,
                             resource: counters.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 4,
+                            resource: buffers[src].as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 5,
+                            resource: buffers[1 - src].as_entire_binding(),
                         },
                     ],
                 })
@@ -541,7 +580,7 @@ impl GpuSim {
                 .and_then(|o| old_pools.get_mut(o))
                 .and_then(Option::take);
             // A one-slot placeholder: `sync` sees the capacity differ and replaces it.
-            let pool = pool.unwrap_or_else(|| self.create_state(1));
+            let pool = pool.unwrap_or_else(|| self.create_state(1, false));
             self.emitters.push(pool);
             let planner = source
                 .and_then(|o| old_planners.get_mut(o))
@@ -559,6 +598,14 @@ impl GpuSim {
             capacity: s.capacity,
             generation: s.generation,
             parity: s.current,
+            packed: s.packed,
+            spawned_total: self
+                .planner
+                .emitters
+                .get(index)
+                .map_or(0, |p| p.spawned_total()),
+            life_range: s.life_range,
+            seed_salt: (s.seed, s.salt),
         })
     }
 
@@ -579,6 +626,11 @@ impl GpuSim {
             .get(index)
             .ok_or_else(|| SimError::Readback(format!("no emitter {index}")))?;
         let n = particles.len().min(s.capacity as usize);
+        if s.packed {
+            return Err(SimError::Readback(
+                "write_particles needs full (unpacked) state".into(),
+            ));
+        }
         for b in &s.buffers {
             self.ctx
                 .queue
@@ -596,9 +648,30 @@ impl GpuSim {
         let bytes = read_buffer(
             &self.ctx,
             &s.buffers[s.current],
-            s.capacity as u64 * size_of::<Particle>() as u64,
+            s.capacity as u64 * state_stride(s.packed),
         )?;
-        Ok(bytemuck::pod_collect_to_vec(&bytes))
+        if !s.packed {
+            return Ok(bytemuck::pod_collect_to_vec(&bytes));
+        }
+        // Unpack with each slot's lifetime re-derived from its spawn counter.
+        let total = self
+            .planner
+            .emitters
+            .get(index)
+            .map_or(0, |p| p.spawned_total());
+        let packed: Vec<PackedParticle> = bytemuck::pod_collect_to_vec(&bytes);
+        Ok(packed
+            .iter()
+            .enumerate()
+            .map(|(slot, q)| {
+                let slot = slot as u32;
+                let c = slot_counter(slot, total, s.capacity);
+                let key = crate::rng::spawn_key(s.seed, s.salt, slot, c);
+                let r = crate::rng::unorm4(crate::rng::rand_block(key, 1))[3];
+                let life = crate::sim::planner::mix(s.life_range.0, s.life_range.1, r);
+                q.unpack(life)
+            })
+            .collect())
     }
 
     /// `[alive after the last step, non-finite kills so far]` of emitter `index` (blocking).
@@ -648,6 +721,10 @@ impl GpuSim {
                             binding: 1,
                             resource: s.counters.as_entire_binding(),
                         },
+                        wgpu::BindGroupEntry {
+                            binding: 2,
+                            resource: s.buffers[s.current].as_entire_binding(),
+                        },
                     ],
                 });
             let mut enc = self.ctx.device.create_command_encoder(&Default::default());
@@ -657,7 +734,7 @@ impl GpuSim {
                     label: Some("GpuSim::count"),
                     timestamp_writes: None,
                 });
-                pass.set_pipeline(count);
+                pass.set_pipeline(&count[usize::from(s.packed)]);
                 pass.set_bind_group(0, &group, &[]);
                 let (x, y) = dispatch_size(s.capacity);
                 pass.dispatch_workgroups(x, y, 1);
@@ -681,6 +758,15 @@ impl GpuSim {
         }
         self.ctx.queue.submit([enc.finish()]);
         self.planner.reset();
+    }
+}
+
+/// Bytes per slot: 20 packed, 32 full.
+pub fn state_stride(packed: bool) -> u64 {
+    if packed {
+        size_of::<PackedParticle>() as u64
+    } else {
+        size_of::<Particle>() as u64
     }
 }
 

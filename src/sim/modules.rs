@@ -27,9 +27,11 @@ impl Modules {
     pub const COLLISIONS: Modules = Modules(128);
     /// Stateless mode: spawn records only, positions in closed form when drawn.
     pub const STATELESS: Modules = Modules(256);
+    /// Packed 20-byte state.
+    pub const PACKED: Modules = Modules(512);
 
     /// Every module with its override-constant name.
-    pub const ALL: [(Modules, &'static str); 9] = [
+    pub const ALL: [(Modules, &'static str); 10] = [
         (Self::DRAG, "MOD_DRAG"),
         (Self::GUSTS, "MOD_GUSTS"),
         (Self::QUADRATIC_DRAG, "MOD_QUADRATIC_DRAG"),
@@ -39,6 +41,7 @@ impl Modules {
         (Self::FLAME_PULL, "MOD_FLAME_PULL"),
         (Self::COLLISIONS, "MOD_COLLISIONS"),
         (Self::STATELESS, "MOD_STATELESS"),
+        (Self::PACKED, "MOD_PACKED"),
     ];
 
     /// The modules an emitter's settings need.
@@ -78,6 +81,8 @@ impl Modules {
         }
         if e.stateless && e.stateless_blockers().is_empty() {
             m.0 |= Self::STATELESS.0;
+        } else if e.packed_state {
+            m.0 |= Self::PACKED.0;
         }
         m
     }
