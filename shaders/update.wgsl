@@ -54,7 +54,10 @@ fn load_state(slot: u32) -> Particle {
 
 fn store_state(slot: u32, p: Particle) {
     if MOD_PACKED {
-        let dither = unorm4(pcg4d(vec4<u32>(slot, params.spawn_base_lo, params.seed, 0xD1u)));
+        // Keyed by slot and step (the simulated time changes every step; the spawn counter
+        // need not).
+        let step_key = bitcast<u32>(params.wind_time.w) ^ params.spawn_base_lo;
+        let dither = unorm4(pcg4d(vec4<u32>(slot, step_key, params.seed, 0xD1u)));
         dst_packed[slot] = pack_particle(p, dither);
     } else {
         dst[slot] = p;

@@ -240,9 +240,55 @@ pub fn measure_error(
     let steps = (T_SECS / dt).round() as u32;
     sim.step(&effect, dt as f32, steps)?;
     let fin = sim.read_particles(0)?;
+    Ok(error_point(setup, integrator, dt, &fin))
+}
+
+/// As [`measure_error`] with the packed 20-byte state: the same burst spawns the same
+/// initial state (packed from its first store on), then the same steps.
+pub fn measure_error_packed(
+    ctx: &GpuContext,
+    setup: &SceneSetup,
+    integrator: Integrator,
+    dt: f64,
+) -> Result<ErrorPoint, SimError> {
+    let mut e = scene_emitter(setup.scene, integrator, setup.initial.len() as u32);
+    e.packed_state = true;
+    let effect = Effect {
+        emitters: vec![e],
+        ..Effect::default()
+    };
+    let mut sim = GpuSim::new(ctx, ShaderLibrary::embedded(), &effect)?;
+    // The spawn step of `setup_scene` (its positions are the initial state).
+    sim.step(&effect, 1e-4, 1)?;
+    let steps = (T_SECS / dt).round() as u32;
+    sim.step(&effect, dt as f32, steps)?;
+    let fin = sim.read_particles(0)?;
+    let mut p = error_point(setup, integrator, dt, &fin);
+    p.integrator = packed_label(integrator);
+    Ok(p)
+}
+
+/// "<integrator> + packed".
+pub fn packed_label(integrator: Integrator) -> &'static str {
+    match integrator {
+        Integrator::ExplicitEuler => "explicit Euler + packed",
+        Integrator::SemiImplicitEuler => "semi-implicit Euler + packed",
+        Integrator::VelocityVerlet => "velocity Verlet + packed",
+        Integrator::Heun => "Heun + packed",
+        Integrator::Rk4 => "RK4 + packed",
+        Integrator::Exponential => "exponential + packed",
+    }
+}
+
+fn error_point(
+    setup: &SceneSetup,
+    integrator: Integrator,
+    dt: f64,
+    fin: &[Particle],
+) -> ErrorPoint {
     let mut sum = 0.0;
     let mut max: f64 = 0.0;
-    for ((p0, p1), x_ref) in setup.initial.iter().zip(&fin).zip(&setup.reference) {
+    for ((p0, p1), x_ref) in setup.initial.iter().zip(fin).zip(&setup.reference) {
         let x0 = p0.position().as_dvec3();
         let travelled = (*x_ref - x0).length().max(1e-9);
         let err = (p1.position().as_dvec3() - *x_ref).length() / travelled;
@@ -254,13 +300,13 @@ pub fn measure_error(
         sum += err * err;
         max = max.max(err);
     }
-    Ok(ErrorPoint {
+    ErrorPoint {
         scene: setup.scene,
         integrator: integrator.label(),
         dt_secs: dt,
         rms_rel_error: (sum / setup.initial.len().max(1) as f64).sqrt(),
         max_rel_error: max,
-    })
+    }
 }
 
 /// Least-squares slope of log(error) against log(dt) over the points in the asymptotic
@@ -289,8 +335,10 @@ pub fn measure_cost(
     integrator: Integrator,
     capacity: u32,
     repeats: usize,
+    packed: bool,
 ) -> Result<f64, SimError> {
-    let e = scene_emitter(scene, integrator, capacity);
+    let mut e = scene_emitter(scene, integrator, capacity);
+    e.packed_state = packed;
     let effect = Effect {
         emitters: vec![e],
         ..Effect::default()
@@ -459,6 +507,7 @@ pub fn run(
     ));
     let mut points = Vec::new();
     let mut costs = Vec::new();
+    let mut packed_costs = Vec::new();
     let mut csv = String::from(
         "scene,integrator,dt_secs,rms_rel_error,max_rel_error,cost_ns_per_particle_step\n",
     );
@@ -474,14 +523,33 @@ pub fn run(
         let setup = setup_scene(ctx, scene, n)?;
         let mut rows = Vec::new();
         let mut frontier = Vec::new();
-        for integrator in Integrator::ALL {
-            eprintln!("bench accuracy: {} / {}", scene.label(), integrator.label());
-            let cost = measure_cost(ctx, scene, integrator, cost_capacity, opts.repeats)?;
-            costs.push((scene, integrator, cost));
+        // Every integrator on the full state, then the packed state's cost for two of them.
+        let runs = Integrator::ALL.iter().map(|i| (*i, false)).chain([
+            (Integrator::SemiImplicitEuler, true),
+            (Integrator::Rk4, true),
+        ]);
+        for (integrator, packed) in runs {
+            let label = if packed {
+                packed_label(integrator)
+            } else {
+                integrator.label()
+            };
+            eprintln!("bench accuracy: {} / {label}", scene.label());
+            let cost = measure_cost(ctx, scene, integrator, cost_capacity, opts.repeats, packed)?;
+            if packed {
+                packed_costs
+                    .push(serde_json::json!({"scene": scene, "integrator": label, "ns": cost}));
+            } else {
+                costs.push((scene, integrator, cost));
+            }
             let mut errs = Vec::new();
-            let mut row = vec![integrator.label().to_owned()];
+            let mut row = vec![label.to_owned()];
             for dt in DTS {
-                let p = measure_error(ctx, &setup, integrator, dt)?;
+                let p = if packed {
+                    measure_error_packed(ctx, &setup, integrator, dt)?
+                } else {
+                    measure_error(ctx, &setup, integrator, dt)?
+                };
                 row.push(format!(
                     "{} / {}",
                     sci(p.rms_rel_error),
@@ -497,7 +565,9 @@ pub fn run(
             let order = convergence_order(&errs);
             row.push(order.map_or("—".into(), |o| format!("{o:.2}")));
             row.push(format!("{cost:.3}"));
-            frontier.push((integrator, errs, cost));
+            if !packed {
+                frontier.push((integrator, errs, cost));
+            }
             rows.push(row);
         }
         let mut header = vec!["integrator"];
@@ -505,7 +575,11 @@ pub fn run(
         header.extend(dt_labels.iter().map(|s| s.as_str()));
         header.push("order");
         header.push("ns/particle-step");
-        report.para("Each cell: RMS / max relative position error.");
+        report.para(
+            "Each cell: RMS / max relative position error. \"+ packed\" rows: the same runs on the packed \
+             20-byte state (f16 velocity with dithered rounding, 16-bit life fraction); the difference to \
+             the row above is the packing's accuracy cost.",
+        );
         report.table(&header, &rows);
         let mut lines = Vec::new();
         for target in [1e-2, 1e-3, 1e-4] {
@@ -589,6 +663,7 @@ pub fn run(
             .collect::<Vec<_>>(),
     )?;
     report.json["frontier"] = serde_json::Value::Array(json_scenes);
+    report.json["packed_costs_ns_per_particle_step"] = serde_json::Value::Array(packed_costs);
     report.json["frame_rate"] = serde_json::Value::Array(fr_json);
     report.json["fixed_step_bit_identical"] = serde_json::Value::Bool(all_equal);
     report.json["timing"] = serde_json::Value::String(timer.source.label().into());

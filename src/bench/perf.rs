@@ -97,12 +97,12 @@ pub struct PerfRow {
     pub frame_ms: f64,
 }
 
-fn copy_pipeline(ctx: &GpuContext) -> (wgpu::ComputePipeline, wgpu::BindGroupLayout) {
+fn copy_pipeline(ctx: &GpuContext, wgsl: &str) -> (wgpu::ComputePipeline, wgpu::BindGroupLayout) {
     let module = ctx
         .device
         .create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("bench copy"),
-            source: wgpu::ShaderSource::Wgsl(COPY_WGSL.into()),
+            source: wgpu::ShaderSource::Wgsl(wgsl.into()),
         });
     let layout = ctx
         .device
@@ -144,6 +144,87 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) n: vec3<u
     if i < arrayLength(&src) { dst[i] = src[i]; }
 }
 ";
+
+/// The same copy with the packed state's 20-byte elements (five scalars, as the update
+/// reads and writes them).
+const COPY20_WGSL: &str = "
+struct Q { a: u32, b: u32, c: u32, d: u32, e: u32 }
+@group(0) @binding(0) var<storage, read> src: array<Q>;
+@group(0) @binding(1) var<storage, read_write> dst: array<Q>;
+@compute @workgroup_size(256)
+fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) n: vec3<u32>, @builtin(local_invocation_index) l: u32) {
+    let i = (wg.y * n.x + wg.x) * 256u + l;
+    if i < arrayLength(&src) { dst[i] = src[i]; }
+}
+";
+
+/// One row of the packed-state table: update ms of the packed pools and of a compute copy
+/// of the same bytes (20 read + 20 written per particle).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct PackedRow {
+    /// Particles.
+    pub particles: u64,
+    /// Update pass on packed state, ms.
+    pub update_ms: f64,
+    /// Copy of the same bytes, ms.
+    pub copy_ms: f64,
+}
+
+fn measure_packed(
+    ctx: &GpuContext,
+    opts: &PerfOptions,
+    n: u64,
+    copy: &(wgpu::ComputePipeline, wgpu::BindGroupLayout),
+) -> Result<PackedRow, SimError> {
+    let max_pool = ctx.max_capacity().min(1 << 24);
+    let mut effect = scaled_campfire(n, max_pool);
+    for e in &mut effect.emitters {
+        e.packed_state = true;
+    }
+    let mut sim = GpuSim::new(ctx, ShaderLibrary::embedded(), &effect)?;
+    for _ in 0..3 {
+        sim.step(&effect, 1.0 / 60.0, 22)?;
+    }
+    let timer = GpuTimer::new(ctx);
+    let update_ms = time_median(&timer, ctx, opts.repeats, |enc| {
+        let plans = sim.plan(&effect, 1.0 / 60.0, 1);
+        sim.record(enc, &effect, &plans);
+    });
+    let groups: Vec<_> = (0..sim.emitter_count())
+        .filter_map(|i| sim.emitter_buffers(i))
+        .map(|b| {
+            let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("bench copy20 group"),
+                layout: &copy.1,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: b.current.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: b.previous.as_entire_binding(),
+                    },
+                ],
+            });
+            (group, b.capacity)
+        })
+        .collect();
+    let copy_ms = time_median(&timer, ctx, opts.repeats, |enc| {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&copy.0);
+        for (g, cap) in &groups {
+            pass.set_bind_group(0, g, &[]);
+            let (x, y) = crate::sim::gpu_sim::dispatch_size(*cap);
+            pass.dispatch_workgroups(x, y, 1);
+        }
+    });
+    Ok(PackedRow {
+        particles: n,
+        update_ms,
+        copy_ms,
+    })
+}
 
 fn time_median(
     timer: &GpuTimer,
@@ -437,7 +518,10 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
     // rows have been allocated and freed.
     eprintln!("bench perf: module costs");
     let costs = module_costs(ctx, opts)?;
-    let copy = copy_pipeline(ctx);
+    let copy = copy_pipeline(ctx, COPY_WGSL);
+    let copy20 = copy_pipeline(ctx, COPY20_WGSL);
+    let mut packed_table = Vec::new();
+    let mut packed_rows = Vec::new();
     let mut rows = Vec::new();
     let mut table = Vec::new();
     let limit = ctx.max_capacity() * 8;
@@ -482,6 +566,33 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
             "side": side, "row": row, "update_gb_per_s": gbps, "copy_gb_per_s": copy_gbps,
             "update_vs_copy": row.copy_ms / row.update_ms, "fps": fps, "thesis_fps": thesis,
         }));
+        // The packed state, from 1M particles up (below, launch overheads dominate).
+        if n >= 1 << 20 {
+            eprintln!("bench perf: {side}² packed");
+            match measure_packed(ctx, opts, n, &copy20) {
+                Ok(p) => {
+                    let pgbps = n as f64 * 40.0 / (p.update_ms * 1e-3) / 1e9;
+                    let pcopy = n as f64 * 40.0 / (p.copy_ms * 1e-3) / 1e9;
+                    packed_table.push(vec![
+                        format!("{side}² = {n}"),
+                        format!("{:.3}", p.update_ms),
+                        format!("{:.3}", row.update_ms),
+                        format!("{:.2}×", row.update_ms / p.update_ms),
+                        format!("{:.3}", p.copy_ms),
+                        format!(
+                            "{pgbps:.3} GB/s ({:.0} % of the copy's {pcopy:.3})",
+                            100.0 * p.copy_ms / p.update_ms
+                        ),
+                    ]);
+                    packed_rows.push(serde_json::json!({
+                        "side": side, "row": p, "full_update_ms": row.update_ms,
+                        "update_gb_per_s": pgbps, "copy_gb_per_s": pcopy,
+                        "update_vs_copy": p.copy_ms / p.update_ms,
+                    }));
+                }
+                Err(e) => report.para(&format!("{side}² packed: {e}")),
+            }
+        }
     }
     report.heading("Throughput");
     report.table(
@@ -500,6 +611,24 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
         ],
         &table,
     );
+    report.heading("Packed state (20 B per particle)");
+    report.para(
+        "The `packed_state` option: f32 position, f16 velocity, 16-bit life fraction, lifetime re-derived \
+         from the spawn hash — 40 B moved per particle-step (20 read + 20 written) instead of 64. The copy \
+         moves the same 20-byte elements in the same run. Accuracy cost: `ignis bench accuracy` (\"+ packed\" rows).",
+    );
+    report.table(
+        &[
+            "particles",
+            "packed update ms",
+            "full update ms (above)",
+            "speed-up",
+            "copy ms (20 B elements)",
+            "packed bandwidth (vs copy)",
+        ],
+        &packed_table,
+    );
+    report.json["packed"] = serde_json::Value::Array(packed_rows);
     report.heading("Optional modules");
     let bare = costs.first().map_or(f64::NAN, |c| c.1);
     let mcap = opts.module_capacity.min(ctx.max_capacity() as u32);
