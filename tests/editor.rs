@@ -983,3 +983,17 @@ fn look_controls_toggle_flipbook_streak_bloom_and_the_gradient_bar_adds_stops() 
     assert!(harness.state().validation_errors.is_empty());
     assert!(harness.state().effect.validate().is_ok());
 }
+
+#[test]
+fn packed_state_is_offered_and_excludes_stateless() {
+    let mut harness = panel_harness(campfire_state());
+    harness.get_by_label("Packed state").click_accesskit();
+    harness.run();
+    let e = &harness.state().effect.emitters[0];
+    assert!(e.packed_state && !e.stateless);
+    harness.get_by_label("Stateless").click_accesskit();
+    harness.run();
+    let e = &harness.state().effect.emitters[0];
+    assert!(e.stateless && !e.packed_state, "turning stateless on turns packed off");
+    assert!(harness.state().effect.validate().is_ok());
+}

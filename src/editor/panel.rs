@@ -1233,7 +1233,25 @@ ui,
                 ui,
                 "Stateless",
                 "Closed form instead of steps: each particle's position is evaluated from its spawn record and age (exact, cheaper). Only for constant acceleration and linear drag",
-                |ui| ui.checkbox(&mut e.stateless, "closed form"),
+                |ui| {
+                    let r = ui.checkbox(&mut e.stateless, "closed form");
+                    if r.changed() && e.stateless {
+                        e.packed_state = false;
+                    }
+                    r
+                },
+            );
+            row_ui(
+                ui,
+                "Packed state",
+                "Store each particle in 20 bytes instead of 32 (f16 velocity, 16-bit life fraction, lifetime re-derived from the spawn hash): less memory traffic for huge pools, at the accuracy cost `ignis bench accuracy` reports (\"+ packed\" rows). Switching restarts this emitter's particles",
+                |ui| {
+                    let r = ui.checkbox(&mut e.packed_state, "20 B / particle");
+                    if r.changed() && e.packed_state {
+                        e.stateless = false;
+                    }
+                    r
+                },
             );
             let blockers = e.stateless_blockers();
             if e.stateless && !blockers.is_empty() {
