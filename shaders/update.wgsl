@@ -2,7 +2,7 @@
 //
 // Contract (plumbing; designers change spawn.wgsl, forces.wgsl, integrators.wgsl):
 // - group 0: binding 0 `params` (SimParams, dynamic offset per step), 1 `src` (read),
-//   2 `dst` (write), 3 `counters` ([0] alive after this step when COUNT_ALIVE is on,
+//   2 `dst` (write; both declared in state_full.wgsl / state_packed.wgsl), 3 `counters` ([0] alive after this step when COUNT_ALIVE is on,
 //   [1] non-finite kills, total).
 // - COUNT_ALIVE (GPUs): a workgroup reduction, one global atomic per workgroup. On CPU
 //   adapters it is off — a workgroup barrier makes lavapipe run every invocation
@@ -15,13 +15,11 @@
 #import "common.wgsl"
 
 @group(0) @binding(0) var<uniform> params: SimParams;
-@group(0) @binding(1) var<storage, read> src: array<Particle>;
-@group(0) @binding(2) var<storage, read_write> dst: array<Particle>;
 @group(0) @binding(3) var<storage, read_write> counters: array<atomic<u32>, 2>;
-// The same buffers seen as packed state (read only when MOD_PACKED is on).
-@group(0) @binding(4) var<storage, read> src_packed: array<PackedParticle>;
-@group(0) @binding(5) var<storage, read_write> dst_packed: array<PackedParticle>;
 
+// The state's bindings (1 `src`, 2 `dst`) and `load_state` / `store_state`: full 32-byte
+// particles, or — for packed_state pipelines — state_packed.wgsl composed in its place.
+#import "state_full.wgsl"
 #import "spawn.wgsl"
 #import "integrators.wgsl"
 #import "collide.wgsl"
@@ -33,36 +31,6 @@
 // pos_age.w the birth time on the 4096 s clock.
 override MOD_STATELESS: bool = false;
 override COUNT_ALIVE: bool = true;
-// Packed state: 20 bytes per particle instead of 32 (f16 velocity, unorm16 life fraction,
-// lifetime re-derived from the spawn hash).
-override MOD_PACKED: bool = false;
-
-// The state of `slot` before this step.
-fn load_state(slot: u32) -> Particle {
-    if MOD_PACKED {
-        let q = src_packed[slot];
-        if !packed_alive(q) {
-            return Particle(vec4<f32>(0.0), vec4<f32>(0.0));
-        }
-        // The ring before this step's spawns: `spawn_base` spawned, next slot `spawn_head`.
-        let c = slot_counter(slot, params.spawn_head, params.spawn_base_lo, params.spawn_base_hi, params.capacity);
-        let key = spawn_key(params.seed, params.emitter_salt, slot, c.x, c.y);
-        return unpack_particle(q, spawn_life(key, params.speed_life.z, params.speed_life.w));
-    }
-    return src[slot];
-}
-
-fn store_state(slot: u32, p: Particle) {
-    if MOD_PACKED {
-        // Keyed by slot and step (the simulated time changes every step; the spawn counter
-        // need not).
-        let step_key = bitcast<u32>(params.wind_time.w) ^ params.spawn_base_lo;
-        let dither = unorm4(pcg4d(vec4<u32>(slot, step_key, params.seed, 0xD1u)));
-        dst_packed[slot] = pack_particle(p, dither);
-    } else {
-        dst[slot] = p;
-    }
-}
 
 fn stateless_spawn(i: u32) {
     if i >= params.spawn_count {
@@ -74,7 +42,7 @@ fn stateless_spawn(i: u32) {
     var p = spawn_particle(slot, spawn_key(params.seed, params.emitter_salt, slot, lo, hi));
     let f = clamp(params.spawn_frac0 + f32(i) * params.spawn_frac_step, 0.0, 1.0);
     p.pos_age.w = (params.wind_time.w + f * params.dt_secs) % 4096.0;
-    dst[slot] = p;
+    store_state(slot, p);
 }
 
 @compute @workgroup_size(256)
@@ -90,7 +58,7 @@ fn main(
     }
     var alive = false;
     if slot < params.capacity {
-        var p = Particle(vec4<f32>(0.0), vec4<f32>(0.0));
+        var p = load_state(slot);
         // Position of this slot in the ring relative to the spawn head (capacity ≤ 2^28).
         let rel = (slot + params.capacity - params.spawn_head) % params.capacity;
         if rel < params.spawn_count {
@@ -113,10 +81,7 @@ fn main(
                 vec4<f32>(v0 * (1.0 - k * pp.x) + c * pp.x, p.vel_life.w),
             );
             alive = is_alive(p);
-        } else {
-            p = load_state(slot);
-        }
-        if rel >= params.spawn_count && is_alive(p) {
+        } else if is_alive(p) {
             let life = p.vel_life.w;
             var s = integrate(p.pos_age.xyz, p.vel_life.xyz, p.pos_age.w, life, params.wind_time.w, params.dt_secs);
             var age = p.pos_age.w + params.dt_secs;

@@ -104,10 +104,14 @@ impl ShaderReloader {
     pub fn new(lib: &ShaderLibrary) -> Self {
         let mut deps = BTreeMap::new();
         for entry in ENTRY_FILES {
-            let files = lib
+            let mut files = lib
                 .compose(entry)
                 .map(|c| c.files)
                 .unwrap_or_else(|_| vec![(*entry).to_owned()]);
+            if *entry == "update.wgsl" {
+                // Packed-state pipelines compose it in place of state_full.wgsl.
+                files.push("state_packed.wgsl".to_owned());
+            }
             deps.insert(*entry, files);
         }
         Self {
@@ -160,7 +164,11 @@ impl ShaderReloader {
             match result {
                 Ok(()) => {
                     if let Ok(c) = lib.compose(entry) {
-                        self.deps.insert(entry, c.files);
+                        let mut files = c.files;
+                        if entry == "update.wgsl" {
+                            files.push("state_packed.wgsl".to_owned());
+                        }
+                        self.deps.insert(entry, files);
                     }
                     if self.errors.remove(entry).is_some() {
                         log::info!("{entry}: fixed, new pipeline in use");

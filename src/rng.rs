@@ -57,5 +57,14 @@ pub fn emitter_salt(emitter_index: u32, seed_offset: u32) -> u32 {
 
 /// A lattice hash for value noise (see `hash_cell` in `shaders/rng.wgsl`).
 pub fn hash_cell(c: [i32; 3], seed: u32) -> f32 {
-    unorm(pcg4d([c[0] as u32, c[1] as u32, c[2] as u32, seed])[0])
+    let mut h = (c[0] as u32).wrapping_mul(0x8DA6_B343)
+        ^ (c[1] as u32).wrapping_mul(0xD816_3841)
+        ^ (c[2] as u32).wrapping_mul(0xCB1A_B31F)
+        ^ seed.wrapping_mul(0x9E37_79B9);
+    h ^= h >> 16;
+    h = h.wrapping_mul(0x7FEB_352D);
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x846C_A68B);
+    h ^= h >> 16;
+    unorm(h)
 }

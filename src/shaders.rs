@@ -26,6 +26,14 @@ pub const EMBEDDED: &[(&str, &str)] = &[
         include_str!("../shaders/alive_count.wgsl"),
     ),
     ("update.wgsl", include_str!("../shaders/update.wgsl")),
+    (
+        "state_full.wgsl",
+        include_str!("../shaders/state_full.wgsl"),
+    ),
+    (
+        "state_packed.wgsl",
+        include_str!("../shaders/state_packed.wgsl"),
+    ),
     ("count.wgsl", include_str!("../shaders/count.wgsl")),
     ("look.wgsl", include_str!("../shaders/look.wgsl")),
     ("billboard.wgsl", include_str!("../shaders/billboard.wgsl")),
@@ -238,8 +246,20 @@ impl ShaderLibrary {
 
     /// Composes `entry` with its imports and validates the result with naga.
     pub fn compose(&self, entry: &str) -> Result<Composed, ShaderError> {
+        self.compose_with(entry, &[])
+    }
+
+    /// As [`compose`](Self::compose), with `(import, replacement)` pairs: an
+    /// `#import "import"` reads `replacement` instead (how the packed state swaps the
+    /// update pass's state I/O, `state_full.wgsl` → `state_packed.wgsl`).
+    pub fn compose_with(
+        &self,
+        entry: &str,
+        aliases: &[(&str, &str)],
+    ) -> Result<Composed, ShaderError> {
         let mut out = Composer {
             lib: self,
+            aliases,
             source: String::new(),
             files: Vec::new(),
             line_map: Vec::new(),
@@ -295,6 +315,7 @@ impl ShaderLibrary {
 
 struct Composer<'a> {
     lib: &'a ShaderLibrary,
+    aliases: &'a [(&'a str, &'a str)],
     source: String,
     files: Vec<String>,
     line_map: Vec<(usize, u32)>,
@@ -303,6 +324,11 @@ struct Composer<'a> {
 impl Composer<'_> {
     /// Appends `name` (once), replacing its `#import` lines by the imported files.
     fn include(&mut self, name: &str, from: Option<(usize, u32, &str)>) -> Result<(), ShaderError> {
+        let name = self
+            .aliases
+            .iter()
+            .find(|(from, _)| *from == name)
+            .map_or(name, |(_, to)| *to);
         if self.files.iter().any(|f| f == name) {
             return Ok(());
         }

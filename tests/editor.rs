@@ -994,6 +994,9 @@ fn packed_state_is_offered_and_excludes_stateless() {
     harness.get_by_label("Stateless").click_accesskit();
     harness.run();
     let e = &harness.state().effect.emitters[0];
-    assert!(e.stateless && !e.packed_state, "turning stateless on turns packed off");
+    assert!(
+        e.stateless && !e.packed_state,
+        "turning stateless on turns packed off"
+    );
     assert!(harness.state().effect.validate().is_ok());
 }

@@ -169,8 +169,8 @@ fn broken_edits_keep_the_last_good_pipeline() {
         ),
         (
             "update.wgsl",
-            "@group(0) @binding(2) var<storage, read_write> dst",
-            "@group(0) @binding(7) var<storage, read_write> dst",
+            "@group(0) @binding(3) var<storage, read_write> counters",
+            "@group(0) @binding(7) var<storage, read_write> counters",
             None,
         ),
         ("update.wgsl", "fn main(", "fn main_renamed(", None),

@@ -74,6 +74,17 @@ pub fn scaled_campfire(n: u64, max_pool: u64) -> Effect {
     }
 }
 
+/// `effect` without turbulence and flame pull (the ALU-heavy modules): what the
+/// bandwidth figures measure.
+pub fn lean_effect(effect: &Effect) -> Effect {
+    let mut lean = effect.clone();
+    for e in &mut lean.emitters {
+        e.forces.turbulence = None;
+        e.forces.flame_pull = None;
+    }
+    lean
+}
+
 /// One row of the throughput table.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct PerfRow {
@@ -83,6 +94,9 @@ pub struct PerfRow {
     pub pools: u64,
     /// Update pass, ms.
     pub update_ms: f64,
+    /// Update pass without the ALU-heavy force modules (turbulence, flame pull): the
+    /// memory-bound case the bandwidth column uses, ms.
+    pub lean_update_ms: f64,
     /// Compute copy of the same bytes, ms.
     pub copy_ms: f64,
     /// Billboard draw, ms (None when skipped).
@@ -177,7 +191,7 @@ fn measure_packed(
     copy: &(wgpu::ComputePipeline, wgpu::BindGroupLayout),
 ) -> Result<PackedRow, SimError> {
     let max_pool = ctx.max_capacity().min(1 << 24);
-    let mut effect = scaled_campfire(n, max_pool);
+    let mut effect = lean_effect(&scaled_campfire(n, max_pool));
     for e in &mut effect.emitters {
         e.packed_state = true;
     }
@@ -254,6 +268,13 @@ fn measure_row(
     let update_ms = time_median(&timer, ctx, opts.repeats, |enc| {
         let plans = sim.plan(&effect, 1.0 / 60.0, 1);
         sim.record(enc, &effect, &plans);
+    });
+    // The same pools without turbulence and flame pull: memory-bound.
+    let lean = lean_effect(&effect);
+    sim.step(&lean, 1.0 / 60.0, 2)?;
+    let lean_update_ms = time_median(&timer, ctx, opts.repeats, |enc| {
+        let plans = sim.plan(&lean, 1.0 / 60.0, 1);
+        sim.record(enc, &lean, &plans);
     });
     // The copy: the same bytes as every pool's read + write, in one run.
     let mut copy_groups = Vec::new();
@@ -373,6 +394,7 @@ fn measure_row(
         particles: n,
         pools: effect.emitters.len() as u64,
         update_ms,
+        lean_update_ms,
         copy_ms,
         billboard_ms,
         splat_ms,
@@ -390,7 +412,9 @@ fn r_targets(r: &Renderer) -> Option<&wgpu::TextureView> {
 /// override constant, and with the module code removed from the source.
 fn module_costs(ctx: &GpuContext, opts: &PerfOptions) -> Result<Vec<(String, f64)>, SimError> {
     let n = opts.module_capacity.min(ctx.max_capacity() as u32);
-    let base = scaled_campfire(n as u64, n as u64);
+    // The flames without their own optional modules (turbulence, flame pull): each row
+    // below switches one on.
+    let base = lean_effect(&scaled_campfire(n as u64, n as u64));
     let timer = GpuTimer::new(ctx);
     let mut plain = base.clone();
     for e in &mut plain.emitters {
@@ -505,8 +529,10 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
     report.para(&format!(
         "Resolution {}×{}; the default campfire's flames scaled to N particles (sizes ∝ 1/√N, so the fire's \
          footprint and light stay those of the original); medians of {} runs measured with **{}**. \
-         Bandwidth = 64 B per particle-step (32 read + 32 written) / update time; the copy is a compute shader \
-         moving the same bytes, in the same run. Pools larger than {} particles are split into several emitters \
+         The frame uses the update as the campfire's flames have it (2-octave curl-noise turbulence and flame \
+         pull: ALU-bound); bandwidth = 64 B per particle-step (32 read + 32 written) / the update time of the same \
+         pools without those two modules (memory-bound); the copy is a compute shader moving the same bytes, in the \
+         same run. Pools larger than {} particles are split into several emitters \
          (one storage binding each).",
         opts.size.0,
         opts.size.1,
@@ -541,17 +567,18 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
                 continue;
             }
         };
-        let gbps = n as f64 * 64.0 / (row.update_ms * 1e-3) / 1e9;
+        let gbps = n as f64 * 64.0 / (row.lean_update_ms * 1e-3) / 1e9;
         let copy_gbps = n as f64 * 64.0 / (row.copy_ms * 1e-3) / 1e9;
         let thesis = THESIS_FPS.iter().find(|(s, _)| *s == side).map(|(_, f)| *f);
         let fps = 1000.0 / row.frame_ms;
         table.push(vec![
             format!("{side}² = {n}"),
             format!("{:.3}", row.update_ms),
+            format!("{:.3}", row.lean_update_ms),
             format!("{:.3}", row.copy_ms),
             format!(
                 "{gbps:.3} GB/s ({:.0} % of the copy's {copy_gbps:.3})",
-                100.0 * row.copy_ms / row.update_ms
+                100.0 * row.copy_ms / row.lean_update_ms
             ),
             row.billboard_ms
                 .map_or("skipped".into(), |m| format!("{m:.3}")),
@@ -564,7 +591,7 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
         ]);
         rows.push(serde_json::json!({
             "side": side, "row": row, "update_gb_per_s": gbps, "copy_gb_per_s": copy_gbps,
-            "update_vs_copy": row.copy_ms / row.update_ms, "fps": fps, "thesis_fps": thesis,
+            "update_vs_copy": row.copy_ms / row.lean_update_ms, "fps": fps, "thesis_fps": thesis,
         }));
         // The packed state, from 1M particles up (below, launch overheads dominate).
         if n >= 1 << 20 {
@@ -576,8 +603,8 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
                     packed_table.push(vec![
                         format!("{side}² = {n}"),
                         format!("{:.3}", p.update_ms),
-                        format!("{:.3}", row.update_ms),
-                        format!("{:.2}×", row.update_ms / p.update_ms),
+                        format!("{:.3}", row.lean_update_ms),
+                        format!("{:.2}×", row.lean_update_ms / p.update_ms),
                         format!("{:.3}", p.copy_ms),
                         format!(
                             "{pgbps:.3} GB/s ({:.0} % of the copy's {pcopy:.3})",
@@ -585,7 +612,7 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
                         ),
                     ]);
                     packed_rows.push(serde_json::json!({
-                        "side": side, "row": p, "full_update_ms": row.update_ms,
+                        "side": side, "row": p, "full_update_ms": row.lean_update_ms,
                         "update_gb_per_s": pgbps, "copy_gb_per_s": pcopy,
                         "update_vs_copy": p.copy_ms / p.update_ms,
                     }));
@@ -598,9 +625,10 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
     report.table(
         &[
             "particles",
-            "update ms",
+            "update ms (campfire flames: turbulence + flame pull)",
+            "update ms (without them)",
             "copy ms",
-            "update bandwidth (vs copy)",
+            "update bandwidth, without them (vs copy)",
             "billboard draw ms",
             "splat draw ms (clear + splat)",
             "composite ms (tonemap + splat resolve)",
@@ -621,7 +649,7 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
         &[
             "particles",
             "packed update ms",
-            "full update ms (above)",
+            "full update ms (above, without turbulence)",
             "speed-up",
             "copy ms (20 B elements)",
             "packed bandwidth (vs copy)",

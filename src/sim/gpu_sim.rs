@@ -70,9 +70,6 @@ impl UpdatePass {
                     storage(1, true),
                     storage(2, false),
                     storage(3, false),
-                    // The same state buffers as packed state.
-                    storage(4, true),
-                    storage(5, false),
                 ],
             });
         let pipeline_layout = ctx
@@ -114,12 +111,20 @@ impl UpdatePass {
         keys: &[PipelineKey],
     ) -> Result<(), ShaderError> {
         let composed = lib.compose("update.wgsl")?;
+        // Packed-state pipelines: the same entry with state_packed.wgsl as the state I/O.
+        let packed =
+            lib.compose_with("update.wgsl", &[("state_full.wgsl", "state_packed.wgsl")])?;
         let mut fresh = HashMap::new();
         for &(integrator, modules) in keys {
+            let composed = if modules.contains(Modules::PACKED) {
+                &packed
+            } else {
+                &composed
+            };
             let mut constants = modules.constants();
             constants.push(("INTEGRATOR", integrator.index() as f64));
             constants.push(("COUNT_ALIVE", if ctx.is_cpu_adapter() { 0.0 } else { 1.0 }));
-            let pipeline = create_checked(&ctx.device, &composed, lib, |module| {
+            let pipeline = create_checked(&ctx.device, composed, lib, |module| {
                 ctx.device
                     .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                         label: Some("UpdatePass::pipeline"),
@@ -159,7 +164,7 @@ impl UpdatePass {
         self.pipelines = fresh;
         self.count = Some(count);
         self.files = composed.files;
-        for f in count_src.files {
+        for f in packed.files.into_iter().chain(count_src.files) {
             if !self.files.contains(&f) {
                 self.files.push(f);
             }
@@ -439,14 +444,6 @@ impl GpuSim {
                         wgpu::BindGroupEntry {
                             binding: 3,
                             resource: counters.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 4,
-                            resource: buffers[src].as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 5,
-                            resource: buffers[1 - src].as_entire_binding(),
                         },
                     ],
                 })
