@@ -69,7 +69,11 @@ fn splat(
     let rnd = particle_random(slot, d.life);
     let size_px = size_at(t, rnd.x) * camera.viewport.z / clip.w;
     let half = 0.5 * size_px;
-    let energy = color.rgb * (color.a * look.size_intensity.z * look.extra.x * half * half);
+    var energy = color.rgb * (color.a * look.size_intensity.z * look.extra.x * half * half);
+    if look.soft.y > 0.0 {
+        // The billboard's ground fade, taken at the particle's centre.
+        energy *= clamp((d.pos.y - look.soft.x) * look.soft.y, 0.0, 1.0);
+    }
     let ndc = clip.xy / clip.w;
     let px = vec2<f32>((ndc.x * 0.5 + 0.5) * camera.viewport.x, (0.5 - ndc.y * 0.5) * camera.viewport.y) - 0.5;
     let dither = unorm4(pcg4d(vec4<u32>(slot, bitcast<u32>(d.age), 0x5EEDu, 0u)));

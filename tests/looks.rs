@@ -30,6 +30,11 @@ const PROBE: &str = r#"
 @group(0) @binding(0) var<uniform> camera: CameraUniform;
 @group(0) @binding(1) var<uniform> look: LookUniform;
 @group(0) @binding(2) var ramps: texture_2d<f32>;
+// The state bindings look.wgsl's `load_pair` reads (unused here).
+@group(1) @binding(0) var<storage, read> prev: array<Particle>;
+@group(1) @binding(1) var<storage, read> cur: array<Particle>;
+@group(1) @binding(3) var<storage, read> prev_packed: array<PackedParticle>;
+@group(1) @binding(4) var<storage, read> cur_packed: array<PackedParticle>;
 // x: age, y: life, z: random start number, w: blend frames (0/1).
 @group(0) @binding(3) var<storage, read> inputs: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read_write> outputs: array<vec4<f32>>;

@@ -1476,6 +1476,9 @@ fn documented_examples_and_defaults_match_the_code() {
     e.forces.flame_pull = Some(FlamePull::default());
     e.collisions.ground = Some(GroundPlane::default());
     e.collisions.spheres = vec![SphereCollider::default()];
+    e.look.flipbook = Some(Flipbook::default());
+    e.look.streak = Some(Streak::default());
+    expected.post.bloom = Some(Bloom::default());
     assert_eq!(documented, expected);
 }
 

@@ -24,6 +24,13 @@ fn every_entry_validates() {
     for entry in ENTRY_FILES {
         reached.extend(project_shaders().compose(entry).expect("valid").files);
     }
+    // The packed-state update: update.wgsl with state_packed.wgsl as its state I/O.
+    let packed = project_shaders()
+        .compose_with("update.wgsl", &[("state_full.wgsl", "state_packed.wgsl")])
+        .unwrap_or_else(|e| panic!("packed update: {e}"));
+    assert!(packed.files.iter().any(|f| f == "state_packed.wgsl"));
+    assert!(!packed.files.iter().any(|f| f == "state_full.wgsl"));
+    reached.extend(packed.files);
     for f in std::fs::read_dir(dir).expect("shaders/") {
         let name = f.expect("entry").file_name().to_string_lossy().into_owned();
         if name.ends_with(".wgsl") {
@@ -49,6 +56,11 @@ fn rust_and_wgsl_struct_sizes_agree() {
     let cases = [
         (&update, "Particle", size_of::<Particle>()),
         (&update, "SimParams", size_of::<SimParams>()),
+        (
+            &update,
+            "PackedParticle",
+            size_of::<ignis::gpu::types::PackedParticle>(),
+        ),
         (&billboard, "CameraUniform", size_of::<CameraUniform>()),
         (&billboard, "LookUniform", size_of::<LookUniform>()),
         (&tonemap, "ToneUniform", size_of::<ToneUniform>()),

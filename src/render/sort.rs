@@ -354,10 +354,16 @@ impl SortPass {
         let state_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("SortPass::no_state_group"),
             layout: &self.state_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: dummy.as_entire_binding(),
-            }],
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: dummy.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: dummy.as_entire_binding(),
+                },
+            ],
         });
         let mut enc = ctx.device.create_command_encoder(&Default::default());
         {
