@@ -751,3 +751,40 @@ fn reference_images() {
         }
     }
 }
+
+/// The editor's PNG hot reload, end to end below the window: the file watcher sees the
+/// sprite's folder change, the library drops the file, the next resolve uploads the new
+/// pixels.
+#[test]
+fn a_png_changed_on_disk_is_seen_by_the_watcher_and_reloaded() {
+    let ctx = gpu();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("glow.png");
+    write_png(&path, 8, 8, |_, _| [255, 255, 255, 128]);
+    let mut lib = SpriteLibrary::new(&ctx);
+    let sprite = Sprite::Image("glow.png".into());
+    let (first, err) = lib.resolve(&ctx, &sprite, Some(dir.path()));
+    assert!(err.is_none());
+    let dirs = lib.watched_dirs();
+    let paths: Vec<&Path> = dirs.iter().map(|d| d.as_path()).collect();
+    let watcher = ignis::hot_reload::FileWatcher::new(&paths).expect("watch");
+    // A save: write a new image next to it, then rename over (as editors do).
+    let tmp = dir.path().join("glow.tmp.png");
+    write_png(&tmp, 8, 8, |_, _| [255, 255, 255, 255]);
+    std::fs::rename(&tmp, &path).expect("rename");
+    let mut changed = Vec::new();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
+    while !changed
+        .iter()
+        .any(|p: &std::path::PathBuf| p.file_name() == path.file_name())
+        && std::time::Instant::now() < deadline
+    {
+        changed.extend(watcher.wait(std::time::Duration::from_millis(200)));
+    }
+    assert!(lib.invalidate(&changed), "the watcher reported {changed:?}");
+    let (second, err) = lib.resolve(&ctx, &sprite, Some(dir.path()));
+    assert!(err.is_none());
+    assert_ne!(second.id, first.id);
+    assert!((first.integral - 4.0 * 128.0 / 255.0).abs() < 1e-3);
+    assert!((second.integral - 4.0).abs() < 1e-3, "{}", second.integral);
+}
