@@ -4,7 +4,8 @@
 // intensity), binding 2 `accum` (the compute splat's fixed-point light, read only when
 // SPLAT is on — the splat resolve is fused into this pass, saving a full-screen pass),
 // binding 3 `bloom_tex` + 4 `bloom_samp` (level 0 of the bloom chain, read only when
-// BLOOM is on).
+// BLOOM is on), binding 5 `alpha_tex` (the alpha-blended layers at reduced resolution,
+// read only when LOW_ALPHA is on).
 // A full-screen triangle; the ACES fit by Krzysztof Narkowicz maps HDR to [0, 1].
 
 struct ToneUniform {
@@ -17,9 +18,12 @@ struct ToneUniform {
 @group(0) @binding(2) var<storage, read> accum: array<u32>;
 @group(0) @binding(3) var bloom_tex: texture_2d<f32>;
 @group(0) @binding(4) var bloom_samp: sampler;
+// The alpha-blended layers drawn at reduced resolution (read only when LOW_ALPHA is on).
+@group(0) @binding(5) var alpha_tex: texture_2d<f32>;
 
 override SPLAT: bool = false;
 override BLOOM: bool = false;
+override LOW_ALPHA: bool = false;
 // Keep in sync with `FIXED_SCALE` in splat.wgsl.
 const SPLAT_FIXED_SCALE: f32 = 4096.0;
 
@@ -45,8 +49,12 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         let i = (u32(frag.y) * textureDimensions(hdr).x + u32(frag.x)) * 3u;
         c += vec3<f32>(f32(accum[i]), f32(accum[i + 1u]), f32(accum[i + 2u])) / SPLAT_FIXED_SCALE;
     }
+    let uv = frag.xy / vec2<f32>(textureDimensions(hdr));
+    if LOW_ALPHA {
+        // Premultiplied smoke over black, under the additive light: it simply adds.
+        c += textureSampleLevel(alpha_tex, bloom_samp, uv, 0.0).rgb;
+    }
     if BLOOM {
-        let uv = frag.xy / vec2<f32>(textureDimensions(hdr));
         c += tone.exposure.y * textureSampleLevel(bloom_tex, bloom_samp, uv, 0.0).rgb;
     }
     return vec4<f32>(aces(c * tone.exposure.x), 1.0);

@@ -788,3 +788,36 @@ fn a_png_changed_on_disk_is_seen_by_the_watcher_and_reloaded() {
     assert!((first.integral - 4.0 * 128.0 / 255.0).abs() < 1e-3);
     assert!((second.integral - 4.0).abs() < 1e-3, "{}", second.integral);
 }
+
+/// Smoke drawn at half resolution (`post.alpha_downscale: 2`) looks like smoke drawn at
+/// full resolution: the frame is close, and the smoke is there.
+#[test]
+fn alpha_layers_at_half_resolution_match_full_resolution() {
+    let ctx = gpu();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut full = ignis::preset::load(&root.join("presets/campfire.ron")).expect("preset");
+    full.post.bloom = None;
+    full.post.alpha_downscale = 1;
+    let mut half = full.clone();
+    half.post.alpha_downscale = 2;
+    let mut no_smoke = full.clone();
+    no_smoke
+        .emitters
+        .retain(|e| e.look.blend != BlendMode::Alpha);
+    let frame = |effect: Effect| {
+        let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+        for _ in 0..150 {
+            run.advance(1.0 / 60.0).expect("advance");
+        }
+        run.render((240, 180)).expect("render")
+    };
+    let (a, b, c) = (frame(full), frame(half), frame(no_smoke));
+    let d_half = mean_abs_diff(&a, &b);
+    let d_smoke = mean_abs_diff(&a, &c);
+    println!("half-resolution smoke: {d_half:.3}; no smoke at all: {d_smoke:.3}");
+    assert!(d_smoke > 1.0, "the smoke is visible ({d_smoke})");
+    assert!(
+        d_half < 0.25 * d_smoke,
+        "half resolution: {d_half} vs {d_smoke}"
+    );
+}

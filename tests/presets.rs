@@ -1408,6 +1408,7 @@ fn effect() -> BoxedStrategy<Effect> {
                 post: Post {
                     exposure: 1.5,
                     bloom: (seed % 2 == 0).then(Bloom::default),
+                    alpha_downscale: 1 + seed % 4,
                 },
             }
         })

@@ -346,7 +346,7 @@ fn measure_row(
         };
         Some(time_median(&timer, ctx, opts.repeats.min(3), |enc| {
             let mut pass = begin_hdr_pass(enc, t);
-            r.billboard.draw(&mut pass, &r.frame, &all_billboard);
+            r.billboard.draw(&mut pass, &r.frame, &all_billboard, None);
         }))
     } else {
         None
@@ -379,6 +379,7 @@ fn measure_row(
                 enc,
                 &targets.hdr_view,
                 accum,
+                None,
                 None,
                 &targets.ldr_view,
                 1.0,

@@ -177,8 +177,12 @@ impl BillboardPass {
         pass: &mut wgpu::RenderPass<'_>,
         frame: &FrameResources,
         items: &[DrawItem],
+        only: Option<BlendMode>,
     ) {
-        let mut sorted: Vec<&DrawItem> = items.iter().filter(|d| !d.splat).collect();
+        let mut sorted: Vec<&DrawItem> = items
+            .iter()
+            .filter(|d| !d.splat && only.is_none_or(|b| d.blend == b))
+            .collect();
         sorted.sort_by_key(|d| match d.blend {
             BlendMode::Alpha => 0,
             BlendMode::Additive => 1,

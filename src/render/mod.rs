@@ -16,7 +16,7 @@ pub use frame::{DrawItem, FrameResources};
 pub use splat::SplatPass;
 pub use tonemap::TonemapPass;
 
-use crate::effect::Effect;
+use crate::effect::{BlendMode, Effect};
 use crate::gpu::GpuContext;
 use crate::shaders::{ShaderError, ShaderLibrary};
 use crate::sim::gpu_sim::{GpuSim, SimError, map_read};
@@ -173,6 +173,8 @@ pub struct Renderer {
     /// The folder PNG sprite paths are relative to (the preset's; the working directory
     /// when `None`).
     pub asset_dir: Option<std::path::PathBuf>,
+    /// The reduced-resolution target of the alpha-blended layers (`post.alpha_downscale`).
+    alpha_layer: Option<((u32, u32), wgpu::TextureView)>,
 }
 
 impl Renderer {
@@ -189,6 +191,7 @@ impl Renderer {
             targets: None,
             exposure: 1.0,
             asset_dir: None,
+            alpha_layer: None,
         })
     }
 
@@ -275,9 +278,31 @@ impl Renderer {
         let live: std::collections::HashSet<u64> = items.iter().map(|d| d.key.0).collect();
         self.sort.retain(&live);
         let splatted = self.splat.splat(ctx, enc, &self.frame, &items, size);
+        // Alpha layers at reduced resolution: their own target, added in the composite.
+        let downscale = effect.post.alpha_downscale.clamp(1, 4);
+        let low_alpha = downscale > 1
+            && items
+                .iter()
+                .any(|d| !d.splat && d.blend == BlendMode::Alpha);
+        if low_alpha {
+            let low = (
+                targets.size.0.div_ceil(downscale),
+                targets.size.1.div_ceil(downscale),
+            );
+            if self.alpha_layer.as_ref().is_none_or(|(s, _)| *s != low) {
+                let view = Targets::new(ctx, low).hdr_view;
+                self.alpha_layer = Some((low, view));
+            }
+            if let Some((_, view)) = &self.alpha_layer {
+                let mut pass = begin_hdr_pass(enc, view);
+                self.billboard
+                    .draw(&mut pass, &self.frame, &items, Some(BlendMode::Alpha));
+            }
+        }
         {
             let mut pass = begin_hdr_pass(enc, &targets.hdr_view);
-            self.billboard.draw(&mut pass, &self.frame, &items);
+            let only = low_alpha.then_some(BlendMode::Additive);
+            self.billboard.draw(&mut pass, &self.frame, &items, only);
         }
         // The splat's light is resolved inside the tonemap (one full-screen pass less).
         let accum = if splatted {
@@ -298,6 +323,10 @@ impl Renderer {
             &targets.hdr_view,
             accum,
             bloom,
+            self.alpha_layer
+                .as_ref()
+                .filter(|_| low_alpha)
+                .map(|(_, v)| v),
             &targets.ldr_view,
             self.exposure * effect.post.exposure,
         );

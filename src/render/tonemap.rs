@@ -10,8 +10,8 @@ use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 pub struct TonemapPass {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
-    /// Indexed by `splat as usize + 2 * bloom as usize`.
-    pipelines: [wgpu::RenderPipeline; 4],
+    /// Indexed by `splat + 2 · bloom + 4 · low_alpha`.
+    pipelines: [wgpu::RenderPipeline; 8],
     uniform: wgpu::Buffer,
     /// Bound in place of the splat buffer when nothing was splatted.
     no_splat: wgpu::Buffer,
@@ -79,6 +79,16 @@ impl TonemapPass {
                         ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                         count: None,
                     },
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 5,
+                        visibility: wgpu::ShaderStages::FRAGMENT,
+                        ty: wgpu::BindingType::Texture {
+                            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                            view_dimension: wgpu::TextureViewDimension::D2,
+                            multisampled: false,
+                        },
+                        count: None,
+                    },
                 ],
             });
         let pipeline_layout = ctx
@@ -141,16 +151,20 @@ impl TonemapPass {
         lib: &ShaderLibrary,
         layout: &wgpu::PipelineLayout,
         format: wgpu::TextureFormat,
-    ) -> Result<[wgpu::RenderPipeline; 4], ShaderError> {
+    ) -> Result<[wgpu::RenderPipeline; 8], ShaderError> {
         let composed = lib.compose("tonemap.wgsl")?;
         create_checked(&ctx.device, &composed, lib, |module| {
             let make = |i: usize| {
-                let (splat, bloom) = (i & 1 != 0, i & 2 != 0);
+                let (splat, bloom, low) = (i & 1 != 0, i & 2 != 0, i & 4 != 0);
                 let b = |v: bool| if v { 1.0 } else { 0.0 };
-                let constants = [("SPLAT", b(splat)), ("BLOOM", b(bloom))];
+                let constants = [
+                    ("SPLAT", b(splat)),
+                    ("BLOOM", b(bloom)),
+                    ("LOW_ALPHA", b(low)),
+                ];
                 crate::render::simple_pipeline(
                     ctx,
-                    &format!("TonemapPass splat={splat} bloom={bloom}"),
+                    &format!("TonemapPass splat={splat} bloom={bloom} low_alpha={low}"),
                     layout,
                     module,
                     ("vs_main", "fs_main"),
@@ -158,7 +172,7 @@ impl TonemapPass {
                     &constants,
                 )
             };
-            [make(0), make(1), make(2), make(3)]
+            std::array::from_fn(make)
         })
     }
 
@@ -178,6 +192,7 @@ impl TonemapPass {
         hdr: &wgpu::TextureView,
         splat: Option<&wgpu::Buffer>,
         bloom: Option<(&wgpu::TextureView, f32)>,
+        low_alpha: Option<&wgpu::TextureView>,
         out: &wgpu::TextureView,
         exposure: f32,
     ) {
@@ -214,6 +229,12 @@ impl TonemapPass {
                     binding: 4,
                     resource: wgpu::BindingResource::Sampler(&self.sampler),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::TextureView(
+                        low_alpha.unwrap_or(&self.no_bloom),
+                    ),
+                },
             ],
         });
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -232,7 +253,9 @@ impl TonemapPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        let variant = usize::from(splat.is_some()) + 2 * usize::from(bloom.is_some());
+        let variant = usize::from(splat.is_some())
+            + 2 * usize::from(bloom.is_some())
+            + 4 * usize::from(low_alpha.is_some());
         pass.set_pipeline(&self.pipelines[variant]);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.draw(0..3, 0..1);
