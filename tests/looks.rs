@@ -185,79 +185,43 @@ fn flipbook_frames_match_hand_computed_values_at_the_ends_and_between() {
         blend_frames: true,
         random_start: false,
     };
+    let fb = |rows, cols, mode, blend_frames, random_start| Flipbook {
+        rows,
+        cols,
+        mode,
+        blend_frames,
+        random_start,
+    };
+    let cut = fb(4, 4, FlipbookMode::OverLife, false, false);
+    let fps10 = FlipbookMode::FrameRate { fps: 10.0 };
     let cases: Vec<(Flipbook, [f32; 4], [f32; 3])> = vec![
         // Blending: position t·(16 − 1).
         (over_life, [0.0, life, 0.0, 1.0], [0.0, 1.0, 0.0]),
         (over_life, [life, life, 0.0, 1.0], [15.0, 15.0, 0.0]),
         (over_life, [1.0, life, 0.0, 1.0], [7.0, 8.0, 0.5]),
         // Cutting: each frame an equal share of life.
-        (
-            Flipbook {
-                blend_frames: false,
-                ..over_life
-            },
-            [0.0, life, 0.0, 0.0],
-            [0.0, 0.0, 0.0],
-        ),
-        (
-            Flipbook {
-                blend_frames: false,
-                ..over_life
-            },
-            [life, life, 0.0, 0.0],
-            [15.0, 15.0, 0.0],
-        ),
-        (
-            Flipbook {
-                blend_frames: false,
-                ..over_life
-            },
-            [1.0, life, 0.0, 0.0],
-            [8.0, 8.0, 0.0],
-        ),
+        (cut, [0.0, life, 0.0, 0.0], [0.0, 0.0, 0.0]),
+        (cut, [life, life, 0.0, 0.0], [15.0, 15.0, 0.0]),
+        (cut, [1.0, life, 0.0, 0.0], [8.0, 8.0, 0.0]),
         // 2 × 3 at 10 fps from a random start: start01 0.5 → frame 3 of 6.
         (
-            Flipbook {
-                rows: 2,
-                cols: 3,
-                mode: FlipbookMode::FrameRate { fps: 10.0 },
-                blend_frames: false,
-                random_start: true,
-            },
+            fb(2, 3, fps10, false, true),
             [0.0, life, 0.5, 0.0],
             [3.0, 4.0, 0.0],
         ),
         (
-            Flipbook {
-                rows: 2,
-                cols: 3,
-                mode: FlipbookMode::FrameRate { fps: 10.0 },
-                blend_frames: false,
-                random_start: true,
-            },
+            fb(2, 3, fps10, false, true),
             [0.25, life, 0.5, 0.0],
             [5.0, 0.0, 0.0],
         ),
         // Looping past the last frame, with blending: 0.35 s × 10 = 3.5 → frames 3, 4.
         (
-            Flipbook {
-                rows: 2,
-                cols: 3,
-                mode: FlipbookMode::FrameRate { fps: 10.0 },
-                blend_frames: true,
-                random_start: false,
-            },
+            fb(2, 3, fps10, true, false),
             [0.35, life, 0.9, 1.0],
             [3.0, 4.0, 0.5],
         ),
         (
-            Flipbook {
-                rows: 2,
-                cols: 3,
-                mode: FlipbookMode::FrameRate { fps: 10.0 },
-                blend_frames: true,
-                random_start: false,
-            },
+            fb(2, 3, fps10, true, false),
             [0.55, life, 0.0, 1.0],
             [5.0, 0.0, 0.5],
         ),

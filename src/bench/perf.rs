@@ -200,15 +200,43 @@ fn measure_packed(
         sim.step(&effect, 1.0 / 60.0, 22)?;
     }
     let timer = GpuTimer::new(ctx);
-    let update_ms = time_median(&timer, ctx, opts.repeats, |enc| {
-        let plans = sim.plan(&effect, 1.0 / 60.0, 1);
-        sim.record(enc, &effect, &plans);
-    });
+    let update_ms = time_update(&timer, ctx, &mut sim, &effect, opts.repeats);
+    let copy_ms = time_copy(&timer, ctx, &sim, copy, opts.repeats);
+    Ok(PackedRow {
+        particles: n,
+        update_ms,
+        copy_ms,
+    })
+}
+
+/// Median time of one update step of every pool of `sim`.
+fn time_update(
+    timer: &GpuTimer,
+    ctx: &GpuContext,
+    sim: &mut GpuSim,
+    effect: &Effect,
+    repeats: usize,
+) -> f64 {
+    time_median(timer, ctx, repeats, |enc| {
+        let plans = sim.plan(effect, 1.0 / 60.0, 1);
+        sim.record(enc, effect, &plans);
+    })
+}
+
+/// Median time of `copy` over every pool of `sim` (current → previous: the bytes one
+/// update step reads and writes).
+fn time_copy(
+    timer: &GpuTimer,
+    ctx: &GpuContext,
+    sim: &GpuSim,
+    copy: &(wgpu::ComputePipeline, wgpu::BindGroupLayout),
+    repeats: usize,
+) -> f64 {
     let groups: Vec<_> = (0..sim.emitter_count())
         .filter_map(|i| sim.emitter_buffers(i))
         .map(|b| {
             let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("bench copy20 group"),
+                label: Some("bench copy group"),
                 layout: &copy.1,
                 entries: &[
                     wgpu::BindGroupEntry {
@@ -224,7 +252,7 @@ fn measure_packed(
             (group, b.capacity)
         })
         .collect();
-    let copy_ms = time_median(&timer, ctx, opts.repeats, |enc| {
+    time_median(timer, ctx, repeats, |enc| {
         let mut pass = enc.begin_compute_pass(&Default::default());
         pass.set_pipeline(&copy.0);
         for (g, cap) in &groups {
@@ -232,11 +260,6 @@ fn measure_packed(
             let (x, y) = crate::sim::gpu_sim::dispatch_size(*cap);
             pass.dispatch_workgroups(x, y, 1);
         }
-    });
-    Ok(PackedRow {
-        particles: n,
-        update_ms,
-        copy_ms,
     })
 }
 
@@ -265,48 +288,13 @@ fn measure_row(
         sim.step(&effect, 1.0 / 60.0, 22)?;
     }
     let timer = GpuTimer::new(ctx);
-    let update_ms = time_median(&timer, ctx, opts.repeats, |enc| {
-        let plans = sim.plan(&effect, 1.0 / 60.0, 1);
-        sim.record(enc, &effect, &plans);
-    });
+    let update_ms = time_update(&timer, ctx, &mut sim, &effect, opts.repeats);
     // The same pools without turbulence and flame pull: memory-bound.
     let lean = lean_effect(&effect);
     sim.step(&lean, 1.0 / 60.0, 2)?;
-    let lean_update_ms = time_median(&timer, ctx, opts.repeats, |enc| {
-        let plans = sim.plan(&lean, 1.0 / 60.0, 1);
-        sim.record(enc, &lean, &plans);
-    });
+    let lean_update_ms = time_update(&timer, ctx, &mut sim, &lean, opts.repeats);
     // The copy: the same bytes as every pool's read + write, in one run.
-    let mut copy_groups = Vec::new();
-    for i in 0..sim.emitter_count() {
-        if let Some(b) = sim.emitter_buffers(i) {
-            let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("bench copy group"),
-                layout: &copy.1,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: b.current.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: b.previous.as_entire_binding(),
-                    },
-                ],
-            });
-            copy_groups.push((group, b.capacity));
-        }
-    }
-    let copy_ms = time_median(&timer, ctx, opts.repeats, |enc| {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&copy.0);
-        for (g, cap) in &copy_groups {
-            pass.set_bind_group(0, g, &[]);
-            let (x, y) = crate::sim::gpu_sim::dispatch_size(*cap);
-            pass.dispatch_workgroups(x, y, 1);
-        }
-    });
-    drop(copy_groups);
+    let copy_ms = time_copy(&timer, ctx, &sim, copy, opts.repeats);
     // Re-run one step so the state is a real one again (the copy wrote into `previous`).
     sim.step(&effect, 1.0 / 60.0, 1)?;
 
