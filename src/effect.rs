@@ -793,9 +793,9 @@ pub struct ColorStop {
     pub rgba: [f32; 4],
 }
 
-/// The most gradient stops a look may have (the ramp baking handles any number; this
-/// only keeps files sane).
-pub const MAX_COLOR_STOPS: usize = 256;
+/// The most gradient stops a look may have: the ramp baking handles any number, but stops
+/// closer than one of its 1024 texels cannot be told apart, so more would be noise.
+pub const MAX_COLOR_STOPS: usize = 1024;
 
 impl Default for Effect {
     fn default() -> Self {

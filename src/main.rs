@@ -261,10 +261,14 @@ fn render(
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let start = Instant::now();
     let mut written = 0;
+    // Simulate + draw + read back, per written frame (PNG encoding excluded).
+    let mut frame_ms = Vec::new();
     for f in 0..frames {
+        let t = Instant::now();
         run.advance(1.0 / fps)?;
         if !last_only || f + 1 == frames {
             let image = run.render(size)?;
+            frame_ms.push(t.elapsed().as_secs_f64() * 1000.0);
             let path = out.join(format!("frame_{f:04}.png"));
             image
                 .save(&path)
@@ -283,6 +287,17 @@ fn render(
         elapsed * 1000.0 / frames.max(1) as f64,
         ctx.info.name
     );
+    if frame_ms.len() >= 10 {
+        // The steady state: the last 30 written frames.
+        let tail = frame_ms.len().saturating_sub(30);
+        let mut last = frame_ms[tail..].to_vec();
+        let median = ignis::gpu::timer::median(&mut last);
+        println!(
+            "last {} frames: median {median:.2} ms simulate + draw + read back ({:.1} fps), PNG writing excluded",
+            last.len(),
+            1000.0 / median
+        );
+    }
     Ok(())
 }
 
