@@ -50,6 +50,13 @@ enum Command {
         /// of each (slower; for finding where the time goes).
         #[arg(long)]
         profile: bool,
+        /// Open exactly these panel sections at start, comma-separated (emitter,
+        /// randomness, forces, time, look, view, stats) — for screenshots.
+        #[arg(long, value_delimiter = ',')]
+        sections: Option<Vec<String>>,
+        /// Select this emitter (by name) at start.
+        #[arg(long)]
+        select: Option<String>,
     },
     /// Write the built-in procedural sprites as PNGs (straight alpha), to start a
     /// texture from.
@@ -174,6 +181,8 @@ fn main() {
             ui_painter,
             render_scale,
             profile,
+            sections,
+            select,
         }) => edit(EditOptions {
             frames: frames.or(screenshot.as_ref().map(|_| 60)),
             preset,
@@ -183,6 +192,8 @@ fn main() {
             ui_painter,
             render_scale,
             profile,
+            sections,
+            select,
         }),
         Some(Command::Render {
             preset,

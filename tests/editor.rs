@@ -1000,3 +1000,27 @@ fn packed_state_is_offered_and_excludes_stateless() {
     );
     assert!(harness.state().effect.validate().is_ok());
 }
+
+/// Merely showing the Look section edits nothing (a colour with alpha 0 used to lose its
+/// RGB in egui's colour button round trip, marking the preset unsaved).
+#[test]
+fn opening_the_look_section_edits_nothing() {
+    for (i, name) in ["smoke", "flames", "embers"].iter().enumerate() {
+        let mut state = campfire_state();
+        state.selected = emitter_index(&state.effect, name);
+        state.open_sections = Some(vec!["look".to_owned()]);
+        let before = state.effect.clone();
+        let mut harness = panel_harness(state);
+        harness.run();
+        harness.run();
+        let after = &harness.state().effect;
+        assert_eq!(
+            after.emitters[i].look, before.emitters[i].look,
+            "{name}: showing the Look section changed the look (egui colour round trip)"
+        );
+        assert_eq!(
+            *after, before,
+            "{name}: showing the Look section changed the effect"
+        );
+    }
+}

@@ -67,6 +67,10 @@ pub struct EditOptions {
     pub render_scale: Option<f32>,
     /// Drain the GPU after each frame stage and report where the time goes.
     pub profile: bool,
+    /// Open exactly these panel sections at start (ids: emitter, look, …).
+    pub sections: Option<Vec<String>>,
+    /// Select this emitter (by name) at start.
+    pub select: Option<String>,
 }
 
 /// What a run with `--frames` measured.
@@ -137,6 +141,14 @@ pub fn run(options: EditOptions) -> anyhow::Result<Option<RunReport>> {
             if let Some(path) = &options.preset {
                 state.preset_path = path.display().to_string();
                 state.loaded_path = Some(path.clone());
+            }
+            state.open_sections = options.sections.clone();
+            if let Some(i) = options
+                .select
+                .as_ref()
+                .and_then(|name| state.effect.emitters.iter().position(|e| &e.name == name))
+            {
+                state.selected = i;
             }
             state
         },

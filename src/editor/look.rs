@@ -487,9 +487,18 @@ pub fn color_stops_ui(ui: &mut Ui, stops: &mut Vec<ColorStop>) {
             )
             .labelled_by(label.id)
             .on_hover_text("Normalised age of this stop (0 = birth, 1 = death)");
-            ui.color_edit_button_rgba_unmultiplied(&mut stop.rgba)
+            // Edit a copy: egui's colour round trip (through premultiplied alpha) would
+            // otherwise rewrite the stop every frame — zeroing the colour of a stop with
+            // alpha 0 and marking the preset unsaved by merely showing it.
+            let mut rgba = stop.rgba;
+            if ui
+                .color_edit_button_rgba_unmultiplied(&mut rgba)
                 .labelled_by(label.id)
-                .on_hover_text("Colour (linear RGB) and alpha");
+                .on_hover_text("Colour (linear RGB) and alpha")
+                .changed()
+            {
+                stop.rgba = rgba;
+            }
             ui.weak(format!("α {:.2}", stop.rgba[3]));
             if ui
                 .add_enabled(n > 1, egui::Button::new("x").small())

@@ -28,6 +28,9 @@ pub const UI_MAX_CAPACITY: u32 = 1 << 22;
 pub fn panel_ui(ui: &mut Ui, state: &mut EditorState) {
     header_ui(ui, state);
     ui.separator();
+    // A one-shot request to open exactly these sections (`ignis edit --sections`).
+    let force = state.open_sections.take();
+    let open = |id: &str| force.as_ref().map(|v| v.iter().any(|s| s == id));
     egui::ScrollArea::vertical()
         .auto_shrink([false, false])
         .show(ui, |ui| {
@@ -37,19 +40,40 @@ pub fn panel_ui(ui: &mut Ui, state: &mut EditorState) {
                 .get(state.selected)
                 .map(|e| e.name.clone())
                 .unwrap_or_default();
-            section_ui(ui, "emitter", "Emitter", "", true, |ui| {
-                emitter_ui(ui, &mut state.effect, &mut state.selected);
-            });
-            section_ui(ui, "randomness", "Randomness", &name, false, |ui| {
-                randomness_ui(ui, &mut state.effect, state.selected);
-            });
-            section_ui(ui, "forces", "Forces", &name, false, |ui| {
-                forces_ui(ui, &mut state.effect, state.selected);
-            });
-            section_ui(ui, "time", "Time", "", true, |ui| {
+            section_ui(
+                ui,
+                "emitter",
+                "Emitter",
+                "",
+                (true, open("emitter")),
+                |ui| {
+                    emitter_ui(ui, &mut state.effect, &mut state.selected);
+                },
+            );
+            section_ui(
+                ui,
+                "randomness",
+                "Randomness",
+                &name,
+                (false, open("randomness")),
+                |ui| {
+                    randomness_ui(ui, &mut state.effect, state.selected);
+                },
+            );
+            section_ui(
+                ui,
+                "forces",
+                "Forces",
+                &name,
+                (false, open("forces")),
+                |ui| {
+                    forces_ui(ui, &mut state.effect, state.selected);
+                },
+            );
+            section_ui(ui, "time", "Time", "", (true, open("time")), |ui| {
                 time_ui(ui, &mut state.effect, &mut state.playback, state.selected);
             });
-            section_ui(ui, "look", "Look", &name, false, |ui| {
+            section_ui(ui, "look", "Look", &name, (false, open("look")), |ui| {
                 let sprite_error = state
                     .sprite_errors
                     .iter()
@@ -63,10 +87,10 @@ pub fn panel_ui(ui: &mut Ui, state: &mut EditorState) {
                     sprite_error,
                 );
             });
-            section_ui(ui, "view", "View", "", false, |ui| {
+            section_ui(ui, "view", "View", "", (false, open("view")), |ui| {
                 view_ui(ui, &mut state.view, &mut state.frame_requested);
             });
-            section_ui(ui, "stats", "Stats", "", true, |ui| {
+            section_ui(ui, "stats", "Stats", "", (true, open("stats")), |ui| {
                 stats_ui(ui, &state.stats, &state.running);
             });
         });
@@ -78,7 +102,7 @@ fn section_ui(
     id: &str,
     title: &str,
     emitter: &str,
-    default_open: bool,
+    (default_open, force_open): (bool, Option<bool>),
     add: impl FnOnce(&mut Ui),
 ) {
     let text = if emitter.is_empty() {
@@ -89,6 +113,7 @@ fn section_ui(
     egui::CollapsingHeader::new(text)
         .id_salt(id)
         .default_open(default_open)
+        .open(force_open)
         .show(ui, add);
 }
 

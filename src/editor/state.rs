@@ -61,6 +61,8 @@ pub struct EditorState {
     pub shader_errors: Vec<String>,
     /// Sprites that failed to load: (emitter index, message); the soft disc is drawn.
     pub sprite_errors: Vec<(usize, String)>,
+    /// Panel sections to open (all others closed) on the next frame, then cleared.
+    pub open_sections: Option<Vec<String>>,
     /// The last simulation failure (the simulation pauses), until playback resumes.
     pub sim_error: Option<String>,
     /// Index of the emitter shown in the emitter-specific sections.
@@ -115,6 +117,7 @@ impl EditorState {
             validation_errors,
             gpu_rejected: None,
             sprite_errors: Vec::new(),
+            open_sections: None,
             sim_error: None,
             shader_errors: Vec::new(),
             selected: 0,
