@@ -751,6 +751,26 @@ fn a_png_changed_on_disk_is_seen_by_the_watcher_and_reloaded() {
     assert_ne!(second.id, first.id);
     assert!((first.integral - 4.0 * 128.0 / 255.0).abs() < 1e-3);
     assert!((second.integral - 4.0).abs() < 1e-3, "{}", second.integral);
+
+    // A PNG that is missing at first and created later is picked up too.
+    let later = Sprite::Image("later.png".into());
+    let (_, err) = lib.resolve(&ctx, &later, Some(dir.path()));
+    assert!(err.is_some());
+    write_png(&dir.path().join("later.png"), 4, 4, |_, _| {
+        [255, 255, 255, 255]
+    });
+    let mut changed: Vec<std::path::PathBuf> = Vec::new();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
+    while !changed
+        .iter()
+        .any(|p| p.file_name() == Some(std::ffi::OsStr::new("later.png")))
+        && std::time::Instant::now() < deadline
+    {
+        changed.extend(watcher.wait(std::time::Duration::from_millis(200)));
+    }
+    assert!(lib.invalidate(&changed), "the watcher reported {changed:?}");
+    let (_, err) = lib.resolve(&ctx, &later, Some(dir.path()));
+    assert!(err.is_none(), "{err:?}");
 }
 
 /// Smoke drawn at half resolution (`post.alpha_downscale: 2`) looks like smoke drawn at

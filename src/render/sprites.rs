@@ -119,7 +119,8 @@ impl SpriteLibrary {
         before != self.files.len()
     }
 
-    /// Folders holding the file sprites in use (to watch for changes).
+    /// Existing folders holding the file sprites in use, missing ones included (to watch
+    /// for changes: a PNG created or fixed there is picked up).
     pub fn watched_dirs(&self) -> Vec<PathBuf> {
         let mut dirs: Vec<PathBuf> = self
             .files
@@ -133,6 +134,7 @@ impl SpriteLibrary {
                 }
             })
             .collect();
+        dirs.retain(|d| d.is_dir());
         dirs.sort();
         dirs.dedup();
         dirs
