@@ -104,14 +104,9 @@ impl ShaderReloader {
     pub fn new(lib: &ShaderLibrary) -> Self {
         let mut deps = BTreeMap::new();
         for entry in ENTRY_FILES {
-            let mut files = lib
-                .compose(entry)
-                .map(|c| c.files)
+            let files = lib
+                .dependencies(entry)
                 .unwrap_or_else(|_| vec![(*entry).to_owned()]);
-            if *entry == "update.wgsl" {
-                // Packed-state pipelines compose it in place of state_full.wgsl.
-                files.push("state_packed.wgsl".to_owned());
-            }
             deps.insert(*entry, files);
         }
         Self {
@@ -163,11 +158,7 @@ impl ShaderReloader {
             };
             match result {
                 Ok(()) => {
-                    if let Ok(c) = lib.compose(entry) {
-                        let mut files = c.files;
-                        if entry == "update.wgsl" {
-                            files.push("state_packed.wgsl".to_owned());
-                        }
+                    if let Ok(files) = lib.dependencies(entry) {
                         self.deps.insert(entry, files);
                     }
                     if self.errors.remove(entry).is_some() {

@@ -43,6 +43,14 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ("bloom.wgsl", include_str!("../shaders/bloom.wgsl")),
 ];
 
+/// The packed-state update: update.wgsl with state_packed.wgsl composed in place of
+/// state_full.wgsl (the state I/O).
+pub const PACKED_STATE_IO: (&str, &str) = ("state_full.wgsl", "state_packed.wgsl");
+
+/// Imports that some pipelines replace by another file (see
+/// [`ShaderLibrary::compose_with`]).
+pub const IMPORT_VARIANTS: &[(&str, &str)] = &[PACKED_STATE_IO];
+
 /// The entry files, one per pipeline family; the others are imported by them.
 pub const ENTRY_FILES: &[&str] = &[
     "update.wgsl",
@@ -242,6 +250,23 @@ impl ShaderLibrary {
                 })
             }
         }
+    }
+
+    /// Every file the pipelines of `entry` depend on: its imports, and — where it imports a
+    /// file that has a variant in [`IMPORT_VARIANTS`] — the variant's imports too (so an
+    /// edit to `state_packed.wgsl` rebuilds the update pass).
+    pub fn dependencies(&self, entry: &str) -> Result<Vec<String>, ShaderError> {
+        let mut files = self.compose(entry)?.files;
+        for &variant in IMPORT_VARIANTS {
+            if files.iter().any(|f| f == variant.0) {
+                for f in self.compose_with(entry, &[variant])?.files {
+                    if !files.contains(&f) {
+                        files.push(f);
+                    }
+                }
+            }
+        }
+        Ok(files)
     }
 
     /// Composes `entry` with its imports and validates the result with naga.

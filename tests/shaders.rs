@@ -26,10 +26,13 @@ fn every_entry_validates() {
     }
     // The packed-state update: update.wgsl with state_packed.wgsl as its state I/O.
     let packed = project_shaders()
-        .compose_with("update.wgsl", &[("state_full.wgsl", "state_packed.wgsl")])
+        .compose_with("update.wgsl", &[ignis::shaders::PACKED_STATE_IO])
         .unwrap_or_else(|e| panic!("packed update: {e}"));
     assert!(packed.files.iter().any(|f| f == "state_packed.wgsl"));
     assert!(!packed.files.iter().any(|f| f == "state_full.wgsl"));
+    // Hot reload's dependencies of the update pass include the variant.
+    let deps = project_shaders().dependencies("update.wgsl").expect("deps");
+    assert!(deps.iter().any(|f| f == "state_packed.wgsl"));
     reached.extend(packed.files);
     for f in std::fs::read_dir(dir).expect("shaders/") {
         let name = f.expect("entry").file_name().to_string_lossy().into_owned();

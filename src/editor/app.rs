@@ -214,7 +214,8 @@ struct Gfx {
     /// Hot reload of `shaders/` (absent with the embedded shaders).
     shader_watch: Option<ShaderWatch>,
     /// Watches the folders of the PNG sprites in use: a changed file is reloaded.
-    sprite_watch: Option<(Vec<PathBuf>, FileWatcher)>,
+    /// (sprite library generation it was set up for, folders, watcher).
+    sprite_watch: Option<(u64, Vec<PathBuf>, Option<FileWatcher>)>,
 }
 
 /// The shader folder's watcher and the reloader that rebuilds affected pipelines.
@@ -614,20 +615,14 @@ impl Gfx {
             .as_ref()
             .is_none_or(|t| (t.width(), t.height()) != size);
         if stale || self.viewport_texture.is_none() {
-            let image = self.ctx.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("editor::viewport_image"),
-                size: wgpu::Extent3d {
-                    width: size.0,
-                    height: size.1,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba8Unorm,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                view_formats: &[],
-            });
+            let image = crate::gpu::texture_2d(
+                &self.ctx.device,
+                "editor::viewport_image",
+                size,
+                1,
+                wgpu::TextureFormat::Rgba8Unorm,
+                wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            );
             let view = image.create_view(&wgpu::TextureViewDescriptor::default());
             self.viewport_texture = Some(self.ui_painter.set_native_texture(
                 &self.ctx.device,
@@ -721,22 +716,26 @@ impl App {
         let Some(gfx) = self.gfx.as_mut() else {
             return;
         };
-        let dirs = gfx.renderer.frame.sprites.watched_dirs();
-        if dirs.is_empty() {
-            gfx.sprite_watch = None;
-            return;
-        }
-        if gfx.sprite_watch.as_ref().is_none_or(|(d, _)| *d != dirs) {
-            let paths: Vec<&std::path::Path> = dirs.iter().map(PathBuf::as_path).collect();
-            gfx.sprite_watch = match FileWatcher::new(&paths) {
-                Ok(w) => Some((dirs, w)),
-                Err(e) => {
-                    log::warn!("not watching sprite folders for changes: {e}");
-                    None
+        // The folders are looked up only when the set of file sprites changed.
+        let generation = gfx.renderer.frame.sprites.generation();
+        if gfx.sprite_watch.as_ref().is_none_or(|w| w.0 != generation) {
+            let dirs = gfx.renderer.frame.sprites.watched_dirs();
+            match gfx.sprite_watch.as_mut() {
+                Some(w) if w.1 == dirs => w.0 = generation,
+                _ => {
+                    let paths: Vec<&std::path::Path> = dirs.iter().map(PathBuf::as_path).collect();
+                    let watcher = if paths.is_empty() {
+                        None
+                    } else {
+                        FileWatcher::new(&paths)
+                            .map_err(|e| log::warn!("not watching sprite folders: {e}"))
+                            .ok()
+                    };
+                    gfx.sprite_watch = Some((generation, dirs, watcher));
                 }
-            };
+            }
         }
-        let Some((_, watcher)) = &gfx.sprite_watch else {
+        let Some((_, _, Some(watcher))) = &gfx.sprite_watch else {
             return;
         };
         let changed = watcher.poll();
@@ -958,17 +957,14 @@ impl App {
                     ));
                 } else {
                     // The surface cannot be copied from: draw the UI again offscreen.
-                    let offscreen = gfx.ctx.device.create_texture(&wgpu::TextureDescriptor {
-                        label: Some("editor::screenshot_target"),
-                        size: frame.texture.size(),
-                        mip_level_count: 1,
-                        sample_count: 1,
-                        dimension: wgpu::TextureDimension::D2,
-                        format: gfx.config.format,
-                        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                            | wgpu::TextureUsages::COPY_SRC,
-                        view_formats: &[],
-                    });
+                    let offscreen = crate::gpu::texture_2d(
+                        &gfx.ctx.device,
+                        "editor::screenshot_target",
+                        (frame.texture.width(), frame.texture.height()),
+                        1,
+                        gfx.config.format,
+                        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                    );
                     let off_view = offscreen.create_view(&Default::default());
                     gfx.render_egui(&mut encoder, &off_view, &paint_jobs, &screen);
                     screenshot = Some(Screenshot::record(

@@ -417,21 +417,15 @@ impl LeanPainter {
                 return;
             }
             (None, _) => (
-                device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some("LeanPainter::texture"),
-                    size: wgpu::Extent3d {
-                        width: w,
-                        height: h,
-                        depth_or_array_layers: 1,
-                    },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
+                crate::gpu::texture_2d(
+                    device,
+                    "LeanPainter::texture",
+                    (w, h),
+                    1,
                     // Gamma-encoded bytes, sampled as they are (like egui-wgpu).
-                    format: wgpu::TextureFormat::Rgba8Unorm,
-                    usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                    view_formats: &[],
-                }),
+                    wgpu::TextureFormat::Rgba8Unorm,
+                    wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                ),
                 wgpu::Origin3d::ZERO,
             ),
         };

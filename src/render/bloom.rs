@@ -30,6 +30,9 @@ struct Chain {
     target_size: (u32, u32),
     levels: u32,
     views: Vec<wgpu::TextureView>,
+    /// `groups[m]` reads level m (the source of the down pass m → m+1 and of the up pass
+    /// m → m−1), built with the chain.
+    groups: Vec<wgpu::BindGroup>,
 }
 
 impl BloomPass {
@@ -118,6 +121,37 @@ impl BloomPass {
         Ok(())
     }
 
+    /// A bind group reading `src` (and `splat`'s light, for the prefilter).
+    fn group(
+        &self,
+        ctx: &GpuContext,
+        src: &wgpu::TextureView,
+        splat: Option<&wgpu::Buffer>,
+    ) -> wgpu::BindGroup {
+        ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("BloomPass::group"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(src),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::Sampler(&self.sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: self.uniform.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: splat.unwrap_or(&self.no_splat).as_entire_binding(),
+                },
+            ],
+        })
+    }
+
     fn ensure_chain(&mut self, ctx: &GpuContext, target_size: (u32, u32), levels: u32) {
         let (w, h) = ((target_size.0 / 2).max(1), (target_size.1 / 2).max(1));
         // No level smaller than 1 × 1.
@@ -127,22 +161,15 @@ impl BloomPass {
             .as_ref()
             .is_none_or(|c| c.target_size != target_size || c.levels != levels);
         if stale {
-            let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("BloomPass::chain"),
-                size: wgpu::Extent3d {
-                    width: w,
-                    height: h,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: levels,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: HDR_FORMAT,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                    | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            });
-            let views = (0..levels)
+            let texture = crate::gpu::texture_2d(
+                &ctx.device,
+                "BloomPass::chain",
+                (w, h),
+                levels,
+                HDR_FORMAT,
+                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            );
+            let views: Vec<wgpu::TextureView> = (0..levels)
                 .map(|m| {
                     texture.create_view(&wgpu::TextureViewDescriptor {
                         label: Some("BloomPass::level"),
@@ -152,10 +179,12 @@ impl BloomPass {
                     })
                 })
                 .collect();
+            let groups = views.iter().map(|v| self.group(ctx, v, None)).collect();
             self.chain = Some(Chain {
                 target_size,
                 levels,
                 views,
+                groups,
             });
         }
     }
@@ -180,37 +209,15 @@ impl BloomPass {
         ctx.queue
             .write_buffer(&self.uniform, 0, bytemuck::cast_slice(&params));
         self.ensure_chain(ctx, target_size, settings.levels);
+        // The prefilter reads this frame's HDR target and splat light; the chain's own
+        // bind groups are built with the chain.
+        let prefilter_group = self.group(ctx, hdr, splat);
         let chain = self.chain.as_ref()?;
-        let group = |src: &wgpu::TextureView| {
-            ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("BloomPass::group"),
-                layout: &self.layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::TextureView(src),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::Sampler(&self.sampler),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: self.uniform.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: splat.unwrap_or(&self.no_splat).as_entire_binding(),
-                    },
-                ],
-            })
-        };
         let pass = |enc: &mut wgpu::CommandEncoder,
                     pipeline: &wgpu::RenderPipeline,
-                    src: &wgpu::TextureView,
+                    bind: &wgpu::BindGroup,
                     dst: &wgpu::TextureView,
                     load: bool| {
-            let bind = group(src);
             let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("BloomPass::pass"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -232,7 +239,7 @@ impl BloomPass {
                 multiview_mask: None,
             });
             rp.set_pipeline(pipeline);
-            rp.set_bind_group(0, &bind, &[]);
+            rp.set_bind_group(0, bind, &[]);
             rp.draw(0..3, 0..1);
         };
         let p = &self.pipelines;
@@ -241,12 +248,12 @@ impl BloomPass {
         } else {
             &p.prefilter
         };
-        pass(enc, prefilter, hdr, &chain.views[0], false);
+        pass(enc, prefilter, &prefilter_group, &chain.views[0], false);
         for m in 1..chain.views.len() {
-            pass(enc, &p.down, &chain.views[m - 1], &chain.views[m], false);
+            pass(enc, &p.down, &chain.groups[m - 1], &chain.views[m], false);
         }
         for m in (1..chain.views.len()).rev() {
-            pass(enc, &p.up, &chain.views[m], &chain.views[m - 1], true);
+            pass(enc, &p.up, &chain.groups[m], &chain.views[m - 1], true);
         }
         chain.views.first()
     }

@@ -244,20 +244,14 @@ impl FrameResources {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let ramps = ctx.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("FrameResources::ramps"),
-            size: wgpu::Extent3d {
-                width: RAMP_WIDTH,
-                height: slots as u32,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
+        let ramps = crate::gpu::texture_2d(
+            &ctx.device,
+            "FrameResources::ramps",
+            (RAMP_WIDTH, slots as u32),
+            1,
+            wgpu::TextureFormat::Rgba32Float,
+            wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        );
         let ramp_view = ramps.create_view(&Default::default());
         let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("FrameResources::frame_group"),
@@ -292,6 +286,41 @@ impl FrameResources {
     /// The particle bind group for a draw item.
     pub fn particle_group(&self, key: (u64, usize, bool)) -> Option<&wgpu::BindGroup> {
         self.particle_groups.get(&key)
+    }
+
+    /// Bakes and uploads emitter `i`'s colour ramp when its gradient changed.
+    fn upload_ramp(&mut self, ctx: &GpuContext, i: usize, look: &Look) {
+        let key = gradient_key(look);
+        if self.ramp_keys.get(i).copied().flatten() == Some(key) {
+            return;
+        }
+        let row = bake_ramp(&look.color_over_life);
+        ctx.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &self.ramps,
+                mip_level: 0,
+                origin: wgpu::Origin3d {
+                    x: 0,
+                    y: i as u32,
+                    z: 0,
+                },
+                aspect: wgpu::TextureAspect::All,
+            },
+            bytemuck::cast_slice(&row),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(RAMP_WIDTH * 16),
+                rows_per_image: Some(1),
+            },
+            wgpu::Extent3d {
+                width: RAMP_WIDTH,
+                height: 1,
+                depth_or_array_layers: 1,
+            },
+        );
+        if let Some(k) = self.ramp_keys.get_mut(i) {
+            *k = Some(key);
+        }
     }
 
     /// Uploads this frame's uniforms and returns what to draw, with each emitter's path.
@@ -340,36 +369,7 @@ impl FrameResources {
             u.clip_from_sim = camera.clip_from_sim(aspect, origin).to_cols_array_2d();
             let ground = e.collisions.ground.as_ref().map_or(0.0, |g| g.height_m);
             u.soft[0] = (f64::from(ground) - origin.y) as f32;
-            let key = gradient_key(&e.look);
-            if self.ramp_keys.get(i).copied().flatten() != Some(key) {
-                let row = bake_ramp(&e.look.color_over_life);
-                ctx.queue.write_texture(
-                    wgpu::TexelCopyTextureInfo {
-                        texture: &self.ramps,
-                        mip_level: 0,
-                        origin: wgpu::Origin3d {
-                            x: 0,
-                            y: i as u32,
-                            z: 0,
-                        },
-                        aspect: wgpu::TextureAspect::All,
-                    },
-                    bytemuck::cast_slice(&row),
-                    wgpu::TexelCopyBufferLayout {
-                        offset: 0,
-                        bytes_per_row: Some(RAMP_WIDTH * 16),
-                        rows_per_image: Some(1),
-                    },
-                    wgpu::Extent3d {
-                        width: RAMP_WIDTH,
-                        height: 1,
-                        depth_or_array_layers: 1,
-                    },
-                );
-                if let Some(k) = self.ramp_keys.get_mut(i) {
-                    *k = Some(key);
-                }
-            }
+            self.upload_ramp(ctx, i, &e.look);
             if Modules::of(e).contains(Modules::STATELESS) {
                 // Closed-form evaluation at the render time (between the last two steps).
                 let t =
@@ -380,22 +380,25 @@ impl FrameResources {
                 u.motion_a = [a.x, a.y, a.z, e.forces.drag_per_sec];
                 u.motion_b = [w[0], w[1], w[2], t.rem_euclid(4096.0) as f32];
             }
-            let Some(b) = sim.emitter_buffers(i) else {
-                let at = i * PARAMS_STRIDE as usize;
-                blocks[at..at + size_of::<LookUniform>()].copy_from_slice(bytemuck::bytes_of(&u));
-                continue;
-            };
-            u.soft[2] = b.life_range.0;
-            u.soft[3] = b.life_range.1;
-            u.ring = [
-                (b.spawned_total % u64::from(b.capacity.max(1))) as u32,
-                b.spawned_total as u32,
-                (b.spawned_total >> 32) as u32,
-                u32::from(b.packed),
-            ];
-            u.ring_b = [b.seed_salt.0, b.seed_salt.1, b.capacity, 0];
+            let buffers = sim.emitter_buffers(i);
+            if let Some(b) = &buffers {
+                // The ring, for packed state's re-derived lifetimes; the capacity bounds
+                // the splat.
+                u.soft[2] = b.life_range.0;
+                u.soft[3] = b.life_range.1;
+                u.ring = [
+                    (b.spawned_total % u64::from(b.capacity.max(1))) as u32,
+                    b.spawned_total as u32,
+                    (b.spawned_total >> 32) as u32,
+                    u32::from(b.packed),
+                ];
+                u.ring_b = [b.seed_salt.0, b.seed_salt.1, b.capacity, 0];
+            }
             let at = i * PARAMS_STRIDE as usize;
             blocks[at..at + size_of::<LookUniform>()].copy_from_slice(bytemuck::bytes_of(&u));
+            let Some(b) = buffers else {
+                continue;
+            };
             if !e.enabled {
                 continue;
             }

@@ -103,7 +103,7 @@ pub fn flipbook_frame(f: &Flipbook, age: f32, life: f32, start01: f32) -> FrameC
     }
 }
 
-/// A stable 32-bit key of what a ramp row holds (rows are re-uploaded only on change).
+/// A key of what a ramp row holds (rows are re-uploaded only when it changes).
 pub fn gradient_key(look: &Look) -> u64 {
     use std::hash::{Hash, Hasher};
     let mut h = std::collections::hash_map::DefaultHasher::new();

@@ -42,28 +42,10 @@ impl Targets {
     /// Creates both targets.
     pub fn new(ctx: &GpuContext, size: (u32, u32)) -> Self {
         let size = (size.0.max(1), size.1.max(1));
-        let extent = wgpu::Extent3d {
-            width: size.0,
-            height: size.1,
-            depth_or_array_layers: 1,
-        };
         let make = |label, format, usage| {
-            ctx.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: extent,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
+            crate::gpu::texture_2d(&ctx.device, label, size, 1, format, usage)
         };
-        let hdr = make(
-            "Targets::hdr",
-            HDR_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-        );
+        let hdr = hdr_texture(ctx, "Targets::hdr", size);
         let ldr = make(
             "Targets::ldr",
             LDR_FORMAT,
@@ -78,6 +60,18 @@ impl Targets {
             ldr,
         }
     }
+}
+
+/// An HDR render target that passes can also sample.
+pub fn hdr_texture(ctx: &GpuContext, label: &str, size: (u32, u32)) -> wgpu::Texture {
+    crate::gpu::texture_2d(
+        &ctx.device,
+        label,
+        size,
+        1,
+        HDR_FORMAT,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+    )
 }
 
 /// A render pipeline without vertex buffers: `vs` and `fs` of one module, one colour
@@ -290,7 +284,8 @@ impl Renderer {
                 targets.size.1.div_ceil(downscale),
             );
             if self.alpha_layer.as_ref().is_none_or(|(s, _)| *s != low) {
-                let view = Targets::new(ctx, low).hdr_view;
+                let view =
+                    hdr_texture(ctx, "Renderer::alpha_layer", low).create_view(&Default::default());
                 self.alpha_layer = Some((low, view));
             }
             if let Some((_, view)) = &self.alpha_layer {

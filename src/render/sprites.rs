@@ -54,6 +54,8 @@ pub struct SpriteLibrary {
     /// Trilinear, clamp-to-edge.
     pub sampler: wgpu::Sampler,
     next_id: u64,
+    /// Changes whenever the set of file sprites changes (what to watch).
+    generation: u64,
 }
 
 impl SpriteLibrary {
@@ -71,6 +73,7 @@ impl SpriteLibrary {
             files: HashMap::new(),
             sampler,
             next_id: 1,
+            generation: 0,
         }
     }
 
@@ -96,6 +99,7 @@ impl SpriteLibrary {
                 log::warn!("{e}");
             }
             self.files.insert(path.clone(), loaded);
+            self.generation += 1;
         }
         match self.files.get(&path) {
             Some(Ok(t)) => (t.clone(), None),
@@ -116,7 +120,16 @@ impl SpriteLibrary {
                 .iter()
                 .any(|c| c == p || (c.file_name() == p.file_name() && same_file(c, p)))
         });
-        before != self.files.len()
+        let dropped = before != self.files.len();
+        if dropped {
+            self.generation += 1;
+        }
+        dropped
+    }
+
+    /// Changes whenever the set of file sprites (and so [`Self::watched_dirs`]) may have.
+    pub fn generation(&self) -> u64 {
+        self.generation
     }
 
     /// Existing folders holding the file sprites in use, missing ones included (to watch
@@ -267,20 +280,14 @@ pub fn brightness_integral(img: &Rgba32FImage) -> f32 {
 fn upload(ctx: &GpuContext, img: &Rgba32FImage, id: u64, label: &str) -> SpriteTexture {
     let levels = mip_chain(img);
     let (w, h) = img.dimensions();
-    let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(&format!("sprite {label}")),
-        size: wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: levels.len() as u32,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: SPRITE_FORMAT,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
+    let texture = crate::gpu::texture_2d(
+        &ctx.device,
+        &format!("sprite {label}"),
+        (w, h),
+        levels.len() as u32,
+        SPRITE_FORMAT,
+        wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+    );
     for (mip, level) in levels.iter().enumerate() {
         let (lw, lh) = level.dimensions();
         let halfs: Vec<half::f16> = level

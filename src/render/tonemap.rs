@@ -64,23 +64,15 @@ impl TonemapPass {
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
-        let no_bloom = ctx
-            .device
-            .create_texture(&wgpu::TextureDescriptor {
-                label: Some("TonemapPass::no_bloom"),
-                size: wgpu::Extent3d {
-                    width: 1,
-                    height: 1,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: crate::render::HDR_FORMAT,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            })
-            .create_view(&Default::default());
+        let no_bloom = crate::gpu::texture_2d(
+            &ctx.device,
+            "TonemapPass::no_bloom",
+            (1, 1),
+            1,
+            crate::render::HDR_FORMAT,
+            wgpu::TextureUsages::TEXTURE_BINDING,
+        )
+        .create_view(&Default::default());
         let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("TonemapPass::sampler"),
             mag_filter: wgpu::FilterMode::Linear,

@@ -5,7 +5,7 @@ use std::collections::HashMap;
 use crate::effect::{Effect, Integrator};
 use crate::gpu::types::{PARAMS_STRIDE, PackedParticle, Particle, SimParams, slot_counter};
 use crate::gpu::{GpuContext, GpuError};
-use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
+use crate::shaders::{PACKED_STATE_IO, ShaderError, ShaderLibrary, create_checked};
 use crate::sim::modules::Modules;
 use crate::sim::planner::EffectPlanner;
 
@@ -112,8 +112,7 @@ impl UpdatePass {
     ) -> Result<(), ShaderError> {
         let composed = lib.compose("update.wgsl")?;
         // Packed-state pipelines: the same entry with state_packed.wgsl as the state I/O.
-        let packed =
-            lib.compose_with("update.wgsl", &[("state_full.wgsl", "state_packed.wgsl")])?;
+        let packed = lib.compose_with("update.wgsl", &[PACKED_STATE_IO])?;
         let mut fresh = HashMap::new();
         for &(integrator, modules) in keys {
             let composed = if modules.contains(Modules::PACKED) {
