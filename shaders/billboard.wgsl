@@ -1,5 +1,6 @@
-// billboard.wgsl — pass 2, large particles: camera-facing quads, one instance per slot
-// (vertex pulling from the state buffer the update pass just wrote).
+// billboard.wgsl — pass 2, large particles: camera-facing quads (4-vertex strips), one
+// instance per slot of the emitter's live window (vertex pulling from the state buffer the
+// update pass just wrote).
 //
 // Contract:
 // - group 0: binding 0 `camera` (CameraUniform), 1 `look` (LookUniform, dynamic offset
@@ -46,9 +47,17 @@ struct VsOut {
 @vertex
 fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) instance: u32) -> VsOut {
     var out: VsOut;
+    // Instances cover the emitter's live window of the ring (first slot = first instance),
+    // or, sorted, the window in back-to-front order; padding of the sort has no slot.
     var slot = instance;
     if SORTED {
         slot = order[instance];
+        if slot >= look.ring_b.z {
+            out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+            return out;
+        }
+    } else if slot >= look.ring_b.z {
+        slot -= look.ring_b.z;
     }
     let pair = load_pair(slot);
     let d = drawn(pair[0], pair[1]);
@@ -59,9 +68,22 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) instance: u3
     let t = age_fraction(d.age, d.life);
     let rnd = particle_random(slot, d.life);
     let size = size_at(t, rnd.x);
-    // Two triangles: 0 1 2, 2 1 3 over the corners (-1,-1) (1,-1) (-1,1) (1,1).
-    let corner_index = array<u32, 6>(0u, 1u, 2u, 2u, 1u, 3u)[vi];
-    let corner = vec2<f32>(f32(corner_index & 1u), f32(corner_index >> 1u)) * 2.0 - 1.0;
+    // A four-vertex triangle strip over the corners (-1,-1) (1,-1) (-1,1) (1,1): a third
+    // fewer vertex invocations than two separate triangles.
+    var corner = vec2<f32>(f32(vi & 1u), f32(vi >> 1u)) * 2.0 - 1.0;
+    if !STREAK {
+        // Cut the quad to the sprite's occupied rectangle (look.trim, frame texture
+        // coordinates), grown by 3 screen pixels: the mip the sampler picks blurs the
+        // edge by about two of its texels, which are about one pixel each.
+        let w = dot(transpose(look.clip_from_sim)[3], vec4<f32>(d.pos, 1.0));
+        let px = size * camera.viewport.z / max(w, 1e-4);
+        let m = 3.0 / max(px, 1e-3);
+        let lo = max(look.trim.xy - m, vec2<f32>(0.0));
+        let hi = min(look.trim.zw + m, vec2<f32>(1.0));
+        let u = mix(lo.x, hi.x, corner.x * 0.5 + 0.5);
+        let v = mix(lo.y, hi.y, 0.5 - corner.y * 0.5);
+        corner = vec2<f32>(2.0 * u - 1.0, 1.0 - 2.0 * v);
+    }
     var world = d.pos;
     if STREAK {
         // Stretched from where the particle was `length` seconds ago (tail, corner.x = -1)

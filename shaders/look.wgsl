@@ -41,12 +41,16 @@ struct LookUniform {
     // Packed state: x: next spawn slot (head), y, z: spawned total (lo, hi), w: 1 when the
     // state is packed.
     ring: vec4<u32>,
-    // Packed state: x: effect seed, y: emitter salt, z: capacity, w: unused.
+    // Packed state: x: effect seed, y: emitter salt; z: capacity; w: the live window's
+    // length (the slots before the head that can hold living particles).
     ring_b: vec4<u32>,
     // Stateless emitters: xyz constant acceleration, w linear drag k.
     motion_a: vec4<f32>,
     // Stateless emitters: xyz wind, w render time on the 4096 s clock.
     motion_b: vec4<f32>,
+    // The sprite's occupied part of each frame: u0, v0, u1, v1 in frame texture
+    // coordinates (v down); billboards are cut to it.
+    trim: vec4<f32>,
 }
 
 override INTERPOLATE: bool = true;

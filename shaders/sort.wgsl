@@ -3,11 +3,16 @@
 // emitter blends with alpha; additive fire needs no order.
 //
 // Contract:
-// - `keys` pass: group 0: 0 `look` (LookUniform of the emitter, dynamic offset),
-//   1 `camera`; group 1: 0 `cur` particles, 1 `keys`, 2 `values`. Alive slots get
-//   key = !bits(view depth) (farthest first), dead and padding slots 0xFFFFFFFF (last).
-// - `bitonic` pass: group 2: 0 `step` ({k, j}), 1 `keys`, 2 `values`; one invocation per
-//   element, compare-and-swap with element i ^ j.
+// - `depth_keys`: group 0: 0 `step`, 1 `keys`, 2 `values`; group 1: 0 `cur` particles,
+//   1 `cur_packed`. Element i of the sort is slot (window.x + i) mod capacity for
+//   i < window.y (the emitter's live window of the ring: only slots that can hold a
+//   living particle are sorted); alive slots get key = !bits(view depth) (farthest first),
+//   dead and padding elements 0xFFFFFFFF (last).
+// - The network is split so that most of it runs in workgroup memory:
+//   `bitonic_local` sorts 512-element blocks completely (window.z = 0: every stage with
+//   k ≤ step.k) or finishes a merge (window.z = 1: stage k = step.k, j = 256 … 1);
+//   `bitonic` is one global compare-and-swap stage (k, j ≥ 512), one invocation per
+//   element. A sort of n ≤ 512 is one dispatch; 2048 is 6 instead of 66.
 #import "common.wgsl"
 
 struct SortStep {
@@ -20,6 +25,8 @@ struct SortStep {
     // when the state is packed (read through `cur_packed`).
     eye: vec4<f32>,
     forward: vec4<f32>,
+    // x: first slot of the live window, y: its length, z: local mode (0 sort, 1 merge).
+    window: vec4<u32>,
 }
 
 @group(0) @binding(0) var<uniform> step: SortStep;
@@ -49,6 +56,70 @@ fn bitonic(
     }
 }
 
+const BLOCK: u32 = 512u;
+var<workgroup> block_keys: array<u32, 512>;
+var<workgroup> block_values: array<u32, 512>;
+
+// One compare-and-swap per invocation at distance j inside a 512-element block held in
+// workgroup memory; `base` is the block's first element (the direction depends on the
+// global index).
+fn local_stage(base: u32, lid: u32, k: u32, j: u32) {
+    let i = ((lid & ~(j - 1u)) << 1u) | (lid & (j - 1u));
+    let p = i | j;
+    let ascending = ((base + i) & k) == 0u;
+    let a = block_keys[i];
+    let b = block_keys[p];
+    if (a > b) == ascending {
+        block_keys[i] = b;
+        block_keys[p] = a;
+        let v = block_values[i];
+        block_values[i] = block_values[p];
+        block_values[p] = v;
+    }
+}
+
+@compute @workgroup_size(256)
+fn bitonic_local(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let base = (wg.y * nwg.x + wg.x) * BLOCK;
+    // Elements past `count` (a sort shorter than a block) are padding, never written.
+    for (var h = 0u; h < 2u; h++) {
+        let e = lid + h * 256u;
+        var key = 0xFFFFFFFFu;
+        var value = 0u;
+        if base + e < step.count {
+            key = keys[base + e];
+            value = values[base + e];
+        }
+        block_keys[e] = key;
+        block_values[e] = value;
+    }
+    if step.window.z == 0u {
+        for (var k = 2u; k <= min(step.k, BLOCK); k <<= 1u) {
+            for (var j = k >> 1u; j > 0u; j >>= 1u) {
+                workgroupBarrier();
+                local_stage(base, lid, k, j);
+            }
+        }
+    } else {
+        for (var j = BLOCK >> 1u; j > 0u; j >>= 1u) {
+            workgroupBarrier();
+            local_stage(base, lid, step.k, j);
+        }
+    }
+    workgroupBarrier();
+    for (var h = 0u; h < 2u; h++) {
+        let e = lid + h * 256u;
+        if base + e < step.count {
+            keys[base + e] = block_keys[e];
+            values[base + e] = block_values[e];
+        }
+    }
+}
+
 @group(1) @binding(0) var<storage, read> cur: array<Particle>;
 @group(1) @binding(1) var<storage, read> cur_packed: array<PackedParticle>;
 
@@ -63,15 +134,21 @@ fn depth_keys(
         return;
     }
     var key = 0xFFFFFFFFu;
-    if i < step.capacity {
+    // Padding carries no slot (the billboard pass skips values ≥ capacity).
+    var slot = 0xFFFFFFFFu;
+    if i < step.window.y {
+        slot = step.window.x + i;
+        if slot >= step.capacity {
+            slot -= step.capacity;
+        }
         var alive = false;
         var pos = vec3<f32>(0.0);
         if step.eye.w > 0.5 {
-            let q = cur_packed[i];
+            let q = cur_packed[slot];
             alive = packed_alive(q);
             pos = vec3<f32>(q.px, q.py, q.pz);
         } else {
-            let p = cur[i];
+            let p = cur[slot];
             alive = is_alive(p);
             pos = p.pos_age.xyz;
         }
@@ -82,5 +159,5 @@ fn depth_keys(
         }
     }
     keys[i] = key;
-    values[i] = i;
+    values[i] = slot;
 }

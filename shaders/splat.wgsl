@@ -51,9 +51,15 @@ fn splat(
     @builtin(num_workgroups) nwg: vec3<u32>,
     @builtin(local_invocation_index) lid: u32,
 ) {
-    let slot = (wg.y * nwg.x + wg.x) * 256u + lid;
-    if slot >= look.ring_b.z {
+    // One invocation per slot of the live window: the last ring_b.w slots before the
+    // ring's head (ring.x), wrapping at the capacity (ring_b.z).
+    let i = (wg.y * nwg.x + wg.x) * 256u + lid;
+    if i >= look.ring_b.w {
         return;
+    }
+    var slot = look.ring.x + look.ring_b.z - look.ring_b.w + i;
+    if slot >= look.ring_b.z {
+        slot -= look.ring_b.z;
     }
     let pair = load_pair(slot);
     let d = drawn(pair[0], pair[1]);

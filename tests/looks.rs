@@ -805,3 +805,49 @@ fn alpha_layers_at_half_resolution_match_full_resolution() {
         "half resolution: {d_half} vs {d_smoke}"
     );
 }
+
+/// Billboards are cut to the part of their sprite that holds something: the flame sheet's
+/// tongues fill about half of each frame's width, the soft disc all of it — and the
+/// trimmed frame is the untrimmed one (the flame quads lose ~40 % of their fill).
+#[test]
+fn trimmed_billboards_draw_the_untrimmed_frame() {
+    let ctx = gpu();
+    let mut sprites = SpriteLibrary::new(&ctx);
+    let (sheet, _) = sprites.resolve(&ctx, &Sprite::FlameSheet, None);
+    let [u0, v0, u1, v1] = sheet.trim_rect(4, 4);
+    assert!(
+        u1 - u0 < 0.6 && u0 > 0.2 && u1 < 0.8,
+        "flame sheet u {u0}..{u1}"
+    );
+    assert!(
+        v1 - v0 > 0.95,
+        "flame tongues span the height: v {v0}..{v1}"
+    );
+    let (disc, _) = sprites.resolve(&ctx, &Sprite::SoftDisc, None);
+    let [u0, _, u1, _] = disc.trim_rect(1, 1);
+    assert!(u1 - u0 > 0.97, "soft disc u {u0}..{u1}");
+
+    let mut effect = Effect::default_campfire();
+    effect.post.bloom = None;
+    let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    for _ in 0..120 {
+        run.advance(1.0 / 60.0).expect("advance");
+    }
+    let trimmed = run.render((320, 240)).expect("render");
+    run.renderer.frame.trim_sprites = false;
+    let whole = run.render((320, 240)).expect("render");
+    let lit = trimmed.pixels().filter(|p| p[0] > 60).count();
+    let max = trimmed
+        .as_raw()
+        .iter()
+        .zip(whole.as_raw())
+        .map(|(a, b)| a.abs_diff(*b))
+        .max()
+        .unwrap_or(0);
+    let mean = mean_abs_diff(&trimmed, &whole);
+    assert!(lit > 2000, "{lit} lit pixels");
+    assert!(
+        mean < 0.01 && max <= 8,
+        "trimmed vs whole: mean {mean}, max {max}"
+    );
+}

@@ -341,3 +341,87 @@ fn gpu_sort_equals_cpu_sort() {
         vec![0, 0, 1, u32::MAX - 1, u32::MAX]
     );
 }
+
+/// Draws and the sort visit only each emitter's live window of the ring (the slots that
+/// can hold a living particle) — the frame is the one drawing every slot gives, also after
+/// the lifetimes were shortened mid-run (older particles keep their longer lives), and the
+/// windows are much shorter than the pools.
+#[test]
+fn live_window_draws_what_the_whole_pool_draws() {
+    let ctx = gpu();
+    let mut effect = Effect::default_campfire();
+    effect.post.bloom = None;
+    let bounds: Vec<f32> = effect
+        .emitters
+        .iter()
+        .map(|e| e.spawn_rate_per_sec * (e.lifetime_secs.max + 2.0 / 60.0))
+        .collect();
+    let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    for f in 0..150 {
+        if f == 120 {
+            // An edit: every emitter's lifetimes shortened to a tenth.
+            for e in &mut run.effect.emitters {
+                e.lifetime_secs.min *= 0.1;
+                e.lifetime_secs.max *= 0.1;
+            }
+        }
+        run.advance(1.0 / 60.0).expect("advance");
+    }
+    let compare = |run: &mut Headless| {
+        run.renderer.frame.live_window_only = true;
+        let windowed = run.render(SIZE).expect("render");
+        run.renderer.frame.live_window_only = false;
+        let whole = run.render(SIZE).expect("render");
+        run.renderer.frame.live_window_only = true;
+        let (mut sum, mut max) = (0u64, 0u8);
+        for (a, b) in windowed.as_raw().iter().zip(whole.as_raw()) {
+            let d = a.abs_diff(*b);
+            sum += u64::from(d);
+            max = max.max(d);
+        }
+        let lit = windowed.pixels().filter(|p| p[0] > 40).count();
+        (sum as f64 / windowed.as_raw().len() as f64, max, lit)
+    };
+    let (mean, max, lit) = compare(&mut run);
+    assert!(lit > 500, "only {lit} lit pixels: nothing to compare");
+    // Additive light adds up in another order: f16 rounding at most.
+    assert!(
+        mean < 0.02 && max <= 2,
+        "window vs whole pool: mean {mean}, max {max}"
+    );
+    // Every particle alive now lies in its emitter's window, and the windows are short.
+    assert_eq!(bounds.len(), run.sim.emitter_count());
+    for (i, bound) in bounds.iter().enumerate() {
+        let b = run.sim.emitter_buffers(i).expect("buffers");
+        let (w, cap) = (b.window, b.capacity);
+        let particles = run.sim.read_particles(i).expect("read");
+        for (slot, p) in particles.iter().enumerate() {
+            if p.is_alive() {
+                let offset = (slot as u32 + cap - w.first_slot) % cap;
+                assert!(
+                    offset < w.len,
+                    "emitter {i}: alive slot {slot} outside {w:?}"
+                );
+            }
+        }
+        let alive = alive_of(&particles) as u32;
+        // At most rate × (the longest lifetime alive) plus two steps of spawns.
+        assert!(
+            (w.len as f32) <= *bound && w.len >= alive,
+            "emitter {i}: window {} for {alive} alive of {cap} (bound {bound})",
+            w.len,
+        );
+    }
+    // Later, once the long-lived particles died, the window shrinks to the new lifetimes.
+    for _ in 0..300 {
+        run.advance(1.0 / 60.0).expect("advance");
+    }
+    let (mean, max, _) = compare(&mut run);
+    assert!(mean < 0.02 && max <= 2, "after: mean {mean}, max {max}");
+    let smoke = run.sim.emitter_buffers(0).expect("smoke").window.len;
+    // 90/s × 0.4 s = 36 spawns can be alive; the batch granularity adds a few steps.
+    assert!(
+        smoke <= 60,
+        "smoke window {smoke} after the lifetimes shortened"
+    );
+}

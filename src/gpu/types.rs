@@ -181,12 +181,15 @@ pub struct LookUniform {
     pub soft: [f32; 4],
     /// Packed state: next spawn slot, spawned total (lo, hi), packed (0/1).
     pub ring: [u32; 4],
-    /// Packed state: effect seed, emitter salt, capacity, unused.
+    /// Packed state: effect seed, emitter salt; capacity; the live window's length (the
+    /// window ends at the ring's head, `ring[0]`).
     pub ring_b: [u32; 4],
     /// Stateless: constant acceleration xyz, drag k.
     pub motion_a: [f32; 4],
     /// Stateless: wind xyz, render time on the 4096 s clock.
     pub motion_b: [f32; 4],
+    /// The sprite's occupied part of a frame, u0 v0 u1 v1 (billboards are cut to it).
+    pub trim: [f32; 4],
 }
 
 /// Tonemap settings (keep in sync with `ToneUniform` in `shaders/tonemap.wgsl`).

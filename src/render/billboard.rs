@@ -74,6 +74,7 @@ impl BillboardPass {
             ("vs_main", "fs_main"),
             crate::render::hdr_target(blend),
             &v.constants(),
+            wgpu::PrimitiveTopology::TriangleStrip,
         )
     }
 
@@ -189,7 +190,14 @@ impl BillboardPass {
             );
             pass.set_bind_group(1, group, &[]);
             pass.set_bind_group(2, sprite, &[]);
-            pass.draw(0..6, 0..d.capacity);
+            // One strip per slot of the live window: sorted, through the sort's order;
+            // otherwise the window's slots directly (the shader wraps at the capacity).
+            let w = d.window;
+            if d.key.2 {
+                pass.draw(0..4, 0..w.len);
+            } else {
+                pass.draw(0..4, w.first_slot..w.first_slot + w.len);
+            }
         }
     }
 }

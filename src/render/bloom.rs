@@ -104,6 +104,7 @@ impl BloomPass {
                         write_mask: wgpu::ColorWrites::ALL,
                     },
                     &constants,
+                    wgpu::PrimitiveTopology::TriangleList,
                 )
             };
             BloomPipelines {

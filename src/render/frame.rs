@@ -22,8 +22,10 @@ pub struct DrawItem {
     pub index: usize,
     /// Key of the cached particle bind group.
     pub key: (u64, usize, bool),
-    /// Slots (instances / invocations).
+    /// Slots of the pool.
     pub capacity: u32,
+    /// The slots that can hold living particles: the instances / invocations drawn.
+    pub window: crate::sim::planner::LiveWindow,
     /// Blend mode.
     pub blend: BlendMode,
     /// The path chosen for this frame.
@@ -55,6 +57,14 @@ pub struct FrameResources {
     particle_groups: HashMap<(u64, usize, bool), wgpu::BindGroup>,
     /// Bound as the draw order of emitters that are not sorted.
     no_order: wgpu::Buffer,
+    /// Cut billboards to the occupied part of their sprite (on by default; off draws the
+    /// whole square, for comparisons).
+    pub trim_sprites: bool,
+    /// Draw and sort only each emitter's live window of the ring (on by default; off
+    /// visits every slot, for comparisons).
+    pub live_window_only: bool,
+    /// Trim rectangles by (sprite id, flipbook rows, columns).
+    trims: HashMap<(u64, u32, u32), [f32; 4]>,
 }
 
 /// The look uniform of an emitter (everything but the matrices, the ground height and
@@ -112,6 +122,7 @@ pub fn look_uniform(look: &Look, ramp_row: u32, salt: u32, sprite_integral: f32)
             streak.max_length_m,
         ],
         soft: [0.0, inv_soft, 0.0, 0.0],
+        trim: [0.0, 0.0, 1.0, 1.0],
         ..LookUniform::default()
     }
 }
@@ -229,6 +240,9 @@ impl FrameResources {
                 usage: wgpu::BufferUsages::STORAGE,
                 mapped_at_creation: false,
             }),
+            trim_sprites: true,
+            live_window_only: true,
+            trims: HashMap::new(),
         }
     }
 
@@ -366,6 +380,17 @@ impl FrameResources {
             }
             let salt = crate::rng::pcg4d([effect.seed, i as u32, e.seed_offset, 0x5EED_100C])[0];
             let mut u = look_uniform(&e.look, i as u32, salt, sprite.integral);
+            if self.trim_sprites && e.look.streak.is_none() {
+                let (rows, cols) = e
+                    .look
+                    .flipbook
+                    .as_ref()
+                    .map_or((1, 1), |f| (f.rows, f.cols));
+                u.trim = *self
+                    .trims
+                    .entry((sprite.id, rows, cols))
+                    .or_insert_with(|| sprite.trim_rect(rows, cols));
+            }
             u.clip_from_sim = camera.clip_from_sim(aspect, origin).to_cols_array_2d();
             let ground = e.collisions.ground.as_ref().map_or(0.0, |g| g.height_m);
             u.soft[0] = (f64::from(ground) - origin.y) as f32;
@@ -380,7 +405,12 @@ impl FrameResources {
                 u.motion_a = [a.x, a.y, a.z, e.forces.drag_per_sec];
                 u.motion_b = [w[0], w[1], w[2], t.rem_euclid(4096.0) as f32];
             }
-            let buffers = sim.emitter_buffers(i);
+            let buffers = sim.emitter_buffers(i).map(|mut b| {
+                if !self.live_window_only {
+                    b.window = crate::sim::planner::LiveWindow::all(b.capacity);
+                }
+                b
+            });
             if let Some(b) = &buffers {
                 // The ring, for packed state's re-derived lifetimes; the capacity bounds
                 // the splat.
@@ -392,7 +422,8 @@ impl FrameResources {
                     (b.spawned_total >> 32) as u32,
                     u32::from(b.packed),
                 ];
-                u.ring_b = [b.seed_salt.0, b.seed_salt.1, b.capacity, 0];
+                // w: the live window's length (it ends at the ring's head, ring.x).
+                u.ring_b = [b.seed_salt.0, b.seed_salt.1, b.capacity, b.window.len];
             }
             let at = i * PARAMS_STRIDE as usize;
             blocks[at..at + size_of::<LookUniform>()].copy_from_slice(bytemuck::bytes_of(&u));
@@ -456,6 +487,7 @@ impl FrameResources {
                 index: i,
                 key,
                 capacity: b.capacity,
+                window: b.window,
                 blend: e.look.blend,
                 splat,
                 variant: LookVariant::of(&e.look),

@@ -75,7 +75,8 @@ pub fn hdr_texture(ctx: &GpuContext, label: &str, size: (u32, u32)) -> wgpu::Tex
 }
 
 /// A render pipeline without vertex buffers: `vs` and `fs` of one module, one colour
-/// target, and override constants (given to both stages).
+/// target, override constants (given to both stages) and the primitive topology.
+#[allow(clippy::too_many_arguments)]
 pub fn simple_pipeline(
     ctx: &GpuContext,
     label: &str,
@@ -84,6 +85,7 @@ pub fn simple_pipeline(
     (vs, fs): (&str, &str),
     target: wgpu::ColorTargetState,
     constants: &[(&str, f64)],
+    topology: wgpu::PrimitiveTopology,
 ) -> wgpu::RenderPipeline {
     ctx.device
         .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -98,7 +100,10 @@ pub fn simple_pipeline(
                 },
                 buffers: &[],
             },
-            primitive: wgpu::PrimitiveState::default(),
+            primitive: wgpu::PrimitiveState {
+                topology,
+                ..Default::default()
+            },
             depth_stencil: None,
             multisample: wgpu::MultisampleState::default(),
             fragment: Some(wgpu::FragmentState {
@@ -263,6 +268,7 @@ impl Renderer {
                     b.generation,
                     b.current,
                     b.capacity,
+                    d.window,
                     eye,
                     forward,
                     b.packed,

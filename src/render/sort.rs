@@ -1,6 +1,11 @@
 //! Back-to-front ordering of alpha-blended emitters on the GPU: depth keys, then a
 //! bitonic sort of (key, slot) pairs. The billboard pass draws alpha emitters through the
 //! sorted slot order; nothing is sorted when no emitter blends with alpha.
+//!
+//! Only the emitter's live window of the ring is sorted (the slots that can hold living
+//! particles), and the network runs mostly in workgroup memory: 512-element blocks are
+//! sorted, and merges finished, in one dispatch each ([`sort_dispatches`]), so a 2048-slot
+//! sort is 6 dispatches instead of 66.
 
 use std::collections::HashMap;
 
@@ -26,6 +31,8 @@ pub struct SortStep {
     pub eye: [f32; 4],
     /// Camera forward axis.
     pub forward: [f32; 4],
+    /// First slot of the live window, its length, local mode (0 sort, 1 merge), unused.
+    pub window: [u32; 4],
 }
 
 const STRIDE: u64 = 256;
@@ -45,8 +52,57 @@ pub fn bitonic_stages(n: u32) -> Vec<(u32, u32)> {
     v
 }
 
+/// Elements a workgroup sorts in its own memory (`BLOCK` in `sort.wgsl`).
+pub const LOCAL_BLOCK: u32 = 512;
+
+/// One dispatch of the split bitonic network.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SortDispatch {
+    /// Sort each 512-element block completely (every stage with k ≤ `k`), in workgroup
+    /// memory.
+    Local {
+        /// The largest stage size (≤ 512).
+        k: u32,
+    },
+    /// One compare-and-swap stage at distance `j` ≥ 512 over the whole array.
+    Global {
+        /// Stage size.
+        k: u32,
+        /// Compare distance.
+        j: u32,
+    },
+    /// Finish stage `k` (distances 256 … 1) in workgroup memory.
+    Merge {
+        /// Stage size.
+        k: u32,
+    },
+}
+
+/// The dispatches that sort `n` (a power of two) elements: the bitonic network of
+/// [`bitonic_stages`], with every run of stages whose distance is below the block size
+/// done in one workgroup-memory dispatch.
+pub fn sort_dispatches(n: u32) -> Vec<SortDispatch> {
+    let mut v = vec![SortDispatch::Local {
+        k: n.min(LOCAL_BLOCK),
+    }];
+    let mut k = LOCAL_BLOCK * 2;
+    while k <= n {
+        let mut j = k / 2;
+        while j >= LOCAL_BLOCK {
+            v.push(SortDispatch::Global { k, j });
+            j /= 2;
+        }
+        v.push(SortDispatch::Merge { k });
+        k *= 2;
+    }
+    v
+}
+
 /// Sort buffers of one emitter.
 pub struct SortBuffers {
+    /// Elements the buffers hold (a power of two ≥ the capacity).
+    size: u32,
+    /// Elements sorted now (a power of two ≤ `size`; the steps are written for it).
     count: u32,
     capacity: u32,
     /// Sorted slot indices (farthest first), bound by the billboard pass.
@@ -62,6 +118,7 @@ pub struct SortPass {
     pipeline_layout: wgpu::PipelineLayout,
     keys: wgpu::ComputePipeline,
     bitonic: wgpu::ComputePipeline,
+    bitonic_local: wgpu::ComputePipeline,
     buffers: HashMap<u64, SortBuffers>,
 }
 
@@ -109,13 +166,14 @@ impl SortPass {
                 bind_group_layouts: &[Some(&layout), Some(&state_layout)],
                 immediate_size: 0,
             });
-        let (keys, bitonic) = Self::build(ctx, lib, &pipeline_layout)?;
+        let [keys, bitonic, bitonic_local] = Self::build(ctx, lib, &pipeline_layout)?;
         Ok(Self {
             layout,
             state_layout,
             pipeline_layout,
             keys,
             bitonic,
+            bitonic_local,
             buffers: HashMap::new(),
         })
     }
@@ -124,7 +182,7 @@ impl SortPass {
         ctx: &GpuContext,
         lib: &ShaderLibrary,
         layout: &wgpu::PipelineLayout,
-    ) -> Result<(wgpu::ComputePipeline, wgpu::ComputePipeline), ShaderError> {
+    ) -> Result<[wgpu::ComputePipeline; 3], ShaderError> {
         let composed = lib.compose("sort.wgsl")?;
         create_checked(&ctx.device, &composed, lib, |module| {
             let make = |entry: &str| {
@@ -138,15 +196,16 @@ impl SortPass {
                         cache: None,
                     })
             };
-            (make("depth_keys"), make("bitonic"))
+            [make("depth_keys"), make("bitonic"), make("bitonic_local")]
         })
     }
 
     /// Rebuilds the pipelines; keeps the old ones on error.
     pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
-        let (keys, bitonic) = Self::build(ctx, lib, &self.pipeline_layout)?;
+        let [keys, bitonic, bitonic_local] = Self::build(ctx, lib, &self.pipeline_layout)?;
         self.keys = keys;
         self.bitonic = bitonic;
+        self.bitonic_local = bitonic_local;
         Ok(())
     }
 
@@ -169,12 +228,11 @@ impl SortPass {
     }
 
     fn create(&self, ctx: &GpuContext, capacity: u32) -> SortBuffers {
-        let count = capacity.max(2).next_power_of_two();
-        let stages = bitonic_stages(count);
+        let size = capacity.max(2).next_power_of_two();
         let make = |label| {
             ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
-                size: count as u64 * 4,
+                size: size as u64 * 4,
                 usage: wgpu::BufferUsages::STORAGE
                     | wgpu::BufferUsages::COPY_SRC
                     | wgpu::BufferUsages::COPY_DST,
@@ -185,23 +243,11 @@ impl SortPass {
         let values = make("SortPass::values");
         let steps = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("SortPass::steps"),
-            size: (stages.len() as u64 + 1) * STRIDE,
+            size: (sort_dispatches(size).len() as u64 + 1) * STRIDE,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let mut blocks = vec![0u8; (stages.len() + 1) * STRIDE as usize];
-        for (i, (k, j)) in stages.iter().enumerate() {
-            let s = SortStep {
-                k: *k,
-                j: *j,
-                count,
-                capacity,
-                ..Default::default()
-            };
-            let at = (i + 1) * STRIDE as usize;
-            blocks[at..at + size_of::<SortStep>()].copy_from_slice(bytemuck::bytes_of(&s));
-        }
-        ctx.queue.write_buffer(&steps, 0, &blocks);
+        Self::write_steps(ctx, &steps, size, capacity);
         let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("SortPass::group"),
             layout: &self.layout,
@@ -227,7 +273,8 @@ impl SortPass {
         // `keys` lives on through the bind group.
         drop(keys);
         SortBuffers {
-            count,
+            size,
+            count: size,
             capacity,
             values,
             steps,
@@ -235,17 +282,48 @@ impl SortPass {
         }
     }
 
+    /// Writes the uniform block of every dispatch of a sort of `count` elements (after
+    /// the depth-key block at offset 0).
+    fn write_steps(ctx: &GpuContext, steps: &wgpu::Buffer, count: u32, capacity: u32) {
+        let dispatches = sort_dispatches(count);
+        let mut blocks = vec![0u8; dispatches.len() * STRIDE as usize];
+        for (i, d) in dispatches.iter().enumerate() {
+            let (k, j, mode) = match *d {
+                SortDispatch::Local { k } => (k, 0, 0),
+                SortDispatch::Global { k, j } => (k, j, 0),
+                SortDispatch::Merge { k } => (k, 0, 1),
+            };
+            let s = SortStep {
+                k,
+                j,
+                count,
+                capacity,
+                window: [0, 0, mode, 0],
+                ..Default::default()
+            };
+            let at = i * STRIDE as usize;
+            blocks[at..at + size_of::<SortStep>()].copy_from_slice(bytemuck::bytes_of(&s));
+        }
+        ctx.queue.write_buffer(steps, STRIDE, &blocks);
+    }
+
     fn record_stages(&self, pass: &mut wgpu::ComputePass<'_>, b: &SortBuffers) {
-        pass.set_pipeline(&self.bitonic);
-        let (x, y) = dispatch_size(b.count);
-        for i in 0..bitonic_stages(b.count).len() {
+        for (i, d) in sort_dispatches(b.count).iter().enumerate() {
             pass.set_bind_group(0, &b.group, &[((i as u64 + 1) * STRIDE) as u32]);
+            let (pipeline, threads) = match d {
+                SortDispatch::Global { .. } => (&self.bitonic, b.count),
+                _ => (&self.bitonic_local, b.count.div_ceil(2)),
+            };
+            pass.set_pipeline(pipeline);
+            let (x, y) = dispatch_size(threads);
             pass.dispatch_workgroups(x, y, 1);
         }
     }
 
-    /// Records depth keys for `state` seen from `eye` along `forward` (simulation space)
-    /// and the sort; afterwards `values` holds slots farthest first.
+    /// Records depth keys for the live `window` of `state` seen from `eye` along
+    /// `forward` (simulation space) and the sort; afterwards the first `window.len`
+    /// entries of `values` hold those slots farthest first (dead slots after the living;
+    /// entries ≥ the capacity are padding).
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
@@ -254,21 +332,34 @@ impl SortPass {
         generation: u64,
         state: &wgpu::Buffer,
         capacity: u32,
+        window: crate::sim::planner::LiveWindow,
         eye: glam::Vec3,
         forward: glam::Vec3,
         packed: bool,
     ) {
+        if window.len == 0 {
+            return;
+        }
         self.buffers(ctx, generation, capacity);
+        let Some(b) = self.buffers.get_mut(&generation) else {
+            return;
+        };
+        let count = window.len.max(2).next_power_of_two().min(b.size);
+        if count != b.count {
+            Self::write_steps(ctx, &b.steps, count, capacity);
+            b.count = count;
+        }
         let Some(b) = self.buffers.get(&generation) else {
             return;
         };
         let head = SortStep {
             k: 0,
             j: 0,
-            count: b.count,
+            count,
             capacity,
             eye: eye.extend(if packed { 1.0 } else { 0.0 }).to_array(),
             forward: forward.extend(0.0).to_array(),
+            window: [window.first_slot, window.len, 0, 0],
         };
         ctx.queue
             .write_buffer(&b.steps, 0, bytemuck::bytes_of(&head));
@@ -389,5 +480,45 @@ impl SortPass {
         k.truncate(keys.len());
         v.truncate(keys.len());
         Ok((k, v))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The split network performs exactly the stages of the plain bitonic network, in
+    /// order: local sorts expand to every stage with k ≤ 512, merges to j = 256 … 1.
+    #[test]
+    fn dispatches_expand_to_the_bitonic_network() {
+        for n in [2u32, 4, 256, 512, 1024, 2048, 1 << 16] {
+            let mut expanded = Vec::new();
+            for d in sort_dispatches(n) {
+                match d {
+                    SortDispatch::Local { k } => {
+                        let mut kk = 2;
+                        while kk <= k {
+                            let mut j = kk / 2;
+                            while j > 0 {
+                                expanded.push((kk, j));
+                                j /= 2;
+                            }
+                            kk *= 2;
+                        }
+                    }
+                    SortDispatch::Global { k, j } => expanded.push((k, j)),
+                    SortDispatch::Merge { k } => {
+                        let mut j = LOCAL_BLOCK / 2;
+                        while j > 0 {
+                            expanded.push((k, j));
+                            j /= 2;
+                        }
+                    }
+                }
+            }
+            assert_eq!(expanded, bitonic_stages(n), "n = {n}");
+        }
+        assert_eq!(sort_dispatches(2048).len(), 6);
+        assert_eq!(bitonic_stages(2048).len(), 66);
     }
 }

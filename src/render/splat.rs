@@ -117,6 +117,7 @@ impl SplatPass {
                 ("vs_resolve", "fs_resolve"),
                 crate::render::hdr_target(ADDITIVE),
                 &[],
+                wgpu::PrimitiveTopology::TriangleList,
             );
             (splat, resolve)
         })
@@ -180,7 +181,7 @@ impl SplatPass {
                 &[FrameResources::look_offset(d.index)],
             );
             pass.set_bind_group(1, particles, &[]);
-            let (x, y) = dispatch_size(d.capacity);
+            let (x, y) = dispatch_size(d.window.len);
             pass.dispatch_workgroups(x, y, 1);
         }
         true

@@ -33,6 +33,47 @@ pub struct SpriteTexture {
     /// ∫ premultiplied brightness over the sprite's quad [-1, 1]² (4 × the mean), the
     /// splat's energy per unit of colour.
     pub integral: f32,
+    /// Which texels of mip 0 carry light or coverage (any channel > [`TRIM_THRESHOLD`]),
+    /// row-major: what [`SpriteTexture::trim_rect`] fits the drawn quads to.
+    occupied: Vec<bool>,
+}
+
+/// A texel whose premultiplied channels are all at or below this draws nothing visible
+/// (an 8-bit display step is 1/255 and bloom thresholds are far above); quads are trimmed
+/// to the texels above it.
+pub const TRIM_THRESHOLD: f32 = 1.0 / 1024.0;
+
+impl SpriteTexture {
+    /// The part of every frame that holds something, as a `rows × cols` flipbook (1 × 1
+    /// without one): `[u0, v0, u1, v1]` in frame-local texture coordinates (v down),
+    /// the union over all frames, grown by one texel for bilinear filtering. Billboards
+    /// are cut to it (plus a mip margin, in the shader): a flame-tongue sheet covers half
+    /// its square, so half of its fill was spent on nothing. The whole frame when the
+    /// sprite is empty.
+    pub fn trim_rect(&self, rows: u32, cols: u32) -> [f32; 4] {
+        let (w, h) = self.size;
+        let (rows, cols) = (rows.max(1) as f32, cols.max(1) as f32);
+        let (sx, sy) = (cols / w as f32, rows / h as f32);
+        let mut rect = [f32::MAX, f32::MAX, f32::MIN, f32::MIN];
+        for (i, _) in self.occupied.iter().enumerate().filter(|(_, o)| **o) {
+            let (x, y) = ((i as u32 % w) as f32, (i as u32 / w) as f32);
+            // Frame-local extent of this texel (frame of its centre).
+            let (cx, cy) = (((x + 0.5) * sx).floor(), ((y + 0.5) * sy).floor());
+            rect[0] = rect[0].min(x * sx - cx);
+            rect[1] = rect[1].min(y * sy - cy);
+            rect[2] = rect[2].max((x + 1.0) * sx - cx);
+            rect[3] = rect[3].max((y + 1.0) * sy - cy);
+        }
+        if rect[0] > rect[2] {
+            return [0.0, 0.0, 1.0, 1.0];
+        }
+        [
+            (rect[0] - sx).max(0.0),
+            (rect[1] - sy).max(0.0),
+            (rect[2] + sx).min(1.0),
+            (rect[3] + sy).min(1.0),
+        ]
+    }
 }
 
 /// A sprite that could not be loaded.
@@ -320,6 +361,10 @@ fn upload(ctx: &GpuContext, img: &Rgba32FImage, id: u64, label: &str) -> SpriteT
         view: texture.create_view(&Default::default()),
         size: (w, h),
         integral: brightness_integral(img),
+        occupied: img
+            .pixels()
+            .map(|p| p.0.iter().any(|&c| c > TRIM_THRESHOLD))
+            .collect(),
     }
 }
 

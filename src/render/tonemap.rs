@@ -115,6 +115,7 @@ impl TonemapPass {
                     ("vs_main", "fs_main"),
                     format.into(),
                     &constants,
+                    wgpu::PrimitiveTopology::TriangleList,
                 )
             };
             std::array::from_fn(make)

@@ -7,7 +7,7 @@ use crate::gpu::types::{PARAMS_STRIDE, PackedParticle, Particle, SimParams, slot
 use crate::gpu::{GpuContext, GpuError};
 use crate::shaders::{PACKED_STATE_IO, ShaderError, ShaderLibrary, create_checked};
 use crate::sim::modules::Modules;
-use crate::sim::planner::EffectPlanner;
+use crate::sim::planner::{EffectPlanner, LiveWindow};
 
 /// Steps recorded per submission (the per-step params blocks live side by side).
 const STEPS_PER_SUBMIT: usize = 32;
@@ -203,6 +203,12 @@ struct EmitterState {
     life_range: (f32, f32),
     seed: u32,
     salt: u32,
+    /// The state was written from outside the planner (`write_particles`): every slot may
+    /// be alive until the next restart.
+    external: bool,
+    /// The spawn counter after the last recorded step (equal to the planner's when the
+    /// steps came from it; otherwise the live window is unknown).
+    spawned_end: u64,
 }
 
 /// The GPU simulation of an effect.
@@ -238,6 +244,8 @@ pub struct EmitterBuffers<'a> {
     pub life_range: (f32, f32),
     /// Effect seed and emitter salt.
     pub seed_salt: (u32, u32),
+    /// The slots that can hold living particles (draws and the sort visit only these).
+    pub window: LiveWindow,
 }
 
 impl GpuSim {
@@ -409,6 +417,8 @@ impl GpuSim {
             life_range: (0.0, 0.0),
             seed: 0,
             salt: 0,
+            external: false,
+            spawned_end: 0,
         }
     }
 
@@ -514,6 +524,8 @@ impl GpuSim {
                 let (Some(p), Some(em)) = (params, self.emitters.get_mut(e)) else {
                     continue;
                 };
+                em.spawned_end = (u64::from(p.spawn_base_hi) << 32 | u64::from(p.spawn_base_lo))
+                    + u64::from(p.spawn_count);
                 let Some(pipeline) = self
                     .update
                     .pipelines
@@ -588,6 +600,7 @@ impl GpuSim {
 
     /// Buffers of emitter `index` for drawing.
     pub fn emitter_buffers(&self, index: usize) -> Option<EmitterBuffers<'_>> {
+        let planner = self.planner.emitters.get(index);
         self.emitters.get(index).map(|s| EmitterBuffers {
             previous: &s.buffers[1 - s.current],
             current: &s.buffers[s.current],
@@ -595,13 +608,15 @@ impl GpuSim {
             generation: s.generation,
             parity: s.current,
             packed: s.packed,
-            spawned_total: self
-                .planner
-                .emitters
-                .get(index)
-                .map_or(0, |p| p.spawned_total()),
+            spawned_total: planner.map_or(0, |p| p.spawned_total()),
             life_range: s.life_range,
             seed_salt: (s.seed, s.salt),
+            window: match planner {
+                Some(p) if !s.external && p.spawned_total() == s.spawned_end => {
+                    p.live_window(s.capacity, self.planner.time_secs, s.life_range.1)
+                }
+                _ => LiveWindow::all(s.capacity),
+            },
         })
     }
 
@@ -631,6 +646,9 @@ impl GpuSim {
             self.ctx
                 .queue
                 .write_buffer(b, 0, bytemuck::cast_slice(&particles[..n]));
+        }
+        if let Some(s) = self.emitters.get_mut(index) {
+            s.external = true;
         }
         Ok(())
     }
@@ -751,6 +769,8 @@ impl GpuSim {
             }
             enc.clear_buffer(&s.counters, 0, None);
             s.current = 0;
+            s.external = false;
+            s.spawned_end = 0;
         }
         self.ctx.queue.submit([enc.finish()]);
         self.planner.reset();

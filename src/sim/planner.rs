@@ -26,6 +26,35 @@ struct Batch {
     first_index: u64,
     count: u32,
     birth_secs: f64,
+    /// The longest lifetime this batch's particles can have (the range at spawn time).
+    max_life_secs: f64,
+}
+
+impl Batch {
+    /// The longest these particles can live.
+    fn life_bound(&self, max_life_now: f64) -> f64 {
+        self.max_life_secs.max(max_life_now)
+    }
+}
+
+/// The slots of a ring that can hold living particles: `len` slots from `first_slot`,
+/// wrapping at the capacity.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LiveWindow {
+    /// The oldest slot that may be alive.
+    pub first_slot: u32,
+    /// How many slots, oldest to newest (≤ the capacity).
+    pub len: u32,
+}
+
+impl LiveWindow {
+    /// The whole pool (state written from outside the planner).
+    pub fn all(capacity: u32) -> Self {
+        Self {
+            first_slot: 0,
+            len: capacity,
+        }
+    }
 }
 
 /// Exact spawn counts for one emitter: rate × dt accumulated in f64.
@@ -138,6 +167,7 @@ impl EmitterPlanner {
                 first_index: base,
                 count: count as u32,
                 birth_secs: t0_secs + dt * frac0.clamp(0.0, 1.0),
+                max_life_secs: e.lifetime_secs.max as f64,
             });
         }
         self.spawned_total += count;
@@ -166,7 +196,7 @@ impl EmitterPlanner {
         while let Some(front) = self.history.front() {
             let end = front.first_index + front.count as u64;
             let overwritten = end + capacity <= self.spawned_total;
-            if overwritten || t0 - front.birth_secs >= max_life {
+            if overwritten || t0 - front.birth_secs >= Batch::life_bound(front, max_life) {
                 self.history.pop_front();
             } else {
                 break;
@@ -201,6 +231,30 @@ impl EmitterPlanner {
     /// emitter moves later.
     pub fn origin(&self) -> glam::DVec3 {
         self.origin.unwrap_or_default()
+    }
+
+    /// The live window of the ring at simulated time `now_secs`: the last `len` spawns
+    /// (slots `first_slot`, `first_slot + 1`, … modulo `capacity`) are the only ones that
+    /// can hold a living particle — every earlier batch has outlived the longest lifetime
+    /// it could have (the range at its spawn, or `max_life_secs` now, whichever is longer;
+    /// packed state re-derives lifetimes from the current range). Draws and the sort visit
+    /// only this window instead of the whole pool. Conservative: a batch counts until
+    /// its earliest particle is surely dead, with a margin for f32 ages.
+    pub fn live_window(&self, capacity: u32, now_secs: f64, max_life_secs: f32) -> LiveWindow {
+        let capacity = u64::from(capacity.max(1));
+        let first = self
+            .history
+            .iter()
+            .find(|b| {
+                let bound = b.life_bound(max_life_secs as f64);
+                now_secs - b.birth_secs < bound * (1.0 + 1e-4) + 1e-4
+            })
+            .map_or(self.spawned_total, |b| b.first_index);
+        let first = first.max(self.spawned_total.saturating_sub(capacity));
+        LiveWindow {
+            first_slot: (first % capacity) as u32,
+            len: (self.spawned_total - first) as u32,
+        }
     }
 
     /// The spawn counter: how many particles this emitter has started.
