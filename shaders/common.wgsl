@@ -68,6 +68,9 @@ struct SimParams {
     spheres: array<vec4<f32>, 4>,
     // x: stick on contact (0/1): the particle stops where it touches, yzw: unused.
     collide_c: vec4<f32>,
+    // x: first slot this step updates, y: how many (wrapping at the capacity): the ring's
+    // live window plus this step's spawns; every other slot is dead in both buffers.
+    update_window: vec4<u32>,
 }
 
 const SHAPE_POINT: u32 = 0u;

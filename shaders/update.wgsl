@@ -8,9 +8,12 @@
 //   adapters it is off — a workgroup barrier makes lavapipe run every invocation
 //   separately — and count.wgsl counts on demand instead. (On the H100 the update with the
 //   reduction measured 0.417 ms at 16.8M particles, without it 0.468 ms: kept.)
-// - Slots in the spawn window [spawn_head, spawn_head + spawn_count) (mod capacity) are
-//   born; alive slots integrate and age; every slot is written, so B never holds stale
-//   data from two steps ago.
+// - One invocation per slot of `update_window` (the planner's live window of the ring as
+//   of the previous step's start, plus this step's spawns): slots in the spawn window
+//   [spawn_head, spawn_head + spawn_count) (mod capacity) are born; alive slots integrate
+//   and age; every visited slot is written. A slot outside the window was dead at the
+//   start of the previous step, so it is dead (and identical) in A and B: B never holds
+//   stale live data from two steps ago.
 // - The dispatch is 2-D (x ≤ 65535 groups) so pools beyond 16M slots fit.
 #import "common.wgsl"
 
@@ -51,13 +54,18 @@ fn main(
     @builtin(num_workgroups) nwg: vec3<u32>,
     @builtin(local_invocation_index) lid: u32,
 ) {
-    let slot = (wg.y * nwg.x + wg.x) * 256u + lid;
+    let i = (wg.y * nwg.x + wg.x) * 256u + lid;
     if MOD_STATELESS {
-        stateless_spawn(slot);
+        stateless_spawn(i);
         return;
     }
     var alive = false;
-    if slot < params.capacity {
+    if i < params.update_window.y {
+        // The i-th slot of this step's window of the ring.
+        var slot = params.update_window.x + i;
+        if slot >= params.capacity {
+            slot -= params.capacity;
+        }
         var p = load_state(slot);
         // Position of this slot in the ring relative to the spawn head (capacity ≤ 2^28).
         let rel = (slot + params.capacity - params.spawn_head) % params.capacity;

@@ -141,6 +141,10 @@ pub struct SimParams {
     pub spheres: [[f32; 4]; 4],
     /// x: stick on contact.
     pub collide_c: [f32; 4],
+    /// The slots this step updates: first slot, count (wrapping at the capacity) — the
+    /// ring's live window plus this step's spawns; every other slot is dead in both
+    /// state buffers.
+    pub update_window: [u32; 4],
 }
 
 /// Camera data for the billboard pass (keep in sync with `CameraUniform` in

@@ -509,11 +509,18 @@ impl GpuSim {
     ) {
         let n_emitters = self.emitters.len();
         let mut blocks = vec![0u8; plans.len() * n_emitters * PARAMS_STRIDE as usize];
+        let mut windows = vec![0u32; plans.len() * n_emitters];
         for (s, plan) in plans.iter().enumerate() {
             for (e, params) in plan.iter().enumerate() {
-                if let Some(p) = params {
+                if let (Some(p), Some(em)) = (params, self.emitters.get(e)) {
+                    let mut p = *p;
+                    // State written from outside the planner: every slot may be alive.
+                    if em.external || p.update_window[1] > em.capacity {
+                        p.update_window = [0, em.capacity, 0, 0];
+                    }
+                    windows[s * n_emitters + e] = p.update_window[1];
                     let at = (s * n_emitters + e) * PARAMS_STRIDE as usize;
-                    blocks[at..at + size_of::<SimParams>()].copy_from_slice(bytemuck::bytes_of(p));
+                    blocks[at..at + size_of::<SimParams>()].copy_from_slice(bytemuck::bytes_of(&p));
                 }
             }
         }
@@ -559,7 +566,7 @@ impl GpuSim {
                 });
                 pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, &em.bind_groups[em.current], &[offset]);
-                let (x, y) = dispatch_size(p.capacity.min(em.capacity));
+                let (x, y) = dispatch_size(windows[s * n_emitters + e]);
                 pass.dispatch_workgroups(x, y, 1);
                 drop(pass);
                 em.current = 1 - em.current;

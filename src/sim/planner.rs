@@ -26,14 +26,20 @@ struct Batch {
     first_index: u64,
     count: u32,
     birth_secs: f64,
+    /// The end of the step that spawned the batch: no particle of it is younger.
+    youngest_birth_secs: f64,
     /// The longest lifetime this batch's particles can have (the range at spawn time).
     max_life_secs: f64,
 }
 
 impl Batch {
-    /// The longest these particles can live.
-    fn life_bound(&self, max_life_now: f64) -> f64 {
-        self.max_life_secs.max(max_life_now)
+    /// Every particle of the batch is dead at `at_secs`: it outlived the longest lifetime
+    /// it could have (the range at its spawn, or `max_life_now` — packed state re-derives
+    /// lifetimes from the current range — whichever is longer), with a margin for the
+    /// f32 ages of the GPU.
+    fn surely_dead(&self, at_secs: f64, max_life_now: f64) -> bool {
+        let bound = self.max_life_secs.max(max_life_now);
+        at_secs - self.youngest_birth_secs >= bound * (1.0 + 1e-4) + 1e-4
     }
 }
 
@@ -67,6 +73,8 @@ pub struct EmitterPlanner {
     history: VecDeque<Batch>,
     /// The origin of this emitter's simulation space, fixed at its first step.
     origin: Option<glam::DVec3>,
+    /// Start time of the last planned step (the time of the older state buffer).
+    last_t0_secs: Option<f64>,
 }
 
 /// Plans every emitter of an effect, step after step.
@@ -160,13 +168,32 @@ impl EmitterPlanner {
         };
 
         let salt = rng::emitter_salt(emitter_index, e.seed_offset);
-        self.account_overwrites(e, seed, salt, count, t0_secs);
+        // The older of the two state buffers holds the state at the last step's start:
+        // a batch dead by then is dead (and identical) in both, and need not be visited.
+        let t_dead = self.last_t0_secs.map_or(t0_secs, |t| t.min(t0_secs));
+        self.last_t0_secs = Some(t0_secs);
+        self.account_overwrites(e, seed, salt, count, t0_secs, t_dead);
         let base = self.spawned_total;
+        let max_life_now = e.lifetime_secs.max as f64;
+        let first_live = self
+            .history
+            .iter()
+            .find(|b| !b.surely_dead(t_dead, max_life_now))
+            .map_or(base, |b| b.first_index);
+        let end = base + count;
+        let first_live = first_live.max(end.saturating_sub(capacity));
+        let update_window = [
+            (first_live % capacity) as u32,
+            (end - first_live) as u32,
+            0,
+            0,
+        ];
         if count > 0 {
             self.history.push_back(Batch {
                 first_index: base,
                 count: count as u32,
                 birth_secs: t0_secs + dt * frac0.clamp(0.0, 1.0),
+                youngest_birth_secs: t0_secs + dt,
                 max_life_secs: e.lifetime_secs.max as f64,
             });
         }
@@ -186,17 +213,26 @@ impl EmitterPlanner {
             count as u32,
         )
         .with_spawn_fractions(frac0 as f32, frac_step as f32)
+        .with_update_window(update_window)
     }
 
     /// Counts still-alive particles the ring is about to overwrite.
-    fn account_overwrites(&mut self, e: &Emitter, seed: u32, salt: u32, count: u64, t0: f64) {
+    fn account_overwrites(
+        &mut self,
+        e: &Emitter,
+        seed: u32,
+        salt: u32,
+        count: u64,
+        t0: f64,
+        t_dead: f64,
+    ) {
         let capacity = e.capacity.max(1) as u64;
         let max_life = e.lifetime_secs.max as f64;
-        // Forget batches that are dead for sure or already overwritten.
+        // Forget batches dead in both state buffers for sure, or already overwritten.
         while let Some(front) = self.history.front() {
             let end = front.first_index + front.count as u64;
             let overwritten = end + capacity <= self.spawned_total;
-            if overwritten || t0 - front.birth_secs >= Batch::life_bound(front, max_life) {
+            if overwritten || front.surely_dead(t_dead, max_life) {
                 self.history.pop_front();
             } else {
                 break;
@@ -245,10 +281,7 @@ impl EmitterPlanner {
         let first = self
             .history
             .iter()
-            .find(|b| {
-                let bound = b.life_bound(max_life_secs as f64);
-                now_secs - b.birth_secs < bound * (1.0 + 1e-4) + 1e-4
-            })
+            .find(|b| !b.surely_dead(now_secs, max_life_secs as f64))
             .map_or(self.spawned_total, |b| b.first_index);
         let first = first.max(self.spawned_total.saturating_sub(capacity));
         LiveWindow {
@@ -272,6 +305,11 @@ impl SimParams {
     fn with_spawn_fractions(mut self, frac0: f32, frac_step: f32) -> Self {
         self.spawn_frac0 = frac0;
         self.spawn_frac_step = frac_step;
+        self
+    }
+
+    fn with_update_window(mut self, window: [u32; 4]) -> Self {
+        self.update_window = window;
         self
     }
 }
@@ -434,5 +472,6 @@ pub fn build_params(
         ],
         spheres,
         collide_c: [if col.stick_on_contact { 1.0 } else { 0.0 }, 0.0, 0.0, 0.0],
+        update_window: [0, capacity, 0, 0],
     }
 }
