@@ -475,24 +475,25 @@ fn module_costs(ctx: &GpuContext, opts: &PerfOptions) -> Result<Vec<(String, f64
             ShaderLibrary::embedded(),
         ));
     }
-    // Two pools: one with the bare pipeline, one whose pipeline cache holds every other
-    // variant (so no compile happens inside the loop). Before each timed sample the GPU
-    // runs 10 untimed steps of the same variant: a GPU idling between submissions
-    // downclocks, and that — not the code — dominated earlier attempts at this table.
+    // One pool per variant, each filled like the throughput rows' (66 steps: every slot
+    // alive). Sharing one pool between variants measured other occupancies than the
+    // variant's own: switching to and from stateless mode rebuilds the pool empty. Before
+    // each timed sample the GPU runs 10 untimed steps of the same variant: a GPU idling
+    // between submissions downclocks, and that — not the code — dominated earlier
+    // attempts at this table.
     let mut sims = Vec::new();
-    for lib in [&variants[0].2, &variants[1].2] {
-        let mut sim = GpuSim::new(ctx, lib.clone(), &plain)?;
-        sim.step(&plain, 1.0 / 60.0, 66)?;
+    for (_, effect, lib) in &variants {
+        let mut sim = GpuSim::new(ctx, lib.clone(), effect)?;
+        sim.step(effect, 1.0 / 60.0, 66)?;
         sims.push(sim);
-    }
-    for (_, effect, _) in &variants[2..] {
-        sims[1].step(effect, 1.0 / 60.0, 1)?;
     }
     // Round-robin over the variants, so slow drifts of a shared machine hit all alike.
     let mut samples = vec![Vec::new(); variants.len()];
     for _ in 0..opts.repeats * 3 {
         for (i, (_, effect, _)) in variants.iter().enumerate() {
-            let sim = &mut sims[i.min(1)];
+            let Some(sim) = sims.get_mut(i) else {
+                continue;
+            };
             sim.step(effect, 1.0 / 60.0, 10)?;
             for _ in 0..3 {
                 let ms = timer.time(ctx, |enc| {
