@@ -310,7 +310,8 @@ fn gpu_sort_equals_cpu_sort() {
         state ^= state << 5;
         state
     };
-    for (n, modulo) in [
+    // The split network (workgroup-memory blocks) at every size, the plain one at some.
+    let sizes = [
         (1usize, 0u32),
         (2, 0),
         (3, 0),
@@ -319,14 +320,21 @@ fn gpu_sort_equals_cpu_sort() {
         (4096, 0),
         (5000, 3),
         (77_777, 1000),
-    ] {
+    ];
+    let plain = [(1000usize, 0u32), (5000, 3), (77_777, 1000)];
+    let cases = sizes
+        .iter()
+        .map(|&(n, m)| (n, m, true))
+        .chain(plain.iter().map(|&(n, m)| (n, m, false)));
+    for (n, modulo, split) in cases {
+        sort.split_network = split;
         let keys: Vec<u32> = (0..n)
             .map(|_| if modulo > 0 { next() % modulo } else { next() })
             .collect();
         let (gpu_keys, gpu_idx) = sort.sort_keys(&ctx, &keys).expect("sort");
         let mut cpu = keys.clone();
         cpu.sort_unstable();
-        assert_eq!(gpu_keys, cpu, "n = {n}");
+        assert_eq!(gpu_keys, cpu, "n = {n}, split network {split}");
         // The indices are a permutation that carries each key with it.
         let mut seen = vec![false; n];
         for (k, i) in gpu_keys.iter().zip(&gpu_idx) {

@@ -512,6 +512,69 @@ fn module_costs(ctx: &GpuContext, opts: &PerfOptions) -> Result<Vec<(String, f64
     Ok(rows)
 }
 
+/// One row of the sort table.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SortRow {
+    /// Keys sorted.
+    pub keys: u32,
+    /// Dispatches of the split network.
+    pub split_dispatches: usize,
+    /// Dispatches of the plain network.
+    pub plain_dispatches: usize,
+    /// Split network, ms.
+    pub split_ms: f64,
+    /// Plain network, ms.
+    pub plain_ms: f64,
+}
+
+/// The GPU sort of random keys with the split and the plain bitonic network.
+fn sort_costs(
+    ctx: &GpuContext,
+    opts: &PerfOptions,
+    timer: &GpuTimer,
+) -> Result<Vec<SortRow>, SimError> {
+    let largest = if ctx.is_cpu_adapter() {
+        1 << 18
+    } else {
+        1 << 24
+    };
+    let split = crate::render::sort::SortPass::new(ctx, &ShaderLibrary::embedded())?;
+    let mut plain = crate::render::sort::SortPass::new(ctx, &ShaderLibrary::embedded())?;
+    plain.split_network = false;
+    let mut rows = Vec::new();
+    let mut state = 0x2545_F491u32;
+    for keys in [1u32 << 12, 1 << 16, 1 << 20, 1 << 24] {
+        if keys > largest || keys > ctx.max_capacity() as u32 {
+            continue;
+        }
+        let data: Vec<u32> = (0..keys)
+            .map(|_| {
+                state ^= state << 13;
+                state ^= state >> 17;
+                state ^= state << 5;
+                state
+            })
+            .collect();
+        let a = split.key_sort(ctx, &data);
+        let b = plain.key_sort(ctx, &data);
+        // Interleaved, so drifts of a shared machine hit both alike. (A bitonic network
+        // costs the same on sorted and unsorted keys.)
+        let (mut sa, mut sb) = (Vec::new(), Vec::new());
+        for _ in 0..opts.repeats {
+            sa.push(timer.time(ctx, |enc| split.record_key_sort(enc, &a)));
+            sb.push(timer.time(ctx, |enc| plain.record_key_sort(enc, &b)));
+        }
+        rows.push(SortRow {
+            keys,
+            split_dispatches: crate::render::sort::sort_dispatches(keys).len(),
+            plain_dispatches: crate::render::sort::bitonic_stages(keys).len(),
+            split_ms: median(&mut sa),
+            plain_ms: median(&mut sb),
+        });
+    }
+    Ok(rows)
+}
+
 /// Runs the perf bench.
 pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
     let mut report = Report::new("ignis bench perf", ctx);
@@ -652,7 +715,7 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
     let mcap = opts.module_capacity.min(ctx.max_capacity() as u32);
     report.para(&format!(
         "Update pass at {mcap} particles, ms per step (median of {} one-step submissions, variants interleaved round-robin, \
-         each sample preceded by 10 untimed steps so the GPU is at its working clock). \
+         each variant on its own full pool, each sample preceded by 10 untimed steps so the GPU is at its working clock). \
          The first two rows are the \"off costs nothing\" check: the pipeline with every module compiled out \
          by its override constant against one built from source with the module code deleted.",
         opts.repeats * 9
@@ -668,6 +731,37 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
         })
         .collect();
     report.table(&["variant", "update ms/step", "vs bare"], &mrows);
+    eprintln!("bench perf: sorting");
+    let sorts = sort_costs(ctx, opts, &timer)?;
+    report.heading("Sorting (alpha-blended emitters)");
+    report.para(
+        "Back-to-front order of (depth key, slot) pairs: the bitonic network split so that every run of stages \
+         with a compare distance below 512 is one dispatch in workgroup memory, against the plain network (one \
+         global dispatch per stage), same keys, same run. In a frame only the emitter's live window is sorted.",
+    );
+    let srows: Vec<Vec<String>> = sorts
+        .iter()
+        .map(|r| {
+            vec![
+                r.keys.to_string(),
+                format!("{} / {}", r.split_dispatches, r.plain_dispatches),
+                format!("{:.3}", r.split_ms),
+                format!("{:.3}", r.plain_ms),
+                format!("{:.2}×", r.plain_ms / r.split_ms),
+            ]
+        })
+        .collect();
+    report.table(
+        &[
+            "keys",
+            "dispatches (split / plain)",
+            "split ms",
+            "plain ms",
+            "speed-up",
+        ],
+        &srows,
+    );
+    report.json["sort"] = serde_json::to_value(&sorts)?;
     report.json["rows"] = serde_json::Value::Array(rows);
     report.json["modules"] = serde_json::to_value(
         costs

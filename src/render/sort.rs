@@ -104,6 +104,8 @@ pub struct SortBuffers {
     size: u32,
     /// Elements sorted now (a power of two ≤ `size`; the steps are written for it).
     count: u32,
+    /// The steps are written for the split network (else the plain one).
+    split: bool,
     capacity: u32,
     /// Sorted slot indices (farthest first), bound by the billboard pass.
     pub values: wgpu::Buffer,
@@ -120,6 +122,18 @@ pub struct SortPass {
     bitonic: wgpu::ComputePipeline,
     bitonic_local: wgpu::ComputePipeline,
     buffers: HashMap<u64, SortBuffers>,
+    /// Run the split network (workgroup-memory blocks; on by default). Off runs every
+    /// stage as its own global dispatch — the plain network, for the bench's comparison.
+    pub split_network: bool,
+}
+
+/// Arbitrary keys with their own sort buffers ([`SortPass::key_sort`]): the GPU sort
+/// outside a frame, for tests and the bench.
+pub struct KeySort {
+    buffers: SortBuffers,
+    keys: wgpu::Buffer,
+    state_group: wgpu::BindGroup,
+    len: usize,
 }
 
 impl SortPass {
@@ -175,6 +189,7 @@ impl SortPass {
             bitonic,
             bitonic_local,
             buffers: HashMap::new(),
+            split_network: true,
         })
     }
 
@@ -243,11 +258,11 @@ impl SortPass {
         let values = make("SortPass::values");
         let steps = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("SortPass::steps"),
-            size: (sort_dispatches(size).len() as u64 + 1) * STRIDE,
+            size: (bitonic_stages(size).len() as u64 + 1) * STRIDE,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Self::write_steps(ctx, &steps, size, capacity);
+        Self::write_steps(ctx, &steps, &self.dispatches(size), size, capacity);
         let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("SortPass::group"),
             layout: &self.layout,
@@ -275,6 +290,7 @@ impl SortPass {
         SortBuffers {
             size,
             count: size,
+            split: self.split_network,
             capacity,
             values,
             steps,
@@ -282,10 +298,28 @@ impl SortPass {
         }
     }
 
+    /// The dispatches of a sort of `n` elements: the split network, or (with
+    /// `split_network` off) every stage as a global dispatch.
+    fn dispatches(&self, n: u32) -> Vec<SortDispatch> {
+        if self.split_network {
+            sort_dispatches(n)
+        } else {
+            bitonic_stages(n)
+                .into_iter()
+                .map(|(k, j)| SortDispatch::Global { k, j })
+                .collect()
+        }
+    }
+
     /// Writes the uniform block of every dispatch of a sort of `count` elements (after
     /// the depth-key block at offset 0).
-    fn write_steps(ctx: &GpuContext, steps: &wgpu::Buffer, count: u32, capacity: u32) {
-        let dispatches = sort_dispatches(count);
+    fn write_steps(
+        ctx: &GpuContext,
+        steps: &wgpu::Buffer,
+        dispatches: &[SortDispatch],
+        count: u32,
+        capacity: u32,
+    ) {
         let mut blocks = vec![0u8; dispatches.len() * STRIDE as usize];
         for (i, d) in dispatches.iter().enumerate() {
             let (k, j, mode) = match *d {
@@ -308,7 +342,7 @@ impl SortPass {
     }
 
     fn record_stages(&self, pass: &mut wgpu::ComputePass<'_>, b: &SortBuffers) {
-        for (i, d) in sort_dispatches(b.count).iter().enumerate() {
+        for (i, d) in self.dispatches(b.count).iter().enumerate() {
             pass.set_bind_group(0, &b.group, &[((i as u64 + 1) * STRIDE) as u32]);
             let (pipeline, threads) = match d {
                 SortDispatch::Global { .. } => (&self.bitonic, b.count),
@@ -340,14 +374,17 @@ impl SortPass {
         if window.len == 0 {
             return;
         }
-        self.buffers(ctx, generation, capacity);
+        let size = self.buffers(ctx, generation, capacity).size;
+        let count = window.len.max(2).next_power_of_two().min(size);
+        let dispatches = self.dispatches(count);
+        let split = self.split_network;
         let Some(b) = self.buffers.get_mut(&generation) else {
             return;
         };
-        let count = window.len.max(2).next_power_of_two().min(b.size);
-        if count != b.count {
-            Self::write_steps(ctx, &b.steps, count, capacity);
+        if count != b.count || b.split != split {
+            Self::write_steps(ctx, &b.steps, &dispatches, count, capacity);
             b.count = count;
+            b.split = split;
         }
         let Some(b) = self.buffers.get(&generation) else {
             return;
@@ -389,19 +426,15 @@ impl SortPass {
         self.record_stages(&mut pass, b);
     }
 
-    /// Sorts arbitrary keys on the GPU (tests): returns (sorted keys, their original
-    /// indices). Sizes need not be powers of two: padding keys are 0xFFFFFFFF.
-    pub fn sort_keys(
-        &mut self,
-        ctx: &GpuContext,
-        keys: &[u32],
-    ) -> Result<(Vec<u32>, Vec<u32>), crate::sim::SimError> {
+    /// Uploads arbitrary keys (values: their indices) for sorting outside a frame. Sizes
+    /// need not be powers of two: padding keys are 0xFFFFFFFF.
+    pub fn key_sort(&self, ctx: &GpuContext, keys: &[u32]) -> KeySort {
         let b = self.create(ctx, keys.len().max(1) as u32);
         let mut padded = keys.to_vec();
         padded.resize(b.count as usize, u32::MAX);
         let iota: Vec<u32> = (0..b.count).collect();
         let keys_buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("SortPass::test_keys"),
+            label: Some("SortPass::key_sort_keys"),
             size: b.count as u64 * 4,
             usage: wgpu::BufferUsages::STORAGE
                 | wgpu::BufferUsages::COPY_SRC
@@ -413,7 +446,7 @@ impl SortPass {
         ctx.queue
             .write_buffer(&b.values, 0, bytemuck::cast_slice(&iota));
         let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("SortPass::test_group"),
+            label: Some("SortPass::key_sort_group"),
             layout: &self.layout,
             entries: &[
                 wgpu::BindGroupEntry {
@@ -434,7 +467,6 @@ impl SortPass {
                 },
             ],
         });
-        let test = SortBuffers { group, ..b };
         // The pipeline layout has the particle group; the bitonic stages do not read it.
         let dummy = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("SortPass::no_state"),
@@ -456,30 +488,53 @@ impl SortPass {
                 },
             ],
         });
-        let mut enc = ctx.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_bind_group(1, &state_group, &[]);
-            self.record_stages(&mut pass, &test);
+        KeySort {
+            buffers: SortBuffers { group, ..b },
+            keys: keys_buffer,
+            state_group,
+            len: keys.len(),
         }
+    }
+
+    /// Records the sort of `k` (the network the pass was created with) into `enc`.
+    pub fn record_key_sort(&self, enc: &mut wgpu::CommandEncoder, k: &KeySort) {
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("SortPass::key_sort"),
+            timestamp_writes: None,
+        });
+        pass.set_bind_group(1, &k.state_group, &[]);
+        self.record_stages(&mut pass, &k.buffers);
+    }
+
+    /// Sorts arbitrary keys on the GPU (tests): returns (sorted keys, their original
+    /// indices).
+    pub fn sort_keys(
+        &mut self,
+        ctx: &GpuContext,
+        keys: &[u32],
+    ) -> Result<(Vec<u32>, Vec<u32>), crate::sim::SimError> {
+        let k = self.key_sort(ctx, keys);
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        self.record_key_sort(&mut enc, &k);
         ctx.queue.submit([enc.finish()]);
+        let count = k.buffers.count as u64;
         let read = |buffer: &wgpu::Buffer| -> Result<Vec<u32>, crate::sim::SimError> {
             let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("SortPass::readback"),
-                size: test.count as u64 * 4,
+                size: count * 4,
                 usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             });
             let mut enc = ctx.device.create_command_encoder(&Default::default());
-            enc.copy_buffer_to_buffer(buffer, 0, &staging, 0, test.count as u64 * 4);
+            enc.copy_buffer_to_buffer(buffer, 0, &staging, 0, count * 4);
             ctx.queue.submit([enc.finish()]);
             Ok(bytemuck::pod_collect_to_vec(&map_read(ctx, &staging)?))
         };
-        let mut k = read(&keys_buffer)?;
-        let mut v = read(&test.values)?;
-        k.truncate(keys.len());
-        v.truncate(keys.len());
-        Ok((k, v))
+        let mut keys_out = read(&k.keys)?;
+        let mut values = read(&k.buffers.values)?;
+        keys_out.truncate(k.len);
+        values.truncate(k.len);
+        Ok((keys_out, values))
     }
 }
 
