@@ -475,27 +475,23 @@ fn module_costs(ctx: &GpuContext, opts: &PerfOptions) -> Result<Vec<(String, f64
             ShaderLibrary::embedded(),
         ));
     }
-    // One pool per variant, each filled like the throughput rows' (66 steps: every slot
-    // alive). Sharing one pool between variants measured other occupancies than the
-    // variant's own: switching to and from stateless mode rebuilds the pool empty. Before
-    // each timed sample the GPU runs 10 untimed steps of the same variant: a GPU idling
-    // between submissions downclocks, and that — not the code — dominated earlier
-    // attempts at this table.
-    let mut sims = Vec::new();
-    for (_, effect, lib) in &variants {
-        let mut sim = GpuSim::new(ctx, lib.clone(), effect)?;
-        sim.step(effect, 1.0 / 60.0, 66)?;
-        sims.push(sim);
-    }
-    // Round-robin over the variants, so slow drifts of a shared machine hit all alike.
+    // Each variant on its own pool, filled like the throughput rows' (66 steps: every
+    // slot alive), and only one pool alive at a time: on the H100 the same one-step update
+    // of a 16.8M pool measured 0.41 ms with one such pool allocated, 0.74 ms with two and
+    // 1.04 ms with ten (round-robin; a device-memory effect, not the code — session 3's
+    // diagnostic), which is what earlier versions of this table, holding every variant's
+    // pool at once, reported. Rounds over the variants keep slow drifts of a shared machine
+    // hitting all alike; before the timed samples the GPU runs 10 untimed steps of the same
+    // variant, so it is at its working clock.
+    let rounds = 3;
+    let per_round = opts.repeats.max(1);
     let mut samples = vec![Vec::new(); variants.len()];
-    for _ in 0..opts.repeats * 3 {
-        for (i, (_, effect, _)) in variants.iter().enumerate() {
-            let Some(sim) = sims.get_mut(i) else {
-                continue;
-            };
+    for _ in 0..rounds {
+        for (i, (_, effect, lib)) in variants.iter().enumerate() {
+            let mut sim = GpuSim::new(ctx, lib.clone(), effect)?;
+            sim.step(effect, 1.0 / 60.0, 66)?;
             sim.step(effect, 1.0 / 60.0, 10)?;
-            for _ in 0..3 {
+            for _ in 0..per_round {
                 let ms = timer.time(ctx, |enc| {
                     let plans = sim.plan(effect, 1.0 / 60.0, 1);
                     sim.record(enc, effect, &plans);
@@ -714,11 +710,12 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
     let bare = costs.first().map_or(f64::NAN, |c| c.1);
     let mcap = opts.module_capacity.min(ctx.max_capacity() as u32);
     report.para(&format!(
-        "Update pass at {mcap} particles, ms per step (median of {} one-step submissions, variants interleaved round-robin, \
-         each variant on its own full pool, each sample preceded by 10 untimed steps so the GPU is at its working clock). \
+        "Update pass at {mcap} particles, ms per step (median of {} one-step submissions in 3 rounds over the variants; \
+         each variant on its own full pool, one pool allocated at a time — several large pools alive at once slow \
+         every one of them on the H100 — after 10 untimed steps so the GPU is at its working clock). \
          The first two rows are the \"off costs nothing\" check: the pipeline with every module compiled out \
          by its override constant against one built from source with the module code deleted.",
-        opts.repeats * 9
+        opts.repeats.max(1) * 3
     ));
     let mrows: Vec<Vec<String>> = costs
         .iter()
