@@ -475,21 +475,41 @@ fn module_costs(ctx: &GpuContext, opts: &PerfOptions) -> Result<Vec<(String, f64
             ShaderLibrary::embedded(),
         ));
     }
-    // Each variant on its own pool, filled like the throughput rows' (66 steps: every
-    // slot alive), and only one pool alive at a time: on the H100 the same one-step update
-    // of a 16.8M pool measured 0.41 ms with one such pool allocated, 0.74 ms with two and
-    // 1.04 ms with ten (round-robin; a device-memory effect, not the code — session 3's
-    // diagnostic), which is what earlier versions of this table, holding every variant's
-    // pool at once, reported. Rounds over the variants keep slow drifts of a shared machine
-    // hitting all alike; before the timed samples the GPU runs 10 untimed steps of the same
-    // variant, so it is at its working clock.
+    // Every variant on one pool, filled like the throughput rows' (66 steps: every slot
+    // alive), and no other large pool alive: on the H100 the same one-step update of a
+    // 16.8M pool measured 0.41 ms with one such pool allocated, 0.74 ms with two and
+    // 1.04 ms with ten (a device-memory effect, not the code — session 3's diagnostic);
+    // earlier versions of this table, holding two or more pools, reported the slowed
+    // figures, and pools allocated and freed in turn land erratically. Switching variants
+    // swaps the pipelines (the bare one is built from another library), never the pool.
+    // Stateless mode clears the pool (its records mean something else), so it is measured
+    // last. Rounds over the variants keep slow drifts of a shared machine hitting all
+    // alike; before the timed samples the GPU runs 10 untimed steps of the same variant,
+    // so it is at its working clock.
     let rounds = 3;
     let per_round = opts.repeats.max(1);
     let mut samples = vec![Vec::new(); variants.len()];
-    for _ in 0..rounds {
-        for (i, (_, effect, lib)) in variants.iter().enumerate() {
-            let mut sim = GpuSim::new(ctx, lib.clone(), effect)?;
-            sim.step(effect, 1.0 / 60.0, 66)?;
+    let is_stateless = |e: &Effect| e.emitters.iter().any(|e| e.stateless);
+    let mut sim = GpuSim::new(ctx, variants[1].2.clone(), &plain)?;
+    sim.step(&plain, 1.0 / 60.0, 66)?;
+    let mut bare_loaded = false;
+    let mut order: Vec<usize> = (0..variants.len())
+        .filter(|&i| !is_stateless(&variants[i].1))
+        .collect();
+    for round in 0..=rounds {
+        if round == rounds {
+            // The last pass: the stateless variants only.
+            order = (0..variants.len())
+                .filter(|&i| is_stateless(&variants[i].1))
+                .collect();
+        }
+        for &i in &order {
+            let (_, effect, lib) = &variants[i];
+            if (i == 0) != bare_loaded {
+                sim.reload_shaders(lib.clone(), effect)
+                    .map_err(SimError::Shader)?;
+                bare_loaded = i == 0;
+            }
             sim.step(effect, 1.0 / 60.0, 10)?;
             for _ in 0..per_round {
                 let ms = timer.time(ctx, |enc| {
@@ -710,9 +730,9 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
     let bare = costs.first().map_or(f64::NAN, |c| c.1);
     let mcap = opts.module_capacity.min(ctx.max_capacity() as u32);
     report.para(&format!(
-        "Update pass at {mcap} particles, ms per step (median of {} one-step submissions in 3 rounds over the variants; \
-         each variant on its own full pool, one pool allocated at a time — several large pools alive at once slow \
-         every one of them on the H100 — after 10 untimed steps so the GPU is at its working clock). \
+        "Update pass at {mcap} particles, ms per step (median of {} one-step submissions in 3 rounds over the variants, \
+         all on one full pool — several large pools alive at once slow every one of them on the H100 — each after \
+         10 untimed steps so the GPU is at its working clock; stateless mode, which clears the pool, last). \
          The first two rows are the \"off costs nothing\" check: the pipeline with every module compiled out \
          by its override constant against one built from source with the module code deleted.",
         opts.repeats.max(1) * 3
