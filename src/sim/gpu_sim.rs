@@ -526,6 +526,11 @@ impl GpuSim {
         }
         self.ctx.queue.write_buffer(&self.params_buffer, 0, &blocks);
         enc.push_debug_group("update particles");
+        // One compute pass for as many dispatches as possible (wgpu orders dependent
+        // dispatches inside a pass): on lavapipe each pass costs about as much as a small
+        // dispatch. GPUs end it where the alive counter must be cleared first.
+        let clear_counters = !self.ctx.is_cpu_adapter();
+        let mut pass: Option<wgpu::ComputePass<'static>> = None;
         for (s, plan) in plans.iter().enumerate() {
             for (e, params) in plan.iter().enumerate() {
                 let (Some(p), Some(em)) = (params, self.emitters.get_mut(e)) else {
@@ -541,37 +546,42 @@ impl GpuSim {
                     continue;
                 };
                 let offset = ((s * n_emitters + e) as u64 * PARAMS_STRIDE) as u32;
-                if em.stateless {
-                    // Spawn records only, written in place into buffer 0 (group 1 reads
-                    // buffer 1 and writes buffer 0); nothing else is touched.
-                    if p.spawn_count > 0 {
-                        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                            label: Some("GpuSim::stateless_spawn"),
-                            timestamp_writes: None,
-                        });
-                        pass.set_pipeline(pipeline);
-                        pass.set_bind_group(0, &em.bind_groups[1], &[offset]);
-                        let (x, y) = dispatch_size(p.spawn_count);
-                        pass.dispatch_workgroups(x, y, 1);
+                // Stateless: spawn records only, written in place into buffer 0 (group 1
+                // reads buffer 1 and writes buffer 0); nothing else is touched.
+                let (group, slots) = if em.stateless {
+                    (&em.bind_groups[1], p.spawn_count)
+                } else {
+                    (&em.bind_groups[em.current], windows[s * n_emitters + e])
+                };
+                if !em.stateless {
+                    em.current = 1 - em.current;
+                    if clear_counters {
+                        // The update counts alive particles (COUNT_ALIVE) into a cleared
+                        // slot.
+                        drop(pass.take());
+                        enc.clear_buffer(&em.counters, 0, Some(4));
                     }
+                }
+                if slots == 0 {
+                    // Nothing can be alive in the window: both buffers hold the same dead
+                    // slots, so the swap above is all a step does (and the cleared counter
+                    // says zero).
                     continue;
                 }
-                if !self.ctx.is_cpu_adapter() {
-                    // The update counts alive particles (COUNT_ALIVE) into a cleared slot.
-                    enc.clear_buffer(&em.counters, 0, Some(4));
-                }
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("GpuSim::update"),
-                    timestamp_writes: None,
+                let pass = pass.get_or_insert_with(|| {
+                    enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some("GpuSim::update"),
+                        timestamp_writes: None,
+                    })
+                    .forget_lifetime()
                 });
                 pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, &em.bind_groups[em.current], &[offset]);
-                let (x, y) = dispatch_size(windows[s * n_emitters + e]);
+                pass.set_bind_group(0, group, &[offset]);
+                let (x, y) = dispatch_size(slots);
                 pass.dispatch_workgroups(x, y, 1);
-                drop(pass);
-                em.current = 1 - em.current;
             }
         }
+        drop(pass);
         enc.pop_debug_group();
     }
 
