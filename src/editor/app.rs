@@ -545,6 +545,7 @@ impl Gfx {
         for (i, e) in effect.emitters.iter().enumerate() {
             let s = &mut stats.emitters[i];
             s.capacity = e.capacity;
+            s.window = self.sim.emitter_buffers(i).map_or(0, |b| b.window.len);
             s.spawn = self
                 .sim
                 .planner

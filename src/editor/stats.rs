@@ -19,6 +19,8 @@ pub struct EmitterStats {
     pub nonfinite: u32,
     /// Slots in the pool.
     pub capacity: u32,
+    /// Slots the update and the draws visit: the ring's live window.
+    pub window: u32,
     /// Spawn accounting from the CPU planner.
     pub spawn: SpawnStats,
 }
@@ -229,8 +231,11 @@ pub fn stats_ui(ui: &mut egui::Ui, stats: &Stats, effect: &Effect) {
                     .text(format!("{} / {} alive", s.alive, s.capacity)),
             )
             .on_hover_text(format!(
-                "spawned {}\ndropped by the per-step cap {}\ndropped over capacity {}\n\
+                "{} of {} slots in the live window (the only ones updated and drawn)\n\
+                 spawned {}\ndropped by the per-step cap {}\ndropped over capacity {}\n\
                  recycled while alive {}\nkilled as non-finite {}",
+                s.window,
+                s.capacity,
                 s.spawn.spawned,
                 s.spawn.dropped_by_cap,
                 s.spawn.dropped_over_capacity,

@@ -222,7 +222,7 @@ fn fs_linear(in: VertexOut) -> @location(0) vec4<f32> {
 "#;
 
 struct LeanTexture {
-    /// `None` for native textures (owned by someone else).
+    /// `None` for native textures (owned by someone else; opaque: drawn without blending).
     texture: Option<wgpu::Texture>,
     options: TextureOptions,
     bind_group: wgpu::BindGroup,
@@ -239,6 +239,9 @@ struct Draw {
 /// Paint callbacks are not supported (the editor uses none).
 pub struct LeanPainter {
     pipeline: wgpu::RenderPipeline,
+    /// The same without blending, for native textures (the viewport image, opaque): no
+    /// framebuffer read under ~60 % of the window.
+    opaque_pipeline: wgpu::RenderPipeline,
     locals: wgpu::Buffer,
     locals_group: wgpu::BindGroup,
     texture_layout: wgpu::BindGroupLayout,
@@ -282,8 +285,9 @@ impl LeanPainter {
             bind_group_layouts: &[Some(&locals_layout), Some(&texture_layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("LeanPainter::pipeline"),
+        let make = |label: &str, blend: Option<wgpu::BlendState>| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
             layout: Some(&layout),
             vertex: wgpu::VertexState {
                 module: &module,
@@ -312,25 +316,29 @@ impl LeanPainter {
                 compilation_options: Default::default(),
                 targets: &[Some(wgpu::ColorTargetState {
                     format,
-                    // Premultiplied alpha, as egui-wgpu does.
-                    blend: Some(wgpu::BlendState {
-                        color: wgpu::BlendComponent {
-                            src_factor: wgpu::BlendFactor::One,
-                            dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
-                            operation: wgpu::BlendOperation::Add,
-                        },
-                        alpha: wgpu::BlendComponent {
-                            src_factor: wgpu::BlendFactor::OneMinusDstAlpha,
-                            dst_factor: wgpu::BlendFactor::One,
-                            operation: wgpu::BlendOperation::Add,
-                        },
-                    }),
+                    blend,
                     write_mask: wgpu::ColorWrites::ALL,
                 })],
             }),
             multiview_mask: None,
             cache: None,
-        });
+        })
+        };
+        // Premultiplied alpha, as egui-wgpu does.
+        let premultiplied = wgpu::BlendState {
+            color: wgpu::BlendComponent {
+                src_factor: wgpu::BlendFactor::One,
+                dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
+                operation: wgpu::BlendOperation::Add,
+            },
+            alpha: wgpu::BlendComponent {
+                src_factor: wgpu::BlendFactor::OneMinusDstAlpha,
+                dst_factor: wgpu::BlendFactor::One,
+                operation: wgpu::BlendOperation::Add,
+            },
+        };
+        let pipeline = make("LeanPainter::pipeline", Some(premultiplied));
+        let opaque_pipeline = make("LeanPainter::opaque_pipeline", None);
         let locals = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("LeanPainter::locals"),
             size: size_of::<Locals>() as u64,
@@ -347,6 +355,7 @@ impl LeanPainter {
         });
         Self {
             pipeline,
+            opaque_pipeline,
             locals,
             locals_group,
             texture_layout,
@@ -570,14 +579,23 @@ impl LeanPainter {
     fn render(&self, pass: &mut wgpu::RenderPass<'static>, screen: &egui_wgpu::ScreenDescriptor) {
         let [w, h] = screen.size_in_pixels;
         pass.set_viewport(0.0, 0.0, w as f32, h as f32, 0.0, 1.0);
-        pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.locals_group, &[]);
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
+        let mut opaque = None;
         for draw in &self.draws {
             let Some(texture) = self.textures.get(&draw.texture) else {
                 continue;
             };
+            let is_opaque = texture.texture.is_none();
+            if opaque != Some(is_opaque) {
+                pass.set_pipeline(if is_opaque {
+                    &self.opaque_pipeline
+                } else {
+                    &self.pipeline
+                });
+                opaque = Some(is_opaque);
+            }
             let [x, y, sw, sh] = draw.scissor;
             pass.set_scissor_rect(x, y, sw, sh);
             pass.set_bind_group(1, &texture.bind_group, &[]);
