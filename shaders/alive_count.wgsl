@@ -5,9 +5,9 @@
 
 var<workgroup> wg_alive: atomic<u32>;
 
-fn add_alive_in_workgroup(alive: bool, lid: u32) {
-    if alive {
-        atomicAdd(&wg_alive, 1u);
+fn add_alive_in_workgroup(alive: u32, lid: u32) {
+    if alive > 0u {
+        atomicAdd(&wg_alive, alive);
     }
     workgroupBarrier();
     if lid == 0u {

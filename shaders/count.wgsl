@@ -33,6 +33,6 @@ fn main(
             atomicAdd(&counters[0], 1u);
         }
     } else {
-        add_alive_in_workgroup(alive, lid);
+        add_alive_in_workgroup(select(0u, 1u, alive), lid);
     }
 }

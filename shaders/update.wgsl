@@ -48,17 +48,37 @@ fn stateless_spawn(i: u32) {
     store_state(slot, p);
 }
 
+// Slots per invocation (keep in sync with `SLOTS_PER_INVOCATION` in src/sim/gpu_sim.rs):
+// a workgroup covers 2 × 256 consecutive slots, each round coalesced — twice the bytes in
+// flight per invocation of a memory-bound pass.
+const SLOTS_PER_INVOCATION: u32 = 2u;
+
 @compute @workgroup_size(256)
 fn main(
     @builtin(workgroup_id) wg: vec3<u32>,
     @builtin(num_workgroups) nwg: vec3<u32>,
     @builtin(local_invocation_index) lid: u32,
 ) {
-    let i = (wg.y * nwg.x + wg.x) * 256u + lid;
+    let base = (wg.y * nwg.x + wg.x) * 256u * SLOTS_PER_INVOCATION + lid;
     if MOD_STATELESS {
-        stateless_spawn(i);
+        for (var r = 0u; r < SLOTS_PER_INVOCATION; r++) {
+            stateless_spawn(base + r * 256u);
+        }
         return;
     }
+    var alive = 0u;
+    for (var r = 0u; r < SLOTS_PER_INVOCATION; r++) {
+        if update_slot(base + r * 256u) {
+            alive += 1u;
+        }
+    }
+    if COUNT_ALIVE {
+        add_alive_in_workgroup(alive, lid);
+    }
+}
+
+// Updates the i-th slot of this step's window of the ring; true when it is alive after.
+fn update_slot(i: u32) -> bool {
     var alive = false;
     if i < params.update_window.y {
         // The i-th slot of this step's window of the ring.
@@ -114,7 +134,5 @@ fn main(
         }
         store_state(slot, p);
     }
-    if COUNT_ALIVE {
-        add_alive_in_workgroup(alive, lid);
-    }
+    return alive;
 }

@@ -577,7 +577,7 @@ impl GpuSim {
                 });
                 pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, group, &[offset]);
-                let (x, y) = dispatch_size(slots);
+                let (x, y) = dispatch_size(slots.div_ceil(SLOTS_PER_INVOCATION));
                 pass.dispatch_workgroups(x, y, 1);
             }
         }
@@ -793,6 +793,9 @@ impl GpuSim {
         self.planner.reset();
     }
 }
+
+/// Slots one update invocation handles (`SLOTS_PER_INVOCATION` in `shaders/update.wgsl`).
+pub const SLOTS_PER_INVOCATION: u32 = 2;
 
 /// Bytes per slot: 20 packed, 32 full.
 pub fn state_stride(packed: bool) -> u64 {
