@@ -6,8 +6,8 @@
 // - `depth_keys`: group 0: 0 `step`, 1 `keys`, 2 `values`; group 1: 0 `cur` particles,
 //   1 `cur_packed`. Element i of the sort is slot (window.x + i) mod capacity for
 //   i < window.y (the emitter's live window of the ring: only slots that can hold a
-//   living particle are sorted); alive slots get key = !bits(view depth) (farthest first),
-//   dead and padding elements 0xFFFFFFFF (last).
+//   living particle are sorted); alive slots get key = min(!bits(view depth), 0xFFFFFFFE)
+//   (farthest first), dead and padding elements 0xFFFFFFFF (last).
 // - The network is split so that most of it runs in workgroup memory:
 //   `bitonic_local` sorts 512-element blocks completely (window.z = 0: every stage with
 //   k ≤ step.k) or finishes a merge (window.z = 1: stage k = step.k, j = 256 … 1);
@@ -155,7 +155,9 @@ fn depth_keys(
         if alive {
             let depth = max(dot(pos - step.eye.xyz, step.forward.xyz), 0.0);
             // Non-negative floats order like their bits; inverted, the farthest comes first.
-            key = ~bitcast<u32>(depth);
+            // 0xFFFFFFFF (depth 0: at or behind the eye) is kept for dead and padding
+            // slots, which must sort after every living one.
+            key = min(~bitcast<u32>(depth), 0xFFFFFFFEu);
         }
     }
     keys[i] = key;

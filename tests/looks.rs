@@ -814,7 +814,8 @@ fn trimmed_billboards_draw_the_untrimmed_frame() {
     let ctx = gpu();
     let mut sprites = SpriteLibrary::new(&ctx);
     let (sheet, _) = sprites.resolve(&ctx, &Sprite::FlameSheet, None);
-    let [u0, v0, u1, v1] = sheet.trim_rect(4, 4);
+    let t = ignis::render::sprites::TRIM_THRESHOLD;
+    let [u0, v0, u1, v1] = sheet.trim_rect(4, 4, t);
     assert!(
         u1 - u0 < 0.6 && u0 > 0.2 && u1 < 0.8,
         "flame sheet u {u0}..{u1}"
@@ -824,8 +825,20 @@ fn trimmed_billboards_draw_the_untrimmed_frame() {
         "flame tongues span the height: v {v0}..{v1}"
     );
     let (disc, _) = sprites.resolve(&ctx, &Sprite::SoftDisc, None);
-    let [u0, _, u1, _] = disc.trim_rect(1, 1);
-    assert!(u1 - u0 > 0.97, "soft disc u {u0}..{u1}");
+    let [d0, _, d1, _] = disc.trim_rect(1, 1, t);
+    assert!(d1 - d0 > 0.97, "soft disc u {d0}..{d1}");
+    // The threshold (divided by the emitter's intensity) decides what is kept: a brighter
+    // emitter keeps fainter texels, never a narrower rectangle.
+    let [w0, _, w1, _] = sheet.trim_rect(4, 4, t / 1000.0);
+    let [n0, _, n1, _] = sheet.trim_rect(4, 4, 0.3);
+    assert!(
+        w1 - w0 >= u1 - u0,
+        "faint texels kept at high intensity: {w0}..{w1}"
+    );
+    assert!(
+        n1 - n0 < u1 - u0,
+        "only bright texels kept at 0.3: {n0}..{n1}"
+    );
 
     let mut effect = Effect::default_campfire();
     effect.post.bloom = None;

@@ -433,3 +433,75 @@ fn live_window_draws_what_the_whole_pool_draws() {
         "smoke window {smoke} after the lifetimes shortened"
     );
 }
+
+/// Every alive slot of emitter `i` lies in its live window; returns (alive, window length).
+fn alive_in_window(run: &Headless, i: usize, when: &str) -> (usize, u32) {
+    let b = run.sim.emitter_buffers(i).expect("buffers");
+    let (w, cap) = (b.window, b.capacity);
+    let particles = run.sim.read_particles(i).expect("read");
+    for (slot, p) in particles.iter().enumerate() {
+        if p.is_alive() {
+            let offset = (slot as u32 + cap - w.first_slot) % cap;
+            assert!(
+                offset < w.len,
+                "{when}: alive slot {slot} outside {w:?} (capacity {cap})"
+            );
+        }
+    }
+    (alive_of(&particles), w.len)
+}
+
+/// Live windows across the edits that move particles or stop the clock: a capacity change
+/// after the ring wrapped (kept particles sit at their old slots until they die), and an
+/// emitter disabled for longer than its lifetime, then enabled again (its frozen particles
+/// live on from where they stopped).
+#[test]
+fn live_windows_survive_capacity_changes_and_disabled_emitters() {
+    let ctx = gpu();
+    let e = ignis::effect::Emitter {
+        capacity: 1000,
+        spawn_rate_per_sec: 600.0,
+        lifetime_secs: ignis::effect::Range::new(0.5, 1.0),
+        ..plain_emitter()
+    };
+    let mut run = Headless::new(&ctx, bare_effect(e), ShaderLibrary::embedded()).expect("run");
+    for _ in 0..200 {
+        run.advance(1.0 / 60.0).expect("advance");
+    }
+    alive_in_window(&run, 0, "before the capacity change");
+    // Wrapped several times: the kept slots do not match the new ring positions.
+    run.effect.emitters[0].capacity = 1500;
+    let mut alive_after = Vec::new();
+    for f in 0..90 {
+        run.advance(1.0 / 60.0).expect("advance");
+        let (alive, _) = alive_in_window(&run, 0, &format!("frame {f} after the capacity change"));
+        alive_after.push(alive);
+    }
+    // The kept particles aged and died (nothing froze): steady state is rate × mean life.
+    let last = *alive_after.last().expect("frames") as f32;
+    assert!((last - 450.0).abs() < 60.0, "{last} alive after the change");
+    let (_, len) = alive_in_window(&run, 0, "steady");
+    assert!(
+        len < 1500,
+        "the window shrank back from the whole pool: {len}"
+    );
+
+    // Disabled for 2 s (longer than any lifetime), then enabled again.
+    let (before, _) = alive_in_window(&run, 0, "before disabling");
+    run.effect.emitters[0].enabled = false;
+    for _ in 0..120 {
+        run.advance(1.0 / 60.0).expect("advance");
+    }
+    run.effect.emitters[0].enabled = true;
+    run.advance(1.0 / 60.0).expect("advance");
+    let (resumed, _) = alive_in_window(&run, 0, "first frame after enabling");
+    // One step later most frozen particles are still alive (and drawn).
+    assert!(
+        resumed as f32 > 0.8 * before as f32,
+        "{resumed} alive after resuming, {before} before"
+    );
+    for f in 0..90 {
+        run.advance(1.0 / 60.0).expect("advance");
+        alive_in_window(&run, 0, &format!("frame {f} after enabling"));
+    }
+}

@@ -63,8 +63,8 @@ pub struct FrameResources {
     /// Draw and sort only each emitter's live window of the ring (on by default; off
     /// visits every slot, for comparisons).
     pub live_window_only: bool,
-    /// Trim rectangles by (sprite id, flipbook rows, columns).
-    trims: HashMap<(u64, u32, u32), [f32; 4]>,
+    /// Trim rectangles by (sprite id, flipbook rows, columns, threshold bits).
+    trims: HashMap<(u64, u32, u32, u32), [f32; 4]>,
 }
 
 /// The look uniform of an emitter (everything but the matrices, the ground height and
@@ -386,10 +386,13 @@ impl FrameResources {
                     .flipbook
                     .as_ref()
                     .map_or((1, 1), |f| (f.rows, f.cols));
+                // What is invisible at intensity 1 shows when the light is multiplied.
+                let gain = (e.look.intensity * effect.post.exposure).max(1.0);
+                let threshold = crate::render::sprites::TRIM_THRESHOLD / gain;
                 u.trim = *self
                     .trims
-                    .entry((sprite.id, rows, cols))
-                    .or_insert_with(|| sprite.trim_rect(rows, cols));
+                    .entry((sprite.id, rows, cols, threshold.to_bits()))
+                    .or_insert_with(|| sprite.trim_rect(rows, cols, threshold));
             }
             u.clip_from_sim = camera.clip_from_sim(aspect, origin).to_cols_array_2d();
             let ground = e.collisions.ground.as_ref().map_or(0.0, |g| g.height_m);

@@ -136,6 +136,15 @@ pub struct KeySort {
     len: usize,
 }
 
+impl KeySort {
+    /// Uploads `keys` (the same length as at creation) again, before the next submission.
+    pub fn reset_keys(&self, ctx: &GpuContext, keys: &[u32]) {
+        let n = keys.len().min(self.len);
+        ctx.queue
+            .write_buffer(&self.keys, 0, bytemuck::cast_slice(&keys[..n]));
+    }
+}
+
 impl SortPass {
     /// Builds the pipelines from `lib`.
     pub fn new(ctx: &GpuContext, lib: &ShaderLibrary) -> Result<Self, ShaderError> {
@@ -497,6 +506,7 @@ impl SortPass {
     }
 
     /// Records the sort of `k` (the network the pass was created with) into `enc`.
+    /// The keys are sorted in place; [`KeySort::reset_keys`] uploads them again.
     pub fn record_key_sort(&self, enc: &mut wgpu::CommandEncoder, k: &KeySort) {
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("SortPass::key_sort"),

@@ -203,9 +203,11 @@ struct EmitterState {
     life_range: (f32, f32),
     seed: u32,
     salt: u32,
-    /// The state was written from outside the planner (`write_particles`): every slot may
-    /// be alive until the next restart.
-    external: bool,
+    /// Until this time on the emitter's planner clock every slot may be alive, and the
+    /// update and the draws visit the whole pool: state written from outside the planner
+    /// (`write_particles`: forever, until a restart), or particles kept at their old slots
+    /// by a capacity change (until they have all died).
+    whole_pool_until: f64,
     /// The spawn counter after the last recorded step (equal to the planner's when the
     /// steps came from it; otherwise the live window is unknown).
     spawned_end: u64,
@@ -316,8 +318,17 @@ impl GpuSim {
                     self.emitters[i] = self.create_state(capacity, packed);
                 }
                 _ => {
-                    let fresh = self.create_state(capacity, packed);
+                    let mut fresh = self.create_state(capacity, packed);
                     if let Some(old) = self.emitters.get(i) {
+                        // The kept particles stay at their old slots, which the ring's
+                        // new modulus does not map their spawn counters to: visit the
+                        // whole pool until they have all died.
+                        let dead_by = self
+                            .planner
+                            .emitters
+                            .get(i)
+                            .map_or(f64::INFINITY, |p| p.all_dead_by(e.lifetime_secs.max));
+                        fresh.whole_pool_until = old.whole_pool_until.max(dead_by);
                         // Keep the particles that fit (packed ones get the lifetimes of
                         // their new ring positions).
                         let keep = old.capacity.min(capacity) as u64 * state_stride(packed);
@@ -417,7 +428,7 @@ impl GpuSim {
             life_range: (0.0, 0.0),
             seed: 0,
             salt: 0,
-            external: false,
+            whole_pool_until: f64::NEG_INFINITY,
             spawned_end: 0,
         }
     }
@@ -514,8 +525,17 @@ impl GpuSim {
             for (e, params) in plan.iter().enumerate() {
                 if let (Some(p), Some(em)) = (params, self.emitters.get(e)) {
                     let mut p = *p;
-                    // State written from outside the planner: every slot may be alive.
-                    if em.external || p.update_window[1] > em.capacity {
+                    // State written from outside the planner, or kept at old slots by a
+                    // capacity change: every slot may be alive.
+                    let clock = self
+                        .planner
+                        .emitters
+                        .get(e)
+                        .map_or(f64::INFINITY, |pl| pl.clock_secs());
+                    if clock < em.whole_pool_until
+                        || p.capacity != em.capacity
+                        || p.update_window[1] > em.capacity
+                    {
                         p.update_window = [0, em.capacity, 0, 0];
                     }
                     windows[s * n_emitters + e] = p.update_window[1];
@@ -563,9 +583,9 @@ impl GpuSim {
                     }
                 }
                 if slots == 0 {
-                    // Nothing can be alive in the window: both buffers hold the same dead
-                    // slots, so the swap above is all a step does (and the cleared counter
-                    // says zero).
+                    // An empty window: nothing in the pool can be alive, both buffers hold
+                    // the same dead slots, so the swap above is all a step does (and the
+                    // cleared counter says zero).
                     continue;
                 }
                 let pass = pass.get_or_insert_with(|| {
@@ -629,8 +649,11 @@ impl GpuSim {
             life_range: s.life_range,
             seed_salt: (s.seed, s.salt),
             window: match planner {
-                Some(p) if !s.external && p.spawned_total() == s.spawned_end => {
-                    p.live_window(s.capacity, self.planner.time_secs, s.life_range.1)
+                Some(p)
+                    if p.clock_secs() >= s.whole_pool_until
+                        && p.spawned_total() == s.spawned_end =>
+                {
+                    p.live_window(s.capacity, s.life_range.1)
                 }
                 _ => LiveWindow::all(s.capacity),
             },
@@ -665,7 +688,7 @@ impl GpuSim {
                 .write_buffer(b, 0, bytemuck::cast_slice(&particles[..n]));
         }
         if let Some(s) = self.emitters.get_mut(index) {
-            s.external = true;
+            s.whole_pool_until = f64::INFINITY;
         }
         Ok(())
     }
@@ -786,7 +809,7 @@ impl GpuSim {
             }
             enc.clear_buffer(&s.counters, 0, None);
             s.current = 0;
-            s.external = false;
+            s.whole_pool_until = f64::NEG_INFINITY;
             s.spawned_end = 0;
         }
         self.ctx.queue.submit([enc.finish()]);

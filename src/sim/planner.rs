@@ -28,18 +28,22 @@ struct Batch {
     birth_secs: f64,
     /// The end of the step that spawned the batch: no particle of it is younger.
     youngest_birth_secs: f64,
-    /// The longest lifetime this batch's particles can have (the range at spawn time).
+    /// The longest lifetime this batch's particles can have: the largest maximum of the
+    /// lifetime range seen since its spawn (packed state re-derives lifetimes from the
+    /// current range, so a particle's life stretches while the range is raised).
     max_life_secs: f64,
 }
 
 impl Batch {
-    /// Every particle of the batch is dead at `at_secs`: it outlived the longest lifetime
-    /// it could have (the range at its spawn, or `max_life_now` — packed state re-derives
-    /// lifetimes from the current range — whichever is longer), with a margin for the
-    /// f32 ages of the GPU.
-    fn surely_dead(&self, at_secs: f64, max_life_now: f64) -> bool {
+    /// Every particle of the batch is dead at `at_secs` (the emitter's clock): it outlived
+    /// the longest lifetime it could have, with a margin for the GPU's f32 ages — they
+    /// grow by `dt` each step, and the rounding of those sums can lean one way for a
+    /// whole lifetime: (steps) × ulp(lifetime) at most, `min_dt_secs` the smallest step.
+    fn surely_dead(&self, at_secs: f64, max_life_now: f64, min_dt_secs: f64) -> bool {
         let bound = self.max_life_secs.max(max_life_now);
-        at_secs - self.youngest_birth_secs >= bound * (1.0 + 1e-4) + 1e-4
+        let steps = bound / min_dt_secs.max(1e-6);
+        let f32_drift = steps * bound * f64::from(f32::EPSILON);
+        at_secs - self.youngest_birth_secs >= bound * (1.0 + 1e-4) + 1e-4 + f32_drift
     }
 }
 
@@ -73,8 +77,17 @@ pub struct EmitterPlanner {
     history: VecDeque<Batch>,
     /// The origin of this emitter's simulation space, fixed at its first step.
     origin: Option<glam::DVec3>,
-    /// Start time of the last planned step (the time of the older state buffer).
+    /// Start time of the last planned step on this emitter's clock (the time of the
+    /// older state buffer).
     last_t0_secs: Option<f64>,
+    /// This emitter's simulated time: advances only with its own steps, so a disabled
+    /// (frozen) emitter's particles do not age on it. Births and deaths of the live
+    /// window are on this clock; bursts follow the effect's.
+    clock_secs: f64,
+    /// The smallest step planned so far (bounds the f32 age drift).
+    min_dt_secs: f64,
+    /// The step size of the last planned step.
+    last_dt_secs: f64,
 }
 
 /// Plans every emitter of an effect, step after step.
@@ -168,17 +181,31 @@ impl EmitterPlanner {
         };
 
         let salt = rng::emitter_salt(emitter_index, e.seed_offset);
+        // The emitter's own clock (it stands still while the emitter is disabled).
+        let c0 = self.clock_secs;
+        self.clock_secs += dt;
+        self.min_dt_secs = if self.min_dt_secs > 0.0 {
+            self.min_dt_secs.min(dt)
+        } else {
+            dt
+        };
+        self.last_dt_secs = dt;
+        let max_life_now = e.lifetime_secs.max as f64;
+        // A raised range stretches the lives of packed particles already born.
+        for b in &mut self.history {
+            b.max_life_secs = b.max_life_secs.max(max_life_now);
+        }
         // The older of the two state buffers holds the state at the last step's start:
         // a batch dead by then is dead (and identical) in both, and need not be visited.
-        let t_dead = self.last_t0_secs.map_or(t0_secs, |t| t.min(t0_secs));
-        self.last_t0_secs = Some(t0_secs);
-        self.account_overwrites(e, seed, salt, count, t0_secs, t_dead);
+        let t_dead = self.last_t0_secs.map_or(c0, |t| t.min(c0));
+        self.last_t0_secs = Some(c0);
+        self.account_overwrites(e, seed, salt, count, c0, t_dead);
         let base = self.spawned_total;
-        let max_life_now = e.lifetime_secs.max as f64;
+        let min_dt = self.min_dt_secs;
         let first_live = self
             .history
             .iter()
-            .find(|b| !b.surely_dead(t_dead, max_life_now))
+            .find(|b| !b.surely_dead(t_dead, max_life_now, min_dt))
             .map_or(base, |b| b.first_index);
         let end = base + count;
         let first_live = first_live.max(end.saturating_sub(capacity));
@@ -192,9 +219,9 @@ impl EmitterPlanner {
             self.history.push_back(Batch {
                 first_index: base,
                 count: count as u32,
-                birth_secs: t0_secs + dt * frac0.clamp(0.0, 1.0),
-                youngest_birth_secs: t0_secs + dt,
-                max_life_secs: e.lifetime_secs.max as f64,
+                birth_secs: c0 + dt * frac0.clamp(0.0, 1.0),
+                youngest_birth_secs: c0 + dt,
+                max_life_secs: max_life_now,
             });
         }
         self.spawned_total += count;
@@ -232,7 +259,7 @@ impl EmitterPlanner {
         while let Some(front) = self.history.front() {
             let end = front.first_index + front.count as u64;
             let overwritten = end + capacity <= self.spawned_total;
-            if overwritten || front.surely_dead(t_dead, max_life) {
+            if overwritten || front.surely_dead(t_dead, max_life, self.min_dt_secs) {
                 self.history.pop_front();
             } else {
                 break;
@@ -269,25 +296,50 @@ impl EmitterPlanner {
         self.origin.unwrap_or_default()
     }
 
-    /// The live window of the ring at simulated time `now_secs`: the last `len` spawns
+    /// The live window of the ring for drawing the last step: the last `len` spawns
     /// (slots `first_slot`, `first_slot + 1`, … modulo `capacity`) are the only ones that
     /// can hold a living particle — every earlier batch has outlived the longest lifetime
-    /// it could have (the range at its spawn, or `max_life_secs` now, whichever is longer;
-    /// packed state re-derives lifetimes from the current range). Draws and the sort visit
-    /// only this window instead of the whole pool. Conservative: a batch counts until
-    /// its earliest particle is surely dead, with a margin for f32 ages.
-    pub fn live_window(&self, capacity: u32, now_secs: f64, max_life_secs: f32) -> LiveWindow {
+    /// it could have (the largest range maximum seen since its spawn, or `max_life_secs`
+    /// now). Draws and the sort visit only this window instead of the whole pool.
+    /// Conservative: a batch counts until its last-born particle is surely dead (margin
+    /// for f32 ages), judged at the start of the last step, since frames are drawn
+    /// between the last two steps (stateless emitters are evaluated there).
+    pub fn live_window(&self, capacity: u32, max_life_secs: f32) -> LiveWindow {
         let capacity = u64::from(capacity.max(1));
+        let at = self.clock_secs - self.last_dt_secs;
         let first = self
             .history
             .iter()
-            .find(|b| !b.surely_dead(now_secs, max_life_secs as f64))
+            .find(|b| !b.surely_dead(at, max_life_secs as f64, self.min_dt_secs))
             .map_or(self.spawned_total, |b| b.first_index);
         let first = first.max(self.spawned_total.saturating_sub(capacity));
         LiveWindow {
             first_slot: (first % capacity) as u32,
             len: (self.spawned_total - first) as u32,
         }
+    }
+
+    /// This emitter's simulated time (it stands still while the emitter is disabled).
+    pub fn clock_secs(&self) -> f64 {
+        self.clock_secs
+    }
+
+    /// The time on this emitter's clock by which every particle born so far is surely
+    /// dead (with the margins of the live window, plus 0.1 s).
+    pub fn all_dead_by(&self, max_life_secs: f32) -> f64 {
+        let max_now = max_life_secs as f64;
+        self.history
+            .iter()
+            .map(|b| {
+                let bound = b.max_life_secs.max(max_now);
+                let steps = bound / self.min_dt_secs.max(1e-6);
+                b.youngest_birth_secs
+                    + bound * (1.0 + 1e-4)
+                    + 1e-4
+                    + steps * bound * f64::from(f32::EPSILON)
+            })
+            .fold(self.clock_secs, f64::max)
+            + 0.1
     }
 
     /// The spawn counter: how many particles this emitter has started.
