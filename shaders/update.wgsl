@@ -1,4 +1,5 @@
-// update.wgsl — pass 1: one invocation per slot, reads state A, writes state B.
+// update.wgsl — pass 1: one invocation per two slots of the live window, reads state A,
+// writes state B.
 //
 // Contract (plumbing; designers change spawn.wgsl, forces.wgsl, integrators.wgsl):
 // - group 0: binding 0 `params` (SimParams, dynamic offset per step), 1 `src` (read),

@@ -415,8 +415,8 @@ impl FrameResources {
                 b
             });
             if let Some(b) = &buffers {
-                // The ring, for packed state's re-derived lifetimes; the capacity bounds
-                // the splat.
+                // The ring, for packed state's re-derived lifetimes; the capacity and the
+                // live window's length (ring_b.zw) place the splat's invocations.
                 u.soft[2] = b.life_range.0;
                 u.soft[3] = b.life_range.1;
                 u.ring = [
