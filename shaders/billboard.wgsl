@@ -1,5 +1,5 @@
-// billboard.wgsl — pass 2, large particles: camera-facing quads (4-vertex strips), one
-// instance per slot of the emitter's live window (vertex pulling from the state buffer the
+// billboard.wgsl — pass 2, large particles: camera-facing quads (four vertices, indexed),
+// one per slot of the emitter's live window (vertex pulling from the state buffer the
 // update pass just wrote).
 //
 // Contract:
@@ -45,8 +45,11 @@ struct VsOut {
 }
 
 @vertex
-fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) instance: u32) -> VsOut {
+fn vs_main(@builtin(vertex_index) vertex: u32) -> VsOut {
     var out: VsOut;
+    // Quad `instance` of the window, corner `vi` (indexed lists: 0 1 2, 2 1 3).
+    let instance = vertex >> 2u;
+    let vi = vertex & 3u;
     // Instances cover the emitter's live window of the ring (first slot = first instance),
     // or, sorted, the window in back-to-front order; padding of the sort has no slot.
     var slot = instance;
@@ -68,8 +71,8 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) instance: u3
     let t = age_fraction(d.age, d.life);
     let rnd = particle_random(slot, d.life);
     let size = size_at(t, rnd.x);
-    // A four-vertex triangle strip over the corners (-1,-1) (1,-1) (-1,1) (1,1): a third
-    // fewer vertex invocations than two separate triangles.
+    // Four shared vertices over the corners (-1,-1) (1,-1) (-1,1) (1,1): a third fewer
+    // vertex invocations than two separate triangles.
     var corner = vec2<f32>(f32(vi & 1u), f32(vi >> 1u)) * 2.0 - 1.0;
     if !STREAK {
         // Cut the quad to the sprite's occupied rectangle (look.trim, frame texture

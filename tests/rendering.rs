@@ -505,3 +505,53 @@ fn live_windows_survive_capacity_changes_and_disabled_emitters() {
         alive_in_window(&run, 0, &format!("frame {f} after enabling"));
     }
 }
+
+/// More billboards than one indexed draw holds (65536 quads): the chunked draws cover every
+/// particle once — the billboards carry the splat's light, as in
+/// `billboard_and_splat_paths_agree`, and a window wrapping past the capacity changes nothing.
+#[test]
+fn billboards_beyond_one_draw_carry_all_their_light() {
+    use ignis::effect::DrawPath;
+    let ctx = gpu();
+    let render = |path: DrawPath| {
+        let mut effect = Effect::default_campfire();
+        effect.post.bloom = None;
+        effect.emitters.retain(|e| e.name == "flames");
+        let e = &mut effect.emitters[0];
+        e.capacity = 150_000;
+        e.spawn_rate_per_sec = 120_000.0;
+        e.lifetime_secs = ignis::effect::Range::new(0.8, 1.0);
+        e.look.size_start_m = 0.012;
+        e.look.size_end_m = 0.008;
+        e.look.intensity = 0.08;
+        e.look.draw_path = path;
+        let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+        run.renderer.exposure = 0.5;
+        // 1.5 s: the ring has wrapped, so the window crosses the end of the pool.
+        for _ in 0..90 {
+            run.advance(1.0 / 60.0).expect("advance");
+        }
+        let w = run.sim.emitter_buffers(0).expect("buffers").window;
+        (run.render(SIZE).expect("render"), w)
+    };
+    let ((a, w), (b, _)) = (render(DrawPath::Billboard), render(DrawPath::Splat));
+    assert!(
+        w.len > 65_536 * 3 / 2,
+        "window {w:?}: more than one draw's worth"
+    );
+    assert!(
+        w.first_slot + w.len > 150_000,
+        "window {w:?} should wrap past the capacity"
+    );
+    let light = |img: &image::RgbaImage| {
+        img.pixels()
+            .map(|p| p[0] as f64 + p[1] as f64 + p[2] as f64)
+            .sum::<f64>()
+    };
+    let (la, lb) = (light(&a), light(&b));
+    assert!(la > 1e5, "billboards drew almost nothing: {la}");
+    assert!(
+        (la - lb).abs() / la < 0.10,
+        "total light differs: billboard {la}, splat {lb}"
+    );
+}

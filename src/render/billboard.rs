@@ -1,7 +1,12 @@
-//! The billboard pass: one instanced draw of camera-facing quads per emitter, vertex
-//! pulling from the state buffer the update pass just wrote.
+//! The billboard pass: camera-facing quads, four vertices each, pulled from the state
+//! buffer the update pass just wrote — drawn as indexed triangle lists over a shared
+//! index buffer rather than as instances: llvmpipe shades vertices eight at a time and
+//! sets up every instance on its own, so a 4-vertex instance wasted half its lanes and
+//! paid the set-up per particle.
 
 use std::collections::HashMap;
+
+use wgpu::util::DeviceExt;
 
 use crate::effect::BlendMode;
 use crate::gpu::GpuContext;
@@ -11,6 +16,8 @@ use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 /// Instanced billboards into the HDR target, one pipeline per look variant (built on
 /// first use), one sprite bind group per texture.
 pub struct BillboardPass {
+    /// Two triangles per quad, `QUADS_PER_DRAW` quads: 4q, 4q+1, 4q+2, 4q+2, 4q+1, 4q+3.
+    quad_indices: wgpu::Buffer,
     pipeline_layout: wgpu::PipelineLayout,
     sprite_layout: wgpu::BindGroupLayout,
     module: wgpu::ShaderModule,
@@ -46,7 +53,18 @@ impl BillboardPass {
                 immediate_size: 0,
             });
         let (module, pipelines) = Self::build(ctx, lib, &pipeline_layout)?;
+        let indices: Vec<u32> = (0..QUADS_PER_DRAW)
+            .flat_map(|q| [0, 1, 2, 2, 1, 3].map(|c| 4 * q + c))
+            .collect();
+        let quad_indices = ctx
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("BillboardPass::quad_indices"),
+                contents: bytemuck::cast_slice(&indices),
+                usage: wgpu::BufferUsages::INDEX,
+            });
         Ok(Self {
+            quad_indices,
             pipeline_layout,
             sprite_layout,
             module,
@@ -74,7 +92,7 @@ impl BillboardPass {
             ("vs_main", "fs_main"),
             crate::render::hdr_target(blend),
             &v.constants(),
-            wgpu::PrimitiveTopology::TriangleStrip,
+            wgpu::PrimitiveTopology::TriangleList,
         )
     }
 
@@ -190,17 +208,25 @@ impl BillboardPass {
             );
             pass.set_bind_group(1, group, &[]);
             pass.set_bind_group(2, sprite, &[]);
-            // One strip per slot of the live window: sorted, through the sort's order;
+            pass.set_index_buffer(self.quad_indices.slice(..), wgpu::IndexFormat::Uint32);
+            // One quad per slot of the live window: sorted, through the sort's order;
             // otherwise the window's slots directly (the shader wraps at the capacity).
+            // Quad q of a draw is vertices 4q … 4q + 3 after its base vertex.
             let w = d.window;
-            if d.key.2 {
-                pass.draw(0..4, 0..w.len);
-            } else {
-                pass.draw(0..4, w.first_slot..w.first_slot + w.len);
+            let start = if d.key.2 { 0 } else { w.first_slot };
+            let mut done = 0;
+            while done < w.len {
+                let n = (w.len - done).min(QUADS_PER_DRAW);
+                let base = (u64::from(start) + u64::from(done)) * 4;
+                pass.draw_indexed(0..n * 6, base.min(i32::MAX as u64) as i32, 0..1);
+                done += n;
             }
         }
     }
 }
+
+/// Quads per indexed draw (the shared index buffer's length / 6).
+pub const QUADS_PER_DRAW: u32 = 1 << 16;
 
 /// Light adds up: colour One + One, destination alpha kept.
 pub const ADDITIVE: wgpu::BlendState = wgpu::BlendState {
