@@ -45,10 +45,11 @@ struct VsOut {
 }
 
 @vertex
-fn vs_main(@builtin(vertex_index) vertex: u32) -> VsOut {
+fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u32) -> VsOut {
     var out: VsOut;
-    // Quad `instance` of the window, corner `vi` (indexed lists: 0 1 2, 2 1 3).
-    let instance = vertex >> 2u;
+    // Quad `instance` of the window, corner `vi` (two triangles: 0 1 2, 2 1 3). Quads come
+    // as instances (vertex 0…3) or as indexed lists (vertex 4q…4q+3, one instance).
+    let instance = (vertex >> 2u) + inst;
     let vi = vertex & 3u;
     // Instances cover the emitter's live window of the ring (first slot = first instance),
     // or, sorted, the window in back-to-front order; padding of the sort has no slot.
