@@ -628,13 +628,7 @@ fn packed_state_renders_like_the_full_state() {
     let (a, alive_a) = render(full);
     let (b, alive_b) = render(packed);
     assert_eq!(alive_a, alive_b);
-    let diff: u64 = a
-        .as_raw()
-        .iter()
-        .zip(b.as_raw())
-        .map(|(x, y)| u64::from(x.abs_diff(*y)))
-        .sum();
-    let mean = diff as f64 / a.as_raw().len() as f64;
+    let (mean, _) = image_diff(&a, &b);
     assert!(mean < 0.5, "mean |difference| {mean}");
     assert!(
         a.pixels().filter(|p| p[0] > 100).count() > 500,

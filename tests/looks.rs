@@ -628,14 +628,7 @@ fn random_size_rotation_and_spin_vary_per_particle_deterministically() {
 
 /// Mean absolute difference per channel (0–255) of two equally sized images.
 fn mean_abs_diff(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
-    assert_eq!(a.dimensions(), b.dimensions());
-    let sum: u64 = a
-        .as_raw()
-        .iter()
-        .zip(b.as_raw())
-        .map(|(x, y)| u64::from(x.abs_diff(*y)))
-        .sum();
-    sum as f64 / a.as_raw().len() as f64
+    image_diff(a, b).0
 }
 
 /// Fixed-seed frames of presets against committed references on the software adapter.
@@ -850,14 +843,7 @@ fn trimmed_billboards_draw_the_untrimmed_frame() {
     run.renderer.frame.trim_sprites = false;
     let whole = run.render((320, 240)).expect("render");
     let lit = trimmed.pixels().filter(|p| p[0] > 60).count();
-    let max = trimmed
-        .as_raw()
-        .iter()
-        .zip(whole.as_raw())
-        .map(|(a, b)| a.abs_diff(*b))
-        .max()
-        .unwrap_or(0);
-    let mean = mean_abs_diff(&trimmed, &whole);
+    let (mean, max) = image_diff(&trimmed, &whole);
     assert!(lit > 2000, "{lit} lit pixels");
     assert!(
         mean < 0.01 && max <= 8,

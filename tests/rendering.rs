@@ -228,12 +228,7 @@ fn billboard_and_splat_paths_agree() {
     };
     let a = render(DrawPath::Billboard);
     let b = render(DrawPath::Splat);
-    let light = |img: &image::RgbaImage| {
-        img.pixels()
-            .map(|p| p[0] as f64 + p[1] as f64 + p[2] as f64)
-            .sum::<f64>()
-    };
-    let (la, lb) = (light(&a), light(&b));
+    let (la, lb) = (total_light(&a), total_light(&b));
     assert!(la > 1e5, "billboards drew almost nothing: {la}");
     assert!(
         (la - lb).abs() / la < 0.10,
@@ -381,14 +376,9 @@ fn live_window_draws_what_the_whole_pool_draws() {
         run.renderer.frame.live_window_only = false;
         let whole = run.render(SIZE).expect("render");
         run.renderer.frame.live_window_only = true;
-        let (mut sum, mut max) = (0u64, 0u8);
-        for (a, b) in windowed.as_raw().iter().zip(whole.as_raw()) {
-            let d = a.abs_diff(*b);
-            sum += u64::from(d);
-            max = max.max(d);
-        }
+        let (mean, max) = image_diff(&windowed, &whole);
         let lit = windowed.pixels().filter(|p| p[0] > 40).count();
-        (sum as f64 / windowed.as_raw().len() as f64, max, lit)
+        (mean, max, lit)
     };
     let (mean, max, lit) = compare(&mut run);
     assert!(lit > 500, "only {lit} lit pixels: nothing to compare");
@@ -543,12 +533,7 @@ fn billboards_beyond_one_draw_carry_all_their_light() {
         w.first_slot + w.len > 150_000,
         "window {w:?} should wrap past the capacity"
     );
-    let light = |img: &image::RgbaImage| {
-        img.pixels()
-            .map(|p| p[0] as f64 + p[1] as f64 + p[2] as f64)
-            .sum::<f64>()
-    };
-    let (la, lb) = (light(&a), light(&b));
+    let (la, lb) = (total_light(&a), total_light(&b));
     assert!(la > 1e5, "billboards drew almost nothing: {la}");
     assert!(
         (la - lb).abs() / la < 0.10,
@@ -571,13 +556,7 @@ fn instanced_and_indexed_billboards_draw_the_same_frame() {
     let indexed = run.render(SIZE).expect("render");
     run.renderer.billboard.indexed = false;
     let instanced = run.render(SIZE).expect("render");
-    let (mut sum, mut max) = (0u64, 0u8);
-    for (a, b) in indexed.as_raw().iter().zip(instanced.as_raw()) {
-        let d = a.abs_diff(*b);
-        sum += u64::from(d);
-        max = max.max(d);
-    }
-    let mean = sum as f64 / indexed.as_raw().len() as f64;
+    let (mean, max) = image_diff(&indexed, &instanced);
     let lit = indexed.pixels().filter(|p| p[0] > 40).count();
     assert!(lit > 500, "{lit} lit pixels");
     assert!(

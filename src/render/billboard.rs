@@ -197,6 +197,7 @@ impl BillboardPass {
             BlendMode::Alpha => 0,
             BlendMode::Additive => 1,
         });
+        pass.set_index_buffer(self.quad_indices.slice(..), wgpu::IndexFormat::Uint32);
         for d in sorted {
             let (Some(group), Some(Some(pipeline)), Some(sprite)) = (
                 frame.particle_group(d.key),
@@ -213,7 +214,6 @@ impl BillboardPass {
             );
             pass.set_bind_group(1, group, &[]);
             pass.set_bind_group(2, sprite, &[]);
-            pass.set_index_buffer(self.quad_indices.slice(..), wgpu::IndexFormat::Uint32);
             // One quad per slot of the live window: sorted, through the sort's order;
             // otherwise the window's slots directly (the shader wraps at the capacity).
             // Quad q of a draw is vertices 4q … 4q + 3 after its base vertex.

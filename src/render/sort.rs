@@ -98,6 +98,19 @@ pub fn sort_dispatches(n: u32) -> Vec<SortDispatch> {
     v
 }
 
+/// The dispatches of a sort of `n` elements: the split network, or every stage of the
+/// plain one as a global dispatch.
+fn network(n: u32, split: bool) -> Vec<SortDispatch> {
+    if split {
+        sort_dispatches(n)
+    } else {
+        bitonic_stages(n)
+            .into_iter()
+            .map(|(k, j)| SortDispatch::Global { k, j })
+            .collect()
+    }
+}
+
 /// Sort buffers of one emitter.
 pub struct SortBuffers {
     /// Elements the buffers hold (a power of two ≥ the capacity).
@@ -271,7 +284,13 @@ impl SortPass {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Self::write_steps(ctx, &steps, &self.dispatches(size), size, capacity);
+        Self::write_steps(
+            ctx,
+            &steps,
+            &network(size, self.split_network),
+            size,
+            capacity,
+        );
         let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("SortPass::group"),
             layout: &self.layout,
@@ -307,19 +326,6 @@ impl SortPass {
         }
     }
 
-    /// The dispatches of a sort of `n` elements: the split network, or (with
-    /// `split_network` off) every stage as a global dispatch.
-    fn dispatches(&self, n: u32) -> Vec<SortDispatch> {
-        if self.split_network {
-            sort_dispatches(n)
-        } else {
-            bitonic_stages(n)
-                .into_iter()
-                .map(|(k, j)| SortDispatch::Global { k, j })
-                .collect()
-        }
-    }
-
     /// Writes the uniform block of every dispatch of a sort of `count` elements (after
     /// the depth-key block at offset 0).
     fn write_steps(
@@ -351,7 +357,8 @@ impl SortPass {
     }
 
     fn record_stages(&self, pass: &mut wgpu::ComputePass<'_>, b: &SortBuffers) {
-        for (i, d) in self.dispatches(b.count).iter().enumerate() {
+        // The network the buffers' steps were written for.
+        for (i, d) in network(b.count, b.split).iter().enumerate() {
             pass.set_bind_group(0, &b.group, &[((i as u64 + 1) * STRIDE) as u32]);
             let (pipeline, threads) = match d {
                 SortDispatch::Global { .. } => (&self.bitonic, b.count),
@@ -385,13 +392,12 @@ impl SortPass {
         }
         let size = self.buffers(ctx, generation, capacity).size;
         let count = window.len.max(2).next_power_of_two().min(size);
-        let dispatches = self.dispatches(count);
         let split = self.split_network;
         let Some(b) = self.buffers.get_mut(&generation) else {
             return;
         };
         if count != b.count || b.split != split {
-            Self::write_steps(ctx, &b.steps, &dispatches, count, capacity);
+            Self::write_steps(ctx, &b.steps, &network(count, split), count, capacity);
             b.count = count;
             b.split = split;
         }

@@ -40,10 +40,15 @@ impl Batch {
     /// grow by `dt` each step, and the rounding of those sums can lean one way for a
     /// whole lifetime: (steps) × ulp(lifetime) at most, `min_dt_secs` the smallest step.
     fn surely_dead(&self, at_secs: f64, max_life_now: f64, min_dt_secs: f64) -> bool {
+        at_secs >= self.dead_by(max_life_now, min_dt_secs)
+    }
+
+    /// The time from which [`Batch::surely_dead`] holds.
+    fn dead_by(&self, max_life_now: f64, min_dt_secs: f64) -> f64 {
         let bound = self.max_life_secs.max(max_life_now);
         let steps = bound / min_dt_secs.max(1e-6);
         let f32_drift = steps * bound * f64::from(f32::EPSILON);
-        at_secs - self.youngest_birth_secs >= bound * (1.0 + 1e-4) + 1e-4 + f32_drift
+        self.youngest_birth_secs + bound * (1.0 + 1e-4) + 1e-4 + f32_drift
     }
 }
 
@@ -327,17 +332,9 @@ impl EmitterPlanner {
     /// The time on this emitter's clock by which every particle born so far is surely
     /// dead (with the margins of the live window, plus 0.1 s).
     pub fn all_dead_by(&self, max_life_secs: f32) -> f64 {
-        let max_now = max_life_secs as f64;
         self.history
             .iter()
-            .map(|b| {
-                let bound = b.max_life_secs.max(max_now);
-                let steps = bound / self.min_dt_secs.max(1e-6);
-                b.youngest_birth_secs
-                    + bound * (1.0 + 1e-4)
-                    + 1e-4
-                    + steps * bound * f64::from(f32::EPSILON)
-            })
+            .map(|b| b.dead_by(max_life_secs as f64, self.min_dt_secs))
             .fold(self.clock_secs, f64::max)
             + 0.1
     }

@@ -88,3 +88,22 @@ pub fn run_gpu(ctx: &GpuContext, effect: &Effect, dt: f32, steps: u32) -> GpuSim
 pub fn alive_of(p: &[Particle]) -> usize {
     p.iter().filter(|p| p.is_alive()).count()
 }
+
+/// Mean and largest absolute difference per channel byte of two same-size images.
+pub fn image_diff(a: &image::RgbaImage, b: &image::RgbaImage) -> (f64, u8) {
+    assert_eq!(a.dimensions(), b.dimensions());
+    let (mut sum, mut max) = (0u64, 0u8);
+    for (x, y) in a.as_raw().iter().zip(b.as_raw()) {
+        let d = x.abs_diff(*y);
+        sum += u64::from(d);
+        max = max.max(d);
+    }
+    (sum as f64 / a.as_raw().len().max(1) as f64, max)
+}
+
+/// The sum of every pixel's R + G + B.
+pub fn total_light(img: &image::RgbaImage) -> f64 {
+    img.pixels()
+        .map(|p| p[0] as f64 + p[1] as f64 + p[2] as f64)
+        .sum()
+}
