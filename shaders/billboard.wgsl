@@ -23,6 +23,8 @@
 // The same state buffers seen as packed state (src/gpu/types.rs `PackedParticle`).
 @group(1) @binding(3) var<storage, read> prev_packed: array<PackedParticle>;
 @group(1) @binding(4) var<storage, read> cur_packed: array<PackedParticle>;
+// A tiny-state emitter's birth table (births.wgsl).
+@group(1) @binding(5) var<storage, read> births: array<Birth>;
 // The sprite: linear, premultiplied, mipmapped (src/render/sprites.rs).
 @group(2) @binding(0) var sprite_tex: texture_2d<f32>;
 @group(2) @binding(1) var sprite_sampler: sampler;

@@ -36,6 +36,7 @@ struct SimParams {
     spawn_count: u32,
     spawn_base_lo: u32,
     spawn_base_hi: u32,
+    // Tiny state: the birth table's index mask (its size − 1).
     flags: u32,
     // Birth time of the k-th spawn within the step, as a fraction of the step:
     // spawn_frac0 + k * spawn_frac_step (sub-step emission: no puffs at low frame rates).
@@ -71,6 +72,10 @@ struct SimParams {
     // x: first slot this step updates, y: how many (wrapping at the capacity): the ring's
     // live window plus this step's spawns; every other slot is dead in both buffers.
     update_window: vec4<u32>,
+    // Tiny state: x, y: the step's start on the emitter's clock (double-single hi, lo, as
+    // f32 bits), z: the birth table's first sequence number, w: its entries (`flags` holds
+    // the table's index mask).
+    tiny: vec4<u32>,
 }
 
 const SHAPE_POINT: u32 = 0u;
@@ -89,9 +94,11 @@ const TAU: f32 = 6.28318530717959;
 // function of (seed, emitter, slot, spawn counter) — see `slot_counter` and `spawn_life`.
 // Keep in sync with `PackedParticle` in src/gpu/types.rs.
 struct PackedParticle {
-    px: f32,
-    py: f32,
-    pz: f32,
+    // f32 position bits (u32 words, so that the same buffer seen as a tiny-state pair —
+    // five words — reads back every bit, NaN patterns included).
+    px: u32,
+    py: u32,
+    pz: u32,
     // f16 velocity x (low half) and y (high half).
     vxy: u32,
     // f16 velocity z (low half), unorm16 remaining life fraction (high half).
@@ -102,7 +109,8 @@ fn packed_alive(q: PackedParticle) -> bool {
     return (q.vz_rest >> 16u) != 0u;
 }
 
-// Half an f16 step (ulp) of x, for dithering before rounding to f16.
+// One f16 step (ulp) at x, for dithering before rounding to f16: x + (d − ½)·ulp rounded
+// to nearest rounds up with probability equal to x's fraction of a step.
 fn f16_ulp(x: f32) -> f32 {
     let e = i32((bitcast<u32>(x) >> 23u) & 0xFFu) - 127;
     return exp2(f32(max(e, -14) - 10));
@@ -123,7 +131,8 @@ fn pack_particle(p: Particle, dither: vec4<f32>) -> PackedParticle {
     let v = p.vel_life.xyz;
     let vd = v + (dither.xyz - 0.5) * vec3<f32>(f16_ulp(v.x), f16_ulp(v.y), f16_ulp(v.z));
     let vz = pack2x16float(vec2<f32>(vd.z, 0.0)) & 0xFFFFu;
-    return PackedParticle(p.pos_age.x, p.pos_age.y, p.pos_age.z, pack2x16float(vd.xy), vz | (r << 16u));
+    let x = bitcast<vec3<u32>>(p.pos_age.xyz);
+    return PackedParticle(x.x, x.y, x.z, pack2x16float(vd.xy), vz | (r << 16u));
 }
 
 // `life` is the particle's lifetime (re-derived by the caller).
@@ -134,7 +143,93 @@ fn unpack_particle(q: PackedParticle, life: f32) -> Particle {
     if r <= 0.0 {
         return Particle(vec4<f32>(0.0), vec4<f32>(0.0));
     }
-    return Particle(vec4<f32>(q.px, q.py, q.pz, (1.0 - r) * life), vec4<f32>(vxy, vz, life));
+    let x = bitcast<vec3<f32>>(vec3<u32>(q.px, q.py, q.pz));
+    return Particle(vec4<f32>(x, (1.0 - r) * life), vec4<f32>(vxy, vz, life));
+}
+
+// Tiny state (10 bytes, the `tiny_state` option): slots 2k and 2k + 1 share the five
+// words of element k of the buffer seen as `PackedParticle`s (w0…w4, one 20-byte pair).
+// A slot is three fields: `xy` = f16 x | f16 y << 16, `z` = f16 z (16 bits) and `vel`
+// (32 bits). Even slot: w0 = xy, w1 = z | vel << 16, low half of w2 = vel >> 16. Odd
+// slot: high half of w2 = x, w3 = y | z << 16, w4 = vel. The position is f16 in the
+// emitter's simulation space (relative to its origin); the velocity a shared exponent
+// (bits 0…4, bias 15) and three 9-bit mantissas offset by 256 (x bits 5…13, y 14…22,
+// z 23…31): v = (m − 256) · 2^(e − 23). Neither the age nor the lifetime is stored: the
+// age comes from the emitter's birth table (births.wgsl) and the lifetime from the spawn
+// hash. x = 0xFFFF (an f16 NaN) marks a dead slot. Keep in sync with `tiny` in
+// src/gpu/types.rs.
+const TINY_DEAD: u32 = 0xFFFFu;
+
+struct TinySlot {
+    pos: vec3<f32>,
+    vel: vec3<f32>,
+    dead: bool,
+}
+
+// The three fields (xy, z, vel) of one slot of pair `q`.
+fn tiny_bits(q: PackedParticle, odd: bool) -> vec3<u32> {
+    if odd {
+        return vec3<u32>((q.pz >> 16u) | (q.vxy << 16u), q.vxy >> 16u, q.vz_rest);
+    }
+    return vec3<u32>(q.px, q.py & 0xFFFFu, (q.py >> 16u) | (q.pz << 16u));
+}
+
+// Pair `q` with one slot's fields replaced.
+fn tiny_put(q: PackedParticle, odd: bool, b: vec3<u32>) -> PackedParticle {
+    var r = q;
+    if odd {
+        r.pz = (r.pz & 0xFFFFu) | (b.x << 16u);
+        r.vxy = (b.x >> 16u) | (b.y << 16u);
+        r.vz_rest = b.z;
+    } else {
+        r.px = b.x;
+        r.py = (b.y & 0xFFFFu) | (b.z << 16u);
+        r.pz = (r.pz & 0xFFFF0000u) | (b.z >> 16u);
+    }
+    return r;
+}
+
+fn tiny_decode(b: vec3<u32>) -> TinySlot {
+    if (b.x & 0xFFFFu) == TINY_DEAD {
+        return TinySlot(vec3<f32>(0.0), vec3<f32>(0.0), true);
+    }
+    let pos = vec3<f32>(unpack2x16float(b.x), unpack2x16float(b.y).x);
+    let scale = exp2(f32(i32(b.z & 31u) - 23));
+    let m = vec3<u32>((b.z >> 5u) & 511u, (b.z >> 14u) & 511u, b.z >> 23u);
+    return TinySlot(pos, (vec3<f32>(m) - 256.0) * scale, false);
+}
+
+// Encodes a living particle's position and velocity with dithered rounding (`d0`, `d1`
+// ∈ [0, 1)⁴, hashes of slot and step: unbiased, so errors average out instead of
+// drifting). Positions beyond the f16 range (65504 m) and speeds of 2^16 m/s or more
+// cannot be stored: the slot is marked dead.
+fn tiny_encode(pos: vec3<f32>, vel: vec3<f32>, d0: vec4<f32>, d1: vec4<f32>) -> vec3<u32> {
+    let m = max(max(abs(vel.x), abs(vel.y)), abs(vel.z));
+    if max(max(abs(pos.x), abs(pos.y)), abs(pos.z)) >= 65504.0 || !(m < 65536.0) {
+        return vec3<u32>(TINY_DEAD, 0u, 0u);
+    }
+    let pd = pos + (d0.xyz - 0.5) * vec3<f32>(f16_ulp(pos.x), f16_ulp(pos.y), f16_ulp(pos.z));
+    // The smallest e with m < 2^e, within [−15, 16]: mantissas |v| / 2^(e − 8) < 256.
+    let e = clamp(i32((bitcast<u32>(m) >> 23u) & 0xFFu) - 126, -15, 16);
+    let q = clamp(floor(vel * exp2(f32(8 - e)) + d1.xyz), vec3<f32>(-255.0), vec3<f32>(255.0));
+    let u = vec3<u32>(vec3<i32>(q) + 256);
+    let v = u32(e + 15) | (u.x << 5u) | (u.y << 14u) | (u.z << 23u);
+    return vec3<u32>(pack2x16float(pd.xy), pack2x16float(vec2<f32>(pd.z, 0.0)) & 0xFFFFu, v);
+}
+
+// One step's births in a tiny-state emitter's birth table (keep in sync with `Birth` in
+// src/gpu/types.rs): `count` spawns from counter `first` (low 32 bits), the k-th born at
+// t0 + dt · clamp(frac0 + k · frac_step, 0, 1) on the emitter's clock, t0 held as a
+// double-single (hi + lo) so ages stay exact in runs of any length.
+struct Birth {
+    first: u32,
+    count: u32,
+    t0_hi: f32,
+    t0_lo: f32,
+    dt: f32,
+    frac0: f32,
+    frac_step: f32,
+    pad: u32,
 }
 
 // The spawn counter (lo, hi) of the particle now in `slot` of a ring of `capacity` slots

@@ -5,9 +5,11 @@
 // (keep both in sync with `src/gpu/types.rs`), `ramps: texture_2d<f32>` (one
 // Rgba32Float colour ramp row per emitter) and the state: `prev`, `cur`
 // (array<Particle>) and the same buffers as `prev_packed`, `cur_packed`
-// (array<PackedParticle>, read when `look.ring.w` says the state is packed).
+// (array<PackedParticle>, read when `look.ring.w` says the state is packed or tiny),
+// and `births: array<Birth>` (a tiny-state emitter's birth table, births.wgsl).
 #import "common.wgsl"
 #import "rng.wgsl"
+#import "births.wgsl"
 
 struct CameraUniform {
     clip_from_world: mat4x4<f32>,
@@ -38,8 +40,8 @@ struct LookUniform {
     // x: ground height in simulation space (m), y: 1 / soft-edge distance (1/m),
     // z, w: lifetime range (s; packed state re-derives lifetimes from it).
     soft: vec4<f32>,
-    // Packed state: x: next spawn slot (head), y, z: spawned total (lo, hi), w: 1 when the
-    // state is packed.
+    // Packed / tiny state: x: next spawn slot (head), y, z: spawned total (lo, hi), w: the
+    // layout (0 full, 1 packed, 2 tiny).
     ring: vec4<u32>,
     // Packed state: x: effect seed, y: emitter salt; z: capacity; w: the live window's
     // length (the slots before the head that can hold living particles).
@@ -51,6 +53,12 @@ struct LookUniform {
     // The sprite's occupied part of each frame: u0, v0, u1, v1 in frame texture
     // coordinates (v down); billboards are cut to it.
     trim: vec4<f32>,
+    // Tiny state (ring.w = 2): x, y: the current state's time on the emitter's clock
+    // (double-single hi, lo, as f32 bits), z: the birth table's first sequence number,
+    // w: its entries.
+    tiny: vec4<u32>,
+    // Tiny state: x: the birth table's index mask, y: the last step's size (f32 bits).
+    tiny_b: vec4<u32>,
 }
 
 override INTERPOLATE: bool = true;
@@ -132,10 +140,28 @@ fn draw_state(p: Particle, q: Particle) -> vec4<f32> {
 // The particle in `slot`: (after the last step, before it), unpacked when packed.
 fn load_pair(slot: u32) -> array<Particle, 2> {
     if look.ring.w != 0u {
-        let q = cur_packed[slot];
         let c = slot_counter(slot, look.ring.x, look.ring.y, look.ring.z, look.ring_b.z);
         let key = spawn_key(look.ring_b.x, look.ring_b.y, slot, c.x, c.y);
         let life = spawn_life(key, look.soft.z, look.soft.w);
+        if look.ring.w == 2u {
+            // Tiny: ages from the birth table; the previous state is one step younger
+            // (dead when that is before the birth: the slot held another particle).
+            let odd = (slot & 1u) != 0u;
+            let age = birth_age(c.x, bitcast<vec2<f32>>(look.tiny.xy), vec3<u32>(look.tiny.zw, look.tiny_b.x));
+            let ages = vec2<f32>(age, age - bitcast<f32>(look.tiny_b.y));
+            let s = array<TinySlot, 2>(
+                tiny_decode(tiny_bits(cur_packed[slot >> 1u], odd)),
+                tiny_decode(tiny_bits(prev_packed[slot >> 1u], odd)),
+            );
+            var out: array<Particle, 2>;
+            for (var i = 0u; i < 2u; i++) {
+                if !s[i].dead && ages[i] >= 0.0 && ages[i] < life {
+                    out[i] = Particle(vec4<f32>(s[i].pos, ages[i]), vec4<f32>(s[i].vel, life));
+                }
+            }
+            return out;
+        }
+        let q = cur_packed[slot];
         // The previous state is only used while it holds the same particle (younger).
         return array<Particle, 2>(unpack_particle(q, life), unpack_particle(prev_packed[slot], life));
     }

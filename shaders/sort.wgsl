@@ -21,8 +21,8 @@ struct SortStep {
     // Power-of-two element count, and the emitter's capacity (slots beyond are padding).
     count: u32,
     capacity: u32,
-    // The camera position and forward axis in the emitter's simulation space; eye.w: 1
-    // when the state is packed (read through `cur_packed`).
+    // The camera position and forward axis in the emitter's simulation space; eye.w: the
+    // state layout, 0 full, 1 packed, 2 tiny (both read through `cur_packed`).
     eye: vec4<f32>,
     forward: vec4<f32>,
     // x: first slot of the live window, y: its length, z: local mode (0 sort, 1 merge).
@@ -143,10 +143,16 @@ fn depth_keys(
         }
         var alive = false;
         var pos = vec3<f32>(0.0);
-        if step.eye.w > 0.5 {
+        if step.eye.w > 1.5 {
+            // Tiny state: slots whose age has run out sort among the living; the draw
+            // skips them.
+            let s = tiny_decode(tiny_bits(cur_packed[slot >> 1u], (slot & 1u) != 0u));
+            alive = !s.dead;
+            pos = s.pos;
+        } else if step.eye.w > 0.5 {
             let q = cur_packed[slot];
             alive = packed_alive(q);
-            pos = vec3<f32>(q.px, q.py, q.pz);
+            pos = bitcast<vec3<f32>>(vec3<u32>(q.px, q.py, q.pz));
         } else {
             let p = cur[slot];
             alive = is_alive(p);

@@ -20,6 +20,8 @@
 @group(1) @binding(1) var<storage, read> cur: array<Particle>;
 @group(1) @binding(3) var<storage, read> prev_packed: array<PackedParticle>;
 @group(1) @binding(4) var<storage, read> cur_packed: array<PackedParticle>;
+// A tiny-state emitter's birth table (births.wgsl).
+@group(1) @binding(5) var<storage, read> births: array<Birth>;
 @group(2) @binding(0) var<storage, read_write> accum: array<atomic<u32>>;
 
 // Keep in sync with `SPLAT_FIXED_SCALE` in src/render/splat.rs.

@@ -10,6 +10,13 @@
 
 // Set for every pipeline (src/sim/modules.rs); only state_packed.wgsl is packed.
 override MOD_PACKED: bool = false;
+override MOD_TINY: bool = false;
+// One slot per store (state_tiny.wgsl pairs them): the pair hooks do nothing.
+const PAIRED_STATE: bool = false;
+
+fn begin_pair(k: u32) {}
+
+fn end_pair(k: u32) {}
 
 fn load_state(slot: u32) -> Particle {
     return src[slot];

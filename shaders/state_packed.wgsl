@@ -13,6 +13,13 @@
 @group(0) @binding(2) var<storage, read_write> dst: array<PackedParticle>;
 
 override MOD_PACKED: bool = true;
+override MOD_TINY: bool = false;
+// One slot per store (state_tiny.wgsl pairs them): the pair hooks do nothing.
+const PAIRED_STATE: bool = false;
+
+fn begin_pair(k: u32) {}
+
+fn end_pair(k: u32) {}
 
 fn load_state(slot: u32) -> Particle {
     let q = src[slot];

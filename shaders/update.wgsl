@@ -16,13 +16,16 @@
 //   start of the previous step, so it is dead (and identical) in A and B: B never holds
 //   stale live data from two steps ago.
 // - The dispatch is 2-D (x ≤ 65535 groups) so pools beyond 16M slots fit.
+// - Tiny state (state_tiny.wgsl, PAIRED_STATE): one invocation per pair of adjacent slots
+//   of the window, since the two share a word.
 #import "common.wgsl"
 
 @group(0) @binding(0) var<uniform> params: SimParams;
 @group(0) @binding(3) var<storage, read_write> counters: array<atomic<u32>, 2>;
 
 // The state's bindings (1 `src`, 2 `dst`) and `load_state` / `store_state`: full 32-byte
-// particles, or — for packed_state pipelines — state_packed.wgsl composed in its place.
+// particles, or — for packed_state / tiny_state pipelines — state_packed.wgsl /
+// state_tiny.wgsl composed in its place.
 #import "state_full.wgsl"
 #import "spawn.wgsl"
 #import "integrators.wgsl"
@@ -68,9 +71,38 @@ fn main(
         return;
     }
     var alive = 0u;
-    for (var r = 0u; r < SLOTS_PER_INVOCATION; r++) {
-        if update_slot(base + r * 256u) {
-            alive += 1u;
+    if PAIRED_STATE {
+        // Tiny state: one invocation per pair of adjacent slots (they share a word), over
+        // the pairs the window touches (a few more is harmless: slots outside the window
+        // are left as they are, dead in both buffers).
+        let j = (wg.y * nwg.x + wg.x) * 256u + lid;
+        let pairs = (params.capacity + 1u) / 2u;
+        let w = params.update_window;
+        if j < min(pairs, w.y / 2u + 2u) {
+            var k = w.x / 2u + j;
+            if k >= pairs {
+                k -= pairs;
+            }
+            begin_pair(k);
+            var touched = false;
+            for (var r = 0u; r < 2u; r++) {
+                let slot = 2u * k + r;
+                if slot < params.capacity && (slot + params.capacity - w.x) % params.capacity < w.y {
+                    touched = true;
+                    if update_at(slot) {
+                        alive += 1u;
+                    }
+                }
+            }
+            if touched {
+                end_pair(k);
+            }
+        }
+    } else {
+        for (var r = 0u; r < SLOTS_PER_INVOCATION; r++) {
+            if update_slot(base + r * 256u) {
+                alive += 1u;
+            }
         }
     }
     if COUNT_ALIVE {
@@ -80,60 +112,66 @@ fn main(
 
 // Updates the i-th slot of this step's window of the ring; true when it is alive after.
 fn update_slot(i: u32) -> bool {
-    var alive = false;
-    if i < params.update_window.y {
-        // The i-th slot of this step's window of the ring.
-        var slot = params.update_window.x + i;
-        if slot >= params.capacity {
-            slot -= params.capacity;
-        }
-        var p = load_state(slot);
-        // Position of this slot in the ring relative to the spawn head (capacity ≤ 2^28).
-        let rel = (slot + params.capacity - params.spawn_head) % params.capacity;
-        if rel < params.spawn_count {
-            // 64-bit spawn counter = base + rel.
-            let lo = params.spawn_base_lo + rel;
-            let hi = params.spawn_base_hi + select(0u, 1u, lo < rel);
-            p = spawn_particle(slot, spawn_key(params.seed, params.emitter_salt, slot, lo, hi));
-            // Sub-step emission: a particle born at fraction f of the step is (1 - f)·dt old
-            // at its end, moved over that partial step in closed form under the constant
-            // acceleration and linear drag (cheap, and exact where stateless mode applies;
-            // the other modules act from its first full step).
-            let f = clamp(params.spawn_frac0 + f32(rel) * params.spawn_frac_step, 0.0, 1.0);
-            let age0 = (1.0 - f) * params.dt_secs;
-            let k = linear_drag_k();
-            let pp = exp_phi_psi(k, age0);
-            let c = params.accel_drag.xyz + k * params.wind_time.xyz;
-            let v0 = p.vel_life.xyz;
-            p = Particle(
-                vec4<f32>(p.pos_age.xyz + v0 * pp.x + c * pp.y, age0),
-                vec4<f32>(v0 * (1.0 - k * pp.x) + c * pp.x, p.vel_life.w),
-            );
-            alive = is_alive(p);
-        } else if is_alive(p) {
-            let life = p.vel_life.w;
-            var s = integrate(p.pos_age.xyz, p.vel_life.xyz, p.pos_age.w, life, params.wind_time.w, params.dt_secs);
-            var age = p.pos_age.w + params.dt_secs;
-            // module-begin
-            if MOD_COLLISIONS {
-                let c = collide(p.pos_age.xyz, s.pos, s.vel);
-                s = State(c.pos, c.vel);
-                if c.killed {
-                    // Killed on contact: dead, and its age says so.
-                    age = life;
-                }
-            }
-            // module-end
-            if finite_vec3(s.pos) && finite_vec3(s.vel) {
-                p = Particle(vec4<f32>(s.pos, age), vec4<f32>(s.vel, life));
-                alive = age < life;
-            } else {
-                // Non-finite guard: kill and count, never let NaN reach the draw.
-                p = Particle(vec4<f32>(0.0), vec4<f32>(0.0));
-                atomicAdd(&counters[1], 1u);
-            }
-        }
-        store_state(slot, p);
+    if i >= params.update_window.y {
+        return false;
     }
+    // The i-th slot of this step's window of the ring.
+    var slot = params.update_window.x + i;
+    if slot >= params.capacity {
+        slot -= params.capacity;
+    }
+    return update_at(slot);
+}
+
+// Spawns or steps the particle in `slot` and stores it; true when it is alive after.
+fn update_at(slot: u32) -> bool {
+    var alive = false;
+    var p = load_state(slot);
+    // Position of this slot in the ring relative to the spawn head (capacity ≤ 2^28).
+    let rel = (slot + params.capacity - params.spawn_head) % params.capacity;
+    if rel < params.spawn_count {
+        // 64-bit spawn counter = base + rel.
+        let lo = params.spawn_base_lo + rel;
+        let hi = params.spawn_base_hi + select(0u, 1u, lo < rel);
+        p = spawn_particle(slot, spawn_key(params.seed, params.emitter_salt, slot, lo, hi));
+        // Sub-step emission: a particle born at fraction f of the step is (1 - f)·dt old
+        // at its end, moved over that partial step in closed form under the constant
+        // acceleration and linear drag (cheap, and exact where stateless mode applies;
+        // the other modules act from its first full step).
+        let f = clamp(params.spawn_frac0 + f32(rel) * params.spawn_frac_step, 0.0, 1.0);
+        let age0 = (1.0 - f) * params.dt_secs;
+        let k = linear_drag_k();
+        let pp = exp_phi_psi(k, age0);
+        let c = params.accel_drag.xyz + k * params.wind_time.xyz;
+        let v0 = p.vel_life.xyz;
+        p = Particle(
+            vec4<f32>(p.pos_age.xyz + v0 * pp.x + c * pp.y, age0),
+            vec4<f32>(v0 * (1.0 - k * pp.x) + c * pp.x, p.vel_life.w),
+        );
+        alive = is_alive(p);
+    } else if is_alive(p) {
+        let life = p.vel_life.w;
+        var s = integrate(p.pos_age.xyz, p.vel_life.xyz, p.pos_age.w, life, params.wind_time.w, params.dt_secs);
+        var age = p.pos_age.w + params.dt_secs;
+        // module-begin
+        if MOD_COLLISIONS {
+            let c = collide(p.pos_age.xyz, s.pos, s.vel);
+            s = State(c.pos, c.vel);
+            if c.killed {
+                // Killed on contact: dead, and its age says so.
+                age = life;
+            }
+        }
+        // module-end
+        if finite_vec3(s.pos) && finite_vec3(s.vel) {
+            p = Particle(vec4<f32>(s.pos, age), vec4<f32>(s.vel, life));
+            alive = age < life;
+        } else {
+            // Non-finite guard: kill and count, never let NaN reach the draw.
+            p = Particle(vec4<f32>(0.0), vec4<f32>(0.0));
+            atomicAdd(&counters[1], 1u);
+        }
+    }
+    store_state(slot, p);
     return alive;
 }

@@ -34,6 +34,11 @@ pub const EMBEDDED: &[(&str, &str)] = &[
         "state_packed.wgsl",
         include_str!("../shaders/state_packed.wgsl"),
     ),
+    (
+        "state_tiny.wgsl",
+        include_str!("../shaders/state_tiny.wgsl"),
+    ),
+    ("births.wgsl", include_str!("../shaders/births.wgsl")),
     ("count.wgsl", include_str!("../shaders/count.wgsl")),
     ("look.wgsl", include_str!("../shaders/look.wgsl")),
     ("billboard.wgsl", include_str!("../shaders/billboard.wgsl")),
@@ -47,9 +52,12 @@ pub const EMBEDDED: &[(&str, &str)] = &[
 /// state_full.wgsl (the state I/O).
 pub const PACKED_STATE_IO: (&str, &str) = ("state_full.wgsl", "state_packed.wgsl");
 
+/// The tiny-state update: update.wgsl with state_tiny.wgsl as the state I/O.
+pub const TINY_STATE_IO: (&str, &str) = ("state_full.wgsl", "state_tiny.wgsl");
+
 /// Imports that some pipelines replace by another file (see
 /// [`ShaderLibrary::compose_with`]).
-pub const IMPORT_VARIANTS: &[(&str, &str)] = &[PACKED_STATE_IO];
+pub const IMPORT_VARIANTS: &[(&str, &str)] = &[PACKED_STATE_IO, TINY_STATE_IO];
 
 /// The entry files, one per pipeline family; the others are imported by them.
 pub const ENTRY_FILES: &[&str] = &[

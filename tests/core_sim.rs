@@ -604,6 +604,113 @@ fn packed_state_follows_the_full_state() {
     assert!(ca.abs_diff(cb) <= borderline as u32, "alive {ca} vs {cb}");
 }
 
+/// The tiny 10-byte state follows the full state: ages exact (from the birth table, not
+/// accumulated), lifetimes re-derived exactly, so the same slots alive; positions and
+/// velocities within the dithered f16 / shared-exponent rounding accumulated over the run.
+#[test]
+fn tiny_state_follows_the_full_state() {
+    let ctx = gpu();
+    let mut e = plain_emitter();
+    e.capacity = 3001;
+    e.spawn_rate_per_sec = 2000.0;
+    e.lifetime_secs = ignis::effect::Range::new(0.5, 1.5);
+    e.speed_m_per_s = ignis::effect::Range::new(1.0, 3.0);
+    e.spread_deg = 30.0;
+    e.forces.gravity_m_per_s2 = [0.0, -9.81, 0.0];
+    e.forces.buoyancy_m_per_s2 = 12.0;
+    e.forces.drag_per_sec = 1.2;
+    e.forces.wind_m_per_s = [0.3, 0.0, 0.0];
+    let full = bare_effect(e.clone());
+    let mut tiny = full.clone();
+    tiny.emitters[0].tiny_state = true;
+    assert!(tiny.validate().is_ok());
+    let dt = 1.0 / 120.0;
+    let steps = 240;
+    let a = run_gpu(&ctx, &full, dt, steps);
+    let b = run_gpu(&ctx, &tiny, dt, steps);
+    let pa = a.read_particles(0).expect("full");
+    let pb = b.read_particles(0).expect("tiny");
+    assert_eq!(pa.len(), pb.len());
+    let (mut alive, mut borderline) = (0, 0);
+    let (mut sum_pos2, mut sum_vel2, mut worst_pos, mut worst_vel, mut worst_age) =
+        (0.0f64, 0.0f64, 0.0f32, 0.0f32, 0.0f32);
+    for (slot, (p, q)) in pa.iter().zip(&pb).enumerate() {
+        if p.is_alive() != q.is_alive() {
+            // Only where f32 age sums and the exact age straddle the lifetime.
+            let (life, age) = (p.vel_life[3].max(q.vel_life[3]), p.pos_age[3].max(q.pos_age[3]));
+            assert!((life - age).abs() <= 1e-4, "slot {slot}: {p:?} vs {q:?}");
+            borderline += 1;
+            continue;
+        }
+        if !p.is_alive() {
+            continue;
+        }
+        alive += 1;
+        assert!((q.vel_life[3] - p.vel_life[3]).abs() <= 1e-6 * p.vel_life[3], "slot {slot}: lifetime");
+        // The full state sums dt each step in f32; the tiny age is t − birth.
+        worst_age = worst_age.max((q.pos_age[3] - p.pos_age[3]).abs());
+        let dx = (q.position() - p.position()).length();
+        let dv = (q.velocity() - p.velocity()).length();
+        sum_pos2 += f64::from(dx * dx);
+        sum_vel2 += f64::from(dv * dv);
+        worst_pos = worst_pos.max(dx);
+        worst_vel = worst_vel.max(dv);
+    }
+    let rms_pos = (sum_pos2 / alive as f64).sqrt();
+    let rms_vel = (sum_vel2 / alive as f64).sqrt();
+    println!(
+        "tiny vs full after {steps} steps: |Δx| rms {rms_pos:.2e} worst {worst_pos:.2e} m, |Δv| rms {rms_vel:.2e} worst {worst_vel:.2e} m/s, |Δage| {worst_age:.2e} s, {borderline} of {alive} differ in liveness"
+    );
+    assert!(alive > 1500, "{alive} alive");
+    assert!(borderline <= 2, "{borderline} liveness mismatches");
+    assert!(worst_age < 1e-4, "age deviation {worst_age} s");
+    // Velocity: 8 significant bits of the largest component (≤ 2⁻⁶ m/s at 2–4 m/s),
+    // dithered each step: a random walk damped by the drag; positions integrate it.
+    assert!(rms_vel < 0.05, "velocity rms deviation {rms_vel} m/s");
+    assert!(rms_pos < 0.03, "position rms deviation {rms_pos} m");
+    assert!(worst_vel < 0.25 && worst_pos < 0.15, "worst {worst_vel} m/s, {worst_pos} m");
+    assert!(worst_pos > 0.0, "tiny state must round something");
+    let (ca, cb) = (a.read_counters(0).expect("count")[0], b.read_counters(0).expect("count")[0]);
+    assert!(ca.abs_diff(cb) <= borderline as u32, "alive {ca} vs {cb}");
+}
+
+/// The tiny state's birth table outgrows its first size (1024 steps) with small steps and
+/// long lives, and a capacity change restarts the tiny pool cleanly: the alive set matches
+/// the full state's before, and after the restart only particles born since are alive.
+#[test]
+fn tiny_birth_table_grows_and_restarts() {
+    let ctx = gpu();
+    let mut e = plain_emitter();
+    e.capacity = 4000;
+    e.spawn_rate_per_sec = 1500.0;
+    e.lifetime_secs = ignis::effect::Range::new(1.5, 2.5);
+    e.speed_m_per_s = ignis::effect::Range::new(0.5, 1.0);
+    e.spread_deg = 20.0;
+    let full = bare_effect(e);
+    let mut tiny = full.clone();
+    tiny.emitters[0].tiny_state = true;
+    let dt = 1.0 / 1000.0;
+    let mut a = run_gpu(&ctx, &full, dt, 2600);
+    let mut b = run_gpu(&ctx, &tiny, dt, 2600);
+    let alive = |sim: &GpuSim| alive_of(&sim.read_particles(0).expect("read"));
+    let (na, nb) = (alive(&a), alive(&b));
+    assert!(na > 2500, "{na} alive");
+    assert!(na.abs_diff(nb) <= 2, "full {na} vs tiny {nb}");
+    // Every step spawns 1–2: about 2000 live batches, beyond the first table's 1024.
+    let mut grown = tiny.clone();
+    grown.emitters[0].capacity = 5000;
+    let mut full_grown = full.clone();
+    full_grown.emitters[0].capacity = 5000;
+    b.step(&grown, dt, 10).expect("step");
+    a.step(&full_grown, dt, 10).expect("step");
+    let after = alive(&b);
+    assert!((14..=16).contains(&after), "after the restart {after} alive (15 born)");
+    b.step(&grown, dt, 500).expect("step");
+    let later = alive(&b);
+    assert!((760..=765).contains(&later), "{later} alive 0.51 s after the restart");
+    assert_eq!(b.read_counters(0).expect("count")[0] as usize, later);
+}
+
 /// Packed and full state draw the same frame (both draw paths read packed state).
 #[test]
 fn packed_state_renders_like_the_full_state() {

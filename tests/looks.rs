@@ -35,6 +35,7 @@ const PROBE: &str = r#"
 @group(1) @binding(1) var<storage, read> cur: array<Particle>;
 @group(1) @binding(3) var<storage, read> prev_packed: array<PackedParticle>;
 @group(1) @binding(4) var<storage, read> cur_packed: array<PackedParticle>;
+@group(1) @binding(5) var<storage, read> births: array<Birth>;
 // x: age, y: life, z: random start number, w: blend frames (0/1).
 @group(0) @binding(3) var<storage, read> inputs: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read_write> outputs: array<vec4<f32>>;

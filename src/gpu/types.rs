@@ -64,6 +64,103 @@ impl PackedParticle {
     }
 }
 
+/// One step's births in a tiny-state emitter's birth table (keep in sync with `Birth` in
+/// `shaders/common.wgsl`): `count` spawns from counter `first` (low 32 bits), the k-th born
+/// at t0 + dt · clamp(frac0 + k · frac_step, 0, 1) on the emitter's clock.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Birth {
+    /// Spawn counter of the step's first birth, low 32 bits.
+    pub first: u32,
+    /// Births in the step.
+    pub count: u32,
+    /// The step's start, double-single high part (s).
+    pub t0_hi: f32,
+    /// The step's start, low part.
+    pub t0_lo: f32,
+    /// The step's size (s).
+    pub dt: f32,
+    /// Birth fraction of the first spawn within the step.
+    pub frac0: f32,
+    /// Birth fraction increment per spawn.
+    pub frac_step: f32,
+    /// Padding.
+    pub pad: u32,
+}
+
+/// A time as a double-single: `hi = f32(t)`, `lo = f32(t − hi)` (the GPU subtracts two of
+/// them part by part, so ages stay exact to f32 however long the run).
+pub fn double_single(t: f64) -> (f32, f32) {
+    let hi = t as f32;
+    (hi, (t - f64::from(hi)) as f32)
+}
+
+/// The tiny state's decoding (mirror of `tiny_bits` / `tiny_decode` in
+/// `shaders/common.wgsl`): slot `slot`'s position and velocity in the pair `words`
+/// (element `slot / 2` of the buffer as 20-byte pairs), or `None` when marked dead.
+pub fn tiny_decode(words: [u32; 5], slot: u32) -> Option<([f32; 3], [f32; 3])> {
+    let [w0, w1, w2, w3, w4] = words;
+    let (xy, z, vel) = if slot & 1 == 1 {
+        ((w2 >> 16) | (w3 << 16), w3 >> 16, w4)
+    } else {
+        (w0, w1 & 0xFFFF, (w1 >> 16) | (w2 << 16))
+    };
+    if xy & 0xFFFF == 0xFFFF {
+        return None;
+    }
+    let h = |bits: u32| half::f16::from_bits(bits as u16).to_f32();
+    let scale = 2f32.powi((vel & 31) as i32 - 23);
+    let m = |shift: u32| (((vel >> shift) & 511) as f32 - 256.0) * scale;
+    Some(([h(xy), h(xy >> 16), h(z)], [m(5), m(14), m(23)]))
+}
+
+/// How an emitter's state is stored.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum StateLayout {
+    /// 32-byte [`Particle`]s.
+    #[default]
+    Full,
+    /// 20-byte [`PackedParticle`]s.
+    Packed,
+    /// 10 bytes a slot, slots paired in 20-byte words (`tiny` in `shaders/common.wgsl`).
+    Tiny,
+}
+
+impl StateLayout {
+    /// The layout an emitter's modules ask for.
+    pub fn of(modules: crate::sim::Modules) -> Self {
+        if modules.contains(crate::sim::Modules::TINY) {
+            Self::Tiny
+        } else if modules.contains(crate::sim::Modules::PACKED) {
+            Self::Packed
+        } else {
+            Self::Full
+        }
+    }
+
+    /// Bytes one slot occupies.
+    pub fn slot_bytes(self) -> u64 {
+        match self {
+            Self::Full => 32,
+            Self::Packed => 20,
+            Self::Tiny => 10,
+        }
+    }
+
+    /// Bytes a pool of `capacity` slots occupies (tiny pools hold whole pairs).
+    pub fn bytes(self, capacity: u32) -> u64 {
+        match self {
+            Self::Tiny => u64::from(capacity.div_ceil(2)) * 20,
+            _ => u64::from(capacity) * self.slot_bytes(),
+        }
+    }
+
+    /// The shaders' layout number (`LookUniform::ring[3]`, the sort's `eye.w`).
+    pub fn index(self) -> u32 {
+        self as u32
+    }
+}
+
 /// The spawn counter of the particle in `slot` of a ring of `capacity` slots that has
 /// spawned `total` (mirror of `slot_counter` in `shaders/common.wgsl`).
 pub fn slot_counter(slot: u32, total: u64, capacity: u32) -> u64 {
@@ -111,7 +208,7 @@ pub struct SimParams {
     pub spawn_base_lo: u32,
     /// High 32 bits.
     pub spawn_base_hi: u32,
-    /// Reserved.
+    /// Tiny state: the birth table's index mask (its size − 1).
     pub flags: u32,
     /// Birth fraction (within the step) of the first spawn.
     pub spawn_frac0: f32,
@@ -145,6 +242,9 @@ pub struct SimParams {
     /// ring's live window plus this step's spawns; every other slot is dead in both
     /// state buffers.
     pub update_window: [u32; 4],
+    /// Tiny state: the step's start on the emitter's clock as a double-single (hi, lo; f32
+    /// bits), the birth table's first sequence number and its number of entries.
+    pub tiny: [u32; 4],
 }
 
 /// Camera data for the billboard pass (keep in sync with `CameraUniform` in
@@ -194,6 +294,11 @@ pub struct LookUniform {
     pub motion_b: [f32; 4],
     /// The sprite's occupied part of a frame, u0 v0 u1 v1 (billboards are cut to it).
     pub trim: [f32; 4],
+    /// Tiny state: the current state's time (double-single hi, lo; f32 bits), the birth
+    /// table's first sequence number and entries.
+    pub tiny: [u32; 4],
+    /// Tiny state: the birth table's index mask, the last step's size (f32 bits).
+    pub tiny_b: [u32; 4],
 }
 
 /// Tonemap settings (keep in sync with `ToneUniform` in `shaders/tonemap.wgsl`).
@@ -210,3 +315,5 @@ pub const PARAMS_STRIDE: u64 = 512;
 const _: () = assert!(std::mem::size_of::<SimParams>() as u64 <= PARAMS_STRIDE);
 const _: () = assert!(std::mem::size_of::<Particle>() == 32);
 const _: () = assert!(std::mem::size_of::<PackedParticle>() == 20);
+const _: () = assert!(std::mem::size_of::<Birth>() == 32);
+const _: () = assert!(std::mem::size_of::<LookUniform>() as u64 <= PARAMS_STRIDE);

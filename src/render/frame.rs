@@ -212,8 +212,16 @@ impl FrameResources {
         });
         let particle_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("FrameResources::particle_layout"),
-            // 3, 4: the same state buffers as 0, 1, seen as packed state.
-            entries: &[storage(0), storage(1), storage(2), storage(3), storage(4)],
+            // 3, 4: the same state buffers as 0, 1, seen as packed (or tiny) state; 5: the
+            // tiny state's birth table.
+            entries: &[
+                storage(0),
+                storage(1),
+                storage(2),
+                storage(3),
+                storage(4),
+                storage(5),
+            ],
         });
         let camera = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some("FrameResources::camera"),
@@ -423,10 +431,11 @@ impl FrameResources {
                     (b.spawned_total % u64::from(b.capacity.max(1))) as u32,
                     b.spawned_total as u32,
                     (b.spawned_total >> 32) as u32,
-                    u32::from(b.packed),
+                    b.layout.index(),
                 ];
                 // w: the live window's length (it ends at the ring's head, ring.x).
                 u.ring_b = [b.seed_salt.0, b.seed_salt.1, b.capacity, b.window.len];
+                (u.tiny, u.tiny_b) = b.tiny;
             }
             let at = i * PARAMS_STRIDE as usize;
             blocks[at..at + size_of::<LookUniform>()].copy_from_slice(bytemuck::bytes_of(&u));
@@ -468,6 +477,10 @@ impl FrameResources {
                         wgpu::BindGroupEntry {
                             binding: 4,
                             resource: b.current.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 5,
+                            resource: b.births.as_entire_binding(),
                         },
                     ],
                 })

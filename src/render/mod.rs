@@ -271,7 +271,7 @@ impl Renderer {
                     d.window,
                     eye,
                     forward,
-                    b.packed,
+                    b.layout,
                 );
             }
         }

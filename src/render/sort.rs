@@ -385,7 +385,7 @@ impl SortPass {
         window: crate::sim::planner::LiveWindow,
         eye: glam::Vec3,
         forward: glam::Vec3,
-        packed: bool,
+        layout: crate::gpu::types::StateLayout,
     ) {
         if window.len == 0 {
             return;
@@ -409,7 +409,7 @@ impl SortPass {
             j: 0,
             count,
             capacity,
-            eye: eye.extend(if packed { 1.0 } else { 0.0 }).to_array(),
+            eye: eye.extend(layout.index() as f32).to_array(),
             forward: forward.extend(0.0).to_array(),
             window: [window.first_slot, window.len, 0, 0],
         };

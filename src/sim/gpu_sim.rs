@@ -1,11 +1,14 @@
 //! Pass 1 on the GPU: per-emitter ping-pong state buffers and the update pipeline.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, VecDeque};
 
 use crate::effect::{Effect, Integrator};
-use crate::gpu::types::{PARAMS_STRIDE, PackedParticle, Particle, SimParams, slot_counter};
+use crate::gpu::types::{
+    Birth, PARAMS_STRIDE, PackedParticle, Particle, SimParams, StateLayout, double_single,
+    slot_counter, tiny_decode,
+};
 use crate::gpu::{GpuContext, GpuError};
-use crate::shaders::{PACKED_STATE_IO, ShaderError, ShaderLibrary, create_checked};
+use crate::shaders::{PACKED_STATE_IO, ShaderError, ShaderLibrary, TINY_STATE_IO, create_checked};
 use crate::sim::modules::Modules;
 use crate::sim::planner::{EffectPlanner, LiveWindow};
 
@@ -70,6 +73,8 @@ impl UpdatePass {
                     storage(1, true),
                     storage(2, false),
                     storage(3, false),
+                    // The birth table (tiny state; a placeholder for the others).
+                    storage(4, true),
                 ],
             });
         let pipeline_layout = ctx
@@ -113,9 +118,13 @@ impl UpdatePass {
         let composed = lib.compose("update.wgsl")?;
         // Packed-state pipelines: the same entry with state_packed.wgsl as the state I/O.
         let packed = lib.compose_with("update.wgsl", &[PACKED_STATE_IO])?;
+        // Tiny-state pipelines: state_tiny.wgsl as the state I/O.
+        let tiny = lib.compose_with("update.wgsl", &[TINY_STATE_IO])?;
         let mut fresh = HashMap::new();
         for &(integrator, modules) in keys {
-            let composed = if modules.contains(Modules::PACKED) {
+            let composed = if modules.contains(Modules::TINY) {
+                &tiny
+            } else if modules.contains(Modules::PACKED) {
                 &packed
             } else {
                 &composed
@@ -163,7 +172,7 @@ impl UpdatePass {
         self.pipelines = fresh;
         self.count = Some(count);
         self.files = composed.files;
-        for f in packed.files.into_iter().chain(count_src.files) {
+        for f in packed.files.into_iter().chain(tiny.files).chain(count_src.files) {
             if !self.files.contains(&f) {
                 self.files.push(f);
             }
@@ -197,8 +206,18 @@ struct EmitterState {
     generation: u64,
     /// Holds stateless spawn records (no ping-pong: buffer 0 only).
     stateless: bool,
-    /// Holds packed 20-byte state.
-    packed: bool,
+    /// How the state is stored.
+    layout: StateLayout,
+    /// Tiny state's birth table: a ring of entries, entry `seq` at `seq & births_mask`
+    /// (one placeholder entry for the other layouts).
+    births: wgpu::Buffer,
+    births_mask: u32,
+    /// The entries the steps recorded last may read (sequence number, entry), oldest
+    /// first: what a larger table must be filled with.
+    births_mirror: VecDeque<(u64, Birth)>,
+    /// Batches before this sequence number belong to particles the pool no longer holds
+    /// (a restart of a tiny pool by a capacity or layout change).
+    births_floor: u64,
     /// Lifetime range, seed and salt of the last sync (packed state re-derives lifetimes).
     life_range: (f32, f32),
     seed: u32,
@@ -238,8 +257,14 @@ pub struct EmitterBuffers<'a> {
     pub generation: u64,
     /// Which of the pair is current (0 or 1).
     pub parity: usize,
-    /// The state is packed (`PackedParticle`, 20 bytes a slot).
-    pub packed: bool,
+    /// How the state is stored (packed and tiny are read through `PackedParticle` views).
+    pub layout: StateLayout,
+    /// The tiny state's birth table (a placeholder for the other layouts).
+    pub births: &'a wgpu::Buffer,
+    /// Tiny state: the current state's time (double-single hi, lo; f32 bits), the birth
+    /// table's first sequence number and entries; the table's index mask and the last
+    /// step's size (f32 bits) — `LookUniform::tiny`, `tiny_b`.
+    pub tiny: ([u32; 4], [u32; 4]),
     /// Particles spawned so far (the ring's position: packed state re-derives lifetimes).
     pub spawned_total: u64,
     /// Lifetime range of the emitter.
@@ -310,15 +335,19 @@ impl GpuSim {
         self.emitters.truncate(effect.emitters.len());
         for (i, e) in effect.emitters.iter().enumerate() {
             let capacity = e.capacity.max(1);
-            let packed = Modules::of(e).contains(Modules::PACKED);
+            let layout = StateLayout::of(Modules::of(e));
+            let next_seq = self.planner.emitters.get(i).map_or(0, |p| p.next_seq());
             match self.emitters.get(i) {
-                Some(s) if s.capacity == capacity && s.packed == packed => {}
-                // Switching the layout restarts the pool (nothing to convert in place).
-                Some(s) if s.packed != packed => {
-                    self.emitters[i] = self.create_state(capacity, packed);
+                Some(s) if s.capacity == capacity && s.layout == layout => {}
+                // Switching the layout restarts the pool (nothing to convert in place), and
+                // so does resizing a tiny pool (its particles' ages are tied to their
+                // slots' spawn counters, which a new modulus changes).
+                Some(s) if s.layout != layout || layout == StateLayout::Tiny => {
+                    self.emitters[i] = self.create_state(capacity, layout);
+                    self.emitters[i].births_floor = next_seq;
                 }
                 _ => {
-                    let mut fresh = self.create_state(capacity, packed);
+                    let mut fresh = self.create_state(capacity, layout);
                     if let Some(old) = self.emitters.get(i) {
                         // The kept particles stay at their old slots, which the ring's
                         // new modulus does not map their spawn counters to: visit the
@@ -331,7 +360,7 @@ impl GpuSim {
                         fresh.whole_pool_until = old.whole_pool_until.max(dead_by);
                         // Keep the particles that fit (packed ones get the lifetimes of
                         // their new ring positions).
-                        let keep = old.capacity.min(capacity) as u64 * state_stride(packed);
+                        let keep = layout.bytes(old.capacity.min(capacity));
                         let mut enc = self.ctx.device.create_command_encoder(&Default::default());
                         for b in 0..2 {
                             enc.copy_buffer_to_buffer(
@@ -381,8 +410,8 @@ impl GpuSim {
                 mapped_at_creation: false,
             });
             for i in 0..self.emitters.len() {
-                self.emitters[i].bind_groups =
-                    self.bind_groups(&self.emitters[i].buffers, &self.emitters[i].counters);
+                let s = &self.emitters[i];
+                self.emitters[i].bind_groups = self.bind_groups(&s.buffers, &s.counters, &s.births);
             }
         }
         for key in used_keys(effect) {
@@ -391,9 +420,9 @@ impl GpuSim {
         Ok(())
     }
 
-    fn create_state(&mut self, capacity: u32, packed: bool) -> EmitterState {
+    fn create_state(&mut self, capacity: u32, layout: StateLayout) -> EmitterState {
         // At least one full `Particle`: the full-state bindings see the same buffer.
-        let size = (capacity as u64 * state_stride(packed)).max(size_of::<Particle>() as u64);
+        let size = layout.bytes(capacity).max(size_of::<Particle>() as u64);
         let make = |label| {
             self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -413,7 +442,9 @@ impl GpuSim {
                 | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let bind_groups = self.bind_groups(&buffers, &counters);
+        let entries = if layout == StateLayout::Tiny { 1024 } else { 1 };
+        let births = self.births_buffer(entries);
+        let bind_groups = self.bind_groups(&buffers, &counters, &births);
         let generation = self.next_generation;
         self.next_generation += 1;
         EmitterState {
@@ -424,7 +455,11 @@ impl GpuSim {
             current: 0,
             generation,
             stateless: false,
-            packed,
+            layout,
+            births,
+            births_mask: entries - 1,
+            births_mirror: VecDeque::new(),
+            births_floor: 0,
             life_range: (0.0, 0.0),
             seed: 0,
             salt: 0,
@@ -433,10 +468,20 @@ impl GpuSim {
         }
     }
 
+    fn births_buffer(&self, entries: u32) -> wgpu::Buffer {
+        self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("GpuSim::births"),
+            size: u64::from(entries) * size_of::<Birth>() as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    }
+
     fn bind_groups(
         &self,
         buffers: &[wgpu::Buffer; 2],
         counters: &wgpu::Buffer,
+        births: &wgpu::Buffer,
     ) -> [wgpu::BindGroup; 2] {
         let make = |src: usize| {
             self.ctx
@@ -464,6 +509,10 @@ impl GpuSim {
                         wgpu::BindGroupEntry {
                             binding: 3,
                             resource: counters.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 4,
+                            resource: births.as_entire_binding(),
                         },
                     ],
                 })
@@ -519,6 +568,11 @@ impl GpuSim {
         plans: &[Vec<Option<SimParams>>],
     ) {
         let n_emitters = self.emitters.len();
+        for e in 0..n_emitters {
+            if self.emitters[e].layout == StateLayout::Tiny {
+                self.upload_births(e, plans);
+            }
+        }
         let mut blocks = vec![0u8; plans.len() * n_emitters * PARAMS_STRIDE as usize];
         let mut windows = vec![0u32; plans.len() * n_emitters];
         for (s, plan) in plans.iter().enumerate() {
@@ -539,6 +593,10 @@ impl GpuSim {
                         p.update_window = [0, em.capacity, 0, 0];
                     }
                     windows[s * n_emitters + e] = p.update_window[1];
+                    if em.layout == StateLayout::Tiny {
+                        p.tiny = tiny_window(&p, em.births_floor);
+                        p.flags = em.births_mask;
+                    }
                     let at = (s * n_emitters + e) * PARAMS_STRIDE as usize;
                     blocks[at..at + size_of::<SimParams>()].copy_from_slice(bytemuck::bytes_of(&p));
                 }
@@ -573,6 +631,12 @@ impl GpuSim {
                 } else {
                     (&em.bind_groups[em.current], windows[s * n_emitters + e])
                 };
+                // Tiny state: one invocation per pair of slots the window touches.
+                let invocations = if em.layout == StateLayout::Tiny {
+                    (slots / 2 + 2).min(em.capacity.div_ceil(2))
+                } else {
+                    slots.div_ceil(SLOTS_PER_INVOCATION)
+                };
                 if !em.stateless {
                     em.current = 1 - em.current;
                     if clear_counters {
@@ -597,12 +661,72 @@ impl GpuSim {
                 });
                 pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, group, &[offset]);
-                let (x, y) = dispatch_size(slots.div_ceil(SLOTS_PER_INVOCATION));
+                let (x, y) = dispatch_size(invocations);
                 pass.dispatch_workgroups(x, y, 1);
             }
         }
         drop(pass);
         enc.pop_debug_group();
+    }
+
+    /// Writes the birth-table entries of the batches `plans` spawned for tiny emitter `e`
+    /// (each step's window of the table must stay intact until the submit has run: a table
+    /// too small for the span of this submit's windows is replaced by a larger one).
+    fn upload_births(&mut self, e: usize, plans: &[Vec<Option<SimParams>>]) {
+        let floor = self.emitters[e].births_floor;
+        let steps: Vec<SimParams> = plans.iter().filter_map(|p| p.get(e).copied().flatten()).collect();
+        let (Some(first), Some(last)) = (steps.first(), steps.last()) else {
+            return;
+        };
+        let mut fresh = Vec::new();
+        for p in &steps {
+            if p.spawn_count > 0 {
+                // The step's own batch is the newest of its window.
+                let seq = u64::from(p.tiny[2]) + u64::from(p.tiny[3]) - 1;
+                let entry = Birth {
+                    first: p.spawn_base_lo,
+                    count: p.spawn_count,
+                    t0_hi: f32::from_bits(p.tiny[0]),
+                    t0_lo: f32::from_bits(p.tiny[1]),
+                    dt: p.dt_secs,
+                    frac0: p.spawn_frac0,
+                    frac_step: p.spawn_frac_step,
+                    pad: 0,
+                };
+                self.emitters[e].births_mirror.push_back((seq, entry));
+                fresh.push((seq, entry));
+            }
+        }
+        let lo = u64::from(tiny_window(first, floor)[2]);
+        let hi = u64::from(last.tiny[2]) + u64::from(last.tiny[3]);
+        let span = hi.saturating_sub(lo);
+        let size = u64::from(self.emitters[e].births_mask) + 1;
+        if span > size {
+            let entries = (span * 2).next_power_of_two().min(u64::from(u32::MAX / 2 + 1)) as u32;
+            let births = self.births_buffer(entries);
+            let s = &self.emitters[e];
+            let bind_groups = self.bind_groups(&s.buffers, &s.counters, &births);
+            let generation = self.next_generation;
+            self.next_generation += 1;
+            let s = &mut self.emitters[e];
+            s.births = births;
+            s.births_mask = entries - 1;
+            s.bind_groups = bind_groups;
+            // The draws' bind groups key on the generation.
+            s.generation = generation;
+            fresh = s.births_mirror.iter().copied().filter(|(q, _)| *q >= lo).collect();
+        }
+        let s = &self.emitters[e];
+        for (seq, entry) in fresh {
+            let at = (seq & u64::from(s.births_mask)) * size_of::<Birth>() as u64;
+            self.ctx.queue.write_buffer(&s.births, at, bytemuck::bytes_of(&entry));
+        }
+        // Later submits read from the last step's window on.
+        let keep = u64::from(tiny_window(last, floor)[2]);
+        let s = &mut self.emitters[e];
+        while s.births_mirror.front().is_some_and(|(q, _)| *q < keep) {
+            s.births_mirror.pop_front();
+        }
     }
 
     /// Follows a structural edit of the effect's emitter list (reorder, insert, remove):
@@ -625,7 +749,7 @@ impl GpuSim {
                 .and_then(|o| old_pools.get_mut(o))
                 .and_then(Option::take);
             // A one-slot placeholder: `sync` sees the capacity differ and replaces it.
-            let pool = pool.unwrap_or_else(|| self.create_state(1, false));
+            let pool = pool.unwrap_or_else(|| self.create_state(1, StateLayout::Full));
             self.emitters.push(pool);
             let planner = source
                 .and_then(|o| old_planners.get_mut(o))
@@ -644,7 +768,18 @@ impl GpuSim {
             capacity: s.capacity,
             generation: s.generation,
             parity: s.current,
-            packed: s.packed,
+            layout: s.layout,
+            births: &s.births,
+            tiny: planner.map_or(([0; 4], [0; 4]), |p| {
+                let (hi, lo) = double_single(p.clock_secs());
+                let (first, len) = p.birth_window();
+                let first_kept = first.max(s.births_floor);
+                let len = (first + u64::from(len)).saturating_sub(first_kept) as u32;
+                (
+                    [hi.to_bits(), lo.to_bits(), first_kept as u32, len],
+                    [s.births_mask, (p.last_dt_secs() as f32).to_bits(), 0, 0],
+                )
+            }),
             spawned_total: planner.map_or(0, |p| p.spawned_total()),
             life_range: s.life_range,
             seed_salt: (s.seed, s.salt),
@@ -677,7 +812,7 @@ impl GpuSim {
             .get(index)
             .ok_or_else(|| SimError::Readback(format!("no emitter {index}")))?;
         let n = particles.len().min(s.capacity as usize);
-        if s.packed {
+        if s.layout != StateLayout::Full {
             return Err(SimError::Readback(
                 "write_particles needs full (unpacked) state".into(),
             ));
@@ -699,31 +834,43 @@ impl GpuSim {
             .emitters
             .get(index)
             .ok_or_else(|| SimError::Readback(format!("no emitter {index}")))?;
-        let bytes = read_buffer(
-            &self.ctx,
-            &s.buffers[s.current],
-            s.capacity as u64 * state_stride(s.packed),
-        )?;
-        if !s.packed {
+        let bytes = read_buffer(&self.ctx, &s.buffers[s.current], s.layout.bytes(s.capacity))?;
+        if s.layout == StateLayout::Full {
             return Ok(bytemuck::pod_collect_to_vec(&bytes));
         }
         // Unpack with each slot's lifetime re-derived from its spawn counter.
-        let total = self
-            .planner
-            .emitters
-            .get(index)
-            .map_or(0, |p| p.spawned_total());
+        let planner = self.planner.emitters.get(index);
+        let total = planner.map_or(0, |p| p.spawned_total());
+        let life_of = |slot: u32| {
+            let c = slot_counter(slot, total, s.capacity);
+            let key = crate::rng::spawn_key(s.seed, s.salt, slot, c);
+            let r = crate::rng::unorm4(crate::rng::rand_block(key, 1))[3];
+            (c, crate::sim::planner::mix(s.life_range.0, s.life_range.1, r))
+        };
         let packed: Vec<PackedParticle> = bytemuck::pod_collect_to_vec(&bytes);
-        Ok(packed
-            .iter()
-            .enumerate()
-            .map(|(slot, q)| {
-                let slot = slot as u32;
-                let c = slot_counter(slot, total, s.capacity);
-                let key = crate::rng::spawn_key(s.seed, s.salt, slot, c);
-                let r = crate::rng::unorm4(crate::rng::rand_block(key, 1))[3];
-                let life = crate::sim::planner::mix(s.life_range.0, s.life_range.1, r);
-                q.unpack(life)
+        if s.layout == StateLayout::Packed {
+            return Ok(packed
+                .iter()
+                .enumerate()
+                .map(|(slot, q)| q.unpack(life_of(slot as u32).1))
+                .collect());
+        }
+        // Tiny: ages from the birth table's batches, as the GPU computes them.
+        let now = planner.map_or(0.0, |p| p.clock_secs());
+        Ok((0..s.capacity)
+            .map(|slot| {
+                let words: [u32; 5] = bytemuck::cast(packed[(slot / 2) as usize]);
+                let (c, life) = life_of(slot);
+                let age = planner.and_then(|p| p.birth_age(c, now, s.births_floor));
+                match (tiny_decode(words, slot), age) {
+                    (Some((pos, vel)), Some(age)) if age >= 0.0 && age < f64::from(life) => {
+                        Particle {
+                            pos_age: [pos[0], pos[1], pos[2], age as f32],
+                            vel_life: [vel[0], vel[1], vel[2], life],
+                        }
+                    }
+                    _ => Particle::default(),
+                }
             })
             .collect())
     }
@@ -738,6 +885,13 @@ impl GpuSim {
             .emitters
             .get(index)
             .ok_or_else(|| SimError::Readback(format!("no emitter {index}")))?;
+        if s.layout == StateLayout::Tiny && self.ctx.is_cpu_adapter() {
+            // Counted from the unpacked state (the on-demand count pass has no birth table).
+            let alive = self.read_particles(index)?.iter().filter(|p| p.is_alive()).count();
+            let bytes = read_buffer(&self.ctx, &s.counters, 8)?;
+            let v: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+            return Ok([alive as u32, v[1]]);
+        }
         if s.stateless {
             let now = self.planner.time_secs.rem_euclid(4096.0) as f32;
             let alive = self
@@ -788,7 +942,7 @@ impl GpuSim {
                     label: Some("GpuSim::count"),
                     timestamp_writes: None,
                 });
-                pass.set_pipeline(&count[usize::from(s.packed)]);
+                pass.set_pipeline(&count[usize::from(s.layout == StateLayout::Packed)]);
                 pass.set_bind_group(0, &group, &[]);
                 let (x, y) = dispatch_size(s.capacity);
                 pass.dispatch_workgroups(x, y, 1);
@@ -811,6 +965,9 @@ impl GpuSim {
             s.current = 0;
             s.whole_pool_until = f64::NEG_INFINITY;
             s.spawned_end = 0;
+            // Batch numbers start again at 0 (the table's entries are rewritten as they come).
+            s.births_floor = 0;
+            s.births_mirror.clear();
         }
         self.ctx.queue.submit([enc.finish()]);
         self.planner.reset();
@@ -820,13 +977,13 @@ impl GpuSim {
 /// Slots one update invocation handles (`SLOTS_PER_INVOCATION` in `shaders/update.wgsl`).
 pub const SLOTS_PER_INVOCATION: u32 = 2;
 
-/// Bytes per slot: 20 packed, 32 full.
-pub fn state_stride(packed: bool) -> u64 {
-    if packed {
-        size_of::<PackedParticle>() as u64
-    } else {
-        size_of::<Particle>() as u64
-    }
+/// A step's window of the birth table without the batches before `floor` (sequence
+/// numbers; see `EmitterState::births_floor`): `SimParams::tiny`.
+fn tiny_window(p: &SimParams, floor: u64) -> [u32; 4] {
+    let first = u64::from(p.tiny[2]);
+    let end = first + u64::from(p.tiny[3]);
+    let kept = first.max(floor);
+    [p.tiny[0], p.tiny[1], kept as u32, end.saturating_sub(kept) as u32]
 }
 
 /// Workgroups for `slots` slots of 256, as a 2-D grid (x ≤ 65535).

@@ -29,9 +29,11 @@ impl Modules {
     pub const STATELESS: Modules = Modules(256);
     /// Packed 20-byte state.
     pub const PACKED: Modules = Modules(512);
+    /// Tiny 10-byte state.
+    pub const TINY: Modules = Modules(1024);
 
     /// Every module with its override-constant name.
-    pub const ALL: [(Modules, &'static str); 10] = [
+    pub const ALL: [(Modules, &'static str); 11] = [
         (Self::DRAG, "MOD_DRAG"),
         (Self::GUSTS, "MOD_GUSTS"),
         (Self::QUADRATIC_DRAG, "MOD_QUADRATIC_DRAG"),
@@ -42,6 +44,7 @@ impl Modules {
         (Self::COLLISIONS, "MOD_COLLISIONS"),
         (Self::STATELESS, "MOD_STATELESS"),
         (Self::PACKED, "MOD_PACKED"),
+        (Self::TINY, "MOD_TINY"),
     ];
 
     /// The modules an emitter's settings need.
@@ -81,6 +84,8 @@ impl Modules {
         }
         if e.stateless && e.stateless_blockers().is_empty() {
             m.0 |= Self::STATELESS.0;
+        } else if e.tiny_state {
+            m.0 |= Self::TINY.0;
         } else if e.packed_state {
             m.0 |= Self::PACKED.0;
         }

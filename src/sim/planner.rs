@@ -4,7 +4,7 @@
 use std::collections::VecDeque;
 
 use crate::effect::{Effect, Emitter, Shape};
-use crate::gpu::types::SimParams;
+use crate::gpu::types::{Birth, SimParams, double_single};
 use crate::rng;
 
 /// Spawn accounting of one emitter (shown in the stats panel).
@@ -32,9 +32,32 @@ struct Batch {
     /// lifetime range seen since its spawn (packed state re-derives lifetimes from the
     /// current range, so a particle's life stretches while the range is raised).
     max_life_secs: f64,
+    /// This emitter's batch sequence number (the tiny state's birth table is indexed by it).
+    seq: u64,
+    /// The spawning step's start (emitter clock), size, and the birth fractions of its
+    /// first spawn and per spawn — exactly the f32 values the GPU spawned with.
+    t0_secs: f64,
+    dt_secs: f32,
+    frac0: f32,
+    frac_step: f32,
 }
 
 impl Batch {
+    /// The birth-table entry of this batch.
+    fn birth(&self) -> Birth {
+        let (t0_hi, t0_lo) = double_single(self.t0_secs);
+        Birth {
+            first: self.first_index as u32,
+            count: self.count,
+            t0_hi,
+            t0_lo,
+            dt: self.dt_secs,
+            frac0: self.frac0,
+            frac_step: self.frac_step,
+            pad: 0,
+        }
+    }
+
     /// Every particle of the batch is dead at `at_secs` (the emitter's clock): it outlived
     /// the longest lifetime it could have, with a margin for the GPU's f32 ages — they
     /// grow by `dt` each step, and the rounding of those sums can lean one way for a
@@ -93,6 +116,8 @@ pub struct EmitterPlanner {
     min_dt_secs: f64,
     /// The step size of the last planned step.
     last_dt_secs: f64,
+    /// The sequence number the next batch gets.
+    next_seq: u64,
 }
 
 /// Plans every emitter of an effect, step after step.
@@ -227,8 +252,16 @@ impl EmitterPlanner {
                 birth_secs: c0 + dt * frac0.clamp(0.0, 1.0),
                 youngest_birth_secs: c0 + dt,
                 max_life_secs: max_life_now,
+                seq: self.next_seq,
+                t0_secs: c0,
+                dt_secs,
+                frac0: frac0 as f32,
+                frac_step: frac_step as f32,
             });
+            self.next_seq += 1;
         }
+        let (t0_hi, t0_lo) = double_single(c0);
+        let (first_seq, entries) = self.birth_window();
         self.spawned_total += count;
         self.stats.spawned += count;
 
@@ -246,6 +279,47 @@ impl EmitterPlanner {
         )
         .with_spawn_fractions(frac0 as f32, frac_step as f32)
         .with_update_window(update_window)
+        .with_births([t0_hi.to_bits(), t0_lo.to_bits(), first_seq as u32, entries])
+    }
+
+    /// The batches of the birth table (tiny state): the first sequence number and how
+    /// many — every step whose particles may still be alive, oldest first.
+    pub fn birth_window(&self) -> (u64, u32) {
+        let first = self.history.front().map_or(self.next_seq, |b| b.seq);
+        (first, self.history.len() as u32)
+    }
+
+    /// The sequence number the next batch will get.
+    pub fn next_seq(&self) -> u64 {
+        self.next_seq
+    }
+
+    /// The birth-table entries of the batches that may still be alive: (sequence number,
+    /// entry), oldest first.
+    pub fn births(&self) -> impl Iterator<Item = (u64, Birth)> + '_ {
+        self.history.iter().map(|b| (b.seq, b.birth()))
+    }
+
+    /// The age at `at_secs` (this emitter's clock) of the particle with spawn counter
+    /// `counter`, if a batch that may still be alive, from sequence number `min_seq` on,
+    /// spawned it (the CPU mirror of the tiny state's `birth_age`).
+    pub fn birth_age(&self, counter: u64, at_secs: f64, min_seq: u64) -> Option<f64> {
+        let b = self.history.iter().find(|b| {
+            b.seq >= min_seq && counter >= b.first_index && counter < b.first_index + b.count as u64
+        })?;
+        let k = (counter - b.first_index) as f32;
+        let f = (b.frac0 + k * b.frac_step).clamp(0.0, 1.0);
+        Some(at_secs - b.t0_secs - f64::from(b.dt_secs * f))
+    }
+
+    /// The time on this emitter's clock of the state before the last step.
+    pub fn previous_clock_secs(&self) -> f64 {
+        self.clock_secs - self.last_dt_secs
+    }
+
+    /// The size of the last planned step (s).
+    pub fn last_dt_secs(&self) -> f64 {
+        self.last_dt_secs
     }
 
     /// Counts still-alive particles the ring is about to overwrite.
@@ -359,6 +433,11 @@ impl SimParams {
 
     fn with_update_window(mut self, window: [u32; 4]) -> Self {
         self.update_window = window;
+        self
+    }
+
+    fn with_births(mut self, tiny: [u32; 4]) -> Self {
+        self.tiny = tiny;
         self
     }
 }
@@ -522,5 +601,6 @@ pub fn build_params(
         spheres,
         collide_c: [if col.stick_on_contact { 1.0 } else { 0.0 }, 0.0, 0.0, 0.0],
         update_window: [0, capacity, 0, 0],
+        tiny: [0; 4],
     }
 }

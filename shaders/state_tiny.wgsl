@@ -1,0 +1,61 @@
+// state_tiny.wgsl — the update pass's state I/O for the `tiny_state` option: 10 bytes a
+// slot (common.wgsl, "Tiny state"): f16 position, a shared-exponent velocity in 32 bits;
+// the age from the birth table (births.wgsl), the lifetime from the spawn hash. Two
+// adjacent slots share a word, so one invocation updates a pair: `begin_pair` reads its
+// five words, `load_state` / `store_state` work on them, `end_pair` writes them. Rounding
+// is dithered by a hash of (slot, step). Composed in place of state_full.wgsl (same
+// bindings, plus 4 `births`). Plumbing, not a hook.
+//
+// Contract: group 0 binding 1 `src` (read), 2 `dst` (written), 4 `births`; needs `params`
+// (SimParams: `tiny` = t0 hi, lo bits, table's first sequence number, entries; `flags` =
+// the table's index mask).
+#import "common.wgsl"
+#import "rng.wgsl"
+#import "births.wgsl"
+
+@group(0) @binding(1) var<storage, read> src: array<PackedParticle>;
+@group(0) @binding(2) var<storage, read_write> dst: array<PackedParticle>;
+@group(0) @binding(4) var<storage, read> births: array<Birth>;
+
+override MOD_PACKED: bool = false;
+override MOD_TINY: bool = true;
+// Invocations update adjacent pairs of slots (update.wgsl).
+const PAIRED_STATE: bool = true;
+
+var<private> pair: PackedParticle;
+
+fn begin_pair(k: u32) {
+    pair = src[k];
+}
+
+fn end_pair(k: u32) {
+    dst[k] = pair;
+}
+
+fn load_state(slot: u32) -> Particle {
+    let s = tiny_decode(tiny_bits(pair, (slot & 1u) != 0u));
+    if s.dead {
+        return Particle(vec4<f32>(0.0), vec4<f32>(0.0));
+    }
+    // The ring before this step's spawns: `spawn_base` spawned, next slot `spawn_head`.
+    let c = slot_counter(slot, params.spawn_head, params.spawn_base_lo, params.spawn_base_hi, params.capacity);
+    let now = bitcast<vec2<f32>>(params.tiny.xy);
+    let age = birth_age(c.x, now, vec3<u32>(params.tiny.zw, params.flags));
+    let key = spawn_key(params.seed, params.emitter_salt, slot, c.x, c.y);
+    let life = spawn_life(key, params.speed_life.z, params.speed_life.w);
+    if !(age >= 0.0 && age < life) {
+        return Particle(vec4<f32>(0.0), vec4<f32>(0.0));
+    }
+    return Particle(vec4<f32>(s.pos, age), vec4<f32>(s.vel, life));
+}
+
+fn store_state(slot: u32, p: Particle) {
+    var b = vec3<u32>(TINY_DEAD, 0u, 0u);
+    if is_alive(p) {
+        let step_key = bitcast<u32>(params.wind_time.w) ^ params.spawn_base_lo;
+        let d0 = unorm4(pcg4d(vec4<u32>(slot, step_key, params.seed, 0x71Au)));
+        let d1 = unorm4(pcg4d(vec4<u32>(slot, step_key, params.seed, 0x71Bu)));
+        b = tiny_encode(p.pos_age.xyz, p.vel_life.xyz, d0, d1);
+    }
+    pair = tiny_put(pair, (slot & 1u) != 0u, b);
+}
