@@ -637,7 +637,10 @@ fn tiny_state_follows_the_full_state() {
     for (slot, (p, q)) in pa.iter().zip(&pb).enumerate() {
         if p.is_alive() != q.is_alive() {
             // Only where f32 age sums and the exact age straddle the lifetime.
-            let (life, age) = (p.vel_life[3].max(q.vel_life[3]), p.pos_age[3].max(q.pos_age[3]));
+            let (life, age) = (
+                p.vel_life[3].max(q.vel_life[3]),
+                p.pos_age[3].max(q.pos_age[3]),
+            );
             assert!((life - age).abs() <= 1e-4, "slot {slot}: {p:?} vs {q:?}");
             borderline += 1;
             continue;
@@ -646,7 +649,10 @@ fn tiny_state_follows_the_full_state() {
             continue;
         }
         alive += 1;
-        assert!((q.vel_life[3] - p.vel_life[3]).abs() <= 1e-6 * p.vel_life[3], "slot {slot}: lifetime");
+        assert!(
+            (q.vel_life[3] - p.vel_life[3]).abs() <= 1e-6 * p.vel_life[3],
+            "slot {slot}: lifetime"
+        );
         // The full state sums dt each step in f32; the tiny age is t − birth.
         worst_age = worst_age.max((q.pos_age[3] - p.pos_age[3]).abs());
         let dx = (q.position() - p.position()).length();
@@ -668,9 +674,15 @@ fn tiny_state_follows_the_full_state() {
     // dithered each step: a random walk damped by the drag; positions integrate it.
     assert!(rms_vel < 0.05, "velocity rms deviation {rms_vel} m/s");
     assert!(rms_pos < 0.03, "position rms deviation {rms_pos} m");
-    assert!(worst_vel < 0.25 && worst_pos < 0.15, "worst {worst_vel} m/s, {worst_pos} m");
+    assert!(
+        worst_vel < 0.25 && worst_pos < 0.15,
+        "worst {worst_vel} m/s, {worst_pos} m"
+    );
     assert!(worst_pos > 0.0, "tiny state must round something");
-    let (ca, cb) = (a.read_counters(0).expect("count")[0], b.read_counters(0).expect("count")[0]);
+    let (ca, cb) = (
+        a.read_counters(0).expect("count")[0],
+        b.read_counters(0).expect("count")[0],
+    );
     assert!(ca.abs_diff(cb) <= borderline as u32, "alive {ca} vs {cb}");
 }
 
@@ -704,22 +716,39 @@ fn tiny_birth_table_grows_and_restarts() {
     b.step(&grown, dt, 10).expect("step");
     a.step(&full_grown, dt, 10).expect("step");
     let after = alive(&b);
-    assert!((14..=16).contains(&after), "after the restart {after} alive (15 born)");
+    assert!(
+        (14..=16).contains(&after),
+        "after the restart {after} alive (15 born)"
+    );
     b.step(&grown, dt, 500).expect("step");
     let later = alive(&b);
-    assert!((760..=765).contains(&later), "{later} alive 0.51 s after the restart");
+    assert!(
+        (760..=765).contains(&later),
+        "{later} alive 0.51 s after the restart"
+    );
     assert_eq!(b.read_counters(0).expect("count")[0] as usize, later);
 }
 
 /// Packed and full state draw the same frame (both draw paths read packed state).
 #[test]
 fn packed_state_renders_like_the_full_state() {
+    compact_state_renders_like_the_full_state(|e| e.packed_state = true, 0.5);
+}
+
+/// Tiny and full state draw nearly the same frame (both draw paths and the sort read tiny
+/// state; the turbulent flames amplify the rounding, so the bound is looser).
+#[test]
+fn tiny_state_renders_like_the_full_state() {
+    compact_state_renders_like_the_full_state(|e| e.tiny_state = true, 1.0);
+}
+
+fn compact_state_renders_like_the_full_state(set: impl Fn(&mut Emitter), max_mean: f64) {
     let ctx = gpu();
     let mut full = ignis::effect::Effect::default_campfire();
     full.post.bloom = None;
     let mut packed = full.clone();
     for e in &mut packed.emitters {
-        e.packed_state = true;
+        set(e);
     }
     let render = |effect: ignis::effect::Effect| {
         let mut run = ignis::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
@@ -736,7 +765,8 @@ fn packed_state_renders_like_the_full_state() {
     let (b, alive_b) = render(packed);
     assert_eq!(alive_a, alive_b);
     let (mean, _) = image_diff(&a, &b);
-    assert!(mean < 0.5, "mean |difference| {mean}");
+    println!("mean |difference| {mean:.3}");
+    assert!(mean < max_mean, "mean |difference| {mean}");
     assert!(
         a.pixels().filter(|p| p[0] > 100).count() > 500,
         "fire drawn"

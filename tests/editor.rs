@@ -985,19 +985,26 @@ fn look_controls_toggle_flipbook_streak_bloom_and_the_gradient_bar_adds_stops() 
 }
 
 #[test]
-fn packed_state_is_offered_and_excludes_stateless() {
+fn state_sizes_are_offered_and_exclude_stateless() {
     let mut harness = panel_harness(campfire_state());
-    harness.get_by_label("Packed state").click_accesskit();
+    harness.get_by_label("20 B packed").click_accesskit();
     harness.run();
     let e = &harness.state().effect.emitters[0];
-    assert!(e.packed_state && !e.stateless);
+    assert!(e.packed_state && !e.tiny_state && !e.stateless);
+    harness.get_by_label("10 B tiny").click_accesskit();
+    harness.run();
+    let e = &harness.state().effect.emitters[0];
+    assert!(e.tiny_state && !e.packed_state, "one layout at a time");
+    assert!(harness.state().effect.validate().is_ok());
     harness.get_by_label("Stateless").click_accesskit();
     harness.run();
     let e = &harness.state().effect.emitters[0];
     assert!(
-        e.stateless && !e.packed_state,
-        "turning stateless on turns packed off"
+        e.stateless && !e.packed_state && !e.tiny_state,
+        "turning stateless on turns the compact layouts off"
     );
+    harness.get_by_label("32 B").click_accesskit();
+    harness.run();
     assert!(harness.state().effect.validate().is_ok());
 }
 

@@ -684,6 +684,17 @@ fn malformed_cases() -> Vec<Case> {
         ],
     ));
 
+    let t = edit(
+        &base,
+        "seed_offset: 3,",
+        "seed_offset: 3, packed_state: true, tiny_state: true,",
+    );
+    cases.push(case(
+        "two_layouts.ron",
+        t,
+        &["emitters[0].tiny_state = true: cannot be combined with `packed_state`"],
+    ));
+
     cases.push(case("empty.ron", "", &["empty.ron:1:1: the file is empty"]));
     cases.push(case(
         "only_comments.ron",

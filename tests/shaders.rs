@@ -30,10 +30,18 @@ fn every_entry_validates() {
         .unwrap_or_else(|e| panic!("packed update: {e}"));
     assert!(packed.files.iter().any(|f| f == "state_packed.wgsl"));
     assert!(!packed.files.iter().any(|f| f == "state_full.wgsl"));
-    // Hot reload's dependencies of the update pass include the variant.
+    // The tiny-state update: state_tiny.wgsl (and the birth table) as its state I/O.
+    let tiny = project_shaders()
+        .compose_with("update.wgsl", &[ignis::shaders::TINY_STATE_IO])
+        .unwrap_or_else(|e| panic!("tiny update: {e}"));
+    assert!(tiny.files.iter().any(|f| f == "state_tiny.wgsl"));
+    assert!(!tiny.files.iter().any(|f| f == "state_full.wgsl"));
+    // Hot reload's dependencies of the update pass include the variants.
     let deps = project_shaders().dependencies("update.wgsl").expect("deps");
     assert!(deps.iter().any(|f| f == "state_packed.wgsl"));
+    assert!(deps.iter().any(|f| f == "state_tiny.wgsl"));
     reached.extend(packed.files);
+    reached.extend(tiny.files);
     for f in std::fs::read_dir(dir).expect("shaders/") {
         let name = f.expect("entry").file_name().to_string_lossy().into_owned();
         if name.ends_with(".wgsl") {
@@ -64,6 +72,7 @@ fn rust_and_wgsl_struct_sizes_agree() {
             "PackedParticle",
             size_of::<ignis::gpu::types::PackedParticle>(),
         ),
+        (&update, "Birth", size_of::<ignis::gpu::types::Birth>()),
         (&billboard, "CameraUniform", size_of::<CameraUniform>()),
         (&billboard, "LookUniform", size_of::<LookUniform>()),
         (&tonemap, "ToneUniform", size_of::<ToneUniform>()),

@@ -13,7 +13,7 @@ use crate::effect::{
 };
 use crate::gpu::GpuContext;
 use crate::gpu::timer::{GpuTimer, median};
-use crate::gpu::types::Particle;
+use crate::gpu::types::{Particle, StateLayout};
 use crate::headless::Headless;
 use crate::shaders::ShaderLibrary;
 use crate::sim::cpu_reference::Forces;
@@ -243,16 +243,17 @@ pub fn measure_error(
     Ok(error_point(setup, integrator, dt, &fin))
 }
 
-/// As [`measure_error`] with the packed 20-byte state: the same burst spawns the same
-/// initial state (packed from its first store on), then the same steps.
-pub fn measure_error_packed(
+/// As [`measure_error`] with a compact state (packed 20 bytes or tiny 10): the same burst
+/// spawns the same initial state (compact from its first store on), then the same steps.
+pub fn measure_error_compact(
     ctx: &GpuContext,
     setup: &SceneSetup,
     integrator: Integrator,
     dt: f64,
+    layout: StateLayout,
 ) -> Result<ErrorPoint, SimError> {
     let mut e = scene_emitter(setup.scene, integrator, setup.initial.len() as u32);
-    e.packed_state = true;
+    set_layout(&mut e, layout);
     let effect = Effect {
         emitters: vec![e],
         ..Effect::default()
@@ -264,19 +265,34 @@ pub fn measure_error_packed(
     sim.step(&effect, dt as f32, steps)?;
     let fin = sim.read_particles(0)?;
     let mut p = error_point(setup, integrator, dt, &fin);
-    p.integrator = packed_label(integrator);
+    p.integrator = compact_label(integrator, layout);
     Ok(p)
 }
 
-/// "<integrator> + packed".
-pub fn packed_label(integrator: Integrator) -> &'static str {
-    match integrator {
-        Integrator::ExplicitEuler => "explicit Euler + packed",
-        Integrator::SemiImplicitEuler => "semi-implicit Euler + packed",
-        Integrator::VelocityVerlet => "velocity Verlet + packed",
-        Integrator::Heun => "Heun + packed",
-        Integrator::Rk4 => "RK4 + packed",
-        Integrator::Exponential => "exponential + packed",
+/// Sets an emitter's state layout.
+fn set_layout(e: &mut crate::effect::Emitter, layout: StateLayout) {
+    e.packed_state = layout == StateLayout::Packed;
+    e.tiny_state = layout == StateLayout::Tiny;
+}
+
+/// "<integrator>", "<integrator> + packed" or "<integrator> + tiny".
+pub fn compact_label(integrator: Integrator, layout: StateLayout) -> &'static str {
+    use Integrator as I;
+    use StateLayout as L;
+    match (layout, integrator) {
+        (L::Full, i) => i.label(),
+        (L::Packed, I::ExplicitEuler) => "explicit Euler + packed",
+        (L::Packed, I::SemiImplicitEuler) => "semi-implicit Euler + packed",
+        (L::Packed, I::VelocityVerlet) => "velocity Verlet + packed",
+        (L::Packed, I::Heun) => "Heun + packed",
+        (L::Packed, I::Rk4) => "RK4 + packed",
+        (L::Packed, I::Exponential) => "exponential + packed",
+        (L::Tiny, I::ExplicitEuler) => "explicit Euler + tiny",
+        (L::Tiny, I::SemiImplicitEuler) => "semi-implicit Euler + tiny",
+        (L::Tiny, I::VelocityVerlet) => "velocity Verlet + tiny",
+        (L::Tiny, I::Heun) => "Heun + tiny",
+        (L::Tiny, I::Rk4) => "RK4 + tiny",
+        (L::Tiny, I::Exponential) => "exponential + tiny",
     }
 }
 
@@ -335,10 +351,10 @@ pub fn measure_cost(
     integrator: Integrator,
     capacity: u32,
     repeats: usize,
-    packed: bool,
+    layout: StateLayout,
 ) -> Result<f64, SimError> {
     let mut e = scene_emitter(scene, integrator, capacity);
-    e.packed_state = packed;
+    set_layout(&mut e, layout);
     let effect = Effect {
         emitters: vec![e],
         ..Effect::default()
@@ -523,19 +539,21 @@ pub fn run(
         let setup = setup_scene(ctx, scene, n)?;
         let mut rows = Vec::new();
         let mut frontier = Vec::new();
-        // Every integrator on the full state, then the packed state's cost for two of them.
-        let runs = Integrator::ALL.iter().map(|i| (*i, false)).chain([
-            (Integrator::SemiImplicitEuler, true),
-            (Integrator::Rk4, true),
-        ]);
-        for (integrator, packed) in runs {
-            let label = if packed {
-                packed_label(integrator)
-            } else {
-                integrator.label()
-            };
+        // Every integrator on the full state, then the compact states' cost for two of them.
+        let runs = Integrator::ALL
+            .iter()
+            .map(|i| (*i, StateLayout::Full))
+            .chain([
+                (Integrator::SemiImplicitEuler, StateLayout::Packed),
+                (Integrator::Rk4, StateLayout::Packed),
+                (Integrator::SemiImplicitEuler, StateLayout::Tiny),
+                (Integrator::Rk4, StateLayout::Tiny),
+            ]);
+        for (integrator, layout) in runs {
+            let packed = layout != StateLayout::Full;
+            let label = compact_label(integrator, layout);
             eprintln!("bench accuracy: {} / {label}", scene.label());
-            let cost = measure_cost(ctx, scene, integrator, cost_capacity, opts.repeats, packed)?;
+            let cost = measure_cost(ctx, scene, integrator, cost_capacity, opts.repeats, layout)?;
             if packed {
                 packed_costs
                     .push(serde_json::json!({"scene": scene, "integrator": label, "ns": cost}));
@@ -546,7 +564,7 @@ pub fn run(
             let mut row = vec![label.to_owned()];
             for dt in DTS {
                 let p = if packed {
-                    measure_error_packed(ctx, &setup, integrator, dt)?
+                    measure_error_compact(ctx, &setup, integrator, dt, layout)?
                 } else {
                     measure_error(ctx, &setup, integrator, dt)?
                 };
@@ -577,8 +595,10 @@ pub fn run(
         header.push("ns/particle-step");
         report.para(
             "Each cell: RMS / max relative position error. \"+ packed\" rows: the same runs on the packed \
-             20-byte state (f16 velocity with dithered rounding, 16-bit life fraction); the difference to \
-             the row above is the packing's accuracy cost.",
+             20-byte state (f16 velocity with dithered rounding, 16-bit life fraction); \"+ tiny\" rows: on \
+             the tiny 10-byte state (f16 position, shared-exponent velocity with 8 significant bits, exact \
+             ages from the birth table); the difference to the full-state row of the same integrator is the \
+             packing's accuracy cost.",
         );
         report.table(&header, &rows);
         let mut lines = Vec::new();

@@ -8,6 +8,7 @@ use crate::bench::report::sci;
 use crate::effect::{DrawPath, Effect, Emitter, Range};
 use crate::gpu::GpuContext;
 use crate::gpu::timer::{GpuTimer, median};
+use crate::gpu::types::StateLayout;
 use crate::render::{OrbitCamera, Renderer, begin_hdr_pass};
 use crate::shaders::ShaderLibrary;
 use crate::sim::{GpuSim, Modules, SimError};
@@ -160,7 +161,7 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) n: vec3<u
 ";
 
 /// The same copy with the packed state's 20-byte elements (five scalars, as the update
-/// reads and writes them).
+/// reads and writes them; a tiny-state pair of slots is the same five words).
 const COPY20_WGSL: &str = "
 struct Q { a: u32, b: u32, c: u32, d: u32, e: u32 }
 @group(0) @binding(0) var<storage, read> src: array<Q>;
@@ -172,28 +173,31 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) n: vec3<u
 }
 ";
 
-/// One row of the packed-state table: update ms of the packed pools and of a compute copy
-/// of the same bytes (20 read + 20 written per particle).
+/// One row of a compact-state table: update ms of the packed (or tiny) pools and of a
+/// compute copy of the same bytes (20 read + 20 written per packed particle, 10 + 10 per
+/// tiny one).
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct PackedRow {
     /// Particles.
     pub particles: u64,
-    /// Update pass on packed state, ms.
+    /// Update pass on the compact state, ms.
     pub update_ms: f64,
     /// Copy of the same bytes, ms.
     pub copy_ms: f64,
 }
 
-fn measure_packed(
+fn measure_compact(
     ctx: &GpuContext,
     opts: &PerfOptions,
     n: u64,
+    layout: StateLayout,
     copy: &(wgpu::ComputePipeline, wgpu::BindGroupLayout),
 ) -> Result<PackedRow, SimError> {
     let max_pool = ctx.max_capacity().min(1 << 24);
     let mut effect = lean_effect(&scaled_campfire(n, max_pool));
     for e in &mut effect.emitters {
-        e.packed_state = true;
+        e.packed_state = layout == StateLayout::Packed;
+        e.tiny_state = layout == StateLayout::Tiny;
     }
     let mut sim = GpuSim::new(ctx, ShaderLibrary::embedded(), &effect)?;
     for _ in 0..3 {
@@ -224,7 +228,7 @@ fn time_update(
 }
 
 /// Median time of `copy` over every pool of `sim` (current → previous: the bytes one
-/// update step reads and writes).
+/// update step reads and writes; one invocation per element of the copy's type).
 fn time_copy(
     timer: &GpuTimer,
     ctx: &GpuContext,
@@ -249,7 +253,11 @@ fn time_copy(
                     },
                 ],
             });
-            (group, b.capacity)
+            let element = match b.layout {
+                StateLayout::Full => 32,
+                _ => 20,
+            };
+            (group, (b.layout.bytes(b.capacity) / element) as u32)
         })
         .collect();
     time_median(timer, ctx, repeats, |enc| {
@@ -630,8 +638,10 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
     let costs = module_costs(ctx, opts)?;
     let copy = copy_pipeline(ctx, COPY_WGSL);
     let copy20 = copy_pipeline(ctx, COPY20_WGSL);
-    let mut packed_table = Vec::new();
-    let mut packed_rows = Vec::new();
+    // Per compact layout: its table and JSON rows.
+    let compact = [(StateLayout::Packed, "packed"), (StateLayout::Tiny, "tiny")];
+    let mut compact_tables = [Vec::new(), Vec::new()];
+    let mut compact_rows = [Vec::new(), Vec::new()];
     let mut rows = Vec::new();
     let mut table = Vec::new();
     let limit = ctx.max_capacity() * 8;
@@ -677,14 +687,18 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
             "side": side, "row": row, "update_gb_per_s": gbps, "copy_gb_per_s": copy_gbps,
             "update_vs_copy": row.copy_ms / row.lean_update_ms, "fps": fps, "thesis_fps": thesis,
         }));
-        // The packed state, from 1M particles up (below, launch overheads dominate).
-        if n >= 1 << 20 {
-            eprintln!("bench perf: {side}² packed");
-            match measure_packed(ctx, opts, n, &copy20) {
+        // The compact states, from 1M particles up (below, launch overheads dominate).
+        for (k, (layout, name)) in compact.iter().enumerate() {
+            if n < 1 << 20 {
+                break;
+            }
+            eprintln!("bench perf: {side}² {name}");
+            let moved = 2.0 * layout.slot_bytes() as f64;
+            match measure_compact(ctx, opts, n, *layout, &copy20) {
                 Ok(p) => {
-                    let pgbps = n as f64 * 40.0 / (p.update_ms * 1e-3) / 1e9;
-                    let pcopy = n as f64 * 40.0 / (p.copy_ms * 1e-3) / 1e9;
-                    packed_table.push(vec![
+                    let pgbps = n as f64 * moved / (p.update_ms * 1e-3) / 1e9;
+                    let pcopy = n as f64 * moved / (p.copy_ms * 1e-3) / 1e9;
+                    compact_tables[k].push(vec![
                         format!("{side}² = {n}"),
                         format!("{:.3}", p.update_ms),
                         format!("{:.3}", row.lean_update_ms),
@@ -695,13 +709,14 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
                             100.0 * p.copy_ms / p.update_ms
                         ),
                     ]);
-                    packed_rows.push(serde_json::json!({
+                    compact_rows[k].push(serde_json::json!({
                         "side": side, "row": p, "full_update_ms": row.lean_update_ms,
+                        "bytes_moved_per_particle_step": moved,
                         "update_gb_per_s": pgbps, "copy_gb_per_s": pcopy,
                         "update_vs_copy": p.copy_ms / p.update_ms,
                     }));
                 }
-                Err(e) => report.para(&format!("{side}² packed: {e}")),
+                Err(e) => report.para(&format!("{side}² {name}: {e}")),
             }
         }
     }
@@ -723,6 +738,18 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
         ],
         &table,
     );
+    let [packed_table, tiny_table] = compact_tables;
+    let [packed_rows, tiny_rows] = compact_rows;
+    let compact_header = |what: &str| {
+        [
+            "particles".to_string(),
+            format!("{what} update ms"),
+            "full update ms (above, without turbulence)".into(),
+            "speed-up".into(),
+            "copy ms (20 B elements)".into(),
+            format!("{what} bandwidth (vs copy)"),
+        ]
+    };
     report.heading("Packed state (20 B per particle)");
     report.para(
         "The `packed_state` option: f32 position, f16 velocity, 16-bit life fraction, lifetime re-derived \
@@ -730,17 +757,23 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
          moves the same 20-byte elements in the same run. Accuracy cost: `ignis bench accuracy` (\"+ packed\" rows).",
     );
     report.table(
-        &[
-            "particles",
-            "packed update ms",
-            "full update ms (above, without turbulence)",
-            "speed-up",
-            "copy ms (20 B elements)",
-            "packed bandwidth (vs copy)",
-        ],
+        &compact_header("packed").each_ref().map(String::as_str),
         &packed_table,
     );
     report.json["packed"] = serde_json::Value::Array(packed_rows);
+    report.heading("Tiny state (10 B per particle)");
+    report.para(
+        "The `tiny_state` option: f16 position, shared-exponent velocity (8 significant bits of the largest \
+         component), no age (each step's births are in a table the update reads, so ages are exact) and no \
+         lifetime (re-derived) — 20 B moved per particle-step (10 read + 10 written). One invocation updates a \
+         pair of slots (they share a word); the copy moves the same bytes as 20-byte pairs in the same run. \
+         Accuracy cost: `ignis bench accuracy` (\"+ tiny\" rows).",
+    );
+    report.table(
+        &compact_header("tiny").each_ref().map(String::as_str),
+        &tiny_table,
+    );
+    report.json["tiny"] = serde_json::Value::Array(tiny_rows);
     report.heading("Optional modules");
     let bare = costs.first().map_or(f64::NAN, |c| c.2);
     let mcap = opts.module_capacity.min(ctx.max_capacity() as u32);

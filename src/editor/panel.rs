@@ -1262,22 +1262,33 @@ ui,
                     let r = ui.checkbox(&mut e.stateless, "closed form");
                     if r.changed() && e.stateless {
                         e.packed_state = false;
+                        e.tiny_state = false;
                     }
                     r
                 },
             );
-            row_ui(
-                ui,
-                "Packed state",
-                "Store each particle in 20 bytes instead of 32 (f16 velocity, 16-bit life fraction, lifetime re-derived from the spawn hash): less memory traffic for huge pools, at the accuracy cost `ignis bench accuracy` reports (\"+ packed\" rows). Switching restarts this emitter's particles",
-                |ui| {
-                    let r = ui.checkbox(&mut e.packed_state, "20 B / particle");
-                    if r.changed() && e.packed_state {
-                        e.stateless = false;
-                    }
-                    r
-                },
-            );
+            // Three radio buttons, each named by its own text (not by the row's label).
+            let tip = "Bytes stored per particle. 32 B: f32 position, velocity, age, lifetime. 20 B packed: f16 velocity, 16-bit life fraction, lifetime re-derived from the spawn hash. 10 B tiny: f16 position, shared-exponent velocity, age from a table of each step's births. Smaller moves less memory for huge pools, at the accuracy cost `ignis bench accuracy` reports (\"+ packed\", \"+ tiny\" rows). Switching restarts this emitter's particles";
+            ui.label("State size").on_hover_text(tip);
+            ui.horizontal(|ui| {
+                let before = (e.packed_state, e.tiny_state);
+                let mut size = if e.tiny_state {
+                    10
+                } else if e.packed_state {
+                    20
+                } else {
+                    32
+                };
+                for (bytes, text) in [(32, "32 B"), (20, "20 B packed"), (10, "10 B tiny")] {
+                    ui.radio_value(&mut size, bytes, text).on_hover_text(tip);
+                }
+                e.packed_state = size == 20;
+                e.tiny_state = size == 10;
+                if (e.packed_state, e.tiny_state) != before && size != 32 {
+                    e.stateless = false;
+                }
+            });
+            ui.end_row();
             let blockers = e.stateless_blockers();
             if e.stateless && !blockers.is_empty() {
                 ui.label("");

@@ -172,7 +172,12 @@ impl UpdatePass {
         self.pipelines = fresh;
         self.count = Some(count);
         self.files = composed.files;
-        for f in packed.files.into_iter().chain(tiny.files).chain(count_src.files) {
+        for f in packed
+            .files
+            .into_iter()
+            .chain(tiny.files)
+            .chain(count_src.files)
+        {
             if !self.files.contains(&f) {
                 self.files.push(f);
             }
@@ -674,7 +679,10 @@ impl GpuSim {
     /// too small for the span of this submit's windows is replaced by a larger one).
     fn upload_births(&mut self, e: usize, plans: &[Vec<Option<SimParams>>]) {
         let floor = self.emitters[e].births_floor;
-        let steps: Vec<SimParams> = plans.iter().filter_map(|p| p.get(e).copied().flatten()).collect();
+        let steps: Vec<SimParams> = plans
+            .iter()
+            .filter_map(|p| p.get(e).copied().flatten())
+            .collect();
         let (Some(first), Some(last)) = (steps.first(), steps.last()) else {
             return;
         };
@@ -702,7 +710,9 @@ impl GpuSim {
         let span = hi.saturating_sub(lo);
         let size = u64::from(self.emitters[e].births_mask) + 1;
         if span > size {
-            let entries = (span * 2).next_power_of_two().min(u64::from(u32::MAX / 2 + 1)) as u32;
+            let entries = (span * 2)
+                .next_power_of_two()
+                .min(u64::from(u32::MAX / 2 + 1)) as u32;
             let births = self.births_buffer(entries);
             let s = &self.emitters[e];
             let bind_groups = self.bind_groups(&s.buffers, &s.counters, &births);
@@ -714,12 +724,19 @@ impl GpuSim {
             s.bind_groups = bind_groups;
             // The draws' bind groups key on the generation.
             s.generation = generation;
-            fresh = s.births_mirror.iter().copied().filter(|(q, _)| *q >= lo).collect();
+            fresh = s
+                .births_mirror
+                .iter()
+                .copied()
+                .filter(|(q, _)| *q >= lo)
+                .collect();
         }
         let s = &self.emitters[e];
         for (seq, entry) in fresh {
             let at = (seq & u64::from(s.births_mask)) * size_of::<Birth>() as u64;
-            self.ctx.queue.write_buffer(&s.births, at, bytemuck::bytes_of(&entry));
+            self.ctx
+                .queue
+                .write_buffer(&s.births, at, bytemuck::bytes_of(&entry));
         }
         // Later submits read from the last step's window on.
         let keep = u64::from(tiny_window(last, floor)[2]);
@@ -845,7 +862,10 @@ impl GpuSim {
             let c = slot_counter(slot, total, s.capacity);
             let key = crate::rng::spawn_key(s.seed, s.salt, slot, c);
             let r = crate::rng::unorm4(crate::rng::rand_block(key, 1))[3];
-            (c, crate::sim::planner::mix(s.life_range.0, s.life_range.1, r))
+            (
+                c,
+                crate::sim::planner::mix(s.life_range.0, s.life_range.1, r),
+            )
         };
         let packed: Vec<PackedParticle> = bytemuck::pod_collect_to_vec(&bytes);
         if s.layout == StateLayout::Packed {
@@ -887,7 +907,11 @@ impl GpuSim {
             .ok_or_else(|| SimError::Readback(format!("no emitter {index}")))?;
         if s.layout == StateLayout::Tiny && self.ctx.is_cpu_adapter() {
             // Counted from the unpacked state (the on-demand count pass has no birth table).
-            let alive = self.read_particles(index)?.iter().filter(|p| p.is_alive()).count();
+            let alive = self
+                .read_particles(index)?
+                .iter()
+                .filter(|p| p.is_alive())
+                .count();
             let bytes = read_buffer(&self.ctx, &s.counters, 8)?;
             let v: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
             return Ok([alive as u32, v[1]]);
@@ -983,7 +1007,12 @@ fn tiny_window(p: &SimParams, floor: u64) -> [u32; 4] {
     let first = u64::from(p.tiny[2]);
     let end = first + u64::from(p.tiny[3]);
     let kept = first.max(floor);
-    [p.tiny[0], p.tiny[1], kept as u32, end.saturating_sub(kept) as u32]
+    [
+        p.tiny[0],
+        p.tiny[1],
+        kept as u32,
+        end.saturating_sub(kept) as u32,
+    ]
 }
 
 /// Workgroups for `slots` slots of 256, as a 2-D grid (x ≤ 65535).
