@@ -612,7 +612,19 @@ fn tiny_state_follows_the_full_state() {
     let ctx = gpu();
     let mut e = plain_emitter();
     e.capacity = 3001;
-    e.spawn_rate_per_sec = 2000.0;
+    e.spawn_rate_per_sec = 1200.0;
+    // An uneven birth table: bursts between the steady steps (the lookup's guess from the
+    // mean rate misses, its search must not).
+    e.bursts = vec![
+        Burst {
+            time_secs: 0.8,
+            count: 400,
+        },
+        Burst {
+            time_secs: 1.5,
+            count: 300,
+        },
+    ];
     e.lifetime_secs = ignis::effect::Range::new(0.5, 1.5);
     e.speed_m_per_s = ignis::effect::Range::new(1.0, 3.0);
     e.spread_deg = 30.0;
