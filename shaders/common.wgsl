@@ -76,6 +76,9 @@ struct SimParams {
     // f32 bits), z: the birth table's first sequence number, w: its entries (`flags` holds
     // the table's index mask).
     tiny: vec4<u32>,
+    // Tiny state: x: the birth table's oldest entry's first spawn counter (low 32 bits),
+    // y: the counters from it to the newest spawn, zw: unused.
+    tiny_b: vec4<u32>,
 }
 
 const SHAPE_POINT: u32 = 0u;
@@ -237,7 +240,12 @@ struct Birth {
 // capacity): slots are filled in counter order, so it is total − 1 − ((head − 1 − slot)
 // mod capacity). Only meaningful for slots that were ever spawned.
 fn slot_counter(slot: u32, head: u32, total_lo: u32, total_hi: u32, capacity: u32) -> vec2<u32> {
-    let back = (head + capacity - 1u - slot) % capacity + 1u;
+    // (head − 1 − slot) mod capacity without an integer division (both are < capacity).
+    var back = head + capacity - 1u - slot;
+    if back >= capacity {
+        back -= capacity;
+    }
+    back += 1u;
     let lo = total_lo - back;
     let hi = total_hi - select(0u, 1u, total_lo < back);
     return vec2<u32>(lo, hi);

@@ -57,7 +57,8 @@ struct LookUniform {
     // (double-single hi, lo, as f32 bits), z: the birth table's first sequence number,
     // w: its entries.
     tiny: vec4<u32>,
-    // Tiny state: x: the birth table's index mask, y: the last step's size (f32 bits).
+    // Tiny state: x: the birth table's index mask, y: the last step's size (f32 bits),
+    // z: the oldest entry's first spawn counter, w: the counters from it to the newest.
     tiny_b: vec4<u32>,
 }
 
@@ -147,7 +148,8 @@ fn load_pair(slot: u32) -> array<Particle, 2> {
             // Tiny: ages from the birth table; the previous state is one step younger
             // (dead when that is before the birth: the slot held another particle).
             let odd = (slot & 1u) != 0u;
-            let age = birth_age(c.x, bitcast<vec2<f32>>(look.tiny.xy), vec3<u32>(look.tiny.zw, look.tiny_b.x));
+            let b = birth_entry(c.x, vec3<u32>(look.tiny.zw, look.tiny_b.x), look.tiny_b.z, look.tiny_b.w);
+            let age = birth_age(b, c.x, bitcast<vec2<f32>>(look.tiny.xy));
             let ages = vec2<f32>(age, age - bitcast<f32>(look.tiny_b.y));
             let s = array<TinySlot, 2>(
                 tiny_decode(tiny_bits(cur_packed[slot >> 1u], odd)),

@@ -7,8 +7,9 @@
 // bindings, plus 4 `births`). Plumbing, not a hook.
 //
 // Contract: group 0 binding 1 `src` (read), 2 `dst` (written), 4 `births`; needs `params`
-// (SimParams: `tiny` = t0 hi, lo bits, table's first sequence number, entries; `flags` =
-// the table's index mask).
+// (SimParams: `tiny` = t0 hi, lo bits, table's first sequence number, entries; `tiny_b` =
+// the oldest entry's first counter, the counters spanned; `flags` = the table's index
+// mask).
 #import "common.wgsl"
 #import "rng.wgsl"
 #import "births.wgsl"
@@ -23,9 +24,13 @@ override MOD_TINY: bool = true;
 const PAIRED_STATE: bool = true;
 
 var<private> pair: PackedParticle;
+// The birth-table entry of the last lookup: the pair's odd slot usually shares the even
+// slot's (consecutive spawn counters).
+var<private> entry: Birth;
 
 fn begin_pair(k: u32) {
     pair = src[k];
+    entry.count = 0u;
 }
 
 fn end_pair(k: u32) {
@@ -39,8 +44,10 @@ fn load_state(slot: u32) -> Particle {
     }
     // The ring before this step's spawns: `spawn_base` spawned, next slot `spawn_head`.
     let c = slot_counter(slot, params.spawn_head, params.spawn_base_lo, params.spawn_base_hi, params.capacity);
-    let now = bitcast<vec2<f32>>(params.tiny.xy);
-    let age = birth_age(c.x, now, vec3<u32>(params.tiny.zw, params.flags));
+    if c.x - entry.first >= entry.count {
+        entry = birth_entry(c.x, vec3<u32>(params.tiny.zw, params.flags), params.tiny_b.x, params.tiny_b.y);
+    }
+    let age = birth_age(entry, c.x, bitcast<vec2<f32>>(params.tiny.xy));
     let key = spawn_key(params.seed, params.emitter_salt, slot, c.x, c.y);
     let life = spawn_life(key, params.speed_life.z, params.speed_life.w);
     if !(age >= 0.0 && age < life) {
@@ -52,9 +59,11 @@ fn load_state(slot: u32) -> Particle {
 fn store_state(slot: u32, p: Particle) {
     var b = vec3<u32>(TINY_DEAD, 0u, 0u);
     if is_alive(p) {
+        // Six dithers from one hash: 16 bits each.
         let step_key = bitcast<u32>(params.wind_time.w) ^ params.spawn_base_lo;
-        let d0 = unorm4(pcg4d(vec4<u32>(slot, step_key, params.seed, 0x71Au)));
-        let d1 = unorm4(pcg4d(vec4<u32>(slot, step_key, params.seed, 0x71Bu)));
+        let h = pcg4d(vec4<u32>(slot, step_key, params.seed, 0x71Au));
+        let d0 = vec4<f32>(vec4<u32>(h.xyz & vec3<u32>(0xFFFFu), 0u)) / 65536.0;
+        let d1 = vec4<f32>(vec4<u32>(h.xyz >> vec3<u32>(16u), 0u)) / 65536.0;
         b = tiny_encode(p.pos_age.xyz, p.vel_life.xyz, d0, d1);
     }
     pair = tiny_put(pair, (slot & 1u) != 0u, b);

@@ -87,7 +87,11 @@ fn main(
             var touched = false;
             for (var r = 0u; r < 2u; r++) {
                 let slot = 2u * k + r;
-                if slot < params.capacity && (slot + params.capacity - w.x) % params.capacity < w.y {
+                var rel = slot + params.capacity - w.x;
+                if rel >= params.capacity {
+                    rel -= params.capacity;
+                }
+                if slot < params.capacity && rel < w.y {
                     touched = true;
                     if update_at(slot) {
                         alive += 1u;
@@ -127,8 +131,12 @@ fn update_slot(i: u32) -> bool {
 fn update_at(slot: u32) -> bool {
     var alive = false;
     var p = load_state(slot);
-    // Position of this slot in the ring relative to the spawn head (capacity ≤ 2^28).
-    let rel = (slot + params.capacity - params.spawn_head) % params.capacity;
+    // Position of this slot in the ring relative to the spawn head (capacity ≤ 2^28; both
+    // are below it, so no integer division).
+    var rel = slot + params.capacity - params.spawn_head;
+    if rel >= params.capacity {
+        rel -= params.capacity;
+    }
     if rel < params.spawn_count {
         // 64-bit spawn counter = base + rel.
         let lo = params.spawn_base_lo + rel;

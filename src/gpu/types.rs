@@ -245,6 +245,9 @@ pub struct SimParams {
     /// Tiny state: the step's start on the emitter's clock as a double-single (hi, lo; f32
     /// bits), the birth table's first sequence number and its number of entries.
     pub tiny: [u32; 4],
+    /// Tiny state: the oldest birth-table entry's first spawn counter (low 32 bits), the
+    /// counters from it to the newest spawn; unused, unused.
+    pub tiny_b: [u32; 4],
 }
 
 /// Camera data for the billboard pass (keep in sync with `CameraUniform` in
@@ -297,7 +300,8 @@ pub struct LookUniform {
     /// Tiny state: the current state's time (double-single hi, lo; f32 bits), the birth
     /// table's first sequence number and entries.
     pub tiny: [u32; 4],
-    /// Tiny state: the birth table's index mask, the last step's size (f32 bits).
+    /// Tiny state: the birth table's index mask, the last step's size (f32 bits), the
+    /// oldest entry's first spawn counter, the counters from it to the newest spawn.
     pub tiny_b: [u32; 4],
 }
 

@@ -220,9 +220,6 @@ struct EmitterState {
     /// The entries the steps recorded last may read (sequence number, entry), oldest
     /// first: what a larger table must be filled with.
     births_mirror: VecDeque<(u64, Birth)>,
-    /// Batches before this sequence number belong to particles the pool no longer holds
-    /// (a restart of a tiny pool by a capacity or layout change).
-    births_floor: u64,
     /// Lifetime range, seed and salt of the last sync (packed state re-derives lifetimes).
     life_range: (f32, f32),
     seed: u32,
@@ -341,7 +338,6 @@ impl GpuSim {
         for (i, e) in effect.emitters.iter().enumerate() {
             let capacity = e.capacity.max(1);
             let layout = StateLayout::of(Modules::of(e));
-            let next_seq = self.planner.emitters.get(i).map_or(0, |p| p.next_seq());
             match self.emitters.get(i) {
                 Some(s) if s.capacity == capacity && s.layout == layout => {}
                 // Switching the layout restarts the pool (nothing to convert in place), and
@@ -349,7 +345,10 @@ impl GpuSim {
                 // slots' spawn counters, which a new modulus changes).
                 Some(s) if s.layout != layout || layout == StateLayout::Tiny => {
                     self.emitters[i] = self.create_state(capacity, layout);
-                    self.emitters[i].births_floor = next_seq;
+                    // The new pool is empty: no batch before it can be alive in it.
+                    if let Some(p) = self.planner.emitters.get_mut(i) {
+                        p.forget_births();
+                    }
                 }
                 _ => {
                     let mut fresh = self.create_state(capacity, layout);
@@ -464,7 +463,6 @@ impl GpuSim {
             births,
             births_mask: entries - 1,
             births_mirror: VecDeque::new(),
-            births_floor: 0,
             life_range: (0.0, 0.0),
             seed: 0,
             salt: 0,
@@ -599,7 +597,6 @@ impl GpuSim {
                     }
                     windows[s * n_emitters + e] = p.update_window[1];
                     if em.layout == StateLayout::Tiny {
-                        p.tiny = tiny_window(&p, em.births_floor);
                         p.flags = em.births_mask;
                     }
                     let at = (s * n_emitters + e) * PARAMS_STRIDE as usize;
@@ -678,7 +675,6 @@ impl GpuSim {
     /// (each step's window of the table must stay intact until the submit has run: a table
     /// too small for the span of this submit's windows is replaced by a larger one).
     fn upload_births(&mut self, e: usize, plans: &[Vec<Option<SimParams>>]) {
-        let floor = self.emitters[e].births_floor;
         let steps: Vec<SimParams> = plans
             .iter()
             .filter_map(|p| p.get(e).copied().flatten())
@@ -705,7 +701,7 @@ impl GpuSim {
                 fresh.push((seq, entry));
             }
         }
-        let lo = u64::from(tiny_window(first, floor)[2]);
+        let lo = u64::from(first.tiny[2]);
         let hi = u64::from(last.tiny[2]) + u64::from(last.tiny[3]);
         let span = hi.saturating_sub(lo);
         let size = u64::from(self.emitters[e].births_mask) + 1;
@@ -739,7 +735,7 @@ impl GpuSim {
                 .write_buffer(&s.births, at, bytemuck::bytes_of(&entry));
         }
         // Later submits read from the last step's window on.
-        let keep = u64::from(tiny_window(last, floor)[2]);
+        let keep = u64::from(last.tiny[2]);
         let s = &mut self.emitters[e];
         while s.births_mirror.front().is_some_and(|(q, _)| *q < keep) {
             s.births_mirror.pop_front();
@@ -790,11 +786,10 @@ impl GpuSim {
             tiny: planner.map_or(([0; 4], [0; 4]), |p| {
                 let (hi, lo) = double_single(p.clock_secs());
                 let (first, len) = p.birth_window();
-                let first_kept = first.max(s.births_floor);
-                let len = (first + u64::from(len)).saturating_sub(first_kept) as u32;
+                let (oldest, span) = p.birth_span_now();
                 (
-                    [hi.to_bits(), lo.to_bits(), first_kept as u32, len],
-                    [s.births_mask, (p.last_dt_secs() as f32).to_bits(), 0, 0],
+                    [hi.to_bits(), lo.to_bits(), first as u32, len],
+                    [s.births_mask, (p.last_dt_secs() as f32).to_bits(), oldest, span],
                 )
             }),
             spawned_total: planner.map_or(0, |p| p.spawned_total()),
@@ -881,7 +876,7 @@ impl GpuSim {
             .map(|slot| {
                 let words: [u32; 5] = bytemuck::cast(packed[(slot / 2) as usize]);
                 let (c, life) = life_of(slot);
-                let age = planner.and_then(|p| p.birth_age(c, now, s.births_floor));
+                let age = planner.and_then(|p| p.birth_age(c, now));
                 match (tiny_decode(words, slot), age) {
                     (Some((pos, vel)), Some(age)) if age >= 0.0 && age < f64::from(life) => {
                         Particle {
@@ -990,7 +985,6 @@ impl GpuSim {
             s.whole_pool_until = f64::NEG_INFINITY;
             s.spawned_end = 0;
             // Batch numbers start again at 0 (the table's entries are rewritten as they come).
-            s.births_floor = 0;
             s.births_mirror.clear();
         }
         self.ctx.queue.submit([enc.finish()]);
@@ -1000,20 +994,6 @@ impl GpuSim {
 
 /// Slots one update invocation handles (`SLOTS_PER_INVOCATION` in `shaders/update.wgsl`).
 pub const SLOTS_PER_INVOCATION: u32 = 2;
-
-/// A step's window of the birth table without the batches before `floor` (sequence
-/// numbers; see `EmitterState::births_floor`): `SimParams::tiny`.
-fn tiny_window(p: &SimParams, floor: u64) -> [u32; 4] {
-    let first = u64::from(p.tiny[2]);
-    let end = first + u64::from(p.tiny[3]);
-    let kept = first.max(floor);
-    [
-        p.tiny[0],
-        p.tiny[1],
-        kept as u32,
-        end.saturating_sub(kept) as u32,
-    ]
-}
 
 /// Workgroups for `slots` slots of 256, as a 2-D grid (x ≤ 65535).
 pub fn dispatch_size(slots: u32) -> (u32, u32) {

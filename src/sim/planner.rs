@@ -262,6 +262,7 @@ impl EmitterPlanner {
         }
         let (t0_hi, t0_lo) = double_single(c0);
         let (first_seq, entries) = self.birth_window();
+        let (oldest, span) = self.birth_span(base + count);
         self.spawned_total += count;
         self.stats.spawned += count;
 
@@ -279,7 +280,29 @@ impl EmitterPlanner {
         )
         .with_spawn_fractions(frac0 as f32, frac_step as f32)
         .with_update_window(update_window)
-        .with_births([t0_hi.to_bits(), t0_lo.to_bits(), first_seq as u32, entries])
+        .with_births(
+            [t0_hi.to_bits(), t0_lo.to_bits(), first_seq as u32, entries],
+            [oldest, span, 0, 0],
+        )
+    }
+
+    /// The birth table's oldest entry's first spawn counter (low 32 bits) and the counters
+    /// from it to `end` (the spawn counter after the newest birth).
+    fn birth_span(&self, end: u64) -> (u32, u32) {
+        let oldest = self.history.front().map_or(end, |b| b.first_index);
+        (oldest as u32, (end - oldest) as u32)
+    }
+
+    /// The birth table's oldest first counter and span after the last step (see
+    /// `SimParams::tiny_b`).
+    pub fn birth_span_now(&self) -> (u32, u32) {
+        self.birth_span(self.spawned_total)
+    }
+
+    /// Forgets every batch: the pool restarted empty (the live window and the tiny state's
+    /// birth table start again from the next spawn).
+    pub fn forget_births(&mut self) {
+        self.history.clear();
     }
 
     /// The batches of the birth table (tiny state): the first sequence number and how
@@ -301,12 +324,13 @@ impl EmitterPlanner {
     }
 
     /// The age at `at_secs` (this emitter's clock) of the particle with spawn counter
-    /// `counter`, if a batch that may still be alive, from sequence number `min_seq` on,
+    /// `counter`, if a batch that may still be alive
     /// spawned it (the CPU mirror of the tiny state's `birth_age`).
-    pub fn birth_age(&self, counter: u64, at_secs: f64, min_seq: u64) -> Option<f64> {
-        let b = self.history.iter().find(|b| {
-            b.seq >= min_seq && counter >= b.first_index && counter < b.first_index + b.count as u64
-        })?;
+    pub fn birth_age(&self, counter: u64, at_secs: f64) -> Option<f64> {
+        let b = self
+            .history
+            .iter()
+            .find(|b| counter >= b.first_index && counter < b.first_index + b.count as u64)?;
         let k = (counter - b.first_index) as f32;
         let f = (b.frac0 + k * b.frac_step).clamp(0.0, 1.0);
         Some(at_secs - b.t0_secs - f64::from(b.dt_secs * f))
@@ -436,8 +460,9 @@ impl SimParams {
         self
     }
 
-    fn with_births(mut self, tiny: [u32; 4]) -> Self {
+    fn with_births(mut self, tiny: [u32; 4], tiny_b: [u32; 4]) -> Self {
         self.tiny = tiny;
+        self.tiny_b = tiny_b;
         self
     }
 }
@@ -602,5 +627,6 @@ pub fn build_params(
         collide_c: [if col.stick_on_contact { 1.0 } else { 0.0 }, 0.0, 0.0, 0.0],
         update_window: [0, capacity, 0, 0],
         tiny: [0; 4],
+        tiny_b: [0; 4],
     }
 }
