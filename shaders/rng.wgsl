@@ -40,17 +40,23 @@ fn spawn_life(key: vec4<u32>, lo: f32, hi: f32) -> f32 {
     return mix(lo, hi, unorm4(rand_block(key, 1u)).w);
 }
 
+// Wellons' "lowbias32" avalanche of one word (two multiplies, three xor-shifts).
+fn lowbias32(x: u32) -> u32 {
+    var h = x;
+    h ^= h >> 16u;
+    h *= 0x7FEB352Du;
+    h ^= h >> 15u;
+    h *= 0x846CA68Bu;
+    h ^= h >> 16u;
+    return h;
+}
+
 // A lattice hash for noise: integer cell + seed → [0, 1). Noise evaluates eight of these
 // per channel and octave (curl noise: 48 per particle-step), so it is a cheap one: the
 // cell folded into one word by large odd multipliers, then Wellons' "lowbias32"
 // avalanche (two multiplies, three xor-shifts) — a third of pcg4d's work.
 fn hash_cell(c: vec3<i32>, seed: u32) -> f32 {
     let u = bitcast<vec3<u32>>(c);
-    var h = (u.x * 0x8DA6B343u) ^ (u.y * 0xD8163841u) ^ (u.z * 0xCB1AB31Fu) ^ (seed * 0x9E3779B9u);
-    h ^= h >> 16u;
-    h *= 0x7FEB352Du;
-    h ^= h >> 15u;
-    h *= 0x846CA68Bu;
-    h ^= h >> 16u;
+    let h = lowbias32((u.x * 0x8DA6B343u) ^ (u.y * 0xD8163841u) ^ (u.z * 0xCB1AB31Fu) ^ (seed * 0x9E3779B9u));
     return f32(h >> 8u) * (1.0 / 16777216.0);
 }

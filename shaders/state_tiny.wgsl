@@ -48,8 +48,14 @@ fn load_state(slot: u32) -> Particle {
         entry = birth_entry(c.x, vec3<u32>(params.tiny.zw, params.flags), params.tiny_b.x, params.tiny_b.y);
     }
     let age = birth_age(entry, c.x, bitcast<vec2<f32>>(params.tiny.xy));
-    let key = spawn_key(params.seed, params.emitter_salt, slot, c.x, c.y);
-    let life = spawn_life(key, params.speed_life.z, params.speed_life.w);
+    // The lifetime (two hashes) only where it matters: a particle younger than the range's
+    // minimum by more than this step survives it whatever its lifetime, and only the flame
+    // pull reads the lifetime otherwise. Elsewhere "longer than any age" stands in for it.
+    var life = 3.4e38;
+    if MOD_FLAME_PULL || age + params.dt_secs >= params.speed_life.z {
+        let key = spawn_key(params.seed, params.emitter_salt, slot, c.x, c.y);
+        life = spawn_life(key, params.speed_life.z, params.speed_life.w);
+    }
     if !(age >= 0.0 && age < life) {
         return Particle(vec4<f32>(0.0), vec4<f32>(0.0));
     }
@@ -59,11 +65,14 @@ fn load_state(slot: u32) -> Particle {
 fn store_state(slot: u32, p: Particle) {
     var b = vec3<u32>(TINY_DEAD, 0u, 0u);
     if is_alive(p) {
-        // Six dithers from one hash: 16 bits each.
+        // Six 10-bit dithers from two cheap hashes of (slot, step, seed): dithering needs
+        // no more (pcg4d's four words would cost a third of the pass on the H100).
         let step_key = bitcast<u32>(params.wind_time.w) ^ params.spawn_base_lo;
-        let h = pcg4d(vec4<u32>(slot, step_key, params.seed, 0x71Au));
-        let d0 = vec4<f32>(vec4<u32>(h.xyz & vec3<u32>(0xFFFFu), 0u)) / 65536.0;
-        let d1 = vec4<f32>(vec4<u32>(h.xyz >> vec3<u32>(16u), 0u)) / 65536.0;
+        let h0 = lowbias32((slot * 0x9E3779B9u) ^ step_key ^ (params.seed * 0x85EBCA6Bu));
+        let h1 = lowbias32(h0 ^ 0x7F4A7C15u);
+        let m = vec3<u32>(0u, 10u, 20u);
+        let d0 = vec4<f32>(vec3<f32>((vec3<u32>(h0) >> m) & vec3<u32>(1023u)) / 1024.0, 0.0);
+        let d1 = vec4<f32>(vec3<f32>((vec3<u32>(h1) >> m) & vec3<u32>(1023u)) / 1024.0, 0.0);
         b = tiny_encode(p.pos_age.xyz, p.vel_life.xyz, d0, d1);
     }
     pair = tiny_put(pair, (slot & 1u) != 0u, b);
