@@ -4,7 +4,7 @@
 use std::collections::VecDeque;
 
 use crate::effect::{Effect, Emitter, Shape};
-use crate::gpu::types::{Birth, SimParams, double_single};
+use crate::gpu::types::{SimParams, double_single};
 use crate::rng;
 
 /// Spawn accounting of one emitter (shown in the stats panel).
@@ -43,21 +43,6 @@ struct Batch {
 }
 
 impl Batch {
-    /// The birth-table entry of this batch.
-    fn birth(&self) -> Birth {
-        let (t0_hi, t0_lo) = double_single(self.t0_secs);
-        Birth {
-            first: self.first_index as u32,
-            count: self.count,
-            t0_hi,
-            t0_lo,
-            dt: self.dt_secs,
-            frac0: self.frac0,
-            frac_step: self.frac_step,
-            pad: 0,
-        }
-    }
-
     /// Every particle of the batch is dead at `at_secs` (the emitter's clock): it outlived
     /// the longest lifetime it could have, with a margin for the GPU's f32 ages — they
     /// grow by `dt` each step, and the rounding of those sums can lean one way for a
@@ -312,20 +297,9 @@ impl EmitterPlanner {
         (first, self.history.len() as u32)
     }
 
-    /// The sequence number the next batch will get.
-    pub fn next_seq(&self) -> u64 {
-        self.next_seq
-    }
-
-    /// The birth-table entries of the batches that may still be alive: (sequence number,
-    /// entry), oldest first.
-    pub fn births(&self) -> impl Iterator<Item = (u64, Birth)> + '_ {
-        self.history.iter().map(|b| (b.seq, b.birth()))
-    }
-
     /// The age at `at_secs` (this emitter's clock) of the particle with spawn counter
-    /// `counter`, if a batch that may still be alive
-    /// spawned it (the CPU mirror of the tiny state's `birth_age`).
+    /// `counter`, if a batch that may still be alive spawned it (the CPU mirror of the tiny
+    /// state's `birth_entry` and `birth_age`).
     pub fn birth_age(&self, counter: u64, at_secs: f64) -> Option<f64> {
         let b = self
             .history
@@ -334,11 +308,6 @@ impl EmitterPlanner {
         let k = (counter - b.first_index) as f32;
         let f = (b.frac0 + k * b.frac_step).clamp(0.0, 1.0);
         Some(at_secs - b.t0_secs - f64::from(b.dt_secs * f))
-    }
-
-    /// The time on this emitter's clock of the state before the last step.
-    pub fn previous_clock_secs(&self) -> f64 {
-        self.clock_secs - self.last_dt_secs
     }
 
     /// The size of the last planned step (s).
