@@ -178,32 +178,39 @@ fn shipped_presets_survive_one_second_steps() {
     let presets = ignis::preset::list(dir);
     assert!(!presets.is_empty());
     for path in presets {
-        let effect = ignis::preset::load(&path).expect("preset loads");
-        for e in &effect.emitters {
-            if let Some(bound) = e.integrator.drag_stability_limit() {
+        let loaded = ignis::preset::load(&path).expect("preset loads");
+        // As shipped, and with every stateful emitter on the tiny 10-byte state.
+        let mut tiny = loaded.clone();
+        for e in &mut tiny.emitters {
+            e.tiny_state = !e.stateless;
+        }
+        for effect in [loaded, tiny] {
+            for e in &effect.emitters {
+                if let Some(bound) = e.integrator.drag_stability_limit() {
+                    assert!(
+                        e.forces.drag_per_sec * 1.0 < bound,
+                        "{}: {} k·dt at dt = 1 s is {}",
+                        path.display(),
+                        e.name,
+                        e.forces.drag_per_sec
+                    );
+                }
+            }
+            let sim = run_gpu(&ctx, &effect, 1.0, 20);
+            for i in 0..effect.emitters.len() {
+                assert_eq!(
+                    sim.read_counters(i).expect("counters")[1],
+                    0,
+                    "{}: non-finite kills",
+                    path.display()
+                );
                 assert!(
-                    e.forces.drag_per_sec * 1.0 < bound,
-                    "{}: {} k·dt at dt = 1 s is {}",
-                    path.display(),
-                    e.name,
-                    e.forces.drag_per_sec
+                    sim.read_particles(i)
+                        .expect("read")
+                        .iter()
+                        .all(|p| p.position().is_finite())
                 );
             }
-        }
-        let sim = run_gpu(&ctx, &effect, 1.0, 20);
-        for i in 0..effect.emitters.len() {
-            assert_eq!(
-                sim.read_counters(i).expect("counters")[1],
-                0,
-                "{}: non-finite kills",
-                path.display()
-            );
-            assert!(
-                sim.read_particles(i)
-                    .expect("read")
-                    .iter()
-                    .all(|p| p.position().is_finite())
-            );
         }
     }
 }
@@ -332,6 +339,45 @@ fn long_gpu_run_keeps_ages_and_counts() {
             .iter()
             .all(|p| p.pos_age[3] >= 0.0 && p.pos_age[3] < 1.0)
     );
+}
+
+/// Tiny-state ages stay exact late in a run: past 10⁵ s on the emitter's clock, where an f32
+/// time has 8 ms steps, the ages from the birth table (double-single times) still match the
+/// full state's summed ones, and the same particles are alive.
+#[test]
+fn tiny_ages_stay_exact_late_in_a_run() {
+    let ctx = gpu();
+    let e = Emitter {
+        spawn_rate_per_sec: 400.0,
+        capacity: 1024,
+        lifetime_secs: ignis::effect::Range::new(0.5, 1.0),
+        ..plain_emitter()
+    };
+    let full = bare_effect(e);
+    let mut tiny = full.clone();
+    tiny.emitters[0].tiny_state = true;
+    let run = |effect: &Effect| {
+        let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), effect).expect("sim");
+        // 1000 steps of 100 s (every particle dies within its step), then 1 s of 1/120 s.
+        sim.step(effect, 100.0, 1000).expect("step");
+        sim.step(effect, 1.0 / 120.0, 120).expect("step");
+        sim.read_particles(0).expect("read")
+    };
+    let (a, b) = (run(&full), run(&tiny));
+    let mut alive = 0;
+    for (slot, (p, q)) in a.iter().zip(&b).enumerate() {
+        assert_eq!(p.is_alive(), q.is_alive(), "slot {slot}: {p:?} vs {q:?}");
+        if p.is_alive() {
+            alive += 1;
+            assert!(
+                (p.pos_age[3] - q.pos_age[3]).abs() < 1e-4,
+                "slot {slot}: age {} vs {}",
+                p.pos_age[3],
+                q.pos_age[3]
+            );
+        }
+    }
+    assert!((290..=310).contains(&alive), "{alive} alive");
 }
 
 /// Capacity 1, capacities that are not multiples of the 256-wide workgroup, and zero
