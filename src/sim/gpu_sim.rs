@@ -789,7 +789,12 @@ impl GpuSim {
                 let (oldest, span) = p.birth_span_now();
                 (
                     [hi.to_bits(), lo.to_bits(), first as u32, len],
-                    [s.births_mask, (p.last_dt_secs() as f32).to_bits(), oldest, span],
+                    [
+                        s.births_mask,
+                        (p.last_dt_secs() as f32).to_bits(),
+                        oldest,
+                        span,
+                    ],
                 )
             }),
             spawned_total: planner.map_or(0, |p| p.spawned_total()),
