@@ -204,11 +204,11 @@ fn tiny_decode(b: vec3<u32>) -> TinySlot {
 
 // Encodes a living particle's position and velocity with dithered rounding (`d0`, `d1`
 // ∈ [0, 1)⁴, hashes of slot and step: unbiased, so errors average out instead of
-// drifting). Positions beyond the f16 range (65504 m) and speeds of 2^16 m/s or more
-// cannot be stored: the slot is marked dead.
+// drifting). Positions beyond ±65000 m (the f16 range, 65504, less the dither's reach) and
+// speeds of 2^16 m/s or more cannot be stored: the slot is marked dead.
 fn tiny_encode(pos: vec3<f32>, vel: vec3<f32>, d0: vec4<f32>, d1: vec4<f32>) -> vec3<u32> {
     let m = max(max(abs(vel.x), abs(vel.y)), abs(vel.z));
-    if max(max(abs(pos.x), abs(pos.y)), abs(pos.z)) >= 65504.0 || !(m < 65536.0) {
+    if !(max(max(abs(pos.x), abs(pos.y)), abs(pos.z)) < 65000.0) || !(m < 65536.0) {
         return vec3<u32>(TINY_DEAD, 0u, 0u);
     }
     let pd = pos + (d0.xyz - 0.5) * vec3<f32>(f16_ulp(pos.x), f16_ulp(pos.y), f16_ulp(pos.z));

@@ -5,6 +5,9 @@
 // seconds, at simulated time `time` (s, wrapped every 4096 s). It must be a pure function:
 // integrators call it 1 (Euler) to 4 (RK4) times per step with predicted states. `params`
 // (SimParams) holds the preset's values. Return `vec3<f32>(0.0)` to switch every force off.
+// On tiny state (state_tiny.wgsl) `life` is exact only where the flame pull is on or the
+// particle is within a step of the lifetime range's minimum; elsewhere it is 3.4e38 (the
+// lifetime hash is skipped) — a force that reads `life` should be a module like the pull.
 //
 // Modules are pipeline override constants: a module that is off is resolved away when
 // the pipeline is built and costs nothing. Keep `MOD_*` in sync with `Modules` in

@@ -60,6 +60,9 @@ struct LookUniform {
     // Tiny state: x: the birth table's index mask, y: the last step's size (f32 bits),
     // z: the oldest entry's first spawn counter, w: the counters from it to the newest.
     tiny_b: vec4<u32>,
+    // Tiny state: x: the counters from the oldest entry's first to the last step's first
+    // spawn (a slot's previous state holds its particle only below it), yzw: unused.
+    tiny_c: vec4<u32>,
 }
 
 override INTERPOLATE: bool = true;
@@ -145,12 +148,16 @@ fn load_pair(slot: u32) -> array<Particle, 2> {
         let key = spawn_key(look.ring_b.x, look.ring_b.y, slot, c.x, c.y);
         let life = spawn_life(key, look.soft.z, look.soft.w);
         if look.ring.w == 2u {
-            // Tiny: ages from the birth table; the previous state is one step younger
-            // (dead when that is before the birth: the slot held another particle).
+            // Tiny: ages from the birth table; the previous state is one step younger, and
+            // holds this particle only if it was born before the last step (otherwise the
+            // slot's previous occupant, or nothing).
             let odd = (slot & 1u) != 0u;
             let b = birth_entry(c.x, vec3<u32>(look.tiny.zw, look.tiny_b.x), look.tiny_b.z, look.tiny_b.w);
             let age = birth_age(b, c.x, bitcast<vec2<f32>>(look.tiny.xy));
-            let ages = vec2<f32>(age, age - bitcast<f32>(look.tiny_b.y));
+            var ages = vec2<f32>(age, age - bitcast<f32>(look.tiny_b.y));
+            if c.x - look.tiny_b.z >= look.tiny_c.x {
+                ages.y = -1.0;
+            }
             let s = array<TinySlot, 2>(
                 tiny_decode(tiny_bits(cur_packed[slot >> 1u], odd)),
                 tiny_decode(tiny_bits(prev_packed[slot >> 1u], odd)),

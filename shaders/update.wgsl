@@ -3,8 +3,10 @@
 //
 // Contract (plumbing; designers change spawn.wgsl, forces.wgsl, integrators.wgsl):
 // - group 0: binding 0 `params` (SimParams, dynamic offset per step), 1 `src` (read),
-//   2 `dst` (write; both declared in state_full.wgsl / state_packed.wgsl), 3 `counters` ([0] alive after this step when COUNT_ALIVE is on,
-//   [1] non-finite kills, total).
+//   2 `dst` (write; both declared in state_full.wgsl / state_packed.wgsl /
+//   state_tiny.wgsl), 3 `counters` ([0] alive after this step when COUNT_ALIVE is on,
+//   [1] non-finite kills, total), 4 the tiny state's birth table (read by
+//   state_tiny.wgsl only).
 // - COUNT_ALIVE (GPUs): a workgroup reduction, one global atomic per workgroup. On CPU
 //   adapters it is off — a workgroup barrier makes lavapipe run every invocation
 //   separately — and count.wgsl counts on demand instead. (On the H100 the update with the

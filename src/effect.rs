@@ -165,7 +165,10 @@ pub struct Emitter {
     /// (derived exactly from a table of each step's births) and no lifetime (re-derived
     /// from the spawn hash). An update moves 20 bytes per particle-step; the accuracy cost
     /// is in `ignis bench accuracy` ("+ tiny" rows). Not with `stateless` or
-    /// `packed_state`. Changing the capacity restarts the emitter's particles.
+    /// `packed_state`. Changing the capacity restarts the emitter's particles; editing the
+    /// lifetime range re-times living ones (as with `packed_state`). Positions stay
+    /// precise while the emitter is near where its pool started (f16 relative to that
+    /// origin: 1 mm at 1 m, 0.5 m at 1 km); particles beyond ±65 km die.
     pub tiny_state: bool,
     /// Ground and sphere colliders.
     pub collisions: Collisions,

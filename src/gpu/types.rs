@@ -303,6 +303,9 @@ pub struct LookUniform {
     /// Tiny state: the birth table's index mask, the last step's size (f32 bits), the
     /// oldest entry's first spawn counter, the counters from it to the newest spawn.
     pub tiny_b: [u32; 4],
+    /// Tiny state: the counters from the oldest entry's first to the last step's first
+    /// spawn (a slot's previous state is its particle's only below it); unused × 3.
+    pub tiny_c: [u32; 4],
 }
 
 /// Tonemap settings (keep in sync with `ToneUniform` in `shaders/tonemap.wgsl`).

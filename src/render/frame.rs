@@ -435,7 +435,7 @@ impl FrameResources {
                 ];
                 // w: the live window's length (it ends at the ring's head, ring.x).
                 u.ring_b = [b.seed_salt.0, b.seed_salt.1, b.capacity, b.window.len];
-                (u.tiny, u.tiny_b) = b.tiny;
+                [u.tiny, u.tiny_b, u.tiny_c] = b.tiny;
             }
             let at = i * PARAMS_STRIDE as usize;
             blocks[at..at + size_of::<LookUniform>()].copy_from_slice(bytemuck::bytes_of(&u));

@@ -263,10 +263,11 @@ pub struct EmitterBuffers<'a> {
     pub layout: StateLayout,
     /// The tiny state's birth table (a placeholder for the other layouts).
     pub births: &'a wgpu::Buffer,
-    /// Tiny state: the current state's time (double-single hi, lo; f32 bits), the birth
-    /// table's first sequence number and entries; the table's index mask and the last
-    /// step's size (f32 bits) — `LookUniform::tiny`, `tiny_b`.
-    pub tiny: ([u32; 4], [u32; 4]),
+    /// Tiny state: `LookUniform::tiny`, `tiny_b` and `tiny_c` — the current state's time
+    /// (double-single hi, lo; f32 bits), the birth table's first sequence number and
+    /// entries; the table's index mask, the last step's size (f32 bits), the oldest
+    /// entry's first counter and the counters spanned; the span before the last step.
+    pub tiny: [[u32; 4]; 3],
     /// Particles spawned so far (the ring's position: packed state re-derives lifetimes).
     pub spawned_total: u64,
     /// Lifetime range of the emitter.
@@ -329,7 +330,8 @@ impl GpuSim {
     }
 
     /// Matches the GPU pools to the effect: new emitters get buffers, removed ones are
-    /// dropped, a changed capacity keeps the particles that fit.
+    /// dropped, a changed capacity keeps the particles that fit (a tiny-state pool, and
+    /// any pool whose layout changes, restarts empty).
     pub fn sync(&mut self, effect: &Effect) -> Result<(), SimError> {
         for e in &effect.emitters {
             self.ctx.check_capacity(&e.name, e.capacity)?;
@@ -783,19 +785,16 @@ impl GpuSim {
             parity: s.current,
             layout: s.layout,
             births: &s.births,
-            tiny: planner.map_or(([0; 4], [0; 4]), |p| {
+            tiny: planner.map_or([[0; 4]; 3], |p| {
                 let (hi, lo) = double_single(p.clock_secs());
                 let (first, len) = p.birth_window();
-                let (oldest, span) = p.birth_span_now();
-                (
+                let (oldest, span, prev_span) = p.birth_span_now();
+                let dt_bits = (p.last_dt_secs() as f32).to_bits();
+                [
                     [hi.to_bits(), lo.to_bits(), first as u32, len],
-                    [
-                        s.births_mask,
-                        (p.last_dt_secs() as f32).to_bits(),
-                        oldest,
-                        span,
-                    ],
-                )
+                    [s.births_mask, dt_bits, oldest, span],
+                    [prev_span, 0, 0, 0],
+                ]
             }),
             spawned_total: planner.map_or(0, |p| p.spawned_total()),
             life_range: s.life_range,
@@ -897,9 +896,11 @@ impl GpuSim {
 
     /// `[alive after the last step, non-finite kills so far]` of emitter `index` (blocking).
     ///
-    /// The alive count is computed now, by a counting pass over the current state (the
-    /// update pass does not count: only the stats need it). Stateless emitters are counted
-    /// on the CPU from their spawn records' ages.
+    /// GPUs count in the update pass (a workgroup reduction). On CPU adapters the alive
+    /// count is computed now, by a counting pass over the current state (the update pass
+    /// does not count there: only the stats need it); tiny-state emitters are counted from
+    /// the unpacked state. Stateless emitters are counted on the CPU from their spawn
+    /// records' ages.
     pub fn read_counters(&self, index: usize) -> Result<[u32; 2], SimError> {
         let s = self
             .emitters

@@ -103,6 +103,8 @@ pub struct EmitterPlanner {
     last_dt_secs: f64,
     /// The sequence number the next batch gets.
     next_seq: u64,
+    /// Particles the last planned step spawned.
+    last_count: u64,
 }
 
 /// Plans every emitter of an effect, step after step.
@@ -250,6 +252,7 @@ impl EmitterPlanner {
         let (oldest, span) = self.birth_span(base + count);
         self.spawned_total += count;
         self.stats.spawned += count;
+        self.last_count = count;
 
         let origin = *self.origin.get_or_insert_with(|| sim_origin_for(e));
         build_params(
@@ -279,15 +282,19 @@ impl EmitterPlanner {
     }
 
     /// The birth table's oldest first counter and span after the last step (see
-    /// `SimParams::tiny_b`).
-    pub fn birth_span_now(&self) -> (u32, u32) {
-        self.birth_span(self.spawned_total)
+    /// `SimParams::tiny_b`), and the span before the last step's spawns (counters below it
+    /// were already alive, or dead, at the last step's start).
+    pub fn birth_span_now(&self) -> (u32, u32, u32) {
+        let (oldest, span) = self.birth_span(self.spawned_total);
+        (oldest, span, span.saturating_sub(self.last_count as u32))
     }
 
     /// Forgets every batch: the pool restarted empty (the live window and the tiny state's
-    /// birth table start again from the next spawn).
+    /// birth table start again from the next spawn), and re-anchors the simulation space
+    /// at the emitter's position at its next step (nothing is left in the old one).
     pub fn forget_births(&mut self) {
         self.history.clear();
+        self.origin = None;
     }
 
     /// The batches of the birth table (tiny state): the first sequence number and how
@@ -301,10 +308,15 @@ impl EmitterPlanner {
     /// `counter`, if a batch that may still be alive spawned it (the CPU mirror of the tiny
     /// state's `birth_entry` and `birth_age`).
     pub fn birth_age(&self, counter: u64, at_secs: f64) -> Option<f64> {
-        let b = self
+        // The history is in counter order: the last batch starting at or before `counter`.
+        let i = self
             .history
-            .iter()
-            .find(|b| counter >= b.first_index && counter < b.first_index + b.count as u64)?;
+            .partition_point(|b| b.first_index <= counter)
+            .checked_sub(1)?;
+        let b = &self.history[i];
+        if counter >= b.first_index + b.count as u64 {
+            return None;
+        }
         let k = (counter - b.first_index) as f32;
         let f = (b.frac0 + k * b.frac_step).clamp(0.0, 1.0);
         Some(at_secs - b.t0_secs - f64::from(b.dt_secs * f))
