@@ -513,15 +513,10 @@ fn pass_timer_reports_labelled_spans() {
     assert!(timer.latest.iter().all(|s| s.1 >= 0.0 && s.1.is_finite()));
 }
 
-/// The packed 20-byte state follows the full state: the same slots alive, lifetimes
-/// re-derived exactly, ages within the unorm16 step, positions and velocities within
-/// f16 rounding accumulated over the run; the alive count and the rendered frame agree.
-#[test]
-fn packed_state_follows_the_full_state() {
-    let ctx = gpu();
+/// A fountain for comparing state layouts: random speeds (1–3 m/s) and lifetimes
+/// (0.5–1.5 s), a 30° spread, gravity, buoyancy, linear drag and wind.
+fn fountain() -> Emitter {
     let mut e = plain_emitter();
-    e.capacity = 3000;
-    e.spawn_rate_per_sec = 2000.0;
     e.lifetime_secs = ignis::effect::Range::new(0.5, 1.5);
     e.speed_m_per_s = ignis::effect::Range::new(1.0, 3.0);
     e.spread_deg = 30.0;
@@ -529,14 +524,39 @@ fn packed_state_follows_the_full_state() {
     e.forces.buoyancy_m_per_s2 = 12.0;
     e.forces.drag_per_sec = 1.2;
     e.forces.wind_m_per_s = [0.3, 0.0, 0.0];
-    let full = bare_effect(e.clone());
-    let mut packed = full.clone();
-    packed.emitters[0].packed_state = true;
-    assert!(packed.validate().is_ok());
-    let dt = 1.0 / 120.0;
-    let steps = 240;
-    let a = run_gpu(&ctx, &full, dt, steps);
-    let b = run_gpu(&ctx, &packed, dt, steps);
+    e
+}
+
+/// Runs `e` on the full state and with `compact` applied (which must validate), `steps`
+/// steps of `dt` each: (full, compact).
+fn run_full_and_compact(
+    ctx: &ignis::gpu::GpuContext,
+    e: Emitter,
+    compact: impl Fn(&mut Emitter),
+    dt: f32,
+    steps: u32,
+) -> (GpuSim, GpuSim) {
+    let full = bare_effect(e);
+    let mut other = full.clone();
+    compact(&mut other.emitters[0]);
+    assert!(other.validate().is_ok());
+    (
+        run_gpu(ctx, &full, dt, steps),
+        run_gpu(ctx, &other, dt, steps),
+    )
+}
+
+/// The packed 20-byte state follows the full state: the same slots alive, lifetimes
+/// re-derived exactly, ages within the unorm16 step, positions and velocities within
+/// f16 rounding accumulated over the run; the alive count and the rendered frame agree.
+#[test]
+fn packed_state_follows_the_full_state() {
+    let ctx = gpu();
+    let (dt, steps) = (1.0 / 120.0, 240);
+    let mut e = fountain();
+    e.capacity = 3000;
+    e.spawn_rate_per_sec = 2000.0;
+    let (a, b) = run_full_and_compact(&ctx, e, |e| e.packed_state = true, dt, steps);
     let pa = a.read_particles(0).expect("full");
     let pb = b.read_particles(0).expect("packed");
     assert_eq!(pa.len(), pb.len());
@@ -610,7 +630,8 @@ fn packed_state_follows_the_full_state() {
 #[test]
 fn tiny_state_follows_the_full_state() {
     let ctx = gpu();
-    let mut e = plain_emitter();
+    let (dt, steps) = (1.0 / 120.0, 240);
+    let mut e = fountain();
     e.capacity = 3001;
     e.spawn_rate_per_sec = 1200.0;
     // An uneven birth table: bursts between the steady steps (the lookup's guess from the
@@ -625,21 +646,7 @@ fn tiny_state_follows_the_full_state() {
             count: 300,
         },
     ];
-    e.lifetime_secs = ignis::effect::Range::new(0.5, 1.5);
-    e.speed_m_per_s = ignis::effect::Range::new(1.0, 3.0);
-    e.spread_deg = 30.0;
-    e.forces.gravity_m_per_s2 = [0.0, -9.81, 0.0];
-    e.forces.buoyancy_m_per_s2 = 12.0;
-    e.forces.drag_per_sec = 1.2;
-    e.forces.wind_m_per_s = [0.3, 0.0, 0.0];
-    let full = bare_effect(e.clone());
-    let mut tiny = full.clone();
-    tiny.emitters[0].tiny_state = true;
-    assert!(tiny.validate().is_ok());
-    let dt = 1.0 / 120.0;
-    let steps = 240;
-    let a = run_gpu(&ctx, &full, dt, steps);
-    let b = run_gpu(&ctx, &tiny, dt, steps);
+    let (a, b) = run_full_and_compact(&ctx, e, |e| e.tiny_state = true, dt, steps);
     let pa = a.read_particles(0).expect("full");
     let pb = b.read_particles(0).expect("tiny");
     assert_eq!(pa.len(), pb.len());

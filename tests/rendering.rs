@@ -390,24 +390,11 @@ fn live_window_draws_what_the_whole_pool_draws() {
     // Every particle alive now lies in its emitter's window, and the windows are short.
     assert_eq!(bounds.len(), run.sim.emitter_count());
     for (i, bound) in bounds.iter().enumerate() {
-        let b = run.sim.emitter_buffers(i).expect("buffers");
-        let (w, cap) = (b.window, b.capacity);
-        let particles = run.sim.read_particles(i).expect("read");
-        for (slot, p) in particles.iter().enumerate() {
-            if p.is_alive() {
-                let offset = (slot as u32 + cap - w.first_slot) % cap;
-                assert!(
-                    offset < w.len,
-                    "emitter {i}: alive slot {slot} outside {w:?}"
-                );
-            }
-        }
-        let alive = alive_of(&particles) as u32;
+        let (alive, len) = alive_in_window(&run, i, &format!("emitter {i}"));
         // At most rate × (the longest lifetime alive) plus two steps of spawns.
         assert!(
-            (w.len as f32) <= *bound && w.len >= alive,
-            "emitter {i}: window {} for {alive} alive of {cap} (bound {bound})",
-            w.len,
+            (len as f32) <= *bound && len >= alive as u32,
+            "emitter {i}: window {len} for {alive} alive (bound {bound})",
         );
     }
     // Later, once the long-lived particles died, the window shrinks to the new lifetimes.
