@@ -14,7 +14,8 @@
 #import "look.wgsl"
 
 @group(0) @binding(0) var<uniform> camera: CameraUniform;
-@group(0) @binding(1) var<uniform> look: LookUniform;
+// Storage, not uniform: see update.wgsl (lavapipe's uniform inlining).
+@group(0) @binding(1) var<storage, read> look: LookUniform;
 @group(0) @binding(2) var ramps: texture_2d<f32>;
 @group(1) @binding(0) var<storage, read> prev: array<Particle>;
 @group(1) @binding(1) var<storage, read> cur: array<Particle>;

@@ -173,11 +173,14 @@ impl FrameResources {
     pub fn new(ctx: &GpuContext) -> Self {
         let d = &ctx.device;
         let all = wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        let uniform = |binding, dynamic| wgpu::BindGroupLayoutEntry {
+        // The per-emitter look is read-only *storage*, not a uniform buffer: lavapipe
+        // (Mesa 22.3) inlines uniform-buffer values that steer branches into the shader
+        // and recompiles it on every bind of a new offset — ~3 ms per emitter per frame.
+        let buffer = |binding, ty, dynamic| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: all,
             ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
+                ty,
                 has_dynamic_offset: dynamic,
                 min_binding_size: None,
             },
@@ -196,8 +199,8 @@ impl FrameResources {
         let frame_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("FrameResources::frame_layout"),
             entries: &[
-                uniform(0, false),
-                uniform(1, true),
+                buffer(0, wgpu::BufferBindingType::Uniform, false),
+                buffer(1, wgpu::BufferBindingType::Storage { read_only: true }, true),
                 wgpu::BindGroupLayoutEntry {
                     binding: 2,
                     visibility: all,
@@ -263,7 +266,7 @@ impl FrameResources {
         let looks = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("FrameResources::looks"),
             size: slots as u64 * PARAMS_STRIDE,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let ramps = crate::gpu::texture_2d(

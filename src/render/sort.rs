@@ -180,7 +180,7 @@ impl SortPass {
                     entry(
                         0,
                         wgpu::BindingType::Buffer {
-                            ty: wgpu::BufferBindingType::Uniform,
+                            ty: wgpu::BufferBindingType::Storage { read_only: true },
                             has_dynamic_offset: true,
                             min_binding_size: wgpu::BufferSize::new(size_of::<SortStep>() as u64),
                         },
@@ -281,7 +281,7 @@ impl SortPass {
         let steps = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("SortPass::steps"),
             size: (bitonic_stages(size).len() as u64 + 1) * STRIDE,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         Self::write_steps(

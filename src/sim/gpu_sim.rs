@@ -62,7 +62,7 @@ impl UpdatePass {
                         binding: 0,
                         visibility: wgpu::ShaderStages::COMPUTE,
                         ty: wgpu::BindingType::Buffer {
-                            ty: wgpu::BufferBindingType::Uniform,
+                            ty: wgpu::BufferBindingType::Storage { read_only: true },
                             has_dynamic_offset: true,
                             min_binding_size: wgpu::BufferSize::new(
                                 std::mem::size_of::<SimParams>() as u64,
@@ -294,7 +294,7 @@ impl GpuSim {
             params_buffer: ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("GpuSim::params"),
                 size: PARAMS_STRIDE,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
             params_slots: 1,
@@ -412,7 +412,7 @@ impl GpuSim {
             self.params_buffer = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("GpuSim::params"),
                 size: slots as u64 * PARAMS_STRIDE,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             });
             for i in 0..self.emitters.len() {
