@@ -1031,3 +1031,156 @@ fn opening_the_look_section_edits_nothing() {
         );
     }
 }
+
+/// One UI frame for the retained-image test: a side panel showing `panel_text` and a
+/// central area whose content moves with `n`. Returns egui's output and the central
+/// rectangle.
+fn retained_test_frame(
+    egui_ctx: &egui::Context,
+    n: u32,
+    panel_text: &str,
+) -> (egui::FullOutput, egui::Rect) {
+    let raw = egui::RawInput {
+        screen_rect: Some(egui::Rect::from_min_size(
+            egui::Pos2::ZERO,
+            egui::vec2(480.0, 270.0),
+        )),
+        ..Default::default()
+    };
+    let mut live = egui::Rect::NOTHING;
+    let out = egui_ctx.run_ui(raw, |ui| {
+        egui::Panel::right("panel").show(ui, |ui| {
+            ui.label(panel_text);
+            let _ = ui.button("A button");
+        });
+        egui::CentralPanel::no_frame().show(ui, |ui| {
+            let (rect, _) = ui.allocate_exact_size(ui.available_size(), egui::Sense::hover());
+            live = rect;
+            let p = ui.painter_at(rect);
+            let c = rect.min + egui::vec2(30.0 + 17.0 * n as f32, 40.0 + 9.0 * n as f32);
+            p.circle_filled(c, 25.0, egui::Color32::from_rgb(240, 120, 30));
+            // Fixed text: new glyphs (or sub-pixel variants) would change egui's atlas.
+            p.text(
+                rect.min + egui::vec2(8.0, 8.0),
+                egui::Align2::LEFT_TOP,
+                "viewport",
+                egui::FontId::monospace(12.0),
+                egui::Color32::WHITE,
+            );
+        });
+    });
+    (out, live)
+}
+
+/// The retained window image (software adapters): repainting only the viewport over
+/// last frame's image gives exactly the pixels of a full repaint, and a panel change
+/// (or the first frame) repaints in full.
+#[test]
+fn retained_ui_repaints_match_full_repaints() {
+    use ignis::editor::retained::{Repaint, RetainedUi};
+    use ignis::editor::screenshot::{Screenshot, read_back};
+    use ignis::editor::ui_painter::{UiPainter, UiPainterKind};
+
+    let ctx = GpuContext::headless().expect("a GPU adapter (lavapipe is fine)");
+    let format = wgpu::TextureFormat::Rgba8Unorm;
+    let mut painter = UiPainter::new(&ctx.device, format, UiPainterKind::Lean, true);
+    let egui_ctx = egui::Context::default();
+    let background = egui::Color32::from_rgb(9, 9, 11);
+    let clear = wgpu::Color {
+        r: 9.0 / 255.0,
+        g: 9.0 / 255.0,
+        b: 11.0 / 255.0,
+        a: 1.0,
+    };
+    let full_target = ignis::gpu::texture_2d(
+        &ctx.device,
+        "test::full",
+        (480, 270),
+        1,
+        format,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+    );
+    let mut retained = RetainedUi::default();
+    let paint =
+        |painter: &mut UiPainter, target: &wgpu::Texture, jobs: &[egui::ClippedPrimitive], load| {
+            let screen = egui_wgpu::ScreenDescriptor {
+                size_in_pixels: [480, 270],
+                pixels_per_point: 1.0,
+            };
+            let mut enc = ctx.device.create_command_encoder(&Default::default());
+            let extra = painter.prepare(&ctx.device, &ctx.queue, &mut enc, jobs, &screen);
+            let view = target.create_view(&Default::default());
+            {
+                let mut pass = enc
+                    .begin_render_pass(&wgpu::RenderPassDescriptor {
+                        label: None,
+                        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                            view: &view,
+                            depth_slice: None,
+                            resolve_target: None,
+                            ops: wgpu::Operations {
+                                load,
+                                store: wgpu::StoreOp::Store,
+                            },
+                        })],
+                        depth_stencil_attachment: None,
+                        timestamp_writes: None,
+                        occlusion_query_set: None,
+                        multiview_mask: None,
+                    })
+                    .forget_lifetime();
+                painter.render(&mut pass, jobs, &screen);
+            }
+            let shot = Screenshot::record(
+                &ctx,
+                &mut enc,
+                target,
+                std::env::temp_dir().join("unused.png"),
+            );
+            ctx.queue.submit(extra.into_iter().chain([enc.finish()]));
+            read_back(&ctx, shot).expect("reading the image back")
+        };
+    let frames = [
+        (0, "Panel A"),
+        (1, "Panel A"),
+        (2, "Panel A"),
+        (3, "Panel B"),
+        (4, "Panel B"),
+    ];
+    let mut kinds = Vec::new();
+    for (n, text) in frames {
+        let (out, live) = retained_test_frame(&egui_ctx, n, text);
+        for (id, deltas) in &out.textures_delta.set {
+            for delta in deltas {
+                painter.update_texture(&ctx.device, &ctx.queue, *id, delta);
+            }
+        }
+        let changed = !out.textures_delta.set.is_empty() || !out.textures_delta.free.is_empty();
+        let jobs = egui_ctx.tessellate(out.shapes, 1.0);
+        let image = retained.image(&ctx.device, (480, 270), format).clone();
+        let plan = retained.plan(&jobs, live, [480, 270], changed, background, None);
+        let got = match &plan {
+            Repaint::Full => paint(&mut painter, &image, &jobs, wgpu::LoadOp::Clear(clear)),
+            Repaint::Live(live_jobs) => paint(&mut painter, &image, live_jobs, wgpu::LoadOp::Load),
+        };
+        kinds.push(matches!(plan, Repaint::Live(_)));
+        let want = paint(
+            &mut painter,
+            &full_target,
+            &jobs,
+            wgpu::LoadOp::Clear(clear),
+        );
+        let differing = got
+            .pixels()
+            .zip(want.pixels())
+            .filter(|(a, b)| a != b)
+            .count();
+        assert_eq!(
+            differing, 0,
+            "frame {n}: the retained image differs from a full repaint in {differing} pixels"
+        );
+    }
+    // The first frames repaint in full (egui sizes the panel, fills its font atlas); then
+    // only the panel text change (frame 3) does.
+    assert_eq!(kinds, [false, false, true, false, true]);
+}

@@ -25,6 +25,7 @@ use crate::sim::{GpuSim, Stepper};
 use super::panel::{PANEL_WIDTH, panel_ui};
 use super::profile::StageProfiler;
 use super::remap::emitter_sources;
+use super::retained::Repaint;
 use super::screenshot::{Screenshot, read_back};
 use super::state::EditorState;
 use super::stats::{EmitterStats, ShaderReloadStats, median};
@@ -44,6 +45,9 @@ const VIEWPORT_BACKGROUND: wgpu::Color = wgpu::Color {
     b: 11.0 / 255.0,
     a: 1.0,
 };
+
+/// [`VIEWPORT_BACKGROUND`] as egui paints it.
+const VIEWPORT_BACKGROUND_32: egui::Color32 = egui::Color32::from_rgb(9, 9, 11);
 
 /// Extra frames `--screenshot` waits for the window to hand out a frame.
 const MAX_EXTRA_FRAMES: u64 = 120;
@@ -92,6 +96,8 @@ pub struct RunReport {
     pub adapter: String,
     /// The per-stage breakdown (`--profile`).
     pub profile: Option<String>,
+    /// With the retained window image: (frames painted in full, viewport-only frames).
+    pub ui_repaints: Option<(u64, u64)>,
 }
 
 impl std::fmt::Display for RunReport {
@@ -115,6 +121,12 @@ impl std::fmt::Display for RunReport {
             self.alive,
             self.adapter
         )?;
+        if let Some((full, live)) = self.ui_repaints {
+            write!(
+                f,
+                "\nretained UI: {full} frames painted in full, {live} only over the viewport"
+            )?;
+        }
         if let Some(profile) = &self.profile {
             write!(f, "\n{profile}")?;
         }
@@ -206,6 +218,11 @@ struct Gfx {
     frame_log: Vec<f32>,
     cpu_log: Vec<f32>,
     viewport_px: (u32, u32),
+    /// Where the viewport is in the window (points).
+    viewport_rect: egui::Rect,
+    /// The retained window image (lean painter and a surface that can be copied to):
+    /// the panel is repainted only when it changed.
+    retained: Option<super::retained::RetainedUi>,
     profiler: StageProfiler,
     /// Per-pass GPU timestamps (None on CPU adapters: their timestamps are not trusted).
     pass_timer: Option<crate::gpu::timer::PassTimer>,
@@ -333,6 +350,7 @@ impl Gfx {
         let format = egui_wgpu::preferred_framebuffer_format(&caps.formats)
             .map_err(|e| anyhow!("the window surface offers no usable format: {e:?}"))?;
         let surface_can_copy = caps.usages.contains(wgpu::TextureUsages::COPY_SRC);
+        let surface_can_receive = caps.usages.contains(wgpu::TextureUsages::COPY_DST);
         let mut config = surface
             .get_default_config(&ctx.adapter, size.width.max(1), size.height.max(1))
             .ok_or_else(|| anyhow!("the adapter cannot present to this window"))?;
@@ -348,7 +366,6 @@ impl Gfx {
         } else {
             wgpu::PresentMode::AutoVsync
         };
-        surface.configure(&ctx.device, &config);
 
         let lib = ShaderLibrary::discover(options.shader_dir.as_deref());
         let renderer = Renderer::new(&ctx, &lib)?;
@@ -372,13 +389,20 @@ impl Gfx {
             options.ui_painter,
             ctx.is_cpu_adapter(),
         );
+        // Software adapters keep the window's image between frames (see retained.rs).
+        let retained = (ui_painter.name() == "lean" && surface_can_receive).then(|| {
+            config.usage |= wgpu::TextureUsages::COPY_DST;
+            super::retained::RetainedUi::default()
+        });
+        surface.configure(&ctx.device, &config);
         log::info!(
-            "editor: {}x{} surface {:?}, COPY_SRC {}, UI painter {}",
+            "editor: {}x{} surface {:?}, COPY_SRC {}, UI painter {}, retained UI {}",
             config.width,
             config.height,
             config.format,
             surface_can_copy,
-            ui_painter.name()
+            ui_painter.name(),
+            retained.is_some()
         );
         Ok(Self {
             window,
@@ -402,6 +426,8 @@ impl Gfx {
             frame_log: Vec::new(),
             cpu_log: Vec::new(),
             viewport_px: (1, 1),
+            viewport_rect: egui::Rect::NOTHING,
+            retained,
             pass_timer,
             pending_steps: (0, 0.0),
             profiler: StageProfiler::new(options.profile),
@@ -651,6 +677,7 @@ impl Gfx {
         target: &wgpu::TextureView,
         paint_jobs: &[egui::ClippedPrimitive],
         screen: &egui_wgpu::ScreenDescriptor,
+        load: wgpu::LoadOp<wgpu::Color>,
     ) {
         let mut pass = encoder
             .begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -660,8 +687,9 @@ impl Gfx {
                     depth_slice: None,
                     resolve_target: None,
                     ops: wgpu::Operations {
-                        // The viewport's background: egui paints only the panel and overlays.
-                        load: wgpu::LoadOp::Clear(VIEWPORT_BACKGROUND),
+                        // Cleared to the viewport's background (egui paints only the
+                        // panel and overlays), or kept for a viewport-only repaint.
+                        load,
                         store: wgpu::StoreOp::Store,
                     },
                 })],
@@ -795,6 +823,7 @@ impl App {
         // 3. The viewport image: particles → HDR → tonemap, then a copy egui can show.
         gfx.profiler.end_stage(&gfx.ctx);
         gfx.viewport_px = viewport.size_px;
+        gfx.viewport_rect = viewport.rect;
         gfx.renderer.exposure = self.state.view.exposure;
         gfx.renderer.asset_dir = self
             .state
@@ -905,13 +934,40 @@ impl App {
             size_in_pixels: [gfx.config.width, gfx.config.height],
             pixels_per_point: ppp,
         };
-        let callbacks = gfx.ui_painter.prepare(
-            &gfx.ctx.device,
-            &gfx.ctx.queue,
-            &mut encoder,
-            &paint_jobs,
-            &screen,
-        );
+        // Software adapters: repaint only the viewport while the panel is unchanged.
+        let textures_changed = !full_output.textures_delta.set.is_empty()
+            || !full_output.textures_delta.free.is_empty();
+        let retained = match gfx.retained.as_mut() {
+            Some(r) => {
+                let image = r
+                    .image(
+                        &gfx.ctx.device,
+                        (gfx.config.width, gfx.config.height),
+                        gfx.config.format,
+                    )
+                    .clone();
+                let repaint = r.plan(
+                    &paint_jobs,
+                    gfx.viewport_rect,
+                    screen.size_in_pixels,
+                    textures_changed,
+                    VIEWPORT_BACKGROUND_32,
+                    gfx.viewport_texture,
+                );
+                Some((image, repaint))
+            }
+            None => None,
+        };
+        let (jobs, load) = match &retained {
+            Some((_, Repaint::Live(jobs))) => (jobs.as_slice(), wgpu::LoadOp::Load),
+            _ => (
+                paint_jobs.as_slice(),
+                wgpu::LoadOp::Clear(VIEWPORT_BACKGROUND),
+            ),
+        };
+        let callbacks =
+            gfx.ui_painter
+                .prepare(&gfx.ctx.device, &gfx.ctx.queue, &mut encoder, jobs, &screen);
 
         let is_last = self
             .options
@@ -943,11 +999,27 @@ impl App {
         };
 
         let mut screenshot = None;
-        if let Some(frame) = &frame {
+        if let (Some(frame), Some((image, _))) = (&frame, &retained) {
+            let view = image.create_view(&wgpu::TextureViewDescriptor::default());
+            gfx.render_egui(&mut encoder, &view, jobs, &screen, load);
+            encoder.copy_texture_to_texture(
+                image.as_image_copy(),
+                frame.texture.as_image_copy(),
+                image.size(),
+            );
+            if is_last && let Some(path) = &self.options.screenshot {
+                screenshot = Some(Screenshot::record(
+                    &gfx.ctx,
+                    &mut encoder,
+                    image,
+                    path.clone(),
+                ));
+            }
+        } else if let Some(frame) = &frame {
             let view = frame
                 .texture
                 .create_view(&wgpu::TextureViewDescriptor::default());
-            gfx.render_egui(&mut encoder, &view, &paint_jobs, &screen);
+            gfx.render_egui(&mut encoder, &view, jobs, &screen, load);
             if is_last && let Some(path) = &self.options.screenshot {
                 if gfx.surface_can_copy {
                     screenshot = Some(Screenshot::record(
@@ -967,7 +1039,7 @@ impl App {
                         wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
                     );
                     let off_view = offscreen.create_view(&Default::default());
-                    gfx.render_egui(&mut encoder, &off_view, &paint_jobs, &screen);
+                    gfx.render_egui(&mut encoder, &off_view, jobs, &screen, load);
                     screenshot = Some(Screenshot::record(
                         &gfx.ctx,
                         &mut encoder,
@@ -976,6 +1048,12 @@ impl App {
                     ));
                 }
             }
+        }
+        if frame.is_none()
+            && let Some(r) = gfx.retained.as_mut()
+        {
+            // Nothing was painted: the image no longer matches the panel.
+            r.invalidate();
         }
         gfx.ctx
             .queue
@@ -1017,6 +1095,10 @@ impl App {
             alive: self.state.stats.total_alive(),
             viewport_px: gfx.viewport_px,
             window_px: (gfx.config.width, gfx.config.height),
+            ui_repaints: gfx
+                .retained
+                .as_ref()
+                .map(|r| (r.full_repaints, r.live_repaints)),
             adapter: gfx.ctx.info.name.clone(),
             profile: gfx.profiler.report(WARMUP_FRAMES),
         });

@@ -9,6 +9,7 @@ pub mod look;
 pub mod panel;
 pub mod profile;
 pub mod remap;
+pub mod retained;
 pub mod screenshot;
 pub mod state;
 pub mod stats;

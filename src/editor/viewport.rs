@@ -13,10 +13,21 @@ use super::state::EditorState;
 const ORBIT_RAD_PER_POINT: f32 = 0.008;
 
 /// What the frame loop needs from the viewport after the UI ran.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ViewportOutput {
     /// Size of the render target, physical pixels (render scale applied).
     pub size_px: (u32, u32),
+    /// Where the viewport is in the window (points): the part repainted every frame.
+    pub rect: Rect,
+}
+
+impl Default for ViewportOutput {
+    fn default() -> Self {
+        Self {
+            size_px: (0, 0),
+            rect: Rect::NOTHING,
+        }
+    }
 }
 
 /// The central viewport: shows `texture` (the tonemapped simulation image), handles the
@@ -35,14 +46,17 @@ pub fn viewport_ui(
     // viewport pixel once more in egui's pass.
     let aspect = rect.width() / rect.height().max(1.0);
     let projector = Projector::new(camera.clip_from_world(aspect), rect);
-    if state.view.show_grid {
-        draw_grid(&painter, &projector);
-    }
     if let Some(id) = texture {
-        // Additive over the grid: a premultiplied tint with zero alpha adds the texels.
+        // Additive over the background: a premultiplied tint with zero alpha adds the
+        // texels. (The lean painter draws it opaque: the image then is the background.)
         let additive = Color32::from_rgba_premultiplied(255, 255, 255, 0);
         let uv = Rect::from_min_max(Pos2::ZERO, egui::pos2(1.0, 1.0));
         painter.image(id, rect, uv, additive);
+    }
+    if state.view.show_grid {
+        // After the image and additive too, so the sum is the same in either order and
+        // an opaque image cannot hide the grid.
+        draw_grid(&painter, &projector);
     }
     if state.view.show_gizmos {
         for (i, e) in state.effect.emitters.iter().enumerate() {
@@ -90,7 +104,10 @@ pub fn viewport_ui(
     let scale = state.view.render_scale.clamp(0.1, 1.0);
     let w = (rect.width() * ppp * scale).round().max(1.0) as u32;
     let h = (rect.height() * ppp * scale).round().max(1.0) as u32;
-    ViewportOutput { size_px: (w, h) }
+    ViewportOutput {
+        size_px: (w, h),
+        rect,
+    }
 }
 
 fn camera_input(
@@ -236,13 +253,15 @@ fn draw_grid(painter: &egui::Painter, projector: &Projector) {
     let n = (HALF_EXTENT_M / CELL_M) as i32;
     for k in -n..=n {
         let v = k as f32 * CELL_M;
-        let color = if k == 0 {
-            Color32::from_gray(70)
+        // Additive (premultiplied, zero alpha): light added over the image.
+        let gray = if k == 0 {
+            61
         } else if k % 2 == 0 {
-            Color32::from_gray(42)
+            33
         } else {
-            Color32::from_gray(28)
+            19
         };
+        let color = Color32::from_rgba_premultiplied(gray, gray, gray, 0);
         let stroke = Stroke::new(1.0, color);
         for (a, b) in [
             (
@@ -261,8 +280,8 @@ fn draw_grid(painter: &egui::Painter, projector: &Projector) {
     }
     // Short axis markers: +X red, +Z blue.
     for (dir, color) in [
-        (Vec3::X, Color32::from_rgb(150, 60, 60)),
-        (Vec3::Z, Color32::from_rgb(60, 80, 160)),
+        (Vec3::X, Color32::from_rgba_premultiplied(141, 51, 51, 0)),
+        (Vec3::Z, Color32::from_rgba_premultiplied(51, 71, 151, 0)),
     ] {
         if let Some(s) = projector.segment(Vec3::ZERO, dir * 0.5) {
             painter.line_segment(s, Stroke::new(1.5, color));

@@ -200,7 +200,11 @@ impl FrameResources {
             label: Some("FrameResources::frame_layout"),
             entries: &[
                 buffer(0, wgpu::BufferBindingType::Uniform, false),
-                buffer(1, wgpu::BufferBindingType::Storage { read_only: true }, true),
+                buffer(
+                    1,
+                    wgpu::BufferBindingType::Storage { read_only: true },
+                    true,
+                ),
                 wgpu::BindGroupLayoutEntry {
                     binding: 2,
                     visibility: all,
