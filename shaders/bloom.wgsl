@@ -88,3 +88,10 @@ fn up(in: VsOut) -> @location(0) vec4<f32> {
         + textureSample(src, samp, in.uv + vec2<f32>(t.x, t.y)).rgb;
     return vec4<f32>(c / 16.0, 1.0);
 }
+
+// Bilinear upsample, added (One + One) onto the target: the draft glow layer (large
+// additive sprites drawn at half resolution) joins the HDR image before the prefilter.
+@fragment
+fn add(in: VsOut) -> @location(0) vec4<f32> {
+    return vec4<f32>(textureSampleLevel(src, samp, in.uv, 0.0).rgb, 0.0);
+}

@@ -57,6 +57,10 @@ enum Command {
         /// Select this emitter (by name) at start.
         #[arg(long)]
         select: Option<String>,
+        /// Draft viewport: large additive sprites at half resolution (default: on for
+        /// software adapters, off elsewhere).
+        #[arg(long)]
+        draft: Option<bool>,
     },
     /// Write the built-in procedural sprites as PNGs (straight alpha), to start a
     /// texture from.
@@ -183,6 +187,7 @@ fn main() {
             profile,
             sections,
             select,
+            draft,
         }) => edit(EditOptions {
             frames: frames.or(screenshot.as_ref().map(|_| 60)),
             preset,
@@ -194,6 +199,7 @@ fn main() {
             profile,
             sections,
             select,
+            draft,
         }),
         Some(Command::Render {
             preset,

@@ -551,3 +551,44 @@ fn instanced_and_indexed_billboards_draw_the_same_frame() {
         "indexed vs instanced: mean {mean}, max {max}"
     );
 }
+
+/// Draft quality (the editor's default on software adapters): the flame tongues drawn at
+/// half resolution and added before the bloom look like the full-resolution frame —
+/// same light, a little softer — while the thin embers stay in the full-resolution pass.
+#[test]
+fn draft_glow_layer_renders_like_full_resolution() {
+    let ctx = gpu();
+    let effect = Effect::default_campfire();
+    let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    for _ in 0..150 {
+        run.advance(1.0 / 60.0).expect("advance");
+    }
+    let full = run.render(SIZE).expect("render");
+    run.renderer.draft = true;
+    let draft = run.render(SIZE).expect("render");
+    // The flames are glow, the streaked embers and the alpha smoke are not.
+    let camera = run.camera;
+    let items = run.renderer.frame.prepare(
+        &ctx,
+        &run.sim,
+        &run.effect,
+        &camera,
+        SIZE,
+        1.0,
+        &mut run.renderer.sort,
+        None,
+    );
+    let glow: Vec<&str> = items
+        .iter()
+        .filter(|d| d.is_glow())
+        .map(|d| run.effect.emitters[d.index].name.as_str())
+        .collect();
+    assert_eq!(glow, ["flames"]);
+    let (mean, max) = image_diff(&full, &draft);
+    let (lf, ld) = (total_light(&full), total_light(&draft));
+    assert!(mean > 0.0, "draft took no other path");
+    assert!(
+        mean < 1.0 && (ld / lf - 1.0).abs() < 0.02,
+        "draft vs full: mean {mean} (max {max}), light {ld} vs {lf}"
+    );
+}

@@ -342,7 +342,8 @@ fn measure_row(
         };
         Some(time_median(&timer, ctx, opts.repeats.min(3), |enc| {
             let mut pass = begin_hdr_pass(enc, t);
-            r.billboard.draw(&mut pass, &r.frame, &all_billboard, None);
+            r.billboard
+                .draw(&mut pass, &r.frame, &all_billboard, |_| true);
         }))
     } else {
         None

@@ -75,6 +75,8 @@ pub struct EditOptions {
     pub sections: Option<Vec<String>>,
     /// Select this emitter (by name) at start.
     pub select: Option<String>,
+    /// Draft viewport (default: on for software adapters).
+    pub draft: Option<bool>,
 }
 
 /// What a run with `--frames` measured.
@@ -279,6 +281,8 @@ impl ApplicationHandler for App {
                     .render_scale
                     .unwrap_or(default_scale)
                     .clamp(0.1, 1.0);
+                // … and draw the large additive sprites at half of that.
+                self.state.view.draft = self.options.draft.unwrap_or(gfx.ctx.is_cpu_adapter());
                 gfx.window.request_redraw();
                 self.gfx = Some(gfx);
             }
@@ -825,6 +829,7 @@ impl App {
         gfx.viewport_px = viewport.size_px;
         gfx.viewport_rect = viewport.rect;
         gfx.renderer.exposure = self.state.view.exposure;
+        gfx.renderer.draft = self.state.view.draft;
         gfx.renderer.asset_dir = self
             .state
             .loaded_path

@@ -1415,6 +1415,12 @@ ui,
             "Render the viewport at this fraction of its pixel size and upscale it (faster on slow GPUs)",
             |ui| ui.add(egui::Slider::new(&mut view.render_scale, 0.25..=1.0).fixed_decimals(2)),
         );
+        row_ui(
+            ui,
+            "Draft glow",
+            "Draw large additive sprites (flame tongues) at half the render resolution: a quarter of their fill, slightly softer (on by default on software adapters)",
+            |ui| ui.checkbox(&mut view.draft, ""),
+        );
     });
     ui.horizontal(|ui| {
         if ui

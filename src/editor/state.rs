@@ -18,6 +18,9 @@ pub struct ViewSettings {
     pub show_gizmos: bool,
     /// Render the viewport at this fraction of its pixel size (upscaled when shown).
     pub render_scale: f32,
+    /// Draft quality: large additive sprites (flame tongues) at half the render
+    /// resolution (`Renderer::draft`).
+    pub draft: bool,
     /// A sphere collider follows the pointer over the viewport: push the fire around.
     pub mouse_collider: bool,
 }
@@ -29,6 +32,7 @@ impl Default for ViewSettings {
             show_grid: true,
             show_gizmos: true,
             render_scale: 1.0,
+            draft: false,
             mouse_collider: false,
         }
     }

@@ -179,20 +179,17 @@ impl BillboardPass {
         }
     }
 
-    /// Draws the billboard items into an open render pass (alpha-blended layers first,
-    /// then additive ones on top). Items whose pipeline or sprite was not prepared are
-    /// skipped.
+    /// Draws the billboard items that `wanted` accepts into an open render pass
+    /// (alpha-blended layers first, then additive ones on top). Items whose pipeline or
+    /// sprite was not prepared are skipped.
     pub fn draw(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
         frame: &FrameResources,
         items: &[DrawItem],
-        only: Option<BlendMode>,
+        wanted: impl Fn(&DrawItem) -> bool,
     ) {
-        let mut sorted: Vec<&DrawItem> = items
-            .iter()
-            .filter(|d| !d.splat && only.is_none_or(|b| d.blend == b))
-            .collect();
+        let mut sorted: Vec<&DrawItem> = items.iter().filter(|d| !d.splat && wanted(d)).collect();
         sorted.sort_by_key(|d| match d.blend {
             BlendMode::Alpha => 0,
             BlendMode::Additive => 1,

@@ -23,6 +23,8 @@ struct BloomPipelines {
     prefilter_splat: wgpu::RenderPipeline,
     down: wgpu::RenderPipeline,
     up: wgpu::RenderPipeline,
+    /// Bilinear upsample added onto the target (the draft glow layer).
+    add: wgpu::RenderPipeline,
 }
 
 /// The mip chain: level 0 is half the target size.
@@ -112,6 +114,7 @@ impl BloomPass {
                 prefilter_splat: make("prefilter", None, true),
                 down: make("down", None, false),
                 up: make("up", Some(crate::render::billboard::ADDITIVE), false),
+                add: make("add", Some(crate::render::billboard::ADDITIVE), false),
             }
         })
     }
@@ -190,6 +193,19 @@ impl BloomPass {
         }
     }
 
+    /// Adds `layer`, upsampled bilinearly, onto `dst` (the draft glow layer onto the HDR
+    /// image).
+    pub fn add_layer(
+        &self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        layer: &wgpu::TextureView,
+        dst: &wgpu::TextureView,
+    ) {
+        let group = self.group(ctx, layer, None);
+        full_screen_pass(enc, &self.pipelines.add, &group, dst, true);
+    }
+
     /// Records the bloom of `hdr` (plus `splat`'s light) and returns the view the tonemap
     /// adds (level 0 of the chain).
     pub fn record(
@@ -214,48 +230,52 @@ impl BloomPass {
         // bind groups are built with the chain.
         let prefilter_group = self.group(ctx, hdr, splat);
         let chain = self.chain.as_ref()?;
-        let pass = |enc: &mut wgpu::CommandEncoder,
-                    pipeline: &wgpu::RenderPipeline,
-                    bind: &wgpu::BindGroup,
-                    dst: &wgpu::TextureView,
-                    load: bool| {
-            let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("BloomPass::pass"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: dst,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: if load {
-                            wgpu::LoadOp::Load
-                        } else {
-                            wgpu::LoadOp::Clear(wgpu::Color::BLACK)
-                        },
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            rp.set_pipeline(pipeline);
-            rp.set_bind_group(0, bind, &[]);
-            rp.draw(0..3, 0..1);
-        };
         let p = &self.pipelines;
         let prefilter = if splat.is_some() {
             &p.prefilter_splat
         } else {
             &p.prefilter
         };
-        pass(enc, prefilter, &prefilter_group, &chain.views[0], false);
+        full_screen_pass(enc, prefilter, &prefilter_group, &chain.views[0], false);
         for m in 1..chain.views.len() {
-            pass(enc, &p.down, &chain.groups[m - 1], &chain.views[m], false);
+            full_screen_pass(enc, &p.down, &chain.groups[m - 1], &chain.views[m], false);
         }
         for m in (1..chain.views.len()).rev() {
-            pass(enc, &p.up, &chain.groups[m], &chain.views[m - 1], true);
+            full_screen_pass(enc, &p.up, &chain.groups[m], &chain.views[m - 1], true);
         }
         chain.views.first()
     }
+}
+
+/// One full-screen triangle of `pipeline` into `dst` (cleared first unless `load`).
+fn full_screen_pass(
+    enc: &mut wgpu::CommandEncoder,
+    pipeline: &wgpu::RenderPipeline,
+    bind: &wgpu::BindGroup,
+    dst: &wgpu::TextureView,
+    load: bool,
+) {
+    let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("BloomPass::pass"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: dst,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: if load {
+                    wgpu::LoadOp::Load
+                } else {
+                    wgpu::LoadOp::Clear(wgpu::Color::BLACK)
+                },
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    rp.set_pipeline(pipeline);
+    rp.set_bind_group(0, bind, &[]);
+    rp.draw(0..3, 0..1);
 }

@@ -34,7 +34,23 @@ pub struct DrawItem {
     pub variant: LookVariant,
     /// The sprite texture.
     pub sprite: Arc<SpriteTexture>,
+    /// The particles' largest size on screen at the emitter's distance, pixels.
+    pub size_px: f32,
 }
+
+impl DrawItem {
+    /// A large additive billboard that a draft render draws at half resolution
+    /// (streaks stay sharp: they are thin however long).
+    pub fn is_glow(&self) -> bool {
+        !self.splat
+            && self.blend == BlendMode::Additive
+            && !self.variant.streak
+            && self.size_px >= GLOW_MIN_PX
+    }
+}
+
+/// Billboards at least this large on screen (pixels at full resolution) count as glow.
+pub const GLOW_MIN_PX: f32 = 12.0;
 
 /// Uniform buffers, layouts and bind groups for the draw passes.
 pub struct FrameResources {
@@ -515,6 +531,7 @@ impl FrameResources {
                 splat,
                 variant: LookVariant::of(&e.look),
                 sprite,
+                size_px,
             });
         }
         if !blocks.is_empty() {

@@ -174,6 +174,12 @@ pub struct Renderer {
     pub asset_dir: Option<std::path::PathBuf>,
     /// The reduced-resolution target of the alpha-blended layers (`post.alpha_downscale`).
     alpha_layer: Option<((u32, u32), wgpu::TextureView)>,
+    /// Draft quality (the editor's default on software adapters): large additive
+    /// billboards ([`DrawItem::is_glow`], e.g. flame tongues) are drawn at half
+    /// resolution and added to the HDR image before the bloom — a quarter of their fill.
+    pub draft: bool,
+    /// The half-resolution target of the glow layer (draft).
+    glow_layer: Option<((u32, u32), wgpu::TextureView)>,
 }
 
 impl Renderer {
@@ -191,6 +197,8 @@ impl Renderer {
             exposure: 1.0,
             asset_dir: None,
             alpha_layer: None,
+            draft: false,
+            glow_layer: None,
         })
     }
 
@@ -296,14 +304,36 @@ impl Renderer {
             }
             if let Some((_, view)) = &self.alpha_layer {
                 let mut pass = begin_hdr_pass(enc, view);
+                self.billboard.draw(&mut pass, &self.frame, &items, |d| {
+                    d.blend == BlendMode::Alpha
+                });
+            }
+        }
+        let glow = self.draft && items.iter().any(DrawItem::is_glow);
+        if glow {
+            let half = (targets.size.0.div_ceil(2), targets.size.1.div_ceil(2));
+            if self.glow_layer.as_ref().is_none_or(|(s, _)| *s != half) {
+                let view =
+                    hdr_texture(ctx, "Renderer::glow_layer", half).create_view(&Default::default());
+                self.glow_layer = Some((half, view));
+            }
+            if let Some((_, view)) = &self.glow_layer {
+                let mut pass = begin_hdr_pass(enc, view);
                 self.billboard
-                    .draw(&mut pass, &self.frame, &items, Some(BlendMode::Alpha));
+                    .draw(&mut pass, &self.frame, &items, DrawItem::is_glow);
             }
         }
         {
             let mut pass = begin_hdr_pass(enc, &targets.hdr_view);
-            let only = low_alpha.then_some(BlendMode::Additive);
-            self.billboard.draw(&mut pass, &self.frame, &items, only);
+            self.billboard.draw(&mut pass, &self.frame, &items, |d| {
+                // What the reduced-resolution layers did not draw.
+                let in_layer = (low_alpha && d.blend == BlendMode::Alpha) || (glow && d.is_glow());
+                !in_layer
+            });
+        }
+        if glow && let Some((_, view)) = &self.glow_layer {
+            // Upsampled (bilinear) and added before the bloom, which must see it.
+            self.bloom.add_layer(ctx, enc, view, &targets.hdr_view);
         }
         // The splat's light is resolved inside the tonemap (one full-screen pass less).
         let accum = if splatted {
