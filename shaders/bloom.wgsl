@@ -19,6 +19,8 @@ struct BloomUniform {
 @group(0) @binding(3) var<storage, read> accum: array<u32>;
 
 override SPLAT: bool = false;
+// Draft: the chain starts at a quarter of the resolution (a 4×4 average).
+override QUARTER: bool = false;
 // Keep in sync with `FIXED_SCALE` in splat.wgsl.
 const BLOOM_FIXED_SCALE: f32 = 4096.0;
 
@@ -47,11 +49,23 @@ fn hdr_at(p: vec2<i32>) -> vec3<f32> {
     return c;
 }
 
-// Full resolution → half: the 2×2 average, kept above a soft threshold (quadratic knee).
+// Full resolution → half: the 2×2 average (4×4 → quarter when QUARTER), kept above a
+// soft threshold (quadratic knee).
 @fragment
 fn prefilter(in: VsOut) -> @location(0) vec4<f32> {
-    let p = vec2<i32>(in.clip.xy) * 2;
-    let c = 0.25 * (hdr_at(p) + hdr_at(p + vec2<i32>(1, 0)) + hdr_at(p + vec2<i32>(0, 1)) + hdr_at(p + vec2<i32>(1, 1)));
+    var c = vec3<f32>(0.0);
+    if QUARTER {
+        let p = vec2<i32>(in.clip.xy) * 4;
+        for (var y = 0; y < 4; y++) {
+            for (var x = 0; x < 4; x++) {
+                c += hdr_at(p + vec2<i32>(x, y));
+            }
+        }
+        c *= 1.0 / 16.0;
+    } else {
+        let p = vec2<i32>(in.clip.xy) * 2;
+        c = 0.25 * (hdr_at(p) + hdr_at(p + vec2<i32>(1, 0)) + hdr_at(p + vec2<i32>(0, 1)) + hdr_at(p + vec2<i32>(1, 1)));
+    }
     let threshold = bloom.params.x;
     let knee = max(bloom.params.y, 1e-5);
     let l = max(c.r, max(c.g, c.b));

@@ -553,8 +553,10 @@ fn instanced_and_indexed_billboards_draw_the_same_frame() {
 }
 
 /// Draft quality (the editor's default on software adapters): the flame tongues drawn at
-/// half resolution and added before the bloom look like the full-resolution frame —
-/// same light, a little softer — while the thin embers stay in the full-resolution pass.
+/// half resolution and added before the bloom, and the bloom from a quarter-resolution
+/// chain, look like the full-resolution frame — the same light within 3 % (measured
+/// 0.46/255 mean, 1.5 % less light: a 4×4 average clips less above the threshold), a
+/// little softer — while the thin embers stay in the full-resolution pass.
 #[test]
 fn draft_glow_layer_renders_like_full_resolution() {
     let ctx = gpu();
@@ -588,7 +590,7 @@ fn draft_glow_layer_renders_like_full_resolution() {
     let (lf, ld) = (total_light(&full), total_light(&draft));
     assert!(mean > 0.0, "draft took no other path");
     assert!(
-        mean < 1.0 && (ld / lf - 1.0).abs() < 0.02,
+        mean < 1.0 && (ld / lf - 1.0).abs() < 0.03,
         "draft vs full: mean {mean} (max {max}), light {ld} vs {lf}"
     );
 }

@@ -21,16 +21,20 @@ pub struct BloomPass {
 struct BloomPipelines {
     prefilter: wgpu::RenderPipeline,
     prefilter_splat: wgpu::RenderPipeline,
+    /// The draft prefilters: to a quarter of the resolution.
+    prefilter_quarter: wgpu::RenderPipeline,
+    prefilter_quarter_splat: wgpu::RenderPipeline,
     down: wgpu::RenderPipeline,
     up: wgpu::RenderPipeline,
     /// Bilinear upsample added onto the target (the draft glow layer).
     add: wgpu::RenderPipeline,
 }
 
-/// The mip chain: level 0 is half the target size.
+/// The mip chain: level 0 is half the target size (a quarter in draft).
 struct Chain {
     target_size: (u32, u32),
     levels: u32,
+    quarter: bool,
     views: Vec<wgpu::TextureView>,
     /// `groups[m]` reads level m (the source of the down pass m → m+1 and of the up pass
     /// m → m−1), built with the chain.
@@ -92,8 +96,9 @@ impl BloomPass {
     ) -> Result<BloomPipelines, ShaderError> {
         let composed = lib.compose("bloom.wgsl")?;
         create_checked(&ctx.device, &composed, lib, |module| {
-            let make = |fs: &str, blend: Option<wgpu::BlendState>, splat: bool| {
-                let constants = [("SPLAT", if splat { 1.0 } else { 0.0 })];
+            let make = |fs: &str, blend: Option<wgpu::BlendState>, splat: bool, quarter: bool| {
+                let b = |v: bool| if v { 1.0 } else { 0.0 };
+                let constants = [("SPLAT", b(splat)), ("QUARTER", b(quarter))];
                 crate::render::simple_pipeline(
                     ctx,
                     &format!("BloomPass::{fs}"),
@@ -110,11 +115,18 @@ impl BloomPass {
                 )
             };
             BloomPipelines {
-                prefilter: make("prefilter", None, false),
-                prefilter_splat: make("prefilter", None, true),
-                down: make("down", None, false),
-                up: make("up", Some(crate::render::billboard::ADDITIVE), false),
-                add: make("add", Some(crate::render::billboard::ADDITIVE), false),
+                prefilter: make("prefilter", None, false, false),
+                prefilter_splat: make("prefilter", None, true, false),
+                prefilter_quarter: make("prefilter", None, false, true),
+                prefilter_quarter_splat: make("prefilter", None, true, true),
+                down: make("down", None, false, false),
+                up: make("up", Some(crate::render::billboard::ADDITIVE), false, false),
+                add: make(
+                    "add",
+                    Some(crate::render::billboard::ADDITIVE),
+                    false,
+                    false,
+                ),
             }
         })
     }
@@ -156,14 +168,20 @@ impl BloomPass {
         })
     }
 
-    fn ensure_chain(&mut self, ctx: &GpuContext, target_size: (u32, u32), levels: u32) {
-        let (w, h) = ((target_size.0 / 2).max(1), (target_size.1 / 2).max(1));
+    fn ensure_chain(
+        &mut self,
+        ctx: &GpuContext,
+        target_size: (u32, u32),
+        levels: u32,
+        quarter: bool,
+    ) {
+        let d = if quarter { 4 } else { 2 };
+        let (w, h) = ((target_size.0 / d).max(1), (target_size.1 / d).max(1));
         // No level smaller than 1 × 1.
         let levels = levels.clamp(1, 32 - w.min(h).leading_zeros());
-        let stale = self
-            .chain
-            .as_ref()
-            .is_none_or(|c| c.target_size != target_size || c.levels != levels);
+        let stale = self.chain.as_ref().is_none_or(|c| {
+            c.target_size != target_size || c.levels != levels || c.quarter != quarter
+        });
         if stale {
             let texture = crate::gpu::texture_2d(
                 &ctx.device,
@@ -187,6 +205,7 @@ impl BloomPass {
             self.chain = Some(Chain {
                 target_size,
                 levels,
+                quarter,
                 views,
                 groups,
             });
@@ -207,7 +226,10 @@ impl BloomPass {
     }
 
     /// Records the bloom of `hdr` (plus `splat`'s light) and returns the view the tonemap
-    /// adds (level 0 of the chain).
+    /// adds (level 0 of the chain). `draft` starts the chain at a quarter of the
+    /// resolution, one level shorter (the same reach): the half-resolution passes are
+    /// most of the bloom's cost on a software rasteriser.
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
         ctx: &GpuContext,
@@ -216,6 +238,7 @@ impl BloomPass {
         splat: Option<&wgpu::Buffer>,
         target_size: (u32, u32),
         settings: &Bloom,
+        draft: bool,
     ) -> Option<&wgpu::TextureView> {
         let params = [
             settings.threshold,
@@ -225,16 +248,19 @@ impl BloomPass {
         ];
         ctx.queue
             .write_buffer(&self.uniform, 0, bytemuck::cast_slice(&params));
-        self.ensure_chain(ctx, target_size, settings.levels);
+        let quarter = draft && settings.levels > 1;
+        let levels = settings.levels - u32::from(quarter);
+        self.ensure_chain(ctx, target_size, levels, quarter);
         // The prefilter reads this frame's HDR target and splat light; the chain's own
         // bind groups are built with the chain.
         let prefilter_group = self.group(ctx, hdr, splat);
         let chain = self.chain.as_ref()?;
         let p = &self.pipelines;
-        let prefilter = if splat.is_some() {
-            &p.prefilter_splat
-        } else {
-            &p.prefilter
+        let prefilter = match (splat.is_some(), quarter) {
+            (false, false) => &p.prefilter,
+            (true, false) => &p.prefilter_splat,
+            (false, true) => &p.prefilter_quarter,
+            (true, true) => &p.prefilter_quarter_splat,
         };
         full_screen_pass(enc, prefilter, &prefilter_group, &chain.views[0], false);
         for m in 1..chain.views.len() {

@@ -344,7 +344,15 @@ impl Renderer {
         let bloom = match &effect.post.bloom {
             Some(b) => self
                 .bloom
-                .record(ctx, enc, &targets.hdr_view, accum, targets.size, b)
+                .record(
+                    ctx,
+                    enc,
+                    &targets.hdr_view,
+                    accum,
+                    targets.size,
+                    b,
+                    self.draft,
+                )
                 .map(|view| (view, b.intensity)),
             None => None,
         };
