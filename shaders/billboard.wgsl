@@ -14,7 +14,7 @@
 #import "look.wgsl"
 
 @group(0) @binding(0) var<uniform> camera: CameraUniform;
-// Storage, not uniform: see update.wgsl (lavapipe's uniform inlining).
+// Storage, not uniform: see params.wgsl (lavapipe's uniform inlining).
 @group(0) @binding(1) var<storage, read> look: LookUniform;
 @group(0) @binding(2) var ramps: texture_2d<f32>;
 @group(1) @binding(0) var<storage, read> prev: array<Particle>;

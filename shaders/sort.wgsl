@@ -29,7 +29,7 @@ struct SortStep {
     window: vec4<u32>,
 }
 
-// Storage, not uniform: see update.wgsl (lavapipe's uniform inlining).
+// Storage, not uniform: see params.wgsl (lavapipe's uniform inlining).
 @group(0) @binding(0) var<storage, read> step: SortStep;
 @group(0) @binding(1) var<storage, read_write> keys: array<u32>;
 @group(0) @binding(2) var<storage, read_write> values: array<u32>;

@@ -22,9 +22,8 @@
 //   of the window, since the two share a word.
 #import "common.wgsl"
 
-// Read-only storage rather than a uniform: lavapipe recompiles shaders whose branches
-// read uniform-buffer values on every bind of a new dynamic offset.
-@group(0) @binding(0) var<storage, read> params: SimParams;
+// `params` (binding 0): a uniform on GPUs, read-only storage on CPU adapters.
+#import "params.wgsl"
 @group(0) @binding(3) var<storage, read_write> counters: array<atomic<u32>, 2>;
 
 // The state's bindings (1 `src`, 2 `dst`) and `load_state` / `store_state`: full 32-byte

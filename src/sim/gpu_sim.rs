@@ -8,7 +8,9 @@ use crate::gpu::types::{
     slot_counter, tiny_decode,
 };
 use crate::gpu::{GpuContext, GpuError};
-use crate::shaders::{PACKED_STATE_IO, ShaderError, ShaderLibrary, TINY_STATE_IO, create_checked};
+use crate::shaders::{
+    PACKED_STATE_IO, PARAMS_STORAGE, ShaderError, ShaderLibrary, TINY_STATE_IO, create_checked,
+};
 use crate::sim::modules::Modules;
 use crate::sim::planner::{EffectPlanner, LiveWindow};
 
@@ -62,7 +64,12 @@ impl UpdatePass {
                         binding: 0,
                         visibility: wgpu::ShaderStages::COMPUTE,
                         ty: wgpu::BindingType::Buffer {
-                            ty: wgpu::BufferBindingType::Storage { read_only: true },
+                            // See params.wgsl: storage on CPU adapters (lavapipe).
+                            ty: if ctx.is_cpu_adapter() {
+                                wgpu::BufferBindingType::Storage { read_only: true }
+                            } else {
+                                wgpu::BufferBindingType::Uniform
+                            },
                             has_dynamic_offset: true,
                             min_binding_size: wgpu::BufferSize::new(
                                 std::mem::size_of::<SimParams>() as u64,
@@ -115,11 +122,20 @@ impl UpdatePass {
         lib: &ShaderLibrary,
         keys: &[PipelineKey],
     ) -> Result<(), ShaderError> {
-        let composed = lib.compose("update.wgsl")?;
+        // CPU adapters read the parameters from storage (params.wgsl says why).
+        let cpu = ctx.is_cpu_adapter();
+        let compose = |io: Option<(&str, &str)>| {
+            let aliases: Vec<(&str, &str)> = io
+                .into_iter()
+                .chain(cpu.then_some(PARAMS_STORAGE))
+                .collect();
+            lib.compose_with("update.wgsl", &aliases)
+        };
+        let composed = compose(None)?;
         // Packed-state pipelines: the same entry with state_packed.wgsl as the state I/O.
-        let packed = lib.compose_with("update.wgsl", &[PACKED_STATE_IO])?;
+        let packed = compose(Some(PACKED_STATE_IO))?;
         // Tiny-state pipelines: state_tiny.wgsl as the state I/O.
-        let tiny = lib.compose_with("update.wgsl", &[TINY_STATE_IO])?;
+        let tiny = compose(Some(TINY_STATE_IO))?;
         let mut fresh = HashMap::new();
         for &(integrator, modules) in keys {
             let composed = if modules.contains(Modules::TINY) {
@@ -294,7 +310,9 @@ impl GpuSim {
             params_buffer: ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("GpuSim::params"),
                 size: PARAMS_STRIDE,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                usage: wgpu::BufferUsages::UNIFORM
+                    | wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
             params_slots: 1,
@@ -412,7 +430,9 @@ impl GpuSim {
             self.params_buffer = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("GpuSim::params"),
                 size: slots as u64 * PARAMS_STRIDE,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                usage: wgpu::BufferUsages::UNIFORM
+                    | wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             });
             for i in 0..self.emitters.len() {
