@@ -14,8 +14,9 @@
 #import "look.wgsl"
 
 @group(0) @binding(0) var<uniform> camera: CameraUniform;
-// Storage, not uniform: see params.wgsl (lavapipe's uniform inlining).
-@group(0) @binding(1) var<storage, read> look: LookUniform;
+// A uniform here (storage in billboard.wgsl): one per-emitter recompile on lavapipe (see
+// params.wgsl) costs less than a million per-particle storage loads.
+@group(0) @binding(1) var<uniform> look: LookUniform;
 @group(0) @binding(2) var ramps: texture_2d<f32>;
 @group(1) @binding(0) var<storage, read> prev: array<Particle>;
 @group(1) @binding(1) var<storage, read> cur: array<Particle>;

@@ -54,8 +54,12 @@ pub const GLOW_MIN_PX: f32 = 12.0;
 
 /// Uniform buffers, layouts and bind groups for the draw passes.
 pub struct FrameResources {
-    /// Group 0: camera + look (dynamic offset).
+    /// Group 0 of the billboards: camera + look (storage, dynamic offset).
     pub frame_layout: wgpu::BindGroupLayout,
+    /// Group 0 of the splat: camera + look (uniform, dynamic offset).
+    pub splat_layout: wgpu::BindGroupLayout,
+    /// The splat's group 0 (the same buffers as `frame_group`).
+    pub splat_group: wgpu::BindGroup,
     /// Group 1: previous and current state.
     pub particle_layout: wgpu::BindGroupLayout,
     camera: wgpu::Buffer,
@@ -189,9 +193,11 @@ impl FrameResources {
     pub fn new(ctx: &GpuContext) -> Self {
         let d = &ctx.device;
         let all = wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        // The per-emitter look is read-only *storage*, not a uniform buffer: lavapipe
+        // The billboards read the per-emitter look as read-only *storage*: lavapipe
         // (Mesa 22.3) inlines uniform-buffer values that steer branches into the shader
-        // and recompiles it on every bind of a new offset — ~3 ms per emitter per frame.
+        // and recompiles it on every bind of a new offset — ~3 ms per emitter draw. The
+        // splat reads it as a uniform: per-particle storage loads cost lavapipe more there
+        // (a million-spark frame 85–117 → 106–161 ms) than one recompile per emitter.
         let buffer = |binding, ty, dynamic| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: all,
@@ -212,27 +218,33 @@ impl FrameResources {
             },
             count: None,
         };
-        let frame_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("FrameResources::frame_layout"),
-            entries: &[
-                buffer(0, wgpu::BufferBindingType::Uniform, false),
-                buffer(
-                    1,
-                    wgpu::BufferBindingType::Storage { read_only: true },
-                    true,
-                ),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: all,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
+        let look_layout = |label, look_type| {
+            d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(label),
+                entries: &[
+                    buffer(0, wgpu::BufferBindingType::Uniform, false),
+                    buffer(1, look_type, true),
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 2,
+                        visibility: all,
+                        ty: wgpu::BindingType::Texture {
+                            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                            view_dimension: wgpu::TextureViewDimension::D2,
+                            multisampled: false,
+                        },
+                        count: None,
                     },
-                    count: None,
-                },
-            ],
-        });
+                ],
+            })
+        };
+        let frame_layout = look_layout(
+            "FrameResources::frame_layout",
+            wgpu::BufferBindingType::Storage { read_only: true },
+        );
+        let splat_layout = look_layout(
+            "FrameResources::splat_layout",
+            wgpu::BufferBindingType::Uniform,
+        );
         let particle_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("FrameResources::particle_layout"),
             // 3, 4: the same state buffers as 0, 1, seen as packed (or tiny) state; 5: the
@@ -252,9 +264,12 @@ impl FrameResources {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let (looks, ramps, frame_group) = Self::look_buffer(ctx, &frame_layout, &camera, 4);
+        let (looks, ramps, [frame_group, splat_group]) =
+            Self::look_buffer(ctx, [&frame_layout, &splat_layout], &camera, 4);
         Self {
             frame_layout,
+            splat_layout,
+            splat_group,
             particle_layout,
             camera,
             looks,
@@ -277,16 +292,19 @@ impl FrameResources {
         }
     }
 
+    /// The looks buffer, the ramps and a group 0 over them for each of `layouts`.
     fn look_buffer(
         ctx: &GpuContext,
-        layout: &wgpu::BindGroupLayout,
+        layouts: [&wgpu::BindGroupLayout; 2],
         camera: &wgpu::Buffer,
         slots: usize,
-    ) -> (wgpu::Buffer, wgpu::Texture, wgpu::BindGroup) {
+    ) -> (wgpu::Buffer, wgpu::Texture, [wgpu::BindGroup; 2]) {
         let looks = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("FrameResources::looks"),
             size: slots as u64 * PARAMS_STRIDE,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::UNIFORM
+                | wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let ramps = crate::gpu::texture_2d(
@@ -298,29 +316,31 @@ impl FrameResources {
             wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
         );
         let ramp_view = ramps.create_view(&Default::default());
-        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("FrameResources::frame_group"),
-            layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: camera.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &looks,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(size_of::<LookUniform>() as u64),
-                    }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(&ramp_view),
-                },
-            ],
+        let groups = layouts.map(|layout| {
+            ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("FrameResources::frame_group"),
+                layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: camera.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer: &looks,
+                            offset: 0,
+                            size: wgpu::BufferSize::new(size_of::<LookUniform>() as u64),
+                        }),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(&ramp_view),
+                    },
+                ],
+            })
         });
-        (looks, ramps, group)
+        (looks, ramps, groups)
     }
 
     /// The dynamic offset of emitter `index`'s look uniform.
@@ -388,12 +408,17 @@ impl FrameResources {
         let n = effect.emitters.len();
         if n > self.look_slots {
             self.look_slots = n.next_power_of_two();
-            let (looks, ramps, group) =
-                Self::look_buffer(ctx, &self.frame_layout, &self.camera, self.look_slots);
+            let (looks, ramps, [group, splat_group]) = Self::look_buffer(
+                ctx,
+                [&self.frame_layout, &self.splat_layout],
+                &self.camera,
+                self.look_slots,
+            );
             self.looks = looks;
             self.ramps = ramps;
             self.ramp_keys = vec![None; self.look_slots];
             self.frame_group = group;
+            self.splat_group = splat_group;
         }
         self.sprite_errors.clear();
         let mut blocks = vec![0u8; n * PARAMS_STRIDE as usize];

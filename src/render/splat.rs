@@ -50,7 +50,7 @@ impl SplatPass {
             .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("SplatPass::pipeline_layout"),
                 bind_group_layouts: &[
-                    Some(&frame.frame_layout),
+                    Some(&frame.splat_layout),
                     Some(&frame.particle_layout),
                     Some(&accum_layout),
                 ],
@@ -73,7 +73,7 @@ impl SplatPass {
             .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("SplatPass::resolve_layout"),
                 bind_group_layouts: &[
-                    Some(&frame.frame_layout),
+                    Some(&frame.splat_layout),
                     Some(&empty_layout),
                     Some(&accum_layout),
                 ],
@@ -177,7 +177,7 @@ impl SplatPass {
             };
             pass.set_bind_group(
                 0,
-                &frame.frame_group,
+                &frame.splat_group,
                 &[FrameResources::look_offset(d.index)],
             );
             pass.set_bind_group(1, particles, &[]);
@@ -200,7 +200,7 @@ impl SplatPass {
             return;
         };
         pass.set_pipeline(&self.resolve);
-        pass.set_bind_group(0, &frame.frame_group, &[0]);
+        pass.set_bind_group(0, &frame.splat_group, &[0]);
         pass.set_bind_group(1, &self.empty_group, &[]);
         pass.set_bind_group(2, group, &[]);
         pass.draw(0..3, 0..1);
