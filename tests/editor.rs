@@ -1110,27 +1110,7 @@ fn retained_ui_repaints_match_full_repaints() {
             let mut enc = ctx.device.create_command_encoder(&Default::default());
             let extra = painter.prepare(&ctx.device, &ctx.queue, &mut enc, jobs, &screen);
             let view = target.create_view(&Default::default());
-            {
-                let mut pass = enc
-                    .begin_render_pass(&wgpu::RenderPassDescriptor {
-                        label: None,
-                        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                            view: &view,
-                            depth_slice: None,
-                            resolve_target: None,
-                            ops: wgpu::Operations {
-                                load,
-                                store: wgpu::StoreOp::Store,
-                            },
-                        })],
-                        depth_stencil_attachment: None,
-                        timestamp_writes: None,
-                        occlusion_query_set: None,
-                        multiview_mask: None,
-                    })
-                    .forget_lifetime();
-                painter.render(&mut pass, jobs, &screen);
-            }
+            painter.paint(&mut enc, &view, jobs, &screen, load);
             let shot = Screenshot::record(
                 &ctx,
                 &mut enc,

@@ -683,27 +683,10 @@ impl Gfx {
         screen: &egui_wgpu::ScreenDescriptor,
         load: wgpu::LoadOp<wgpu::Color>,
     ) {
-        let mut pass = encoder
-            .begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("editor::egui"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: target,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        // Cleared to the viewport's background (egui paints only the
-                        // panel and overlays), or kept for a viewport-only repaint.
-                        load,
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            })
-            .forget_lifetime();
-        self.ui_painter.render(&mut pass, paint_jobs, screen);
+        // Cleared to the viewport's background (egui paints only the panel and overlays),
+        // or kept for a viewport-only repaint.
+        self.ui_painter
+            .paint(encoder, target, paint_jobs, screen, load);
     }
 }
 

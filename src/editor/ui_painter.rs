@@ -141,6 +141,37 @@ impl UiPainter {
         }
     }
 
+    /// Draws the prepared meshes into `target` in a render pass of its own that starts
+    /// with `load` (a clear, or what the target holds).
+    pub fn paint(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        paint_jobs: &[ClippedPrimitive],
+        screen: &egui_wgpu::ScreenDescriptor,
+        load: wgpu::LoadOp<wgpu::Color>,
+    ) {
+        let mut pass = encoder
+            .begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("UiPainter::paint"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: target,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load,
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            })
+            .forget_lifetime();
+        self.render(&mut pass, paint_jobs, screen);
+    }
+
     /// Draws the prepared meshes.
     pub fn render(
         &self,
