@@ -47,17 +47,20 @@ impl RetainedUi {
             .as_ref()
             .is_none_or(|t| (t.width(), t.height()) != size || t.format() != format);
         if stale {
+            // A new image holds nothing yet: the next plan repaints in full.
             self.key = None;
-            self.image = Some(crate::gpu::texture_2d(
+            self.image = None;
+        }
+        self.image.get_or_insert_with(|| {
+            crate::gpu::texture_2d(
                 device,
                 "editor::retained_ui",
                 size,
                 1,
                 format,
                 wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            ));
-        }
-        self.image.as_ref().expect("created above")
+            )
+        })
     }
 
     /// Decides this frame's repaint. `live` is the rectangle (points) repainted every
