@@ -141,7 +141,7 @@ pub struct ErrorPoint {
     /// Scene.
     pub scene: Scene,
     /// Integrator label.
-    pub integrator: &'static str,
+    pub integrator: String,
     /// Step size, seconds.
     pub dt_secs: f64,
     /// RMS over particles of |x − x_ref| / |x_ref − x0|.
@@ -276,24 +276,13 @@ fn set_layout(e: &mut crate::effect::Emitter, layout: StateLayout) {
 }
 
 /// "<integrator>", "<integrator> + packed" or "<integrator> + tiny".
-pub fn compact_label(integrator: Integrator, layout: StateLayout) -> &'static str {
-    use Integrator as I;
-    use StateLayout as L;
-    match (layout, integrator) {
-        (L::Full, i) => i.label(),
-        (L::Packed, I::ExplicitEuler) => "explicit Euler + packed",
-        (L::Packed, I::SemiImplicitEuler) => "semi-implicit Euler + packed",
-        (L::Packed, I::VelocityVerlet) => "velocity Verlet + packed",
-        (L::Packed, I::Heun) => "Heun + packed",
-        (L::Packed, I::Rk4) => "RK4 + packed",
-        (L::Packed, I::Exponential) => "exponential + packed",
-        (L::Tiny, I::ExplicitEuler) => "explicit Euler + tiny",
-        (L::Tiny, I::SemiImplicitEuler) => "semi-implicit Euler + tiny",
-        (L::Tiny, I::VelocityVerlet) => "velocity Verlet + tiny",
-        (L::Tiny, I::Heun) => "Heun + tiny",
-        (L::Tiny, I::Rk4) => "RK4 + tiny",
-        (L::Tiny, I::Exponential) => "exponential + tiny",
-    }
+pub fn compact_label(integrator: Integrator, layout: StateLayout) -> String {
+    let suffix = match layout {
+        StateLayout::Full => "",
+        StateLayout::Packed => " + packed",
+        StateLayout::Tiny => " + tiny",
+    };
+    format!("{}{suffix}", integrator.label())
 }
 
 fn error_point(
@@ -318,7 +307,7 @@ fn error_point(
     }
     ErrorPoint {
         scene: setup.scene,
-        integrator: integrator.label(),
+        integrator: integrator.label().to_owned(),
         dt_secs: dt,
         rms_rel_error: (sum / setup.initial.len().max(1) as f64).sqrt(),
         max_rel_error: max,

@@ -39,15 +39,15 @@ const COUNTER_INTERVAL_FRAMES: u64 = 15;
 const WARMUP_FRAMES: usize = 3;
 
 /// The viewport's background colour (gamma-encoded, as egui's colours are).
-const VIEWPORT_BACKGROUND: wgpu::Color = wgpu::Color {
-    r: 9.0 / 255.0,
-    g: 9.0 / 255.0,
-    b: 11.0 / 255.0,
+const VIEWPORT_BACKGROUND: egui::Color32 = egui::Color32::from_rgb(9, 9, 11);
+
+/// [`VIEWPORT_BACKGROUND`] as the UI pass's clear colour.
+const VIEWPORT_CLEAR: wgpu::Color = wgpu::Color {
+    r: VIEWPORT_BACKGROUND.r() as f64 / 255.0,
+    g: VIEWPORT_BACKGROUND.g() as f64 / 255.0,
+    b: VIEWPORT_BACKGROUND.b() as f64 / 255.0,
     a: 1.0,
 };
-
-/// [`VIEWPORT_BACKGROUND`] as egui paints it.
-const VIEWPORT_BACKGROUND_32: egui::Color32 = egui::Color32::from_rgb(9, 9, 11);
 
 /// Extra frames `--screenshot` waits for the window to hand out a frame.
 const MAX_EXTRA_FRAMES: u64 = 120;
@@ -673,21 +673,6 @@ impl Gfx {
             );
         }
     }
-
-    /// Draws egui's paint jobs into `target`.
-    fn render_egui(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        target: &wgpu::TextureView,
-        paint_jobs: &[egui::ClippedPrimitive],
-        screen: &egui_wgpu::ScreenDescriptor,
-        load: wgpu::LoadOp<wgpu::Color>,
-    ) {
-        // Cleared to the viewport's background (egui paints only the panel and overlays),
-        // or kept for a viewport-only repaint.
-        self.ui_painter
-            .paint(encoder, target, paint_jobs, screen, load);
-    }
 }
 
 impl App {
@@ -939,19 +924,18 @@ impl App {
                     gfx.viewport_rect,
                     screen.size_in_pixels,
                     textures_changed,
-                    VIEWPORT_BACKGROUND_32,
+                    VIEWPORT_BACKGROUND,
                     gfx.viewport_texture,
                 );
                 Some((image, repaint))
             }
             None => None,
         };
+        // Cleared to the viewport's background (egui paints only the panel and overlays),
+        // or kept for a viewport-only repaint.
         let (jobs, load) = match &retained {
             Some((_, Repaint::Live(jobs))) => (jobs.as_slice(), wgpu::LoadOp::Load),
-            _ => (
-                paint_jobs.as_slice(),
-                wgpu::LoadOp::Clear(VIEWPORT_BACKGROUND),
-            ),
+            _ => (paint_jobs.as_slice(), wgpu::LoadOp::Clear(VIEWPORT_CLEAR)),
         };
         let callbacks =
             gfx.ui_painter
@@ -989,7 +973,8 @@ impl App {
         let mut screenshot = None;
         if let (Some(frame), Some((image, _))) = (&frame, &retained) {
             let view = image.create_view(&wgpu::TextureViewDescriptor::default());
-            gfx.render_egui(&mut encoder, &view, jobs, &screen, load);
+            gfx.ui_painter
+                .paint(&mut encoder, &view, jobs, &screen, load);
             encoder.copy_texture_to_texture(
                 image.as_image_copy(),
                 frame.texture.as_image_copy(),
@@ -1007,7 +992,8 @@ impl App {
             let view = frame
                 .texture
                 .create_view(&wgpu::TextureViewDescriptor::default());
-            gfx.render_egui(&mut encoder, &view, jobs, &screen, load);
+            gfx.ui_painter
+                .paint(&mut encoder, &view, jobs, &screen, load);
             if is_last && let Some(path) = &self.options.screenshot {
                 if gfx.surface_can_copy {
                     screenshot = Some(Screenshot::record(
@@ -1027,7 +1013,8 @@ impl App {
                         wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
                     );
                     let off_view = offscreen.create_view(&Default::default());
-                    gfx.render_egui(&mut encoder, &off_view, jobs, &screen, load);
+                    gfx.ui_painter
+                        .paint(&mut encoder, &off_view, jobs, &screen, load);
                     screenshot = Some(Screenshot::record(
                         &gfx.ctx,
                         &mut encoder,

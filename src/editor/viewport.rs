@@ -49,7 +49,7 @@ pub fn viewport_ui(
     if let Some(id) = texture {
         // Additive over the background: a premultiplied tint with zero alpha adds the
         // texels. (The lean painter draws it opaque: the image then is the background.)
-        let additive = Color32::from_rgba_premultiplied(255, 255, 255, 0);
+        let additive = Color32::from_rgb_additive(255, 255, 255);
         let uv = Rect::from_min_max(Pos2::ZERO, egui::pos2(1.0, 1.0));
         painter.image(id, rect, uv, additive);
     }
@@ -261,7 +261,7 @@ fn draw_grid(painter: &egui::Painter, projector: &Projector) {
         } else {
             19
         };
-        let color = Color32::from_rgba_premultiplied(gray, gray, gray, 0);
+        let color = Color32::from_rgb_additive(gray, gray, gray);
         let stroke = Stroke::new(1.0, color);
         for (a, b) in [
             (
@@ -280,8 +280,8 @@ fn draw_grid(painter: &egui::Painter, projector: &Projector) {
     }
     // Short axis markers: +X red, +Z blue.
     for (dir, color) in [
-        (Vec3::X, Color32::from_rgba_premultiplied(141, 51, 51, 0)),
-        (Vec3::Z, Color32::from_rgba_premultiplied(51, 71, 151, 0)),
+        (Vec3::X, Color32::from_rgb_additive(141, 51, 51)),
+        (Vec3::Z, Color32::from_rgb_additive(51, 71, 151)),
     ] {
         if let Some(s) = projector.segment(Vec3::ZERO, dir * 0.5) {
             painter.line_segment(s, Stroke::new(1.5, color));

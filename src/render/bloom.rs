@@ -212,17 +212,21 @@ impl BloomPass {
         }
     }
 
-    /// Adds `layer`, upsampled bilinearly, onto `dst` (the draft glow layer onto the HDR
-    /// image).
+    /// The bind group [`add_layer`](Self::add_layer) reads `layer` through (made once per
+    /// layer texture).
+    pub fn layer_group(&self, ctx: &GpuContext, layer: &wgpu::TextureView) -> wgpu::BindGroup {
+        self.group(ctx, layer, None)
+    }
+
+    /// Adds the layer of `layer_group`, upsampled bilinearly, onto `dst` (the draft glow
+    /// layer onto the HDR image).
     pub fn add_layer(
         &self,
-        ctx: &GpuContext,
         enc: &mut wgpu::CommandEncoder,
-        layer: &wgpu::TextureView,
+        layer_group: &wgpu::BindGroup,
         dst: &wgpu::TextureView,
     ) {
-        let group = self.group(ctx, layer, None);
-        full_screen_pass(enc, &self.pipelines.add, &group, dst, true);
+        full_screen_pass(enc, &self.pipelines.add, layer_group, dst, true);
     }
 
     /// Records the bloom of `hdr` (plus `splat`'s light) and returns the view the tonemap

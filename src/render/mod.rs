@@ -129,6 +129,28 @@ pub fn hdr_target(blend: wgpu::BlendState) -> wgpu::ColorTargetState {
     }
 }
 
+/// `size` divided by `factor`, rounded up.
+fn reduced(size: (u32, u32), factor: u32) -> (u32, u32) {
+    (size.0.div_ceil(factor), size.1.div_ceil(factor))
+}
+
+/// Makes `slot` an HDR target of `size` unless it already is one; true when it made one.
+fn ensure_layer(
+    ctx: &GpuContext,
+    slot: &mut Option<((u32, u32), wgpu::TextureView)>,
+    label: &str,
+    size: (u32, u32),
+) -> bool {
+    if slot.as_ref().is_some_and(|(s, _)| *s == size) {
+        return false;
+    }
+    *slot = Some((
+        size,
+        hdr_texture(ctx, label, size).create_view(&Default::default()),
+    ));
+    true
+}
+
 /// Opens a render pass that clears the HDR target to transparent black.
 pub fn begin_hdr_pass<'a>(
     enc: &'a mut wgpu::CommandEncoder,
@@ -180,6 +202,8 @@ pub struct Renderer {
     pub draft: bool,
     /// The half-resolution target of the glow layer (draft).
     glow_layer: Option<((u32, u32), wgpu::TextureView)>,
+    /// The bloom's bind group that reads `glow_layer` (made with it).
+    glow_group: Option<wgpu::BindGroup>,
 }
 
 impl Renderer {
@@ -199,6 +223,7 @@ impl Renderer {
             alpha_layer: None,
             draft: false,
             glow_layer: None,
+            glow_group: None,
         })
     }
 
@@ -293,15 +318,8 @@ impl Renderer {
                 .iter()
                 .any(|d| !d.splat && d.blend == BlendMode::Alpha);
         if low_alpha {
-            let low = (
-                targets.size.0.div_ceil(downscale),
-                targets.size.1.div_ceil(downscale),
-            );
-            if self.alpha_layer.as_ref().is_none_or(|(s, _)| *s != low) {
-                let view =
-                    hdr_texture(ctx, "Renderer::alpha_layer", low).create_view(&Default::default());
-                self.alpha_layer = Some((low, view));
-            }
+            let low = reduced(targets.size, downscale);
+            ensure_layer(ctx, &mut self.alpha_layer, "Renderer::alpha_layer", low);
             if let Some((_, view)) = &self.alpha_layer {
                 let mut pass = begin_hdr_pass(enc, view);
                 self.billboard.draw(&mut pass, &self.frame, &items, |d| {
@@ -311,11 +329,12 @@ impl Renderer {
         }
         let glow = self.draft && items.iter().any(DrawItem::is_glow);
         if glow {
-            let half = (targets.size.0.div_ceil(2), targets.size.1.div_ceil(2));
-            if self.glow_layer.as_ref().is_none_or(|(s, _)| *s != half) {
-                let view =
-                    hdr_texture(ctx, "Renderer::glow_layer", half).create_view(&Default::default());
-                self.glow_layer = Some((half, view));
+            let half = reduced(targets.size, 2);
+            if ensure_layer(ctx, &mut self.glow_layer, "Renderer::glow_layer", half) {
+                self.glow_group = self
+                    .glow_layer
+                    .as_ref()
+                    .map(|(_, view)| self.bloom.layer_group(ctx, view));
             }
             if let Some((_, view)) = &self.glow_layer {
                 let mut pass = begin_hdr_pass(enc, view);
@@ -331,9 +350,9 @@ impl Renderer {
                 !in_layer
             });
         }
-        if glow && let Some((_, view)) = &self.glow_layer {
+        if glow && let Some(group) = &self.glow_group {
             // Upsampled (bilinear) and added before the bloom, which must see it.
-            self.bloom.add_layer(ctx, enc, view, &targets.hdr_view);
+            self.bloom.add_layer(enc, group, &targets.hdr_view);
         }
         // The splat's light is resolved inside the tonemap (one full-screen pass less).
         let accum = if splatted {
