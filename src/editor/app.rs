@@ -7,7 +7,7 @@
 
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anyhow::{Context as _, anyhow};
 use winit::application::ApplicationHandler;
@@ -25,7 +25,7 @@ use crate::sim::{GpuSim, Stepper};
 use super::panel::{PANEL_WIDTH, panel_ui};
 use super::profile::StageProfiler;
 use super::remap::emitter_sources;
-use super::retained::Repaint;
+use super::retained::{Repaint, UiReuse};
 use super::screenshot::{Screenshot, read_back};
 use super::state::EditorState;
 use super::stats::{EmitterStats, ShaderReloadStats, median};
@@ -100,6 +100,8 @@ pub struct RunReport {
     pub profile: Option<String>,
     /// With the retained window image: (frames painted in full, viewport-only frames).
     pub ui_repaints: Option<(u64, u64)>,
+    /// With the retained window image: (UI passes built, frames that reused the last).
+    pub ui_builds: Option<(u64, u64)>,
 }
 
 impl std::fmt::Display for RunReport {
@@ -127,6 +129,12 @@ impl std::fmt::Display for RunReport {
             write!(
                 f,
                 "\nretained UI: {full} frames painted in full, {live} only over the viewport"
+            )?;
+        }
+        if let Some((built, reused)) = self.ui_builds {
+            write!(
+                f,
+                "; UI built {built} times, reused on {reused} frames without input"
             )?;
         }
         if let Some(profile) = &self.profile {
@@ -225,6 +233,8 @@ struct Gfx {
     /// The retained window image (lean painter and a surface that can be copied to):
     /// the panel is repainted only when it changed.
     retained: Option<super::retained::RetainedUi>,
+    /// With the retained image: the last UI pass, painted again on frames without input.
+    ui_reuse: Option<UiReuse>,
     profiler: StageProfiler,
     /// Per-pass GPU timestamps (None on CPU adapters: their timestamps are not trusted).
     pass_timer: Option<crate::gpu::timer::PassTimer>,
@@ -297,7 +307,13 @@ impl ApplicationHandler for App {
         let Some(gfx) = self.gfx.as_mut() else {
             return;
         };
-        let _ = gfx.egui_state.on_window_event(&gfx.window, &event);
+        let response = gfx.egui_state.on_window_event(&gfx.window, &event);
+        if response.repaint
+            && !matches!(event, WindowEvent::RedrawRequested)
+            && let Some(reuse) = gfx.ui_reuse.as_mut()
+        {
+            reuse.input = true;
+        }
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(size) => {
@@ -431,6 +447,7 @@ impl Gfx {
             cpu_log: Vec::new(),
             viewport_px: (1, 1),
             viewport_rect: egui::Rect::NOTHING,
+            ui_reuse: retained.as_ref().map(|_| UiReuse::default()),
             retained,
             pass_timer,
             pending_steps: (0, 0.0),
@@ -759,26 +776,48 @@ impl App {
         gfx.last_frame = Some(now);
         gfx.frame_index += 1;
 
-        // 1. The UI: edits, camera, the viewport's size.
+        // 1. The UI: edits, camera, the viewport's size — or, on a software adapter with
+        // no input, the last UI pass again (see `UiReuse`).
         gfx.profiler.begin(&gfx.ctx);
-        let raw_input = gfx.egui_state.take_egui_input(&gfx.window);
-        let state = &mut self.state;
-        let camera = &mut self.camera;
-        let texture = gfx.viewport_texture;
-        let mut viewport = ViewportOutput::default();
-        let full_output = gfx.egui_ctx.run_ui(raw_input, |ui| {
-            egui::Panel::right("inspector")
-                .resizable(true)
-                .default_size(PANEL_WIDTH)
-                .size_range(300.0..=640.0)
-                .show(ui, |ui| panel_ui(ui, state));
-            egui::CentralPanel::no_frame().show(ui, |ui| {
-                viewport = viewport_ui(ui, camera, state, texture);
+        let is_last = self
+            .options
+            .frames
+            .is_some_and(|n| gfx.frame_index >= n as u64);
+        if let Some(reuse) = gfx.ui_reuse.as_mut() {
+            reuse.tick(Duration::try_from_secs_f64(frame_dt_secs).unwrap_or(Duration::MAX));
+        }
+        let build_ui = gfx.ui_reuse.as_ref().is_none_or(|r| r.due(is_last));
+        let mut ui_output = None;
+        if build_ui {
+            let raw_input = gfx.egui_state.take_egui_input(&gfx.window);
+            let state = &mut self.state;
+            let camera = &mut self.camera;
+            let texture = gfx.viewport_texture;
+            let mut viewport = ViewportOutput::default();
+            let full_output = gfx.egui_ctx.run_ui(raw_input, |ui| {
+                egui::Panel::right("inspector")
+                    .resizable(true)
+                    .default_size(PANEL_WIDTH)
+                    .size_range(300.0..=640.0)
+                    .show(ui, |ui| panel_ui(ui, state));
+                egui::CentralPanel::no_frame().show(ui, |ui| {
+                    viewport = viewport_ui(ui, camera, state, texture);
+                });
+                state.end_frame(ui.ctx());
             });
-            state.end_frame(ui.ctx());
-        });
-        gfx.egui_state
-            .handle_platform_output(&gfx.window, full_output.platform_output);
+            gfx.egui_state
+                .handle_platform_output(&gfx.window, full_output.platform_output);
+            gfx.viewport_px = viewport.size_px;
+            gfx.viewport_rect = viewport.rect;
+            ui_output = Some((
+                full_output.shapes,
+                full_output.pixels_per_point,
+                full_output.textures_delta,
+                full_output.viewport_output,
+            ));
+        } else if let Some(reuse) = gfx.ui_reuse.as_mut() {
+            reuse.reuses += 1;
+        }
 
         // 2. The simulation follows the running effect and steps.
         gfx.profiler.end_stage(&gfx.ctx);
@@ -794,8 +833,6 @@ impl App {
 
         // 3. The viewport image: particles → HDR → tonemap, then a copy egui can show.
         gfx.profiler.end_stage(&gfx.ctx);
-        gfx.viewport_px = viewport.size_px;
-        gfx.viewport_rect = viewport.rect;
         gfx.renderer.exposure = self.state.view.exposure;
         gfx.renderer.draft = self.state.view.draft;
         gfx.renderer.asset_dir = self
@@ -895,9 +932,27 @@ impl App {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("editor::ui"),
             });
-        let ppp = full_output.pixels_per_point;
-        let paint_jobs = gfx.egui_ctx.tessellate(full_output.shapes, ppp);
-        for (id, deltas) in &full_output.textures_delta.set {
+        let (paint_jobs, ppp, textures_delta) = match ui_output {
+            Some((shapes, ppp, textures_delta, viewports)) => {
+                let jobs = gfx.egui_ctx.tessellate(shapes, ppp);
+                let repaint_after = viewports
+                    .get(&egui::ViewportId::ROOT)
+                    .map_or(Duration::ZERO, |v| v.repaint_delay);
+                if let Some(reuse) = gfx.ui_reuse.as_mut() {
+                    reuse.built(Vec::new(), ppp, repaint_after);
+                }
+                (jobs, ppp, textures_delta)
+            }
+            None => {
+                let reuse = gfx
+                    .ui_reuse
+                    .as_mut()
+                    .map(|r| (std::mem::take(&mut r.jobs), r.pixels_per_point));
+                let (jobs, ppp) = reuse.unwrap_or_default();
+                (jobs, ppp, egui::TexturesDelta::default())
+            }
+        };
+        for (id, deltas) in &textures_delta.set {
             for delta in deltas {
                 gfx.ui_painter
                     .update_texture(&gfx.ctx.device, &gfx.ctx.queue, *id, delta);
@@ -908,8 +963,7 @@ impl App {
             pixels_per_point: ppp,
         };
         // Software adapters: repaint only the viewport while the panel is unchanged.
-        let textures_changed = !full_output.textures_delta.set.is_empty()
-            || !full_output.textures_delta.free.is_empty();
+        let textures_changed = !textures_delta.set.is_empty() || !textures_delta.free.is_empty();
         let retained = match gfx.retained.as_mut() {
             Some(r) => {
                 let image = r
@@ -941,10 +995,6 @@ impl App {
             gfx.ui_painter
                 .prepare(&gfx.ctx.device, &gfx.ctx.queue, &mut encoder, jobs, &screen);
 
-        let is_last = self
-            .options
-            .frames
-            .is_some_and(|n| gfx.frame_index >= n as u64);
         let frame = match gfx.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(f) => Some(f),
             wgpu::CurrentSurfaceTexture::Suboptimal(f) => {
@@ -1029,6 +1079,9 @@ impl App {
         {
             // Nothing was painted: the image no longer matches the panel.
             r.invalidate();
+            if let Some(reuse) = gfx.ui_reuse.as_mut() {
+                reuse.invalidate();
+            }
         }
         gfx.ctx
             .queue
@@ -1039,8 +1092,12 @@ impl App {
             gfx.ctx.queue.present(frame);
         }
         gfx.profiler.end_stage(&gfx.ctx);
-        for id in &full_output.textures_delta.free {
+        for id in &textures_delta.free {
             gfx.ui_painter.free_texture(id);
+        }
+        if let Some(reuse) = gfx.ui_reuse.as_mut() {
+            // Kept for the next frames without input (a lost frame invalidated it).
+            reuse.jobs = paint_jobs;
         }
 
         if !is_last {
@@ -1074,6 +1131,7 @@ impl App {
                 .retained
                 .as_ref()
                 .map(|r| (r.full_repaints, r.live_repaints)),
+            ui_builds: gfx.ui_reuse.as_ref().map(|r| (r.builds, r.reuses)),
             adapter: gfx.ctx.info.name.clone(),
             profile: gfx.profiler.report(WARMUP_FRAMES),
         });
