@@ -57,8 +57,8 @@ enum Command {
         /// Select this emitter (by name) at start.
         #[arg(long)]
         select: Option<String>,
-        /// Draft viewport: large additive sprites at half resolution (default: on for
-        /// software adapters, off elsewhere).
+        /// Draft viewport: large additive sprites at half resolution, alpha-blended
+        /// layers at half theirs (default: on for software adapters, off elsewhere).
         #[arg(long)]
         draft: Option<bool>,
     },

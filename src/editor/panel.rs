@@ -1418,7 +1418,7 @@ ui,
         row_ui(
             ui,
             "Draft glow",
-            "Draw large additive sprites (flame tongues) at half the render resolution: a quarter of their fill, slightly softer (on by default on software adapters)",
+            "Draw large additive sprites (flame tongues) at half the render resolution and alpha-blended layers (smoke) at half their own: a quarter of their fill, slightly softer (on by default on software adapters)",
             |ui| ui.checkbox(&mut view.draft, ""),
         );
     });

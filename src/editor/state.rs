@@ -19,7 +19,7 @@ pub struct ViewSettings {
     /// Render the viewport at this fraction of its pixel size (upscaled when shown).
     pub render_scale: f32,
     /// Draft quality: large additive sprites (flame tongues) at half the render
-    /// resolution (`Renderer::draft`).
+    /// resolution, alpha-blended layers at half their own (`Renderer::draft`).
     pub draft: bool,
     /// A sphere collider follows the pointer over the viewport: push the fire around.
     pub mouse_collider: bool,

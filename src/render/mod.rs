@@ -198,7 +198,9 @@ pub struct Renderer {
     alpha_layer: Option<((u32, u32), wgpu::TextureView)>,
     /// Draft quality (the editor's default on software adapters): large additive
     /// billboards ([`DrawItem::is_glow`], e.g. flame tongues) are drawn at half
-    /// resolution and added to the HDR image before the bloom — a quarter of their fill.
+    /// resolution and added to the HDR image before the bloom — a quarter of their fill;
+    /// the alpha-blended layers are drawn at half the resolution `post.alpha_downscale`
+    /// asks for (the campfire's smoke at an eighth).
     pub draft: bool,
     /// The half-resolution target of the glow layer (draft).
     glow_layer: Option<((u32, u32), wgpu::TextureView)>,
@@ -312,7 +314,8 @@ impl Renderer {
         self.sort.retain(&live);
         let splatted = self.splat.splat(ctx, enc, &self.frame, &items, size);
         // Alpha layers at reduced resolution: their own target, added in the composite.
-        let downscale = effect.post.alpha_downscale.clamp(1, 4);
+        // Draft halves it again (soft smoke hides it).
+        let downscale = effect.post.alpha_downscale.clamp(1, 4) << u32::from(self.draft);
         let low_alpha = downscale > 1
             && items
                 .iter()
