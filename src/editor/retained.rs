@@ -188,8 +188,9 @@ fn hash_rect(h: &mut impl Hasher, r: Rect) {
     }
 }
 
-/// The jobs that touch `live`, clipped to it, after a `background` rectangle over it
-/// (left out when the first of them is an `opaque_cover` mesh that covers `live`).
+/// The jobs that touch `live`, clipped to it, after a `background` rectangle over it.
+/// When one of them is an `opaque_cover` mesh covering `live`, it is the background: the
+/// rectangle and every job before it (hidden under it) are left out.
 pub fn live_jobs(
     jobs: &[ClippedPrimitive],
     live: Rect,
@@ -205,22 +206,29 @@ pub fn live_jobs(
         })
         .filter(|j| j.clip_rect.is_positive())
         .collect();
-    let covered = out.first().is_some_and(|j| match &j.primitive {
+    let cover = out.iter().rposition(|j| match &j.primitive {
         Primitive::Mesh(m) => {
-            Some(m.texture_id) == opaque_cover && mesh_bounds(m).contains_rect(live)
+            opaque_cover.is_some()
+                && Some(m.texture_id) == opaque_cover
+                && mesh_bounds(m).contains_rect(live)
         }
         Primitive::Callback(_) => false,
     });
-    if !covered {
-        let mut mesh = Mesh::default();
-        mesh.add_colored_rect(live, background);
-        out.insert(
-            0,
-            ClippedPrimitive {
-                clip_rect: live,
-                primitive: Primitive::Mesh(mesh),
-            },
-        );
+    match cover {
+        Some(first) => {
+            out.drain(..first);
+        }
+        None => {
+            let mut mesh = Mesh::default();
+            mesh.add_colored_rect(live, background);
+            out.insert(
+                0,
+                ClippedPrimitive {
+                    clip_rect: live,
+                    primitive: Primitive::Mesh(mesh),
+                },
+            );
+        }
     }
     out
 }
@@ -331,14 +339,28 @@ mod tests {
             Rect::from_min_max(pos2(0.0, 0.0), pos2(1.0, 1.0)),
             Color32::WHITE,
         );
-        let jobs = vec![ClippedPrimitive {
-            clip_rect: live,
-            primitive: Primitive::Mesh(image),
-        }];
-        assert_eq!(
-            live_jobs(&jobs, live, Color32::BLACK, Some(TextureId::User(7))).len(),
-            1
+        // Under it, a panel border's end that reaches into the viewport: hidden.
+        let jobs = vec![
+            rect_job(
+                whole,
+                Rect::from_min_max(pos2(595.0, 0.0), pos2(605.0, 400.0)),
+                Color32::GRAY,
+            ),
+            ClippedPrimitive {
+                clip_rect: live,
+                primitive: Primitive::Mesh(image),
+            },
+            rect_job(
+                live,
+                Rect::from_min_max(pos2(10.0, 10.0), pos2(20.0, 20.0)),
+                Color32::GREEN,
+            ),
+        ];
+        let covered = live_jobs(&jobs, live, Color32::BLACK, Some(TextureId::User(7)));
+        assert_eq!(covered.len(), 2, "the image and the overlay after it");
+        assert!(
+            matches!(&covered[0].primitive, Primitive::Mesh(m) if m.texture_id == TextureId::User(7))
         );
-        assert_eq!(live_jobs(&jobs, live, Color32::BLACK, None).len(), 2);
+        assert_eq!(live_jobs(&jobs, live, Color32::BLACK, None).len(), 4);
     }
 }
