@@ -3,10 +3,11 @@
 // upsamples added back up the chain (Jimenez 2014, "Next Generation Post Processing in
 // Call of Duty: Advanced Warfare"). tonemap.wgsl adds the top of the chain to the image.
 //
-// Contract: group 0: 0 `src` (the level read: the HDR target for `prefilter`, a mip of
+// Contract: group 0: 0 `src` (the level read: the HDR target for `prefilter`, a level of
 // the bloom chain otherwise), 1 `samp` (linear, clamp), 2 `bloom` (BloomUniform, keep in
 // sync with src/render/bloom.rs), 3 `accum` (the splat's fixed-point light, read by
-// `prefilter` when SPLAT is on).
+// `prefilter` when SPLAT is on), 4 `glow` (the draft glow layer, half the HDR target's
+// resolution, read by `prefilter` when GLOW is on; tonemap.wgsl adds it to the image).
 
 struct BloomUniform {
     // x: threshold, y: knee (soft range below the threshold), zw: unused.
@@ -17,10 +18,13 @@ struct BloomUniform {
 @group(0) @binding(1) var samp: sampler;
 @group(0) @binding(2) var<uniform> bloom: BloomUniform;
 @group(0) @binding(3) var<storage, read> accum: array<u32>;
+@group(0) @binding(4) var glow: texture_2d<f32>;
 
 override SPLAT: bool = false;
 // Draft: the chain starts at a quarter of the resolution (a 4×4 average).
 override QUARTER: bool = false;
+// Draft: the large additive sprites were drawn into a half-resolution glow layer.
+override GLOW: bool = false;
 // Keep in sync with `FIXED_SCALE` in splat.wgsl.
 const BLOOM_FIXED_SCALE: f32 = 4096.0;
 
@@ -66,6 +70,19 @@ fn prefilter(in: VsOut) -> @location(0) vec4<f32> {
         let p = vec2<i32>(in.clip.xy) * 2;
         c = 0.25 * (hdr_at(p) + hdr_at(p + vec2<i32>(1, 0)) + hdr_at(p + vec2<i32>(0, 1)) + hdr_at(p + vec2<i32>(1, 1)));
     }
+    if GLOW {
+        // The same block of the glow layer: 2×2 of its texels (quarter), or one.
+        let size = vec2<i32>(textureDimensions(glow)) - 1;
+        if QUARTER {
+            let g = vec2<i32>(in.clip.xy) * 2;
+            c += 0.25 * (textureLoad(glow, min(g, size), 0).rgb
+                + textureLoad(glow, min(g + vec2<i32>(1, 0), size), 0).rgb
+                + textureLoad(glow, min(g + vec2<i32>(0, 1), size), 0).rgb
+                + textureLoad(glow, min(g + vec2<i32>(1, 1), size), 0).rgb);
+        } else {
+            c += textureLoad(glow, min(vec2<i32>(in.clip.xy), size), 0).rgb;
+        }
+    }
     let threshold = bloom.params.x;
     let knee = max(bloom.params.y, 1e-5);
     let l = max(c.r, max(c.g, c.b));
@@ -101,11 +118,4 @@ fn up(in: VsOut) -> @location(0) vec4<f32> {
         + textureSample(src, samp, in.uv + vec2<f32>(-t.x, t.y)).rgb
         + textureSample(src, samp, in.uv + vec2<f32>(t.x, t.y)).rgb;
     return vec4<f32>(c / 16.0, 1.0);
-}
-
-// Bilinear upsample, added (One + One) onto the target: the draft glow layer (large
-// additive sprites drawn at half resolution) joins the HDR image before the prefilter.
-@fragment
-fn add(in: VsOut) -> @location(0) vec4<f32> {
-    return vec4<f32>(textureSampleLevel(src, samp, in.uv, 0.0).rgb, 0.0);
 }

@@ -5,7 +5,8 @@
 // SPLAT is on — the splat resolve is fused into this pass, saving a full-screen pass),
 // binding 3 `bloom_tex` + 4 `bloom_samp` (level 0 of the bloom chain, read only when
 // BLOOM is on), binding 5 `alpha_tex` (the alpha-blended layers at reduced resolution,
-// read only when LOW_ALPHA is on).
+// read only when LOW_ALPHA is on), binding 6 `glow_tex` (the draft glow layer at half
+// resolution, read only when GLOW is on: upsampled here instead of in a pass of its own).
 // A full-screen triangle; the ACES fit by Krzysztof Narkowicz maps HDR to [0, 1].
 
 struct ToneUniform {
@@ -20,10 +21,13 @@ struct ToneUniform {
 @group(0) @binding(4) var bloom_samp: sampler;
 // The alpha-blended layers drawn at reduced resolution (read only when LOW_ALPHA is on).
 @group(0) @binding(5) var alpha_tex: texture_2d<f32>;
+// The draft glow layer (read only when GLOW is on).
+@group(0) @binding(6) var glow_tex: texture_2d<f32>;
 
 override SPLAT: bool = false;
 override BLOOM: bool = false;
 override LOW_ALPHA: bool = false;
+override GLOW: bool = false;
 // Keep in sync with `FIXED_SCALE` in splat.wgsl.
 const SPLAT_FIXED_SCALE: f32 = 4096.0;
 
@@ -50,6 +54,10 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         c += vec3<f32>(f32(accum[i]), f32(accum[i + 1u]), f32(accum[i + 2u])) / SPLAT_FIXED_SCALE;
     }
     let uv = frag.xy / vec2<f32>(textureDimensions(hdr));
+    if GLOW {
+        // Bilinear, as the pass that added it to the HDR image did.
+        c += textureSampleLevel(glow_tex, bloom_samp, uv, 0.0).rgb;
+    }
     if LOW_ALPHA {
         // Premultiplied smoke over black, under the additive light: it simply adds.
         c += textureSampleLevel(alpha_tex, bloom_samp, uv, 0.0).rgb;

@@ -378,6 +378,7 @@ fn measure_row(
                 accum,
                 None,
                 None,
+                None,
                 &targets.ldr_view,
                 1.0,
             );

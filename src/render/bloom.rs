@@ -15,19 +15,17 @@ pub struct BloomPass {
     sampler: wgpu::Sampler,
     uniform: wgpu::Buffer,
     no_splat: wgpu::Buffer,
+    /// Bound in place of the glow layer when there is none.
+    no_glow: wgpu::TextureView,
     chain: Option<Chain>,
 }
 
 struct BloomPipelines {
-    prefilter: wgpu::RenderPipeline,
-    prefilter_splat: wgpu::RenderPipeline,
-    /// The draft prefilters: to a quarter of the resolution.
-    prefilter_quarter: wgpu::RenderPipeline,
-    prefilter_quarter_splat: wgpu::RenderPipeline,
+    /// Indexed by `splat + 2 · quarter + 4 · glow`: with the splat's light, to a quarter
+    /// of the resolution (draft), with the draft glow layer.
+    prefilter: [wgpu::RenderPipeline; 8],
     down: wgpu::RenderPipeline,
     up: wgpu::RenderPipeline,
-    /// Bilinear upsample added onto the target (the draft glow layer).
-    add: wgpu::RenderPipeline,
 }
 
 /// The chain: level 0 is half the target size (a quarter in draft), each next level half
@@ -56,6 +54,7 @@ impl BloomPass {
                     3,
                     wgpu::BufferBindingType::Storage { read_only: true },
                 ),
+                crate::gpu::fragment_texture_entry(4, true),
             ],
         });
         let pipeline_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -86,6 +85,15 @@ impl BloomPass {
                 usage: wgpu::BufferUsages::STORAGE,
                 mapped_at_creation: false,
             }),
+            no_glow: crate::gpu::texture_2d(
+                d,
+                "BloomPass::no_glow",
+                (1, 1),
+                1,
+                HDR_FORMAT,
+                wgpu::TextureUsages::TEXTURE_BINDING,
+            )
+            .create_view(&Default::default()),
             chain: None,
         })
     }
@@ -97,9 +105,9 @@ impl BloomPass {
     ) -> Result<BloomPipelines, ShaderError> {
         let composed = lib.compose("bloom.wgsl")?;
         create_checked(&ctx.device, &composed, lib, |module| {
-            let make = |fs: &str, blend: Option<wgpu::BlendState>, splat: bool, quarter: bool| {
-                let b = |v: bool| if v { 1.0 } else { 0.0 };
-                let constants = [("SPLAT", b(splat)), ("QUARTER", b(quarter))];
+            let make = |fs: &str, blend: Option<wgpu::BlendState>, variant: usize| {
+                let b = |bit: usize| if variant & bit != 0 { 1.0 } else { 0.0 };
+                let constants = [("SPLAT", b(1)), ("QUARTER", b(2)), ("GLOW", b(4))];
                 crate::render::simple_pipeline(
                     ctx,
                     &format!("BloomPass::{fs}"),
@@ -116,18 +124,9 @@ impl BloomPass {
                 )
             };
             BloomPipelines {
-                prefilter: make("prefilter", None, false, false),
-                prefilter_splat: make("prefilter", None, true, false),
-                prefilter_quarter: make("prefilter", None, false, true),
-                prefilter_quarter_splat: make("prefilter", None, true, true),
-                down: make("down", None, false, false),
-                up: make("up", Some(crate::render::billboard::ADDITIVE), false, false),
-                add: make(
-                    "add",
-                    Some(crate::render::billboard::ADDITIVE),
-                    false,
-                    false,
-                ),
+                prefilter: std::array::from_fn(|v| make("prefilter", None, v)),
+                down: make("down", None, 0),
+                up: make("up", Some(crate::render::billboard::ADDITIVE), 0),
             }
         })
     }
@@ -138,12 +137,14 @@ impl BloomPass {
         Ok(())
     }
 
-    /// A bind group reading `src` (and `splat`'s light, for the prefilter).
+    /// A bind group reading `src` (and `splat`'s light and the `glow` layer, for the
+    /// prefilter).
     fn group(
         &self,
         ctx: &GpuContext,
         src: &wgpu::TextureView,
         splat: Option<&wgpu::Buffer>,
+        glow: Option<&wgpu::TextureView>,
     ) -> wgpu::BindGroup {
         ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("BloomPass::group"),
@@ -164,6 +165,10 @@ impl BloomPass {
                 wgpu::BindGroupEntry {
                     binding: 3,
                     resource: splat.unwrap_or(&self.no_splat).as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::TextureView(glow.unwrap_or(&self.no_glow)),
                 },
             ],
         })
@@ -201,7 +206,10 @@ impl BloomPass {
                     .create_view(&Default::default())
                 })
                 .collect();
-            let groups = views.iter().map(|v| self.group(ctx, v, None)).collect();
+            let groups = views
+                .iter()
+                .map(|v| self.group(ctx, v, None, None))
+                .collect();
             self.chain = Some(Chain {
                 target_size,
                 levels,
@@ -212,25 +220,8 @@ impl BloomPass {
         }
     }
 
-    /// The bind group [`add_layer`](Self::add_layer) reads `layer` through (made once per
-    /// layer texture).
-    pub fn layer_group(&self, ctx: &GpuContext, layer: &wgpu::TextureView) -> wgpu::BindGroup {
-        self.group(ctx, layer, None)
-    }
-
-    /// Adds the layer of `layer_group`, upsampled bilinearly, onto `dst` (the draft glow
-    /// layer onto the HDR image).
-    pub fn add_layer(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
-        layer_group: &wgpu::BindGroup,
-        dst: &wgpu::TextureView,
-    ) {
-        full_screen_pass(enc, &self.pipelines.add, layer_group, dst, true);
-    }
-
-    /// Records the bloom of `hdr` (plus `splat`'s light) and returns the view the tonemap
-    /// adds (level 0 of the chain). `draft` starts the chain at a quarter of the
+    /// Records the bloom of `hdr` (plus `splat`'s light and the draft `glow` layer) and
+    /// returns the view the tonemap adds (level 0 of the chain). `draft` starts the chain at a quarter of the
     /// resolution, one level shorter (the same reach): the half-resolution passes are
     /// most of the bloom's cost on a software rasteriser.
     #[allow(clippy::too_many_arguments)]
@@ -240,6 +231,7 @@ impl BloomPass {
         enc: &mut wgpu::CommandEncoder,
         hdr: &wgpu::TextureView,
         splat: Option<&wgpu::Buffer>,
+        glow: Option<&wgpu::TextureView>,
         target_size: (u32, u32),
         settings: &Bloom,
         draft: bool,
@@ -255,18 +247,21 @@ impl BloomPass {
         let quarter = draft && settings.levels > 1;
         let levels = settings.levels - u32::from(quarter);
         self.ensure_chain(ctx, target_size, levels, quarter);
-        // The prefilter reads this frame's HDR target and splat light; the chain's own
-        // bind groups are built with the chain.
-        let prefilter_group = self.group(ctx, hdr, splat);
+        // The prefilter reads this frame's HDR target, splat light and glow layer; the
+        // chain's own bind groups are built with the chain.
+        let prefilter_group = self.group(ctx, hdr, splat, glow);
         let chain = self.chain.as_ref()?;
         let p = &self.pipelines;
-        let prefilter = match (splat.is_some(), quarter) {
-            (false, false) => &p.prefilter,
-            (true, false) => &p.prefilter_splat,
-            (false, true) => &p.prefilter_quarter,
-            (true, true) => &p.prefilter_quarter_splat,
-        };
-        full_screen_pass(enc, prefilter, &prefilter_group, &chain.views[0], false);
+        let variant = usize::from(splat.is_some())
+            + 2 * usize::from(quarter)
+            + 4 * usize::from(glow.is_some());
+        full_screen_pass(
+            enc,
+            &p.prefilter[variant],
+            &prefilter_group,
+            &chain.views[0],
+            false,
+        );
         for m in 1..chain.views.len() {
             full_screen_pass(enc, &p.down, &chain.groups[m - 1], &chain.views[m], false);
         }

@@ -134,21 +134,20 @@ fn reduced(size: (u32, u32), factor: u32) -> (u32, u32) {
     (size.0.div_ceil(factor), size.1.div_ceil(factor))
 }
 
-/// Makes `slot` an HDR target of `size` unless it already is one; true when it made one.
+/// Makes `slot` an HDR target of `size` unless it already is one.
 fn ensure_layer(
     ctx: &GpuContext,
     slot: &mut Option<((u32, u32), wgpu::TextureView)>,
     label: &str,
     size: (u32, u32),
-) -> bool {
+) {
     if slot.as_ref().is_some_and(|(s, _)| *s == size) {
-        return false;
+        return;
     }
     *slot = Some((
         size,
         hdr_texture(ctx, label, size).create_view(&Default::default()),
     ));
-    true
 }
 
 /// Opens a render pass that clears the HDR target to transparent black.
@@ -204,8 +203,6 @@ pub struct Renderer {
     pub draft: bool,
     /// The half-resolution target of the glow layer (draft).
     glow_layer: Option<((u32, u32), wgpu::TextureView)>,
-    /// The bloom's bind group that reads `glow_layer` (made with it).
-    glow_group: Option<wgpu::BindGroup>,
 }
 
 impl Renderer {
@@ -225,7 +222,6 @@ impl Renderer {
             alpha_layer: None,
             draft: false,
             glow_layer: None,
-            glow_group: None,
         })
     }
 
@@ -333,12 +329,7 @@ impl Renderer {
         let glow = self.draft && items.iter().any(DrawItem::is_glow);
         if glow {
             let half = reduced(targets.size, 2);
-            if ensure_layer(ctx, &mut self.glow_layer, "Renderer::glow_layer", half) {
-                self.glow_group = self
-                    .glow_layer
-                    .as_ref()
-                    .map(|(_, view)| self.bloom.layer_group(ctx, view));
-            }
+            ensure_layer(ctx, &mut self.glow_layer, "Renderer::glow_layer", half);
             if let Some((_, view)) = &self.glow_layer {
                 let mut pass = begin_hdr_pass(enc, view);
                 self.billboard
@@ -353,10 +344,9 @@ impl Renderer {
                 !in_layer
             });
         }
-        if glow && let Some(group) = &self.glow_group {
-            // Upsampled (bilinear) and added before the bloom, which must see it.
-            self.bloom.add_layer(enc, group, &targets.hdr_view);
-        }
+        // The glow layer joins the image in the bloom's prefilter and in the tonemap
+        // (upsampled bilinearly there): no pass of its own.
+        let glow_view = self.glow_layer.as_ref().filter(|_| glow).map(|(_, v)| v);
         // The splat's light is resolved inside the tonemap (one full-screen pass less).
         let accum = if splatted {
             self.splat.accum_buffer()
@@ -371,6 +361,7 @@ impl Renderer {
                     enc,
                     &targets.hdr_view,
                     accum,
+                    glow_view,
                     targets.size,
                     b,
                     self.draft,
@@ -388,6 +379,7 @@ impl Renderer {
                 .as_ref()
                 .filter(|_| low_alpha)
                 .map(|(_, v)| v),
+            glow_view,
             &targets.ldr_view,
             self.exposure * effect.post.exposure,
         );

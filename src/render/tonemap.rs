@@ -5,13 +5,13 @@ use crate::gpu::GpuContext;
 use crate::gpu::types::ToneUniform;
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 
-/// A full-screen tonemap pass, in four variants: with and without the splat's light and
-/// the bloom.
+/// A full-screen tonemap pass, in sixteen variants: with and without the splat's light,
+/// the bloom, the reduced-resolution alpha layer and the draft glow layer.
 pub struct TonemapPass {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
-    /// Indexed by `splat + 2 · bloom + 4 · low_alpha`.
-    pipelines: [wgpu::RenderPipeline; 8],
+    /// Indexed by `splat + 2 · bloom + 4 · low_alpha + 8 · glow`.
+    pipelines: [wgpu::RenderPipeline; 16],
     uniform: wgpu::Buffer,
     /// Bound in place of the splat buffer when nothing was splatted.
     no_splat: wgpu::Buffer,
@@ -42,6 +42,7 @@ impl TonemapPass {
                     crate::gpu::fragment_texture_entry(3, true),
                     crate::gpu::fragment_sampler_entry(4),
                     crate::gpu::fragment_texture_entry(5, true),
+                    crate::gpu::fragment_texture_entry(6, true),
                 ],
             });
         let pipeline_layout = ctx
@@ -96,20 +97,21 @@ impl TonemapPass {
         lib: &ShaderLibrary,
         layout: &wgpu::PipelineLayout,
         format: wgpu::TextureFormat,
-    ) -> Result<[wgpu::RenderPipeline; 8], ShaderError> {
+    ) -> Result<[wgpu::RenderPipeline; 16], ShaderError> {
         let composed = lib.compose("tonemap.wgsl")?;
         create_checked(&ctx.device, &composed, lib, |module| {
             let make = |i: usize| {
-                let (splat, bloom, low) = (i & 1 != 0, i & 2 != 0, i & 4 != 0);
+                let (splat, bloom, low, glow) = (i & 1 != 0, i & 2 != 0, i & 4 != 0, i & 8 != 0);
                 let b = |v: bool| if v { 1.0 } else { 0.0 };
                 let constants = [
                     ("SPLAT", b(splat)),
                     ("BLOOM", b(bloom)),
                     ("LOW_ALPHA", b(low)),
+                    ("GLOW", b(glow)),
                 ];
                 crate::render::simple_pipeline(
                     ctx,
-                    &format!("TonemapPass splat={splat} bloom={bloom} low_alpha={low}"),
+                    &format!("TonemapPass splat={splat} bloom={bloom} low_alpha={low} glow={glow}"),
                     layout,
                     module,
                     ("vs_main", "fs_main"),
@@ -128,8 +130,8 @@ impl TonemapPass {
         Ok(())
     }
 
-    /// Records the tonemap from `hdr` (plus `splat`'s accumulated light and `bloom`'s
-    /// glow × intensity, when given) into `out`.
+    /// Records the tonemap from `hdr` (plus `splat`'s accumulated light, `bloom`'s glow ×
+    /// intensity, the `low_alpha` layer and the draft `glow` layer, when given) into `out`.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -139,6 +141,7 @@ impl TonemapPass {
         splat: Option<&wgpu::Buffer>,
         bloom: Option<(&wgpu::TextureView, f32)>,
         low_alpha: Option<&wgpu::TextureView>,
+        glow: Option<&wgpu::TextureView>,
         out: &wgpu::TextureView,
         exposure: f32,
     ) {
@@ -181,6 +184,10 @@ impl TonemapPass {
                         low_alpha.unwrap_or(&self.no_bloom),
                     ),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: wgpu::BindingResource::TextureView(glow.unwrap_or(&self.no_bloom)),
+                },
             ],
         });
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -201,7 +208,8 @@ impl TonemapPass {
         });
         let variant = usize::from(splat.is_some())
             + 2 * usize::from(bloom.is_some())
-            + 4 * usize::from(low_alpha.is_some());
+            + 4 * usize::from(low_alpha.is_some())
+            + 8 * usize::from(glow.is_some());
         pass.set_pipeline(&self.pipelines[variant]);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.draw(0..3, 0..1);
