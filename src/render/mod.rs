@@ -197,9 +197,9 @@ pub struct Renderer {
     alpha_layer: Option<((u32, u32), wgpu::TextureView)>,
     /// Draft quality (the editor's default on software adapters): large additive
     /// billboards ([`DrawItem::is_glow`], e.g. flame tongues) are drawn at half
-    /// resolution and added to the HDR image before the bloom — a quarter of their fill;
-    /// the alpha-blended layers are drawn at half the resolution `post.alpha_downscale`
-    /// asks for (the campfire's smoke at an eighth).
+    /// resolution into a glow layer that the bloom's prefilter and the tonemap read — a
+    /// quarter of their fill; the alpha-blended layers are drawn at half the resolution
+    /// `post.alpha_downscale` asks for (the campfire's smoke at an eighth).
     pub draft: bool,
     /// The half-resolution target of the glow layer (draft).
     glow_layer: Option<((u32, u32), wgpu::TextureView)>,
