@@ -939,7 +939,7 @@ impl App {
                     .get(&egui::ViewportId::ROOT)
                     .map_or(Duration::ZERO, |v| v.repaint_delay);
                 if let Some(reuse) = gfx.ui_reuse.as_mut() {
-                    reuse.built(Vec::new(), ppp, repaint_after);
+                    reuse.built(ppp, repaint_after);
                 }
                 (jobs, ppp, textures_delta)
             }

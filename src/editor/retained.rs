@@ -27,7 +27,7 @@ pub const UI_REFRESH: Duration = Duration::from_millis(250);
 /// The last UI pass, painted again while nothing asks for a new one.
 #[derive(Debug, Default)]
 pub struct UiReuse {
-    /// Its paint jobs and pixels per point.
+    /// Its paint jobs (the frame loop keeps them here after painting).
     pub jobs: Vec<ClippedPrimitive>,
     /// Pixels per point of `jobs`.
     pub pixels_per_point: f32,
@@ -52,14 +52,9 @@ impl UiReuse {
         force || !self.is_built || self.input || self.age >= self.repaint_after.min(UI_REFRESH)
     }
 
-    /// Records a fresh UI pass: its jobs and when egui wants the next one.
-    pub fn built(
-        &mut self,
-        jobs: Vec<ClippedPrimitive>,
-        pixels_per_point: f32,
-        repaint_after: Duration,
-    ) {
-        self.jobs = jobs;
+    /// Records that a fresh UI pass was built (its jobs are stored in [`Self::jobs`] once
+    /// painted) and when egui wants the next one.
+    pub fn built(&mut self, pixels_per_point: f32, repaint_after: Duration) {
         self.pixels_per_point = pixels_per_point;
         self.repaint_after = repaint_after;
         self.age = Duration::ZERO;
@@ -264,7 +259,7 @@ mod tests {
         let frame = Duration::from_millis(30);
         let mut r = UiReuse::default();
         assert!(r.due(false), "nothing to reuse yet");
-        r.built(Vec::new(), 1.0, Duration::MAX);
+        r.built(1.0, Duration::MAX);
         assert!(!r.due(false));
         assert!(r.due(true), "forced");
         // Without input: reused until the refresh interval has passed.
@@ -278,18 +273,18 @@ mod tests {
             reused,
             UI_REFRESH.as_millis().div_ceil(frame.as_millis()) as u32
         );
-        r.built(Vec::new(), 1.0, Duration::MAX);
+        r.built(1.0, Duration::MAX);
         r.input = true;
         assert!(r.due(false), "input");
         // egui asks for a repaint at once (an animation) or a little later.
-        r.built(Vec::new(), 1.0, Duration::ZERO);
+        r.built(1.0, Duration::ZERO);
         assert!(r.due(false));
-        r.built(Vec::new(), 1.0, Duration::from_millis(50));
+        r.built(1.0, Duration::from_millis(50));
         r.tick(frame);
         assert!(!r.due(false));
         r.tick(frame);
         assert!(r.due(false));
-        r.built(Vec::new(), 1.0, Duration::MAX);
+        r.built(1.0, Duration::MAX);
         r.invalidate();
         assert!(r.due(false), "invalidated");
         assert_eq!(r.builds, 5);
