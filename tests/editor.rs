@@ -1137,8 +1137,11 @@ fn retained_ui_repaints_match_full_repaints() {
         }
         let changed = !out.textures_delta.set.is_empty() || !out.textures_delta.free.is_empty();
         let jobs = egui_ctx.tessellate(out.shapes, 1.0);
-        let image = retained.image(&ctx.device, (480, 270), format).clone();
-        let plan = retained.plan(&jobs, live, [480, 270], changed, background, None);
+        let image = retained
+            .image(&ctx.device, (480, 270), format)
+            .texture
+            .clone();
+        let plan = retained.plan(&jobs, true, live, [480, 270], changed, background, None);
         let got = match &plan {
             Repaint::Full => paint(&mut painter, &image, &jobs, wgpu::LoadOp::Clear(clear)),
             Repaint::Live(live_jobs) => paint(&mut painter, &image, live_jobs, wgpu::LoadOp::Load),

@@ -815,8 +815,6 @@ impl App {
                 full_output.textures_delta,
                 full_output.viewport_output,
             ));
-        } else if let Some(reuse) = gfx.ui_reuse.as_mut() {
-            reuse.reuses += 1;
         }
 
         // 2. The simulation follows the running effect and steps.
@@ -932,6 +930,7 @@ impl App {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("editor::ui"),
             });
+        let rebuilt = ui_output.is_some();
         let (paint_jobs, ppp, textures_delta) = match ui_output {
             Some((shapes, ppp, textures_delta, viewports)) => {
                 let jobs = gfx.egui_ctx.tessellate(shapes, ppp);
@@ -944,11 +943,7 @@ impl App {
                 (jobs, ppp, textures_delta)
             }
             None => {
-                let reuse = gfx
-                    .ui_reuse
-                    .as_mut()
-                    .map(|r| (std::mem::take(&mut r.jobs), r.pixels_per_point));
-                let (jobs, ppp) = reuse.unwrap_or_default();
+                let (jobs, ppp) = gfx.ui_reuse.as_mut().map(UiReuse::take).unwrap_or_default();
                 (jobs, ppp, egui::TexturesDelta::default())
             }
         };
@@ -975,6 +970,7 @@ impl App {
                     .clone();
                 let repaint = r.plan(
                     &paint_jobs,
+                    rebuilt,
                     gfx.viewport_rect,
                     screen.size_in_pixels,
                     textures_changed,
@@ -1022,19 +1018,18 @@ impl App {
 
         let mut screenshot = None;
         if let (Some(frame), Some((image, _))) = (&frame, &retained) {
-            let view = image.create_view(&wgpu::TextureViewDescriptor::default());
             gfx.ui_painter
-                .paint(&mut encoder, &view, jobs, &screen, load);
+                .paint(&mut encoder, &image.view, jobs, &screen, load);
             encoder.copy_texture_to_texture(
-                image.as_image_copy(),
+                image.texture.as_image_copy(),
                 frame.texture.as_image_copy(),
-                image.size(),
+                image.texture.size(),
             );
             if is_last && let Some(path) = &self.options.screenshot {
                 screenshot = Some(Screenshot::record(
                     &gfx.ctx,
                     &mut encoder,
-                    image,
+                    &image.texture,
                     path.clone(),
                 ));
             }

@@ -38,7 +38,7 @@ pub struct UiReuse {
     pub input: bool,
     /// Whether there is a pass to reuse.
     is_built: bool,
-    /// UI passes built, and frames that reused the last one.
+    /// UI passes built.
     pub builds: u64,
     /// Frames that reused the last UI pass.
     pub reuses: u64,
@@ -63,6 +63,13 @@ impl UiReuse {
         self.builds += 1;
     }
 
+    /// The last pass's jobs and pixels per point, for a frame that reuses it (hand the
+    /// jobs back to [`Self::jobs`] after painting).
+    pub fn take(&mut self) -> (Vec<ClippedPrimitive>, f32) {
+        self.reuses += 1;
+        (std::mem::take(&mut self.jobs), self.pixels_per_point)
+    }
+
     /// Advances the clock by a frame's `dt` (call once per frame, before [`Self::due`]).
     pub fn tick(&mut self, dt: Duration) {
         self.age = self.age.saturating_add(dt);
@@ -83,10 +90,19 @@ pub enum Repaint {
     Live(Vec<ClippedPrimitive>),
 }
 
+/// The persistent image the UI is painted into, and its view.
+#[derive(Clone, Debug)]
+pub struct RetainedImage {
+    /// The image (copied to the window's frame).
+    pub texture: wgpu::Texture,
+    /// Its view (painted into).
+    pub view: wgpu::TextureView,
+}
+
 /// The persistent image and what the panel looked like when it was painted.
 #[derive(Debug, Default)]
 pub struct RetainedUi {
-    image: Option<wgpu::Texture>,
+    image: Option<RetainedImage>,
     key: Option<u64>,
     /// Frames painted in full (start, panel changes, resizes).
     pub full_repaints: u64,
@@ -102,42 +118,51 @@ impl RetainedUi {
         device: &wgpu::Device,
         size: (u32, u32),
         format: wgpu::TextureFormat,
-    ) -> &wgpu::Texture {
-        let stale = self
-            .image
-            .as_ref()
-            .is_none_or(|t| (t.width(), t.height()) != size || t.format() != format);
+    ) -> &RetainedImage {
+        let stale = self.image.as_ref().is_none_or(|i| {
+            let t = &i.texture;
+            (t.width(), t.height()) != size || t.format() != format
+        });
         if stale {
             // A new image holds nothing yet: the next plan repaints in full.
             self.key = None;
             self.image = None;
         }
         self.image.get_or_insert_with(|| {
-            crate::gpu::texture_2d(
+            let texture = crate::gpu::texture_2d(
                 device,
                 "editor::retained_ui",
                 size,
                 1,
                 format,
                 wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            )
+            );
+            let view = texture.create_view(&Default::default());
+            RetainedImage { texture, view }
         })
     }
 
     /// Decides this frame's repaint. `live` is the rectangle (points) repainted every
-    /// frame (the viewport); `textures_changed` is true when egui set or freed a
-    /// texture; `background` fills the live rectangle first unless `opaque_cover` (a
-    /// texture drawn opaque) covers it as the first job inside it.
+    /// frame (the viewport); `rebuilt` is false when `jobs` are last frame's again (a
+    /// reused UI pass: nothing to compare); `textures_changed` is true when egui set or
+    /// freed a texture; `background` fills the live rectangle first unless an
+    /// `opaque_cover` mesh (a texture drawn opaque) covers it (see [`live_jobs`]).
+    #[allow(clippy::too_many_arguments)]
     pub fn plan(
         &mut self,
         jobs: &[ClippedPrimitive],
+        rebuilt: bool,
         live: Rect,
         screen: [u32; 2],
         textures_changed: bool,
         background: Color32,
         opaque_cover: Option<TextureId>,
     ) -> Repaint {
-        let key = panel_key(jobs, live, screen);
+        let key = if rebuilt {
+            panel_key(jobs, live, screen)
+        } else {
+            self.key
+        };
         let same = key.is_some() && self.key == key && !textures_changed && self.image.is_some();
         self.key = key;
         if same {
@@ -203,9 +228,7 @@ pub fn live_jobs(
         .collect();
     let cover = out.iter().rposition(|j| match &j.primitive {
         Primitive::Mesh(m) => {
-            opaque_cover.is_some()
-                && Some(m.texture_id) == opaque_cover
-                && mesh_bounds(m).contains_rect(live)
+            Some(m.texture_id) == opaque_cover && mesh_bounds(m).contains_rect(live)
         }
         Primitive::Callback(_) => false,
     });
@@ -265,7 +288,7 @@ mod tests {
         // Without input: reused until the refresh interval has passed.
         let mut reused = 0;
         while !r.due(false) {
-            r.reuses += 1;
+            r.take();
             reused += 1;
             r.tick(frame);
         }
