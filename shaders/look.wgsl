@@ -5,7 +5,7 @@
 // (keep both in sync with `src/gpu/types.rs`), `ramps: texture_2d<f32>` (one
 // Rgba32Float colour ramp row per emitter) and the state: `prev`, `cur`
 // (array<Particle>) and the same buffers as `prev_packed`, `cur_packed`
-// (array<PackedParticle>, read when `look.ring.w` says the state is packed or tiny),
+// (array<PackedParticle>, read when `STATE_LAYOUT` says the state is packed or tiny),
 // and `births: array<Birth>` (a tiny-state emitter's birth table, births.wgsl).
 #import "common.wgsl"
 #import "rng.wgsl"
@@ -66,6 +66,13 @@ struct LookUniform {
 }
 
 override INTERPOLATE: bool = true;
+// The emitter's state layout (0 full, 1 packed, 2 tiny; `ring.w` holds the same) and
+// whether it is stateless (closed-form positions; `extra.y`). Pipeline constants, set per
+// emitter by the renderer, not branches on the uniform: a CPU adapter runs both sides of
+// a branch for every SIMD batch of particles (masked lanes), so run-time switches would
+// make every particle pay for every layout (the million-spark splat took 2× as long).
+override STATE_LAYOUT: u32 = 0u;
+override STATELESS: bool = false;
 
 // Texels per colour ramp row (keep in sync with `RAMP_WIDTH` in src/render/look.rs).
 const RAMP_WIDTH: u32 = 1024u;
@@ -143,11 +150,11 @@ fn draw_state(p: Particle, q: Particle) -> vec4<f32> {
 
 // The particle in `slot`: (after the last step, before it), unpacked when packed.
 fn load_pair(slot: u32) -> array<Particle, 2> {
-    if look.ring.w != 0u {
+    if STATE_LAYOUT != 0u {
         let c = slot_counter(slot, look.ring.x, look.ring.y, look.ring.z, look.ring_b.z);
         let key = spawn_key(look.ring_b.x, look.ring_b.y, slot, c.x, c.y);
         let life = spawn_life(key, look.soft.z, look.soft.w);
-        if look.ring.w == 2u {
+        if STATE_LAYOUT == 2u {
             // Tiny: ages from the birth table; the previous state is one step younger, and
             // holds this particle only if it was born before the last step (otherwise the
             // slot's previous occupant, or nothing).
@@ -191,7 +198,7 @@ struct Drawn {
 // x(t) = x0 + v0·φ + (a + k·wind)·ψ, φ = (1 − e^{−kt})/k, ψ = (t − φ)/k (exact for constant
 // acceleration with linear drag, the only forces stateless mode allows).
 fn drawn(p: Particle, q: Particle) -> Drawn {
-    if look.extra.y > 0.5 {
+    if STATELESS {
         let life = p.vel_life.w;
         var age = look.motion_b.w - p.pos_age.w;
         if age < 0.0 {

@@ -87,20 +87,21 @@ fn splat(
     let ndc = clip.xy / clip.w;
     let px = vec2<f32>((ndc.x * 0.5 + 0.5) * camera.viewport.x, (0.5 - ndc.y * 0.5) * camera.viewport.y) - 0.5;
     let dither = unorm4(pcg4d(vec4<u32>(slot, bitcast<u32>(d.age), 0x5EEDu, 0u)));
-    if size_px < 2.0 {
-        // Below two pixels one tap (3 atomics) suffices: the footprint is sub-pixel anyway,
-        // and atomics are the splat's cost.
-        let c = vec2<i32>(floor(px + 0.5));
-        add_light(c.x, c.y, energy, dither.x);
-        return;
+    // Bilinear over the 2×2 nearest pixels; below two pixels one tap (3 atomics)
+    // suffices: the footprint is sub-pixel anyway, and atomics are the splat's cost. One
+    // loop for both, so a CPU adapter (which runs every branch for a SIMD batch of
+    // particles, masked) pays for the taps the batch needs, not for both paths.
+    let small = size_px < 2.0;
+    let near = floor(px + 0.5);
+    let b = vec2<i32>(select(floor(px), near, small));
+    let f = select(px - floor(px), vec2<f32>(0.0), small);
+    let taps = select(4u, 1u, small);
+    for (var k = 0u; k < taps; k++) {
+        let o = vec2<u32>(k & 1u, k >> 1u);
+        let wx = select(1.0 - f.x, f.x, o.x == 1u);
+        let wy = select(1.0 - f.y, f.y, o.y == 1u);
+        add_light(b.x + i32(o.x), b.y + i32(o.y), energy * (wx * wy), dither[k]);
     }
-    let base = floor(px);
-    let f = px - base;
-    let b = vec2<i32>(base);
-    add_light(b.x, b.y, energy * ((1.0 - f.x) * (1.0 - f.y)), dither.x);
-    add_light(b.x + 1, b.y, energy * (f.x * (1.0 - f.y)), dither.y);
-    add_light(b.x, b.y + 1, energy * ((1.0 - f.x) * f.y), dither.z);
-    add_light(b.x + 1, b.y + 1, energy * (f.x * f.y), dither.w);
 }
 
 // The resolve: a full-screen triangle reading the accumulated light into the HDR target

@@ -118,13 +118,7 @@ impl BillboardPass {
         create_checked(&ctx.device, &composed, lib, |module| {
             let mut pipelines = HashMap::new();
             for alpha in [false, true] {
-                let v = LookVariant {
-                    alpha,
-                    flipbook: false,
-                    flip_blend: false,
-                    streak: false,
-                    soft: false,
-                };
+                let v = LookVariant::basic(alpha);
                 pipelines.insert(v, Some(Self::pipeline(ctx, layout, module, v)));
             }
             (module.clone(), pipelines)

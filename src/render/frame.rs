@@ -9,7 +9,7 @@ use std::sync::Arc;
 
 use crate::effect::{BlendMode, DrawPath, Effect, FlipbookMode, Look, SPLAT_BELOW_PX, Streak};
 use crate::gpu::GpuContext;
-use crate::gpu::types::{CameraUniform, LookUniform, PARAMS_STRIDE};
+use crate::gpu::types::{CameraUniform, LookUniform, PARAMS_STRIDE, StateLayout};
 use crate::render::OrbitCamera;
 use crate::render::look::{RAMP_WIDTH, bake_ramp, gradient_key};
 use crate::render::sprites::{SpriteError, SpriteLibrary, SpriteTexture};
@@ -161,29 +161,59 @@ pub struct LookVariant {
     pub streak: bool,
     /// Ground-plane depth fade.
     pub soft: bool,
+    /// The emitter's state layout (how the shader reads a slot).
+    pub state: StateLayout,
+    /// Closed-form (stateless) positions.
+    pub stateless: bool,
 }
 
 impl LookVariant {
-    /// The variant a look needs.
-    pub fn of(look: &Look) -> Self {
+    /// The variant a look needs, for state in `state` (`stateless`: closed form).
+    pub fn of(look: &Look, state: StateLayout, stateless: bool) -> Self {
         Self {
             alpha: look.blend == BlendMode::Alpha,
             flipbook: look.flipbook.is_some(),
             flip_blend: look.flipbook.is_some_and(|f| f.blend_frames),
             streak: look.streak.is_some(),
             soft: look.soft_ground_m > 0.0,
+            state,
+            stateless,
         }
     }
 
-    /// The override constants of this variant.
-    pub fn constants(self) -> [(&'static str, f64); 5] {
+    /// The plain variant of a blend mode (full state, no look modules).
+    pub fn basic(alpha: bool) -> Self {
+        Self {
+            alpha,
+            flipbook: false,
+            flip_blend: false,
+            streak: false,
+            soft: false,
+            state: StateLayout::Full,
+            stateless: false,
+        }
+    }
+
+    /// The override constants of this variant's billboard pipeline.
+    pub fn constants(self) -> [(&'static str, f64); 7] {
         let b = |v: bool| if v { 1.0 } else { 0.0 };
+        let [layout, stateless] = self.state_constants();
         [
             ("SORTED", b(self.alpha)),
             ("FLIPBOOK", b(self.flipbook)),
             ("FLIP_BLEND", b(self.flip_blend)),
             ("STREAK", b(self.streak)),
             ("SOFT", b(self.soft)),
+            layout,
+            stateless,
+        ]
+    }
+
+    /// The override constants that say how look.wgsl reads the state (both draw paths).
+    pub fn state_constants(self) -> [(&'static str, f64); 2] {
+        [
+            ("STATE_LAYOUT", f64::from(self.state.index())),
+            ("STATELESS", if self.stateless { 1.0 } else { 0.0 }),
         ]
     }
 }
@@ -554,7 +584,11 @@ impl FrameResources {
                 window: b.window,
                 blend: e.look.blend,
                 splat,
-                variant: LookVariant::of(&e.look),
+                variant: LookVariant::of(
+                    &e.look,
+                    b.layout,
+                    Modules::of(e).contains(Modules::STATELESS),
+                ),
                 sprite,
                 size_px,
             });

@@ -2,9 +2,12 @@
 //! light with atomics, resolve into the HDR target. ~90× cheaper than tiny instanced
 //! quads on GPUs whose rasteriser runs on a few SMs (see the perf bench).
 
+use std::collections::HashMap;
+
 use crate::gpu::GpuContext;
+use crate::gpu::types::StateLayout;
 use crate::render::billboard::ADDITIVE;
-use crate::render::frame::{DrawItem, FrameResources};
+use crate::render::frame::{DrawItem, FrameResources, LookVariant};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 use crate::sim::gpu_sim::dispatch_size;
 
@@ -18,7 +21,9 @@ pub struct SplatPass {
     pipeline_layout: wgpu::PipelineLayout,
     resolve_layout: wgpu::PipelineLayout,
     empty_group: wgpu::BindGroup,
-    splat: wgpu::ComputePipeline,
+    module: wgpu::ShaderModule,
+    /// Splat pipelines per state variant (`LookVariant::state_constants`), built on first use.
+    splats: HashMap<(StateLayout, bool), Option<wgpu::ComputePipeline>>,
     resolve: wgpu::RenderPipeline,
     accum: Option<((u32, u32), wgpu::Buffer, wgpu::BindGroup)>,
 }
@@ -79,36 +84,61 @@ impl SplatPass {
                 ],
                 immediate_size: 0,
             });
-        let (splat, resolve) = Self::build(ctx, lib, &pipeline_layout, &resolve_layout)?;
+        let (module, splats, resolve) = Self::build(ctx, lib, &pipeline_layout, &resolve_layout)?;
         Ok(Self {
             accum_layout,
             pipeline_layout,
             resolve_layout,
             empty_group,
-            splat,
+            module,
+            splats,
             resolve,
             accum: None,
         })
     }
 
+    fn splat_pipeline(
+        ctx: &GpuContext,
+        layout: &wgpu::PipelineLayout,
+        module: &wgpu::ShaderModule,
+        state: (StateLayout, bool),
+    ) -> wgpu::ComputePipeline {
+        let mut variant = LookVariant::basic(false);
+        (variant.state, variant.stateless) = state;
+        ctx.device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(&format!("SplatPass::splat {state:?}")),
+                layout: Some(layout),
+                module,
+                entry_point: Some("splat"),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &variant.state_constants(),
+                    ..Default::default()
+                },
+                cache: None,
+            })
+    }
+
+    /// The module, the full-state splat (validated with it) and the resolve.
+    #[allow(clippy::type_complexity)]
     fn build(
         ctx: &GpuContext,
         lib: &ShaderLibrary,
         layout: &wgpu::PipelineLayout,
         resolve_layout: &wgpu::PipelineLayout,
-    ) -> Result<(wgpu::ComputePipeline, wgpu::RenderPipeline), ShaderError> {
+    ) -> Result<
+        (
+            wgpu::ShaderModule,
+            HashMap<(StateLayout, bool), Option<wgpu::ComputePipeline>>,
+            wgpu::RenderPipeline,
+        ),
+        ShaderError,
+    > {
         let composed = lib.compose("splat.wgsl")?;
         create_checked(&ctx.device, &composed, lib, |module| {
-            let splat = ctx
-                .device
-                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some("SplatPass::splat"),
-                    layout: Some(layout),
-                    module,
-                    entry_point: Some("splat"),
-                    compilation_options: Default::default(),
-                    cache: None,
-                });
+            let full = (StateLayout::Full, false);
+            let splats =
+                HashMap::from([(full, Some(Self::splat_pipeline(ctx, layout, module, full)))]);
             let resolve = crate::render::simple_pipeline(
                 ctx,
                 "SplatPass::resolve",
@@ -119,14 +149,17 @@ impl SplatPass {
                 &[],
                 wgpu::PrimitiveTopology::TriangleList,
             );
-            (splat, resolve)
+            (module.clone(), splats, resolve)
         })
     }
 
-    /// Rebuilds the pipelines; keeps the old ones on error.
+    /// Rebuilds the pipelines; keeps the old ones on error. Other state variants are
+    /// rebuilt on first use.
     pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
-        let (splat, resolve) = Self::build(ctx, lib, &self.pipeline_layout, &self.resolve_layout)?;
-        self.splat = splat;
+        let (module, splats, resolve) =
+            Self::build(ctx, lib, &self.pipeline_layout, &self.resolve_layout)?;
+        self.module = module;
+        self.splats = splats;
         self.resolve = resolve;
         Ok(())
     }
@@ -164,17 +197,36 @@ impl SplatPass {
         let Some((_, buffer, group)) = self.accum.as_ref() else {
             return false;
         };
+        for d in items.iter().filter(|d| d.splat) {
+            let state = (d.variant.state, d.variant.stateless);
+            if !self.splats.contains_key(&state) {
+                let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
+                let p = Self::splat_pipeline(ctx, &self.pipeline_layout, &self.module, state);
+                let ok = match pollster::block_on(scope.pop()) {
+                    None => Some(p),
+                    Some(err) => {
+                        log::error!("splat variant {state:?} failed: {err}");
+                        None
+                    }
+                };
+                self.splats.insert(state, ok);
+            }
+        }
         enc.clear_buffer(buffer, 0, None);
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("SplatPass::splat"),
             timestamp_writes: None,
         });
-        pass.set_pipeline(&self.splat);
         pass.set_bind_group(2, group, &[]);
         for d in items.iter().filter(|d| d.splat) {
             let Some(particles) = frame.particle_group(d.key) else {
                 continue;
             };
+            let state = (d.variant.state, d.variant.stateless);
+            let Some(Some(pipeline)) = self.splats.get(&state) else {
+                continue;
+            };
+            pass.set_pipeline(pipeline);
             pass.set_bind_group(
                 0,
                 &frame.splat_group,
