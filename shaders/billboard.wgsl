@@ -45,7 +45,7 @@ struct VsOut {
     // The same at every corner: flat, so llvmpipe's triangle set-up and per-fragment
     // interpolation skip it (the flames' glow layer about 5 % faster).
     @location(2) @interpolate(flat) color: vec4<f32>,
-    // x: weight of the next frame, y: height above the ground plane (m).
+    // x: weight of the next frame, y: height above the ground over the soft-edge distance.
     @location(3) blend_height: vec2<f32>,
 }
 
@@ -134,8 +134,17 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u3
         out.uv0 = vec2<f32>(corner.x * 0.5 + 0.5, 0.5 - corner.y * 0.5);
         out.uv1 = out.uv0;
     }
-    out.blend_height.y = world.y - look.soft.x;
-    out.color = particle_color(t);
+    // Soft particles: the ground fade's argument (linear in world.y, so interpolating it
+    // is exact).
+    out.blend_height.y = (world.y - look.soft.x) * look.soft.y;
+    // Premultiplied here, once per vertex, and scaled by the intensity when additive:
+    // the fragment shader reads nothing from the look.
+    let c = particle_color(t);
+    var gain = c.a;
+    if !SORTED {
+        gain *= look.size_intensity.z;
+    }
+    out.color = vec4<f32>(c.rgb * gain, c.a);
     return out;
 }
 
@@ -145,17 +154,15 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     if FLIPBOOK && FLIP_BLEND {
         tex = mix(tex, textureSample(sprite_tex, sprite_sampler, in.uv1), in.blend_height.x);
     }
-    // The sprite is premultiplied: its rgb already carries its alpha.
+    // The sprite is premultiplied: its rgb already carries its alpha (and the colour its
+    // own alpha and, additive, the intensity).
     var a = in.color.a * tex.a;
-    var rgb = in.color.rgb * tex.rgb * in.color.a;
+    var rgb = in.color.rgb * tex.rgb;
     if SOFT {
         // Soft particles: fade out towards the ground plane instead of a hard cut.
-        let fade = clamp(in.blend_height.y * look.soft.y, 0.0, 1.0);
+        let fade = clamp(in.blend_height.y, 0.0, 1.0);
         a *= fade;
         rgb *= fade;
-    }
-    if look.ids.y == 0u {
-        rgb = rgb * look.size_intensity.z;
     }
     return vec4<f32>(rgb, a);
 }
