@@ -33,7 +33,8 @@ struct LookUniform {
     // z: per-emitter random salt, w: unused.
     flags: vec4<u32>,
     // x: ∫ sprite brightness over the quad (the splat's energy), y: 1 for a stateless
-    // emitter, z: random rotation spread (rad), w: flipbook frames per second.
+    // emitter (read as STATELESS below), z: random rotation spread (rad), w: flipbook
+    // frames per second.
     extra: vec4<f32>,
     // x, y: angular velocity range (rad/s), z: streak length (s), w: longest streak (m).
     spin_streak: vec4<f32>,
@@ -41,7 +42,7 @@ struct LookUniform {
     // z, w: lifetime range (s; packed state re-derives lifetimes from it).
     soft: vec4<f32>,
     // Packed / tiny state: x: next spawn slot (head), y, z: spawned total (lo, hi), w: the
-    // layout (0 full, 1 packed, 2 tiny).
+    // layout (0 full, 1 packed, 2 tiny; read as STATE_LAYOUT below).
     ring: vec4<u32>,
     // Packed state: x: effect seed, y: emitter salt; z: capacity; w: the live window's
     // length (the slots before the head that can hold living particles).
