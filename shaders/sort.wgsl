@@ -22,7 +22,7 @@ struct SortStep {
     count: u32,
     capacity: u32,
     // The camera position and forward axis in the emitter's simulation space; eye.w: the
-    // state layout, 0 full, 1 packed, 2 tiny (both read through `cur_packed`).
+    // state layout, 0 full, 1 packed, 2 tiny (as STATE_LAYOUT below).
     eye: vec4<f32>,
     forward: vec4<f32>,
     // x: first slot of the live window, y: its length, z: local mode (0 sort, 1 merge).
@@ -124,6 +124,11 @@ fn bitonic_local(
 @group(1) @binding(0) var<storage, read> cur: array<Particle>;
 @group(1) @binding(1) var<storage, read> cur_packed: array<PackedParticle>;
 
+// The state layout: 0 full, 1 packed, 2 tiny (both read through `cur_packed`). A pipeline
+// constant (one depth-key pipeline per layout), not a branch on `step.eye.w`: a CPU adapter
+// would decode every layout for every key.
+override STATE_LAYOUT: u32 = 0u;
+
 @compute @workgroup_size(256)
 fn depth_keys(
     @builtin(workgroup_id) wg: vec3<u32>,
@@ -144,13 +149,13 @@ fn depth_keys(
         }
         var alive = false;
         var pos = vec3<f32>(0.0);
-        if step.eye.w > 1.5 {
+        if STATE_LAYOUT == 2u {
             // Tiny state: slots whose age has run out sort among the living; the draw
             // skips them.
             let s = tiny_decode(tiny_bits(cur_packed[slot >> 1u], (slot & 1u) != 0u));
             alive = !s.dead;
             pos = s.pos;
-        } else if step.eye.w > 0.5 {
+        } else if STATE_LAYOUT == 1u {
             let q = cur_packed[slot];
             alive = packed_alive(q);
             pos = bitcast<vec3<f32>>(vec3<u32>(q.px, q.py, q.pz));

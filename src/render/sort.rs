@@ -131,7 +131,8 @@ pub struct SortPass {
     layout: wgpu::BindGroupLayout,
     state_layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
-    keys: wgpu::ComputePipeline,
+    /// The depth keys per state layout (`StateLayout::index`: full, packed, tiny).
+    keys: [wgpu::ComputePipeline; 3],
     bitonic: wgpu::ComputePipeline,
     bitonic_local: wgpu::ComputePipeline,
     buffers: HashMap<u64, SortBuffers>,
@@ -202,7 +203,7 @@ impl SortPass {
                 bind_group_layouts: &[Some(&layout), Some(&state_layout)],
                 immediate_size: 0,
             });
-        let [keys, bitonic, bitonic_local] = Self::build(ctx, lib, &pipeline_layout)?;
+        let (keys, bitonic, bitonic_local) = Self::build(ctx, lib, &pipeline_layout)?;
         Ok(Self {
             layout,
             state_layout,
@@ -219,27 +220,40 @@ impl SortPass {
         ctx: &GpuContext,
         lib: &ShaderLibrary,
         layout: &wgpu::PipelineLayout,
-    ) -> Result<[wgpu::ComputePipeline; 3], ShaderError> {
+    ) -> Result<
+        (
+            [wgpu::ComputePipeline; 3],
+            wgpu::ComputePipeline,
+            wgpu::ComputePipeline,
+        ),
+        ShaderError,
+    > {
         let composed = lib.compose("sort.wgsl")?;
         create_checked(&ctx.device, &composed, lib, |module| {
-            let make = |entry: &str| {
+            let make = |entry: &str, constants: &[(&str, f64)]| {
                 ctx.device
                     .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                         label: Some(entry),
                         layout: Some(layout),
                         module,
                         entry_point: Some(entry),
-                        compilation_options: Default::default(),
+                        compilation_options: wgpu::PipelineCompilationOptions {
+                            constants,
+                            ..Default::default()
+                        },
                         cache: None,
                     })
             };
-            [make("depth_keys"), make("bitonic"), make("bitonic_local")]
+            // The state layout is a constant, not a branch on the step block: a CPU adapter
+            // would run every layout's decode for every key (see look.wgsl).
+            let keys = [0.0, 1.0, 2.0].map(|l| make("depth_keys", &[("STATE_LAYOUT", l)]));
+            (keys, make("bitonic", &[]), make("bitonic_local", &[]))
         })
     }
 
     /// Rebuilds the pipelines; keeps the old ones on error.
     pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
-        let [keys, bitonic, bitonic_local] = Self::build(ctx, lib, &self.pipeline_layout)?;
+        let (keys, bitonic, bitonic_local) = Self::build(ctx, lib, &self.pipeline_layout)?;
         self.keys = keys;
         self.bitonic = bitonic;
         self.bitonic_local = bitonic_local;
@@ -433,7 +447,10 @@ impl SortPass {
             label: Some("SortPass::sort"),
             timestamp_writes: None,
         });
-        pass.set_pipeline(&self.keys);
+        let Some(keys) = self.keys.get(layout.index() as usize) else {
+            return;
+        };
+        pass.set_pipeline(keys);
         pass.set_bind_group(0, &b.group, &[0]);
         pass.set_bind_group(1, &state_group, &[]);
         let (x, y) = dispatch_size(b.count);
