@@ -12,6 +12,7 @@ use std::collections::HashMap;
 use bytemuck::{Pod, Zeroable};
 
 use crate::gpu::GpuContext;
+use crate::gpu::types::StateLayout;
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 use crate::sim::gpu_sim::{dispatch_size, map_read};
 
@@ -246,7 +247,8 @@ impl SortPass {
             };
             // The state layout is a constant, not a branch on the step block: a CPU adapter
             // would run every layout's decode for every key (see look.wgsl).
-            let keys = [0.0, 1.0, 2.0].map(|l| make("depth_keys", &[("STATE_LAYOUT", l)]));
+            let keys = [StateLayout::Full, StateLayout::Packed, StateLayout::Tiny]
+                .map(|l| make("depth_keys", &[("STATE_LAYOUT", f64::from(l.index()))]));
             (keys, make("bitonic", &[]), make("bitonic_local", &[]))
         })
     }
@@ -399,7 +401,7 @@ impl SortPass {
         window: crate::sim::planner::LiveWindow,
         eye: glam::Vec3,
         forward: glam::Vec3,
-        layout: crate::gpu::types::StateLayout,
+        layout: StateLayout,
     ) {
         if window.len == 0 {
             return;
