@@ -138,16 +138,12 @@ impl BillboardPass {
     pub fn prepare(&mut self, ctx: &GpuContext, items: &[DrawItem], sampler: &wgpu::Sampler) {
         for d in items.iter().filter(|d| !d.splat) {
             if !self.pipelines.contains_key(&d.variant) {
-                let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
-                let p = Self::pipeline(ctx, &self.pipeline_layout, &self.module, d.variant);
-                let ok = match pollster::block_on(scope.pop()) {
-                    None => Some(p),
-                    Some(err) => {
-                        log::error!("billboard variant {:?} failed: {err}", d.variant);
-                        None
-                    }
-                };
-                self.pipelines.insert(d.variant, ok);
+                let p = crate::render::scoped_variant(
+                    ctx,
+                    format_args!("billboard variant {:?}", d.variant),
+                    || Self::pipeline(ctx, &self.pipeline_layout, &self.module, d.variant),
+                );
+                self.pipelines.insert(d.variant, p);
             }
             self.sprite_groups.entry(d.sprite.id).or_insert_with(|| {
                 ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {

@@ -161,15 +161,34 @@ pub struct LookVariant {
     pub streak: bool,
     /// Ground-plane depth fade.
     pub soft: bool,
-    /// The emitter's state layout (how the shader reads a slot).
-    pub state: StateLayout,
+    /// How the shaders read the emitter's state (both draw paths).
+    pub state: StateVariant,
+}
+
+/// How look.wgsl reads an emitter's state: its layout and whether positions are closed
+/// form (stateless). Pipeline constants of both draw paths, not branches: a CPU adapter
+/// would run every layout's code for every particle.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct StateVariant {
+    /// The state layout (how a slot is stored).
+    pub layout: StateLayout,
     /// Closed-form (stateless) positions.
     pub stateless: bool,
 }
 
+impl StateVariant {
+    /// The override constants `STATE_LAYOUT` and `STATELESS`.
+    pub fn constants(self) -> [(&'static str, f64); 2] {
+        [
+            ("STATE_LAYOUT", f64::from(self.layout.index())),
+            ("STATELESS", if self.stateless { 1.0 } else { 0.0 }),
+        ]
+    }
+}
+
 impl LookVariant {
-    /// The variant a look needs, for state in `state` (`stateless`: closed form).
-    pub fn of(look: &Look, state: StateLayout, stateless: bool) -> Self {
+    /// The variant a look needs, for state read as `state`.
+    pub fn of(look: &Look, state: StateVariant) -> Self {
         Self {
             alpha: look.blend == BlendMode::Alpha,
             flipbook: look.flipbook.is_some(),
@@ -177,7 +196,6 @@ impl LookVariant {
             streak: look.streak.is_some(),
             soft: look.soft_ground_m > 0.0,
             state,
-            stateless,
         }
     }
 
@@ -189,15 +207,14 @@ impl LookVariant {
             flip_blend: false,
             streak: false,
             soft: false,
-            state: StateLayout::Full,
-            stateless: false,
+            state: StateVariant::default(),
         }
     }
 
     /// The override constants of this variant's billboard pipeline.
     pub fn constants(self) -> [(&'static str, f64); 7] {
         let b = |v: bool| if v { 1.0 } else { 0.0 };
-        let [layout, stateless] = self.state_constants();
+        let [layout, stateless] = self.state.constants();
         [
             ("SORTED", b(self.alpha)),
             ("FLIPBOOK", b(self.flipbook)),
@@ -206,14 +223,6 @@ impl LookVariant {
             ("SOFT", b(self.soft)),
             layout,
             stateless,
-        ]
-    }
-
-    /// The override constants that say how look.wgsl reads the state (both draw paths).
-    pub fn state_constants(self) -> [(&'static str, f64); 2] {
-        [
-            ("STATE_LAYOUT", f64::from(self.state.index())),
-            ("STATELESS", if self.stateless { 1.0 } else { 0.0 }),
         ]
     }
 }
@@ -586,8 +595,10 @@ impl FrameResources {
                 splat,
                 variant: LookVariant::of(
                     &e.look,
-                    b.layout,
-                    Modules::of(e).contains(Modules::STATELESS),
+                    StateVariant {
+                        layout: b.layout,
+                        stateless: Modules::of(e).contains(Modules::STATELESS),
+                    },
                 ),
                 sprite,
                 size_px,

@@ -74,6 +74,26 @@ pub fn hdr_texture(ctx: &GpuContext, label: &str, size: (u32, u32)) -> wgpu::Tex
     )
 }
 
+/// A pipeline variant built on first use from an already validated module: `make` runs
+/// inside a validation error scope, and a failure (an override constant the edited shader
+/// no longer declares, say) is logged with `what` and gives `None`, so the frame goes on
+/// without that draw instead of reaching the device's uncaptured-error handler.
+pub fn scoped_variant<P>(
+    ctx: &GpuContext,
+    what: impl std::fmt::Display,
+    make: impl FnOnce() -> P,
+) -> Option<P> {
+    let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let p = make();
+    match pollster::block_on(scope.pop()) {
+        None => Some(p),
+        Some(err) => {
+            log::error!("{what} failed: {err}");
+            None
+        }
+    }
+}
+
 /// A render pipeline without vertex buffers: `vs` and `fs` of one module, one colour
 /// target, override constants (given to both stages) and the primitive topology.
 #[allow(clippy::too_many_arguments)]

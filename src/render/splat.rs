@@ -5,9 +5,8 @@
 use std::collections::HashMap;
 
 use crate::gpu::GpuContext;
-use crate::gpu::types::StateLayout;
 use crate::render::billboard::ADDITIVE;
-use crate::render::frame::{DrawItem, FrameResources, LookVariant};
+use crate::render::frame::{DrawItem, FrameResources, StateVariant};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 use crate::sim::gpu_sim::dispatch_size;
 
@@ -22,8 +21,8 @@ pub struct SplatPass {
     resolve_layout: wgpu::PipelineLayout,
     empty_group: wgpu::BindGroup,
     module: wgpu::ShaderModule,
-    /// Splat pipelines per state variant (`LookVariant::state_constants`), built on first use.
-    splats: HashMap<(StateLayout, bool), Option<wgpu::ComputePipeline>>,
+    /// Splat pipelines per state variant, built on first use (`None`: failed, logged).
+    splats: HashMap<StateVariant, Option<wgpu::ComputePipeline>>,
     resolve: wgpu::RenderPipeline,
     accum: Option<((u32, u32), wgpu::Buffer, wgpu::BindGroup)>,
 }
@@ -101,10 +100,8 @@ impl SplatPass {
         ctx: &GpuContext,
         layout: &wgpu::PipelineLayout,
         module: &wgpu::ShaderModule,
-        state: (StateLayout, bool),
+        state: StateVariant,
     ) -> wgpu::ComputePipeline {
-        let mut variant = LookVariant::basic(false);
-        (variant.state, variant.stateless) = state;
         ctx.device
             .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(&format!("SplatPass::splat {state:?}")),
@@ -112,7 +109,7 @@ impl SplatPass {
                 module,
                 entry_point: Some("splat"),
                 compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &variant.state_constants(),
+                    constants: &state.constants(),
                     ..Default::default()
                 },
                 cache: None,
@@ -129,14 +126,14 @@ impl SplatPass {
     ) -> Result<
         (
             wgpu::ShaderModule,
-            HashMap<(StateLayout, bool), Option<wgpu::ComputePipeline>>,
+            HashMap<StateVariant, Option<wgpu::ComputePipeline>>,
             wgpu::RenderPipeline,
         ),
         ShaderError,
     > {
         let composed = lib.compose("splat.wgsl")?;
         create_checked(&ctx.device, &composed, lib, |module| {
-            let full = (StateLayout::Full, false);
+            let full = StateVariant::default();
             let splats =
                 HashMap::from([(full, Some(Self::splat_pipeline(ctx, layout, module, full)))]);
             let resolve = crate::render::simple_pipeline(
@@ -198,18 +195,14 @@ impl SplatPass {
             return false;
         };
         for d in items.iter().filter(|d| d.splat) {
-            let state = (d.variant.state, d.variant.stateless);
+            let state = d.variant.state;
             if !self.splats.contains_key(&state) {
-                let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
-                let p = Self::splat_pipeline(ctx, &self.pipeline_layout, &self.module, state);
-                let ok = match pollster::block_on(scope.pop()) {
-                    None => Some(p),
-                    Some(err) => {
-                        log::error!("splat variant {state:?} failed: {err}");
-                        None
-                    }
-                };
-                self.splats.insert(state, ok);
+                let p = crate::render::scoped_variant(
+                    ctx,
+                    format_args!("splat variant {state:?}"),
+                    || Self::splat_pipeline(ctx, &self.pipeline_layout, &self.module, state),
+                );
+                self.splats.insert(state, p);
             }
         }
         enc.clear_buffer(buffer, 0, None);
@@ -222,8 +215,7 @@ impl SplatPass {
             let Some(particles) = frame.particle_group(d.key) else {
                 continue;
             };
-            let state = (d.variant.state, d.variant.stateless);
-            let Some(Some(pipeline)) = self.splats.get(&state) else {
+            let Some(Some(pipeline)) = self.splats.get(&d.variant.state) else {
                 continue;
             };
             pass.set_pipeline(pipeline);
