@@ -32,17 +32,16 @@ struct LookUniform {
     // x: flipbook mode (0 over life, 1 frame rate), y: random start frame (0/1),
     // z: per-emitter random salt, w: unused.
     flags: vec4<u32>,
-    // x: ∫ sprite brightness over the quad (the splat's energy), y: 1 for a stateless
-    // emitter (read as STATELESS below), z: random rotation spread (rad), w: flipbook
-    // frames per second.
+    // x: ∫ sprite brightness over the quad (the splat's energy), y: unused (STATELESS
+    // below), z: random rotation spread (rad), w: flipbook frames per second.
     extra: vec4<f32>,
     // x, y: angular velocity range (rad/s), z: streak length (s), w: longest streak (m).
     spin_streak: vec4<f32>,
     // x: ground height in simulation space (m), y: 1 / soft-edge distance (1/m),
     // z, w: lifetime range (s; packed state re-derives lifetimes from it).
     soft: vec4<f32>,
-    // Packed / tiny state: x: next spawn slot (head), y, z: spawned total (lo, hi), w: the
-    // layout (0 full, 1 packed, 2 tiny; read as STATE_LAYOUT below).
+    // Packed / tiny state: x: next spawn slot (head), y, z: spawned total (lo, hi), w:
+    // unused (the layout is STATE_LAYOUT below).
     ring: vec4<u32>,
     // Packed state: x: effect seed, y: emitter salt; z: capacity; w: the live window's
     // length (the slots before the head that can hold living particles).
@@ -54,7 +53,7 @@ struct LookUniform {
     // The sprite's occupied part of each frame: u0, v0, u1, v1 in frame texture
     // coordinates (v down); billboards are cut to it.
     trim: vec4<f32>,
-    // Tiny state (ring.w = 2): x, y: the current state's time on the emitter's clock
+    // Tiny state (STATE_LAYOUT = 2): x, y: the current state's time on the emitter's clock
     // (double-single hi, lo, as f32 bits), z: the birth table's first sequence number,
     // w: its entries.
     tiny: vec4<u32>,
@@ -67,11 +66,11 @@ struct LookUniform {
 }
 
 override INTERPOLATE: bool = true;
-// The emitter's state layout (0 full, 1 packed, 2 tiny; `ring.w` holds the same) and
-// whether it is stateless (closed-form positions; `extra.y`). Pipeline constants, set per
-// emitter by the renderer, not branches on the uniform: a CPU adapter runs both sides of
-// a branch for every SIMD batch of particles (masked lanes), so run-time switches would
-// make every particle pay for every layout (the million-spark splat took 2× as long).
+// The emitter's state layout (0 full, 1 packed, 2 tiny) and whether it is stateless
+// (closed-form positions). Pipeline constants, set per emitter by the renderer, not
+// branches on the uniform: a CPU adapter runs both sides of a branch for every SIMD batch
+// of particles (masked lanes), so run-time switches would make every particle pay for
+// every layout (the million-spark splat took 2× as long).
 override STATE_LAYOUT: u32 = 0u;
 override STATELESS: bool = false;
 

@@ -21,8 +21,8 @@ struct SortStep {
     // Power-of-two element count, and the emitter's capacity (slots beyond are padding).
     count: u32,
     capacity: u32,
-    // The camera position and forward axis in the emitter's simulation space; eye.w: the
-    // state layout, 0 full, 1 packed, 2 tiny (as STATE_LAYOUT below).
+    // The camera position and forward axis in the emitter's simulation space (w unused;
+    // the state layout is STATE_LAYOUT below).
     eye: vec4<f32>,
     forward: vec4<f32>,
     // x: first slot of the live window, y: its length, z: local mode (0 sort, 1 merge).
@@ -125,7 +125,7 @@ fn bitonic_local(
 @group(1) @binding(1) var<storage, read> cur_packed: array<PackedParticle>;
 
 // The state layout: 0 full, 1 packed, 2 tiny (both read through `cur_packed`). A pipeline
-// constant (one depth-key pipeline per layout), not a branch on `step.eye.w`: a CPU adapter
+// constant (one depth-key pipeline per layout), not a branch on the step block: a CPU adapter
 // would decode every layout for every key.
 override STATE_LAYOUT: u32 = 0u;
 

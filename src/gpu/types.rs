@@ -155,7 +155,7 @@ impl StateLayout {
         }
     }
 
-    /// The shaders' layout number (`LookUniform::ring[3]`, the sort's `eye.w`).
+    /// The shaders' layout number (the `STATE_LAYOUT` pipeline constant).
     pub fn index(self) -> u32 {
         self as u32
     }
@@ -278,16 +278,16 @@ pub struct LookUniform {
     pub ids: [u32; 4],
     /// flipbook mode (0 over life, 1 frame rate), random start frame, random salt, unused.
     pub flags: [u32; 4],
-    /// ∫ sprite brightness over the quad, stateless (0/1; the draw pipelines take it as
-    /// the `STATELESS` constant), rotation spread (rad), flipbook fps.
+    /// ∫ sprite brightness over the quad, unused (stateless mode is the draw pipelines'
+    /// `STATELESS` constant), rotation spread (rad), flipbook fps.
     pub extra: [f32; 4],
     /// spin min, spin max (rad/s), streak length (s), longest streak (m).
     pub spin_streak: [f32; 4],
     /// ground height in simulation space (m), 1 / soft-edge distance (1/m), lifetime
     /// range (s).
     pub soft: [f32; 4],
-    /// Packed state: next spawn slot, spawned total (lo, hi), the layout (0 full, 1 packed,
-    /// 2 tiny; the draw pipelines take it as the `STATE_LAYOUT` constant).
+    /// Packed state: next spawn slot, spawned total (lo, hi), unused (the layout is the
+    /// draw pipelines' `STATE_LAYOUT` constant).
     pub ring: [u32; 4],
     /// Packed state: effect seed, emitter salt; capacity; the live window's length (the
     /// window ends at the ring's head, `ring[0]`).

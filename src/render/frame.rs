@@ -499,7 +499,6 @@ impl FrameResources {
                     sim.planner.time_secs - (1.0 - alpha as f64) * sim.planner.last_dt_secs as f64;
                 let a = e.forces.constant_acceleration();
                 let w = e.forces.wind_m_per_s;
-                u.extra[1] = 1.0;
                 u.motion_a = [a.x, a.y, a.z, e.forces.drag_per_sec];
                 u.motion_b = [w[0], w[1], w[2], t.rem_euclid(4096.0) as f32];
             }
@@ -518,7 +517,7 @@ impl FrameResources {
                     (b.spawned_total % u64::from(b.capacity.max(1))) as u32,
                     b.spawned_total as u32,
                     (b.spawned_total >> 32) as u32,
-                    b.layout.index(),
+                    0,
                 ];
                 // w: the live window's length (it ends at the ring's head, ring.x).
                 u.ring_b = [b.seed_salt.0, b.seed_salt.1, b.capacity, b.window.len];

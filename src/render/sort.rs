@@ -425,7 +425,7 @@ impl SortPass {
             j: 0,
             count,
             capacity,
-            eye: eye.extend(layout.index() as f32).to_array(),
+            eye: eye.extend(0.0).to_array(),
             forward: forward.extend(0.0).to_array(),
             window: [window.first_slot, window.len, 0, 0],
         };
