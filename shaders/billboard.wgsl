@@ -29,6 +29,9 @@
 // The sprite: linear, premultiplied, mipmapped (src/render/sprites.rs).
 @group(2) @binding(0) var sprite_tex: texture_2d<f32>;
 @group(2) @binding(1) var sprite_sampler: sampler;
+// The host's depth buffer (runtime player), read for soft edges; a 1×1 placeholder when
+// SOFT_DEPTH is off.
+@group(3) @binding(0) var scene_depth: texture_depth_2d;
 
 // Pipeline variants: each look module is compiled in only when an emitter uses it.
 override SORTED: bool = false;
@@ -36,6 +39,8 @@ override FLIPBOOK: bool = false;
 override FLIP_BLEND: bool = false;
 override STREAK: bool = false;
 override SOFT: bool = false;
+// Soft edges against the host's depth buffer (replaces SOFT's ground plane).
+override SOFT_DEPTH: bool = false;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -45,7 +50,8 @@ struct VsOut {
     // The same at every corner: flat, so llvmpipe's triangle set-up and per-fragment
     // interpolation skip it (the flames' glow layer about 5 % faster).
     @location(2) @interpolate(flat) color: vec4<f32>,
-    // x: weight of the next frame, y: height above the ground over the soft-edge distance.
+    // x: weight of the next frame, y: height above the ground over the soft-edge distance
+    // (SOFT_DEPTH: 1 / the soft-edge distance).
     @location(3) blend_height: vec2<f32>,
 }
 
@@ -137,6 +143,9 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u3
     // Soft particles: the ground fade's argument (linear in world.y, so interpolating it
     // is exact).
     out.blend_height.y = (world.y - look.soft.x) * look.soft.y;
+    if SOFT_DEPTH {
+        out.blend_height.y = look.soft.y;
+    }
     // Premultiplied here, once per vertex, and scaled by the intensity when additive:
     // the fragment shader reads nothing from the look.
     let c = particle_color(t);
@@ -164,5 +173,19 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
         a *= fade;
         rgb *= fade;
     }
+    if SOFT_DEPTH {
+        // Soft particles against the host's scene: fade over the soft-edge distance
+        // between this fragment and what the host drew behind it (view-space distances).
+        let scene = textureLoad(scene_depth, vec2<i32>(in.clip.xy), 0);
+        let fade = clamp((view_distance(scene) - view_distance(in.clip.z)) * in.blend_height.y, 0.0, 1.0);
+        a *= fade;
+        rgb *= fade;
+    }
     return vec4<f32>(rgb, a);
+}
+
+// The view-space distance in front of the camera of a depth-buffer value.
+fn view_distance(depth: f32) -> f32 {
+    let k = camera.depth_to_view;
+    return -(k.x * depth + k.y) / (k.z * depth + k.w);
 }

@@ -19,6 +19,9 @@ struct CameraUniform {
     up: vec4<f32>,
     // xy: target size in pixels, z: pixels per unit of (size / clip w), w: unused.
     viewport: vec4<f32>,
+    // View-space z from a depth d: (x·d + y) / (z·d + w) (soft edges against the host's
+    // depth buffer).
+    depth_to_view: vec4<f32>,
 }
 
 struct LookUniform {

@@ -1,19 +1,90 @@
-//! ignis — design real-time GPU fire effects.
+//! ignis — design real-time GPU fire effects, and play them in any wgpu program.
 //!
-//! The library holds everything the binary, the tests and the benches share: the effect
-//! model and presets, the shader library, the GPU simulation (update pass) with its CPU
-//! reference, and the renderer (billboard pass + tonemap).
+//! The library is the runtime: load a preset made in the ignis editor, create a
+//! [`Player`] for it on your own `wgpu::Device`, add instances, and each frame record its
+//! simulation into your encoder and draw it inside your own render pass, depth-tested
+//! against your depth buffer.
+//!
+//! ```no_run
+//! # fn frame(device: &wgpu::Device, queue: &wgpu::Queue,
+//! #          color: &wgpu::TextureView, depth: &wgpu::TextureView) -> Result<(), ignis::PlayerError> {
+//! use ignis::{Camera, Player, PlayerSettings};
+//!
+//! // Once: the effect, a player on the host's device and formats, an instance.
+//! let effect = ignis::preset::load("presets/torch.ron".as_ref())?;
+//! let settings = PlayerSettings {
+//!     depth_format: Some(wgpu::TextureFormat::Depth32Float),
+//!     ..PlayerSettings::new(wgpu::TextureFormat::Rgba16Float)
+//! };
+//! let mut player = Player::new(device, queue, &effect, settings)?;
+//! let torch = player.add_instance(glam::Mat4::from_translation(glam::vec3(2.0, 1.5, 0.0)), 7)?;
+//!
+//! // Every frame: advance, record the compute work, draw in the host's pass.
+//! player.set_transform(torch, glam::Mat4::from_translation(glam::vec3(2.0, 1.5, 0.1)));
+//! player.advance(1.0 / 60.0);
+//! let camera = Camera::new(
+//!     glam::Mat4::look_at_rh(glam::vec3(0.0, 2.0, 6.0), glam::Vec3::ZERO, glam::Vec3::Y),
+//!     glam::Mat4::perspective_rh(0.8, 16.0 / 9.0, 0.1, 100.0),
+//!     (1280, 720),
+//! );
+//! let mut encoder = device.create_command_encoder(&Default::default());
+//! // ... the host's opaque pass writes `depth` here ...
+//! player.record(&mut encoder, &camera, Some(depth));
+//! {
+//!     let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+//!         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+//!             view: color,
+//!             depth_slice: None,
+//!             resolve_target: None,
+//!             ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+//!         })],
+//!         // Read-only depth: the particles test against it and also sample it.
+//!         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+//!             view: depth,
+//!             depth_ops: None,
+//!             stencil_ops: None,
+//!         }),
+//!         ..Default::default()
+//!     });
+//!     player.draw(&mut pass);
+//! }
+//! queue.submit([encoder.finish()]);
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! `docs/embedding.md` describes the frame's order of calls, what the host provides,
+//! threading and costs. The modules marked hidden below are the editor's and the tests'
+//! internals, not part of the runtime's API.
+#![deny(missing_docs)]
 
-pub mod editor;
-pub mod effect;
-pub mod gpu;
-pub mod headless;
-pub mod preset;
-pub mod render;
-pub mod rng;
-pub mod shaders;
-pub mod sim;
+mod runtime;
 
 pub use effect::Effect;
+pub use runtime::{Camera, InstanceId, Player, PlayerError, PlayerSettings};
+
+#[doc(hidden)]
+pub mod effect;
+#[doc(hidden)]
+pub mod gpu;
+#[doc(hidden)]
+pub mod headless;
+pub mod preset;
+#[doc(hidden)]
+pub mod render;
+#[doc(hidden)]
+pub mod rng;
+#[doc(hidden)]
+pub mod shaders;
+#[doc(hidden)]
+pub mod sim;
+
+#[cfg(feature = "editor")]
+#[doc(hidden)]
 pub mod bench;
+#[cfg(feature = "editor")]
+#[doc(hidden)]
+pub mod editor;
+#[cfg(feature = "editor")]
+#[doc(hidden)]
 pub mod hot_reload;

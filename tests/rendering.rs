@@ -570,12 +570,14 @@ fn draft_glow_layer_renders_like_full_resolution() {
     let draft = run.render(SIZE).expect("render");
     // The flames are glow, the streaked embers and the alpha smoke are not.
     let camera = run.camera;
+    let scenes = [ignis::render::Scene {
+        sim: &run.sim,
+        effect: &run.effect,
+    }];
     let items = run.renderer.frame.prepare(
         &ctx,
-        &run.sim,
-        &run.effect,
-        &camera,
-        SIZE,
+        &scenes,
+        &camera.view(SIZE),
         1.0,
         &mut run.renderer.sort,
         None,

@@ -312,7 +312,11 @@ fn measure_row(
     renderer.targets(ctx, size);
     let items = {
         let Renderer { frame, sort, .. } = &mut renderer;
-        frame.prepare(ctx, &sim, &effect, &camera, size, 1.0, sort, None)
+        let scenes = [crate::render::Scene {
+            sim: &sim,
+            effect: &effect,
+        }];
+        frame.prepare(ctx, &scenes, &camera.view(size), 1.0, sort, None)
     };
     let auto_splat = items.iter().all(|d| d.splat);
     let all_billboard: Vec<_> = items

@@ -363,16 +363,20 @@ impl Gfx {
         ))
         .map_err(|e| anyhow!("no GPU adapter can draw to this window: {e}"))?;
         let ctx = GpuContext::from_adapter(adapter)?;
+        let adapter = ctx
+            .adapter
+            .clone()
+            .ok_or_else(|| anyhow!("the GPU context lost its adapter"))?;
         let pass_timer = crate::gpu::timer::PassTimer::new(&ctx);
 
         let size = window.inner_size();
-        let caps = surface.get_capabilities(&ctx.adapter);
+        let caps = surface.get_capabilities(&adapter);
         let format = egui_wgpu::preferred_framebuffer_format(&caps.formats)
             .map_err(|e| anyhow!("the window surface offers no usable format: {e:?}"))?;
         let surface_can_copy = caps.usages.contains(wgpu::TextureUsages::COPY_SRC);
         let surface_can_receive = caps.usages.contains(wgpu::TextureUsages::COPY_DST);
         let mut config = surface
-            .get_default_config(&ctx.adapter, size.width.max(1), size.height.max(1))
+            .get_default_config(&adapter, size.width.max(1), size.height.max(1))
             .ok_or_else(|| anyhow!("the adapter cannot present to this window"))?;
         config.format = format;
         config.usage = wgpu::TextureUsages::RENDER_ATTACHMENT;

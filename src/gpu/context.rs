@@ -36,8 +36,8 @@ pub enum GpuError {
 /// An adapter, device and queue, shared by the simulation and the renderers.
 #[derive(Clone)]
 pub struct GpuContext {
-    /// The adapter in use.
-    pub adapter: Arc<wgpu::Adapter>,
+    /// The adapter in use (`None` on a host's device: the runtime is given a device).
+    pub adapter: Option<Arc<wgpu::Adapter>>,
     /// The device.
     pub device: wgpu::Device,
     /// Its queue.
@@ -87,11 +87,22 @@ impl GpuContext {
             info.driver_info
         );
         Ok(Self {
-            adapter: Arc::new(adapter),
+            adapter: Some(Arc::new(adapter)),
             device,
             queue,
             info,
         })
+    }
+
+    /// A context over a host's device and queue (the runtime player). The host's error
+    /// handling is left alone.
+    pub fn from_device(device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
+        Self {
+            adapter: None,
+            device: device.clone(),
+            queue: queue.clone(),
+            info: device.adapter_info(),
+        }
     }
 
     /// True on software adapters (lavapipe), whose timestamps are not trustworthy.

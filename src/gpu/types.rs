@@ -263,6 +263,9 @@ pub struct CameraUniform {
     pub up: [f32; 4],
     /// xy: target size in pixels, z: pixels per unit of size / clip w.
     pub viewport: [f32; 4],
+    /// View-space z from a depth d: (x·d + y) / (z·d + w) (soft edges against the host's
+    /// depth buffer).
+    pub depth_to_view: [f32; 4],
 }
 
 /// Look data for both draw paths (keep in sync with `LookUniform` in

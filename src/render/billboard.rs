@@ -15,9 +15,37 @@ use crate::gpu::GpuContext;
 use crate::render::frame::{DrawItem, FrameResources, LookVariant};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 
+/// What the billboards draw into: the colour format, the depth buffer they test against
+/// (read-only) and the sample count — the editor's HDR target, or a host's pass.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DrawTarget {
+    /// The colour attachment's format.
+    pub color_format: wgpu::TextureFormat,
+    /// The depth attachment's format and the test (particles never write depth).
+    pub depth: Option<(wgpu::TextureFormat, wgpu::CompareFunction)>,
+    /// Samples per pixel of the attachments.
+    pub sample_count: u32,
+}
+
+impl DrawTarget {
+    /// The renderer's own HDR target: no depth, one sample.
+    pub fn hdr() -> Self {
+        Self {
+            color_format: crate::render::HDR_FORMAT,
+            depth: None,
+            sample_count: 1,
+        }
+    }
+}
+
 /// Instanced billboards into the HDR target, one pipeline per look variant (built on
 /// first use), one sprite bind group per texture.
 pub struct BillboardPass {
+    target: DrawTarget,
+    /// Group 3: the host's depth, sampled for soft edges.
+    depth_layout: wgpu::BindGroupLayout,
+    /// Group 3 now: the host's depth, or a 1×1 placeholder.
+    depth_group: wgpu::BindGroup,
     /// Two triangles per quad, `QUADS_PER_DRAW` quads: 4q, 4q+1, 4q+2, 4q+2, 4q+1, 4q+3.
     quad_indices: wgpu::Buffer,
     /// Issue quads as indexed lists (default on CPU adapters) rather than instances.
@@ -35,7 +63,36 @@ impl BillboardPass {
         ctx: &GpuContext,
         lib: &ShaderLibrary,
         frame: &FrameResources,
+        target: DrawTarget,
     ) -> Result<Self, ShaderError> {
+        let depth_layout = ctx
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("BillboardPass::depth_layout"),
+                entries: &[wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                }],
+            });
+        let placeholder = crate::gpu::texture_2d(
+            &ctx.device,
+            "BillboardPass::no_depth",
+            (1, 1),
+            1,
+            wgpu::TextureFormat::Depth32Float,
+            wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let depth_group = Self::depth_group(
+            ctx,
+            &depth_layout,
+            &placeholder.create_view(&Default::default()),
+        );
         let sprite_layout = ctx
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -53,10 +110,11 @@ impl BillboardPass {
                     Some(&frame.frame_layout),
                     Some(&frame.particle_layout),
                     Some(&sprite_layout),
+                    Some(&depth_layout),
                 ],
                 immediate_size: 0,
             });
-        let (module, pipelines) = Self::build(ctx, lib, &pipeline_layout)?;
+        let (module, pipelines) = Self::build(ctx, lib, &pipeline_layout, target)?;
         let indices: Vec<u32> = (0..QUADS_PER_DRAW)
             .flat_map(|q| [0, 1, 2, 2, 1, 3].map(|c| 4 * q + c))
             .collect();
@@ -68,6 +126,9 @@ impl BillboardPass {
                 usage: wgpu::BufferUsages::INDEX,
             });
         Ok(Self {
+            target,
+            depth_layout,
+            depth_group,
             quad_indices,
             indexed: ctx.is_cpu_adapter(),
             pipeline_layout,
@@ -83,22 +144,78 @@ impl BillboardPass {
         layout: &wgpu::PipelineLayout,
         module: &wgpu::ShaderModule,
         v: LookVariant,
+        target: DrawTarget,
     ) -> wgpu::RenderPipeline {
         let blend = if v.alpha {
             wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING
         } else {
             ADDITIVE
         };
-        crate::render::simple_pipeline(
-            ctx,
-            &format!("BillboardPass {v:?}"),
+        let constants = v.constants();
+        let options = wgpu::PipelineCompilationOptions {
+            constants: &constants,
+            zero_initialize_workgroup_memory: true,
+        };
+        ctx.device
+            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(&format!("BillboardPass {v:?}")),
+                layout: Some(layout),
+                vertex: wgpu::VertexState {
+                    module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: options.clone(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState::default(),
+                // Particles test against the host's depth and never write it.
+                depth_stencil: target
+                    .depth
+                    .map(|(format, compare)| wgpu::DepthStencilState {
+                        format,
+                        depth_write_enabled: Some(false),
+                        depth_compare: Some(compare),
+                        stencil: Default::default(),
+                        bias: Default::default(),
+                    }),
+                multisample: wgpu::MultisampleState {
+                    count: target.sample_count.max(1),
+                    ..Default::default()
+                },
+                fragment: Some(wgpu::FragmentState {
+                    module,
+                    entry_point: Some("fs_main"),
+                    compilation_options: options,
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: target.color_format,
+                        blend: Some(blend),
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+    }
+
+    /// The soft-edge depth group over `view`.
+    fn depth_group(
+        ctx: &GpuContext,
+        layout: &wgpu::BindGroupLayout,
+        view: &wgpu::TextureView,
+    ) -> wgpu::BindGroup {
+        ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("BillboardPass::depth_group"),
             layout,
-            module,
-            ("vs_main", "fs_main"),
-            crate::render::hdr_target(blend),
-            &v.constants(),
-            wgpu::PrimitiveTopology::TriangleList,
-        )
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(view),
+            }],
+        })
+    }
+
+    /// Samples `view` (the host's single-sample depth, the size of the colour target)
+    /// for soft edges from now on.
+    pub fn set_scene_depth(&mut self, ctx: &GpuContext, view: &wgpu::TextureView) {
+        self.depth_group = Self::depth_group(ctx, &self.depth_layout, view);
     }
 
     /// The two basic variants (validated together with the module).
@@ -107,6 +224,7 @@ impl BillboardPass {
         ctx: &GpuContext,
         lib: &ShaderLibrary,
         layout: &wgpu::PipelineLayout,
+        target: DrawTarget,
     ) -> Result<
         (
             wgpu::ShaderModule,
@@ -119,7 +237,7 @@ impl BillboardPass {
             let mut pipelines = HashMap::new();
             for alpha in [false, true] {
                 let v = LookVariant::basic(alpha);
-                pipelines.insert(v, Some(Self::pipeline(ctx, layout, module, v)));
+                pipelines.insert(v, Some(Self::pipeline(ctx, layout, module, v, target)));
             }
             (module.clone(), pipelines)
         })
@@ -128,7 +246,7 @@ impl BillboardPass {
     /// Rebuilds the pipelines; keeps the old ones on error. Other variants are rebuilt
     /// on first use.
     pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
-        let (module, pipelines) = Self::build(ctx, lib, &self.pipeline_layout)?;
+        let (module, pipelines) = Self::build(ctx, lib, &self.pipeline_layout, self.target)?;
         self.module = module;
         self.pipelines = pipelines;
         Ok(())
@@ -141,7 +259,15 @@ impl BillboardPass {
                 let p = crate::render::scoped_variant(
                     ctx,
                     format_args!("billboard variant {:?}", d.variant),
-                    || Self::pipeline(ctx, &self.pipeline_layout, &self.module, d.variant),
+                    || {
+                        Self::pipeline(
+                            ctx,
+                            &self.pipeline_layout,
+                            &self.module,
+                            d.variant,
+                            self.target,
+                        )
+                    },
                 );
                 self.pipelines.insert(d.variant, p);
             }
@@ -197,10 +323,11 @@ impl BillboardPass {
             pass.set_bind_group(
                 0,
                 &frame.frame_group,
-                &[FrameResources::look_offset(d.index)],
+                &[FrameResources::look_offset(d.look_slot)],
             );
             pass.set_bind_group(1, group, &[]);
             pass.set_bind_group(2, sprite, &[]);
+            pass.set_bind_group(3, &self.depth_group, &[]);
             // One quad per slot of the live window: sorted, through the sort's order;
             // otherwise the window's slots directly (the shader wraps at the capacity).
             // Quad q of a draw is vertices 4q … 4q + 3 after its base vertex.

@@ -1,6 +1,8 @@
-//! An orbit camera around a target, as in the 2006 thesis (rotate, zoom, pan).
+//! The camera a frame is drawn with ([`Camera`]: any view and projection, the runtime's
+//! and every host's), and the editor's orbit camera around a target, as in the 2006
+//! thesis (rotate, zoom, pan), which produces one.
 
-use glam::{Mat4, Vec3};
+use glam::{DMat4, Mat4, Vec3};
 
 use crate::effect::CameraHint;
 use crate::gpu::types::CameraUniform;
@@ -53,24 +55,30 @@ impl OrbitCamera {
             * self.view_from_world()
     }
 
-    /// World → clip in f64, for composing with far-away simulation origins.
-    pub fn clip_from_world_f64(&self, aspect: f32) -> glam::DMat4 {
+    /// World → view in f64.
+    fn view_from_world_f64(&self) -> DMat4 {
         let eye = self.eye().as_dvec3();
-        let view =
-            glam::dcamera::rh::view::look_at_mat4(eye, self.target.as_dvec3(), glam::DVec3::Y);
+        glam::dcamera::rh::view::look_at_mat4(eye, self.target.as_dvec3(), glam::DVec3::Y)
+    }
+
+    /// View → clip in f64: right-handed, depth 0..1 (wgpu), like `clip_from_world`.
+    fn clip_from_view_f64(&self, aspect: f32) -> DMat4 {
         let near = (self.distance as f64 * 0.01).max(1e-3);
         let far = self.distance as f64 * 100.0 + 100.0;
         let f = 1.0 / (0.5 * self.fov_y as f64).tan();
         let aspect = aspect.max(1e-3) as f64;
-        // Right-handed, depth 0..1 (wgpu), like `clip_from_world`.
         let r = far / (near - far);
-        let proj = glam::DMat4::from_cols(
+        DMat4::from_cols(
             glam::DVec4::new(f / aspect, 0.0, 0.0, 0.0),
             glam::DVec4::new(0.0, f, 0.0, 0.0),
             glam::DVec4::new(0.0, 0.0, r, -1.0),
             glam::DVec4::new(0.0, 0.0, r * near, 0.0),
-        );
-        proj * view
+        )
+    }
+
+    /// World → clip in f64, for composing with far-away simulation origins.
+    pub fn clip_from_world_f64(&self, aspect: f32) -> DMat4 {
+        self.clip_from_view_f64(aspect) * self.view_from_world_f64()
     }
 
     /// Simulation space with origin `origin` → clip, composed in f64 and rounded once.
@@ -78,25 +86,19 @@ impl OrbitCamera {
         (self.clip_from_world_f64(aspect) * glam::DMat4::from_translation(origin)).as_mat4()
     }
 
+    /// The camera of a frame of `size` pixels.
+    pub fn view(&self, size: (u32, u32)) -> Camera {
+        let aspect = size.0 as f32 / size.1.max(1) as f32;
+        Camera::from_parts(
+            self.view_from_world_f64(),
+            self.clip_from_view_f64(aspect),
+            size,
+        )
+    }
+
     /// The uniform block for the billboard pass.
     pub fn uniform(&self, size: (u32, u32), alpha: f32) -> CameraUniform {
-        let aspect = size.0 as f32 / size.1.max(1) as f32;
-        let view = self.view_from_world();
-        // The camera's right and up axes in world space are the rows of the view rotation.
-        let right = Vec3::new(view.x_axis.x, view.y_axis.x, view.z_axis.x);
-        let up = Vec3::new(view.x_axis.y, view.y_axis.y, view.z_axis.y);
-        CameraUniform {
-            clip_from_world: self.clip_from_world(aspect).to_cols_array_2d(),
-            right_alpha: [right.x, right.y, right.z, alpha],
-            up: [up.x, up.y, up.z, 0.0],
-            viewport: [
-                size.0 as f32,
-                size.1 as f32,
-                // Pixels per (metre / clip w): half the height times the focal factor.
-                0.5 * size.1 as f32 / (0.5 * self.fov_y).tan(),
-                0.0,
-            ],
-        }
+        self.view(size).uniform(alpha)
     }
 
     /// Rotates by screen-space drag deltas (radians).
@@ -122,5 +124,103 @@ impl OrbitCamera {
     pub fn frame(&mut self, center: Vec3, radius: f32) {
         self.target = center;
         self.distance = (radius.max(0.05) / (0.5 * self.fov_y).sin()) * 1.1;
+    }
+}
+
+/// Where a frame is seen from: the host's view and projection matrices and the size of
+/// the target in pixels. Any projection wgpu accepts works (perspective or orthographic,
+/// reversed Z included): depth in clip space runs 0..1, and the player's soft edges read
+/// view-space distances back from the host's depth buffer through the projection's
+/// inverse.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    view_from_world: DMat4,
+    clip_from_view: DMat4,
+    size: (u32, u32),
+}
+
+impl Camera {
+    /// A camera from the host's `view_from_world` (world → view, right-handed or not) and
+    /// `clip_from_view` (view → wgpu clip space, depth 0..1) matrices, drawing into a
+    /// target of `size_px` pixels.
+    pub fn new(view_from_world: Mat4, clip_from_view: Mat4, size_px: (u32, u32)) -> Self {
+        Self::from_parts(
+            view_from_world.as_dmat4(),
+            clip_from_view.as_dmat4(),
+            size_px,
+        )
+    }
+
+    fn from_parts(view_from_world: DMat4, clip_from_view: DMat4, size: (u32, u32)) -> Self {
+        Self {
+            view_from_world,
+            clip_from_view,
+            size: (size.0.max(1), size.1.max(1)),
+        }
+    }
+
+    /// The target size in pixels.
+    pub fn size_px(&self) -> (u32, u32) {
+        self.size
+    }
+
+    /// The eye position in world space.
+    pub fn eye(&self) -> Vec3 {
+        self.view_from_world.inverse().w_axis.truncate().as_vec3()
+    }
+
+    /// The eye position in world space, f64.
+    pub(crate) fn eye_f64(&self) -> glam::DVec3 {
+        self.view_from_world.inverse().w_axis.truncate()
+    }
+
+    /// The viewing direction in world space.
+    pub fn forward(&self) -> Vec3 {
+        let v = self.view_from_world;
+        -glam::DVec3::new(v.x_axis.z, v.y_axis.z, v.z_axis.z)
+            .as_vec3()
+            .normalize_or(Vec3::Z)
+    }
+
+    /// World → clip, f64.
+    pub(crate) fn clip_from_world(&self) -> DMat4 {
+        self.clip_from_view * self.view_from_world
+    }
+
+    /// Simulation space with origin `origin` → clip, composed in f64 and rounded once.
+    pub(crate) fn clip_from_sim(&self, origin: glam::DVec3) -> Mat4 {
+        (self.clip_from_world() * DMat4::from_translation(origin)).as_mat4()
+    }
+
+    /// Pixels per (metre / clip w): half the height times the projection's vertical
+    /// focal factor.
+    pub(crate) fn pixels_per_unit(&self) -> f32 {
+        (0.5 * self.size.1 as f64 * self.clip_from_view.y_axis.y.abs()) as f32
+    }
+
+    /// The uniform block of both draw paths, with the interpolation `alpha` between the
+    /// last two steps.
+    pub(crate) fn uniform(&self, alpha: f32) -> CameraUniform {
+        let view = self.view_from_world.as_mat4();
+        // The camera's right and up axes in world space are the rows of the view rotation.
+        let right = Vec3::new(view.x_axis.x, view.y_axis.x, view.z_axis.x).normalize_or(Vec3::X);
+        let up = Vec3::new(view.x_axis.y, view.y_axis.y, view.z_axis.y).normalize_or(Vec3::Y);
+        // View-space z from a depth d is (a·d + b) / (c·d + e): the z and w rows of the
+        // projection's inverse (a projection has no x or y terms there).
+        let inv = self.clip_from_view.inverse();
+        let depth_to_view =
+            [inv.z_axis.z, inv.w_axis.z, inv.z_axis.w, inv.w_axis.w].map(|v| v as f32);
+        CameraUniform {
+            clip_from_world: self.clip_from_world().as_mat4().to_cols_array_2d(),
+            right_alpha: [right.x, right.y, right.z, alpha],
+            up: [up.x, up.y, up.z, 0.0],
+            viewport: [
+                self.size.0 as f32,
+                self.size.1 as f32,
+                self.pixels_per_unit(),
+                0.0,
+            ],
+            depth_to_view,
+        }
     }
 }

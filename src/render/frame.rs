@@ -10,16 +10,30 @@ use std::sync::Arc;
 use crate::effect::{BlendMode, DrawPath, Effect, FlipbookMode, Look, SPLAT_BELOW_PX, Streak};
 use crate::gpu::GpuContext;
 use crate::gpu::types::{CameraUniform, LookUniform, PARAMS_STRIDE, StateLayout};
-use crate::render::OrbitCamera;
+use crate::render::camera::Camera;
 use crate::render::look::{RAMP_WIDTH, bake_ramp, gradient_key};
 use crate::render::sprites::{SpriteError, SpriteLibrary, SpriteTexture};
 use crate::sim::{GpuSim, Modules};
 
+/// One simulation to draw: its state and the effect it runs (the editor's effect, or one
+/// instance of a runtime player).
+#[derive(Clone, Copy)]
+pub struct Scene<'a> {
+    /// The particles.
+    pub sim: &'a GpuSim,
+    /// The effect they follow (looks, forces for closed-form emitters).
+    pub effect: &'a Effect,
+}
+
 /// One emitter to draw this frame.
 #[derive(Clone, Debug)]
 pub struct DrawItem {
-    /// Emitter index (the look uniform's slot).
+    /// The scene (index into `prepare`'s scenes).
+    pub scene: usize,
+    /// Emitter index in its effect (the colour ramp's row).
     pub index: usize,
+    /// The look uniform's slot.
+    pub look_slot: usize,
     /// Key of the cached particle bind group.
     pub key: (u64, usize, bool),
     /// Slots of the pool.
@@ -66,6 +80,7 @@ pub struct FrameResources {
     looks: wgpu::Buffer,
     look_slots: usize,
     ramps: wgpu::Texture,
+    ramp_rows: usize,
     /// What each ramp row holds (`gradient_key`), to upload only changes.
     ramp_keys: Vec<Option<u64>>,
     /// Sprite textures (built-in and PNG).
@@ -85,6 +100,11 @@ pub struct FrameResources {
     pub live_window_only: bool,
     /// Trim rectangles by (sprite id, flipbook rows, columns, threshold bits).
     trims: HashMap<(u64, u32, u32, u32), [f32; 4]>,
+    /// Let small additive particles take the compute splat (off in the runtime player,
+    /// which draws everything inside the host's pass).
+    pub allow_splat: bool,
+    /// Soft edges read the host's depth buffer instead of the preset's ground plane.
+    pub soft_depth: bool,
 }
 
 /// The look uniform of an emitter (everything but the matrices, the ground height and
@@ -161,6 +181,8 @@ pub struct LookVariant {
     pub streak: bool,
     /// Ground-plane depth fade.
     pub soft: bool,
+    /// Fade against the host's depth buffer (replaces the ground-plane fade).
+    pub soft_depth: bool,
     /// How the shaders read the emitter's state (both draw paths).
     pub state: StateVariant,
 }
@@ -195,6 +217,7 @@ impl LookVariant {
             flip_blend: look.flipbook.is_some_and(|f| f.blend_frames),
             streak: look.streak.is_some(),
             soft: look.soft_ground_m > 0.0,
+            soft_depth: false,
             state,
         }
     }
@@ -207,12 +230,13 @@ impl LookVariant {
             flip_blend: false,
             streak: false,
             soft: false,
+            soft_depth: false,
             state: StateVariant::default(),
         }
     }
 
     /// The override constants of this variant's billboard pipeline.
-    pub fn constants(self) -> [(&'static str, f64); 7] {
+    pub fn constants(self) -> [(&'static str, f64); 8] {
         let b = |v: bool| if v { 1.0 } else { 0.0 };
         let [layout, stateless] = self.state.constants();
         [
@@ -220,7 +244,8 @@ impl LookVariant {
             ("FLIPBOOK", b(self.flipbook)),
             ("FLIP_BLEND", b(self.flip_blend)),
             ("STREAK", b(self.streak)),
-            ("SOFT", b(self.soft)),
+            ("SOFT", b(self.soft && !self.soft_depth)),
+            ("SOFT_DEPTH", b(self.soft && self.soft_depth)),
             layout,
             stateless,
         ]
@@ -304,7 +329,7 @@ impl FrameResources {
             mapped_at_creation: false,
         });
         let (looks, ramps, [frame_group, splat_group]) =
-            Self::look_buffer(ctx, [&frame_layout, &splat_layout], &camera, 4);
+            Self::look_buffer(ctx, [&frame_layout, &splat_layout], &camera, (4, 4));
         Self {
             frame_layout,
             splat_layout,
@@ -314,6 +339,7 @@ impl FrameResources {
             looks,
             look_slots: 4,
             ramps,
+            ramp_rows: 4,
             ramp_keys: vec![None; 4],
             sprites: SpriteLibrary::new(ctx),
             sprite_errors: Vec::new(),
@@ -328,15 +354,18 @@ impl FrameResources {
             trim_sprites: true,
             live_window_only: true,
             trims: HashMap::new(),
+            allow_splat: true,
+            soft_depth: false,
         }
     }
 
-    /// The looks buffer, the ramps and a group 0 over them for each of `layouts`.
+    /// The looks buffer (`slots.0` uniforms), the ramps (`slots.1` rows) and a group 0
+    /// over them for each of `layouts`.
     fn look_buffer(
         ctx: &GpuContext,
         layouts: [&wgpu::BindGroupLayout; 2],
         camera: &wgpu::Buffer,
-        slots: usize,
+        (slots, rows): (usize, usize),
     ) -> (wgpu::Buffer, wgpu::Texture, [wgpu::BindGroup; 2]) {
         let looks = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("FrameResources::looks"),
@@ -349,7 +378,7 @@ impl FrameResources {
         let ramps = crate::gpu::texture_2d(
             &ctx.device,
             "FrameResources::ramps",
-            (RAMP_WIDTH, slots as u32),
+            (RAMP_WIDTH, rows as u32),
             1,
             wgpu::TextureFormat::Rgba32Float,
             wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
@@ -383,8 +412,8 @@ impl FrameResources {
     }
 
     /// The dynamic offset of emitter `index`'s look uniform.
-    pub fn look_offset(index: usize) -> u32 {
-        (index as u64 * PARAMS_STRIDE) as u32
+    pub fn look_offset(slot: usize) -> u32 {
+        (slot as u64 * PARAMS_STRIDE) as u32
     }
 
     /// The particle bind group for a draw item.
@@ -427,181 +456,66 @@ impl FrameResources {
         }
     }
 
+    /// Grows the looks buffer to `slots` uniforms and the ramps to `rows` rows (powers of
+    /// two; both only grow).
+    fn reserve(&mut self, ctx: &GpuContext, slots: usize, rows: usize) {
+        if slots <= self.look_slots && rows <= self.ramp_rows {
+            return;
+        }
+        self.look_slots = self.look_slots.max(slots.next_power_of_two());
+        self.ramp_rows = self.ramp_rows.max(rows.next_power_of_two());
+        let (looks, ramps, [group, splat_group]) = Self::look_buffer(
+            ctx,
+            [&self.frame_layout, &self.splat_layout],
+            &self.camera,
+            (self.look_slots, self.ramp_rows),
+        );
+        self.looks = looks;
+        self.ramps = ramps;
+        self.ramp_keys = vec![None; self.ramp_rows];
+        self.frame_group = group;
+        self.splat_group = splat_group;
+    }
+
     /// Uploads this frame's uniforms and returns what to draw, with each emitter's path.
-    #[allow(clippy::too_many_arguments)]
+    /// The scenes' emitters take consecutive look slots; emitter `i` of every scene
+    /// shares ramp row `i` (the scenes are instances of one effect, or just one).
     pub fn prepare(
         &mut self,
         ctx: &GpuContext,
-        sim: &GpuSim,
-        effect: &Effect,
-        camera: &OrbitCamera,
-        size: (u32, u32),
+        scenes: &[Scene<'_>],
+        camera: &Camera,
         alpha: f32,
         sort: &mut crate::render::sort::SortPass,
         asset_dir: Option<&Path>,
     ) -> Vec<DrawItem> {
-        let aspect = size.0 as f32 / size.1.max(1) as f32;
-        let cam = camera.uniform(size, alpha);
+        let cam = camera.uniform(alpha);
         ctx.queue
             .write_buffer(&self.camera, 0, bytemuck::bytes_of(&cam));
-        let n = effect.emitters.len();
-        if n > self.look_slots {
-            self.look_slots = n.next_power_of_two();
-            let (looks, ramps, [group, splat_group]) = Self::look_buffer(
-                ctx,
-                [&self.frame_layout, &self.splat_layout],
-                &self.camera,
-                self.look_slots,
-            );
-            self.looks = looks;
-            self.ramps = ramps;
-            self.ramp_keys = vec![None; self.look_slots];
-            self.frame_group = group;
-            self.splat_group = splat_group;
-        }
+        let slots: usize = scenes.iter().map(|s| s.effect.emitters.len()).sum();
+        let rows = scenes
+            .iter()
+            .map(|s| s.effect.emitters.len())
+            .max()
+            .unwrap_or(0);
+        self.reserve(ctx, slots, rows);
         self.sprite_errors.clear();
-        let mut blocks = vec![0u8; n * PARAMS_STRIDE as usize];
+        let mut blocks = vec![0u8; slots * PARAMS_STRIDE as usize];
         let mut items = Vec::new();
-        for (i, e) in effect.emitters.iter().enumerate() {
-            let origin = sim
-                .planner
-                .emitters
-                .get(i)
-                .map(|p| p.origin())
-                .unwrap_or_default();
-            let (sprite, error) = self.sprites.resolve(ctx, &e.look.sprite, asset_dir);
-            if let Some(err) = error {
-                self.sprite_errors.push((i, err));
+        let mut slot = 0;
+        for (k, scene) in scenes.iter().enumerate() {
+            for i in 0..scene.effect.emitters.len() {
+                let block =
+                    &mut blocks[slot * PARAMS_STRIDE as usize..][..size_of::<LookUniform>()];
+                let item =
+                    self.prepare_emitter(ctx, scene, i, camera, alpha, sort, asset_dir, block);
+                items.extend(item.map(|d| DrawItem {
+                    scene: k,
+                    look_slot: slot,
+                    ..d
+                }));
+                slot += 1;
             }
-            let salt = crate::rng::pcg4d([effect.seed, i as u32, e.seed_offset, 0x5EED_100C])[0];
-            let mut u = look_uniform(&e.look, i as u32, salt, sprite.integral);
-            if self.trim_sprites && e.look.streak.is_none() {
-                let (rows, cols) = e
-                    .look
-                    .flipbook
-                    .as_ref()
-                    .map_or((1, 1), |f| (f.rows, f.cols));
-                // What is invisible at intensity 1 shows when the light is multiplied.
-                let gain = (e.look.intensity * effect.post.exposure).max(1.0);
-                let threshold = crate::render::sprites::TRIM_THRESHOLD / gain;
-                u.trim = *self
-                    .trims
-                    .entry((sprite.id, rows, cols, threshold.to_bits()))
-                    .or_insert_with(|| sprite.trim_rect(rows, cols, threshold));
-            }
-            u.clip_from_sim = camera.clip_from_sim(aspect, origin).to_cols_array_2d();
-            let ground = e.collisions.ground.as_ref().map_or(0.0, |g| g.height_m);
-            u.soft[0] = (f64::from(ground) - origin.y) as f32;
-            self.upload_ramp(ctx, i, &e.look);
-            if Modules::of(e).contains(Modules::STATELESS) {
-                // Closed-form evaluation at the render time (between the last two steps).
-                let t =
-                    sim.planner.time_secs - (1.0 - alpha as f64) * sim.planner.last_dt_secs as f64;
-                let a = e.forces.constant_acceleration();
-                let w = e.forces.wind_m_per_s;
-                u.motion_a = [a.x, a.y, a.z, e.forces.drag_per_sec];
-                u.motion_b = [w[0], w[1], w[2], t.rem_euclid(4096.0) as f32];
-            }
-            let buffers = sim.emitter_buffers(i).map(|mut b| {
-                if !self.live_window_only {
-                    b.window = crate::sim::planner::LiveWindow::all(b.capacity);
-                }
-                b
-            });
-            if let Some(b) = &buffers {
-                // The ring, for packed state's re-derived lifetimes; the capacity and the
-                // live window's length (ring_b.zw) place the splat's invocations.
-                u.soft[2] = b.life_range.0;
-                u.soft[3] = b.life_range.1;
-                u.ring = [
-                    (b.spawned_total % u64::from(b.capacity.max(1))) as u32,
-                    b.spawned_total as u32,
-                    (b.spawned_total >> 32) as u32,
-                    0,
-                ];
-                // w: the live window's length (it ends at the ring's head, ring.x).
-                u.ring_b = [b.seed_salt.0, b.seed_salt.1, b.capacity, b.window.len];
-                [u.tiny, u.tiny_b, u.tiny_c] = b.tiny;
-            }
-            let at = i * PARAMS_STRIDE as usize;
-            blocks[at..at + size_of::<LookUniform>()].copy_from_slice(bytemuck::bytes_of(&u));
-            let Some(b) = buffers else {
-                continue;
-            };
-            if !e.enabled {
-                continue;
-            }
-            // Alpha-blended emitters are drawn back to front through the sort's order.
-            let sorted = e.look.blend == BlendMode::Alpha;
-            let order = if sorted {
-                &sort.buffers(ctx, b.generation, b.capacity).values
-            } else {
-                &self.no_order
-            };
-            let key = (b.generation, b.parity, sorted);
-            self.particle_groups.entry(key).or_insert_with(|| {
-                ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("FrameResources::particle_group"),
-                    layout: &self.particle_layout,
-                    entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: b.previous.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: b.current.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 2,
-                            resource: order.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 3,
-                            resource: b.previous.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 4,
-                            resource: b.current.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 5,
-                            resource: b.births.as_entire_binding(),
-                        },
-                    ],
-                })
-            });
-            // Projected size at the emitter's distance decides the automatic path.
-            let distance = (camera.eye() - glam::Vec3::from(e.transform.position_m))
-                .length()
-                .max(1e-3);
-            let size_m = e.look.size_start_m.max(e.look.size_end_m);
-            let size_px = size_m * cam.viewport[2] / distance;
-            let additive = e.look.blend == BlendMode::Additive;
-            let splat = additive
-                && match e.look.draw_path {
-                    // Streaks are long even when the particles are small.
-                    DrawPath::Auto => size_px < SPLAT_BELOW_PX && e.look.streak.is_none(),
-                    DrawPath::Billboard => false,
-                    DrawPath::Splat => true,
-                };
-            items.push(DrawItem {
-                index: i,
-                key,
-                capacity: b.capacity,
-                window: b.window,
-                blend: e.look.blend,
-                splat,
-                variant: LookVariant::of(
-                    &e.look,
-                    StateVariant {
-                        layout: b.layout,
-                        stateless: Modules::of(e).contains(Modules::STATELESS),
-                    },
-                ),
-                sprite,
-                size_px,
-            });
         }
         if !blocks.is_empty() {
             ctx.queue.write_buffer(&self.looks, 0, &blocks);
@@ -609,5 +523,174 @@ impl FrameResources {
         let live: std::collections::HashSet<u64> = items.iter().map(|d| d.key.0).collect();
         self.particle_groups.retain(|k, _| live.contains(&k.0));
         items
+    }
+
+    /// Writes emitter `i`'s look uniform into `block` and returns its draw (scene and
+    /// look slot left for the caller), or `None` when it has no pool or is disabled.
+    #[allow(clippy::too_many_arguments)]
+    fn prepare_emitter(
+        &mut self,
+        ctx: &GpuContext,
+        scene: &Scene<'_>,
+        i: usize,
+        camera: &Camera,
+        alpha: f32,
+        sort: &mut crate::render::sort::SortPass,
+        asset_dir: Option<&Path>,
+        block: &mut [u8],
+    ) -> Option<DrawItem> {
+        let (sim, effect) = (scene.sim, scene.effect);
+        let e = &effect.emitters[i];
+        let cam_px = camera.pixels_per_unit();
+        let origin = sim
+            .planner
+            .emitters
+            .get(i)
+            .map(|p| p.origin())
+            .unwrap_or_default();
+        let (sprite, error) = self.sprites.resolve(ctx, &e.look.sprite, asset_dir);
+        if let Some(err) = error {
+            self.sprite_errors.push((i, err));
+        }
+        let salt = crate::rng::pcg4d([effect.seed, i as u32, e.seed_offset, 0x5EED_100C])[0];
+        let mut u = look_uniform(&e.look, i as u32, salt, sprite.integral);
+        if self.trim_sprites && e.look.streak.is_none() {
+            let (rows, cols) = e
+                .look
+                .flipbook
+                .as_ref()
+                .map_or((1, 1), |f| (f.rows, f.cols));
+            // What is invisible at intensity 1 shows when the light is multiplied.
+            let gain = (e.look.intensity * effect.post.exposure).max(1.0);
+            let threshold = crate::render::sprites::TRIM_THRESHOLD / gain;
+            u.trim = *self
+                .trims
+                .entry((sprite.id, rows, cols, threshold.to_bits()))
+                .or_insert_with(|| sprite.trim_rect(rows, cols, threshold));
+        }
+        u.clip_from_sim = camera.clip_from_sim(origin).to_cols_array_2d();
+        let ground = e.collisions.ground.as_ref().map_or(0.0, |g| g.height_m);
+        u.soft[0] = (f64::from(ground) - origin.y) as f32;
+        self.upload_ramp(ctx, i, &e.look);
+        if Modules::of(e).contains(Modules::STATELESS) {
+            // Closed-form evaluation at the render time (between the last two steps).
+            let t = sim.planner.time_secs - (1.0 - alpha as f64) * sim.planner.last_dt_secs as f64;
+            let a = e.forces.constant_acceleration();
+            let w = e.forces.wind_m_per_s;
+            u.motion_a = [a.x, a.y, a.z, e.forces.drag_per_sec];
+            u.motion_b = [w[0], w[1], w[2], t.rem_euclid(4096.0) as f32];
+        }
+        let buffers = sim.emitter_buffers(i).map(|mut b| {
+            if !self.live_window_only {
+                b.window = crate::sim::planner::LiveWindow::all(b.capacity);
+            }
+            b
+        });
+        if let Some(b) = &buffers {
+            // The ring, for packed state's re-derived lifetimes; the capacity and the
+            // live window's length (ring_b.zw) place the splat's invocations.
+            u.soft[2] = b.life_range.0;
+            u.soft[3] = b.life_range.1;
+            u.ring = [
+                (b.spawned_total % u64::from(b.capacity.max(1))) as u32,
+                b.spawned_total as u32,
+                (b.spawned_total >> 32) as u32,
+                0,
+            ];
+            // w: the live window's length (it ends at the ring's head, ring.x).
+            u.ring_b = [b.seed_salt.0, b.seed_salt.1, b.capacity, b.window.len];
+            [u.tiny, u.tiny_b, u.tiny_c] = b.tiny;
+        }
+        block.copy_from_slice(bytemuck::bytes_of(&u));
+        let b = buffers?;
+        if !e.enabled {
+            return None;
+        }
+        // Alpha-blended emitters are drawn back to front through the sort's order.
+        let sorted = e.look.blend == BlendMode::Alpha;
+        let order_buffer =
+            sorted.then(|| sort.buffers(ctx, b.generation, b.capacity).values.clone());
+        let key = (b.generation, b.parity, sorted);
+        self.ensure_particle_group(ctx, key, &b, order_buffer);
+        // Projected size at the emitter's distance decides the automatic path.
+        let distance = (camera.eye() - glam::Vec3::from(e.transform.position_m))
+            .length()
+            .max(1e-3);
+        let size_m = e.look.size_start_m.max(e.look.size_end_m);
+        let size_px = size_m * cam_px / distance;
+        let additive = e.look.blend == BlendMode::Additive;
+        let splat = self.allow_splat
+            && additive
+            && match e.look.draw_path {
+                // Streaks are long even when the particles are small.
+                DrawPath::Auto => size_px < SPLAT_BELOW_PX && e.look.streak.is_none(),
+                DrawPath::Billboard => false,
+                DrawPath::Splat => true,
+            };
+        let mut variant = LookVariant::of(
+            &e.look,
+            StateVariant {
+                layout: b.layout,
+                stateless: Modules::of(e).contains(Modules::STATELESS),
+            },
+        );
+        variant.soft_depth = self.soft_depth;
+        Some(DrawItem {
+            scene: 0,
+            index: i,
+            look_slot: 0,
+            key,
+            capacity: b.capacity,
+            window: b.window,
+            blend: e.look.blend,
+            splat,
+            variant,
+            sprite,
+            size_px,
+        })
+    }
+
+    /// Creates the particle bind group `key` names unless it exists: `b`'s state, and
+    /// `order` (the sort's) or the unsorted placeholder.
+    fn ensure_particle_group(
+        &mut self,
+        ctx: &GpuContext,
+        key: (u64, usize, bool),
+        b: &crate::sim::gpu_sim::EmitterBuffers<'_>,
+        order: Option<wgpu::Buffer>,
+    ) {
+        let order = order.as_ref().unwrap_or(&self.no_order);
+        self.particle_groups.entry(key).or_insert_with(|| {
+            ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("FrameResources::particle_group"),
+                layout: &self.particle_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: b.previous.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: b.current.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: order.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: b.previous.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 4,
+                        resource: b.current.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 5,
+                        resource: b.births.as_entire_binding(),
+                    },
+                ],
+            })
+        });
     }
 }

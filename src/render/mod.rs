@@ -11,8 +11,9 @@ pub mod sprites;
 pub mod tonemap;
 
 pub use billboard::BillboardPass;
+pub use camera::Camera;
 pub use camera::OrbitCamera;
-pub use frame::{DrawItem, FrameResources};
+pub use frame::{DrawItem, FrameResources, Scene};
 pub use splat::SplatPass;
 pub use tonemap::TonemapPass;
 
@@ -230,7 +231,7 @@ impl Renderer {
     pub fn new(ctx: &GpuContext, lib: &ShaderLibrary) -> Result<Self, ShaderError> {
         let frame = FrameResources::new(ctx);
         Ok(Self {
-            billboard: BillboardPass::new(ctx, lib, &frame)?,
+            billboard: BillboardPass::new(ctx, lib, &frame, billboard::DrawTarget::hdr())?,
             splat: SplatPass::new(ctx, lib, &frame)?,
             sort: sort::SortPass::new(ctx, lib)?,
             frame,
@@ -290,44 +291,19 @@ impl Renderer {
         let Some(targets) = self.targets.as_ref() else {
             return;
         };
+        let view = camera.view(targets.size);
+        let scenes = [Scene { sim, effect }];
         let items = self.frame.prepare(
             ctx,
-            sim,
-            effect,
-            camera,
-            size,
+            &scenes,
+            &view,
             alpha,
             &mut self.sort,
             self.asset_dir.as_deref(),
         );
         self.billboard
             .prepare(ctx, &items, &self.frame.sprites.sampler);
-        // Sort the alpha-blended emitters back to front (nothing runs when there is none).
-        for d in items.iter().filter(|d| d.key.2) {
-            if let Some(b) = sim.emitter_buffers(d.index) {
-                let origin = sim
-                    .planner
-                    .emitters
-                    .get(d.index)
-                    .map(|p| p.origin())
-                    .unwrap_or_default();
-                let eye = (camera.eye().as_dvec3() - origin).as_vec3();
-                let forward = (camera.target - camera.eye()).normalize_or(glam::Vec3::NEG_Z);
-                self.sort.record(
-                    ctx,
-                    enc,
-                    b.generation,
-                    b.current,
-                    b.capacity,
-                    d.window,
-                    eye,
-                    forward,
-                    b.layout,
-                );
-            }
-        }
-        let live: std::collections::HashSet<u64> = items.iter().map(|d| d.key.0).collect();
-        self.sort.retain(&live);
+        self.sort.record_items(ctx, enc, &scenes, &items, &view);
         let splatted = self.splat.splat(ctx, enc, &self.frame, &items, size);
         // Alpha layers at reduced resolution: their own target, added in the composite.
         // Draft halves it again (soft smoke hides it).

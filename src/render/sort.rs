@@ -571,6 +571,45 @@ impl SortPass {
         values.truncate(k.len);
         Ok((keys_out, values))
     }
+
+    /// Sorts the alpha-blended items back to front for `camera` (nothing runs when there
+    /// is none) and forgets the buffers of pools no longer drawn.
+    pub fn record_items(
+        &mut self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        scenes: &[crate::render::Scene<'_>],
+        items: &[crate::render::DrawItem],
+        camera: &crate::render::Camera,
+    ) {
+        for d in items.iter().filter(|d| d.key.2) {
+            let Some(sim) = scenes.get(d.scene).map(|s| s.sim) else {
+                continue;
+            };
+            if let Some(b) = sim.emitter_buffers(d.index) {
+                let origin = sim
+                    .planner
+                    .emitters
+                    .get(d.index)
+                    .map(|p| p.origin())
+                    .unwrap_or_default();
+                let eye = (camera.eye_f64() - origin).as_vec3();
+                self.record(
+                    ctx,
+                    enc,
+                    b.generation,
+                    b.current,
+                    b.capacity,
+                    d.window,
+                    eye,
+                    camera.forward(),
+                    b.layout,
+                );
+            }
+        }
+        let live: std::collections::HashSet<u64> = items.iter().map(|d| d.key.0).collect();
+        self.retain(&live);
+    }
 }
 
 #[cfg(test)]

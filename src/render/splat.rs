@@ -222,7 +222,7 @@ impl SplatPass {
             pass.set_bind_group(
                 0,
                 &frame.splat_group,
-                &[FrameResources::look_offset(d.index)],
+                &[FrameResources::look_offset(d.look_slot)],
             );
             pass.set_bind_group(1, particles, &[]);
             let (x, y) = dispatch_size(d.window.len);

@@ -1,6 +1,8 @@
 //! Pass 1 on the GPU: per-emitter ping-pong state buffers and the update pipeline.
 
 use std::collections::{HashMap, VecDeque};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 use crate::effect::{Effect, Integrator};
 use crate::gpu::types::{
@@ -250,17 +252,31 @@ struct EmitterState {
     spawned_end: u64,
 }
 
+/// Buffer generations, unique in the process: the draws' bind-group caches key on them,
+/// and several simulations (a player's instances) share one cache.
+static NEXT_GENERATION: AtomicU64 = AtomicU64::new(1);
+
+fn next_generation() -> u64 {
+    NEXT_GENERATION.fetch_add(1, Ordering::Relaxed)
+}
+
+/// The update pipelines, shared by the simulations of one effect's instances.
+pub type SharedUpdate = Arc<Mutex<UpdatePass>>;
+
+fn lock(update: &SharedUpdate) -> MutexGuard<'_, UpdatePass> {
+    update.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
 /// The GPU simulation of an effect.
 pub struct GpuSim {
     ctx: GpuContext,
     library: ShaderLibrary,
-    update: UpdatePass,
+    update: SharedUpdate,
     params_buffer: wgpu::Buffer,
     params_slots: usize,
     emitters: Vec<EmitterState>,
     /// CPU planning (time, spawn counts).
     pub planner: EffectPlanner,
-    next_generation: u64,
 }
 
 /// Read-only views of an emitter's state buffers, for the draw passes.
@@ -301,8 +317,29 @@ impl GpuSim {
         library: ShaderLibrary,
         effect: &Effect,
     ) -> Result<Self, SimError> {
+        let update = Self::shared_update(ctx, &library, effect)?;
+        Self::with_update(ctx, library, update, effect)
+    }
+
+    /// The update pipelines `effect` needs, built once to be shared by the simulations
+    /// of its instances ([`GpuSim::with_update`]).
+    pub fn shared_update(
+        ctx: &GpuContext,
+        library: &ShaderLibrary,
+        effect: &Effect,
+    ) -> Result<SharedUpdate, SimError> {
         let mut update = UpdatePass::new(ctx);
-        update.rebuild(ctx, &library, &used_keys(effect))?;
+        update.rebuild(ctx, library, &used_keys(effect))?;
+        Ok(Arc::new(Mutex::new(update)))
+    }
+
+    /// A simulation of `effect` on shared update pipelines: only its buffers are created.
+    pub fn with_update(
+        ctx: &GpuContext,
+        library: ShaderLibrary,
+        update: SharedUpdate,
+        effect: &Effect,
+    ) -> Result<Self, SimError> {
         let mut sim = Self {
             ctx: ctx.clone(),
             library,
@@ -318,7 +355,6 @@ impl GpuSim {
             params_slots: 1,
             emitters: Vec::new(),
             planner: EffectPlanner::default(),
-            next_generation: 1,
         };
         sim.sync(effect)?;
         Ok(sim)
@@ -330,8 +366,8 @@ impl GpuSim {
     }
 
     /// Files the update pipelines depend on.
-    pub fn shader_files(&self) -> &[String] {
-        &self.update.files
+    pub fn shader_files(&self) -> Vec<String> {
+        lock(&self.update).files.clone()
     }
 
     /// Rebuilds the update pipelines from `library`; the particles are untouched, and on
@@ -341,8 +377,7 @@ impl GpuSim {
         library: ShaderLibrary,
         effect: &Effect,
     ) -> Result<(), ShaderError> {
-        self.update
-            .rebuild(&self.ctx, &library, &used_keys(effect))?;
+        lock(&self.update).rebuild(&self.ctx, &library, &used_keys(effect))?;
         self.library = library;
         Ok(())
     }
@@ -441,7 +476,7 @@ impl GpuSim {
             }
         }
         for key in used_keys(effect) {
-            self.update.ensure(&self.ctx, &self.library, key)?;
+            lock(&self.update).ensure(&self.ctx, &self.library, key)?;
         }
         Ok(())
     }
@@ -471,8 +506,7 @@ impl GpuSim {
         let entries = if layout == StateLayout::Tiny { 1024 } else { 1 };
         let births = self.births_buffer(entries);
         let bind_groups = self.bind_groups(&buffers, &counters, &births);
-        let generation = self.next_generation;
-        self.next_generation += 1;
+        let generation = next_generation();
         EmitterState {
             capacity,
             buffers,
@@ -508,12 +542,13 @@ impl GpuSim {
         counters: &wgpu::Buffer,
         births: &wgpu::Buffer,
     ) -> [wgpu::BindGroup; 2] {
+        let layout = lock(&self.update).layout.clone();
         let make = |src: usize| {
             self.ctx
                 .device
                 .create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("GpuSim::bind_group"),
-                    layout: &self.update.layout,
+                    layout: &layout,
                     entries: &[
                         wgpu::BindGroupEntry {
                             binding: 0,
@@ -632,6 +667,8 @@ impl GpuSim {
         // dispatches inside a pass): on lavapipe each pass costs about as much as a small
         // dispatch. GPUs end it where the alive counter must be cleared first.
         let clear_counters = !self.ctx.is_cpu_adapter();
+        let update = Arc::clone(&self.update);
+        let update = lock(&update);
         let mut pass: Option<wgpu::ComputePass<'static>> = None;
         for (s, plan) in plans.iter().enumerate() {
             for (e, params) in plan.iter().enumerate() {
@@ -640,10 +677,7 @@ impl GpuSim {
                 };
                 em.spawned_end = (u64::from(p.spawn_base_hi) << 32 | u64::from(p.spawn_base_lo))
                     + u64::from(p.spawn_count);
-                let Some(pipeline) = self
-                    .update
-                    .pipelines
-                    .get(&pipeline_key(&effect.emitters[e]))
+                let Some(pipeline) = update.pipelines.get(&pipeline_key(&effect.emitters[e]))
                 else {
                     continue;
                 };
@@ -734,8 +768,7 @@ impl GpuSim {
             let births = self.births_buffer(entries);
             let s = &self.emitters[e];
             let bind_groups = self.bind_groups(&s.buffers, &s.counters, &births);
-            let generation = self.next_generation;
-            self.next_generation += 1;
+            let generation = next_generation();
             let s = &mut self.emitters[e];
             s.births = births;
             s.births_mask = entries - 1;
@@ -953,18 +986,14 @@ impl GpuSim {
             return Ok([alive, 0]);
         }
         // GPUs count in the update pass itself; CPU adapters count here, on demand.
-        if let Some(count) = self
-            .update
-            .count
-            .as_ref()
-            .filter(|_| self.ctx.is_cpu_adapter())
-        {
+        let update = lock(&self.update);
+        if let Some(count) = update.count.as_ref().filter(|_| self.ctx.is_cpu_adapter()) {
             let group = self
                 .ctx
                 .device
                 .create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("GpuSim::count_group"),
-                    layout: &self.update.count_layout,
+                    layout: &update.count_layout,
                     entries: &[
                         wgpu::BindGroupEntry {
                             binding: 0,

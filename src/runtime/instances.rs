@@ -1,0 +1,127 @@
+//! A player's instances: a slab of simulations with generation-checked handles, and the
+//! per-instance copy of the effect (its seed and its emitters placed in the world).
+
+use glam::{EulerRot, Mat4};
+
+use crate::effect::Effect;
+use crate::sim::GpuSim;
+
+/// A handle to one instance of a [`crate::Player`]'s effect. It stays valid until the
+/// instance is removed; a handle of a removed instance is refused, never aliased to a
+/// later one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct InstanceId {
+    index: u32,
+    generation: u32,
+}
+
+/// One instance: its own state, seed and placement.
+pub(crate) struct Instance {
+    /// The particles.
+    pub sim: GpuSim,
+    /// The effect with this instance's seed and its emitters' world transforms.
+    pub effect: Effect,
+    /// Where the effect's origin is in the world.
+    pub world_from_effect: Mat4,
+}
+
+impl Instance {
+    /// `template` placed by `world_from_effect`, with `seed`.
+    pub fn effect_for(template: &Effect, world_from_effect: Mat4, seed: u32) -> Effect {
+        let mut effect = template.clone();
+        effect.seed = seed;
+        place(&mut effect, template, world_from_effect);
+        effect
+    }
+
+    /// Moves this instance: new particles spawn at the new place; living ones keep their
+    /// world-space motion.
+    pub fn set_transform(&mut self, template: &Effect, world_from_effect: Mat4) {
+        self.world_from_effect = world_from_effect;
+        place(&mut self.effect, template, world_from_effect);
+    }
+}
+
+/// Sets `effect`'s emitter transforms to `template`'s composed with `world_from_effect`
+/// (rotation and translation; a scale is ignored — sizes are the preset's).
+fn place(effect: &mut Effect, template: &Effect, world_from_effect: Mat4) {
+    let (_, rotation, translation) = world_from_effect.to_scale_rotation_translation();
+    let outer = Mat4::from_rotation_translation(rotation.normalize(), translation);
+    for (e, t) in effect.emitters.iter_mut().zip(&template.emitters) {
+        let world = outer * t.transform.world_from_emitter();
+        let (_, r, p) = world.to_scale_rotation_translation();
+        let (z, y, x) = r.to_euler(EulerRot::ZYX);
+        e.transform.position_m = p.into();
+        e.transform.rotation_deg = [x, y, z].map(f32::to_degrees);
+    }
+}
+
+/// Instances in slots that are reused after removal; each slot's generation tells a
+/// handle of its earlier occupant from one of the current.
+#[derive(Default)]
+pub(crate) struct Slab {
+    slots: Vec<(u32, Option<Instance>)>,
+    free: Vec<u32>,
+}
+
+impl Slab {
+    /// Stores `instance` and returns its handle.
+    pub fn insert(&mut self, instance: Instance) -> InstanceId {
+        if let Some(index) = self.free.pop() {
+            let slot = &mut self.slots[index as usize];
+            slot.0 = slot.0.wrapping_add(1);
+            slot.1 = Some(instance);
+            return InstanceId {
+                index,
+                generation: slot.0,
+            };
+        }
+        self.slots.push((0, Some(instance)));
+        InstanceId {
+            index: (self.slots.len() - 1) as u32,
+            generation: 0,
+        }
+    }
+
+    /// Takes the instance `id` names out, if it is still there.
+    pub fn remove(&mut self, id: InstanceId) -> Option<Instance> {
+        let slot = self.slots.get_mut(id.index as usize)?;
+        if slot.0 != id.generation {
+            return None;
+        }
+        let instance = slot.1.take()?;
+        self.free.push(id.index);
+        Some(instance)
+    }
+
+    /// The instance `id` names.
+    pub fn get(&self, id: InstanceId) -> Option<&Instance> {
+        let slot = self.slots.get(id.index as usize)?;
+        (slot.0 == id.generation)
+            .then_some(slot.1.as_ref())
+            .flatten()
+    }
+
+    /// The instance `id` names, mutably.
+    pub fn get_mut(&mut self, id: InstanceId) -> Option<&mut Instance> {
+        let slot = self.slots.get_mut(id.index as usize)?;
+        (slot.0 == id.generation)
+            .then_some(slot.1.as_mut())
+            .flatten()
+    }
+
+    /// Every instance, in slot order.
+    pub fn iter(&self) -> impl Iterator<Item = &Instance> {
+        self.slots.iter().filter_map(|(_, i)| i.as_ref())
+    }
+
+    /// Every instance, mutably.
+    pub fn iter_mut(&mut self) -> impl Iterator<Item = &mut Instance> {
+        self.slots.iter_mut().filter_map(|(_, i)| i.as_mut())
+    }
+
+    /// How many instances there are.
+    pub fn len(&self) -> usize {
+        self.slots.len() - self.free.len()
+    }
+}

@@ -1,0 +1,325 @@
+//! [`Player`]: one effect's pipelines, ramps and sprites, shared by its instances, and
+//! the three calls a host makes each frame — advance, record, draw.
+
+use std::path::PathBuf;
+
+use glam::Mat4;
+
+use crate::effect::{Effect, ValidationError};
+use crate::gpu::GpuContext;
+use crate::render::billboard::{BillboardPass, DrawTarget};
+use crate::render::sort::SortPass;
+use crate::render::{Camera, DrawItem, FrameResources, Scene};
+use crate::runtime::instances::{Instance, InstanceId, Slab};
+use crate::shaders::ShaderLibrary;
+use crate::sim::gpu_sim::{SharedUpdate, SimError};
+use crate::sim::{GpuSim, Stepper};
+
+/// How a [`Player`] draws into the host's render pass.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlayerSettings {
+    /// The format of the colour attachment the particles are drawn into. An HDR format
+    /// (`Rgba16Float`) keeps the fire's light for the host's own tonemap; an sRGB display
+    /// format works too (additive light then clips at white).
+    pub color_format: wgpu::TextureFormat,
+    /// The format of the host's depth attachment, or `None` to draw without depth.
+    pub depth_format: Option<wgpu::TextureFormat>,
+    /// The depth test (`LessEqual` for the usual 0 = near; `GreaterEqual` for reversed
+    /// Z). Particles never write depth.
+    pub depth_compare: wgpu::CompareFunction,
+    /// Samples per pixel of the host's attachments (MSAA).
+    pub sample_count: u32,
+    /// The folder the preset's PNG sprite paths are relative to (the preset's own
+    /// folder); `None`: the working directory.
+    pub asset_dir: Option<PathBuf>,
+}
+
+impl PlayerSettings {
+    /// Settings for a colour attachment of `color_format`: no depth, one sample.
+    pub fn new(color_format: wgpu::TextureFormat) -> Self {
+        Self {
+            color_format,
+            depth_format: None,
+            depth_compare: wgpu::CompareFunction::LessEqual,
+            sample_count: 1,
+            asset_dir: None,
+        }
+    }
+}
+
+/// Why a player could not be created or an instance added.
+#[derive(Debug, thiserror::Error)]
+pub enum PlayerError {
+    /// The preset file could not be read.
+    #[error(transparent)]
+    Preset(#[from] crate::preset::PresetError),
+    /// The effect has impossible values (each error names the field).
+    #[error("the effect is not valid: {}", list(.0))]
+    Invalid(Vec<ValidationError>),
+    /// A shader, a device limit or a GPU readback failed.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+}
+
+fn list(errors: &[ValidationError]) -> String {
+    errors
+        .iter()
+        .map(ToString::to_string)
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+/// Plays one effect inside a host's frame, as any number of instances.
+///
+/// Instances share the player's pipelines, colour ramps and sprites; each has its own
+/// particles, seed and transform. All instances advance on the player's clock (the
+/// preset's fixed step or the frame's delta), so a fixed-step effect is the same at any
+/// frame rate. Each frame: [`Player::advance`], then [`Player::record`] into the host's
+/// encoder (after the host's opaque pass when it hands over its depth for soft edges),
+/// then [`Player::draw`] inside the host's render pass.
+pub struct Player {
+    ctx: GpuContext,
+    effect: Effect,
+    library: ShaderLibrary,
+    update: SharedUpdate,
+    frame: FrameResources,
+    billboard: BillboardPass,
+    sort: SortPass,
+    instances: Slab,
+    stepper: Stepper,
+    is_paused: bool,
+    /// Steps planned by `advance` and not yet recorded, and their size.
+    pending: (u32, f32),
+    /// Where frames are drawn between the last two steps (fixed step).
+    alpha: f32,
+    settings: PlayerSettings,
+    items: Vec<DrawItem>,
+}
+
+/// Steps one `record` runs at most (the simulation's per-submit parameter ring); more
+/// are dropped like the stepper's hitch guard.
+const MAX_STEPS_PER_RECORD: u32 = 32;
+
+impl Player {
+    /// A player for `effect` on the host's device: builds its pipelines for the host's
+    /// formats. No instance yet.
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        effect: &Effect,
+        settings: PlayerSettings,
+    ) -> Result<Self, PlayerError> {
+        effect.validate().map_err(PlayerError::Invalid)?;
+        let ctx = GpuContext::from_device(device, queue);
+        let library = ShaderLibrary::embedded();
+        let update = GpuSim::shared_update(&ctx, &library, effect)?;
+        let mut frame = FrameResources::new(&ctx);
+        // Everything is drawn in the host's pass: no compute splat (it needs a target of
+        // its own).
+        frame.allow_splat = false;
+        let target = DrawTarget {
+            color_format: settings.color_format,
+            depth: settings.depth_format.map(|f| (f, settings.depth_compare)),
+            sample_count: settings.sample_count.max(1),
+        };
+        let billboard =
+            BillboardPass::new(&ctx, &library, &frame, target).map_err(SimError::from)?;
+        let sort = SortPass::new(&ctx, &library).map_err(SimError::from)?;
+        Ok(Self {
+            ctx,
+            effect: effect.clone(),
+            library,
+            update,
+            frame,
+            billboard,
+            sort,
+            instances: Slab::default(),
+            stepper: Stepper::default(),
+            is_paused: false,
+            pending: (0, 0.0),
+            alpha: 1.0,
+            settings,
+            items: Vec::new(),
+        })
+    }
+
+    /// The effect this player plays.
+    pub fn effect(&self) -> &Effect {
+        &self.effect
+    }
+
+    /// The settings it draws with.
+    pub fn settings(&self) -> &PlayerSettings {
+        &self.settings
+    }
+
+    /// Adds an instance at `world_from_effect` (rotation and translation; scale is
+    /// ignored) with its own `seed`. It starts empty, at time 0 of its own. Creates only
+    /// its particle buffers: no pipeline is built and no other instance is touched.
+    pub fn add_instance(
+        &mut self,
+        world_from_effect: Mat4,
+        seed: u32,
+    ) -> Result<InstanceId, PlayerError> {
+        let effect = Instance::effect_for(&self.effect, world_from_effect, seed);
+        let sim = GpuSim::with_update(
+            &self.ctx,
+            self.library.clone(),
+            self.update.clone(),
+            &effect,
+        )?;
+        Ok(self.instances.insert(Instance {
+            sim,
+            effect,
+            world_from_effect,
+        }))
+    }
+
+    /// Removes an instance; its buffers are freed once the GPU is done with them. Returns
+    /// false if `id` was already removed.
+    pub fn remove_instance(&mut self, id: InstanceId) -> bool {
+        self.instances.remove(id).is_some()
+    }
+
+    /// Moves an instance (call it every frame for a carried torch): new particles spawn
+    /// at the new place, living ones keep their world-space motion. Returns false if `id`
+    /// was removed.
+    pub fn set_transform(&mut self, id: InstanceId, world_from_effect: Mat4) -> bool {
+        let Some(instance) = self.instances.get_mut(id) else {
+            return false;
+        };
+        instance.set_transform(&self.effect, world_from_effect);
+        true
+    }
+
+    /// Where an instance is, if it exists.
+    pub fn transform(&self, id: InstanceId) -> Option<Mat4> {
+        self.instances.get(id).map(|i| i.world_from_effect)
+    }
+
+    /// How many instances there are.
+    pub fn instance_count(&self) -> usize {
+        self.instances.len()
+    }
+
+    /// Advances the clock by a frame of `frame_dt_secs` seconds: plans the steps the next
+    /// [`Player::record`] runs (fixed steps as the preset says, or one step of the frame's
+    /// delta). Nothing moves while paused.
+    pub fn advance(&mut self, frame_dt_secs: f64) {
+        if self.is_paused {
+            return;
+        }
+        let plan = self.stepper.advance(frame_dt_secs, &self.effect.time);
+        self.pending = (
+            (self.pending.0 + plan.steps).min(MAX_STEPS_PER_RECORD),
+            plan.dt_secs,
+        );
+        self.alpha = plan.alpha;
+    }
+
+    /// Pauses or resumes the clock (a paused effect is still drawn).
+    pub fn set_paused(&mut self, is_paused: bool) {
+        self.is_paused = is_paused;
+    }
+
+    /// Whether the clock is paused.
+    pub fn is_paused(&self) -> bool {
+        self.is_paused
+    }
+
+    /// Empties every instance and starts the clock again from 0.
+    pub fn restart(&mut self) {
+        for instance in self.instances.iter_mut() {
+            instance.sim.restart();
+        }
+        self.stepper.reset();
+        self.pending = (0, 0.0);
+        self.alpha = 1.0;
+    }
+
+    /// Records this frame's compute work into the host's encoder — the planned steps of
+    /// every instance, then the back-to-front sort of alpha-blended layers for `camera` —
+    /// and uploads the draw's uniforms. `scene_depth` is the host's depth buffer as a
+    /// single-sample view the size of the target (with `TEXTURE_BINDING` usage), for
+    /// soft edges where particles meet the host's geometry; without it the preset's
+    /// ground plane softens them.
+    pub fn record(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        camera: &Camera,
+        scene_depth: Option<&wgpu::TextureView>,
+    ) {
+        self.simulate(encoder);
+        let depth = scene_depth.filter(|_| self.settings.depth_format.is_some());
+        if let Some(view) = depth {
+            self.billboard.set_scene_depth(&self.ctx, view);
+        }
+        self.frame.soft_depth = depth.is_some();
+        let eye = camera.eye_f64();
+        // Far instances first: their smoke lies under nearer instances' smoke.
+        let mut order: Vec<&Instance> = self.instances.iter().collect();
+        order.sort_by(|a, b| {
+            let d =
+                |i: &Instance| (i.world_from_effect.w_axis.truncate().as_dvec3() - eye).length();
+            d(b).total_cmp(&d(a))
+        });
+        let scenes: Vec<Scene<'_>> = order
+            .iter()
+            .map(|i| Scene {
+                sim: &i.sim,
+                effect: &i.effect,
+            })
+            .collect();
+        self.items = self.frame.prepare(
+            &self.ctx,
+            &scenes,
+            camera,
+            self.alpha,
+            &mut self.sort,
+            self.settings.asset_dir.as_deref(),
+        );
+        self.billboard
+            .prepare(&self.ctx, &self.items, &self.frame.sprites.sampler);
+        self.sort
+            .record_items(&self.ctx, encoder, &scenes, &self.items, camera);
+    }
+
+    /// Records the steps `advance` planned for every instance.
+    fn simulate(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        let (steps, dt_secs) = std::mem::take(&mut self.pending);
+        if steps == 0 {
+            return;
+        }
+        for instance in self.instances.iter_mut() {
+            if let Err(err) = instance.sim.sync(&instance.effect) {
+                log::error!(
+                    "ignis: an instance of {:?} cannot run: {err}",
+                    self.effect.name
+                );
+                continue;
+            }
+            let plans = instance.sim.plan(&instance.effect, dt_secs, steps as usize);
+            instance.sim.record(encoder, &instance.effect, &plans);
+        }
+    }
+
+    /// Draws every instance's particles into the host's open render pass (alpha-blended
+    /// layers first, then the additive light), as last recorded. The pass must have the
+    /// colour format, depth format and sample count of the player's settings; its depth
+    /// attachment must be read-only (`depth_ops: None`) when the depth is also handed to
+    /// [`Player::record`] for soft edges.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
+        self.billboard
+            .draw(pass, &self.frame, &self.items, |_| true);
+    }
+
+    /// Sprite files that failed to load at the last `record` (the emitter draws with a
+    /// built-in sprite instead), as messages naming the emitter and the file.
+    pub fn sprite_errors(&self) -> Vec<String> {
+        self.frame
+            .sprite_errors
+            .iter()
+            .map(|(i, e)| format!("emitter {i}: {e}"))
+            .collect()
+    }
+}
