@@ -23,8 +23,8 @@
 //! player.set_transform(torch, glam::Mat4::from_translation(glam::vec3(2.0, 1.5, 0.1)));
 //! player.advance(1.0 / 60.0);
 //! let camera = Camera::new(
-//!     glam::Mat4::look_at_rh(glam::vec3(0.0, 2.0, 6.0), glam::Vec3::ZERO, glam::Vec3::Y),
-//!     glam::Mat4::perspective_rh(0.8, 16.0 / 9.0, 0.1, 100.0),
+//!     glam::camera::rh::view::look_at_mat4(glam::vec3(0.0, 2.0, 6.0), glam::Vec3::ZERO, glam::Vec3::Y),
+//!     glam::camera::rh::proj::directx::perspective(0.8, 16.0 / 9.0, 0.1, 100.0),
 //!     (1280, 720),
 //! );
 //! let mut encoder = device.create_command_encoder(&Default::default());

@@ -1,5 +1,7 @@
 //! The editor's UI logic, driven through egui_kittest (no window, no GPU for the UI), and
 //! the path from a widget to the GPU simulation (headless `GpuSim`).
+// The editor, the `ignis` binary or the benches: the default `editor` feature.
+#![cfg(feature = "editor")]
 
 use egui::{Key, Modifiers, Role};
 use egui_kittest::Harness;

@@ -3,6 +3,8 @@
 //!
 //! Needs `xvfb-run` (packages `xvfb` and `xauth`) and a Vulkan driver (lavapipe is fine);
 //! the test fails, rather than skips, when they are missing.
+// The editor, the `ignis` binary or the benches: the default `editor` feature.
+#![cfg(feature = "editor")]
 
 use std::path::PathBuf;
 use std::process::Command;

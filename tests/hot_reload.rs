@@ -1,6 +1,8 @@
 //! WGSL hot reload on a real adapter: valid edits change the simulation, broken edits are
 //! reported at file:line and leave the last good pipeline (and the particles) running,
 //! fixes restore; the file watcher sees editor-style saves.
+// The editor, the `ignis` binary or the benches: the default `editor` feature.
+#![cfg(feature = "editor")]
 
 mod common;
 

@@ -5,6 +5,8 @@
 //! Reference images live in `tests/reference/`. They are regenerated only deliberately:
 //! `IGNIS_BLESS=1 cargo test --release --test looks reference_images` (then look at them
 //! and commit them with the change that moved them).
+// The editor, the `ignis` binary or the benches: the default `editor` feature.
+#![cfg(feature = "editor")]
 
 mod common;
 

@@ -2,6 +2,8 @@
 //! files give located, specific errors and never panic; saving never loses work; any valid
 //! effect survives save → load exactly; version-1 files keep loading; newer versions are
 //! refused with a message to update.
+// The editor, the `ignis` binary or the benches: the default `editor` feature.
+#![cfg(feature = "editor")]
 
 mod common;
 

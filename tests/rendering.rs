@@ -1,5 +1,7 @@
 //! Rendering on a real adapter: warm fire above the emitter, black elsewhere, dead
 //! particles invisible, deterministic PNGs, `ignis render` end to end.
+// The editor, the `ignis` binary or the benches: the default `editor` feature.
+#![cfg(feature = "editor")]
 
 mod common;
 

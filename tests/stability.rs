@@ -1,5 +1,7 @@
 //! Numerical stability at the extremes, convergence orders and frame-rate independence,
 //! on a real adapter.
+// The editor, the `ignis` binary or the benches: the default `editor` feature.
+#![cfg(feature = "editor")]
 
 mod common;
 

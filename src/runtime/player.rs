@@ -322,4 +322,17 @@ impl Player {
             .map(|(i, e)| format!("emitter {i}: {e}"))
             .collect()
     }
+
+    /// Emitter `emitter`'s particles in instance `id` (a blocking readback, for tests
+    /// that compare instances bit for bit). `None` if `id` was removed.
+    #[doc(hidden)]
+    pub fn read_particles(
+        &self,
+        id: InstanceId,
+        emitter: usize,
+    ) -> Option<Result<Vec<crate::gpu::types::Particle>, SimError>> {
+        self.instances
+            .get(id)
+            .map(|i| i.sim.read_particles(emitter))
+    }
 }
