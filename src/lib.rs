@@ -58,7 +58,7 @@
 //! internals, not part of the runtime's API.
 #![deny(missing_docs)]
 
-mod runtime;
+pub(crate) mod runtime;
 
 pub use effect::Effect;
 pub use runtime::{Camera, InstanceId, Player, PlayerError, PlayerSettings};

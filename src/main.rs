@@ -95,7 +95,8 @@ enum Command {
         #[arg(long)]
         shader_dir: Option<PathBuf>,
     },
-    /// Measure: `accuracy` (integrators' error vs cost) or `perf` (throughput).
+    /// Measure: `accuracy` (integrators' error vs cost), `perf` (throughput) or `runtime`
+    /// (instances in a host's frame).
     Bench {
         #[command(subcommand)]
         kind: BenchKind,
@@ -109,6 +110,28 @@ enum Command {
 
 #[derive(Subcommand)]
 enum BenchKind {
+    /// The runtime's cost in a host frame for 1, 10, 100 instances, and 100 instances
+    /// against one emitter with the same particles.
+    Runtime {
+        /// The effect played (default: presets/torch.ron).
+        #[arg(long, default_value = "presets/torch.ron")]
+        preset: PathBuf,
+        /// Instance counts.
+        #[arg(long, value_delimiter = ',', default_value = "1,10,100")]
+        counts: Vec<u32>,
+        /// The host's target size, WxH.
+        #[arg(long, default_value = "1920x1080", value_parser = parse_size)]
+        size: (u32, u32),
+        /// Measured frames per row (the median is reported).
+        #[arg(long, default_value_t = 15)]
+        frames: usize,
+        /// Output folder.
+        #[arg(long, default_value = "bench/results")]
+        out: PathBuf,
+        /// File name stem (default: runtime-<adapter>).
+        #[arg(long)]
+        name: Option<String>,
+    },
     /// Error against exact / high-precision references, next to GPU cost, per integrator and dt.
     Accuracy {
         /// Particles per error run.
@@ -337,6 +360,27 @@ fn adapter_tag(ctx: &GpuContext) -> String {
 fn bench(kind: BenchKind) -> anyhow::Result<()> {
     let ctx = GpuContext::headless()?;
     match kind {
+        BenchKind::Runtime {
+            preset,
+            counts,
+            size,
+            frames,
+            out,
+            name,
+        } => {
+            let opts = ignis::bench::runtime::RuntimeOptions {
+                effect: ignis::preset::load(&preset)?,
+                asset_dir: preset.parent().unwrap_or(Path::new(".")).to_path_buf(),
+                counts,
+                size,
+                frames: frames.max(1),
+            };
+            let report = ignis::bench::runtime::run(&ctx, &opts)?;
+            let name = name.unwrap_or_else(|| format!("runtime-{}", adapter_tag(&ctx)));
+            report.save(&out, &name)?;
+            println!("{}", report.markdown);
+            println!("wrote {}/{name}.md and .json", out.display());
+        }
         BenchKind::Accuracy {
             particles,
             cost_capacity,

@@ -4,5 +4,6 @@
 pub mod accuracy;
 pub mod perf;
 pub mod report;
+pub mod runtime;
 
 pub use report::Report;

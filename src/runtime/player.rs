@@ -112,7 +112,9 @@ impl Player {
         effect.validate().map_err(PlayerError::Invalid)?;
         let ctx = GpuContext::from_device(device, queue);
         let library = ShaderLibrary::embedded();
-        let update = GpuSim::shared_update(&ctx, &library, effect)?;
+        // Nobody reads alive counts every frame here: the update need not count them
+        // (which would end the instances' shared compute pass to clear the counters).
+        let update = GpuSim::shared_update(&ctx, &library, effect, false)?;
         let mut frame = FrameResources::new(&ctx);
         // Everything is drawn in the host's pass: no compute splat (it needs a target of
         // its own).

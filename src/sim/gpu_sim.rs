@@ -52,10 +52,13 @@ pub struct UpdatePass {
     count: Option<[wgpu::ComputePipeline; 2]>,
     /// Files the current pipelines were built from.
     pub files: Vec<String>,
+    /// The update counts alive particles as it goes (GPUs; the editor's statistics).
+    /// Off, nothing clears a counter between steps and counts are taken on demand.
+    count_alive: bool,
 }
 
 impl UpdatePass {
-    fn new(ctx: &GpuContext) -> Self {
+    fn new(ctx: &GpuContext, count_alive: bool) -> Self {
         let storage = crate::gpu::compute_storage_entry;
         let layout = ctx
             .device
@@ -114,6 +117,8 @@ impl UpdatePass {
             count_pipeline_layout,
             count: None,
             files: Vec::new(),
+            // Workgroup reductions cost CPU adapters more than a count on demand.
+            count_alive: count_alive && !ctx.is_cpu_adapter(),
         }
     }
 
@@ -149,7 +154,7 @@ impl UpdatePass {
             };
             let mut constants = modules.constants();
             constants.push(("INTEGRATOR", integrator.index() as f64));
-            constants.push(("COUNT_ALIVE", if ctx.is_cpu_adapter() { 0.0 } else { 1.0 }));
+            constants.push(("COUNT_ALIVE", if self.count_alive { 1.0 } else { 0.0 }));
             let pipeline = create_checked(&ctx.device, composed, lib, |module| {
                 ctx.device
                     .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -267,6 +272,10 @@ fn lock(update: &SharedUpdate) -> MutexGuard<'_, UpdatePass> {
     update.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
+fn update_counts(update: &SharedUpdate) -> bool {
+    lock(update).count_alive
+}
+
 /// The GPU simulation of an effect.
 pub struct GpuSim {
     ctx: GpuContext,
@@ -317,18 +326,21 @@ impl GpuSim {
         library: ShaderLibrary,
         effect: &Effect,
     ) -> Result<Self, SimError> {
-        let update = Self::shared_update(ctx, &library, effect)?;
+        let update = Self::shared_update(ctx, &library, effect, true)?;
         Self::with_update(ctx, library, update, effect)
     }
 
     /// The update pipelines `effect` needs, built once to be shared by the simulations
-    /// of its instances ([`GpuSim::with_update`]).
+    /// of its instances ([`GpuSim::with_update`]). `count_alive`: the update counts the
+    /// living particles as it goes (worth it where the counts are read every frame, as
+    /// the editor's statistics do; otherwise [`GpuSim::read_counters`] counts on demand).
     pub fn shared_update(
         ctx: &GpuContext,
         library: &ShaderLibrary,
         effect: &Effect,
+        count_alive: bool,
     ) -> Result<SharedUpdate, SimError> {
-        let mut update = UpdatePass::new(ctx);
+        let mut update = UpdatePass::new(ctx, count_alive);
         update.rebuild(ctx, library, &used_keys(effect))?;
         Ok(Arc::new(Mutex::new(update)))
     }
@@ -440,23 +452,25 @@ impl GpuSim {
         }
         // Switching an emitter between stateless records and stateful particles restarts
         // its pool: the two layouts mean different things.
-        let mut enc = self.ctx.device.create_command_encoder(&Default::default());
-        let mut cleared = false;
+        // Created only when a pool must be cleared (this runs every frame).
+        let mut enc: Option<wgpu::CommandEncoder> = None;
         for (i, (s, e)) in self.emitters.iter_mut().zip(&effect.emitters).enumerate() {
             s.life_range = (e.lifetime_secs.min, e.lifetime_secs.max);
             s.seed = effect.seed;
             s.salt = crate::rng::emitter_salt(i as u32, e.seed_offset);
             let stateless = Modules::of(e).contains(Modules::STATELESS);
             if s.stateless != stateless {
+                let enc = enc.get_or_insert_with(|| {
+                    self.ctx.device.create_command_encoder(&Default::default())
+                });
                 for b in &s.buffers {
                     enc.clear_buffer(b, 0, None);
                 }
                 s.current = 0;
                 s.stateless = stateless;
-                cleared = true;
             }
         }
-        if cleared {
+        if let Some(enc) = enc {
             self.ctx.queue.submit([enc.finish()]);
         }
         let slots = STEPS_PER_SUBMIT * effect.emitters.len().max(1);
@@ -627,6 +641,23 @@ impl GpuSim {
         effect: &Effect,
         plans: &[Vec<Option<SimParams>>],
     ) {
+        enc.push_debug_group("update particles");
+        let mut pass = None;
+        self.record_into(enc, &mut pass, effect, plans);
+        drop(pass);
+        enc.pop_debug_group();
+    }
+
+    /// [`GpuSim::record`] into an open compute pass of `enc` (opened on first need), so
+    /// that several simulations (a player's instances) share one pass. A simulation that
+    /// counts alive particles ends the pass before its last step to clear its counters.
+    pub fn record_into(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        pass: &mut Option<wgpu::ComputePass<'static>>,
+        effect: &Effect,
+        plans: &[Vec<Option<SimParams>>],
+    ) {
         let n_emitters = self.emitters.len();
         for e in 0..n_emitters {
             if self.emitters[e].layout == StateLayout::Tiny {
@@ -662,15 +693,24 @@ impl GpuSim {
             }
         }
         self.ctx.queue.write_buffer(&self.params_buffer, 0, &blocks);
-        enc.push_debug_group("update particles");
         // One compute pass for as many dispatches as possible (wgpu orders dependent
         // dispatches inside a pass): on lavapipe each pass costs about as much as a small
         // dispatch. GPUs end it where the alive counter must be cleared first.
-        let clear_counters = !self.ctx.is_cpu_adapter();
+        let clear_counters = update_counts(&self.update);
         let update = Arc::clone(&self.update);
         let update = lock(&update);
-        let mut pass: Option<wgpu::ComputePass<'static>> = None;
         for (s, plan) in plans.iter().enumerate() {
+            if clear_counters && s + 1 == plans.len() {
+                // The update counts alive particles (COUNT_ALIVE) into the counter: clear
+                // it before the last step only, whose count is the one read (one break
+                // of the pass per record, not one per emitter and step).
+                drop(pass.take());
+                for (em, params) in self.emitters.iter().zip(plan) {
+                    if params.is_some() && !em.stateless {
+                        enc.clear_buffer(&em.counters, 0, Some(4));
+                    }
+                }
+            }
             for (e, params) in plan.iter().enumerate() {
                 let (Some(p), Some(em)) = (params, self.emitters.get_mut(e)) else {
                     continue;
@@ -697,12 +737,6 @@ impl GpuSim {
                 };
                 if !em.stateless {
                     em.current = 1 - em.current;
-                    if clear_counters {
-                        // The update counts alive particles (COUNT_ALIVE) into a cleared
-                        // slot.
-                        drop(pass.take());
-                        enc.clear_buffer(&em.counters, 0, Some(4));
-                    }
                 }
                 if slots == 0 {
                     // An empty window: nothing in the pool can be alive, both buffers hold
@@ -723,8 +757,6 @@ impl GpuSim {
                 pass.dispatch_workgroups(x, y, 1);
             }
         }
-        drop(pass);
-        enc.pop_debug_group();
     }
 
     /// Writes the birth-table entries of the batches `plans` spawned for tiny emitter `e`
@@ -959,7 +991,7 @@ impl GpuSim {
             .emitters
             .get(index)
             .ok_or_else(|| SimError::Readback(format!("no emitter {index}")))?;
-        if s.layout == StateLayout::Tiny && self.ctx.is_cpu_adapter() {
+        if s.layout == StateLayout::Tiny && !update_counts(&self.update) {
             // Counted from the unpacked state (the on-demand count pass has no birth table).
             let alive = self
                 .read_particles(index)?
@@ -987,7 +1019,7 @@ impl GpuSim {
         }
         // GPUs count in the update pass itself; CPU adapters count here, on demand.
         let update = lock(&self.update);
-        if let Some(count) = update.count.as_ref().filter(|_| self.ctx.is_cpu_adapter()) {
+        if let Some(count) = update.count.as_ref().filter(|_| !update.count_alive) {
             let group = self
                 .ctx
                 .device

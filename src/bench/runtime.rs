@@ -1,0 +1,310 @@
+//! `ignis bench runtime`: what the runtime adds to a host's frame, through the public
+//! API only. A host with an HDR target and a depth buffer plays N torches (1, 10, 100
+//! instances of one player); for each N, after a warm-up past the longest lifetime, the
+//! median over frames of the GPU time of `record` (simulation + sort) and of `draw`
+//! (inside the host's pass, soft edges against its depth), and of the CPU time of the
+//! calls themselves. Then 100 instances against the same particles in one instance whose
+//! emitters have 100× the capacity and spawn rate, both at one spot (the same fill), to
+//! separate the per-instance constant from the per-particle cost.
+
+use std::time::Instant;
+
+use glam::{Mat4, Vec3, vec3};
+
+use crate::bench::Report;
+use crate::effect::Effect;
+use crate::gpu::GpuContext;
+use crate::gpu::timer::{GpuTimer, median};
+use crate::runtime::{Camera, Player, PlayerError, PlayerSettings};
+
+const COLOR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// Settings of the runtime bench.
+pub struct RuntimeOptions {
+    /// The effect played (the torch).
+    pub effect: Effect,
+    /// Its folder (PNG sprites).
+    pub asset_dir: std::path::PathBuf,
+    /// Instance counts to measure.
+    pub counts: Vec<u32>,
+    /// The host's target size.
+    pub size: (u32, u32),
+    /// Measured frames per row (the median is reported).
+    pub frames: usize,
+}
+
+/// One measured configuration.
+struct Row {
+    label: String,
+    instances: u32,
+    slots: u64,
+    record_ms: f64,
+    draw_ms: f64,
+    cpu_us: f64,
+}
+
+/// Runs the bench and returns its report.
+pub fn run(ctx: &GpuContext, opts: &RuntimeOptions) -> Result<Report, PlayerError> {
+    let host = Host::new(ctx, opts.size);
+    let timer = GpuTimer::new(ctx);
+    let mut rows = Vec::new();
+    for &n in &opts.counts {
+        let spots = grid(n);
+        rows.push(measure(
+            &host,
+            &timer,
+            opts,
+            &opts.effect,
+            &spots,
+            format!("{n} torches, a grid 1 m apart"),
+        )?);
+    }
+    let n = opts.counts.iter().copied().max().unwrap_or(100).max(2);
+    let same_spot = vec![Vec3::ZERO; n as usize];
+    let many = measure(
+        &host,
+        &timer,
+        opts,
+        &opts.effect,
+        &same_spot,
+        format!("{n} torches at one spot"),
+    )?;
+    let merged = scaled(&opts.effect, n);
+    let one = measure(
+        &host,
+        &timer,
+        opts,
+        &merged,
+        &[Vec3::ZERO],
+        format!("1 torch with {n}× the particles"),
+    )?;
+    Ok(report(ctx, opts, &timer, &rows, &many, &one))
+}
+
+/// `n` spots on a square grid 1 m apart, centred on the origin.
+fn grid(n: u32) -> Vec<Vec3> {
+    let side = (n as f32).sqrt().ceil().max(1.0) as u32;
+    (0..n)
+        .map(|i| {
+            let (x, z) = ((i % side) as f32, (i / side) as f32);
+            vec3(
+                x - 0.5 * (side - 1) as f32,
+                0.0,
+                -(z - 0.5 * (side - 1) as f32),
+            )
+        })
+        .collect()
+}
+
+/// `effect` with every emitter's capacity and spawn rate multiplied by `n`.
+fn scaled(effect: &Effect, n: u32) -> Effect {
+    let mut e = effect.clone();
+    for em in &mut e.emitters {
+        em.capacity *= n;
+        em.spawn_rate_per_sec *= n as f32;
+    }
+    e
+}
+
+/// Plays `effect` at `spots` and measures the median frame.
+fn measure(
+    host: &Host,
+    timer: &GpuTimer,
+    opts: &RuntimeOptions,
+    effect: &Effect,
+    spots: &[Vec3],
+    label: String,
+) -> Result<Row, PlayerError> {
+    let settings = PlayerSettings {
+        depth_format: Some(DEPTH),
+        asset_dir: Some(opts.asset_dir.clone()),
+        ..PlayerSettings::new(COLOR)
+    };
+    let mut player = Player::new(&host.ctx.device, &host.ctx.queue, effect, settings)?;
+    for (i, spot) in spots.iter().enumerate() {
+        player.add_instance(Mat4::from_translation(*spot), i as u32 + 1)?;
+    }
+    let camera = host.camera(spots);
+    let longest = effect
+        .emitters
+        .iter()
+        .map(|e| e.lifetime_secs.max)
+        .fold(0.0, f32::max);
+    let warm_up = (f64::from(longest) * 60.0).ceil() as usize + 10;
+    let (mut record, mut draw, mut cpu) = (Vec::new(), Vec::new(), Vec::new());
+    for frame in 0..warm_up + opts.frames {
+        // The CPU time of the calls alone: the GPU (on a CPU adapter, the same cores)
+        // is idle while they run.
+        let _ = host.ctx.device.poll(wgpu::PollType::wait_indefinitely());
+        let start = Instant::now();
+        player.advance(1.0 / 60.0);
+        let mut enc = host.ctx.device.create_command_encoder(&Default::default());
+        player.record(&mut enc, &camera, Some(&host.depth));
+        host.pass(&mut enc, |pass| player.draw(pass));
+        let commands = enc.finish();
+        let cpu_us = start.elapsed().as_secs_f64() * 1e6;
+        host.ctx.queue.submit([commands]);
+        if frame < warm_up {
+            continue;
+        }
+        // The next frame timed on the GPU, in two parts.
+        cpu.push(cpu_us);
+        player.advance(1.0 / 60.0);
+        record.push(timer.time(&host.ctx, |enc| {
+            player.record(enc, &camera, Some(&host.depth))
+        }));
+        draw.push(timer.time(&host.ctx, |enc| host.pass(enc, |pass| player.draw(pass))));
+    }
+    Ok(Row {
+        label,
+        instances: spots.len() as u32,
+        slots: spots.len() as u64
+            * effect
+                .emitters
+                .iter()
+                .map(|e| u64::from(e.capacity))
+                .sum::<u64>(),
+        record_ms: median(&mut record),
+        draw_ms: median(&mut draw),
+        cpu_us: median(&mut cpu),
+    })
+}
+
+fn report(
+    ctx: &GpuContext,
+    opts: &RuntimeOptions,
+    timer: &GpuTimer,
+    rows: &[Row],
+    many: &Row,
+    one: &Row,
+) -> Report {
+    let mut r = Report::new(
+        "ignis runtime: the cost of N instances in a host frame",
+        ctx,
+    );
+    r.para(&format!(
+        "`{}` at {}×{}: a host HDR target and depth buffer; medians of {} frames after a warm-up past the longest lifetime, {} frames at 60 fps. `record` = the instances' simulation steps and the smoke's sort; `draw` = every instance's billboards in the host's pass, soft edges against its depth. CPU = the API calls of a frame (advance, record, draw; encoding, not waiting). GPU times: {}.",
+        opts.effect.name, opts.size.0, opts.size.1, opts.frames, opts.frames, timer.source.label()
+    ));
+    let row = |x: &Row| {
+        vec![
+            x.label.clone(),
+            x.slots.to_string(),
+            format!("{:.3}", x.record_ms),
+            format!("{:.3}", x.draw_ms),
+            format!("{:.3}", x.record_ms + x.draw_ms),
+            format!("{:.0}", x.cpu_us),
+            format!("{:.1}", x.cpu_us / f64::from(x.instances.max(1))),
+        ]
+    };
+    let header = [
+        "configuration",
+        "slots",
+        "record ms",
+        "draw ms",
+        "total ms",
+        "CPU µs",
+        "CPU µs / instance",
+    ];
+    r.heading("Instances in a host frame");
+    r.table(&header, &rows.iter().map(row).collect::<Vec<_>>());
+    r.heading("Instances against one emitter with the same particles");
+    r.table(&header, &[row(many), row(one)]);
+    let extra = (many.record_ms + many.draw_ms) - (one.record_ms + one.draw_ms);
+    let per = extra / f64::from(many.instances.saturating_sub(1).max(1));
+    r.para(&format!(
+        "{} instances cost {:.3} ms more than one emitter with the same particles: {:.4} ms ({:.1} µs) of GPU time per extra instance (its own dispatches, sort and draw calls); CPU {:.1} µs per instance.",
+        many.instances, extra, per, per * 1e3, (many.cpu_us - one.cpu_us) / f64::from(many.instances.saturating_sub(1).max(1))
+    ));
+    r.json["runtime"] = serde_json::json!({
+        "effect": opts.effect.name,
+        "size": format!("{}x{}", opts.size.0, opts.size.1),
+        "timing": timer.source.label(),
+        "rows": rows.iter().chain([many, one]).map(|x| serde_json::json!({
+            "configuration": x.label,
+            "instances": x.instances,
+            "slots": x.slots,
+            "record_ms": x.record_ms,
+            "draw_ms": x.draw_ms,
+            "cpu_us": x.cpu_us,
+        })).collect::<Vec<_>>(),
+        "extra_gpu_ms_per_instance": per,
+    });
+    r
+}
+
+/// The bench's host: colour and depth targets.
+struct Host {
+    ctx: GpuContext,
+    size: (u32, u32),
+    color: wgpu::TextureView,
+    depth: wgpu::TextureView,
+}
+
+impl Host {
+    fn new(ctx: &GpuContext, size: (u32, u32)) -> Self {
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        let make = |format| {
+            crate::gpu::texture_2d(&ctx.device, "bench host", size, 1, format, usage)
+                .create_view(&Default::default())
+        };
+        let host = Self {
+            ctx: ctx.clone(),
+            size,
+            color: make(COLOR),
+            depth: make(DEPTH),
+        };
+        // The host's opaque pass: here it only clears the depth the particles read.
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        drop(enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &host.depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            ..Default::default()
+        }));
+        ctx.queue.submit([enc.finish()]);
+        host
+    }
+
+    /// A camera that frames every spot (the torches' flames are about 1 m up).
+    fn camera(&self, spots: &[Vec3]) -> Camera {
+        let radius = spots.iter().map(|s| s.length()).fold(0.0, f32::max) + 1.0;
+        let target = vec3(0.0, 1.0, 0.0);
+        let eye = target + vec3(0.0, 0.6, 1.0).normalize() * radius * 2.2;
+        let aspect = self.size.0 as f32 / self.size.1 as f32;
+        Camera::new(
+            glam::camera::rh::view::look_at_mat4(eye, target, Vec3::Y),
+            glam::camera::rh::proj::directx::perspective(0.8, aspect, 0.05, 200.0),
+            self.size,
+        )
+    }
+
+    /// The host's transparent pass: its colour loaded, its depth read-only.
+    fn pass(&self, enc: &mut wgpu::CommandEncoder, draw: impl FnOnce(&mut wgpu::RenderPass<'_>)) {
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("bench host pass"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &self.color,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Load,
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.depth,
+                depth_ops: None,
+                stencil_ops: None,
+            }),
+            ..Default::default()
+        });
+        draw(&mut pass);
+    }
+}
