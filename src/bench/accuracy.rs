@@ -275,7 +275,7 @@ fn set_layout(e: &mut crate::effect::Emitter, layout: StateLayout) {
     e.tiny_state = layout == StateLayout::Tiny;
 }
 
-/// "<integrator>", "<integrator> + packed" or "<integrator> + tiny".
+/// "`<integrator>`", "`<integrator>` + packed" or "`<integrator>` + tiny".
 pub fn compact_label(integrator: Integrator, layout: StateLayout) -> String {
     let suffix = match layout {
         StateLayout::Full => "",

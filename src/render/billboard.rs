@@ -46,6 +46,8 @@ pub struct BillboardPass {
     depth_layout: wgpu::BindGroupLayout,
     /// Group 3 now: the host's depth, or a 1×1 placeholder.
     depth_group: wgpu::BindGroup,
+    /// The host depth view `depth_group` is over.
+    depth_view: Option<wgpu::TextureView>,
     /// Two triangles per quad, `QUADS_PER_DRAW` quads: 4q, 4q+1, 4q+2, 4q+2, 4q+1, 4q+3.
     quad_indices: wgpu::Buffer,
     /// Issue quads as indexed lists (default on CPU adapters) rather than instances.
@@ -129,6 +131,7 @@ impl BillboardPass {
             target,
             depth_layout,
             depth_group,
+            depth_view: None,
             quad_indices,
             indexed: ctx.is_cpu_adapter(),
             pipeline_layout,
@@ -213,9 +216,12 @@ impl BillboardPass {
     }
 
     /// Samples `view` (the host's single-sample depth, the size of the colour target)
-    /// for soft edges from now on.
+    /// for soft edges from now on (a new bind group only when the view changes).
     pub fn set_scene_depth(&mut self, ctx: &GpuContext, view: &wgpu::TextureView) {
-        self.depth_group = Self::depth_group(ctx, &self.depth_layout, view);
+        if self.depth_view.as_ref() != Some(view) {
+            self.depth_group = Self::depth_group(ctx, &self.depth_layout, view);
+            self.depth_view = Some(view.clone());
+        }
     }
 
     /// The two basic variants (validated together with the module).
@@ -306,11 +312,16 @@ impl BillboardPass {
         wanted: impl Fn(&DrawItem) -> bool,
     ) {
         let mut sorted: Vec<&DrawItem> = items.iter().filter(|d| !d.splat && wanted(d)).collect();
+        // Alpha-blended layers in the given order (back to front), then the additive light
+        // grouped by emitter — each emitter's instances share a pipeline and a sprite, so
+        // consecutive draws skip setting them again (light adds up in any order).
         sorted.sort_by_key(|d| match d.blend {
-            BlendMode::Alpha => 0,
-            BlendMode::Additive => 1,
+            BlendMode::Alpha => (0, 0),
+            BlendMode::Additive => (1, d.index),
         });
         pass.set_index_buffer(self.quad_indices.slice(..), wgpu::IndexFormat::Uint32);
+        pass.set_bind_group(3, &self.depth_group, &[]);
+        let mut bound: Option<(LookVariant, u64)> = None;
         for d in sorted {
             let (Some(group), Some(Some(pipeline)), Some(sprite)) = (
                 frame.particle_group(d.key),
@@ -319,15 +330,19 @@ impl BillboardPass {
             ) else {
                 continue;
             };
-            pass.set_pipeline(pipeline);
+            if bound.is_none_or(|(v, _)| v != d.variant) {
+                pass.set_pipeline(pipeline);
+            }
+            if bound.is_none_or(|(_, id)| id != d.sprite.id) {
+                pass.set_bind_group(2, sprite, &[]);
+            }
+            bound = Some((d.variant, d.sprite.id));
             pass.set_bind_group(
                 0,
                 &frame.frame_group,
                 &[FrameResources::look_offset(d.look_slot)],
             );
             pass.set_bind_group(1, group, &[]);
-            pass.set_bind_group(2, sprite, &[]);
-            pass.set_bind_group(3, &self.depth_group, &[]);
             // One quad per slot of the live window: sorted, through the sort's order;
             // otherwise the window's slots directly (the shader wraps at the capacity).
             // Quad q of a draw is vertices 4q … 4q + 3 after its base vertex.

@@ -125,6 +125,8 @@ pub struct SortBuffers {
     pub values: wgpu::Buffer,
     steps: wgpu::Buffer,
     group: wgpu::BindGroup,
+    /// The depth keys' state bind groups, by state buffer (the two of a ping-pong pair).
+    state_groups: Vec<(wgpu::Buffer, wgpu::BindGroup)>,
 }
 
 /// The depth-key and bitonic pipelines, and per-emitter sort buffers.
@@ -339,6 +341,7 @@ impl SortPass {
             values,
             steps,
             group,
+            state_groups: Vec::new(),
         }
     }
 
@@ -417,6 +420,26 @@ impl SortPass {
             b.count = count;
             b.split = split;
         }
+        if !b.state_groups.iter().any(|(s, _)| s == state) {
+            let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("SortPass::state_group"),
+                layout: &self.state_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: state.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: state.as_entire_binding(),
+                    },
+                ],
+            });
+            if b.state_groups.len() >= 2 {
+                b.state_groups.remove(0);
+            }
+            b.state_groups.push((state.clone(), group));
+        }
         let Some(b) = self.buffers.get(&generation) else {
             return;
         };
@@ -431,20 +454,9 @@ impl SortPass {
         };
         ctx.queue
             .write_buffer(&b.steps, 0, bytemuck::bytes_of(&head));
-        let state_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("SortPass::state_group"),
-            layout: &self.state_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: state.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: state.as_entire_binding(),
-                },
-            ],
-        });
+        let Some((_, state_group)) = b.state_groups.iter().find(|(s, _)| s == state) else {
+            return;
+        };
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("SortPass::sort"),
             timestamp_writes: None,
@@ -454,7 +466,7 @@ impl SortPass {
         };
         pass.set_pipeline(keys);
         pass.set_bind_group(0, &b.group, &[0]);
-        pass.set_bind_group(1, &state_group, &[]);
+        pass.set_bind_group(1, state_group, &[]);
         let (x, y) = dispatch_size(b.count);
         pass.dispatch_workgroups(x, y, 1);
         self.record_stages(&mut pass, b);

@@ -56,72 +56,125 @@ fn place(effect: &mut Effect, template: &Effect, world_from_effect: Mat4) {
     }
 }
 
-/// Instances in slots that are reused after removal; each slot's generation tells a
-/// handle of its earlier occupant from one of the current.
-#[derive(Default)]
-pub(crate) struct Slab {
-    slots: Vec<(u32, Option<Instance>)>,
+/// Items (a player's instances) in slots that are reused after removal; each slot's
+/// generation tells a handle of its earlier occupant from one of the current.
+pub(crate) struct Slab<T> {
+    slots: Vec<(u32, Option<T>)>,
     free: Vec<u32>,
 }
 
-impl Slab {
-    /// Stores `instance` and returns its handle.
-    pub fn insert(&mut self, instance: Instance) -> InstanceId {
+impl<T> Default for Slab<T> {
+    fn default() -> Self {
+        Self {
+            slots: Vec::new(),
+            free: Vec::new(),
+        }
+    }
+}
+
+impl<T> Slab<T> {
+    /// Stores `item` and returns its handle.
+    pub fn insert(&mut self, item: T) -> InstanceId {
         if let Some(index) = self.free.pop() {
             let slot = &mut self.slots[index as usize];
             slot.0 = slot.0.wrapping_add(1);
-            slot.1 = Some(instance);
+            slot.1 = Some(item);
             return InstanceId {
                 index,
                 generation: slot.0,
             };
         }
-        self.slots.push((0, Some(instance)));
+        self.slots.push((0, Some(item)));
         InstanceId {
             index: (self.slots.len() - 1) as u32,
             generation: 0,
         }
     }
 
-    /// Takes the instance `id` names out, if it is still there.
-    pub fn remove(&mut self, id: InstanceId) -> Option<Instance> {
+    /// Takes the item `id` names out, if it is still there.
+    pub fn remove(&mut self, id: InstanceId) -> Option<T> {
         let slot = self.slots.get_mut(id.index as usize)?;
         if slot.0 != id.generation {
             return None;
         }
-        let instance = slot.1.take()?;
+        let item = slot.1.take()?;
         self.free.push(id.index);
-        Some(instance)
+        Some(item)
     }
 
-    /// The instance `id` names.
-    pub fn get(&self, id: InstanceId) -> Option<&Instance> {
+    /// The item `id` names.
+    pub fn get(&self, id: InstanceId) -> Option<&T> {
         let slot = self.slots.get(id.index as usize)?;
         (slot.0 == id.generation)
             .then_some(slot.1.as_ref())
             .flatten()
     }
 
-    /// The instance `id` names, mutably.
-    pub fn get_mut(&mut self, id: InstanceId) -> Option<&mut Instance> {
+    /// The item `id` names, mutably.
+    pub fn get_mut(&mut self, id: InstanceId) -> Option<&mut T> {
         let slot = self.slots.get_mut(id.index as usize)?;
         (slot.0 == id.generation)
             .then_some(slot.1.as_mut())
             .flatten()
     }
 
-    /// Every instance, in slot order.
-    pub fn iter(&self) -> impl Iterator<Item = &Instance> {
+    /// Every item, in slot order.
+    pub fn iter(&self) -> impl Iterator<Item = &T> {
         self.slots.iter().filter_map(|(_, i)| i.as_ref())
     }
 
-    /// Every instance, mutably.
-    pub fn iter_mut(&mut self) -> impl Iterator<Item = &mut Instance> {
+    /// Every item, mutably.
+    pub fn iter_mut(&mut self) -> impl Iterator<Item = &mut T> {
         self.slots.iter_mut().filter_map(|(_, i)| i.as_mut())
     }
 
-    /// How many instances there are.
+    /// How many items there are.
     pub fn len(&self) -> usize {
         self.slots.len() - self.free.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn placing_composes_the_instance_with_each_emitter() {
+        let template = Effect::default_campfire();
+        let world = Mat4::from_rotation_translation(
+            glam::Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
+            glam::vec3(10.0, 0.0, -2.0),
+        );
+        let placed = Instance::effect_for(&template, world, 42);
+        assert_eq!(placed.seed, 42);
+        for (p, t) in placed.emitters.iter().zip(&template.emitters) {
+            let expected = world * t.transform.world_from_emitter();
+            let got = p.transform.world_from_emitter();
+            assert!(
+                got.abs_diff_eq(expected, 1e-4),
+                "{}: {got} vs {expected}",
+                t.name
+            );
+        }
+    }
+
+    #[test]
+    fn stale_handles_are_refused_and_slots_are_reused() {
+        let mut slab = Slab::default();
+        let a = slab.insert("a");
+        let b = slab.insert("b");
+        assert_eq!(slab.remove(a), Some("a"));
+        assert_eq!(slab.remove(a), None, "removed twice");
+        let c = slab.insert("c");
+        assert_ne!(a, c, "the reused slot has a new generation");
+        assert_eq!(
+            slab.get(a),
+            None,
+            "a stale handle does not reach the new item"
+        );
+        assert_eq!(slab.get(c), Some(&"c"));
+        assert_eq!(slab.get(b), Some(&"b"));
+        assert_eq!(slab.len(), 2);
+        assert_eq!(slab.iter().copied().collect::<Vec<_>>(), ["c", "b"]);
     }
 }

@@ -85,7 +85,7 @@ pub struct Player {
     frame: FrameResources,
     billboard: BillboardPass,
     sort: SortPass,
-    instances: Slab,
+    instances: Slab<Instance>,
     stepper: Stepper,
     is_paused: bool,
     /// Steps planned by `advance` and not yet recorded, and their size.
@@ -336,5 +336,15 @@ impl Player {
         self.instances
             .get(id)
             .map(|i| i.sim.read_particles(emitter))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn a_player_can_move_to_another_thread() {
+        fn send<T: Send>() {}
+        send::<super::Player>();
+        send::<super::InstanceId>();
     }
 }
