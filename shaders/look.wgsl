@@ -33,7 +33,8 @@ struct LookUniform {
     // x: colour ramp row, y: blend (0 additive, 1 alpha), z: flipbook rows, w: columns.
     ids: vec4<u32>,
     // x: flipbook mode (0 over life, 1 frame rate), y: random start frame (0/1),
-    // z: per-emitter random salt, w: unused.
+    // z: per-emitter random salt, w: the first slot of the pool's segment in the state
+    // buffers (a batched instance's; else 0).
     flags: vec4<u32>,
     // x: ∫ sprite brightness over the quad (the splat's energy), y: unused (STATELESS
     // below), z: random rotation spread (rad), w: flipbook frames per second.
@@ -180,11 +181,13 @@ fn load_pair(slot: u32) -> array<Particle, 2> {
             }
             return out;
         }
-        let q = cur_packed[slot];
+        // A batched instance's pool is a segment of the buffers from look.flags.w.
+        let i = look.flags.w + slot;
+        let q = cur_packed[i];
         // The previous state is only used while it holds the same particle (younger).
-        return array<Particle, 2>(unpack_particle(q, life), unpack_particle(prev_packed[slot], life));
+        return array<Particle, 2>(unpack_particle(q, life), unpack_particle(prev_packed[i], life));
     }
-    return array<Particle, 2>(cur[slot], prev[slot]);
+    return array<Particle, 2>(cur[look.flags.w + slot], prev[look.flags.w + slot]);
 }
 
 // A particle as drawn: position, velocity, age, lifetime, alive.

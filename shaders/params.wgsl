@@ -7,3 +7,7 @@
 #import "common.wgsl"
 
 @group(0) @binding(0) var<uniform> params: SimParams;
+
+// One emitter's pool per dispatch, from slot 0 (params_instanced.wgsl batches instances).
+const slot_base: u32 = 0u;
+fn select_instance(i: u32) {}

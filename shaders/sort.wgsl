@@ -25,7 +25,8 @@ struct SortStep {
     // the state layout is STATE_LAYOUT below).
     eye: vec4<f32>,
     forward: vec4<f32>,
-    // x: first slot of the live window, y: its length, z: local mode (0 sort, 1 merge).
+    // x: first slot of the live window, y: its length, z: local mode (0 sort, 1 merge),
+    // w: where the pool's segment starts in the state buffer (a batched instance's).
     window: vec4<u32>,
 }
 
@@ -156,11 +157,11 @@ fn depth_keys(
             alive = !s.dead;
             pos = s.pos;
         } else if STATE_LAYOUT == 1u {
-            let q = cur_packed[slot];
+            let q = cur_packed[step.window.w + slot];
             alive = packed_alive(q);
             pos = bitcast<vec3<f32>>(vec3<u32>(q.px, q.py, q.pz));
         } else {
-            let p = cur[slot];
+            let p = cur[step.window.w + slot];
             alive = is_alive(p);
             pos = p.pos_age.xyz;
         }

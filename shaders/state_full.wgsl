@@ -18,10 +18,11 @@ fn begin_pair(k: u32) {}
 
 fn end_pair(k: u32) {}
 
+// `slot_base`: where this pool's segment starts (params.wgsl: 0).
 fn load_state(slot: u32) -> Particle {
-    return src[slot];
+    return src[slot_base + slot];
 }
 
 fn store_state(slot: u32, p: Particle) {
-    dst[slot] = p;
+    dst[slot_base + slot] = p;
 }

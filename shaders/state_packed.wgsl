@@ -22,7 +22,7 @@ fn begin_pair(k: u32) {}
 fn end_pair(k: u32) {}
 
 fn load_state(slot: u32) -> Particle {
-    let q = src[slot];
+    let q = src[slot_base + slot];
     if !packed_alive(q) {
         return Particle(vec4<f32>(0.0), vec4<f32>(0.0));
     }
@@ -37,5 +37,5 @@ fn store_state(slot: u32, p: Particle) {
     // need not).
     let step_key = bitcast<u32>(params.wind_time.w) ^ params.spawn_base_lo;
     let dither = unorm4(pcg4d(vec4<u32>(slot, step_key, params.seed, 0xD1u)));
-    dst[slot] = pack_particle(p, dither);
+    dst[slot_base + slot] = pack_particle(p, dither);
 }

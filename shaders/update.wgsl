@@ -66,6 +66,7 @@ fn main(
     @builtin(num_workgroups) nwg: vec3<u32>,
     @builtin(local_invocation_index) lid: u32,
 ) {
+    select_instance(wg.z);
     let base = (wg.y * nwg.x + wg.x) * 256u * SLOTS_PER_INVOCATION + lid;
     if MOD_STATELESS {
         for (var r = 0u; r < SLOTS_PER_INVOCATION; r++) {

@@ -28,6 +28,10 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ("update.wgsl", include_str!("../shaders/update.wgsl")),
     ("params.wgsl", include_str!("../shaders/params.wgsl")),
     (
+        "params_instanced.wgsl",
+        include_str!("../shaders/params_instanced.wgsl"),
+    ),
+    (
         "params_storage.wgsl",
         include_str!("../shaders/params_storage.wgsl"),
     ),
@@ -64,9 +68,18 @@ pub const TINY_STATE_IO: (&str, &str) = ("state_full.wgsl", "state_tiny.wgsl");
 /// buffer (see `params.wgsl`).
 pub const PARAMS_STORAGE: (&str, &str) = ("params.wgsl", "params_storage.wgsl");
 
+/// The batched update of a runtime player's instances: one SimParams per instance, each
+/// instance's pool a segment of shared buffers (see `params_instanced.wgsl`).
+pub const PARAMS_INSTANCED: (&str, &str) = ("params.wgsl", "params_instanced.wgsl");
+
 /// Imports that some pipelines replace by another file (see
 /// [`ShaderLibrary::compose_with`]).
-pub const IMPORT_VARIANTS: &[(&str, &str)] = &[PACKED_STATE_IO, TINY_STATE_IO, PARAMS_STORAGE];
+pub const IMPORT_VARIANTS: &[(&str, &str)] = &[
+    PACKED_STATE_IO,
+    TINY_STATE_IO,
+    PARAMS_STORAGE,
+    PARAMS_INSTANCED,
+];
 
 /// The entry files, one per pipeline family; the others are imported by them.
 pub const ENTRY_FILES: &[&str] = &[

@@ -482,16 +482,26 @@ fn additive_torch() -> Effect {
 
 #[test]
 fn instances_add_up_and_stay_independent() {
+    // Batched instances (full state), and one simulation per instance (tiny state).
+    let mut tiny = additive_torch();
+    for e in &mut tiny.emitters {
+        e.tiny_state = true;
+    }
+    for effect in [additive_torch(), tiny] {
+        instances_add_up(&effect);
+    }
+}
+
+fn instances_add_up(effect: &Effect) {
     let (eye, target) = (vec3(0.0, 1.3, 3.0), vec3(0.0, 1.0, 0.0));
     let host = Host::new(eye, target);
-    let effect = additive_torch();
     // One behind the other, so that their light overlaps on screen.
     let left = Mat4::from_translation(vec3(-0.02, 0.0, 0.0));
     let right =
         Mat4::from_rotation_translation(glam::Quat::from_rotation_y(0.5), vec3(0.03, 0.05, -0.4));
-    let mut both = host.player(&effect);
-    let mut only_a = host.player(&effect);
-    let mut only_b = host.player(&effect);
+    let mut both = host.player(effect);
+    let mut only_a = host.player(effect);
+    let mut only_b = host.player(effect);
     let a = both.add_instance(left, 1).expect("instance");
     let b = both.add_instance(right, 2).expect("instance");
     let a_alone = only_a.add_instance(left, 1).expect("instance");
@@ -549,6 +559,73 @@ fn instances_add_up_and_stay_independent() {
         );
     }
     assert_eq!(both.instance_count(), 2);
+}
+
+#[test]
+fn a_batched_instance_steps_exactly_as_a_simulation_of_its_own() {
+    let (eye, target) = (vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+    let host = Host::new(eye, target);
+    let effect = preset("campfire");
+    let mut player = host.player(&effect);
+    let places = [
+        Mat4::from_translation(vec3(-1.0, 0.0, 0.0)),
+        Mat4::from_rotation_translation(glam::Quat::from_rotation_y(1.0), vec3(1.0, 0.2, -0.5)),
+        Mat4::from_translation(vec3(0.0, 0.0, -2.0)),
+    ];
+    let ids: Vec<_> = (0..3)
+        .map(|k| {
+            player
+                .add_instance(places[k], 10 + k as u32)
+                .expect("instance")
+        })
+        .collect();
+    // A slot freed and taken again mid-run: the newcomer starts from an empty segment.
+    advance(&mut [&mut player], &host, 20);
+    assert!(player.remove_instance(ids[1]));
+    let late = player.add_instance(places[1], 77).expect("instance");
+    let ctx = ignis::gpu::GpuContext::from_device(&host.device, &host.queue);
+    // The instance's own simulation, stepped as the player's clock stepped it from frame
+    // `from` (a clock's steps per frame depend on its history: it is replayed).
+    let own = |id, from: u32, frames: u32| {
+        let placed = player.instance_effect(id).expect("instance").clone();
+        let mut sim =
+            ignis::sim::GpuSim::new(&ctx, ignis::shaders::ShaderLibrary::embedded(), &placed)
+                .expect("sim");
+        let mut stepper = ignis::sim::Stepper::default();
+        for frame in 0..from + frames {
+            let plan = stepper.advance(1.0 / 60.0, &placed.time);
+            if frame >= from {
+                sim.step(&placed, plan.dt_secs, plan.steps).expect("step");
+            }
+        }
+        sim
+    };
+    let first = own(ids[0], 0, 50);
+    let newcomer = own(late, 20, 30);
+    advance(&mut [&mut player], &host, 30);
+    for e in 0..effect.emitters.len() {
+        for (id, sim) in [(ids[0], &first), (late, &newcomer)] {
+            let batched = player.read_particles(id, e).expect("there").expect("read");
+            let alone = sim.read_particles(e).expect("read");
+            assert!(
+                alone.iter().any(|p| p.is_alive()),
+                "emitter {e} has particles"
+            );
+            let differ: Vec<usize> = (0..alone.len())
+                .filter(|&k| bytemuck::bytes_of(&batched[k]) != bytemuck::bytes_of(&alone[k]))
+                .collect();
+            assert!(
+                differ.is_empty(),
+                "emitter {e}: {} of {} slots differ from the instance's own simulation, \
+                 first {:?}: {:?} vs {:?}",
+                differ.len(),
+                alone.len(),
+                differ.first(),
+                differ.first().map(|&k| batched[k]),
+                differ.first().map(|&k| alone[k]),
+            );
+        }
+    }
 }
 
 #[test]

@@ -47,9 +47,16 @@ fn every_entry_validates() {
     assert!(deps.iter().any(|f| f == "state_packed.wgsl"));
     assert!(deps.iter().any(|f| f == "state_tiny.wgsl"));
     assert!(deps.iter().any(|f| f == "params_storage.wgsl"));
+    // A runtime player's batched instances: an array of parameters (params_instanced.wgsl).
+    let instanced = project_shaders()
+        .compose_with("update.wgsl", &[ignis::shaders::PARAMS_INSTANCED])
+        .unwrap_or_else(|e| panic!("update with batched instances: {e}"));
+    assert!(instanced.files.iter().any(|f| f == "params_instanced.wgsl"));
+    assert!(!instanced.files.iter().any(|f| f == "params.wgsl"));
     reached.extend(packed.files);
     reached.extend(tiny.files);
     reached.extend(storage.files);
+    reached.extend(instanced.files);
     for f in std::fs::read_dir(dir).expect("shaders/") {
         let name = f.expect("entry").file_name().to_string_lossy().into_owned();
         if name.ends_with(".wgsl") {

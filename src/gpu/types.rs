@@ -279,7 +279,8 @@ pub struct LookUniform {
     pub size_intensity: [f32; 4],
     /// ramp row, blend (0 additive, 1 alpha), flipbook rows, flipbook columns.
     pub ids: [u32; 4],
-    /// flipbook mode (0 over life, 1 frame rate), random start frame, random salt, unused.
+    /// flipbook mode (0 over life, 1 frame rate), random start frame, random salt, the
+    /// first slot of the pool's segment in the state buffers (a batched instance's; else 0).
     pub flags: [u32; 4],
     /// ∫ sprite brightness over the quad, unused (stateless mode is the draw pipelines'
     /// `STATELESS` constant), rotation spread (rad), flipbook fps.

@@ -13,14 +13,15 @@ use crate::gpu::types::{CameraUniform, LookUniform, PARAMS_STRIDE, StateLayout};
 use crate::render::camera::Camera;
 use crate::render::look::{RAMP_WIDTH, bake_ramp, gradient_key};
 use crate::render::sprites::{SpriteError, SpriteLibrary, SpriteTexture};
-use crate::sim::{GpuSim, Modules};
+use crate::sim::Modules;
+use crate::sim::gpu_sim::SimState;
 
 /// One simulation to draw: its state and the effect it runs (the editor's effect, or one
 /// instance of a runtime player).
 #[derive(Clone, Copy)]
 pub struct Scene<'a> {
     /// The particles.
-    pub sim: &'a GpuSim,
+    pub sim: &'a dyn SimState,
     /// The effect they follow (looks, forces for closed-form emitters).
     pub effect: &'a Effect,
 }
@@ -543,7 +544,7 @@ impl FrameResources {
         let e = &effect.emitters[i];
         let cam_px = camera.pixels_per_unit();
         let origin = sim
-            .planner
+            .planner()
             .emitters
             .get(i)
             .map(|p| p.origin())
@@ -574,7 +575,8 @@ impl FrameResources {
         self.upload_ramp(ctx, i, &e.look);
         if Modules::of(e).contains(Modules::STATELESS) {
             // Closed-form evaluation at the render time (between the last two steps).
-            let t = sim.planner.time_secs - (1.0 - alpha as f64) * sim.planner.last_dt_secs as f64;
+            let planner = sim.planner();
+            let t = planner.time_secs - (1.0 - alpha as f64) * planner.last_dt_secs as f64;
             let a = e.forces.constant_acceleration();
             let w = e.forces.wind_m_per_s;
             u.motion_a = [a.x, a.y, a.z, e.forces.drag_per_sec];
@@ -600,6 +602,7 @@ impl FrameResources {
             // w: the live window's length (it ends at the ring's head, ring.x).
             u.ring_b = [b.seed_salt.0, b.seed_salt.1, b.capacity, b.window.len];
             [u.tiny, u.tiny_b, u.tiny_c] = b.tiny;
+            u.flags[3] = b.slot_base;
         }
         block.copy_from_slice(bytemuck::bytes_of(&u));
         let b = buffers?;
@@ -608,9 +611,13 @@ impl FrameResources {
         }
         // Alpha-blended emitters are drawn back to front through the sort's order.
         let sorted = e.look.blend == BlendMode::Alpha;
-        let order_buffer =
-            sorted.then(|| sort.buffers(ctx, b.generation, b.capacity).values.clone());
-        let key = (b.generation, b.parity, sorted);
+        let order_buffer = sorted.then(|| sort.buffers(ctx, b.sort_key, b.capacity).values.clone());
+        // Unsorted pools of a batch share one bind group; a sorted one has its own order.
+        let key = (
+            if sorted { b.sort_key } else { b.generation },
+            b.parity,
+            sorted,
+        );
         self.ensure_particle_group(ctx, key, &b, order_buffer);
         // Projected size at the emitter's distance decides the automatic path.
         let distance = (camera.eye() - glam::Vec3::from(e.transform.position_m))

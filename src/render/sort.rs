@@ -32,7 +32,8 @@ pub struct SortStep {
     pub eye: [f32; 4],
     /// Camera forward axis.
     pub forward: [f32; 4],
-    /// First slot of the live window, its length, local mode (0 sort, 1 merge), unused.
+    /// First slot of the live window, its length, local mode (0 sort, 1 merge), the first
+    /// slot of the pool's segment in the state buffer (a batched instance's; else 0).
     pub window: [u32; 4],
 }
 
@@ -389,23 +390,20 @@ impl SortPass {
         }
     }
 
-    /// Records depth keys for the live `window` of `state` seen from `eye` along
-    /// `forward` (simulation space) and the sort; afterwards the first `window.len`
-    /// entries of `values` hold those slots farthest first (dead slots after the living;
-    /// entries ≥ the capacity are padding).
-    #[allow(clippy::too_many_arguments)]
+    /// Records depth keys for the live window of `pool`'s current state seen from `eye`
+    /// along `forward` (simulation space) and the sort; afterwards the first `window.len`
+    /// entries of `values` (the buffers of `pool.sort_key`) hold those slots farthest
+    /// first (dead slots after the living; entries ≥ the capacity are padding).
     pub fn record(
         &mut self,
         ctx: &GpuContext,
         enc: &mut wgpu::CommandEncoder,
-        generation: u64,
-        state: &wgpu::Buffer,
-        capacity: u32,
-        window: crate::sim::planner::LiveWindow,
+        pool: &crate::sim::gpu_sim::EmitterBuffers<'_>,
         eye: glam::Vec3,
         forward: glam::Vec3,
-        layout: StateLayout,
     ) {
+        let (generation, state, capacity) = (pool.sort_key, pool.current, pool.capacity);
+        let (window, layout) = (pool.window, pool.layout);
         if window.len == 0 {
             return;
         }
@@ -450,7 +448,7 @@ impl SortPass {
             capacity,
             eye: eye.extend(0.0).to_array(),
             forward: forward.extend(0.0).to_array(),
-            window: [window.first_slot, window.len, 0, 0],
+            window: [window.first_slot, window.len, 0, pool.slot_base],
         };
         ctx.queue
             .write_buffer(&b.steps, 0, bytemuck::bytes_of(&head));
@@ -598,25 +596,17 @@ impl SortPass {
             let Some(sim) = scenes.get(d.scene).map(|s| s.sim) else {
                 continue;
             };
-            if let Some(b) = sim.emitter_buffers(d.index) {
+            if let Some(mut b) = sim.emitter_buffers(d.index) {
+                // The window the draw visits (the whole pool when asked).
+                b.window = d.window;
                 let origin = sim
-                    .planner
+                    .planner()
                     .emitters
                     .get(d.index)
                     .map(|p| p.origin())
                     .unwrap_or_default();
                 let eye = (camera.eye_f64() - origin).as_vec3();
-                self.record(
-                    ctx,
-                    enc,
-                    b.generation,
-                    b.current,
-                    b.capacity,
-                    d.window,
-                    eye,
-                    camera.forward(),
-                    b.layout,
-                );
+                self.record(ctx, enc, &b, eye, camera.forward());
             }
         }
         let live: std::collections::HashSet<u64> = items.iter().map(|d| d.key.0).collect();

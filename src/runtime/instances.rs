@@ -15,10 +15,18 @@ pub struct InstanceId {
     generation: u32,
 }
 
+/// Where an instance's particles live.
+pub(crate) enum Backing {
+    /// A segment of a batch of the player's (`batch` index, `slot` in it).
+    Batched { batch: usize, slot: u32 },
+    /// A simulation of its own (effects with tiny-state or stateless emitters).
+    Own(Box<GpuSim>),
+}
+
 /// One instance: its own state, seed and placement.
 pub(crate) struct Instance {
     /// The particles.
-    pub sim: GpuSim,
+    pub state: Backing,
     /// The effect with this instance's seed and its emitters' world transforms.
     pub effect: Effect,
     /// Where the effect's origin is in the world.

@@ -10,9 +10,10 @@ use crate::gpu::GpuContext;
 use crate::render::billboard::{BillboardPass, DrawTarget};
 use crate::render::sort::SortPass;
 use crate::render::{Camera, DrawItem, FrameResources, Scene};
-use crate::runtime::instances::{Instance, InstanceId, Slab};
+use crate::runtime::instances::{Backing, Instance, InstanceId, Slab};
 use crate::shaders::ShaderLibrary;
-use crate::sim::gpu_sim::{SharedUpdate, SimError};
+use crate::sim::batch::{BATCH_SLOTS, BatchMember, InstanceBatch, batchable};
+use crate::sim::gpu_sim::{SharedUpdate, SimError, SimState, UpdateMode};
 use crate::sim::{GpuSim, Stepper};
 
 /// How a [`Player`] draws into the host's render pass.
@@ -86,6 +87,10 @@ pub struct Player {
     billboard: BillboardPass,
     sort: SortPass,
     instances: Slab<Instance>,
+    /// The batches of instances (when the effect can be batched; else each instance has
+    /// a simulation of its own).
+    batches: Vec<InstanceBatch>,
+    batched: bool,
     stepper: Stepper,
     is_paused: bool,
     /// Steps planned by `advance` and not yet recorded, and their size.
@@ -112,9 +117,16 @@ impl Player {
         effect.validate().map_err(PlayerError::Invalid)?;
         let ctx = GpuContext::from_device(device, queue);
         let library = ShaderLibrary::embedded();
-        // Nobody reads alive counts every frame here: the update need not count them
-        // (which would end the instances' shared compute pass to clear the counters).
-        let update = GpuSim::shared_update(&ctx, &library, effect, false)?;
+        // Instances are batched: one update dispatch per emitter and step for up to
+        // BATCH_SLOTS of them. Nobody reads alive counts every frame here: the update
+        // need not count them.
+        let batched = batchable(effect);
+        let mode = if batched {
+            UpdateMode::Batched
+        } else {
+            UpdateMode::Uncounted
+        };
+        let update = GpuSim::shared_update(&ctx, &library, effect, mode)?;
         let mut frame = FrameResources::new(&ctx);
         // Everything is drawn in the host's pass: no compute splat (it needs a target of
         // its own).
@@ -136,6 +148,8 @@ impl Player {
             billboard,
             sort,
             instances: Slab::default(),
+            batches: Vec::new(),
+            batched,
             stepper: Stepper::default(),
             is_paused: false,
             pending: (0, 0.0),
@@ -164,23 +178,51 @@ impl Player {
         seed: u32,
     ) -> Result<InstanceId, PlayerError> {
         let effect = Instance::effect_for(&self.effect, world_from_effect, seed);
-        let sim = GpuSim::with_update(
-            &self.ctx,
-            self.library.clone(),
-            self.update.clone(),
-            &effect,
-        )?;
+        let state = if self.batched {
+            self.batch_slot(seed)?
+        } else {
+            let update = self.update.clone();
+            let sim = GpuSim::with_update(&self.ctx, self.library.clone(), update, &effect)?;
+            Backing::Own(Box::new(sim))
+        };
         Ok(self.instances.insert(Instance {
-            sim,
+            state,
             effect,
             world_from_effect,
         }))
     }
 
+    /// A free slot in a batch, in a new batch when every one is full (the others are not
+    /// touched).
+    fn batch_slot(&mut self, seed: u32) -> Result<Backing, PlayerError> {
+        for (batch, b) in self.batches.iter_mut().enumerate() {
+            if let Some(slot) = b.insert(seed) {
+                return Ok(Backing::Batched { batch, slot });
+            }
+        }
+        let mut b = InstanceBatch::new(&self.ctx, self.update.clone(), &self.effect)?;
+        let slot = b
+            .insert(seed)
+            .ok_or_else(|| SimError::Readback("a new batch is full".into()))?;
+        self.batches.push(b);
+        Ok(Backing::Batched {
+            batch: self.batches.len() - 1,
+            slot,
+        })
+    }
+
     /// Removes an instance; its buffers are freed once the GPU is done with them. Returns
     /// false if `id` was already removed.
     pub fn remove_instance(&mut self, id: InstanceId) -> bool {
-        self.instances.remove(id).is_some()
+        let Some(instance) = self.instances.remove(id) else {
+            return false;
+        };
+        if let Backing::Batched { batch, slot } = instance.state
+            && let Some(b) = self.batches.get_mut(batch)
+        {
+            b.remove(slot);
+        }
+        true
     }
 
     /// Moves an instance (call it every frame for a carried torch): new particles spawn
@@ -232,7 +274,12 @@ impl Player {
     /// Empties every instance and starts the clock again from 0.
     pub fn restart(&mut self) {
         for instance in self.instances.iter_mut() {
-            instance.sim.restart();
+            if let Backing::Own(sim) = &mut instance.state {
+                sim.restart();
+            }
+        }
+        for b in &mut self.batches {
+            b.restart();
         }
         self.stepper.reset();
         self.pending = (0, 0.0);
@@ -265,11 +312,28 @@ impl Player {
                 |i: &Instance| (i.world_from_effect.w_axis.truncate().as_dvec3() - eye).length();
             d(b).total_cmp(&d(a))
         });
+        let members: Vec<Option<BatchMember<'_>>> = order
+            .iter()
+            .map(|i| match i.state {
+                Backing::Batched { batch, slot } => {
+                    self.batches.get(batch).and_then(|b| b.member(slot))
+                }
+                Backing::Own(_) => None,
+            })
+            .collect();
         let scenes: Vec<Scene<'_>> = order
             .iter()
-            .map(|i| Scene {
-                sim: &i.sim,
-                effect: &i.effect,
+            .zip(&members)
+            .filter_map(|(i, member)| {
+                let sim: &dyn SimState = match (&i.state, member) {
+                    (Backing::Own(sim), _) => sim.as_ref(),
+                    (_, Some(m)) => m,
+                    _ => return None,
+                };
+                Some(Scene {
+                    sim,
+                    effect: &i.effect,
+                })
             })
             .collect();
         self.items = self.frame.prepare(
@@ -292,17 +356,37 @@ impl Player {
         if steps == 0 {
             return;
         }
+        encoder.push_debug_group("ignis: update particles");
+        // One compute pass for every instance's steps.
+        let mut pass = None;
+        for (b, batch) in self.batches.iter_mut().enumerate() {
+            let mut effects: Vec<Option<&Effect>> = vec![None; BATCH_SLOTS as usize];
+            for i in self.instances.iter() {
+                if let Backing::Batched { batch, slot } = i.state
+                    && batch == b
+                    && let Some(e) = effects.get_mut(slot as usize)
+                {
+                    *e = Some(&i.effect);
+                }
+            }
+            batch.record_into(encoder, &mut pass, &effects, dt_secs, steps as usize);
+        }
         for instance in self.instances.iter_mut() {
-            if let Err(err) = instance.sim.sync(&instance.effect) {
+            let Backing::Own(sim) = &mut instance.state else {
+                continue;
+            };
+            if let Err(err) = sim.sync(&instance.effect) {
                 log::error!(
                     "ignis: an instance of {:?} cannot run: {err}",
                     self.effect.name
                 );
                 continue;
             }
-            let plans = instance.sim.plan(&instance.effect, dt_secs, steps as usize);
-            instance.sim.record(encoder, &instance.effect, &plans);
+            let plans = sim.plan(&instance.effect, dt_secs, steps as usize);
+            sim.record_into(encoder, &mut pass, &instance.effect, &plans);
         }
+        drop(pass);
+        encoder.pop_debug_group();
     }
 
     /// Draws every instance's particles into the host's open render pass (alpha-blended
@@ -325,6 +409,13 @@ impl Player {
             .collect()
     }
 
+    /// The effect instance `id` runs: the player's, with the instance's seed and its
+    /// emitters placed in the world (tests compare it with a simulation of its own).
+    #[doc(hidden)]
+    pub fn instance_effect(&self, id: InstanceId) -> Option<&Effect> {
+        self.instances.get(id).map(|i| &i.effect)
+    }
+
     /// Emitter `emitter`'s particles in instance `id` (a blocking readback, for tests
     /// that compare instances bit for bit). `None` if `id` was removed.
     #[doc(hidden)]
@@ -333,9 +424,13 @@ impl Player {
         id: InstanceId,
         emitter: usize,
     ) -> Option<Result<Vec<crate::gpu::types::Particle>, SimError>> {
-        self.instances
-            .get(id)
-            .map(|i| i.sim.read_particles(emitter))
+        self.instances.get(id).map(|i| match &i.state {
+            Backing::Own(sim) => sim.read_particles(emitter),
+            Backing::Batched { batch, slot } => match self.batches.get(*batch) {
+                Some(b) => b.read_particles(*slot, emitter),
+                None => Err(SimError::Readback("no such batch".into())),
+            },
+        })
     }
 }
 

@@ -11,7 +11,8 @@ use crate::gpu::types::{
 };
 use crate::gpu::{GpuContext, GpuError};
 use crate::shaders::{
-    PACKED_STATE_IO, PARAMS_STORAGE, ShaderError, ShaderLibrary, TINY_STATE_IO, create_checked,
+    PACKED_STATE_IO, PARAMS_INSTANCED, PARAMS_STORAGE, ShaderError, ShaderLibrary, TINY_STATE_IO,
+    create_checked,
 };
 use crate::sim::modules::Modules;
 use crate::sim::planner::{EffectPlanner, LiveWindow};
@@ -55,10 +56,25 @@ pub struct UpdatePass {
     /// The update counts alive particles as it goes (GPUs; the editor's statistics).
     /// Off, nothing clears a counter between steps and counts are taken on demand.
     count_alive: bool,
+    /// Batched instances (params_instanced.wgsl): parameters are an array in storage.
+    batched: bool,
+}
+
+/// How an update pass's pipelines are specialised.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UpdateMode {
+    /// One simulation per dispatch; the update counts alive particles on GPUs (the
+    /// editor's statistics read them every frame).
+    Counted,
+    /// One simulation per dispatch; counts are taken on demand.
+    Uncounted,
+    /// The same emitter of many instances per dispatch (`params_instanced.wgsl`).
+    Batched,
 }
 
 impl UpdatePass {
-    fn new(ctx: &GpuContext, count_alive: bool) -> Self {
+    fn new(ctx: &GpuContext, mode: UpdateMode) -> Self {
+        let batched = mode == UpdateMode::Batched;
         let storage = crate::gpu::compute_storage_entry;
         let layout = ctx
             .device
@@ -69,8 +85,9 @@ impl UpdatePass {
                         binding: 0,
                         visibility: wgpu::ShaderStages::COMPUTE,
                         ty: wgpu::BindingType::Buffer {
-                            // See params.wgsl: storage on CPU adapters (lavapipe).
-                            ty: if ctx.is_cpu_adapter() {
+                            // See params.wgsl: storage on CPU adapters (lavapipe), and
+                            // an array of blocks for batched instances.
+                            ty: if ctx.is_cpu_adapter() || batched {
                                 wgpu::BufferBindingType::Storage { read_only: true }
                             } else {
                                 wgpu::BufferBindingType::Uniform
@@ -118,8 +135,19 @@ impl UpdatePass {
             count: None,
             files: Vec::new(),
             // Workgroup reductions cost CPU adapters more than a count on demand.
-            count_alive: count_alive && !ctx.is_cpu_adapter(),
+            count_alive: mode == UpdateMode::Counted && !ctx.is_cpu_adapter(),
+            batched,
         }
+    }
+
+    /// The layout of group 0 (parameters, state, counters, birth table).
+    pub(crate) fn layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
+    }
+
+    /// The pipeline for `key`, if built.
+    pub(crate) fn pipeline(&self, key: &PipelineKey) -> Option<&wgpu::ComputePipeline> {
+        self.pipelines.get(key)
     }
 
     /// Builds the pipelines for `integrators` from `lib`; on any error keeps the old ones.
@@ -131,11 +159,13 @@ impl UpdatePass {
     ) -> Result<(), ShaderError> {
         // CPU adapters read the parameters from storage (params.wgsl says why).
         let cpu = ctx.is_cpu_adapter();
+        let params = if self.batched {
+            Some(PARAMS_INSTANCED)
+        } else {
+            cpu.then_some(PARAMS_STORAGE)
+        };
         let compose = |io: Option<(&str, &str)>| {
-            let aliases: Vec<(&str, &str)> = io
-                .into_iter()
-                .chain(cpu.then_some(PARAMS_STORAGE))
-                .collect();
+            let aliases: Vec<(&str, &str)> = io.into_iter().chain(params).collect();
             lib.compose_with("update.wgsl", &aliases)
         };
         let composed = compose(None)?;
@@ -261,14 +291,17 @@ struct EmitterState {
 /// and several simulations (a player's instances) share one cache.
 static NEXT_GENERATION: AtomicU64 = AtomicU64::new(1);
 
-fn next_generation() -> u64 {
+/// A generation no pool has had.
+pub(crate) fn next_generation() -> u64 {
     NEXT_GENERATION.fetch_add(1, Ordering::Relaxed)
 }
 
 /// The update pipelines, shared by the simulations of one effect's instances.
 pub type SharedUpdate = Arc<Mutex<UpdatePass>>;
 
-fn lock(update: &SharedUpdate) -> MutexGuard<'_, UpdatePass> {
+/// The update pass behind `update` (a poisoned lock is taken over: the pipelines in it
+/// are whole).
+pub(crate) fn lock(update: &SharedUpdate) -> MutexGuard<'_, UpdatePass> {
     update.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
@@ -317,6 +350,29 @@ pub struct EmitterBuffers<'a> {
     pub seed_salt: (u32, u32),
     /// The slots that can hold living particles (draws and the sort visit only these).
     pub window: LiveWindow,
+    /// Where this pool's slots start in the buffers (a batched instance's segment; else 0).
+    pub slot_base: u32,
+    /// Keys this pool's sort buffers (the generation, or a batched instance's own key).
+    pub sort_key: u64,
+}
+
+/// What the draw passes read of a simulation: its pools and its planner (a
+/// [`GpuSim`], or one instance of an [`crate::sim::batch::InstanceBatch`]).
+pub trait SimState {
+    /// Buffers of emitter `index` for drawing.
+    fn emitter_buffers(&self, index: usize) -> Option<EmitterBuffers<'_>>;
+    /// The CPU planning: times, origins, spawn counters.
+    fn planner(&self) -> &EffectPlanner;
+}
+
+impl SimState for GpuSim {
+    fn emitter_buffers(&self, index: usize) -> Option<EmitterBuffers<'_>> {
+        GpuSim::emitter_buffers(self, index)
+    }
+
+    fn planner(&self) -> &EffectPlanner {
+        &self.planner
+    }
 }
 
 impl GpuSim {
@@ -326,21 +382,20 @@ impl GpuSim {
         library: ShaderLibrary,
         effect: &Effect,
     ) -> Result<Self, SimError> {
-        let update = Self::shared_update(ctx, &library, effect, true)?;
+        let update = Self::shared_update(ctx, &library, effect, UpdateMode::Counted)?;
         Self::with_update(ctx, library, update, effect)
     }
 
-    /// The update pipelines `effect` needs, built once to be shared by the simulations
-    /// of its instances ([`GpuSim::with_update`]). `count_alive`: the update counts the
-    /// living particles as it goes (worth it where the counts are read every frame, as
-    /// the editor's statistics do; otherwise [`GpuSim::read_counters`] counts on demand).
+    /// The update pipelines `effect` needs in `mode`, built once to be shared by the
+    /// simulations of its instances ([`GpuSim::with_update`], or batched in an
+    /// [`crate::sim::batch::InstanceBatch`]).
     pub fn shared_update(
         ctx: &GpuContext,
         library: &ShaderLibrary,
         effect: &Effect,
-        count_alive: bool,
+        mode: UpdateMode,
     ) -> Result<SharedUpdate, SimError> {
-        let mut update = UpdatePass::new(ctx, count_alive);
+        let mut update = UpdatePass::new(ctx, mode);
         update.rebuild(ctx, library, &used_keys(effect))?;
         Ok(Arc::new(Mutex::new(update)))
     }
@@ -893,6 +948,8 @@ impl GpuSim {
                 }
                 _ => LiveWindow::all(s.capacity),
             },
+            slot_base: 0,
+            sort_key: s.generation,
         })
     }
 

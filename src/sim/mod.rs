@@ -1,6 +1,7 @@
 //! The simulation: CPU-side planning (time, exact spawn counts), the GPU update pass over
 //! ping-pong buffers, and a CPU reference of the same maths for tests.
 
+pub mod batch;
 pub mod cpu_reference;
 pub mod gpu_sim;
 pub mod modules;

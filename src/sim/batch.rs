@@ -1,0 +1,360 @@
+//! A runtime player's instances, batched: up to [`BATCH_SLOTS`] instances of one effect
+//! share each emitter's state buffers (instance k owns the segment of `capacity` slots
+//! from `k · capacity`) and one update dispatch per emitter and step, whose workgroups'
+//! z is the instance (`params_instanced.wgsl`: one `SimParams` per instance — its own
+//! seed, place, clock and ring). Each instance keeps its own planner, so a batched
+//! instance steps exactly as a [`GpuSim`](crate::sim::GpuSim) of the same effect would:
+//! `tests/runtime.rs` compares them bit for bit.
+//!
+//! Full and packed state only: tiny state's birth tables and stateless records are per
+//! simulation (a player with such an emitter runs one simulation per instance).
+
+use crate::effect::Effect;
+use crate::gpu::GpuContext;
+use crate::gpu::types::{Particle, SimParams, StateLayout};
+use crate::sim::gpu_sim::{
+    EmitterBuffers, SLOTS_PER_INVOCATION, SharedUpdate, SimError, SimState, dispatch_size, lock,
+    pipeline_key, read_buffer,
+};
+use crate::sim::modules::Modules;
+use crate::sim::planner::{EffectPlanner, LiveWindow};
+
+// WGSL's `array<SimParams>` strides by the struct's size rounded to its 16-byte alignment:
+// the blocks are written at `size_of` strides.
+const _: () = assert!(size_of::<SimParams>() % 16 == 0);
+
+/// Instances per batch: the segments of one set of buffers.
+pub const BATCH_SLOTS: u32 = 16;
+
+/// Steps one record may plan (the parameter blocks of a record live side by side).
+const MAX_STEPS: usize = 32;
+
+/// Whether `effect`'s emitters can be batched (full or packed state, not stateless).
+pub fn batchable(effect: &Effect) -> bool {
+    effect.emitters.iter().all(|e| {
+        let m = Modules::of(e);
+        !m.contains(Modules::TINY) && !m.contains(Modules::STATELESS)
+    })
+}
+
+/// One emitter's buffers for every instance of a batch.
+struct Pool {
+    capacity: u32,
+    layout: StateLayout,
+    buffers: [wgpu::Buffer; 2],
+    groups: [wgpu::BindGroup; 2],
+    current: usize,
+    generation: u64,
+    life_range: (f32, f32),
+    /// The emitter's random salt (`rng::emitter_salt`).
+    salt: u32,
+}
+
+/// One instance in a batch: its planner and seed.
+struct Member {
+    planner: EffectPlanner,
+    seed: u32,
+}
+
+/// Up to [`BATCH_SLOTS`] instances of one effect, updated together.
+pub struct InstanceBatch {
+    ctx: GpuContext,
+    update: SharedUpdate,
+    pools: Vec<Pool>,
+    params: wgpu::Buffer,
+    /// Bytes of one (step, emitter) block: a `SimParams` per slot, 256-aligned.
+    block_bytes: u64,
+    members: Vec<Option<Member>>,
+}
+
+impl InstanceBatch {
+    /// Buffers for [`BATCH_SLOTS`] instances of `effect` on batched update pipelines.
+    pub fn new(ctx: &GpuContext, update: SharedUpdate, effect: &Effect) -> Result<Self, SimError> {
+        let block_bytes = (u64::from(BATCH_SLOTS) * size_of::<SimParams>() as u64)
+            .next_multiple_of(u64::from(
+                ctx.device.limits().min_storage_buffer_offset_alignment,
+            ));
+        let params = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("InstanceBatch::params"),
+            size: block_bytes * (MAX_STEPS * effect.emitters.len().max(1)) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut batch = Self {
+            ctx: ctx.clone(),
+            update,
+            pools: Vec::new(),
+            params,
+            block_bytes,
+            members: (0..BATCH_SLOTS).map(|_| None).collect(),
+        };
+        for (i, e) in effect.emitters.iter().enumerate() {
+            let slots = e.capacity.max(1).saturating_mul(BATCH_SLOTS);
+            ctx.check_capacity(&e.name, slots)?;
+            let layout = StateLayout::of(Modules::of(e));
+            let mut pool = batch.pool(e.capacity.max(1), layout);
+            pool.life_range = (e.lifetime_secs.min, e.lifetime_secs.max);
+            pool.salt = crate::rng::emitter_salt(i as u32, e.seed_offset);
+            batch.pools.push(pool);
+        }
+        Ok(batch)
+    }
+
+    fn pool(&self, capacity: u32, layout: StateLayout) -> Pool {
+        let d = &self.ctx.device;
+        let bytes = layout.bytes(capacity * BATCH_SLOTS).max(32);
+        let buffer = |label| {
+            d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let buffers = [
+            buffer("InstanceBatch::state_a"),
+            buffer("InstanceBatch::state_b"),
+        ];
+        // Counters nobody reads (the batched update does not count) and a birth table
+        // nobody reads (no tiny state): bindings of the shared layout.
+        let spare = |label| {
+            d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: 32,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            })
+        };
+        let (counters, births) = (
+            spare("InstanceBatch::counters"),
+            spare("InstanceBatch::births"),
+        );
+        let update = lock(&self.update);
+        let group = |src: usize| {
+            let entry = |binding, resource| wgpu::BindGroupEntry { binding, resource };
+            d.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("InstanceBatch::group"),
+                layout: update.layout(),
+                entries: &[
+                    entry(
+                        0,
+                        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer: &self.params,
+                            offset: 0,
+                            size: wgpu::BufferSize::new(self.block_bytes),
+                        }),
+                    ),
+                    entry(1, buffers[src].as_entire_binding()),
+                    entry(2, buffers[1 - src].as_entire_binding()),
+                    entry(3, counters.as_entire_binding()),
+                    entry(4, births.as_entire_binding()),
+                ],
+            })
+        };
+        let groups = [group(0), group(1)];
+        Pool {
+            capacity,
+            layout,
+            buffers,
+            groups,
+            current: 0,
+            generation: crate::sim::gpu_sim::next_generation(),
+            life_range: (0.0, 0.0),
+            salt: 0,
+        }
+    }
+
+    /// Takes a free slot for a new instance with `seed` (`None` when the batch is full).
+    /// Its segments are cleared before the next step.
+    pub fn insert(&mut self, seed: u32) -> Option<u32> {
+        let slot = self.members.iter().position(Option::is_none)?;
+        let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+        for p in &self.pools {
+            let bytes = p.layout.bytes(p.capacity);
+            for b in &p.buffers {
+                enc.clear_buffer(b, bytes * slot as u64, Some(bytes));
+            }
+        }
+        self.ctx.queue.submit([enc.finish()]);
+        self.members[slot] = Some(Member {
+            planner: EffectPlanner::default(),
+            seed,
+        });
+        Some(slot as u32)
+    }
+
+    /// Frees `slot`.
+    pub fn remove(&mut self, slot: u32) {
+        if let Some(m) = self.members.get_mut(slot as usize) {
+            *m = None;
+        }
+    }
+
+    /// Whether no instance is left.
+    pub fn is_empty(&self) -> bool {
+        self.members.iter().all(Option::is_none)
+    }
+
+    /// Empties every instance and restarts their clocks.
+    pub fn restart(&mut self) {
+        let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+        for p in &mut self.pools {
+            for b in &p.buffers {
+                enc.clear_buffer(b, 0, None);
+            }
+        }
+        self.ctx.queue.submit([enc.finish()]);
+        for m in self.members.iter_mut().flatten() {
+            m.planner.reset();
+        }
+    }
+
+    /// Plans `steps` steps of `dt_secs` for every instance (`effects[slot]`: the slot's
+    /// placed effect) and records them into the open compute pass of `enc`: one dispatch
+    /// per emitter and step for the whole batch.
+    pub fn record_into(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        pass: &mut Option<wgpu::ComputePass<'static>>,
+        effects: &[Option<&Effect>],
+        dt_secs: f32,
+        steps: usize,
+    ) {
+        let steps = steps.min(MAX_STEPS);
+        let n = self.pools.len();
+        let active = self
+            .members
+            .iter()
+            .rposition(Option::is_some)
+            .map_or(0, |i| i + 1);
+        if steps == 0 || active == 0 {
+            return;
+        }
+        let mut blocks = vec![0u8; self.block_bytes as usize * steps * n];
+        // The invocations each (step, emitter) needs: the largest window of its instances.
+        let mut widest = vec![0u32; steps * n];
+        for (slot, member) in self.members.iter_mut().enumerate() {
+            let (Some(m), Some(Some(effect))) = (member.as_mut(), effects.get(slot)) else {
+                continue;
+            };
+            for s in 0..steps {
+                for (e, p) in m.planner.plan_step(effect, dt_secs).into_iter().enumerate() {
+                    let (Some(mut p), Some(pool)) = (p, self.pools.get(e)) else {
+                        continue;
+                    };
+                    if p.update_window[1] > pool.capacity {
+                        p.update_window = [0, pool.capacity, 0, 0];
+                    }
+                    let block = (s * n + e) * self.block_bytes as usize;
+                    let at = block + slot * size_of::<SimParams>();
+                    blocks[at..at + size_of::<SimParams>()].copy_from_slice(bytemuck::bytes_of(&p));
+                    widest[s * n + e] = widest[s * n + e].max(p.update_window[1]);
+                }
+            }
+        }
+        self.ctx.queue.write_buffer(&self.params, 0, &blocks);
+        let update = lock(&self.update);
+        for s in 0..steps {
+            for (e, pool) in self.pools.iter_mut().enumerate() {
+                let effect = effects.iter().flatten().next();
+                let Some(pipeline) = effect
+                    .and_then(|fx| fx.emitters.get(e))
+                    .and_then(|em| update.pipeline(&pipeline_key(em)))
+                else {
+                    continue;
+                };
+                let group = &pool.groups[pool.current];
+                pool.current = 1 - pool.current;
+                let invocations = widest[s * n + e].div_ceil(SLOTS_PER_INVOCATION);
+                if invocations == 0 {
+                    // Every window is empty: the swap above is all a step does.
+                    continue;
+                }
+                let pass = pass.get_or_insert_with(|| {
+                    enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some("InstanceBatch::update"),
+                        timestamp_writes: None,
+                    })
+                    .forget_lifetime()
+                });
+                pass.set_pipeline(pipeline);
+                let offset = ((s * n + e) as u64 * self.block_bytes) as u32;
+                pass.set_bind_group(0, group, &[offset]);
+                let (x, y) = dispatch_size(invocations);
+                pass.dispatch_workgroups(x, y, active as u32);
+            }
+        }
+    }
+
+    /// Instance `slot` as the draw passes see it.
+    pub fn member(&self, slot: u32) -> Option<BatchMember<'_>> {
+        let m = self.members.get(slot as usize)?.as_ref()?;
+        Some(BatchMember {
+            batch: self,
+            slot,
+            planner: &m.planner,
+            seed: m.seed,
+        })
+    }
+
+    /// Emitter `e`'s particles of instance `slot` (a blocking readback; full state only).
+    pub fn read_particles(&self, slot: u32, e: usize) -> Result<Vec<Particle>, SimError> {
+        let pool = self
+            .pools
+            .get(e)
+            .ok_or_else(|| SimError::Readback(format!("no emitter {e}")))?;
+        if pool.layout != StateLayout::Full {
+            return Err(SimError::Readback(
+                "reading a batched packed pool is not supported".into(),
+            ));
+        }
+        let bytes = pool.layout.bytes(pool.capacity);
+        let all = read_buffer(
+            &self.ctx,
+            &pool.buffers[pool.current],
+            bytes * BATCH_SLOTS as u64,
+        )?;
+        let segment = &all[(bytes * u64::from(slot)) as usize..][..bytes as usize];
+        Ok(bytemuck::pod_collect_to_vec(segment))
+    }
+}
+
+/// One instance of a batch, for the draw passes.
+pub struct BatchMember<'a> {
+    batch: &'a InstanceBatch,
+    slot: u32,
+    planner: &'a EffectPlanner,
+    seed: u32,
+}
+
+impl SimState for BatchMember<'_> {
+    fn emitter_buffers(&self, index: usize) -> Option<EmitterBuffers<'_>> {
+        let pool = self.batch.pools.get(index)?;
+        let planner = self.planner.emitters.get(index);
+        Some(EmitterBuffers {
+            previous: &pool.buffers[1 - pool.current],
+            current: &pool.buffers[pool.current],
+            capacity: pool.capacity,
+            generation: pool.generation,
+            parity: pool.current,
+            layout: pool.layout,
+            // Read by tiny state only, which is not batched.
+            births: &pool.buffers[0],
+            tiny: [[0; 4]; 3],
+            spawned_total: planner.map_or(0, |p| p.spawned_total()),
+            life_range: pool.life_range,
+            seed_salt: (self.seed, pool.salt),
+            window: planner.map_or(LiveWindow::all(0), |p| {
+                p.live_window(pool.capacity, pool.life_range.1)
+            }),
+            slot_base: self.slot * pool.capacity,
+            sort_key: pool.generation | (u64::from(self.slot) + 1) << 48,
+        })
+    }
+
+    fn planner(&self) -> &EffectPlanner {
+        self.planner
+    }
+}
