@@ -21,7 +21,7 @@ use crate::sim::planner::{EffectPlanner, LiveWindow};
 
 // WGSL's `array<SimParams>` strides by the struct's size rounded to its 16-byte alignment:
 // the blocks are written at `size_of` strides.
-const _: () = assert!(size_of::<SimParams>() % 16 == 0);
+const _: () = assert!(size_of::<SimParams>().is_multiple_of(16));
 
 /// Instances per batch: the segments of one set of buffers.
 pub const BATCH_SLOTS: u32 = 16;
