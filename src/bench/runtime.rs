@@ -12,7 +12,7 @@ use std::time::Instant;
 use glam::{Mat4, Vec3, vec3};
 
 use crate::bench::Report;
-use crate::effect::Effect;
+use crate::effect::{BlendMode, Effect};
 use crate::gpu::GpuContext;
 use crate::gpu::timer::{GpuTimer, median};
 use crate::runtime::{Camera, Player, PlayerError, PlayerSettings};
@@ -42,6 +42,8 @@ struct Row {
     record_ms: f64,
     draw_ms: f64,
     cpu_us: f64,
+    /// Of which `draw` (and finishing the encoder).
+    cpu_draw_us: f64,
 }
 
 /// Runs the bench and returns its report.
@@ -79,7 +81,30 @@ pub fn run(ctx: &GpuContext, opts: &RuntimeOptions) -> Result<Report, PlayerErro
         &[Vec3::ZERO],
         format!("1 torch with {n}× the particles"),
     )?;
-    Ok(report(ctx, opts, &timer, &rows, &many, &one))
+    // The same without the alpha-blended layers (no sort): what the sort adds per instance.
+    let mut additive = opts.effect.clone();
+    additive
+        .emitters
+        .retain(|e| e.look.blend == BlendMode::Additive);
+    let label = |what: &str| format!("{what}, additive layers only");
+    let many_additive = measure(
+        &host,
+        &timer,
+        opts,
+        &additive,
+        &same_spot,
+        label(&format!("{n} torches at one spot")),
+    )?;
+    let one_additive = measure(
+        &host,
+        &timer,
+        opts,
+        &scaled(&additive, n),
+        &[Vec3::ZERO],
+        label(&format!("1 torch with {n}× the particles")),
+    )?;
+    let compare = [many, one, many_additive, one_additive];
+    Ok(report(ctx, opts, &timer, &rows, &compare))
 }
 
 /// `n` spots on a square grid 1 m apart, centred on the origin.
@@ -132,7 +157,8 @@ fn measure(
         .map(|e| e.lifetime_secs.max)
         .fold(0.0, f32::max);
     let warm_up = (f64::from(longest) * 60.0).ceil() as usize + 10;
-    let (mut record, mut draw, mut cpu) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut record, mut draw) = (Vec::new(), Vec::new());
+    let (mut cpu, mut cpu_draw) = (Vec::new(), Vec::new());
     for frame in 0..warm_up + opts.frames {
         // The CPU time of the calls alone: the GPU (on a CPU adapter, the same cores)
         // is idle while they run.
@@ -141,15 +167,18 @@ fn measure(
         player.advance(1.0 / 60.0);
         let mut enc = host.ctx.device.create_command_encoder(&Default::default());
         player.record(&mut enc, &camera, Some(&host.depth));
+        let recorded = Instant::now();
         host.pass(&mut enc, |pass| player.draw(pass));
         let commands = enc.finish();
         let cpu_us = start.elapsed().as_secs_f64() * 1e6;
+        let cpu_draw_us = recorded.elapsed().as_secs_f64() * 1e6;
         host.ctx.queue.submit([commands]);
         if frame < warm_up {
             continue;
         }
         // The next frame timed on the GPU, in two parts.
         cpu.push(cpu_us);
+        cpu_draw.push(cpu_draw_us);
         player.advance(1.0 / 60.0);
         record.push(timer.time(&host.ctx, |enc| {
             player.record(enc, &camera, Some(&host.depth))
@@ -168,6 +197,7 @@ fn measure(
         record_ms: median(&mut record),
         draw_ms: median(&mut draw),
         cpu_us: median(&mut cpu),
+        cpu_draw_us: median(&mut cpu_draw),
     })
 }
 
@@ -176,15 +206,15 @@ fn report(
     opts: &RuntimeOptions,
     timer: &GpuTimer,
     rows: &[Row],
-    many: &Row,
-    one: &Row,
+    compare: &[Row; 4],
 ) -> Report {
+    let [many, one, ..] = compare;
     let mut r = Report::new(
         "ignis runtime: the cost of N instances in a host frame",
         ctx,
     );
     r.para(&format!(
-        "`{}` at {}×{}: a host HDR target and depth buffer; medians of {} frames after a warm-up past the longest lifetime, {} frames at 60 fps. `record` = the instances' simulation steps and the smoke's sort; `draw` = every instance's billboards in the host's pass, soft edges against its depth. CPU = the API calls of a frame (advance, record, draw; encoding, not waiting). GPU times: {}.",
+        "`{}` at {}×{}: a host HDR target and depth buffer; medians of {} frames after a warm-up past the longest lifetime, {} frames at 60 fps. `record` = the instances' simulation steps and the smoke's sort; `draw` = every instance's billboards in the host's pass, soft edges against its depth. CPU = the API calls of a frame (advance, record, draw and finishing the encoder; encoding, not waiting), and of it the draw. GPU times: {}.",
         opts.effect.name, opts.size.0, opts.size.1, opts.frames, opts.frames, timer.source.label()
     ));
     let row = |x: &Row| {
@@ -195,6 +225,7 @@ fn report(
             format!("{:.3}", x.draw_ms),
             format!("{:.3}", x.record_ms + x.draw_ms),
             format!("{:.0}", x.cpu_us),
+            format!("{:.0}", x.cpu_draw_us),
             format!("{:.1}", x.cpu_us / f64::from(x.instances.max(1))),
         ]
     };
@@ -205,12 +236,13 @@ fn report(
         "draw ms",
         "total ms",
         "CPU µs",
+        "of which draw µs",
         "CPU µs / instance",
     ];
     r.heading("Instances in a host frame");
     r.table(&header, &rows.iter().map(row).collect::<Vec<_>>());
     r.heading("Instances against one emitter with the same particles");
-    r.table(&header, &[row(many), row(one)]);
+    r.table(&header, &compare.iter().map(row).collect::<Vec<_>>());
     let extra = (many.record_ms + many.draw_ms) - (one.record_ms + one.draw_ms);
     let per = extra / f64::from(many.instances.saturating_sub(1).max(1));
     r.para(&format!(
@@ -221,13 +253,14 @@ fn report(
         "effect": opts.effect.name,
         "size": format!("{}x{}", opts.size.0, opts.size.1),
         "timing": timer.source.label(),
-        "rows": rows.iter().chain([many, one]).map(|x| serde_json::json!({
+        "rows": rows.iter().chain(compare).map(|x| serde_json::json!({
             "configuration": x.label,
             "instances": x.instances,
             "slots": x.slots,
             "record_ms": x.record_ms,
             "draw_ms": x.draw_ms,
             "cpu_us": x.cpu_us,
+            "cpu_draw_us": x.cpu_draw_us,
         })).collect::<Vec<_>>(),
         "extra_gpu_ms_per_instance": per,
     });

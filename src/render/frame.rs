@@ -508,8 +508,17 @@ impl FrameResources {
             for i in 0..scene.effect.emitters.len() {
                 let block =
                     &mut blocks[slot * PARAMS_STRIDE as usize..][..size_of::<LookUniform>()];
-                let item =
-                    self.prepare_emitter(ctx, scene, i, camera, alpha, sort, asset_dir, block);
+                let item = self.prepare_emitter(
+                    ctx,
+                    scene,
+                    i,
+                    camera,
+                    alpha,
+                    sort,
+                    asset_dir,
+                    block,
+                    k == 0,
+                );
                 items.extend(item.map(|d| DrawItem {
                     scene: k,
                     look_slot: slot,
@@ -527,7 +536,8 @@ impl FrameResources {
     }
 
     /// Writes emitter `i`'s look uniform into `block` and returns its draw (scene and
-    /// look slot left for the caller), or `None` when it has no pool or is disabled.
+    /// look slot left for the caller), or `None` when it has no pool or is disabled. The
+    /// first scene's emitters also bake the shared colour ramps.
     #[allow(clippy::too_many_arguments)]
     fn prepare_emitter(
         &mut self,
@@ -539,6 +549,7 @@ impl FrameResources {
         sort: &mut crate::render::sort::SortPass,
         asset_dir: Option<&Path>,
         block: &mut [u8],
+        first_scene: bool,
     ) -> Option<DrawItem> {
         let (sim, effect) = (scene.sim, scene.effect);
         let e = &effect.emitters[i];
@@ -572,7 +583,10 @@ impl FrameResources {
         u.clip_from_sim = camera.clip_from_sim(origin).to_cols_array_2d();
         let ground = e.collisions.ground.as_ref().map_or(0.0, |g| g.height_m);
         u.soft[0] = (f64::from(ground) - origin.y) as f32;
-        self.upload_ramp(ctx, i, &e.look);
+        if first_scene {
+            // Emitter i of every scene shares ramp row i: the first scene's look bakes it.
+            self.upload_ramp(ctx, i, &e.look);
+        }
         if Modules::of(e).contains(Modules::STATELESS) {
             // Closed-form evaluation at the render time (between the last two steps).
             let planner = sim.planner();

@@ -394,10 +394,14 @@ impl SortPass {
     /// along `forward` (simulation space) and the sort; afterwards the first `window.len`
     /// entries of `values` (the buffers of `pool.sort_key`) hold those slots farthest
     /// first (dead slots after the living; entries ≥ the capacity are padding).
+    ///
+    /// Recorded into the open compute pass `pass` of `enc` (opened on first need), so that
+    /// every sorted pool of a frame shares one pass.
     pub fn record(
         &mut self,
         ctx: &GpuContext,
         enc: &mut wgpu::CommandEncoder,
+        pass: &mut Option<wgpu::ComputePass<'static>>,
         pool: &crate::sim::gpu_sim::EmitterBuffers<'_>,
         eye: glam::Vec3,
         forward: glam::Vec3,
@@ -455,19 +459,22 @@ impl SortPass {
         let Some((_, state_group)) = b.state_groups.iter().find(|(s, _)| s == state) else {
             return;
         };
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("SortPass::sort"),
-            timestamp_writes: None,
-        });
         let Some(keys) = self.keys.get(layout.index() as usize) else {
             return;
         };
+        let pass = pass.get_or_insert_with(|| {
+            enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("SortPass::sort"),
+                timestamp_writes: None,
+            })
+            .forget_lifetime()
+        });
         pass.set_pipeline(keys);
         pass.set_bind_group(0, &b.group, &[0]);
         pass.set_bind_group(1, state_group, &[]);
         let (x, y) = dispatch_size(b.count);
         pass.dispatch_workgroups(x, y, 1);
-        self.record_stages(&mut pass, b);
+        self.record_stages(pass, b);
     }
 
     /// Uploads arbitrary keys (values: their indices) for sorting outside a frame. Sizes
@@ -592,6 +599,7 @@ impl SortPass {
         items: &[crate::render::DrawItem],
         camera: &crate::render::Camera,
     ) {
+        let mut pass = None;
         for d in items.iter().filter(|d| d.key.2) {
             let Some(sim) = scenes.get(d.scene).map(|s| s.sim) else {
                 continue;
@@ -606,9 +614,10 @@ impl SortPass {
                     .map(|p| p.origin())
                     .unwrap_or_default();
                 let eye = (camera.eye_f64() - origin).as_vec3();
-                self.record(ctx, enc, &b, eye, camera.forward());
+                self.record(ctx, enc, &mut pass, &b, eye, camera.forward());
             }
         }
+        drop(pass);
         let live: std::collections::HashSet<u64> = items.iter().map(|d| d.key.0).collect();
         self.retain(&live);
     }
