@@ -629,6 +629,32 @@ fn a_batched_instance_steps_exactly_as_a_simulation_of_its_own() {
 }
 
 #[test]
+fn large_pools_batch_as_many_instances_as_a_binding_holds() {
+    // 2^20 slots of 32 bytes per instance: the test host's device has wgpu's default
+    // limits (128 MiB per storage binding), which hold four, so five instances take two
+    // batches.
+    let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+    let mut effect = still_disc(0.0);
+    effect.emitters[0].capacity = 1 << 20;
+    let mut player = host.player(&effect);
+    let ids: Vec<_> = (0..5)
+        .map(|k| player.add_instance(Mat4::from_translation(vec3(k as f32, 0.0, 0.0)), k))
+        .collect::<Result<_, _>>()
+        .expect("instances");
+    // 40 frames: 2/3 s at 4 spawns per second.
+    advance(&mut [&mut player], &host, 40);
+    for id in ids {
+        let particles = player.read_particles(id, 0).expect("there").expect("read");
+        assert_eq!(particles.len(), 1 << 20);
+        assert_eq!(
+            particles.iter().filter(|p| p.is_alive()).count(),
+            2,
+            "{id:?}"
+        );
+    }
+}
+
+#[test]
 fn a_moving_instance_spawns_where_it_is_and_keeps_world_motion() {
     let (eye, target) = (vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
     let host = Host::new(eye, target);

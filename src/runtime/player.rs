@@ -12,7 +12,7 @@ use crate::render::sort::SortPass;
 use crate::render::{Camera, DrawItem, FrameResources, Scene};
 use crate::runtime::instances::{Backing, Instance, InstanceId, Slab};
 use crate::shaders::ShaderLibrary;
-use crate::sim::batch::{BATCH_SLOTS, BatchMember, InstanceBatch, batchable};
+use crate::sim::batch::{BatchMember, InstanceBatch, batchable};
 use crate::sim::gpu_sim::{SharedUpdate, SimError, SimState, UpdateMode};
 use crate::sim::{GpuSim, Stepper};
 
@@ -360,7 +360,7 @@ impl Player {
         // One compute pass for every instance's steps.
         let mut pass = None;
         for (b, batch) in self.batches.iter_mut().enumerate() {
-            let mut effects: Vec<Option<&Effect>> = vec![None; BATCH_SLOTS as usize];
+            let mut effects: Vec<Option<&Effect>> = vec![None; batch.slots() as usize];
             for i in self.instances.iter() {
                 if let Backing::Batched { batch, slot } = i.state
                     && batch == b

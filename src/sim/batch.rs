@@ -23,7 +23,8 @@ use crate::sim::planner::{EffectPlanner, LiveWindow};
 // the blocks are written at `size_of` strides.
 const _: () = assert!(size_of::<SimParams>().is_multiple_of(16));
 
-/// Instances per batch: the segments of one set of buffers.
+/// Instances per batch at most: the segments of one set of buffers (fewer when an
+/// emitter's pool times this would not fit one storage binding).
 pub const BATCH_SLOTS: u32 = 16;
 
 /// Steps one record may plan (the parameter blocks of a record live side by side).
@@ -64,16 +65,26 @@ pub struct InstanceBatch {
     params: wgpu::Buffer,
     /// Bytes of one (step, emitter) block: a `SimParams` per slot, 256-aligned.
     block_bytes: u64,
+    /// Instances this batch holds.
+    slots: u32,
     members: Vec<Option<Member>>,
 }
 
 impl InstanceBatch {
-    /// Buffers for [`BATCH_SLOTS`] instances of `effect` on batched update pipelines.
+    /// Buffers for up to [`BATCH_SLOTS`] instances of `effect` (as many as one storage
+    /// binding holds of its largest pool, at least one) on batched update pipelines.
     pub fn new(ctx: &GpuContext, update: SharedUpdate, effect: &Effect) -> Result<Self, SimError> {
-        let block_bytes = (u64::from(BATCH_SLOTS) * size_of::<SimParams>() as u64)
-            .next_multiple_of(u64::from(
-                ctx.device.limits().min_storage_buffer_offset_alignment,
-            ));
+        let largest = effect
+            .emitters
+            .iter()
+            .map(|e| e.capacity.max(1))
+            .max()
+            .unwrap_or(1);
+        let slots =
+            (ctx.max_capacity() / u64::from(largest)).clamp(1, u64::from(BATCH_SLOTS)) as u32;
+        let block_bytes = (u64::from(slots) * size_of::<SimParams>() as u64).next_multiple_of(
+            u64::from(ctx.device.limits().min_storage_buffer_offset_alignment),
+        );
         let params = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("InstanceBatch::params"),
             size: block_bytes * (MAX_STEPS * effect.emitters.len().max(1)) as u64,
@@ -86,11 +97,11 @@ impl InstanceBatch {
             pools: Vec::new(),
             params,
             block_bytes,
-            members: (0..BATCH_SLOTS).map(|_| None).collect(),
+            slots,
+            members: (0..slots).map(|_| None).collect(),
         };
         for (i, e) in effect.emitters.iter().enumerate() {
-            let slots = e.capacity.max(1).saturating_mul(BATCH_SLOTS);
-            ctx.check_capacity(&e.name, slots)?;
+            ctx.check_capacity(&e.name, e.capacity.max(1).saturating_mul(slots))?;
             let layout = StateLayout::of(Modules::of(e));
             let mut pool = batch.pool(e.capacity.max(1), layout);
             pool.life_range = (e.lifetime_secs.min, e.lifetime_secs.max);
@@ -102,7 +113,7 @@ impl InstanceBatch {
 
     fn pool(&self, capacity: u32, layout: StateLayout) -> Pool {
         let d = &self.ctx.device;
-        let bytes = layout.bytes(capacity * BATCH_SLOTS).max(32);
+        let bytes = layout.bytes(capacity * self.slots).max(32);
         let buffer = |label| {
             d.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -192,9 +203,9 @@ impl InstanceBatch {
         }
     }
 
-    /// Whether no instance is left.
-    pub fn is_empty(&self) -> bool {
-        self.members.iter().all(Option::is_none)
+    /// Instances this batch holds.
+    pub fn slots(&self) -> u32 {
+        self.slots
     }
 
     /// Empties every instance and restarts their clocks.
@@ -314,7 +325,7 @@ impl InstanceBatch {
         let all = read_buffer(
             &self.ctx,
             &pool.buffers[pool.current],
-            bytes * BATCH_SLOTS as u64,
+            bytes * u64::from(self.slots),
         )?;
         let segment = &all[(bytes * u64::from(slot)) as usize..][..bytes as usize];
         Ok(bytemuck::pod_collect_to_vec(segment))
