@@ -46,8 +46,10 @@ pub struct BillboardPass {
     depth_layout: wgpu::BindGroupLayout,
     /// Group 3 now: the host's depth, or a 1×1 placeholder.
     depth_group: wgpu::BindGroup,
-    /// The host depth view `depth_group` is over.
+    /// The host depth view `depth_group` is over (`None`: the placeholder).
     depth_view: Option<wgpu::TextureView>,
+    /// The 1×1 placeholder bound when no host depth is sampled.
+    no_depth: wgpu::TextureView,
     /// Two triangles per quad, `QUADS_PER_DRAW` quads: 4q, 4q+1, 4q+2, 4q+2, 4q+1, 4q+3.
     quad_indices: wgpu::Buffer,
     /// Issue quads as indexed lists (default on CPU adapters) rather than instances.
@@ -90,11 +92,8 @@ impl BillboardPass {
             wgpu::TextureFormat::Depth32Float,
             wgpu::TextureUsages::TEXTURE_BINDING,
         );
-        let depth_group = Self::depth_group(
-            ctx,
-            &depth_layout,
-            &placeholder.create_view(&Default::default()),
-        );
+        let no_depth = placeholder.create_view(&Default::default());
+        let depth_group = Self::depth_group(ctx, &depth_layout, &no_depth);
         let sprite_layout = ctx
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -132,6 +131,7 @@ impl BillboardPass {
             depth_layout,
             depth_group,
             depth_view: None,
+            no_depth,
             quad_indices,
             indexed: ctx.is_cpu_adapter(),
             pipeline_layout,
@@ -217,10 +217,13 @@ impl BillboardPass {
 
     /// Samples `view` (the host's single-sample depth, the size of the colour target)
     /// for soft edges from now on (a new bind group only when the view changes).
-    pub fn set_scene_depth(&mut self, ctx: &GpuContext, view: &wgpu::TextureView) {
-        if self.depth_view.as_ref() != Some(view) {
-            self.depth_group = Self::depth_group(ctx, &self.depth_layout, view);
-            self.depth_view = Some(view.clone());
+    /// `None` binds the placeholder again, so that the host's texture is not bound (its
+    /// pass may then write depth, or it may be destroyed).
+    pub fn set_scene_depth(&mut self, ctx: &GpuContext, view: Option<&wgpu::TextureView>) {
+        if self.depth_view.as_ref() != view {
+            let bound = view.unwrap_or(&self.no_depth);
+            self.depth_group = Self::depth_group(ctx, &self.depth_layout, bound);
+            self.depth_view = view.cloned();
         }
     }
 

@@ -140,7 +140,9 @@ pub struct Camera {
 }
 
 impl Camera {
-    /// A camera from the host's `view_from_world` (world → view, right-handed or not) and
+    /// A camera from the host's `view_from_world` (world → view, right-handed: the camera
+    /// looks down −z, as `glam`'s `look_at_rh` makes it; the sort and the soft edges read
+    /// depth along −z) and
     /// `clip_from_view` (view → wgpu clip space, depth 0..1) matrices, drawing into a
     /// target of `size_px` pixels.
     pub fn new(view_from_world: Mat4, clip_from_view: Mat4, size_px: (u32, u32)) -> Self {

@@ -561,7 +561,7 @@ impl FrameResources {
             .map(|p| p.origin())
             .unwrap_or_default();
         let (sprite, error) = self.sprites.resolve(ctx, &e.look.sprite, asset_dir);
-        if let Some(err) = error {
+        if let Some(err) = error.filter(|_| first_scene) {
             self.sprite_errors.push((i, err));
         }
         let salt = crate::rng::pcg4d([effect.seed, i as u32, e.seed_offset, 0x5EED_100C])[0];

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use glam::Mat4;
 
-use crate::effect::{Effect, ValidationError};
+use crate::effect::{Effect, TimeMode, ValidationError};
 use crate::gpu::GpuContext;
 use crate::render::billboard::{BillboardPass, DrawTarget};
 use crate::render::sort::SortPass;
@@ -254,10 +254,18 @@ impl Player {
             return;
         }
         let plan = self.stepper.advance(frame_dt_secs, &self.effect.time);
-        self.pending = (
-            (self.pending.0 + plan.steps).min(MAX_STEPS_PER_RECORD),
-            plan.dt_secs,
-        );
+        let dt_secs = match self.effect.time.mode {
+            // Frames not yet recorded join this one's step (one step per record).
+            TimeMode::FrameDelta if self.pending.0 > 0 => {
+                (self.pending.1 + plan.dt_secs).min(self.effect.time.max_frame_dt_secs)
+            }
+            _ => plan.dt_secs,
+        };
+        let steps = match self.effect.time.mode {
+            TimeMode::FrameDelta => plan.steps.max(self.pending.0).min(1),
+            TimeMode::FixedStep => (self.pending.0 + plan.steps).min(MAX_STEPS_PER_RECORD),
+        };
+        self.pending = (steps, dt_secs);
         self.alpha = plan.alpha;
     }
 
@@ -291,7 +299,8 @@ impl Player {
     /// and uploads the draw's uniforms. `scene_depth` is the host's depth buffer as a
     /// single-sample view the size of the target (with `TEXTURE_BINDING` usage), for
     /// soft edges where particles meet the host's geometry; without it the preset's
-    /// ground plane softens them.
+    /// ground plane softens them. Call it once per submitted encoder (its uploads go
+    /// through the queue); draw the result in as many passes as needed.
     pub fn record(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
@@ -300,16 +309,17 @@ impl Player {
     ) {
         self.simulate(encoder);
         let depth = scene_depth.filter(|_| self.settings.depth_format.is_some());
-        if let Some(view) = depth {
-            self.billboard.set_scene_depth(&self.ctx, view);
-        }
+        self.billboard.set_scene_depth(&self.ctx, depth);
         self.frame.soft_depth = depth.is_some();
         let eye = camera.eye_f64();
-        // Far instances first: their smoke lies under nearer instances' smoke.
+        // Far instances first (depth along the view): their smoke lies under nearer
+        // instances' smoke.
+        let forward = camera.forward().as_dvec3();
         let mut order: Vec<&Instance> = self.instances.iter().collect();
         order.sort_by(|a, b| {
-            let d =
-                |i: &Instance| (i.world_from_effect.w_axis.truncate().as_dvec3() - eye).length();
+            let d = |i: &Instance| {
+                (i.world_from_effect.w_axis.truncate().as_dvec3() - eye).dot(forward)
+            };
             d(b).total_cmp(&d(a))
         });
         let members: Vec<Option<BatchMember<'_>>> = order
@@ -352,6 +362,10 @@ impl Player {
 
     /// Records the steps `advance` planned for every instance.
     fn simulate(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        // New instances' segments are cleared before any step of this record.
+        for batch in &mut self.batches {
+            batch.clear_taken(encoder);
+        }
         let (steps, dt_secs) = std::mem::take(&mut self.pending);
         if steps == 0 {
             return;

@@ -68,6 +68,8 @@ pub struct InstanceBatch {
     /// Instances this batch holds.
     slots: u32,
     members: Vec<Option<Member>>,
+    /// Slots taken since the last record, whose segments it clears first.
+    pending_clears: Vec<u32>,
 }
 
 impl InstanceBatch {
@@ -98,6 +100,7 @@ impl InstanceBatch {
             params,
             block_bytes,
             slots,
+            pending_clears: Vec::new(),
             members: (0..slots).map(|_| None).collect(),
         };
         for (i, e) in effect.emitters.iter().enumerate() {
@@ -178,22 +181,29 @@ impl InstanceBatch {
     }
 
     /// Takes a free slot for a new instance with `seed` (`None` when the batch is full).
-    /// Its segments are cleared before the next step.
+    /// Its segments are cleared by the next [`InstanceBatch::clear_taken`], in the same
+    /// encoder as (and before) the steps, so work of the slot's earlier occupant already
+    /// recorded still runs before the clear.
     pub fn insert(&mut self, seed: u32) -> Option<u32> {
         let slot = self.members.iter().position(Option::is_none)?;
-        let mut enc = self.ctx.device.create_command_encoder(&Default::default());
-        for p in &self.pools {
-            let bytes = p.layout.bytes(p.capacity);
-            for b in &p.buffers {
-                enc.clear_buffer(b, bytes * slot as u64, Some(bytes));
-            }
-        }
-        self.ctx.queue.submit([enc.finish()]);
+        self.pending_clears.push(slot as u32);
         self.members[slot] = Some(Member {
             planner: EffectPlanner::default(),
             seed,
         });
         Some(slot as u32)
+    }
+
+    /// Clears the segments of the slots taken since the last call (outside a pass).
+    pub fn clear_taken(&mut self, enc: &mut wgpu::CommandEncoder) {
+        for slot in self.pending_clears.drain(..) {
+            for p in &self.pools {
+                let bytes = p.layout.bytes(p.capacity);
+                for b in &p.buffers {
+                    enc.clear_buffer(b, bytes * u64::from(slot), Some(bytes));
+                }
+            }
+        }
     }
 
     /// Frees `slot`.
