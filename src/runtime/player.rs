@@ -311,17 +311,7 @@ impl Player {
         let depth = scene_depth.filter(|_| self.settings.depth_format.is_some());
         self.billboard.set_scene_depth(&self.ctx, depth);
         self.frame.soft_depth = depth.is_some();
-        let eye = camera.eye_f64();
-        // Far instances first (depth along the view): their smoke lies under nearer
-        // instances' smoke.
-        let forward = camera.forward().as_dvec3();
-        let mut order: Vec<&Instance> = self.instances.iter().collect();
-        order.sort_by(|a, b| {
-            let d = |i: &Instance| {
-                (i.world_from_effect.w_axis.truncate().as_dvec3() - eye).dot(forward)
-            };
-            d(b).total_cmp(&d(a))
-        });
+        let order = Self::draw_order(&self.instances, camera);
         let members: Vec<Option<BatchMember<'_>>> = order
             .iter()
             .map(|i| match i.state {
@@ -358,6 +348,17 @@ impl Player {
             .prepare(&self.ctx, &self.items, &self.frame.sprites.sampler);
         self.sort
             .record_items(&self.ctx, encoder, &scenes, &self.items, camera);
+    }
+
+    /// The instances far to near, by depth along the view: far instances' smoke lies
+    /// under nearer instances' smoke.
+    fn draw_order<'a>(instances: &'a Slab<Instance>, camera: &Camera) -> Vec<&'a Instance> {
+        let (eye, forward) = (camera.eye_f64(), camera.forward().as_dvec3());
+        let depth =
+            |i: &Instance| (i.world_from_effect.w_axis.truncate().as_dvec3() - eye).dot(forward);
+        let mut order: Vec<&Instance> = instances.iter().collect();
+        order.sort_by(|a, b| depth(b).total_cmp(&depth(a)));
+        order
     }
 
     /// Records the steps `advance` planned for every instance.

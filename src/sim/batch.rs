@@ -277,13 +277,17 @@ impl InstanceBatch {
         }
         self.ctx.queue.write_buffer(&self.params, 0, &blocks);
         let update = lock(&self.update);
+        // Every instance runs the same emitters: one pipeline per emitter for the batch.
+        let effect = effects.iter().flatten().next();
+        let pipelines: Vec<Option<&wgpu::ComputePipeline>> = (0..n)
+            .map(|e| {
+                let em = effect.and_then(|fx| fx.emitters.get(e))?;
+                update.pipeline(&pipeline_key(em))
+            })
+            .collect();
         for s in 0..steps {
             for (e, pool) in self.pools.iter_mut().enumerate() {
-                let effect = effects.iter().flatten().next();
-                let Some(pipeline) = effect
-                    .and_then(|fx| fx.emitters.get(e))
-                    .and_then(|em| update.pipeline(&pipeline_key(em)))
-                else {
+                let Some(pipeline) = pipelines[e] else {
                     continue;
                 };
                 let group = &pool.groups[pool.current];
