@@ -1,12 +1,11 @@
 // bloom.wgsl — the glow in the HDR composite: a soft threshold while halving the HDR
-// image (plus the compute splat's light), a chain of 2× downsamples, then tent-filtered
+// image, a chain of 2× downsamples, then tent-filtered
 // upsamples added back up the chain (Jimenez 2014, "Next Generation Post Processing in
 // Call of Duty: Advanced Warfare"). tonemap.wgsl adds the top of the chain to the image.
 //
 // Contract: group 0: 0 `src` (the level read: the HDR target for `prefilter`, a level of
 // the bloom chain otherwise), 1 `samp` (linear, clamp), 2 `bloom` (BloomUniform, keep in
-// sync with src/render/bloom.rs), 3 `accum` (the splat's fixed-point light, read by
-// `prefilter` when SPLAT is on), 4 `glow` (the draft glow layer, half the HDR target's
+// sync with src/render/bloom.rs), 4 `glow` (the draft glow layer, half the HDR target's
 // resolution, read by `prefilter` when GLOW is on; tonemap.wgsl adds it to the image).
 
 struct BloomUniform {
@@ -17,16 +16,12 @@ struct BloomUniform {
 @group(0) @binding(0) var src: texture_2d<f32>;
 @group(0) @binding(1) var samp: sampler;
 @group(0) @binding(2) var<uniform> bloom: BloomUniform;
-@group(0) @binding(3) var<storage, read> accum: array<u32>;
 @group(0) @binding(4) var glow: texture_2d<f32>;
 
-override SPLAT: bool = false;
 // Draft: the chain starts at a quarter of the resolution (a 4×4 average).
 override QUARTER: bool = false;
 // Draft: the large additive sprites were drawn into a half-resolution glow layer.
 override GLOW: bool = false;
-// Keep in sync with `FIXED_SCALE` in splat.wgsl.
-const BLOOM_FIXED_SCALE: f32 = 4096.0;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -45,12 +40,7 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
 fn hdr_at(p: vec2<i32>) -> vec3<f32> {
     let size = vec2<i32>(textureDimensions(src));
     let q = clamp(p, vec2<i32>(0), size - 1);
-    var c = textureLoad(src, q, 0).rgb;
-    if SPLAT {
-        let i = u32(q.y * size.x + q.x) * 3u;
-        c += vec3<f32>(f32(accum[i]), f32(accum[i + 1u]), f32(accum[i + 2u])) / BLOOM_FIXED_SCALE;
-    }
-    return c;
+    return textureLoad(src, q, 0).rgb;
 }
 
 // Full resolution → half: the 2×2 average (4×4 → quarter when QUARTER), kept above a

@@ -8,7 +8,10 @@
 // Contract:
 // - group 0: 0 `camera`, 1 `look` (dynamic offset per emitter), as billboard.wgsl.
 // - group 1: 0 `prev`, 1 `cur` (state buffers).
-// - group 2: 0 `accum` (3 × u32 per pixel: R, G, B in units of 1/FIXED_SCALE).
+// - group 2: 0 `accum` (3 × u32 per pixel: R, G, B in units of 1/FIXED_SCALE), 1
+//   `scene_depth` (the host's depth; tested only when it is the viewport's size).
+// - DEPTH_TEST: 0 none, 1 a particle nearer than or level with the host's depth passes
+//   (depth 0 = near), 2 the reverse (reversed Z). Particles never write depth.
 #import "common.wgsl"
 #import "rng.wgsl"
 #import "look.wgsl"
@@ -25,6 +28,20 @@
 // A tiny-state emitter's birth table (births.wgsl).
 @group(1) @binding(5) var<storage, read> births: array<Birth>;
 @group(2) @binding(0) var<storage, read_write> accum: array<atomic<u32>>;
+@group(2) @binding(1) var scene_depth: texture_depth_2d;
+
+override DEPTH_TEST: u32 = 0u;
+
+// Whether a particle at NDC depth `z` over pixel `px` is in front of the host's geometry.
+fn visible(px: vec2<f32>, z: f32) -> bool {
+    let dims = textureDimensions(scene_depth);
+    if DEPTH_TEST == 0u || dims.x != u32(camera.viewport.x) || dims.y != u32(camera.viewport.y) {
+        return true;
+    }
+    let p = clamp(vec2<i32>(floor(px + 0.5)), vec2<i32>(0), vec2<i32>(dims) - 1);
+    let d = textureLoad(scene_depth, p, 0);
+    return select(z >= d, z <= d, DEPTH_TEST == 1u);
+}
 
 // Keep in sync with `SPLAT_FIXED_SCALE` in src/render/splat.rs.
 const FIXED_SCALE: f32 = 4096.0;
@@ -86,6 +103,9 @@ fn splat(
     }
     let ndc = clip.xy / clip.w;
     let px = vec2<f32>((ndc.x * 0.5 + 0.5) * camera.viewport.x, (0.5 - ndc.y * 0.5) * camera.viewport.y) - 0.5;
+    if !visible(px, clip.z / clip.w) {
+        return;
+    }
     let dither = unorm4(pcg4d(vec4<u32>(slot, bitcast<u32>(d.age), 0x5EEDu, 0u)));
     // Bilinear over the 2×2 nearest pixels; below two pixels one tap (3 atomics)
     // suffices: the footprint is sub-pixel anyway, and atomics are the splat's cost. One

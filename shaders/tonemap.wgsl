@@ -1,9 +1,7 @@
 // tonemap.wgsl — HDR (linear, Rgba16Float) → display (sRGB target does the encoding).
 //
 // Contract: group 0 binding 0 `hdr` texture, binding 1 `tone` (x: exposure, y: bloom
-// intensity), binding 2 `accum` (the compute splat's fixed-point light, read only when
-// SPLAT is on — the splat resolve is fused into this pass, saving a full-screen pass),
-// binding 3 `bloom_tex` + 4 `bloom_samp` (level 0 of the bloom chain, read only when
+// intensity), binding 3 `bloom_tex` + 4 `bloom_samp` (level 0 of the bloom chain, read only when
 // BLOOM is on), binding 5 `alpha_tex` (the alpha-blended layers at reduced resolution,
 // read only when LOW_ALPHA is on), binding 6 `glow_tex` (the draft glow layer at half
 // resolution, read only when GLOW is on: upsampled here instead of in a pass of its own).
@@ -16,7 +14,6 @@ struct ToneUniform {
 
 @group(0) @binding(0) var hdr: texture_2d<f32>;
 @group(0) @binding(1) var<uniform> tone: ToneUniform;
-@group(0) @binding(2) var<storage, read> accum: array<u32>;
 @group(0) @binding(3) var bloom_tex: texture_2d<f32>;
 @group(0) @binding(4) var bloom_samp: sampler;
 // The alpha-blended layers drawn at reduced resolution (read only when LOW_ALPHA is on).
@@ -24,12 +21,9 @@ struct ToneUniform {
 // The draft glow layer (read only when GLOW is on).
 @group(0) @binding(6) var glow_tex: texture_2d<f32>;
 
-override SPLAT: bool = false;
 override BLOOM: bool = false;
 override LOW_ALPHA: bool = false;
 override GLOW: bool = false;
-// Keep in sync with `FIXED_SCALE` in splat.wgsl.
-const SPLAT_FIXED_SCALE: f32 = 4096.0;
 
 @vertex
 fn vs_main(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
@@ -49,10 +43,6 @@ fn aces(x: vec3<f32>) -> vec3<f32> {
 @fragment
 fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     var c = textureLoad(hdr, vec2<i32>(frag.xy), 0).rgb;
-    if SPLAT {
-        let i = (u32(frag.y) * textureDimensions(hdr).x + u32(frag.x)) * 3u;
-        c += vec3<f32>(f32(accum[i]), f32(accum[i + 1u]), f32(accum[i + 2u])) / SPLAT_FIXED_SCALE;
-    }
     let uv = frag.xy / vec2<f32>(textureDimensions(hdr));
     if GLOW {
         // Bilinear, as the pass that added it to the HDR image did.

@@ -1,73 +1,94 @@
-//! A headless session: simulation + renderer + stepper, for `ignis render`, tests and
-//! benches.
+//! A headless host: a [`Player`] with one instance drawn through a [`Composite`], for
+//! `ignis render`, tests and benches — a client of the public API like any program that
+//! embeds ignis.
 
 use crate::effect::Effect;
 use crate::gpu::GpuContext;
-use crate::render::{OrbitCamera, Renderer};
-use crate::shaders::ShaderLibrary;
-use crate::sim::{GpuSim, SimError, StepPlan, Stepper};
+use crate::render::{Composite, OrbitCamera};
+use crate::runtime::{InstanceId, Player, PlayerError, PlayerSettings};
+use crate::shaders::{ShaderLibrary, ShaderSourceDir};
+use crate::sim::SimError;
 
 /// Everything needed to simulate and draw an effect without a window.
 pub struct Headless {
     /// The GPU.
     pub ctx: GpuContext,
-    /// The effect being simulated.
-    pub effect: Effect,
-    /// The GPU simulation.
-    pub sim: GpuSim,
-    /// The renderer.
-    pub renderer: Renderer,
-    /// Frame time → steps.
-    pub stepper: Stepper,
+    /// The player.
+    pub player: Player,
+    /// Its one instance, at the origin with the effect's seed.
+    pub instance: InstanceId,
+    /// The HDR target, bloom and tonemap.
+    pub composite: Composite,
     /// The camera.
     pub camera: OrbitCamera,
-    last_alpha: f32,
 }
 
 impl Headless {
     /// Sets up `effect` on `ctx` with shaders from `lib`.
-    pub fn new(ctx: &GpuContext, effect: Effect, lib: ShaderLibrary) -> Result<Self, SimError> {
-        let renderer = Renderer::new(ctx, &lib)?;
-        let sim = GpuSim::new(ctx, lib, &effect)?;
+    pub fn new(ctx: &GpuContext, effect: Effect, lib: ShaderLibrary) -> Result<Self, PlayerError> {
+        Self::with_settings(ctx, effect, lib, Composite::player_settings())
+    }
+
+    /// Sets up `effect` with player `settings` (they draw into the composite's HDR
+    /// target: its colour format, no depth, one sample).
+    pub fn with_settings(
+        ctx: &GpuContext,
+        effect: Effect,
+        lib: ShaderLibrary,
+        settings: PlayerSettings,
+    ) -> Result<Self, PlayerError> {
+        let shader_dir = match lib.source() {
+            ShaderSourceDir::Dir(dir) => Some(dir.clone()),
+            ShaderSourceDir::Embedded => None,
+        };
+        let settings = PlayerSettings {
+            shader_dir,
+            ..settings
+        };
+        let mut player = Player::new(&ctx.device, &ctx.queue, &effect, settings)?;
+        let instance = player.add_instance(glam::Mat4::IDENTITY, effect.seed)?;
+        let composite = Composite::new(ctx, &lib).map_err(SimError::from)?;
         Ok(Self {
             ctx: ctx.clone(),
             camera: OrbitCamera::from_hint(&effect.camera),
-            effect,
-            sim,
-            renderer,
-            stepper: Stepper::default(),
-            last_alpha: 1.0,
+            player,
+            instance,
+            composite,
         })
     }
 
-    /// Simulates one frame of `frame_dt_secs` wall-clock time.
-    pub fn advance(&mut self, frame_dt_secs: f64) -> Result<StepPlan, SimError> {
-        let plan = self.stepper.advance(frame_dt_secs, &self.effect.time);
-        self.sim.step(&self.effect, plan.dt_secs, plan.steps)?;
-        self.last_alpha = plan.alpha;
-        Ok(plan)
+    /// The effect being played.
+    pub fn effect(&self) -> &Effect {
+        self.player.effect()
+    }
+
+    /// Applies an edit of the effect to the player ([`Player::set_effect`]).
+    pub fn edit(&mut self, f: impl FnOnce(&mut Effect)) -> Result<(), PlayerError> {
+        let mut effect = self.player.effect().clone();
+        f(&mut effect);
+        self.player.set_effect(&effect)?;
+        self.player.set_seed(self.instance, effect.seed);
+        Ok(())
+    }
+
+    /// Simulates one frame of `frame_dt_secs` wall-clock time (submitted now).
+    pub fn advance(&mut self, frame_dt_secs: f64) {
+        self.player.advance(frame_dt_secs);
+        let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+        self.player.simulate(&mut enc);
+        self.ctx.queue.submit([enc.finish()]);
     }
 
     /// Renders the current state to an image.
     pub fn render(&mut self, size: (u32, u32)) -> Result<image::RgbaImage, SimError> {
-        self.renderer.render_image(
-            &self.ctx,
-            &self.sim,
-            &self.effect,
-            &self.camera,
-            self.last_alpha,
-            size,
-        )
+        let camera = self.camera.view(size);
+        self.composite
+            .render_image(&self.ctx, &mut self.player, &camera)
     }
 
     /// Alive particles over all emitters (blocking readback of the GPU counters).
-    pub fn alive(&self) -> Result<u64, SimError> {
-        let mut total = 0;
-        for i in 0..self.sim.emitter_count() {
-            if self.effect.emitters.get(i).is_some_and(|e| e.enabled) {
-                total += self.sim.read_counters(i)?[0] as u64;
-            }
-        }
-        Ok(total)
+    pub fn alive(&self) -> Result<u64, PlayerError> {
+        let counts = self.player.count_particles(self.instance)?;
+        Ok(counts.iter().map(|c| u64::from(c.alive)).sum())
     }
 }

@@ -10,11 +10,10 @@ use std::time::{Duration, Instant};
 
 use notify_debouncer_full::{DebounceEventResult, Debouncer, RecommendedCache, new_debouncer};
 
-use crate::effect::Effect;
 use crate::gpu::GpuContext;
-use crate::render::Renderer;
+use crate::render::Composite;
+use crate::runtime::Player;
 use crate::shaders::{ENTRY_FILES, ShaderError, ShaderLibrary};
-use crate::sim::GpuSim;
 
 /// How long the debouncer waits for a burst of file events to settle.
 pub const DEBOUNCE: Duration = Duration::from_millis(80);
@@ -132,29 +131,25 @@ impl ShaderReloader {
             .collect()
     }
 
-    /// Rebuilds the pipelines affected by `changed` from `lib`. `changed_at` is when the
-    /// change was noticed (for the latency figure).
-    #[allow(clippy::too_many_arguments)]
+    /// Rebuilds the pipelines affected by `changed` from the WGSL in `dir`: the player's
+    /// through its public [`Player::reload_shader`], the composite's own. `changed_at` is
+    /// when the change was noticed (for the latency figure).
     pub fn reload(
         &mut self,
         ctx: &GpuContext,
-        lib: &ShaderLibrary,
-        sim: &mut GpuSim,
-        renderer: &mut Renderer,
-        effect: &Effect,
+        dir: &Path,
+        player: &mut Player,
+        composite: &mut Composite,
         changed: &[String],
         changed_at: Instant,
     ) -> ReloadReport {
+        let lib = ShaderLibrary::from_dir(dir);
         let mut report = ReloadReport::default();
         for entry in self.affected(changed) {
-            let result = match entry {
-                "update.wgsl" | "count.wgsl" => sim.reload_shaders(lib.clone(), effect),
-                "billboard.wgsl" => renderer.billboard.rebuild(ctx, lib),
-                "splat.wgsl" => renderer.splat.rebuild(ctx, lib),
-                "sort.wgsl" => renderer.sort.rebuild(ctx, lib),
-                "tonemap.wgsl" => renderer.tonemap.rebuild(ctx, lib),
-                "bloom.wgsl" => renderer.bloom.rebuild(ctx, lib),
-                _ => Ok(()),
+            let result = if crate::PLAYER_SHADERS.contains(&entry) {
+                player.reload_shader(dir, entry)
+            } else {
+                composite.reload_shader(ctx, &lib, entry)
             };
             match result {
                 Ok(()) => {

@@ -61,7 +61,12 @@
 pub(crate) mod runtime;
 
 pub use effect::Effect;
-pub use runtime::{Camera, InstanceId, Player, PlayerError, PlayerSettings};
+pub use runtime::{
+    Camera, ClockStats, EmitterStats, InstanceId, Layers, PLAYER_SHADERS, ParticleCount, Player,
+    PlayerError, PlayerSettings,
+};
+pub use shaders::ShaderError;
+pub use sim::planner::SpawnStats;
 
 #[doc(hidden)]
 pub mod effect;

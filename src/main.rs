@@ -295,9 +295,12 @@ fn render(
     }
     let ctx = GpuContext::headless()?;
     let lib = ShaderLibrary::discover(shader_dir);
-    let mut run = Headless::new(&ctx, effect, lib)?;
     // PNG sprites are relative to the preset file.
-    run.renderer.asset_dir = preset.and_then(Path::parent).map(Path::to_path_buf);
+    let settings = ignis::PlayerSettings {
+        asset_dir: preset.and_then(Path::parent).map(Path::to_path_buf),
+        ..ignis::render::Composite::player_settings()
+    };
+    let mut run = Headless::with_settings(&ctx, effect, lib, settings)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let start = Instant::now();
     let mut written = 0;
@@ -305,7 +308,7 @@ fn render(
     let mut frame_ms = Vec::new();
     for f in 0..frames {
         let t = Instant::now();
-        run.advance(1.0 / fps)?;
+        run.advance(1.0 / fps);
         if !last_only || f + 1 == frames {
             let image = run.render(size)?;
             frame_ms.push(t.elapsed().as_secs_f64() * 1000.0);
@@ -320,7 +323,7 @@ fn render(
     println!(
         "rendered {frames} frames ({written} written to {}) of \"{}\" at {}x{}: {} particles alive, {:.2} ms per frame on {}",
         out.display(),
-        run.effect.name,
+        run.effect().name,
         size.0,
         size.1,
         run.alive()?,

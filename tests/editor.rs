@@ -9,7 +9,6 @@ use egui_kittest::kittest::Queryable as _;
 
 use ignis::editor::EditorState;
 use ignis::editor::panel::panel_ui;
-use ignis::editor::remap::emitter_sources;
 use ignis::editor::viewport::viewport_ui;
 use ignis::effect::Effect;
 use ignis::gpu::GpuContext;
@@ -17,6 +16,7 @@ use ignis::gpu::types::Particle;
 use ignis::render::OrbitCamera;
 use ignis::shaders::ShaderLibrary;
 use ignis::sim::GpuSim;
+use ignis::{Player, PlayerSettings};
 
 /// The side panel over an editor state, as the window runs it (UI, then end of frame).
 fn panel_harness(state: EditorState) -> Harness<'static, EditorState> {
@@ -440,16 +440,35 @@ fn a_smaller_capacity_keeps_the_particles_that_fit() {
     assert_eq!(&after[..], &before[..1024]);
 }
 
+/// Runs `steps` single steps of `player` on the GPU.
+fn play_steps(ctx: &GpuContext, player: &mut Player, steps: u32) {
+    for _ in 0..steps {
+        player.step();
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        player.simulate(&mut enc);
+        ctx.queue.submit([enc.finish()]);
+    }
+}
+
 #[test]
 fn reordering_emitters_moves_their_particles_along() {
     let ctx = GpuContext::headless().expect("a GPU adapter (lavapipe is fine)");
     let state = campfire_state();
-    let gpu_effect = state.running.clone();
-    let mut sim = GpuSim::new(&ctx, ShaderLibrary::discover(None), &gpu_effect).expect("sim");
-    sim.step(&gpu_effect, DT_SECS, 60).expect("step");
-    let smoke = sim.read_particles(0).expect("read");
-    let flames = sim.read_particles(1).expect("read");
-    let spawned_smoke = sim.planner.emitters[0].stats.spawned;
+    // The editor's player: one instance with a simulation of its own.
+    let settings = PlayerSettings {
+        batch_instances: false,
+        ..PlayerSettings::new(wgpu::TextureFormat::Rgba16Float)
+    };
+    let mut player =
+        Player::new(&ctx.device, &ctx.queue, &state.running, settings).expect("player");
+    let id = player
+        .add_instance(glam::Mat4::IDENTITY, state.running.seed)
+        .expect("instance");
+    play_steps(&ctx, &mut player, 60);
+    let smoke = player.particles(id, 0).expect("read");
+    let flames = player.particles(id, 1).expect("read");
+    let spawned = |p: &Player, e: usize| p.emitter_stats(id).expect("stats")[e].spawn.spawned;
+    let spawned_smoke = spawned(&player, 0);
 
     // Move the smoke down one place, then duplicate the flames.
     let mut harness = panel_harness(state);
@@ -466,17 +485,14 @@ fn reordering_emitters_moves_their_particles_along() {
         .collect();
     assert_eq!(names, ["flames", "smoke", "smoke copy", "embers"]);
 
-    let sources = emitter_sources(&gpu_effect, &state.running).expect("a structural edit");
-    assert_eq!(sources, [Some(1), Some(0), None, Some(2)]);
-    sim.remap_emitters(&sources);
-    sim.sync(&state.running).expect("sync");
-    assert_eq!(sim.read_particles(0).expect("read"), flames);
-    assert_eq!(sim.read_particles(1).expect("read"), smoke);
-    assert_eq!(alive(&sim.read_particles(2).expect("read")), 0);
-    assert_eq!(sim.planner.emitters[1].stats.spawned, spawned_smoke);
-    sim.step(&state.running, DT_SECS, 30).expect("step");
+    player.set_effect(&state.running).expect("the edit");
+    assert_eq!(player.particles(id, 0).expect("read"), flames);
+    assert_eq!(player.particles(id, 1).expect("read"), smoke);
+    assert_eq!(alive(&player.particles(id, 2).expect("read")), 0);
+    assert_eq!(spawned(&player, 1), spawned_smoke);
+    play_steps(&ctx, &mut player, 30);
     assert!(
-        alive(&sim.read_particles(2).expect("read")) > 0,
+        alive(&player.particles(id, 2).expect("read")) > 0,
         "the copy spawns"
     );
 }

@@ -14,19 +14,44 @@ use ignis::effect::Effect;
 use ignis::gpu::GpuContext;
 use ignis::gpu::types::Particle;
 use ignis::hot_reload::{FileWatcher, ShaderReloader, wgsl_names};
-use ignis::render::Renderer;
+use ignis::render::Composite;
 use ignis::shaders::{EMBEDDED, ShaderLibrary};
-use ignis::sim::GpuSim;
+use ignis::{InstanceId, Player, PlayerSettings};
 
 struct Rig {
     ctx: GpuContext,
     dir: tempfile::TempDir,
-    lib: ShaderLibrary,
-    effect: Effect,
-    live: GpuSim,
-    control: GpuSim,
-    renderer: Renderer,
+    /// Reloads its shaders.
+    live: (Player, InstanceId),
+    /// Built from the same files and never reloaded.
+    control: (Player, InstanceId),
+    composite: Composite,
     reloader: ShaderReloader,
+}
+
+/// An editor-style player (its own simulation) built from the WGSL in `dir`, with its one
+/// instance.
+fn player(ctx: &GpuContext, dir: &Path, effect: &Effect) -> (Player, InstanceId) {
+    let settings = PlayerSettings {
+        batch_instances: false,
+        shader_dir: Some(dir.to_path_buf()),
+        ..Composite::player_settings()
+    };
+    let mut player = Player::new(&ctx.device, &ctx.queue, effect, settings).expect("player");
+    let id = player
+        .add_instance(glam::Mat4::IDENTITY, effect.seed)
+        .expect("instance");
+    (player, id)
+}
+
+/// Runs `steps` fixed steps of `player` on the GPU.
+fn play(ctx: &GpuContext, player: &mut Player, steps: u32) {
+    for _ in 0..steps {
+        player.step();
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        player.simulate(&mut enc);
+        ctx.queue.submit([enc.finish()]);
+    }
 }
 
 impl Rig {
@@ -41,21 +66,21 @@ impl Rig {
         e.forces.buoyancy_m_per_s2 = 3.0;
         e.speed_m_per_s = ignis::effect::Range::new(0.5, 1.0);
         e.spread_deg = 30.0;
-        let effect = bare_effect(e);
-        let mut live = GpuSim::new(&ctx, lib.clone(), &effect).expect("sim");
-        let mut control = GpuSim::new(&ctx, lib.clone(), &effect).expect("sim");
-        live.step(&effect, 1.0 / 120.0, 30).expect("step");
-        control.step(&effect, 1.0 / 120.0, 30).expect("step");
-        let renderer = Renderer::new(&ctx, &lib).expect("renderer");
+        let mut effect = bare_effect(e);
+        effect.time.mode = ignis::effect::TimeMode::FixedStep;
+        effect.time.step_secs = 1.0 / 120.0;
+        let mut live = player(&ctx, dir.path(), &effect);
+        let mut control = player(&ctx, dir.path(), &effect);
+        play(&ctx, &mut live.0, 30);
+        play(&ctx, &mut control.0, 30);
+        let composite = Composite::new(&ctx, &lib).expect("composite");
         let reloader = ShaderReloader::new(&lib);
         Self {
             ctx,
             dir,
-            lib,
-            effect,
             live,
             control,
-            renderer,
+            composite,
             reloader,
         }
     }
@@ -71,29 +96,33 @@ impl Rig {
     }
 
     fn reload(&mut self, changed: &[&str]) -> ignis::hot_reload::ReloadReport {
+        self.reload_at(changed, Instant::now())
+    }
+
+    fn reload_at(&mut self, changed: &[&str], noticed: Instant) -> ignis::hot_reload::ReloadReport {
         let changed: Vec<String> = changed.iter().map(|s| (*s).to_owned()).collect();
         self.reloader.reload(
             &self.ctx,
-            &self.lib,
-            &mut self.live,
-            &mut self.renderer,
-            &self.effect,
+            self.dir.path(),
+            &mut self.live.0,
+            &mut self.composite,
             &changed,
-            Instant::now(),
+            noticed,
         )
     }
 
-    /// Steps both sims and returns their states.
+    /// The live player's particles.
+    fn live_particles(&self) -> Vec<Particle> {
+        self.live.0.particles(self.live.1, 0).expect("read")
+    }
+
+    /// Steps both players and returns their states.
     fn step_both(&mut self, steps: u32) -> (Vec<Particle>, Vec<Particle>) {
-        self.live
-            .step(&self.effect, 1.0 / 120.0, steps)
-            .expect("step");
-        self.control
-            .step(&self.effect, 1.0 / 120.0, steps)
-            .expect("step");
+        play(&self.ctx, &mut self.live.0, steps);
+        play(&self.ctx, &mut self.control.0, steps);
         (
-            self.live.read_particles(0).expect("read"),
-            self.control.read_particles(0).expect("read"),
+            self.live_particles(),
+            self.control.0.particles(self.control.1, 0).expect("read"),
         )
     }
 }
@@ -114,7 +143,7 @@ const FORCE_FN: &str = "fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age: f32
 #[test]
 fn valid_edit_changes_behaviour() {
     let mut rig = Rig::new();
-    let before = rig.live.read_particles(0).expect("read");
+    let before = rig.live_particles();
     rig.edit("forces.wgsl", FORCE_FN, ZERO_FORCE);
     let report = rig.reload(&["forces.wgsl"]);
     assert_eq!(
@@ -345,15 +374,7 @@ fn watcher_sees_editor_saves_and_reload_latency_is_small() {
         let written = Instant::now();
         std::fs::write(rig.path("forces.wgsl"), text).expect("write");
         wait_for(&watcher, "forces.wgsl");
-        let report = rig.reloader.reload(
-            &rig.ctx,
-            &rig.lib,
-            &mut rig.live,
-            &mut rig.renderer,
-            &rig.effect,
-            &["forces.wgsl".to_owned()],
-            written,
-        );
+        let report = rig.reload_at(&["forces.wgsl"], written);
         assert_eq!(report.rebuilt, vec!["update.wgsl"]);
         latencies.push(rig.reloader.last_latency.expect("latency").as_secs_f64() * 1e3);
     }

@@ -398,13 +398,13 @@ fn missing_or_broken_pngs_fall_back_with_a_clear_error_and_changed_files_reload(
     e.emitters[0].look.sprite = Sprite::Image("missing/fire.png".into());
     e.emitters[0].look.draw_path = DrawPath::Billboard;
     let mut run = Headless::new(&ctx, e, ShaderLibrary::embedded()).expect("headless");
-    run.renderer.asset_dir = Some(dir.path().to_path_buf());
+    run.player.set_asset_dir(Some(dir.path().to_path_buf()));
     for _ in 0..30 {
-        run.advance(1.0 / 60.0).expect("advance");
+        run.advance(1.0 / 60.0);
     }
     let img = run.render((160, 120)).expect("render");
     assert!(img.pixels().any(|p| p[0] > 40), "fallback sprite drawn");
-    let errors = &run.renderer.frame.sprite_errors;
+    let errors = run.player.sprite_errors();
     assert_eq!(errors.len(), 1);
     assert!(errors[0].1.to_string().contains("fire.png"));
 }
@@ -444,7 +444,7 @@ fn single(pos: Vec3, vel: Vec3, look: Look) -> Effect {
 fn render_after(ctx: &GpuContext, effect: Effect, frames: u32) -> image::RgbaImage {
     let mut run = Headless::new(ctx, effect, ShaderLibrary::embedded()).expect("headless");
     for _ in 0..frames {
-        run.advance(1.0 / 60.0).expect("advance");
+        run.advance(1.0 / 60.0);
     }
     run.render((200, 200)).expect("render")
 }
@@ -649,13 +649,14 @@ fn reference_images() {
         let preset = root.join("presets").join(format!("{name}.ron"));
         let effect = ignis::preset::load(&preset).expect("preset");
         let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
-        run.renderer.asset_dir = preset.parent().map(Path::to_path_buf);
+        run.player
+            .set_asset_dir(preset.parent().map(Path::to_path_buf));
         for _ in 0..90 {
-            run.advance(1.0 / 60.0).expect("advance");
+            run.advance(1.0 / 60.0);
         }
         let img = run.render((240, 180)).expect("render");
         assert!(
-            run.renderer.frame.sprite_errors.is_empty(),
+            run.player.sprite_errors().is_empty(),
             "{name}: sprites load"
         );
         let reference = root.join("tests/reference").join(format!("{name}.png"));
@@ -690,7 +691,7 @@ fn reference_images() {
     effect.post.bloom = None;
     let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
     for _ in 0..90 {
-        run.advance(1.0 / 60.0).expect("advance");
+        run.advance(1.0 / 60.0);
     }
     let no_bloom = run.render((240, 180)).expect("render");
     let d = mean_abs_diff(&no_bloom, &rendered[0]);
@@ -787,7 +788,7 @@ fn alpha_layers_at_half_resolution_match_full_resolution() {
     let frame = |effect: Effect| {
         let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
         for _ in 0..150 {
-            run.advance(1.0 / 60.0).expect("advance");
+            run.advance(1.0 / 60.0);
         }
         run.render((240, 180)).expect("render")
     };
@@ -840,10 +841,10 @@ fn trimmed_billboards_draw_the_untrimmed_frame() {
     effect.post.bloom = None;
     let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
     for _ in 0..120 {
-        run.advance(1.0 / 60.0).expect("advance");
+        run.advance(1.0 / 60.0);
     }
     let trimmed = run.render((320, 240)).expect("render");
-    run.renderer.frame.trim_sprites = false;
+    run.player.draw_resources().0.trim_sprites = false;
     let whole = run.render((320, 240)).expect("render");
     let lit = trimmed.pixels().filter(|p| p[0] > 60).count();
     let (mean, max) = image_diff(&trimmed, &whole);

@@ -25,7 +25,7 @@ fn campfire_after(
     let mut run = Headless::new(ctx, effect, ShaderLibrary::embedded()).expect("headless");
     let frames = (secs * 60.0) as u32;
     for _ in 0..frames {
-        run.advance(1.0 / 60.0).expect("advance");
+        run.advance(1.0 / 60.0);
     }
     let img = run.render(SIZE).expect("render");
     (run, img)
@@ -119,13 +119,16 @@ fn all_dead_frame_is_black() {
     );
     // After every particle died: lifetimes ≤ 4 s, spawning stopped.
     for _ in 0..60 {
-        run.advance(1.0 / 60.0).expect("advance");
+        run.advance(1.0 / 60.0);
     }
-    for e in &mut run.effect.emitters {
-        e.spawn_rate_per_sec = 0.0;
-    }
+    run.edit(|fx| {
+        for e in &mut fx.emitters {
+            e.spawn_rate_per_sec = 0.0;
+        }
+    })
+    .expect("edit");
     for _ in 0..(5 * 60) {
-        run.advance(1.0 / 60.0).expect("advance");
+        run.advance(1.0 / 60.0);
     }
     assert_eq!(run.alive().expect("alive"), 0);
     let img = run.render(SIZE).expect("render");
@@ -222,9 +225,9 @@ fn billboard_and_splat_paths_agree() {
         e.look.intensity = 0.6;
         e.look.draw_path = path;
         let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
-        run.renderer.exposure = 0.5;
+        run.composite.exposure = 0.5;
         for _ in 0..60 {
-            run.advance(1.0 / 60.0).expect("advance");
+            run.advance(1.0 / 60.0);
         }
         run.render(SIZE).expect("render")
     };
@@ -272,11 +275,15 @@ fn stateless_emitter_renders_like_the_stateful_one() {
     let render = |stateless: bool| {
         let mut effect = Effect::default_campfire();
         effect.emitters.retain(|e| e.name == "flames");
-        effect.emitters[0].integrator = ignis::effect::Integrator::Exponential;
-        effect.emitters[0].stateless = stateless;
+        let e = &mut effect.emitters[0];
+        e.integrator = ignis::effect::Integrator::Exponential;
+        // Closed form: constant acceleration and linear drag only.
+        e.forces.turbulence = None;
+        e.forces.flame_pull = None;
+        e.stateless = stateless;
         let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
         for _ in 0..45 {
-            run.advance(1.0 / 60.0).expect("advance");
+            run.advance(1.0 / 60.0);
         }
         run.render(SIZE).expect("render")
     };
@@ -365,19 +372,22 @@ fn live_window_draws_what_the_whole_pool_draws() {
     for f in 0..150 {
         if f == 120 {
             // An edit: every emitter's lifetimes shortened to a tenth.
-            for e in &mut run.effect.emitters {
-                e.lifetime_secs.min *= 0.1;
-                e.lifetime_secs.max *= 0.1;
-            }
+            run.edit(|fx| {
+                for e in &mut fx.emitters {
+                    e.lifetime_secs.min *= 0.1;
+                    e.lifetime_secs.max *= 0.1;
+                }
+            })
+            .expect("edit");
         }
-        run.advance(1.0 / 60.0).expect("advance");
+        run.advance(1.0 / 60.0);
     }
     let compare = |run: &mut Headless| {
-        run.renderer.frame.live_window_only = true;
+        run.player.draw_resources().0.live_window_only = true;
         let windowed = run.render(SIZE).expect("render");
-        run.renderer.frame.live_window_only = false;
+        run.player.draw_resources().0.live_window_only = false;
         let whole = run.render(SIZE).expect("render");
-        run.renderer.frame.live_window_only = true;
+        run.player.draw_resources().0.live_window_only = true;
         let (mean, max) = image_diff(&windowed, &whole);
         let lit = windowed.pixels().filter(|p| p[0] > 40).count();
         (mean, max, lit)
@@ -390,7 +400,7 @@ fn live_window_draws_what_the_whole_pool_draws() {
         "window vs whole pool: mean {mean}, max {max}"
     );
     // Every particle alive now lies in its emitter's window, and the windows are short.
-    assert_eq!(bounds.len(), run.sim.emitter_count());
+    assert_eq!(bounds.len(), run.effect().emitters.len());
     for (i, bound) in bounds.iter().enumerate() {
         let (alive, len) = alive_in_window(&run, i, &format!("emitter {i}"));
         // At most rate × (the longest lifetime alive) plus two steps of spawns.
@@ -401,11 +411,11 @@ fn live_window_draws_what_the_whole_pool_draws() {
     }
     // Later, once the long-lived particles died, the window shrinks to the new lifetimes.
     for _ in 0..300 {
-        run.advance(1.0 / 60.0).expect("advance");
+        run.advance(1.0 / 60.0);
     }
     let (mean, max, _) = compare(&mut run);
     assert!(mean < 0.02 && max <= 2, "after: mean {mean}, max {max}");
-    let smoke = run.sim.emitter_buffers(0).expect("smoke").window.len;
+    let smoke = window(&run, 0).1;
     // 90/s × 0.4 s = 36 spawns can be alive; the batch granularity adds a few steps.
     assert!(
         smoke <= 60,
@@ -415,19 +425,24 @@ fn live_window_draws_what_the_whole_pool_draws() {
 
 /// Every alive slot of emitter `i` lies in its live window; returns (alive, window length).
 fn alive_in_window(run: &Headless, i: usize, when: &str) -> (usize, u32) {
-    let b = run.sim.emitter_buffers(i).expect("buffers");
-    let (w, cap) = (b.window, b.capacity);
-    let particles = run.sim.read_particles(i).expect("read");
+    let (first, len, cap) = window(run, i);
+    let particles = run.player.particles(run.instance, i).expect("read");
     for (slot, p) in particles.iter().enumerate() {
         if p.is_alive() {
-            let offset = (slot as u32 + cap - w.first_slot) % cap;
+            let offset = (slot as u32 + cap - first) % cap;
             assert!(
-                offset < w.len,
-                "{when}: alive slot {slot} outside {w:?} (capacity {cap})"
+                offset < len,
+                "{when}: alive slot {slot} outside {first}+{len} (capacity {cap})"
             );
         }
     }
-    (alive_of(&particles), w.len)
+    (alive_of(&particles), len)
+}
+
+/// Emitter `i`'s visited window: (first slot, length, capacity).
+fn window(run: &Headless, i: usize) -> (u32, u32, u32) {
+    let s = run.player.emitter_stats(run.instance).expect("instance")[i];
+    (s.first_visited, s.visited, s.capacity)
 }
 
 /// Live windows across the edits that move particles or stop the clock: a capacity change
@@ -445,14 +460,14 @@ fn live_windows_survive_capacity_changes_and_disabled_emitters() {
     };
     let mut run = Headless::new(&ctx, bare_effect(e), ShaderLibrary::embedded()).expect("run");
     for _ in 0..200 {
-        run.advance(1.0 / 60.0).expect("advance");
+        run.advance(1.0 / 60.0);
     }
     alive_in_window(&run, 0, "before the capacity change");
     // Wrapped several times: the kept slots do not match the new ring positions.
-    run.effect.emitters[0].capacity = 1500;
+    run.edit(|fx| fx.emitters[0].capacity = 1500).expect("edit");
     let mut alive_after = Vec::new();
     for f in 0..90 {
-        run.advance(1.0 / 60.0).expect("advance");
+        run.advance(1.0 / 60.0);
         let (alive, _) = alive_in_window(&run, 0, &format!("frame {f} after the capacity change"));
         alive_after.push(alive);
     }
@@ -467,12 +482,12 @@ fn live_windows_survive_capacity_changes_and_disabled_emitters() {
 
     // Disabled for 2 s (longer than any lifetime), then enabled again.
     let (before, _) = alive_in_window(&run, 0, "before disabling");
-    run.effect.emitters[0].enabled = false;
+    run.edit(|fx| fx.emitters[0].enabled = false).expect("edit");
     for _ in 0..120 {
-        run.advance(1.0 / 60.0).expect("advance");
+        run.advance(1.0 / 60.0);
     }
-    run.effect.emitters[0].enabled = true;
-    run.advance(1.0 / 60.0).expect("advance");
+    run.edit(|fx| fx.emitters[0].enabled = true).expect("edit");
+    run.advance(1.0 / 60.0);
     let (resumed, _) = alive_in_window(&run, 0, "first frame after enabling");
     // One step later most frozen particles are still alive (and drawn).
     assert!(
@@ -480,7 +495,7 @@ fn live_windows_survive_capacity_changes_and_disabled_emitters() {
         "{resumed} alive after resuming, {before} before"
     );
     for f in 0..90 {
-        run.advance(1.0 / 60.0).expect("advance");
+        run.advance(1.0 / 60.0);
         alive_in_window(&run, 0, &format!("frame {f} after enabling"));
     }
 }
@@ -505,21 +520,21 @@ fn billboards_beyond_one_draw_carry_all_their_light() {
         e.look.intensity = 0.08;
         e.look.draw_path = path;
         let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
-        run.renderer.exposure = 0.5;
+        run.composite.exposure = 0.5;
         // 1.5 s: the ring has wrapped, so the window crosses the end of the pool.
         for _ in 0..90 {
-            run.advance(1.0 / 60.0).expect("advance");
+            run.advance(1.0 / 60.0);
         }
-        let w = run.sim.emitter_buffers(0).expect("buffers").window;
+        let w = window(&run, 0);
         (run.render(SIZE).expect("render"), w)
     };
     let ((a, w), (b, _)) = (render(DrawPath::Billboard), render(DrawPath::Splat));
     assert!(
-        w.len > 65_536 * 3 / 2,
+        w.1 > 65_536 * 3 / 2,
         "window {w:?}: more than one draw's worth"
     );
     assert!(
-        w.first_slot + w.len > 150_000,
+        w.0 + w.1 > 150_000,
         "window {w:?} should wrap past the capacity"
     );
     let (la, lb) = (total_light(&a), total_light(&b));
@@ -539,11 +554,11 @@ fn instanced_and_indexed_billboards_draw_the_same_frame() {
     effect.post.bloom = None;
     let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
     for _ in 0..150 {
-        run.advance(1.0 / 60.0).expect("advance");
+        run.advance(1.0 / 60.0);
     }
-    run.renderer.billboard.indexed = true;
+    run.player.draw_resources().1.indexed = true;
     let indexed = run.render(SIZE).expect("render");
-    run.renderer.billboard.indexed = false;
+    run.player.draw_resources().1.indexed = false;
     let instanced = run.render(SIZE).expect("render");
     let (mean, max) = image_diff(&indexed, &instanced);
     let lit = indexed.pixels().filter(|p| p[0] > 40).count();
@@ -565,29 +580,18 @@ fn draft_glow_layer_renders_like_full_resolution() {
     let effect = Effect::default_campfire();
     let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
     for _ in 0..150 {
-        run.advance(1.0 / 60.0).expect("advance");
+        run.advance(1.0 / 60.0);
     }
     let full = run.render(SIZE).expect("render");
-    run.renderer.draft = true;
+    run.composite.draft = true;
     let draft = run.render(SIZE).expect("render");
     // The flames are glow, the streaked embers and the alpha smoke are not.
-    let camera = run.camera;
-    let scenes = [ignis::render::Scene {
-        sim: &run.sim,
-        effect: &run.effect,
-    }];
-    let items = run.renderer.frame.prepare(
-        &ctx,
-        &scenes,
-        &camera.view(SIZE),
-        1.0,
-        &mut run.renderer.sort,
-        None,
-    );
-    let glow: Vec<&str> = items
+    let glow: Vec<&str> = run
+        .player
+        .draw_items()
         .iter()
         .filter(|d| d.is_glow())
-        .map(|d| run.effect.emitters[d.index].name.as_str())
+        .map(|d| run.effect().emitters[d.index].name.as_str())
         .collect();
     assert_eq!(glow, ["flames"]);
     let (mean, max) = image_diff(&full, &draft);

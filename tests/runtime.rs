@@ -540,14 +540,8 @@ fn instances_add_up(effect: &Effect) {
     );
     advance(&mut [&mut both, &mut only_a], &host, 45);
     for e in 0..effect.emitters.len() {
-        let kept = both
-            .read_particles(a, e)
-            .expect("a is there")
-            .expect("read");
-        let alone = only_a
-            .read_particles(a_alone, e)
-            .expect("there")
-            .expect("read");
+        let kept = both.particles(a, e).expect("read");
+        let alone = only_a.particles(a_alone, e).expect("read");
         assert!(
             kept.iter().any(|p| p.is_alive()),
             "emitter {e} has particles"
@@ -605,7 +599,7 @@ fn a_batched_instance_steps_exactly_as_a_simulation_of_its_own() {
     advance(&mut [&mut player], &host, 30);
     for e in 0..effect.emitters.len() {
         for (id, sim) in [(ids[0], &first), (late, &newcomer)] {
-            let batched = player.read_particles(id, e).expect("there").expect("read");
+            let batched = player.particles(id, e).expect("read");
             let alone = sim.read_particles(e).expect("read");
             assert!(
                 alone.iter().any(|p| p.is_alive()),
@@ -644,7 +638,7 @@ fn large_pools_batch_as_many_instances_as_a_binding_holds() {
     // 40 frames: 2/3 s at 4 spawns per second.
     advance(&mut [&mut player], &host, 40);
     for id in ids {
-        let particles = player.read_particles(id, 0).expect("there").expect("read");
+        let particles = player.particles(id, 0).expect("read");
         assert_eq!(particles.len(), 1 << 20);
         assert_eq!(
             particles.iter().filter(|p| p.is_alive()).count(),
@@ -666,7 +660,7 @@ fn a_moving_instance_spawns_where_it_is_and_keeps_world_motion() {
     assert_eq!(fire.transform(id), Some(moved));
     // The flames (emitter 1): the newest are born around x = 2, the older ones stay.
     advance(&mut [&mut fire], &host, 6);
-    let flames = fire.read_particles(id, 1).expect("there").expect("read");
+    let flames = fire.particles(id, 1).expect("read");
     let alive: Vec<DVec3> = flames
         .iter()
         .filter(|p| p.is_alive())

@@ -235,11 +235,11 @@ fn far_from_the_origin_motion_still_resolves() {
         let mut h = ignis::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
             .expect("headless");
         for _ in 0..60 {
-            h.advance(1.0 / 60.0).expect("advance");
+            h.advance(1.0 / 60.0);
         }
         let img = h.render((160, 120)).expect("render");
         let state: Vec<Vec<Particle>> = (0..3)
-            .map(|i| h.sim.read_particles(i).expect("read"))
+            .map(|i| h.player.particles(h.instance, i).expect("read"))
             .collect();
         (img, state)
     };

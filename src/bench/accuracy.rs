@@ -8,6 +8,7 @@
 use glam::DVec3;
 use serde::Serialize;
 
+use crate::PlayerError;
 use crate::effect::{
     Burst, Effect, Emitter, Integrator, Range, Shape, SpawnNoise, TimeMode, Turbulence,
 };
@@ -411,20 +412,24 @@ fn fnv1a(bytes: &[u8]) -> u64 {
 }
 
 /// The default campfire in fixed-step mode over every frame sequence: state hashes.
-pub fn fixed_step_hashes(ctx: &GpuContext) -> Result<Vec<(String, u64, u64)>, SimError> {
+/// Played through the runtime's [`crate::Player`], as `ignis render` plays it.
+pub fn fixed_step_hashes(ctx: &GpuContext) -> Result<Vec<(String, u64, u64)>, PlayerError> {
     let mut out = Vec::new();
     for (name, frames) in frame_sequences() {
         let mut effect = Effect::default_campfire();
         effect.time.mode = TimeMode::FixedStep;
+        let step_secs = f64::from(effect.time.step_secs);
         let mut run = Headless::new(ctx, effect, ShaderLibrary::embedded())?;
         for dt in &frames {
-            run.advance(*dt)?;
+            run.advance(*dt);
         }
         let mut bytes = Vec::new();
-        for i in 0..run.sim.emitter_count() {
-            bytes.extend_from_slice(bytemuck::cast_slice(&run.sim.read_particles(i)?));
+        for i in 0..run.effect().emitters.len() {
+            let particles = run.player.particles(run.instance, i)?;
+            bytes.extend_from_slice(bytemuck::cast_slice(&particles));
         }
-        out.push((name, fnv1a(&bytes), run.sim.planner.step_index));
+        let time = run.player.time_secs(run.instance).unwrap_or_default();
+        out.push((name, fnv1a(&bytes), (time / step_secs).round() as u64));
     }
     Ok(out)
 }

@@ -9,7 +9,11 @@ use crate::effect::{DrawPath, Effect, Emitter, Range};
 use crate::gpu::GpuContext;
 use crate::gpu::timer::{GpuTimer, median};
 use crate::gpu::types::StateLayout;
-use crate::render::{OrbitCamera, Renderer, begin_hdr_pass};
+use crate::render::billboard::{BillboardPass, DrawTarget};
+use crate::render::sort::SortPass;
+use crate::render::{
+    DrawItem, FrameResources, OrbitCamera, SplatPass, TonemapPass, begin_hdr_pass,
+};
 use crate::shaders::ShaderLibrary;
 use crate::sim::{GpuSim, Modules, SimError};
 
@@ -306,88 +310,59 @@ fn measure_row(
     // Re-run one step so the state is a real one again (the copy wrote into `previous`).
     sim.step(&effect, 1.0 / 60.0, 1)?;
 
-    let mut renderer = Renderer::new(ctx, &ShaderLibrary::embedded())?;
+    let lib = ShaderLibrary::embedded();
+    let mut frame = FrameResources::new(ctx);
+    let mut sort = SortPass::new(ctx, &lib)?;
+    let mut billboard = BillboardPass::new(ctx, &lib, &frame, DrawTarget::hdr())?;
+    let mut splat = SplatPass::new(ctx, &lib, &frame, DrawTarget::hdr())?;
+    let tonemap = TonemapPass::new(ctx, &lib, crate::render::LDR_FORMAT)?;
     let camera = OrbitCamera::from_hint(&effect.camera);
     let size = opts.size;
-    renderer.targets(ctx, size);
-    let items = {
-        let Renderer { frame, sort, .. } = &mut renderer;
-        let scenes = [crate::render::Scene {
-            sim: &sim,
-            effect: &effect,
-        }];
-        frame.prepare(ctx, &scenes, &camera.view(size), 1.0, sort, None)
-    };
+    let targets = crate::render::Targets::new(ctx, size);
+    let scenes = [crate::render::Scene {
+        sim: &sim,
+        effect: &effect,
+    }];
+    let items = frame.prepare(ctx, &scenes, &camera.view(size), 1.0, &mut sort, None);
     let auto_splat = items.iter().all(|d| d.splat);
-    let all_billboard: Vec<_> = items
-        .iter()
-        .map(|d| crate::render::DrawItem {
-            splat: false,
-            ..d.clone()
-        })
-        .collect();
-    let all_splat: Vec<_> = items
-        .iter()
-        .map(|d| crate::render::DrawItem {
-            splat: true,
-            ..d.clone()
-        })
-        .collect();
-    {
-        let Renderer {
-            frame, billboard, ..
-        } = &mut renderer;
-        billboard.prepare(ctx, &all_billboard, &frame.sprites.sampler);
-    }
-    let billboard_ms = if n <= opts.billboard_limit {
-        let r = &renderer;
-        let Some(t) = r_targets(r) else {
-            return Err(SimError::Readback("no targets".into()));
-        };
-        Some(time_median(&timer, ctx, opts.repeats.min(3), |enc| {
-            let mut pass = begin_hdr_pass(enc, t);
-            r.billboard
-                .draw(&mut pass, &r.frame, &all_billboard, |_| true);
-        }))
-    } else {
-        None
+    let with_path = |splat: bool| -> Vec<DrawItem> {
+        items
+            .iter()
+            .map(|d| DrawItem { splat, ..d.clone() })
+            .collect()
     };
-    // Splat: clear + compute splat (its resolve is fused into the composite below).
+    let (all_billboard, all_splat) = (with_path(false), with_path(true));
+    billboard.prepare(ctx, &all_billboard, &frame.sprites.sampler);
+    let billboard_ms = (n <= opts.billboard_limit).then(|| {
+        time_median(&timer, ctx, opts.repeats.min(3), |enc| {
+            let mut pass = begin_hdr_pass(enc, &targets.hdr_view);
+            billboard.draw(&mut pass, &frame, &all_billboard, |_| true);
+        })
+    });
+    // Splat: clear + compute splat + its resolve into the HDR target.
     let splat_ms = {
         let mut samples = Vec::new();
         for _ in 0..opts.repeats {
-            let Renderer { frame, splat, .. } = &mut renderer;
             samples.push(timer.time(ctx, |enc| {
-                splat.splat(ctx, enc, frame, &all_splat, size);
+                splat.splat(ctx, enc, &frame, &all_splat, size, None);
+                splat.resolve(&mut begin_hdr_pass(enc, &targets.hdr_view), &frame);
             }));
         }
         median(&mut samples)
     };
-    // Composite: the tonemap, reading the splat's light when the auto path splats.
-    let composite_ms = {
-        let r = &renderer;
-        let Some(targets) = r.targets_ref() else {
-            return Err(SimError::Readback("no targets".into()));
-        };
-        let accum = if auto_splat {
-            r.splat.accum_buffer()
-        } else {
-            None
-        };
-        time_median(&timer, ctx, opts.repeats, |enc| {
-            r.tonemap.record(
-                ctx,
-                enc,
-                &targets.hdr_view,
-                accum,
-                None,
-                None,
-                None,
-                &targets.ldr_view,
-                1.0,
-            );
-        })
-    };
+    // Composite: the tonemap.
+    let composite_ms = time_median(&timer, ctx, opts.repeats, |enc| {
+        tonemap.record(
+            ctx,
+            enc,
+            &targets.hdr_view,
+            None,
+            None,
+            None,
+            &targets.ldr_view,
+            1.0,
+        );
+    });
     let draw = if auto_splat {
         splat_ms
     } else {
@@ -405,10 +380,6 @@ fn measure_row(
         auto_path: if auto_splat { "splat" } else { "billboard" },
         frame_ms: update_ms + draw + composite_ms,
     })
-}
-
-fn r_targets(r: &Renderer) -> Option<&wgpu::TextureView> {
-    r.targets_ref().map(|t| &t.hdr_view)
 }
 
 /// Update cost with each optional module on, with every module compiled out by its

@@ -1,9 +1,10 @@
 //! The editor window: winit event loop, wgpu surface, egui, and the frame loop.
 //!
 //! One frame: the UI runs (edits land in `EditorState::effect`, the valid ones in
-//! `running`), the GPU pools follow structural edits, the simulation steps, the
-//! renderer records the viewport image into its own HDR target and tonemaps it, then
-//! egui draws the panel and composites that image in the same encoder.
+//! `running`), the player follows them ([`Player::set_effect`]) and advances, the
+//! composite records the player's frame into its own HDR target and tonemaps it, then
+//! egui draws the panel and composites that image in the same encoder. The viewport is a
+//! host of the public runtime API, as any program that embeds ignis.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -15,16 +16,15 @@ use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::window::{Window, WindowId};
 
-use crate::effect::{Effect, TimeMode};
+use crate::effect::Effect;
 use crate::gpu::GpuContext;
 use crate::hot_reload::{FileWatcher, ShaderReloader, wgsl_names};
-use crate::render::{OrbitCamera, Renderer};
+use crate::render::{Composite, OrbitCamera};
+use crate::runtime::{InstanceId, Player, PlayerSettings};
 use crate::shaders::{ShaderLibrary, ShaderSourceDir};
-use crate::sim::{GpuSim, Stepper};
 
 use super::panel::{PANEL_WIDTH, panel_ui};
 use super::profile::StageProfiler;
-use super::remap::emitter_sources;
 use super::retained::{Repaint, UiReuse};
 use super::screenshot::{Screenshot, read_back};
 use super::state::EditorState;
@@ -209,20 +209,20 @@ struct Gfx {
     config: wgpu::SurfaceConfiguration,
     surface_can_copy: bool,
     ctx: GpuContext,
-    sim: GpuSim,
-    renderer: Renderer,
-    stepper: Stepper,
-    /// The effect the GPU pools currently match.
+    /// Plays the running effect (one instance, at the origin).
+    player: Player,
+    instance: InstanceId,
+    /// The viewport's HDR target, bloom and tonemap around the player.
+    composite: Composite,
+    /// The running effect the player last accepted (it plays this plus the mouse
+    /// collider).
     gpu_effect: Effect,
-    /// What is simulated and drawn this frame: `gpu_effect` plus the mouse collider.
-    frame_effect: Effect,
     egui_ctx: egui::Context,
     egui_state: egui_winit::State,
     ui_painter: UiPainter,
     viewport_texture: Option<egui::TextureId>,
     /// The viewport image egui shows (a gamma-encoded copy of the display image).
     viewport_image: Option<wgpu::Texture>,
-    last_alpha: f32,
     frame_index: u64,
     last_frame: Option<Instant>,
     frame_log: Vec<f32>,
@@ -238,13 +238,11 @@ struct Gfx {
     profiler: StageProfiler,
     /// Per-pass GPU timestamps (None on CPU adapters: their timestamps are not trusted).
     pass_timer: Option<crate::gpu::timer::PassTimer>,
-    /// Steps planned for this frame, recorded into the viewport encoder.
-    pending_steps: (u32, f32),
     /// Hot reload of `shaders/` (absent with the embedded shaders).
     shader_watch: Option<ShaderWatch>,
     /// Watches the folders of the PNG sprites in use: a changed file is reloaded.
-    /// (sprite library generation it was set up for, folders, watcher).
-    sprite_watch: Option<(u64, Vec<PathBuf>, Option<FileWatcher>)>,
+    /// (folders, their watcher).
+    sprite_watch: Option<(Vec<PathBuf>, Option<FileWatcher>)>,
 }
 
 /// The shader folder's watcher and the reloader that rebuilds affected pipelines.
@@ -272,6 +270,32 @@ impl ShaderWatch {
             }
         }
     }
+}
+
+/// The editor's player: the running effect as one instance at the origin, drawn into the
+/// composite's HDR target, built from the shader folder when there is one. Not batched:
+/// an edit that resizes a pool keeps the particles that fit.
+fn editor_player(
+    ctx: &GpuContext,
+    lib: &ShaderLibrary,
+    state: &EditorState,
+) -> anyhow::Result<(Player, InstanceId)> {
+    let settings = PlayerSettings {
+        batch_instances: false,
+        shader_dir: match lib.source() {
+            ShaderSourceDir::Dir(dir) => Some(dir.clone()),
+            ShaderSourceDir::Embedded => None,
+        },
+        asset_dir: state
+            .loaded_path
+            .as_deref()
+            .and_then(std::path::Path::parent)
+            .map(std::path::Path::to_path_buf),
+        ..Composite::player_settings()
+    };
+    let mut player = Player::new(&ctx.device, &ctx.queue, &state.running, settings)?;
+    let instance = player.add_instance(glam::Mat4::IDENTITY, state.running.seed)?;
+    Ok((player, instance))
 }
 
 impl ApplicationHandler for App {
@@ -392,9 +416,9 @@ impl Gfx {
         };
 
         let lib = ShaderLibrary::discover(options.shader_dir.as_deref());
-        let renderer = Renderer::new(&ctx, &lib)?;
+        let composite = Composite::new(&ctx, &lib)?;
         let shader_watch = ShaderWatch::new(&lib);
-        let sim = GpuSim::new(&ctx, lib, &state.running)?;
+        let (player, instance) = editor_player(&ctx, &lib, state)?;
 
         let egui_ctx = egui::Context::default();
         egui_ctx.set_visuals(egui::Visuals::dark());
@@ -434,17 +458,15 @@ impl Gfx {
             config,
             surface_can_copy,
             gpu_effect: state.running.clone(),
-            frame_effect: state.running.clone(),
             ctx,
-            sim,
-            renderer,
-            stepper: Stepper::default(),
+            player,
+            instance,
+            composite,
             egui_ctx,
             egui_state,
             ui_painter,
             viewport_texture: None,
             viewport_image: None,
-            last_alpha: 1.0,
             frame_index: 0,
             last_frame: None,
             frame_log: Vec::new(),
@@ -454,7 +476,6 @@ impl Gfx {
             ui_reuse: retained.as_ref().map(|_| UiReuse::default()),
             retained,
             pass_timer,
-            pending_steps: (0, 0.0),
             profiler: StageProfiler::new(options.profile),
             shader_watch,
             sprite_watch: None,
@@ -470,28 +491,25 @@ impl Gfx {
         self.surface.configure(&self.ctx.device, &self.config);
     }
 
-    /// Makes the GPU pools follow `state.running`; on a GPU refusal, goes back to the
-    /// last effect that worked.
+    /// Makes the player follow `state.running` (plus the mouse collider); on a GPU
+    /// refusal, goes back to the last effect that worked.
     fn apply_running(&mut self, state: &mut EditorState) {
-        if state.running == self.gpu_effect {
+        let wanted = super::state::with_mouse_collider(&state.running, state.mouse_point);
+        if wanted == *self.player.effect() {
             return;
         }
-        let remap = emitter_sources(&self.gpu_effect, &state.running);
-        if let Some(sources) = &remap {
-            self.sim.remap_emitters(sources);
-        }
-        match self.sim.sync(&state.running) {
+        match self.player.set_effect(&wanted) {
             Ok(()) => self.gpu_effect.clone_from(&state.running),
             Err(err) => {
                 log::warn!("effect refused by the GPU: {err}");
-                if remap.is_some()
-                    && let Some(back) = emitter_sources(&state.running, &self.gpu_effect)
-                {
-                    self.sim.remap_emitters(&back);
-                }
                 state.reject_running(&self.gpu_effect, err.to_string());
+                let back = super::state::with_mouse_collider(&self.gpu_effect, state.mouse_point);
+                if let Err(err) = self.player.set_effect(&back) {
+                    log::error!("the last effect that worked was refused too: {err}");
+                }
             }
         }
+        self.player.set_seed(self.instance, self.gpu_effect.seed);
     }
 
     /// Rebuilds the pipelines whose shaders changed on disk; a failure keeps the last
@@ -505,13 +523,11 @@ impl Gfx {
             return;
         }
         let noticed = Instant::now();
-        let lib = ShaderLibrary::from_dir(watch.dir.clone());
         let report = watch.reloader.reload(
             &self.ctx,
-            &lib,
-            &mut self.sim,
-            &mut self.renderer,
-            &self.gpu_effect,
+            &watch.dir,
+            &mut self.player,
+            &mut self.composite,
             &changed,
             noticed,
         );
@@ -539,115 +555,64 @@ impl Gfx {
         });
     }
 
-    /// Runs this frame's simulation steps.
-    fn simulate(&mut self, state: &mut EditorState, frame_dt_secs: f64) -> anyhow::Result<()> {
+    /// Plans this frame's simulation steps (recorded with the viewport).
+    fn simulate(&mut self, state: &mut EditorState, frame_dt_secs: f64) {
         let playback = &mut state.playback;
         if playback.restart_requested {
             playback.restart_requested = false;
-            self.sim.restart();
-            self.stepper.reset();
+            self.player.restart();
         }
-        self.frame_effect = super::state::with_mouse_collider(&self.gpu_effect, state.mouse_point);
-        let effect = &self.frame_effect;
-        let (steps, dt_secs) = if playback.step_requested {
+        if playback.step_requested {
             playback.step_requested = false;
             playback.is_paused = true;
-            let dt = match effect.time.mode {
-                TimeMode::FixedStep => effect.time.step_secs,
-                TimeMode::FrameDelta => effect.time.max_frame_dt_secs.min(1.0 / 60.0),
-            };
-            self.last_alpha = 1.0;
-            (1, dt)
-        } else if playback.is_paused {
-            (0, 0.0)
-        } else {
-            let plan = self.stepper.advance(frame_dt_secs, &effect.time);
-            self.last_alpha = plan.alpha;
-            (plan.steps, plan.dt_secs)
-        };
-        // Up to 32 steps are recorded into the frame's encoder (timed per pass when the
-        // adapter has timestamps); more go through their own submissions.
-        self.pending_steps = (0, dt_secs);
-        if steps > 32 {
-            self.sim
-                .step(effect, dt_secs, steps)
-                .context("simulation step")?;
-        } else if steps > 0 {
-            self.sim.sync(effect).context("simulation step")?;
-            self.pending_steps = (steps, dt_secs);
+            self.player.step();
         }
-        let stats = &mut state.stats;
-        stats.steps_last_frame = steps;
-        stats.dt_secs = dt_secs;
-        stats.dropped_steps = self.stepper.dropped_steps;
-        stats.sim_time_secs = self.sim.planner.time_secs;
-        Ok(())
+        self.player.set_paused(playback.is_paused);
+        self.player.advance(frame_dt_secs);
     }
 
-    /// Refreshes the per-emitter counters (the alive counts only every few frames: the
-    /// readback waits for the GPU).
-    fn refresh_counters(&mut self, state: &mut EditorState, force: bool) {
-        let effect = &self.gpu_effect;
+    /// Copies the player's clock and per-emitter figures into the stats (the alive counts
+    /// only every few frames: the readback waits for the GPU).
+    fn refresh_stats(&mut self, state: &mut EditorState, force: bool) {
         let stats = &mut state.stats;
+        let clock = self.player.clock_stats();
+        stats.steps_last_frame = clock.steps;
+        stats.dt_secs = clock.step_secs;
+        stats.dropped_steps = clock.dropped_steps;
+        stats.sim_time_secs = self.player.time_secs(self.instance).unwrap_or_default();
+        let emitters = self.player.emitter_stats(self.instance).unwrap_or_default();
         stats
             .emitters
-            .resize(effect.emitters.len(), EmitterStats::default());
-        let read = force || self.frame_index % COUNTER_INTERVAL_FRAMES == 1;
-        for (i, e) in effect.emitters.iter().enumerate() {
-            let s = &mut stats.emitters[i];
+            .resize(emitters.len(), EmitterStats::default());
+        for (s, e) in stats.emitters.iter_mut().zip(&emitters) {
             s.capacity = e.capacity;
-            s.window = self.sim.emitter_buffers(i).map_or(0, |b| b.window.len);
-            s.spawn = self
-                .sim
-                .planner
-                .emitters
-                .get(i)
-                .map(|p| p.stats)
-                .unwrap_or_default();
-            if read {
-                if !e.enabled {
-                    s.alive = 0;
-                    continue;
-                }
-                match self.sim.read_counters(i) {
-                    Ok([alive, nonfinite]) => {
-                        s.alive = alive;
-                        s.nonfinite = nonfinite;
-                    }
-                    Err(err) => log::warn!("reading the counters of emitter {i}: {err}"),
-                }
-            }
+            s.window = e.visited;
+            s.spawn = e.spawn;
         }
-        if read {
-            stats.counters_age_frames = 0;
+        if !(force || self.frame_index % COUNTER_INTERVAL_FRAMES == 1) {
+            return;
+        }
+        match self.player.count_particles(self.instance) {
+            Ok(counts) => {
+                for (s, c) in stats.emitters.iter_mut().zip(counts) {
+                    s.alive = c.alive;
+                    s.nonfinite = c.nonfinite;
+                }
+                stats.counters_age_frames = 0;
+            }
+            Err(err) => log::warn!("counting the particles: {err}"),
         }
     }
 
     /// Centres the camera on the alive particles (or on the emitters when none).
     fn frame_camera(&self, camera: &mut OrbitCamera) {
-        let mut positions = Vec::new();
-        for (i, e) in self.gpu_effect.emitters.iter().enumerate() {
-            // Stateless pools hold spawn records, not positions.
-            if !e.enabled || e.stateless {
-                continue;
-            }
-            // Particles live in their emitter's simulation space (relative to its origin).
-            let origin = self
-                .sim
-                .planner
-                .emitters
-                .get(i)
-                .map_or(glam::Vec3::ZERO, |p| p.origin().as_vec3());
-            match self.sim.read_particles(i) {
-                Ok(particles) => positions.extend(
-                    particles
-                        .iter()
-                        .filter(|p| p.is_alive())
-                        .map(|p| p.position() + origin),
-                ),
-                Err(err) => log::warn!("reading particles for framing: {err}"),
-            }
-        }
+        let positions = self
+            .player
+            .particle_positions(self.instance)
+            .unwrap_or_else(|err| {
+                log::warn!("reading particles for framing: {err}");
+                Vec::new()
+            });
         let (center, radius) =
             frame_bounds(&positions).unwrap_or_else(|| emitter_bounds(&self.gpu_effect));
         camera.frame(center, radius);
@@ -683,7 +648,7 @@ impl Gfx {
             ));
             self.viewport_image = Some(image);
         }
-        let targets = self.renderer.targets(&self.ctx, size);
+        let targets = self.composite.targets(&self.ctx, size);
         if let Some(image) = &self.viewport_image
             && targets.size == size
         {
@@ -738,30 +703,23 @@ impl App {
         let Some(gfx) = self.gfx.as_mut() else {
             return;
         };
-        // The folders are looked up only when the set of file sprites changed.
-        let generation = gfx.renderer.frame.sprites.generation();
-        if gfx.sprite_watch.as_ref().is_none_or(|w| w.0 != generation) {
-            let dirs = gfx.renderer.frame.sprites.watched_dirs();
-            match gfx.sprite_watch.as_mut() {
-                Some(w) if w.1 == dirs => w.0 = generation,
-                _ => {
-                    let paths: Vec<&std::path::Path> = dirs.iter().map(PathBuf::as_path).collect();
-                    let watcher = if paths.is_empty() {
-                        None
-                    } else {
-                        FileWatcher::new(&paths)
-                            .map_err(|e| log::warn!("not watching sprite folders: {e}"))
-                            .ok()
-                    };
-                    gfx.sprite_watch = Some((generation, dirs, watcher));
-                }
-            }
+        let dirs = gfx.player.sprite_folders();
+        if gfx.sprite_watch.as_ref().is_none_or(|w| w.0 != dirs) {
+            let paths: Vec<&std::path::Path> = dirs.iter().map(PathBuf::as_path).collect();
+            let watcher = if paths.is_empty() {
+                None
+            } else {
+                FileWatcher::new(&paths)
+                    .map_err(|e| log::warn!("not watching sprite folders: {e}"))
+                    .ok()
+            };
+            gfx.sprite_watch = Some((dirs, watcher));
         }
-        let Some((_, _, Some(watcher))) = &gfx.sprite_watch else {
+        let Some((_, Some(watcher))) = &gfx.sprite_watch else {
             return;
         };
         let changed = watcher.poll();
-        if !changed.is_empty() && gfx.renderer.frame.sprites.invalidate(&changed) {
+        if !changed.is_empty() && gfx.player.reload_sprites(&changed) {
             log::info!("sprite changed on disk, reloading");
         }
     }
@@ -826,23 +784,20 @@ impl App {
         gfx.reload_changed_shaders(&mut self.state);
         gfx.apply_running(&mut self.state);
         let cpu_start = Instant::now();
-        if let Err(err) = gfx.simulate(&mut self.state, frame_dt_secs) {
-            // Keep the editor alive: pause and show why, the user can fix and resume.
-            log::error!("{err:#}");
-            self.state.playback.is_paused = true;
-            self.state.sim_error = Some(format!("{err:#}"));
-        }
+        gfx.simulate(&mut self.state, frame_dt_secs);
 
-        // 3. The viewport image: particles → HDR → tonemap, then a copy egui can show.
+        // 3. The viewport image: the player's frame → HDR → tonemap, then a copy egui can
+        // show.
         gfx.profiler.end_stage(&gfx.ctx);
-        gfx.renderer.exposure = self.state.view.exposure;
-        gfx.renderer.draft = self.state.view.draft;
-        gfx.renderer.asset_dir = self
-            .state
-            .loaded_path
-            .as_deref()
-            .and_then(std::path::Path::parent)
-            .map(std::path::Path::to_path_buf);
+        gfx.composite.exposure = self.state.view.exposure;
+        gfx.composite.draft = self.state.view.draft;
+        gfx.player.set_asset_dir(
+            self.state
+                .loaded_path
+                .as_deref()
+                .and_then(std::path::Path::parent)
+                .map(std::path::Path::to_path_buf),
+        );
         let mut encoder = gfx
             .ctx
             .device
@@ -850,56 +805,27 @@ impl App {
                 label: Some("editor::viewport"),
             });
         let timing = gfx.pass_timer.as_mut().is_some_and(|t| t.begin_frame());
-        let (steps, dt_secs) = gfx.pending_steps;
-        if steps > 0 {
-            let plans = gfx.sim.plan(&gfx.frame_effect, dt_secs, steps as usize);
-            let Gfx {
-                sim,
-                frame_effect,
-                pass_timer,
-                ..
-            } = &mut *gfx;
-            match pass_timer.as_mut().filter(|_| timing) {
-                Some(t) => t.scope(&mut encoder, "update", |enc| {
-                    sim.record(enc, frame_effect, &plans)
-                }),
-                None => sim.record(&mut encoder, frame_effect, &plans),
-            }
-        }
         {
             let Gfx {
-                renderer,
+                composite,
+                player,
                 ctx,
-                sim,
-                frame_effect,
                 pass_timer,
-                last_alpha,
                 viewport_px,
                 ..
             } = &mut *gfx;
-            let mut draw = |enc: &mut wgpu::CommandEncoder| {
-                renderer.record(
-                    ctx,
-                    enc,
-                    sim,
-                    frame_effect,
-                    &self.camera,
-                    *last_alpha,
-                    *viewport_px,
-                );
-            };
+            let camera = self.camera.view(*viewport_px);
             match pass_timer.as_mut().filter(|_| timing) {
-                Some(t) => t.scope(&mut encoder, "draw + composite", draw),
-                None => draw(&mut encoder),
+                Some(t) => {
+                    t.scope(&mut encoder, "update", |enc| player.simulate(enc));
+                    t.scope(&mut encoder, "draw + composite", |enc| {
+                        composite.record(ctx, enc, player, &camera)
+                    });
+                }
+                None => composite.record(ctx, &mut encoder, player, &camera),
             }
         }
-        self.state.sprite_errors = gfx
-            .renderer
-            .frame
-            .sprite_errors
-            .iter()
-            .map(|(i, e)| (*i, e.to_string()))
-            .collect();
+        self.state.sprite_errors = gfx.player.sprite_errors();
         if let Some(t) = gfx.pass_timer.as_mut().filter(|_| timing) {
             t.end_frame(&mut encoder);
         }
@@ -918,7 +844,7 @@ impl App {
             self.state.frame_requested = false;
             gfx.frame_camera(&mut self.camera);
         }
-        gfx.refresh_counters(&mut self.state, false);
+        gfx.refresh_stats(&mut self.state, false);
         if gfx.frame_index > 1 {
             self.state.stats.push_frame(frame_dt_secs as f32, cpu_secs);
             gfx.frame_log.push(frame_dt_secs as f32);
@@ -1117,7 +1043,7 @@ impl App {
             }
             return Ok(false);
         }
-        gfx.refresh_counters(&mut self.state, true);
+        gfx.refresh_stats(&mut self.state, true);
         let warm = gfx.frame_log.len().min(WARMUP_FRAMES);
         self.report = Some(RunReport {
             frames: gfx.frame_index as u32,

@@ -8,7 +8,6 @@ pub mod app;
 pub mod look;
 pub mod panel;
 pub mod profile;
-pub mod remap;
 pub mod retained;
 pub mod screenshot;
 pub mod state;

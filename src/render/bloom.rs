@@ -1,4 +1,4 @@
-//! Bloom: the HDR image (and the splat's light) thresholded into a half-resolution
+//! Bloom: the HDR image thresholded into a half-resolution
 //! chain of levels, blurred down and back up (`shaders/bloom.wgsl`); the tonemap adds the result.
 //! Nothing is recorded when the effect has no bloom.
 
@@ -14,16 +14,15 @@ pub struct BloomPass {
     pipelines: BloomPipelines,
     sampler: wgpu::Sampler,
     uniform: wgpu::Buffer,
-    no_splat: wgpu::Buffer,
     /// Bound in place of the glow layer when there is none.
     no_glow: wgpu::TextureView,
     chain: Option<Chain>,
 }
 
 struct BloomPipelines {
-    /// Indexed by `splat + 2 · quarter + 4 · glow`: with the splat's light, to a quarter
-    /// of the resolution (draft), with the draft glow layer.
-    prefilter: [wgpu::RenderPipeline; 8],
+    /// Indexed by `quarter + 2 · glow`: to a quarter of the resolution (draft), with the
+    /// draft glow layer.
+    prefilter: [wgpu::RenderPipeline; 4],
     down: wgpu::RenderPipeline,
     up: wgpu::RenderPipeline,
 }
@@ -50,10 +49,6 @@ impl BloomPass {
                 crate::gpu::fragment_texture_entry(0, true),
                 crate::gpu::fragment_sampler_entry(1),
                 crate::gpu::fragment_buffer_entry(2, wgpu::BufferBindingType::Uniform),
-                crate::gpu::fragment_buffer_entry(
-                    3,
-                    wgpu::BufferBindingType::Storage { read_only: true },
-                ),
                 crate::gpu::fragment_texture_entry(4, true),
             ],
         });
@@ -79,12 +74,6 @@ impl BloomPass {
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
-            no_splat: d.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("BloomPass::no_splat"),
-                size: 16,
-                usage: wgpu::BufferUsages::STORAGE,
-                mapped_at_creation: false,
-            }),
             no_glow: crate::gpu::texture_2d(
                 d,
                 "BloomPass::no_glow",
@@ -107,7 +96,7 @@ impl BloomPass {
         create_checked(&ctx.device, &composed, lib, |module| {
             let make = |fs: &str, blend: Option<wgpu::BlendState>, variant: usize| {
                 let b = |bit: usize| if variant & bit != 0 { 1.0 } else { 0.0 };
-                let constants = [("SPLAT", b(1)), ("QUARTER", b(2)), ("GLOW", b(4))];
+                let constants = [("QUARTER", b(1)), ("GLOW", b(2))];
                 crate::render::simple_pipeline(
                     ctx,
                     &format!("BloomPass::{fs}"),
@@ -137,13 +126,11 @@ impl BloomPass {
         Ok(())
     }
 
-    /// A bind group reading `src` (and `splat`'s light and the `glow` layer, for the
-    /// prefilter).
+    /// A bind group reading `src` (and the `glow` layer, for the prefilter).
     fn group(
         &self,
         ctx: &GpuContext,
         src: &wgpu::TextureView,
-        splat: Option<&wgpu::Buffer>,
         glow: Option<&wgpu::TextureView>,
     ) -> wgpu::BindGroup {
         ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -161,10 +148,6 @@ impl BloomPass {
                 wgpu::BindGroupEntry {
                     binding: 2,
                     resource: self.uniform.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: splat.unwrap_or(&self.no_splat).as_entire_binding(),
                 },
                 wgpu::BindGroupEntry {
                     binding: 4,
@@ -206,10 +189,7 @@ impl BloomPass {
                     .create_view(&Default::default())
                 })
                 .collect();
-            let groups = views
-                .iter()
-                .map(|v| self.group(ctx, v, None, None))
-                .collect();
+            let groups = views.iter().map(|v| self.group(ctx, v, None)).collect();
             self.chain = Some(Chain {
                 target_size,
                 levels,
@@ -220,8 +200,8 @@ impl BloomPass {
         }
     }
 
-    /// Records the bloom of `hdr` (plus `splat`'s light and the draft `glow` layer) and
-    /// returns the view the tonemap adds (level 0 of the chain). `draft` starts the chain at a quarter of the
+    /// Records the bloom of `hdr` (plus the draft `glow` layer) and returns the view the
+    /// tonemap adds (level 0 of the chain). `draft` starts the chain at a quarter of the
     /// resolution, one level shorter (the same reach): the half-resolution passes are
     /// most of the bloom's cost on a software rasteriser.
     #[allow(clippy::too_many_arguments)]
@@ -230,7 +210,6 @@ impl BloomPass {
         ctx: &GpuContext,
         enc: &mut wgpu::CommandEncoder,
         hdr: &wgpu::TextureView,
-        splat: Option<&wgpu::Buffer>,
         glow: Option<&wgpu::TextureView>,
         target_size: (u32, u32),
         settings: &Bloom,
@@ -247,14 +226,12 @@ impl BloomPass {
         let quarter = draft && settings.levels > 1;
         let levels = settings.levels - u32::from(quarter);
         self.ensure_chain(ctx, target_size, levels, quarter);
-        // The prefilter reads this frame's HDR target, splat light and glow layer; the
-        // chain's own bind groups are built with the chain.
-        let prefilter_group = self.group(ctx, hdr, splat, glow);
+        // The prefilter reads this frame's HDR target and glow layer; the chain's own bind
+        // groups are built with the chain.
+        let prefilter_group = self.group(ctx, hdr, glow);
         let chain = self.chain.as_ref()?;
         let p = &self.pipelines;
-        let variant = usize::from(splat.is_some())
-            + 2 * usize::from(quarter)
-            + 4 * usize::from(glow.is_some());
+        let variant = usize::from(quarter) + 2 * usize::from(glow.is_some());
         full_screen_pass(
             enc,
             &p.prefilter[variant],

@@ -5,7 +5,7 @@
 use std::collections::HashMap;
 
 use crate::gpu::GpuContext;
-use crate::render::billboard::ADDITIVE;
+use crate::render::billboard::{ADDITIVE, DrawTarget};
 use crate::render::frame::{DrawItem, FrameResources, StateVariant};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 use crate::sim::gpu_sim::dispatch_size;
@@ -16,7 +16,10 @@ pub const SPLAT_FIXED_SCALE: f32 = 4096.0;
 
 /// Compute splat + resolve.
 pub struct SplatPass {
+    target: DrawTarget,
     accum_layout: wgpu::BindGroupLayout,
+    /// A 1×1 depth texture bound when no host depth is tested.
+    no_depth: wgpu::TextureView,
     pipeline_layout: wgpu::PipelineLayout,
     resolve_layout: wgpu::PipelineLayout,
     empty_group: wgpu::BindGroup,
@@ -24,31 +27,72 @@ pub struct SplatPass {
     /// Splat pipelines per state variant, built on first use (`None`: failed, logged).
     splats: HashMap<StateVariant, Option<wgpu::ComputePipeline>>,
     resolve: wgpu::RenderPipeline,
-    accum: Option<((u32, u32), wgpu::Buffer, wgpu::BindGroup)>,
+    accum: Option<Accum>,
+}
+
+/// The accumulation buffer of one size and its bind group (with the depth it tests).
+struct Accum {
+    size: (u32, u32),
+    buffer: wgpu::Buffer,
+    group: wgpu::BindGroup,
+    depth: Option<wgpu::TextureView>,
+}
+
+/// The splat's depth test constant for a target (see splat.wgsl).
+fn depth_test(target: DrawTarget) -> f64 {
+    use wgpu::CompareFunction as C;
+    match target.depth.map(|(_, c)| c) {
+        Some(C::Less | C::LessEqual | C::Equal) => 1.0,
+        Some(C::Greater | C::GreaterEqual) => 2.0,
+        _ => 0.0,
+    }
 }
 
 impl SplatPass {
-    /// Builds the pipelines from `lib`.
+    /// Builds the pipelines from `lib`; the resolve draws into `target` (a pass with its
+    /// formats), and the splat tests against its depth when it has one.
     pub fn new(
         ctx: &GpuContext,
         lib: &ShaderLibrary,
         frame: &FrameResources,
+        target: DrawTarget,
     ) -> Result<Self, ShaderError> {
         let accum_layout = ctx
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("SplatPass::accum_layout"),
-                entries: &[wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::COMPUTE | wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: false },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
+                entries: &[
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 0,
+                        visibility: wgpu::ShaderStages::COMPUTE | wgpu::ShaderStages::FRAGMENT,
+                        ty: wgpu::BindingType::Buffer {
+                            ty: wgpu::BufferBindingType::Storage { read_only: false },
+                            has_dynamic_offset: false,
+                            min_binding_size: None,
+                        },
+                        count: None,
                     },
-                    count: None,
-                }],
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 1,
+                        visibility: wgpu::ShaderStages::COMPUTE,
+                        ty: wgpu::BindingType::Texture {
+                            sample_type: wgpu::TextureSampleType::Depth,
+                            view_dimension: wgpu::TextureViewDimension::D2,
+                            multisampled: false,
+                        },
+                        count: None,
+                    },
+                ],
             });
+        let no_depth = crate::gpu::texture_2d(
+            &ctx.device,
+            "SplatPass::no_depth",
+            (1, 1),
+            1,
+            wgpu::TextureFormat::Depth32Float,
+            wgpu::TextureUsages::TEXTURE_BINDING,
+        )
+        .create_view(&Default::default());
         let pipeline_layout = ctx
             .device
             .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -83,9 +127,12 @@ impl SplatPass {
                 ],
                 immediate_size: 0,
             });
-        let (module, splats, resolve) = Self::build(ctx, lib, &pipeline_layout, &resolve_layout)?;
+        let (module, splats, resolve) =
+            Self::build(ctx, lib, &pipeline_layout, &resolve_layout, target)?;
         Ok(Self {
+            target,
             accum_layout,
+            no_depth,
             pipeline_layout,
             resolve_layout,
             empty_group,
@@ -101,7 +148,10 @@ impl SplatPass {
         layout: &wgpu::PipelineLayout,
         module: &wgpu::ShaderModule,
         state: StateVariant,
+        target: DrawTarget,
     ) -> wgpu::ComputePipeline {
+        let [a, b] = state.constants();
+        let constants = [a, b, ("DEPTH_TEST", depth_test(target))];
         ctx.device
             .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(&format!("SplatPass::splat {state:?}")),
@@ -109,7 +159,7 @@ impl SplatPass {
                 module,
                 entry_point: Some("splat"),
                 compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &state.constants(),
+                    constants: &constants,
                     ..Default::default()
                 },
                 cache: None,
@@ -123,6 +173,7 @@ impl SplatPass {
         lib: &ShaderLibrary,
         layout: &wgpu::PipelineLayout,
         resolve_layout: &wgpu::PipelineLayout,
+        target: DrawTarget,
     ) -> Result<
         (
             wgpu::ShaderModule,
@@ -134,35 +185,81 @@ impl SplatPass {
         let composed = lib.compose("splat.wgsl")?;
         create_checked(&ctx.device, &composed, lib, |module| {
             let full = StateVariant::default();
-            let splats =
-                HashMap::from([(full, Some(Self::splat_pipeline(ctx, layout, module, full)))]);
-            let resolve = crate::render::simple_pipeline(
-                ctx,
-                "SplatPass::resolve",
-                resolve_layout,
-                module,
-                ("vs_resolve", "fs_resolve"),
-                crate::render::hdr_target(ADDITIVE),
-                &[],
-                wgpu::PrimitiveTopology::TriangleList,
-            );
+            let splats = HashMap::from([(
+                full,
+                Some(Self::splat_pipeline(ctx, layout, module, full, target)),
+            )]);
+            let resolve = Self::resolve_pipeline(ctx, resolve_layout, module, target);
             (module.clone(), splats, resolve)
         })
+    }
+
+    /// The resolve: a full-screen triangle adding the light into `target` (it passes
+    /// any depth test and writes no depth).
+    fn resolve_pipeline(
+        ctx: &GpuContext,
+        layout: &wgpu::PipelineLayout,
+        module: &wgpu::ShaderModule,
+        target: DrawTarget,
+    ) -> wgpu::RenderPipeline {
+        let color = wgpu::ColorTargetState {
+            format: target.color_format,
+            blend: Some(ADDITIVE),
+            write_mask: wgpu::ColorWrites::ALL,
+        };
+        ctx.device
+            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("SplatPass::resolve"),
+                layout: Some(layout),
+                vertex: wgpu::VertexState {
+                    module,
+                    entry_point: Some("vs_resolve"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState::default(),
+                depth_stencil: target.depth.map(|(format, _)| wgpu::DepthStencilState {
+                    format,
+                    depth_write_enabled: Some(false),
+                    depth_compare: Some(wgpu::CompareFunction::Always),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: wgpu::MultisampleState {
+                    count: target.sample_count.max(1),
+                    ..Default::default()
+                },
+                fragment: Some(wgpu::FragmentState {
+                    module,
+                    entry_point: Some("fs_resolve"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(color)],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
     }
 
     /// Rebuilds the pipelines; keeps the old ones on error. Other state variants are
     /// rebuilt on first use.
     pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
-        let (module, splats, resolve) =
-            Self::build(ctx, lib, &self.pipeline_layout, &self.resolve_layout)?;
+        let (module, splats, resolve) = Self::build(
+            ctx,
+            lib,
+            &self.pipeline_layout,
+            &self.resolve_layout,
+            self.target,
+        )?;
         self.module = module;
         self.splats = splats;
         self.resolve = resolve;
         Ok(())
     }
 
-    /// Clears the accumulation buffer and splats every splat item (compute). Returns
-    /// false when there was nothing to splat (then `resolve` can be skipped).
+    /// Clears the accumulation buffer and splats every splat item (compute), testing
+    /// against `depth` (the host's, single-sample and `size`) when given. Returns false
+    /// when there was nothing to splat (then `resolve` can be skipped).
+    #[allow(clippy::too_many_arguments)]
     pub fn splat(
         &mut self,
         ctx: &GpuContext,
@@ -170,28 +267,21 @@ impl SplatPass {
         frame: &FrameResources,
         items: &[DrawItem],
         size: (u32, u32),
+        depth: Option<&wgpu::TextureView>,
     ) -> bool {
         if !items.iter().any(|d| d.splat) {
+            // Nothing is resolved, and the host's depth is not held.
+            self.accum = None;
             return false;
         }
-        if self.accum.as_ref().is_none_or(|a| a.0 != size) {
-            let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("SplatPass::accum"),
-                size: size.0 as u64 * size.1 as u64 * 12,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("SplatPass::accum_group"),
-                layout: &self.accum_layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: buffer.as_entire_binding(),
-                }],
-            });
-            self.accum = Some((size, buffer, group));
+        if self
+            .accum
+            .as_ref()
+            .is_none_or(|a| a.size != size || a.depth.as_ref() != depth)
+        {
+            self.accum = Some(self.accum_for(ctx, size, depth));
         }
-        let Some((_, buffer, group)) = self.accum.as_ref() else {
+        let Some(Accum { buffer, group, .. }) = self.accum.as_ref() else {
             return false;
         };
         for d in items.iter().filter(|d| d.splat) {
@@ -200,7 +290,15 @@ impl SplatPass {
                 let p = crate::render::scoped_variant(
                     ctx,
                     format_args!("splat variant {state:?}"),
-                    || Self::splat_pipeline(ctx, &self.pipeline_layout, &self.module, state),
+                    || {
+                        Self::splat_pipeline(
+                            ctx,
+                            &self.pipeline_layout,
+                            &self.module,
+                            state,
+                            self.target,
+                        )
+                    },
                 );
                 self.splats.insert(state, p);
             }
@@ -231,16 +329,46 @@ impl SplatPass {
         true
     }
 
-    /// The accumulation buffer of the last splat (the tonemap reads it directly).
-    pub fn accum_buffer(&self) -> Option<&wgpu::Buffer> {
-        self.accum.as_ref().map(|a| &a.1)
+    /// A cleared-on-use accumulation buffer of `size` and its bind group over `depth`
+    /// (the placeholder when `None`: the shader then tests nothing).
+    fn accum_for(
+        &self,
+        ctx: &GpuContext,
+        size: (u32, u32),
+        depth: Option<&wgpu::TextureView>,
+    ) -> Accum {
+        let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("SplatPass::accum"),
+            size: (size.0 as u64 * size.1 as u64 * 12).max(12),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("SplatPass::accum_group"),
+            layout: &self.accum_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(depth.unwrap_or(&self.no_depth)),
+                },
+            ],
+        });
+        Accum {
+            size,
+            buffer,
+            group,
+            depth: depth.cloned(),
+        }
     }
 
-    /// Adds the accumulated light into the HDR target (inside an open render pass). The
-    /// renderer fuses this into the tonemap instead; kept for the bench and for targets
-    /// without a tonemap.
+    /// Adds the light of the last splat into an open render pass of the target's
+    /// formats (nothing when the last splat had nothing to do).
     pub fn resolve(&self, pass: &mut wgpu::RenderPass<'_>, frame: &FrameResources) {
-        let Some((_, _, group)) = self.accum.as_ref() else {
+        let Some(Accum { group, .. }) = self.accum.as_ref() else {
             return;
         };
         pass.set_pipeline(&self.resolve);

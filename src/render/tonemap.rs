@@ -1,20 +1,18 @@
-//! The composite: HDR (+ the compute splat's light, fused here) → exposure → ACES fit →
-//! sRGB display target.
+//! The tonemap: HDR (+ the reduced-resolution layers and the bloom) → exposure → ACES
+//! fit → sRGB display target.
 
 use crate::gpu::GpuContext;
 use crate::gpu::types::ToneUniform;
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 
-/// A full-screen tonemap pass, in sixteen variants: with and without the splat's light,
-/// the bloom, the reduced-resolution alpha layer and the draft glow layer.
+/// A full-screen tonemap pass, in eight variants: with and without the bloom, the
+/// reduced-resolution alpha layer and the draft glow layer.
 pub struct TonemapPass {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
-    /// Indexed by `splat + 2 · bloom + 4 · low_alpha + 8 · glow`.
-    pipelines: [wgpu::RenderPipeline; 16],
+    /// Indexed by `bloom + 2 · low_alpha + 4 · glow`.
+    pipelines: [wgpu::RenderPipeline; 8],
     uniform: wgpu::Buffer,
-    /// Bound in place of the splat buffer when nothing was splatted.
-    no_splat: wgpu::Buffer,
     /// Bound in place of the bloom chain when there is no bloom.
     no_bloom: wgpu::TextureView,
     sampler: wgpu::Sampler,
@@ -35,10 +33,6 @@ impl TonemapPass {
                 entries: &[
                     crate::gpu::fragment_texture_entry(0, false),
                     crate::gpu::fragment_buffer_entry(1, wgpu::BufferBindingType::Uniform),
-                    crate::gpu::fragment_buffer_entry(
-                        2,
-                        wgpu::BufferBindingType::Storage { read_only: true },
-                    ),
                     crate::gpu::fragment_texture_entry(3, true),
                     crate::gpu::fragment_sampler_entry(4),
                     crate::gpu::fragment_texture_entry(5, true),
@@ -57,12 +51,6 @@ impl TonemapPass {
             label: Some("TonemapPass::uniform"),
             size: size_of::<ToneUniform>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let no_splat = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("TonemapPass::no_splat"),
-            size: 16,
-            usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
         let no_bloom = crate::gpu::texture_2d(
@@ -85,7 +73,6 @@ impl TonemapPass {
             pipeline_layout,
             pipelines,
             uniform,
-            no_splat,
             no_bloom,
             sampler,
             format,
@@ -97,21 +84,20 @@ impl TonemapPass {
         lib: &ShaderLibrary,
         layout: &wgpu::PipelineLayout,
         format: wgpu::TextureFormat,
-    ) -> Result<[wgpu::RenderPipeline; 16], ShaderError> {
+    ) -> Result<[wgpu::RenderPipeline; 8], ShaderError> {
         let composed = lib.compose("tonemap.wgsl")?;
         create_checked(&ctx.device, &composed, lib, |module| {
             let make = |i: usize| {
-                let (splat, bloom, low, glow) = (i & 1 != 0, i & 2 != 0, i & 4 != 0, i & 8 != 0);
+                let (bloom, low, glow) = (i & 1 != 0, i & 2 != 0, i & 4 != 0);
                 let b = |v: bool| if v { 1.0 } else { 0.0 };
                 let constants = [
-                    ("SPLAT", b(splat)),
                     ("BLOOM", b(bloom)),
                     ("LOW_ALPHA", b(low)),
                     ("GLOW", b(glow)),
                 ];
                 crate::render::simple_pipeline(
                     ctx,
-                    &format!("TonemapPass splat={splat} bloom={bloom} low_alpha={low} glow={glow}"),
+                    &format!("TonemapPass bloom={bloom} low_alpha={low} glow={glow}"),
                     layout,
                     module,
                     ("vs_main", "fs_main"),
@@ -130,15 +116,14 @@ impl TonemapPass {
         Ok(())
     }
 
-    /// Records the tonemap from `hdr` (plus `splat`'s accumulated light, `bloom`'s glow ×
-    /// intensity, the `low_alpha` layer and the draft `glow` layer, when given) into `out`.
+    /// Records the tonemap from `hdr` (plus `bloom`'s glow × intensity, the `low_alpha`
+    /// layer and the draft `glow` layer, when given) into `out`.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         ctx: &GpuContext,
         enc: &mut wgpu::CommandEncoder,
         hdr: &wgpu::TextureView,
-        splat: Option<&wgpu::Buffer>,
         bloom: Option<(&wgpu::TextureView, f32)>,
         low_alpha: Option<&wgpu::TextureView>,
         glow: Option<&wgpu::TextureView>,
@@ -163,10 +148,6 @@ impl TonemapPass {
                 wgpu::BindGroupEntry {
                     binding: 1,
                     resource: self.uniform.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: splat.unwrap_or(&self.no_splat).as_entire_binding(),
                 },
                 wgpu::BindGroupEntry {
                     binding: 3,
@@ -206,10 +187,9 @@ impl TonemapPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        let variant = usize::from(splat.is_some())
-            + 2 * usize::from(bloom.is_some())
-            + 4 * usize::from(low_alpha.is_some())
-            + 8 * usize::from(glow.is_some());
+        let variant = usize::from(bloom.is_some())
+            + 2 * usize::from(low_alpha.is_some())
+            + 4 * usize::from(glow.is_some());
         pass.set_pipeline(&self.pipelines[variant]);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.draw(0..3, 0..1);

@@ -2,9 +2,16 @@
 //! host's wgpu frame — its compute work in the host's encoder, its particles in the
 //! host's render pass, tested against the host's depth buffer.
 
+mod editing;
+mod inspect;
 mod instances;
+mod layers;
 mod player;
+mod remap;
 
 pub use crate::render::Camera;
+pub use editing::PLAYER_SHADERS;
+pub use inspect::{ClockStats, EmitterStats, ParticleCount};
 pub use instances::InstanceId;
+pub use layers::Layers;
 pub use player::{Player, PlayerError, PlayerSettings};

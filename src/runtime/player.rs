@@ -9,9 +9,10 @@ use crate::effect::{Effect, TimeMode, ValidationError};
 use crate::gpu::GpuContext;
 use crate::render::billboard::{BillboardPass, DrawTarget};
 use crate::render::sort::SortPass;
-use crate::render::{Camera, DrawItem, FrameResources, Scene};
+use crate::render::{Camera, DrawItem, FrameResources, Scene, SplatPass};
+use crate::runtime::Layers;
 use crate::runtime::instances::{Backing, Instance, InstanceId, Slab};
-use crate::shaders::ShaderLibrary;
+use crate::shaders::{ShaderError, ShaderLibrary};
 use crate::sim::batch::{BatchMember, InstanceBatch, batchable};
 use crate::sim::gpu_sim::{SharedUpdate, SimError, SimState, UpdateMode};
 use crate::sim::{GpuSim, Stepper};
@@ -33,6 +34,14 @@ pub struct PlayerSettings {
     /// The folder the preset's PNG sprite paths are relative to (the preset's own
     /// folder); `None`: the working directory.
     pub asset_dir: Option<PathBuf>,
+    /// Batch instances (on by default): up to 16 instances share each emitter's buffers
+    /// and one update dispatch. Off, every instance has a simulation of its own: it
+    /// costs a dispatch per instance, and in return an edit ([`Player::set_effect`]) that
+    /// resizes a pool keeps the particles that fit — what an editor wants.
+    pub batch_instances: bool,
+    /// A folder of WGSL files to build the pipelines from instead of the shaders built
+    /// into the library (a host that edits them; see [`Player::reload_shader`]).
+    pub shader_dir: Option<PathBuf>,
 }
 
 impl PlayerSettings {
@@ -44,11 +53,13 @@ impl PlayerSettings {
             depth_compare: wgpu::CompareFunction::LessEqual,
             sample_count: 1,
             asset_dir: None,
+            batch_instances: true,
+            shader_dir: None,
         }
     }
 }
 
-/// Why a player could not be created or an instance added.
+/// Why a player could not be created, an instance added or an edit applied.
 #[derive(Debug, thiserror::Error)]
 pub enum PlayerError {
     /// The preset file could not be read.
@@ -60,6 +71,9 @@ pub enum PlayerError {
     /// A shader, a device limit or a GPU readback failed.
     #[error(transparent)]
     Sim(#[from] SimError),
+    /// The instance was removed.
+    #[error("no such instance (it was removed)")]
+    NoInstance,
 }
 
 fn list(errors: &[ValidationError]) -> String {
@@ -79,26 +93,33 @@ fn list(errors: &[ValidationError]) -> String {
 /// encoder (after the host's opaque pass when it hands over its depth for soft edges),
 /// then [`Player::draw`] inside the host's render pass.
 pub struct Player {
-    ctx: GpuContext,
-    effect: Effect,
-    library: ShaderLibrary,
-    update: SharedUpdate,
-    frame: FrameResources,
-    billboard: BillboardPass,
-    sort: SortPass,
-    instances: Slab<Instance>,
+    pub(super) ctx: GpuContext,
+    pub(super) effect: Effect,
+    pub(super) library: ShaderLibrary,
+    pub(super) update: SharedUpdate,
+    pub(super) frame: FrameResources,
+    pub(super) billboard: BillboardPass,
+    pub(super) splat: SplatPass,
+    pub(super) sort: SortPass,
+    pub(super) instances: Slab<Instance>,
     /// The batches of instances (when the effect can be batched; else each instance has
     /// a simulation of its own).
-    batches: Vec<InstanceBatch>,
-    batched: bool,
-    stepper: Stepper,
+    pub(super) batches: Vec<InstanceBatch>,
+    pub(super) batched: bool,
+    pub(super) stepper: Stepper,
     is_paused: bool,
     /// Steps planned by `advance` and not yet recorded, and their size.
     pending: (u32, f32),
+    /// The steps the last record ran, and their size.
+    pub(super) last_steps: (u32, f32),
     /// Where frames are drawn between the last two steps (fixed step).
     alpha: f32,
-    settings: PlayerSettings,
-    items: Vec<DrawItem>,
+    pub(super) settings: PlayerSettings,
+    pub(super) items: Vec<DrawItem>,
+    /// Whether the last record splatted light that `draw` resolves.
+    splatted: bool,
+    /// `simulate` ran since the last `record`, which then does not run it again.
+    simulated: bool,
 }
 
 /// Steps one `record` runs at most (the simulation's per-submit parameter ring); more
@@ -116,29 +137,22 @@ impl Player {
     ) -> Result<Self, PlayerError> {
         effect.validate().map_err(PlayerError::Invalid)?;
         let ctx = GpuContext::from_device(device, queue);
-        let library = ShaderLibrary::embedded();
-        // Instances are batched: one update dispatch per emitter and step for up to
-        // BATCH_SLOTS of them. Nobody reads alive counts every frame here: the update
-        // need not count them.
-        let batched = batchable(effect);
-        let mode = if batched {
-            UpdateMode::Batched
-        } else {
-            UpdateMode::Uncounted
+        let library = match &settings.shader_dir {
+            Some(dir) => ShaderLibrary::from_dir(dir),
+            None => ShaderLibrary::embedded(),
         };
-        let update = GpuSim::shared_update(&ctx, &library, effect, mode)?;
-        let mut frame = FrameResources::new(&ctx);
-        // Everything is drawn in the host's pass: no compute splat (it needs a target of
-        // its own).
-        frame.allow_splat = false;
+        let batched = settings.batch_instances && batchable(effect);
+        let update = GpuSim::shared_update(&ctx, &library, effect, update_mode(batched))?;
+        let frame = FrameResources::new(&ctx);
         let target = DrawTarget {
             color_format: settings.color_format,
             depth: settings.depth_format.map(|f| (f, settings.depth_compare)),
             sample_count: settings.sample_count.max(1),
         };
-        let billboard =
-            BillboardPass::new(&ctx, &library, &frame, target).map_err(SimError::from)?;
-        let sort = SortPass::new(&ctx, &library).map_err(SimError::from)?;
+        let shader = |e: ShaderError| PlayerError::Sim(e.into());
+        let billboard = BillboardPass::new(&ctx, &library, &frame, target).map_err(shader)?;
+        let splat = SplatPass::new(&ctx, &library, &frame, target).map_err(shader)?;
+        let sort = SortPass::new(&ctx, &library).map_err(shader)?;
         Ok(Self {
             ctx,
             effect: effect.clone(),
@@ -146,6 +160,7 @@ impl Player {
             update,
             frame,
             billboard,
+            splat,
             sort,
             instances: Slab::default(),
             batches: Vec::new(),
@@ -153,9 +168,12 @@ impl Player {
             stepper: Stepper::default(),
             is_paused: false,
             pending: (0, 0.0),
+            last_steps: (0, 0.0),
             alpha: 1.0,
             settings,
             items: Vec::new(),
+            splatted: false,
+            simulated: false,
         })
     }
 
@@ -178,13 +196,7 @@ impl Player {
         seed: u32,
     ) -> Result<InstanceId, PlayerError> {
         let effect = Instance::effect_for(&self.effect, world_from_effect, seed);
-        let state = if self.batched {
-            self.batch_slot(seed)?
-        } else {
-            let update = self.update.clone();
-            let sim = GpuSim::with_update(&self.ctx, self.library.clone(), update, &effect)?;
-            Backing::Own(Box::new(sim))
-        };
+        let state = self.backing(&effect)?;
         Ok(self.instances.insert(Instance {
             state,
             effect,
@@ -192,17 +204,23 @@ impl Player {
         }))
     }
 
-    /// A free slot in a batch, in a new batch when every one is full (the others are not
-    /// touched).
-    fn batch_slot(&mut self, seed: u32) -> Result<Backing, PlayerError> {
+    /// Where a new instance running `placed` (its seed and place) keeps its particles: a
+    /// free batch slot (a new batch when every one is full; the others are not touched),
+    /// or a simulation of its own.
+    pub(super) fn backing(&mut self, placed: &Effect) -> Result<Backing, PlayerError> {
+        if !self.batched {
+            let update = self.update.clone();
+            let sim = GpuSim::with_update(&self.ctx, self.library.clone(), update, placed)?;
+            return Ok(Backing::Own(Box::new(sim)));
+        }
         for (batch, b) in self.batches.iter_mut().enumerate() {
-            if let Some(slot) = b.insert(seed) {
+            if let Some(slot) = b.insert(placed.seed) {
                 return Ok(Backing::Batched { batch, slot });
             }
         }
         let mut b = InstanceBatch::new(&self.ctx, self.update.clone(), &self.effect)?;
         let slot = b
-            .insert(seed)
+            .insert(placed.seed)
             .ok_or_else(|| SimError::Readback("a new batch is full".into()))?;
         self.batches.push(b);
         Ok(Backing::Batched {
@@ -269,6 +287,23 @@ impl Player {
         self.alpha = plan.alpha;
     }
 
+    /// Plans exactly one more step for the next [`Player::record`], paused or not (a
+    /// frame-by-frame look): the preset's fixed step, or a 60 Hz frame in frame-delta
+    /// mode. Frames are then drawn at that step, not between two.
+    pub fn step(&mut self) {
+        let time = &self.effect.time;
+        let dt_secs = match time.mode {
+            TimeMode::FixedStep => time.step_secs,
+            TimeMode::FrameDelta => time.max_frame_dt_secs.min(1.0 / 60.0),
+        };
+        let steps = match time.mode {
+            TimeMode::FixedStep => (self.pending.0 + 1).min(MAX_STEPS_PER_RECORD),
+            TimeMode::FrameDelta => 1,
+        };
+        self.pending = (steps, dt_secs);
+        self.alpha = 1.0;
+    }
+
     /// Pauses or resumes the clock (a paused effect is still drawn).
     pub fn set_paused(&mut self, is_paused: bool) {
         self.is_paused = is_paused;
@@ -295,19 +330,23 @@ impl Player {
     }
 
     /// Records this frame's compute work into the host's encoder — the planned steps of
-    /// every instance, then the back-to-front sort of alpha-blended layers for `camera` —
-    /// and uploads the draw's uniforms. `scene_depth` is the host's depth buffer as a
-    /// single-sample view the size of the target (with `TEXTURE_BINDING` usage), for
-    /// soft edges where particles meet the host's geometry; without it the preset's
-    /// ground plane softens them. Call it once per submitted encoder (its uploads go
-    /// through the queue); draw the result in as many passes as needed.
+    /// every instance, the back-to-front sort of alpha-blended layers for `camera`, and
+    /// the compute splat of small additive particles — and uploads the draw's uniforms.
+    /// `scene_depth` is the host's depth buffer as a single-sample view the size of the
+    /// target (with `TEXTURE_BINDING` usage): soft edges fade where particles meet the
+    /// host's geometry, and splatted particles behind it are hidden. Without it the
+    /// preset's ground plane softens them. Call it once per submitted encoder (its
+    /// uploads go through the queue); draw the result in as many passes as needed.
     pub fn record(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         camera: &Camera,
         scene_depth: Option<&wgpu::TextureView>,
     ) {
-        self.simulate(encoder);
+        if !std::mem::take(&mut self.simulated) {
+            self.simulate(encoder);
+            self.simulated = false;
+        }
         let depth = scene_depth.filter(|_| self.settings.depth_format.is_some());
         self.billboard.set_scene_depth(&self.ctx, depth);
         self.frame.soft_depth = depth.is_some();
@@ -348,6 +387,14 @@ impl Player {
             .prepare(&self.ctx, &self.items, &self.frame.sprites.sampler);
         self.sort
             .record_items(&self.ctx, encoder, &scenes, &self.items, camera);
+        self.splatted = self.splat.splat(
+            &self.ctx,
+            encoder,
+            &self.frame,
+            &self.items,
+            camera.size_px(),
+            depth,
+        );
     }
 
     /// The instances far to near, by depth along the view: far instances' smoke lies
@@ -361,13 +408,18 @@ impl Player {
         order
     }
 
-    /// Records the steps `advance` planned for every instance.
-    fn simulate(&mut self, encoder: &mut wgpu::CommandEncoder) {
+    /// Records only the steps [`Player::advance`] planned for every instance, with no sort
+    /// or draw preparation: for a frame that steps without drawing (a hidden window, a
+    /// warm-up), or to time the update on its own. [`Player::record`] does this first
+    /// unless it was called since the last record.
+    pub fn simulate(&mut self, encoder: &mut wgpu::CommandEncoder) {
         // New instances' segments are cleared before any step of this record.
         for batch in &mut self.batches {
             batch.clear_taken(encoder);
         }
         let (steps, dt_secs) = std::mem::take(&mut self.pending);
+        self.last_steps = (steps, dt_secs);
+        self.simulated = true;
         if steps == 0 {
             return;
         }
@@ -390,13 +442,6 @@ impl Player {
             let Backing::Own(sim) = &mut instance.state else {
                 continue;
             };
-            if let Err(err) = sim.sync(&instance.effect) {
-                log::error!(
-                    "ignis: an instance of {:?} cannot run: {err}",
-                    self.effect.name
-                );
-                continue;
-            }
             let plans = sim.plan(&instance.effect, dt_secs, steps as usize);
             sim.record_into(encoder, &mut pass, &instance.effect, &plans);
         }
@@ -410,42 +455,41 @@ impl Player {
     /// attachment must be read-only (`depth_ops: None`) when the depth is also handed to
     /// [`Player::record`] for soft edges.
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
-        self.billboard
-            .draw(pass, &self.frame, &self.items, |_| true);
+        self.draw_layers(pass, Layers::ALL);
     }
 
-    /// Sprite files that failed to load at the last `record` (the emitter draws with a
-    /// built-in sprite instead), as messages naming the emitter and the file.
-    pub fn sprite_errors(&self) -> Vec<String> {
-        self.frame
-            .sprite_errors
-            .iter()
-            .map(|(i, e)| format!("emitter {i}: {e}"))
-            .collect()
+    /// Draws the `layers` of every instance's particles into the host's open render pass
+    /// (as [`Player::draw`]): a host can send the soft layers to reduced-resolution
+    /// targets of its own and draw the rest at full resolution.
+    pub fn draw_layers(&self, pass: &mut wgpu::RenderPass<'_>, layers: Layers) {
+        self.billboard.draw(pass, &self.frame, &self.items, |d| {
+            layers.contains(Layers::of(d))
+        });
+        if self.splatted && layers.contains(Layers::LIGHT) {
+            self.splat.resolve(pass, &self.frame);
+        }
     }
 
-    /// The effect instance `id` runs: the player's, with the instance's seed and its
-    /// emitters placed in the world (tests compare it with a simulation of its own).
-    #[doc(hidden)]
-    pub fn instance_effect(&self, id: InstanceId) -> Option<&Effect> {
-        self.instances.get(id).map(|i| &i.effect)
+    /// The layers that hold particles to draw, as last recorded.
+    pub fn drawn_layers(&self) -> Layers {
+        let mut layers = Layers::NONE;
+        for d in self.items.iter().filter(|d| !d.splat) {
+            layers |= Layers::of(d);
+        }
+        if self.splatted {
+            layers |= Layers::LIGHT;
+        }
+        layers
     }
+}
 
-    /// Emitter `emitter`'s particles in instance `id` (a blocking readback, for tests
-    /// that compare instances bit for bit). `None` if `id` was removed.
-    #[doc(hidden)]
-    pub fn read_particles(
-        &self,
-        id: InstanceId,
-        emitter: usize,
-    ) -> Option<Result<Vec<crate::gpu::types::Particle>, SimError>> {
-        self.instances.get(id).map(|i| match &i.state {
-            Backing::Own(sim) => sim.read_particles(emitter),
-            Backing::Batched { batch, slot } => match self.batches.get(*batch) {
-                Some(b) => b.read_particles(*slot, emitter),
-                None => Err(SimError::Readback("no such batch".into())),
-            },
-        })
+/// The update pipelines' specialisation for a player. Nobody reads alive counts every
+/// frame here: the update need not count them (they are counted on demand).
+pub(super) fn update_mode(batched: bool) -> UpdateMode {
+    if batched {
+        UpdateMode::Batched
+    } else {
+        UpdateMode::Uncounted
     }
 }
 

@@ -11,10 +11,10 @@
 
 use crate::effect::Effect;
 use crate::gpu::GpuContext;
-use crate::gpu::types::{Particle, SimParams, StateLayout};
+use crate::gpu::types::{PackedParticle, Particle, SimParams, StateLayout};
 use crate::sim::gpu_sim::{
     EmitterBuffers, SLOTS_PER_INVOCATION, SharedUpdate, SimError, SimState, dispatch_size, lock,
-    pipeline_key, read_buffer,
+    packed_life, pipeline_key, read_buffer,
 };
 use crate::sim::modules::Modules;
 use crate::sim::planner::{EffectPlanner, LiveWindow};
@@ -206,6 +206,13 @@ impl InstanceBatch {
         }
     }
 
+    /// Gives `slot`'s instance a new seed (for particles born from now on).
+    pub fn set_seed(&mut self, slot: u32, seed: u32) {
+        if let Some(Some(m)) = self.members.get_mut(slot as usize) {
+            m.seed = seed;
+        }
+    }
+
     /// Frees `slot`.
     pub fn remove(&mut self, slot: u32) {
         if let Some(m) = self.members.get_mut(slot as usize) {
@@ -324,17 +331,12 @@ impl InstanceBatch {
         })
     }
 
-    /// Emitter `e`'s particles of instance `slot` (a blocking readback; full state only).
+    /// Emitter `e`'s particles of instance `slot` (a blocking readback).
     pub fn read_particles(&self, slot: u32, e: usize) -> Result<Vec<Particle>, SimError> {
-        let pool = self
-            .pools
-            .get(e)
-            .ok_or_else(|| SimError::Readback(format!("no emitter {e}")))?;
-        if pool.layout != StateLayout::Full {
-            return Err(SimError::Readback(
-                "reading a batched packed pool is not supported".into(),
-            ));
-        }
+        let (Some(pool), Some(Some(member))) = (self.pools.get(e), self.members.get(slot as usize))
+        else {
+            return Err(SimError::Readback(format!("no emitter {e} in slot {slot}")));
+        };
         let bytes = pool.layout.bytes(pool.capacity);
         let all = read_buffer(
             &self.ctx,
@@ -342,7 +344,24 @@ impl InstanceBatch {
             bytes * u64::from(self.slots),
         )?;
         let segment = &all[(bytes * u64::from(slot)) as usize..][..bytes as usize];
-        Ok(bytemuck::pod_collect_to_vec(segment))
+        if pool.layout == StateLayout::Full {
+            return Ok(bytemuck::pod_collect_to_vec(segment));
+        }
+        let total = member
+            .planner
+            .emitters
+            .get(e)
+            .map_or(0, |p| p.spawned_total());
+        let packed: Vec<PackedParticle> = bytemuck::pod_collect_to_vec(segment);
+        Ok(packed
+            .iter()
+            .enumerate()
+            .map(|(i, q)| {
+                let key = (member.seed, pool.salt);
+                let (_, life) = packed_life(pool.capacity, total, key, pool.life_range, i as u32);
+                q.unpack(life)
+            })
+            .collect())
     }
 }
 

@@ -238,7 +238,7 @@ impl UpdatePass {
         Ok(())
     }
 
-    fn ensure(
+    pub(crate) fn ensure(
         &mut self,
         ctx: &GpuContext,
         lib: &ShaderLibrary,
@@ -285,6 +285,21 @@ struct EmitterState {
     /// The spawn counter after the last recorded step (equal to the planner's when the
     /// steps came from it; otherwise the live window is unknown).
     spawned_end: u64,
+}
+
+/// The spawn counter and lifetime of `slot` in a ring of `capacity` slots after `total`
+/// spawns (packed and tiny state re-derive lifetimes rather than store them).
+pub(crate) fn packed_life(
+    capacity: u32,
+    total: u64,
+    (seed, salt): (u32, u32),
+    life_range: (f32, f32),
+    slot: u32,
+) -> (u64, f32) {
+    let c = slot_counter(slot, total, capacity);
+    let key = crate::rng::spawn_key(seed, salt, slot, c);
+    let r = crate::rng::unorm4(crate::rng::rand_block(key, 1))[3];
+    (c, crate::sim::planner::mix(life_range.0, life_range.1, r))
 }
 
 /// Buffer generations, unique in the process: the draws' bind-group caches key on them,
@@ -996,18 +1011,10 @@ impl GpuSim {
         if s.layout == StateLayout::Full {
             return Ok(bytemuck::pod_collect_to_vec(&bytes));
         }
-        // Unpack with each slot's lifetime re-derived from its spawn counter.
         let planner = self.planner.emitters.get(index);
         let total = planner.map_or(0, |p| p.spawned_total());
-        let life_of = |slot: u32| {
-            let c = slot_counter(slot, total, s.capacity);
-            let key = crate::rng::spawn_key(s.seed, s.salt, slot, c);
-            let r = crate::rng::unorm4(crate::rng::rand_block(key, 1))[3];
-            (
-                c,
-                crate::sim::planner::mix(s.life_range.0, s.life_range.1, r),
-            )
-        };
+        let life_of =
+            |slot: u32| packed_life(s.capacity, total, (s.seed, s.salt), s.life_range, slot);
         let packed: Vec<PackedParticle> = bytemuck::pod_collect_to_vec(&bytes);
         if s.layout == StateLayout::Packed {
             return Ok(packed

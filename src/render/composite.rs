@@ -1,0 +1,214 @@
+//! [`Composite`]: the host that the editor's viewport, `ignis render` and the headless
+//! tests are — a client of the public [`Player`] API like any embedding program. It
+//! draws the player's layers into an HDR target of its own (the soft ones at reduced
+//! resolution when the preset or draft quality asks), then its bloom and tonemap into a
+//! display image.
+
+use crate::gpu::GpuContext;
+use crate::render::bloom::BloomPass;
+use crate::render::{
+    Camera, HDR_FORMAT, Targets, TonemapPass, begin_hdr_pass, ensure_layer, reduced,
+};
+use crate::runtime::{Layers, Player, PlayerSettings};
+use crate::shaders::{ShaderError, ShaderLibrary};
+use crate::sim::gpu_sim::{SimError, map_read};
+
+/// The composite's own WGSL entry files (the player's are [`crate::PLAYER_SHADERS`]).
+pub const COMPOSITE_SHADERS: &[&str] = &["tonemap.wgsl", "bloom.wgsl"];
+
+/// HDR target, reduced-resolution layers, bloom and tonemap around a [`Player`].
+pub struct Composite {
+    /// The tonemap pass.
+    pub tonemap: TonemapPass,
+    /// The bloom passes (recorded only when the effect has bloom).
+    pub bloom: BloomPass,
+    targets: Option<Targets>,
+    /// Exposure multiplier applied before tonemapping (times the effect's own).
+    pub exposure: f32,
+    /// Draft quality (the editor's default on software adapters): the glow layer
+    /// ([`Layers::GLOW`], e.g. flame tongues) is drawn at half resolution into a layer
+    /// the bloom's prefilter and the tonemap read — a quarter of its fill; the blended
+    /// layer at half the resolution `post.alpha_downscale` asks for.
+    pub draft: bool,
+    /// The reduced-resolution target of the blended layer (`post.alpha_downscale`).
+    alpha_layer: Option<((u32, u32), wgpu::TextureView)>,
+    /// The half-resolution target of the glow layer (draft).
+    glow_layer: Option<((u32, u32), wgpu::TextureView)>,
+}
+
+impl Composite {
+    /// Builds the composite's pipelines from `lib`.
+    pub fn new(ctx: &GpuContext, lib: &ShaderLibrary) -> Result<Self, ShaderError> {
+        Ok(Self {
+            tonemap: TonemapPass::new(ctx, lib, crate::render::LDR_FORMAT)?,
+            bloom: BloomPass::new(ctx, lib)?,
+            targets: None,
+            exposure: 1.0,
+            draft: false,
+            alpha_layer: None,
+            glow_layer: None,
+        })
+    }
+
+    /// The settings of a player that draws into this composite.
+    pub fn player_settings() -> PlayerSettings {
+        PlayerSettings::new(HDR_FORMAT)
+    }
+
+    /// Rebuilds the pipelines built from `entry` (one of [`COMPOSITE_SHADERS`]), keeping
+    /// the old ones on error.
+    pub fn reload_shader(
+        &mut self,
+        ctx: &GpuContext,
+        lib: &ShaderLibrary,
+        entry: &str,
+    ) -> Result<(), ShaderError> {
+        match entry {
+            "tonemap.wgsl" => self.tonemap.rebuild(ctx, lib),
+            "bloom.wgsl" => self.bloom.rebuild(ctx, lib),
+            _ => Ok(()),
+        }
+    }
+
+    /// The targets, (re)created at `size` when needed.
+    pub fn targets(&mut self, ctx: &GpuContext, size: (u32, u32)) -> &Targets {
+        if self.targets.as_ref().is_some_and(|t| t.size != size) {
+            self.targets = None;
+        }
+        self.targets.get_or_insert_with(|| Targets::new(ctx, size))
+    }
+
+    /// The targets of the last frame, if any.
+    pub fn targets_ref(&self) -> Option<&Targets> {
+        self.targets.as_ref()
+    }
+
+    /// Records `player`'s frame for `camera` (its compute work, then its layers into the
+    /// HDR target) and the bloom and tonemap into the display image.
+    pub fn record(
+        &mut self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        player: &mut Player,
+        camera: &Camera,
+    ) {
+        player.record(enc, camera, None);
+        let size = self.targets(ctx, camera.size_px()).size;
+        let post = player.effect().post.clone();
+        let drawn = player.drawn_layers();
+        let mut layered = Layers::NONE;
+        // The blended layer at reduced resolution (draft halves it again: soft smoke
+        // hides it), added in the tonemap.
+        let downscale = post.alpha_downscale.clamp(1, 4) << u32::from(self.draft);
+        if downscale > 1 && drawn.contains(Layers::BLENDED) {
+            let low = reduced(size, downscale);
+            ensure_layer(ctx, &mut self.alpha_layer, "Composite::alpha_layer", low);
+            if let Some((_, view)) = &self.alpha_layer {
+                player.draw_layers(&mut begin_hdr_pass(enc, view), Layers::BLENDED);
+                layered |= Layers::BLENDED;
+            }
+        }
+        if self.draft && drawn.contains(Layers::GLOW) {
+            let half = reduced(size, 2);
+            ensure_layer(ctx, &mut self.glow_layer, "Composite::glow_layer", half);
+            if let Some((_, view)) = &self.glow_layer {
+                player.draw_layers(&mut begin_hdr_pass(enc, view), Layers::GLOW);
+                layered |= Layers::GLOW;
+            }
+        }
+        let Some(targets) = self.targets.as_ref() else {
+            return;
+        };
+        player.draw_layers(
+            &mut begin_hdr_pass(enc, &targets.hdr_view),
+            Layers::ALL.without(layered),
+        );
+        let low_alpha = layer_view(&self.alpha_layer, layered.contains(Layers::BLENDED));
+        let glow = layer_view(&self.glow_layer, layered.contains(Layers::GLOW));
+        // The glow layer joins the image in the bloom's prefilter and in the tonemap
+        // (upsampled bilinearly there): no pass of its own.
+        let bloom = post.bloom.as_ref().and_then(|b| {
+            let view = self.bloom.record(
+                ctx,
+                enc,
+                &targets.hdr_view,
+                glow,
+                targets.size,
+                b,
+                self.draft,
+            )?;
+            Some((view, b.intensity))
+        });
+        self.tonemap.record(
+            ctx,
+            enc,
+            &targets.hdr_view,
+            bloom,
+            low_alpha,
+            glow,
+            &targets.ldr_view,
+            self.exposure * post.exposure,
+        );
+    }
+
+    /// Renders `player`'s frame for `camera` and reads it back as an RGBA8 image
+    /// (blocking).
+    pub fn render_image(
+        &mut self,
+        ctx: &GpuContext,
+        player: &mut Player,
+        camera: &Camera,
+    ) -> Result<image::RgbaImage, SimError> {
+        let mut enc = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("Composite::render_image"),
+            });
+        self.record(ctx, &mut enc, player, camera);
+        let Some(targets) = self.targets.as_ref() else {
+            return Err(SimError::Readback("no render target".into()));
+        };
+        let (w, h) = targets.size;
+        let row = (w * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("Composite::readback"),
+            size: row as u64 * h as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        enc.copy_texture_to_buffer(
+            targets.ldr.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &staging,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: Some(h),
+                },
+            },
+            wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+        );
+        ctx.queue.submit([enc.finish()]);
+        let bytes = map_read(ctx, &staging)?;
+        let mut pixels = Vec::with_capacity((w * h * 4) as usize);
+        for y in 0..h as usize {
+            let start = y * row as usize;
+            pixels.extend_from_slice(&bytes[start..start + (w * 4) as usize]);
+        }
+        image::RgbaImage::from_raw(w, h, pixels)
+            .ok_or_else(|| SimError::Readback("image size mismatch".into()))
+    }
+}
+
+/// The view of a layer target, if it was drawn this frame.
+fn layer_view(
+    slot: &Option<((u32, u32), wgpu::TextureView)>,
+    drawn: bool,
+) -> Option<&wgpu::TextureView> {
+    slot.as_ref().filter(|_| drawn).map(|(_, v)| v)
+}

@@ -1,0 +1,210 @@
+//! Live changes to a playing [`Player`]: a new version of its effect (an edit, a preset
+//! saved again), WGSL and PNG sprites changed on disk. None of them waits for the GPU or
+//! loses the particles of an emitter that survives the change.
+
+use std::path::{Path, PathBuf};
+
+use crate::effect::Effect;
+use crate::gpu::types::StateLayout;
+use crate::runtime::instances::{Backing, Instance};
+use crate::runtime::player::update_mode;
+use crate::runtime::remap::emitter_sources;
+use crate::runtime::{InstanceId, Player, PlayerError};
+use crate::shaders::{ShaderError, ShaderLibrary};
+use crate::sim::Modules;
+use crate::sim::batch::batchable;
+use crate::sim::gpu_sim::{lock, used_keys};
+use crate::sim::{GpuSim, SimError};
+
+/// The WGSL entry files a player's pipelines are built from (see
+/// [`Player::reload_shader`]); their imports are found from these.
+pub const PLAYER_SHADERS: &[&str] = &[
+    "update.wgsl",
+    "count.wgsl",
+    "billboard.wgsl",
+    "splat.wgsl",
+    "sort.wgsl",
+];
+
+impl Player {
+    /// Plays `effect` from now on, keeping every instance and its particles: emitters are
+    /// matched by name (a renamed, added, removed or reordered emitter keeps the right
+    /// pool), and a resized pool keeps the particles that fit. Pipelines the edit needs
+    /// are built now. With batched instances, an edit that changes an emitter's pool
+    /// size or state layout, or the list of emitters, restarts the instances (their
+    /// shared buffers are laid out by the pools). On error nothing changes.
+    pub fn set_effect(&mut self, effect: &Effect) -> Result<(), PlayerError> {
+        if *effect == self.effect {
+            return Ok(());
+        }
+        effect.validate().map_err(PlayerError::Invalid)?;
+        let batched = self.settings.batch_instances && batchable(effect);
+        if batched != self.batched {
+            self.update =
+                GpuSim::shared_update(&self.ctx, &self.library, effect, update_mode(batched))?;
+        } else {
+            let mut update = lock(&self.update);
+            for key in used_keys(effect) {
+                update
+                    .ensure(&self.ctx, &self.library, key)
+                    .map_err(SimError::from)?;
+            }
+        }
+        if batched {
+            let keep = self.batched && batch_shape(&self.effect) == batch_shape(effect);
+            self.effect = effect.clone();
+            self.batched = true;
+            if keep {
+                self.replace_effects();
+            } else {
+                self.rebuild_instances()?;
+            }
+            return Ok(());
+        }
+        if !self.batched {
+            return self.edit_own(effect);
+        }
+        self.effect = effect.clone();
+        self.batched = false;
+        self.rebuild_instances()
+    }
+
+    /// Every instance's copy of the effect follows the player's (seed and place kept).
+    fn replace_effects(&mut self) {
+        for i in self.instances.iter_mut() {
+            i.effect = Instance::effect_for(&self.effect, i.world_from_effect, i.effect.seed);
+        }
+    }
+
+    /// New buffers for every instance (each starts empty, its clock at 0).
+    fn rebuild_instances(&mut self) -> Result<(), PlayerError> {
+        self.batches.clear();
+        self.replace_effects();
+        let placed: Vec<Effect> = self.instances.iter().map(|i| i.effect.clone()).collect();
+        let mut backings = Vec::with_capacity(placed.len());
+        for p in &placed {
+            backings.push(self.backing(p)?);
+        }
+        for (i, b) in self.instances.iter_mut().zip(backings) {
+            i.state = b;
+        }
+        Ok(())
+    }
+
+    /// Instances with simulations of their own follow an edit in place; if any refuses
+    /// it (a device limit), every one goes back to the old effect.
+    fn edit_own(&mut self, effect: &Effect) -> Result<(), PlayerError> {
+        let forward = emitter_sources(&self.effect, effect);
+        let back = emitter_sources(effect, &self.effect);
+        let old = std::mem::replace(&mut self.effect, effect.clone());
+        // How many instances took (or tried) the edit before one refused it.
+        let mut touched = 0;
+        let mut failure = None;
+        for i in self.instances.iter_mut() {
+            let Backing::Own(sim) = &mut i.state else {
+                continue;
+            };
+            touched += 1;
+            if let Some(sources) = &forward {
+                sim.remap_emitters(sources);
+            }
+            let placed = Instance::effect_for(effect, i.world_from_effect, i.effect.seed);
+            if let Err(err) = sim.sync(&placed) {
+                failure = Some(err);
+                break;
+            }
+            i.effect = placed;
+        }
+        let Some(err) = failure else {
+            return Ok(());
+        };
+        self.effect = old;
+        let own = self
+            .instances
+            .iter_mut()
+            .filter_map(|i| match &mut i.state {
+                Backing::Own(sim) => Some((sim, &mut i.effect, i.world_from_effect)),
+                Backing::Batched { .. } => None,
+            });
+        for (sim, placed, world) in own.take(touched) {
+            if let Some(sources) = &back {
+                sim.remap_emitters(sources);
+            }
+            *placed = Instance::effect_for(&self.effect, world, placed.seed);
+            if let Err(e) = sim.sync(placed) {
+                log::error!("ignis: an instance could not go back to its effect: {e}");
+            }
+        }
+        Err(err.into())
+    }
+
+    /// Rebuilds the pipelines built from `entry` (one of [`PLAYER_SHADERS`]) with the
+    /// WGSL files in `dir`, for a host that watches its shader folder. On error the last
+    /// good pipelines keep running, the particles are untouched, and the error names the
+    /// file, line and column.
+    pub fn reload_shader(&mut self, dir: &Path, entry: &str) -> Result<(), ShaderError> {
+        let lib = ShaderLibrary::from_dir(dir);
+        match entry {
+            "update.wgsl" | "count.wgsl" => {
+                lock(&self.update).rebuild(&self.ctx, &lib, &used_keys(&self.effect))?
+            }
+            "billboard.wgsl" => self.billboard.rebuild(&self.ctx, &lib)?,
+            "splat.wgsl" => self.splat.rebuild(&self.ctx, &lib)?,
+            "sort.wgsl" => self.sort.rebuild(&self.ctx, &lib)?,
+            _ => return Ok(()),
+        }
+        // Pipelines built later (a new variant, an edit's new integrator) use it too.
+        self.library = lib;
+        Ok(())
+    }
+
+    /// Gives an instance a new seed: particles born from now on draw their randomness
+    /// from it (the living ones keep theirs). Returns false if `id` was removed.
+    pub fn set_seed(&mut self, id: InstanceId, seed: u32) -> bool {
+        let Some(i) = self.instances.get_mut(id) else {
+            return false;
+        };
+        if i.effect.seed != seed {
+            i.effect.seed = seed;
+            match &mut i.state {
+                Backing::Own(sim) => {
+                    if let Err(err) = sim.sync(&i.effect) {
+                        log::error!("ignis: a new seed was refused: {err}");
+                    }
+                }
+                Backing::Batched { batch, slot } => {
+                    if let Some(b) = self.batches.get_mut(*batch) {
+                        b.set_seed(*slot, seed);
+                    }
+                }
+            }
+        }
+        true
+    }
+
+    /// Looks the preset's PNG sprites up in `dir` from now on (the folder of a preset
+    /// opened from elsewhere; `None`: the working directory).
+    pub fn set_asset_dir(&mut self, dir: Option<PathBuf>) {
+        self.settings.asset_dir = dir;
+    }
+
+    /// The folders holding the PNG sprites in use (for a host that watches them).
+    pub fn sprite_folders(&self) -> Vec<PathBuf> {
+        self.frame.sprites.watched_dirs()
+    }
+
+    /// Forgets the sprites among `changed` files: they load again at the next
+    /// [`Player::record`]. Returns true when any was in use.
+    pub fn reload_sprites(&mut self, changed: &[PathBuf]) -> bool {
+        self.frame.sprites.invalidate(changed)
+    }
+}
+
+/// What lays out a batch's buffers: each emitter's pool size and state layout.
+fn batch_shape(effect: &Effect) -> Vec<(u32, StateLayout)> {
+    effect
+        .emitters
+        .iter()
+        .map(|e| (e.capacity.max(1), StateLayout::of(Modules::of(e))))
+        .collect()
+}

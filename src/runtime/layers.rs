@@ -1,0 +1,80 @@
+//! [`Layers`]: which of a player's particles one draw call draws, so a host can send the
+//! soft layers to reduced-resolution targets of its own.
+
+use crate::effect::BlendMode;
+use crate::render::DrawItem;
+
+/// A set of particle layers. [`Player::draw`](crate::Player::draw) draws
+/// [`Layers::ALL`]; [`Player::draw_layers`](crate::Player::draw_layers) draws a subset,
+/// and [`Player::drawn_layers`](crate::Player::drawn_layers) says which hold anything.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Layers(u8);
+
+impl Layers {
+    /// Nothing.
+    pub const NONE: Self = Self(0);
+    /// Alpha-blended emitters (smoke), back to front. Soft: a host may draw them at a
+    /// reduced resolution and add the result in its composite.
+    pub const BLENDED: Self = Self(1);
+    /// Additive emitters whose particles are small or thin on screen (sparks, embers,
+    /// streaks, and the compute splat's light).
+    pub const LIGHT: Self = Self(2);
+    /// Additive emitters whose particles are large on screen (flame tongues, glow):
+    /// soft enough for half resolution.
+    pub const GLOW: Self = Self(4);
+    /// Every layer.
+    pub const ALL: Self = Self(7);
+
+    /// Whether every layer of `other` is in `self`.
+    pub fn contains(self, other: Self) -> bool {
+        self.0 & other.0 == other.0
+    }
+
+    /// Whether `self` and `other` share a layer.
+    pub fn intersects(self, other: Self) -> bool {
+        self.0 & other.0 != 0
+    }
+
+    /// The layers of `self` that are not in `other`.
+    pub fn without(self, other: Self) -> Self {
+        Self(self.0 & !other.0)
+    }
+
+    /// The layer a billboard draw belongs to.
+    pub(crate) fn of(item: &DrawItem) -> Self {
+        match item.blend {
+            BlendMode::Alpha => Self::BLENDED,
+            BlendMode::Additive if item.is_glow() => Self::GLOW,
+            BlendMode::Additive => Self::LIGHT,
+        }
+    }
+}
+
+impl std::ops::BitOr for Layers {
+    type Output = Self;
+
+    fn bitor(self, other: Self) -> Self {
+        Self(self.0 | other.0)
+    }
+}
+
+impl std::ops::BitOrAssign for Layers {
+    fn bitor_assign(&mut self, other: Self) {
+        self.0 |= other.0;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Layers;
+
+    #[test]
+    fn layer_sets_combine() {
+        let soft = Layers::BLENDED | Layers::GLOW;
+        assert!(Layers::ALL.contains(soft));
+        assert!(!soft.contains(Layers::LIGHT));
+        assert_eq!(Layers::ALL.without(soft), Layers::LIGHT);
+        assert!(soft.intersects(Layers::GLOW));
+        assert!(!Layers::NONE.intersects(Layers::ALL));
+    }
+}
