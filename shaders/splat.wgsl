@@ -9,7 +9,8 @@
 // - group 0: 0 `camera`, 1 `look` (dynamic offset per emitter), as billboard.wgsl.
 // - group 1: 0 `prev`, 1 `cur` (state buffers).
 // - group 2: 0 `accum` (3 × u32 per pixel: R, G, B in units of 1/FIXED_SCALE), 1
-//   `scene_depth` (the host's depth; tested only when it is the viewport's size).
+//   `scene_depth` (the host's depth, tested at every pixel a particle adds light to
+//   when it is the viewport's size).
 // - DEPTH_TEST: 0 none, 1 a particle nearer than or level with the host's depth passes
 //   (depth 0 = near), 2 the reverse (reversed Z). Particles never write depth.
 #import "common.wgsl"
@@ -32,13 +33,12 @@
 
 override DEPTH_TEST: u32 = 0u;
 
-// Whether a particle at NDC depth `z` over pixel `px` is in front of the host's geometry.
-fn visible(px: vec2<f32>, z: f32) -> bool {
+// Whether a particle at NDC depth `z` is in front of the host's geometry at pixel `p`.
+fn visible(p: vec2<i32>, z: f32) -> bool {
     let dims = textureDimensions(scene_depth);
     if DEPTH_TEST == 0u || dims.x != u32(camera.viewport.x) || dims.y != u32(camera.viewport.y) {
         return true;
     }
-    let p = clamp(vec2<i32>(floor(px + 0.5)), vec2<i32>(0), vec2<i32>(dims) - 1);
     let d = textureLoad(scene_depth, p, 0);
     return select(z >= d, z <= d, DEPTH_TEST == 1u);
 }
@@ -46,10 +46,10 @@ fn visible(px: vec2<f32>, z: f32) -> bool {
 // Keep in sync with `SPLAT_FIXED_SCALE` in src/render/splat.rs.
 const FIXED_SCALE: f32 = 4096.0;
 
-fn add_light(x: i32, y: i32, rgb: vec3<f32>, dither: f32) {
+fn add_light(x: i32, y: i32, z: f32, rgb: vec3<f32>, dither: f32) {
     let w = i32(camera.viewport.x);
     let h = i32(camera.viewport.y);
-    if x < 0 || y < 0 || x >= w || y >= h {
+    if x < 0 || y < 0 || x >= w || y >= h || !visible(vec2<i32>(x, y), z) {
         return;
     }
     let base = u32(y * w + x) * 3u;
@@ -103,9 +103,6 @@ fn splat(
     }
     let ndc = clip.xy / clip.w;
     let px = vec2<f32>((ndc.x * 0.5 + 0.5) * camera.viewport.x, (0.5 - ndc.y * 0.5) * camera.viewport.y) - 0.5;
-    if !visible(px, clip.z / clip.w) {
-        return;
-    }
     let dither = unorm4(pcg4d(vec4<u32>(slot, bitcast<u32>(d.age), 0x5EEDu, 0u)));
     // Bilinear over the 2×2 nearest pixels; below two pixels one tap (3 atomics)
     // suffices: the footprint is sub-pixel anyway, and atomics are the splat's cost. One
@@ -120,7 +117,7 @@ fn splat(
         let o = vec2<u32>(k & 1u, k >> 1u);
         let wx = select(1.0 - f.x, f.x, o.x == 1u);
         let wy = select(1.0 - f.y, f.y, o.y == 1u);
-        add_light(b.x + i32(o.x), b.y + i32(o.y), energy * (wx * wy), dither[k]);
+        add_light(b.x + i32(o.x), b.y + i32(o.y), clip.z / clip.w, energy * (wx * wy), dither[k]);
     }
 }
 

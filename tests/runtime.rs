@@ -342,12 +342,32 @@ fn differs(a: [f32; 4], b: [f32; 4], by: f32) -> bool {
 
 #[test]
 fn host_geometry_in_front_hides_the_fire_exactly() {
+    hides_the_fire_exactly(&preset("campfire"), false);
+}
+
+/// The compute splat (small additive particles) tests the host's depth at every pixel it
+/// lights; without the depth view the player draws billboards, which the pass tests.
+#[test]
+fn host_geometry_hides_splatted_particles_exactly() {
+    let mut effect = preset("campfire");
+    for e in &mut effect.emitters {
+        if e.look.blend == BlendMode::Additive {
+            e.look.draw_path = ignis::effect::DrawPath::Splat;
+        }
+    }
+    hides_the_fire_exactly(&effect, true);
+    hides_the_fire_exactly(&effect, false);
+}
+
+/// An opaque wall between the camera and the left half of `effect`: the pixels behind it
+/// are exactly the host's, and fire shows beside it. `depth`: the host hands its depth
+/// over.
+fn hides_the_fire_exactly(effect: &Effect, depth: bool) {
     let (eye, target) = (vec3(0.0, 0.7, 3.0), vec3(0.0, 0.5, 0.0));
     let host = Host::new(eye, target);
-    let mut fire = host.player(&preset("campfire"));
+    let mut fire = host.player(effect);
     fire.add_instance(Mat4::IDENTITY, 3).expect("instance");
     advance(&mut [&mut fire], &host, 90);
-    // An opaque wall between the camera and the left half of the fire.
     let wall = Quad(
         [
             vec3(-3.0, -1.0, 1.2),
@@ -358,9 +378,9 @@ fn host_geometry_in_front_hides_the_fire_exactly() {
         [0.2, 0.3, 0.4],
     );
     let bg = [0.05, 0.04, 0.03];
-    let host_only = host.frame(bg, std::slice::from_ref(&wall), &mut [], false);
-    let with_fire = host.frame(bg, std::slice::from_ref(&wall), &mut [&mut fire], false);
-    let no_wall = host.frame(bg, &[], &mut [&mut fire], false);
+    let host_only = host.frame(bg, std::slice::from_ref(&wall), &mut [], depth);
+    let with_fire = host.frame(bg, std::slice::from_ref(&wall), &mut [&mut fire], depth);
+    let no_wall = host.frame(bg, &[], &mut [&mut fire], depth);
     let is_wall = |p: [f32; 4]| !differs(p, [0.2, 0.3, 0.4, 1.0], 1e-3);
     let (mut wall_px, mut fire_behind, mut fire_beside) = (0, 0, 0);
     for i in 0..host_only.rgba.len() {
@@ -368,7 +388,7 @@ fn host_geometry_in_front_hides_the_fire_exactly() {
             wall_px += 1;
             assert_eq!(
                 with_fire.rgba[i], host_only.rgba[i],
-                "pixel {i} behind the wall is not exactly the host's"
+                "pixel {i} behind the wall is not exactly the host's (depth view: {depth})"
             );
             fire_behind += usize::from(differs(no_wall.rgba[i], host_only.rgba[i], 0.05));
         } else {
@@ -384,6 +404,12 @@ fn host_geometry_in_front_hides_the_fire_exactly() {
         fire_beside > 150,
         "only {fire_beside} pixels beside the wall hold fire"
     );
+    let splatted = fire.draw_items().iter().any(|d| d.splat);
+    let wants_splat = effect
+        .emitters
+        .iter()
+        .any(|e| e.look.draw_path == ignis::effect::DrawPath::Splat);
+    assert_eq!(splatted, wants_splat && depth, "the splat ran");
 }
 
 /// One still, additive disc at (0, 0.2, 0), 1 m wide: its lower part crosses the ground.
@@ -712,4 +738,79 @@ fn the_runtime_build_pulls_in_no_editor_crates() {
             .collect();
         assert!(found.is_empty(), "the runtime pulls in {banned}: {found:?}");
     }
+}
+
+/// Live edits of a batched player: a parameter edit keeps every instance's particles; an
+/// edit that resizes a pool restarts the instances (their shared buffers are laid out by
+/// the pools), which then play the new effect; an invalid effect is refused and changes
+/// nothing.
+#[test]
+fn edits_reach_every_batched_instance() {
+    let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+    let effect = preset("torch");
+    let mut player = host.player(&effect);
+    let ids = [0.0, 2.0].map(|x| {
+        player
+            .add_instance(Mat4::from_translation(vec3(x, 0.0, 0.0)), 5)
+            .expect("instance")
+    });
+    advance(&mut [&mut player], &host, 30);
+    let alive = |p: &Player| -> Vec<u32> {
+        ids.iter()
+            .map(|id| {
+                p.count_particles(*id)
+                    .expect("count")
+                    .iter()
+                    .map(|c| c.alive)
+                    .sum()
+            })
+            .collect()
+    };
+    let before: Vec<_> = ids
+        .iter()
+        .map(|id| player.particles(*id, 0).expect("read"))
+        .collect();
+    assert!(
+        alive(&player).iter().all(|n| *n > 0),
+        "{:?}",
+        alive(&player)
+    );
+
+    let mut brighter = effect.clone();
+    brighter.emitters[0].spawn_rate_per_sec *= 2.0;
+    brighter.emitters[0].look.intensity *= 1.5;
+    player.set_effect(&brighter).expect("a parameter edit");
+    for (id, b) in ids.iter().zip(&before) {
+        assert_eq!(
+            &player.particles(*id, 0).expect("read"),
+            b,
+            "particles kept"
+        );
+        let placed = player.instance_effect(*id).expect("there");
+        assert_eq!(
+            placed.emitters[0].spawn_rate_per_sec,
+            brighter.emitters[0].spawn_rate_per_sec
+        );
+    }
+
+    let mut invalid = brighter.clone();
+    invalid.emitters[0].lifetime_secs = ignis::effect::Range::new(-1.0, 1.0);
+    assert!(matches!(
+        player.set_effect(&invalid),
+        Err(ignis::PlayerError::Invalid(_))
+    ));
+    assert_eq!(player.effect(), &brighter, "a refused edit changes nothing");
+
+    let mut larger = brighter.clone();
+    larger.emitters[0].capacity *= 2;
+    player.set_effect(&larger).expect("a pool edit");
+    assert_eq!(alive(&player), [0, 0], "the instances restarted");
+    advance(&mut [&mut player], &host, 30);
+    assert!(
+        alive(&player).iter().all(|n| *n > 0),
+        "{:?}",
+        alive(&player)
+    );
+    let stats = player.emitter_stats(ids[1]).expect("there");
+    assert_eq!(stats[0].capacity, larger.emitters[0].capacity);
 }

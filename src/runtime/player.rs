@@ -334,8 +334,9 @@ impl Player {
     /// the compute splat of small additive particles — and uploads the draw's uniforms.
     /// `scene_depth` is the host's depth buffer as a single-sample view the size of the
     /// target (with `TEXTURE_BINDING` usage): soft edges fade where particles meet the
-    /// host's geometry, and splatted particles behind it are hidden. Without it the
-    /// preset's ground plane softens them. Call it once per submitted encoder (its
+    /// host's geometry, and the splat hides particles behind it. Without it the preset's
+    /// ground plane softens them, and a player with a depth format draws every particle
+    /// as a billboard (the pass's depth test is then the only one). Call it once per submitted encoder (its
     /// uploads go through the queue); draw the result in as many passes as needed.
     pub fn record(
         &mut self,
@@ -350,6 +351,9 @@ impl Player {
         let depth = scene_depth.filter(|_| self.settings.depth_format.is_some());
         self.billboard.set_scene_depth(&self.ctx, depth);
         self.frame.soft_depth = depth.is_some();
+        // The splat tests the host's depth itself: without the view, billboards (tested by
+        // the pass's depth attachment) draw every particle.
+        self.frame.allow_splat = depth.is_some() || self.settings.depth_format.is_none();
         let order = Self::draw_order(&self.instances, camera);
         let members: Vec<Option<BatchMember<'_>>> = order
             .iter()
