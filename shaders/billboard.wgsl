@@ -1,11 +1,15 @@
 // billboard.wgsl — pass 2, large particles: camera-facing quads (four vertices, indexed),
 // one per slot of the emitter's live window (vertex pulling from the state buffer the
-// update pass just wrote).
+// update pass just wrote). One draw covers an emitter of every instance of a batch: the
+// instances' pools are segments of one state buffer, each with its own look.
 //
 // Contract:
-// - group 0: binding 0 `camera` (CameraUniform), 1 `look` (LookUniform, dynamic offset
-//   per emitter) — keep in sync with `src/gpu/types.rs`.
-// - group 1: binding 0 `prev` (state before the last step), 1 `cur` (state after it).
+// - group 0: binding 0 `camera` (CameraUniform), 1 `looks` (one LookSlot per instance of
+//   the draw, from a dynamic offset) — keep in sync with `src/gpu/types.rs`.
+// - group 1: binding 0 `prev` (state before the last step), 1 `cur` (state after it), 2
+//   `order` (sorted: buffer indices of the batch's slots, farthest first).
+// - Unsorted, quad q is slot q mod W of instance q / W's live window (W: the widest
+//   window of the draw's instances); sorted, quad q is `order[q]`.
 // - Dead slots emit a degenerate quad outside the clip volume: no fragments, unlike the
 //   2006 thesis whose dead particles piled up at the origin.
 // - The fragment output is premultiplied: additive blending adds it, alpha blending
@@ -13,9 +17,17 @@
 #import "common.wgsl"
 #import "look.wgsl"
 
+// A look at the 512-byte stride of the looks buffer (src/render/frame.rs).
+struct LookSlot {
+    look: LookUniform,
+    pad: array<vec4<u32>, 14>,
+}
+
 @group(0) @binding(0) var<uniform> camera: CameraUniform;
 // Storage, not uniform: see params.wgsl (lavapipe's uniform inlining).
-@group(0) @binding(1) var<storage, read> look: LookUniform;
+@group(0) @binding(1) var<storage, read> looks: array<LookSlot>;
+// The look of the instance this invocation draws (look.wgsl reads it).
+var<private> look: LookUniform;
 @group(0) @binding(2) var ramps: texture_2d<f32>;
 @group(1) @binding(0) var<storage, read> prev: array<Particle>;
 @group(1) @binding(1) var<storage, read> cur: array<Particle>;
@@ -55,25 +67,46 @@ struct VsOut {
     @location(3) blend_height: vec2<f32>,
 }
 
+// Which instance of the draw and which slot of its pool quad `q` is, or none.
+fn quad_slot(q: u32) -> vec2<u32> {
+    if SORTED {
+        // A buffer index (instance k's segment starts at k · capacity); padding has none.
+        let v = order[q];
+        if v == 0xFFFFFFFFu {
+            return vec2<u32>(0xFFFFFFFFu);
+        }
+        let capacity = looks[0].look.ring_b.z;
+        return vec2<u32>(v / capacity, v % capacity);
+    }
+    let width = max(looks[0].look.ring.w, 1u);
+    let k = q / width;
+    let i = q - k * width;
+    // The window: the last `len` slots before the ring's head, wrapping at the capacity.
+    let l = looks[k].look;
+    if i >= l.ring_b.w {
+        return vec2<u32>(0xFFFFFFFFu);
+    }
+    var slot = l.ring.x + l.ring_b.z - l.ring_b.w + i;
+    if slot >= l.ring_b.z {
+        slot -= l.ring_b.z;
+    }
+    return vec2<u32>(k, slot);
+}
+
 @vertex
 fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u32) -> VsOut {
     var out: VsOut;
-    // Quad `instance` of the window, corner `vi` (two triangles: 0 1 2, 2 1 3). Quads come
-    // as instances (vertex 0…3) or as indexed lists (vertex 4q…4q+3, one instance).
-    let instance = (vertex >> 2u) + inst;
+    // Quad q, corner `vi` (two triangles: 0 1 2, 2 1 3). Quads come as instances (vertex
+    // 0…3) or as indexed lists (vertex 4q…4q+3, one instance).
+    let q = (vertex >> 2u) + inst;
     let vi = vertex & 3u;
-    // Instances cover the emitter's live window of the ring (first slot = first instance),
-    // or, sorted, the window in back-to-front order; padding of the sort has no slot.
-    var slot = instance;
-    if SORTED {
-        slot = order[instance];
-        if slot >= look.ring_b.z {
-            out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
-            return out;
-        }
-    } else if slot >= look.ring_b.z {
-        slot -= look.ring_b.z;
+    let ks = quad_slot(q);
+    if ks.x == 0xFFFFFFFFu {
+        out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+        return out;
     }
+    look = looks[ks.x].look;
+    let slot = ks.y;
     let pair = load_pair(slot);
     let d = drawn(pair[0], pair[1]);
     if !d.alive {

@@ -1,8 +1,8 @@
 // look.wgsl — how a particle looks, shared by both draw paths (billboards and the
 // compute splat) so they render the same fire. A designer hook: `particle_color`.
 //
-// Contract: the including file declares `camera: CameraUniform`, `look: LookUniform`
-// (keep both in sync with `src/gpu/types.rs`), `ramps: texture_2d<f32>` (one
+// Contract: the including file declares `camera: CameraUniform`, `look: LookUniform` (the
+// instance being drawn; keep both in sync with `src/gpu/types.rs`), `ramps: texture_2d<f32>` (one
 // Rgba32Float colour ramp row per emitter) and the state: `prev`, `cur`
 // (array<Particle>) and the same buffers as `prev_packed`, `cur_packed`
 // (array<PackedParticle>, read when `STATE_LAYOUT` says the state is packed or tiny),
@@ -44,8 +44,8 @@ struct LookUniform {
     // x: ground height in simulation space (m), y: 1 / soft-edge distance (1/m),
     // z, w: lifetime range (s; packed state re-derives lifetimes from it).
     soft: vec4<f32>,
-    // Packed / tiny state: x: next spawn slot (head), y, z: spawned total (lo, hi), w:
-    // unused (the layout is STATE_LAYOUT below).
+    // x: next spawn slot (head), y, z: spawned total (lo, hi), w: quads per instance of
+    // the unsorted billboard draw this look is part of (the widest live window).
     ring: vec4<u32>,
     // Packed state: x: effect seed, y: emitter salt; z: capacity; w: the live window's
     // length (the slots before the head that can hold living particles).

@@ -3,11 +3,14 @@
 // emitter blends with alpha; additive fire needs no order.
 //
 // Contract:
-// - `depth_keys`: group 0: 0 `step`, 1 `keys`, 2 `values`; group 1: 0 `cur` particles,
-//   1 `cur_packed`. Element i of the sort is slot (window.x + i) mod capacity for
-//   i < window.y (the emitter's live window of the ring: only slots that can hold a
-//   living particle are sorted); alive slots get key = min(!bits(view depth), 0xFFFFFFFE)
-//   (farthest first), dead and padding elements 0xFFFFFFFF (last).
+// - `depth_keys`: group 0: 0 `step`, 1 `keys`, 2 `values`, 3 `members` (the instances
+//   sorted together: a batch's pools are segments of one buffer); group 1: 0 `cur`
+//   particles, 1 `cur_packed`. Element i of the sort is instance k = i / window.x, and
+//   for j = i mod window.x < its window's length, slot (first + j) mod capacity of its
+//   live window (only slots that can hold a living particle are sorted); its value is
+//   the slot's index in the state buffer. Alive slots get key = min(!bits(view depth),
+//   0xFFFFFFFE) (farthest first), dead and padding elements 0xFFFFFFFF (last, with value
+//   0xFFFFFFFF).
 // - The network is split so that most of it runs in workgroup memory:
 //   `bitonic_local` sorts 512-element blocks completely (window.z = 0: every stage with
 //   k ≤ step.k) or finishes a merge (window.z = 1: stage k = step.k, j = 256 … 1);
@@ -25,8 +28,17 @@ struct SortStep {
     // the state layout is STATE_LAYOUT below).
     eye: vec4<f32>,
     forward: vec4<f32>,
-    // x: first slot of the live window, y: its length, z: local mode (0 sort, 1 merge),
-    // w: where the pool's segment starts in the state buffer (a batched instance's).
+    // x: elements per instance (the widest window), y: instances, z: local mode (0 sort,
+    // 1 merge), w: unused.
+    window: vec4<u32>,
+}
+
+// One instance of the sort.
+struct SortMember {
+    // The camera position in the instance's simulation space (w unused).
+    eye: vec4<f32>,
+    // x: first slot of its live window, y: the window's length, z: where its segment
+    // starts in the state buffer, w: unused.
     window: vec4<u32>,
 }
 
@@ -34,6 +46,7 @@ struct SortStep {
 @group(0) @binding(0) var<storage, read> step: SortStep;
 @group(0) @binding(1) var<storage, read_write> keys: array<u32>;
 @group(0) @binding(2) var<storage, read_write> values: array<u32>;
+@group(0) @binding(3) var<storage, read> members: array<SortMember>;
 
 @compute @workgroup_size(256)
 fn bitonic(
@@ -141,32 +154,37 @@ fn depth_keys(
         return;
     }
     var key = 0xFFFFFFFFu;
-    // Padding carries no slot (the billboard pass skips values ≥ capacity).
-    var slot = 0xFFFFFFFFu;
-    if i < step.window.y {
-        slot = step.window.x + i;
+    // Padding carries no slot (the billboard pass skips 0xFFFFFFFF).
+    var index = 0xFFFFFFFFu;
+    let width = max(step.window.x, 1u);
+    let k = i / width;
+    let j = i - k * width;
+    if k < step.window.y && j < members[k].window.y {
+        let m = members[k];
+        var slot = m.window.x + j;
         if slot >= step.capacity {
             slot -= step.capacity;
         }
+        index = m.window.z + slot;
         var alive = false;
         var pos = vec3<f32>(0.0);
         if STATE_LAYOUT == 2u {
-            // Tiny state: slots whose age has run out sort among the living; the draw
-            // skips them.
+            // Tiny state (never batched): slots whose age has run out sort among the
+            // living; the draw skips them.
             let s = tiny_decode(tiny_bits(cur_packed[slot >> 1u], (slot & 1u) != 0u));
             alive = !s.dead;
             pos = s.pos;
         } else if STATE_LAYOUT == 1u {
-            let q = cur_packed[step.window.w + slot];
+            let q = cur_packed[index];
             alive = packed_alive(q);
             pos = bitcast<vec3<f32>>(vec3<u32>(q.px, q.py, q.pz));
         } else {
-            let p = cur[step.window.w + slot];
+            let p = cur[index];
             alive = is_alive(p);
             pos = p.pos_age.xyz;
         }
         if alive {
-            let depth = max(dot(pos - step.eye.xyz, step.forward.xyz), 0.0);
+            let depth = max(dot(pos - m.eye.xyz, step.forward.xyz), 0.0);
             // Non-negative floats order like their bits; inverted, the farthest comes first.
             // 0xFFFFFFFF (depth 0: at or behind the eye) is kept for dead and padding
             // slots, which must sort after every living one.
@@ -174,5 +192,5 @@ fn depth_keys(
         }
     }
     keys[i] = key;
-    values[i] = slot;
+    values[i] = index;
 }

@@ -319,11 +319,11 @@ fn measure_row(
     let camera = OrbitCamera::from_hint(&effect.camera);
     let size = opts.size;
     let targets = crate::render::Targets::new(ctx, size);
-    let scenes = [crate::render::Scene {
+    let scene = [Some(crate::render::Scene {
         sim: &sim,
         effect: &effect,
-    }];
-    let items = frame.prepare(ctx, &scenes, &camera.view(size), 1.0, &mut sort, None);
+    })];
+    let items = frame.prepare(ctx, &[&scene], &camera.view(size), 1.0, &mut sort, None);
     let auto_splat = items.iter().all(|d| d.splat);
     let with_path = |splat: bool| -> Vec<DrawItem> {
         items

@@ -290,8 +290,8 @@ pub struct LookUniform {
     /// ground height in simulation space (m), 1 / soft-edge distance (1/m), lifetime
     /// range (s).
     pub soft: [f32; 4],
-    /// Packed state: next spawn slot, spawned total (lo, hi), unused (the layout is the
-    /// draw pipelines' `STATE_LAYOUT` constant).
+    /// Next spawn slot (the ring's head), spawned total (lo, hi), quads per instance of
+    /// the unsorted billboard draw this look is part of (the widest live window).
     pub ring: [u32; 4],
     /// Packed state: effect seed, emitter salt; capacity; the live window's length (the
     /// window ends at the ring's head, `ring[0]`).
@@ -329,3 +329,5 @@ const _: () = assert!(std::mem::size_of::<Particle>() == 32);
 const _: () = assert!(std::mem::size_of::<PackedParticle>() == 20);
 const _: () = assert!(std::mem::size_of::<Birth>() == 32);
 const _: () = assert!(std::mem::size_of::<LookUniform>() as u64 <= PARAMS_STRIDE);
+// billboard.wgsl's `LookSlot` pads a look to PARAMS_STRIDE with 14 vec4s: keep in sync.
+const _: () = assert!(std::mem::size_of::<LookUniform>() as u64 + 14 * 16 == PARAMS_STRIDE);

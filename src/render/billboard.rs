@@ -346,19 +346,18 @@ impl BillboardPass {
                 &[FrameResources::look_offset(d.look_slot)],
             );
             pass.set_bind_group(1, group, &[]);
-            // One quad per slot of the live window: sorted, through the sort's order;
-            // otherwise the window's slots directly (the shader wraps at the capacity).
-            // Quad q of a draw is vertices 4q … 4q + 3 after its base vertex.
-            let w = d.window;
-            let start = if d.key.2 { 0 } else { w.first_slot };
+            // One quad per slot of each instance's live window (`width` per instance), or
+            // sorted, through the sort's order; quad q of a draw is vertices 4q … 4q + 3
+            // after its base vertex.
+            let quads = d.width * d.members;
             if !self.indexed {
-                pass.draw_indexed(0..6, 0, start..start + w.len);
+                pass.draw_indexed(0..6, 0, 0..quads);
                 continue;
             }
             let mut done = 0;
-            while done < w.len {
-                let n = (w.len - done).min(QUADS_PER_DRAW);
-                let base = (u64::from(start) + u64::from(done)) * 4;
+            while done < quads {
+                let n = (quads - done).min(QUADS_PER_DRAW);
+                let base = u64::from(done) * 4;
                 pass.draw_indexed(0..n * 6, base.min(i32::MAX as u64) as i32, 0..1);
                 done += n;
             }

@@ -12,12 +12,12 @@ use crate::gpu::GpuContext;
 use crate::gpu::types::{CameraUniform, LookUniform, PARAMS_STRIDE, StateLayout};
 use crate::render::camera::Camera;
 use crate::render::look::{RAMP_WIDTH, bake_ramp, gradient_key};
+use crate::render::sort::{SortJob, SortMember};
 use crate::render::sprites::{SpriteError, SpriteLibrary, SpriteTexture};
 use crate::sim::Modules;
 use crate::sim::gpu_sim::SimState;
 
-/// One simulation to draw: its state and the effect it runs (the editor's effect, or one
-/// instance of a runtime player).
+/// One simulation to draw: its state and the effect it runs (one instance of a player).
 #[derive(Clone, Copy)]
 pub struct Scene<'a> {
     /// The particles.
@@ -26,21 +26,31 @@ pub struct Scene<'a> {
     pub effect: &'a Effect,
 }
 
-/// One emitter to draw this frame.
+/// Instances drawn together, one draw per emitter: their pools are segments of one set
+/// of state buffers (a batch; `members[k]` owns segment k, `None` an empty segment), or
+/// one instance's own buffers.
+pub type SceneGroup<'a> = [Option<Scene<'a>>];
+
+/// Looks one draw reads at most (a batch's instances).
+pub const LOOKS_PER_DRAW: usize = crate::sim::batch::BATCH_SLOTS as usize;
+
+/// One emitter of a group of instances to draw this frame.
 #[derive(Clone, Debug)]
 pub struct DrawItem {
-    /// The scene (index into `prepare`'s scenes).
-    pub scene: usize,
     /// Emitter index in its effect (the colour ramp's row).
     pub index: usize,
-    /// The look uniform's slot.
+    /// The look uniform slot of the group's first instance (the others follow).
     pub look_slot: usize,
+    /// Instances (segments) the draw covers.
+    pub members: u32,
     /// Key of the cached particle bind group.
     pub key: (u64, usize, bool),
-    /// Slots of the pool.
+    /// Slots of each instance's pool.
     pub capacity: u32,
-    /// The slots that can hold living particles: the instances / invocations drawn.
-    pub window: crate::sim::planner::LiveWindow,
+    /// Quads per instance: the widest live window of the group.
+    pub width: u32,
+    /// The back-to-front sort of the group's slots (alpha-blended emitters).
+    pub sort: Option<SortJob>,
     /// Blend mode.
     pub blend: BlendMode,
     /// The path chosen for this frame.
@@ -66,6 +76,16 @@ impl DrawItem {
 
 /// Billboards at least this large on screen (pixels at full resolution) count as glow.
 pub const GLOW_MIN_PX: f32 = 12.0;
+
+/// What `prepare` draws one group with.
+struct GroupView<'g, 'a> {
+    group: &'g SceneGroup<'a>,
+    camera: &'g Camera,
+    alpha: f32,
+    asset_dir: Option<&'g Path>,
+    /// The first group reports sprite errors and bakes the ramps.
+    first_group: bool,
+}
 
 /// Uniform buffers, layouts and bind groups for the draw passes.
 pub struct FrameResources {
@@ -370,7 +390,8 @@ impl FrameResources {
     ) -> (wgpu::Buffer, wgpu::Texture, [wgpu::BindGroup; 2]) {
         let looks = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("FrameResources::looks"),
-            size: slots as u64 * PARAMS_STRIDE,
+            // Room for a full draw's array from the last slot.
+            size: (slots + LOOKS_PER_DRAW) as u64 * PARAMS_STRIDE,
             usage: wgpu::BufferUsages::UNIFORM
                 | wgpu::BufferUsages::STORAGE
                 | wgpu::BufferUsages::COPY_DST,
@@ -385,7 +406,13 @@ impl FrameResources {
             wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
         );
         let ramp_view = ramps.create_view(&Default::default());
-        let groups = layouts.map(|layout| {
+        // The billboards read a draw's instances' looks as an array; the splat one look.
+        let sizes = [
+            LOOKS_PER_DRAW as u64 * PARAMS_STRIDE,
+            size_of::<LookUniform>() as u64,
+        ];
+        let groups = [0, 1].map(|g| {
+            let (layout, binding_bytes) = (layouts[g], sizes[g]);
             ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("FrameResources::frame_group"),
                 layout,
@@ -399,7 +426,7 @@ impl FrameResources {
                         resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                             buffer: &looks,
                             offset: 0,
-                            size: wgpu::BufferSize::new(size_of::<LookUniform>() as u64),
+                            size: wgpu::BufferSize::new(binding_bytes),
                         }),
                     },
                     wgpu::BindGroupEntry {
@@ -478,13 +505,14 @@ impl FrameResources {
         self.splat_group = splat_group;
     }
 
-    /// Uploads this frame's uniforms and returns what to draw, with each emitter's path.
-    /// The scenes' emitters take consecutive look slots; emitter `i` of every scene
-    /// shares ramp row `i` (the scenes are instances of one effect, or just one).
+    /// Uploads this frame's uniforms and returns what to draw, with each emitter's path:
+    /// one item per group and emitter. A group's instances take consecutive look slots
+    /// for each emitter; emitter `i` of every instance shares ramp row `i` (the groups
+    /// are instances of one effect).
     pub fn prepare(
         &mut self,
         ctx: &GpuContext,
-        scenes: &[Scene<'_>],
+        groups: &[&SceneGroup<'_>],
         camera: &Camera,
         alpha: f32,
         sort: &mut crate::render::sort::SortPass,
@@ -493,38 +521,36 @@ impl FrameResources {
         let cam = camera.uniform(alpha);
         ctx.queue
             .write_buffer(&self.camera, 0, bytemuck::bytes_of(&cam));
-        let slots: usize = scenes.iter().map(|s| s.effect.emitters.len()).sum();
-        let rows = scenes
-            .iter()
-            .map(|s| s.effect.emitters.len())
-            .max()
-            .unwrap_or(0);
+        let emitters = |g: &SceneGroup<'_>| {
+            g.iter()
+                .flatten()
+                .next()
+                .map_or(0, |s| s.effect.emitters.len())
+        };
+        let slots: usize = groups.iter().map(|g| g.len() * emitters(g)).sum();
+        let rows = groups.iter().map(|g| emitters(g)).max().unwrap_or(0);
         self.reserve(ctx, slots, rows);
         self.sprite_errors.clear();
         let mut blocks = vec![0u8; slots * PARAMS_STRIDE as usize];
         let mut items = Vec::new();
         let mut slot = 0;
-        for (k, scene) in scenes.iter().enumerate() {
-            for i in 0..scene.effect.emitters.len() {
-                let block =
-                    &mut blocks[slot * PARAMS_STRIDE as usize..][..size_of::<LookUniform>()];
-                let item = self.prepare_emitter(
-                    ctx,
-                    scene,
-                    i,
+        for (n, group) in groups.iter().enumerate() {
+            for i in 0..emitters(group) {
+                let block = &mut blocks[slot * PARAMS_STRIDE as usize..]
+                    [..group.len() * PARAMS_STRIDE as usize];
+                let view = GroupView {
+                    group,
                     camera,
                     alpha,
-                    sort,
                     asset_dir,
-                    block,
-                    k == 0,
-                );
+                    first_group: n == 0,
+                };
+                let item = self.prepare_emitter(ctx, &view, i, sort, block);
                 items.extend(item.map(|d| DrawItem {
-                    scene: k,
                     look_slot: slot,
                     ..d
                 }));
-                slot += 1;
+                slot += group.len();
             }
         }
         if !blocks.is_empty() {
@@ -535,35 +561,22 @@ impl FrameResources {
         items
     }
 
-    /// Writes emitter `i`'s look uniform into `block` and returns its draw (scene and
-    /// look slot left for the caller), or `None` when it has no pool or is disabled. The
-    /// first scene's emitters also bake the shared colour ramps.
-    #[allow(clippy::too_many_arguments)]
-    fn prepare_emitter(
+    /// Emitter `i`'s look uniform of one instance, and its pool (`None`: no pool).
+    fn member_look<'s>(
         &mut self,
-        ctx: &GpuContext,
-        scene: &Scene<'_>,
+        view: &GroupView<'_, '_>,
+        scene: &Scene<'s>,
         i: usize,
-        camera: &Camera,
-        alpha: f32,
-        sort: &mut crate::render::sort::SortPass,
-        asset_dir: Option<&Path>,
-        block: &mut [u8],
-        first_scene: bool,
-    ) -> Option<DrawItem> {
+        sprite: &SpriteTexture,
+    ) -> Option<(LookUniform, crate::sim::gpu_sim::EmitterBuffers<'s>)> {
         let (sim, effect) = (scene.sim, scene.effect);
-        let e = &effect.emitters[i];
-        let cam_px = camera.pixels_per_unit();
+        let e = effect.emitters.get(i)?;
         let origin = sim
             .planner()
             .emitters
             .get(i)
             .map(|p| p.origin())
             .unwrap_or_default();
-        let (sprite, error) = self.sprites.resolve(ctx, &e.look.sprite, asset_dir);
-        if let Some(err) = error.filter(|_| first_scene) {
-            self.sprite_errors.push((i, err));
-        }
         let salt = crate::rng::pcg4d([effect.seed, i as u32, e.seed_offset, 0x5EED_100C])[0];
         let mut u = look_uniform(&e.look, i as u32, salt, sprite.integral);
         if self.trim_sprites && e.look.streak.is_none() {
@@ -580,65 +593,138 @@ impl FrameResources {
                 .entry((sprite.id, rows, cols, threshold.to_bits()))
                 .or_insert_with(|| sprite.trim_rect(rows, cols, threshold));
         }
-        u.clip_from_sim = camera.clip_from_sim(origin).to_cols_array_2d();
+        u.clip_from_sim = view.camera.clip_from_sim(origin).to_cols_array_2d();
         let ground = e.collisions.ground.as_ref().map_or(0.0, |g| g.height_m);
         u.soft[0] = (f64::from(ground) - origin.y) as f32;
-        if first_scene {
-            // Emitter i of every scene shares ramp row i: the first scene's look bakes it.
-            self.upload_ramp(ctx, i, &e.look);
-        }
         if Modules::of(e).contains(Modules::STATELESS) {
             // Closed-form evaluation at the render time (between the last two steps).
             let planner = sim.planner();
-            let t = planner.time_secs - (1.0 - alpha as f64) * planner.last_dt_secs as f64;
+            let t = planner.time_secs - (1.0 - view.alpha as f64) * planner.last_dt_secs as f64;
             let a = e.forces.constant_acceleration();
             let w = e.forces.wind_m_per_s;
             u.motion_a = [a.x, a.y, a.z, e.forces.drag_per_sec];
             u.motion_b = [w[0], w[1], w[2], t.rem_euclid(4096.0) as f32];
         }
-        let buffers = sim.emitter_buffers(i).map(|mut b| {
-            if !self.live_window_only {
-                b.window = crate::sim::planner::LiveWindow::all(b.capacity);
-            }
-            b
-        });
-        if let Some(b) = &buffers {
-            // The ring, for packed state's re-derived lifetimes; the capacity and the
-            // live window's length (ring_b.zw) place the splat's invocations.
-            u.soft[2] = b.life_range.0;
-            u.soft[3] = b.life_range.1;
-            u.ring = [
-                (b.spawned_total % u64::from(b.capacity.max(1))) as u32,
-                b.spawned_total as u32,
-                (b.spawned_total >> 32) as u32,
-                0,
-            ];
-            // w: the live window's length (it ends at the ring's head, ring.x).
-            u.ring_b = [b.seed_salt.0, b.seed_salt.1, b.capacity, b.window.len];
-            [u.tiny, u.tiny_b, u.tiny_c] = b.tiny;
-            u.flags[3] = b.slot_base;
+        let mut b = sim.emitter_buffers(i)?;
+        if !self.live_window_only {
+            b.window = crate::sim::planner::LiveWindow::all(b.capacity);
         }
-        block.copy_from_slice(bytemuck::bytes_of(&u));
-        let b = buffers?;
+        // The ring, for packed state's re-derived lifetimes; the capacity and the live
+        // window's length (ring_b.zw) place the draws' and the splat's invocations.
+        u.soft[2] = b.life_range.0;
+        u.soft[3] = b.life_range.1;
+        u.ring = [
+            (b.spawned_total % u64::from(b.capacity.max(1))) as u32,
+            b.spawned_total as u32,
+            (b.spawned_total >> 32) as u32,
+            0,
+        ];
+        // w: the live window's length (it ends at the ring's head, ring.x).
+        u.ring_b = [b.seed_salt.0, b.seed_salt.1, b.capacity, b.window.len];
+        [u.tiny, u.tiny_b, u.tiny_c] = b.tiny;
+        u.flags[3] = b.slot_base;
+        Some((u, b))
+    }
+
+    /// Writes emitter `i`'s look uniform of every instance of a group into `block` and
+    /// returns its draw (look slot left for the caller), or `None` when it has no pool or
+    /// is disabled. The first group's emitters also bake the shared colour ramps.
+    fn prepare_emitter(
+        &mut self,
+        ctx: &GpuContext,
+        view: &GroupView<'_, '_>,
+        i: usize,
+        sort: &mut crate::render::sort::SortPass,
+        block: &mut [u8],
+    ) -> Option<DrawItem> {
+        let first = view.group.iter().flatten().next()?;
+        let e = first.effect.emitters.get(i)?;
+        let (sprite, error) = self.sprites.resolve(ctx, &e.look.sprite, view.asset_dir);
+        if let Some(err) = error.filter(|_| view.first_group) {
+            self.sprite_errors.push((i, err));
+        }
+        if view.first_group {
+            // Emitter i of every instance shares ramp row i: the first group's look bakes it.
+            self.upload_ramp(ctx, i, &e.look);
+        }
+        let eye = view.camera.eye_f64();
+        let mut looks = Vec::with_capacity(view.group.len());
+        let mut pool = None;
+        let mut members = Vec::new();
+        // The nearest instance's distance decides the projected size (and the path).
+        let mut distance = f32::INFINITY;
+        for scene in view.group {
+            let Some(scene) = scene else {
+                looks.push(None);
+                members.push(SortMember::default());
+                continue;
+            };
+            let Some((u, b)) = self.member_look(view, scene, i, &sprite) else {
+                looks.push(None);
+                members.push(SortMember::default());
+                continue;
+            };
+            let placed = glam::Vec3::from(scene.effect.emitters[i].transform.position_m);
+            distance = distance.min((view.camera.eye() - placed).length());
+            let origin = scene
+                .sim
+                .planner()
+                .emitters
+                .get(i)
+                .map(|p| p.origin())
+                .unwrap_or_default();
+            let cap = b.capacity.max(1);
+            members.push(SortMember {
+                eye: (eye - origin).as_vec3().extend(0.0).to_array(),
+                window: [
+                    (u.ring[0] + cap - b.window.len.min(cap)) % cap,
+                    b.window.len,
+                    b.slot_base,
+                    0,
+                ],
+            });
+            looks.push(Some(u));
+            pool.get_or_insert(b);
+        }
+        let b = pool?;
+        let width = looks
+            .iter()
+            .flatten()
+            .map(|u| u.ring_b[3])
+            .max()
+            .unwrap_or(0);
+        for (k, u) in looks.iter().enumerate() {
+            let mut u = u.unwrap_or(LookUniform {
+                // An empty segment: no window, nothing drawn.
+                ring_b: [0, 0, b.capacity, 0],
+                ..LookUniform::default()
+            });
+            u.ring[3] = width;
+            block[k * PARAMS_STRIDE as usize..][..size_of::<LookUniform>()]
+                .copy_from_slice(bytemuck::bytes_of(&u));
+        }
         if !e.enabled {
             return None;
         }
-        // Alpha-blended emitters are drawn back to front through the sort's order.
+        // Alpha-blended emitters are drawn back to front through the sort's order: one
+        // sort over the group's slots.
         let sorted = e.look.blend == BlendMode::Alpha;
-        let order_buffer = sorted.then(|| sort.buffers(ctx, b.sort_key, b.capacity).values.clone());
-        // Unsorted pools of a batch share one bind group; a sorted one has its own order.
-        let key = (
-            if sorted { b.sort_key } else { b.generation },
-            b.parity,
-            sorted,
-        );
+        let n = view.group.len() as u32;
+        let job = sorted.then(|| SortJob {
+            key: b.generation,
+            state: b.current.clone(),
+            layout: b.layout,
+            capacity: b.capacity,
+            width,
+            members: std::mem::take(&mut members),
+        });
+        let order_buffer = job
+            .as_ref()
+            .map(|j| sort.buffers(ctx, j.key, b.capacity * n).values.clone());
+        let key = (b.generation, b.parity, sorted);
         self.ensure_particle_group(ctx, key, &b, order_buffer);
-        // Projected size at the emitter's distance decides the automatic path.
-        let distance = (camera.eye() - glam::Vec3::from(e.transform.position_m))
-            .length()
-            .max(1e-3);
         let size_m = e.look.size_start_m.max(e.look.size_end_m);
-        let size_px = size_m * cam_px / distance;
+        let size_px = size_m * view.camera.pixels_per_unit() / distance.max(1e-3);
         let additive = e.look.blend == BlendMode::Additive;
         let splat = self.allow_splat
             && additive
@@ -657,12 +743,13 @@ impl FrameResources {
         );
         variant.soft_depth = self.soft_depth;
         Some(DrawItem {
-            scene: 0,
             index: i,
             look_slot: 0,
+            members: n,
             key,
             capacity: b.capacity,
-            window: b.window,
+            width,
+            sort: job,
             blend: e.look.blend,
             splat,
             variant,

@@ -28,14 +28,46 @@ pub struct SortStep {
     pub count: u32,
     /// Slots that hold particles.
     pub capacity: u32,
-    /// Camera position in the emitter's simulation space.
+    /// Unused (each member has its own eye).
     pub eye: [f32; 4],
     /// Camera forward axis.
     pub forward: [f32; 4],
-    /// First slot of the live window, its length, local mode (0 sort, 1 merge), the first
-    /// slot of the pool's segment in the state buffer (a batched instance's; else 0).
+    /// Elements per member (the widest window), members, local mode (0 sort, 1 merge),
+    /// unused.
     pub window: [u32; 4],
 }
+
+/// One instance of a sort (keep in sync with `SortMember` in `shaders/sort.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SortMember {
+    /// The camera position in the instance's simulation space (w unused).
+    pub eye: [f32; 4],
+    /// First slot of its live window, the window's length, the first slot of its segment
+    /// in the state buffer, unused.
+    pub window: [u32; 4],
+}
+
+/// One sort of a frame: an emitter's slots over a group of instances whose pools are
+/// segments of one state buffer.
+#[derive(Clone, Debug)]
+pub struct SortJob {
+    /// Names the sort buffers (the pool's generation).
+    pub key: u64,
+    /// The current state.
+    pub state: wgpu::Buffer,
+    /// How it is stored.
+    pub layout: StateLayout,
+    /// Slots of each instance's pool.
+    pub capacity: u32,
+    /// Elements per member: the widest live window.
+    pub width: u32,
+    /// The instances, by segment.
+    pub members: Vec<SortMember>,
+}
+
+/// Members one sort holds at most.
+const MAX_MEMBERS: usize = crate::render::frame::LOOKS_PER_DRAW;
 
 const STRIDE: u64 = 256;
 
@@ -125,6 +157,8 @@ pub struct SortBuffers {
     /// Sorted slot indices (farthest first), bound by the billboard pass.
     pub values: wgpu::Buffer,
     steps: wgpu::Buffer,
+    /// The members of the sort (`SortMember`s).
+    members: wgpu::Buffer,
     group: wgpu::BindGroup,
     /// The depth keys' state bind groups, by state buffer (the two of a ping-pong pair).
     state_groups: Vec<(wgpu::Buffer, wgpu::BindGroup)>,
@@ -192,6 +226,7 @@ impl SortPass {
                     ),
                     entry(1, storage(false)),
                     entry(2, storage(false)),
+                    entry(3, storage(true)),
                 ],
             });
         let state_layout = ctx
@@ -297,6 +332,12 @@ impl SortPass {
         };
         let keys = make("SortPass::keys");
         let values = make("SortPass::values");
+        let members = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("SortPass::members"),
+            size: (MAX_MEMBERS * size_of::<SortMember>()) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
         let steps = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("SortPass::steps"),
             size: (bitonic_stages(size).len() as u64 + 1) * STRIDE,
@@ -330,6 +371,10 @@ impl SortPass {
                     binding: 2,
                     resource: values.as_entire_binding(),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: members.as_entire_binding(),
+                },
             ],
         });
         // `keys` lives on through the bind group.
@@ -341,6 +386,7 @@ impl SortPass {
             capacity,
             values,
             steps,
+            members,
             group,
             state_groups: Vec::new(),
         }
@@ -390,38 +436,40 @@ impl SortPass {
         }
     }
 
-    /// Records depth keys for the live window of `pool`'s current state seen from `eye`
-    /// along `forward` (simulation space) and the sort; afterwards the first `window.len`
-    /// entries of `values` (the buffers of `pool.sort_key`) hold those slots farthest
-    /// first (dead slots after the living; entries ≥ the capacity are padding).
+    /// Records depth keys for `job`'s slots (every member's live window of its current
+    /// state, each seen from its own eye, along `forward`) and the sort; afterwards the
+    /// first entries of `values` (the buffers of `job.key`) hold the state-buffer indices
+    /// of those slots farthest first (dead slots after the living, then padding).
     ///
     /// Recorded into the open compute pass `pass` of `enc` (opened on first need), so that
-    /// every sorted pool of a frame shares one pass.
+    /// every sort of a frame shares one pass.
     pub fn record(
         &mut self,
         ctx: &GpuContext,
         enc: &mut wgpu::CommandEncoder,
         pass: &mut Option<wgpu::ComputePass<'static>>,
-        pool: &crate::sim::gpu_sim::EmitterBuffers<'_>,
-        eye: glam::Vec3,
+        job: &SortJob,
         forward: glam::Vec3,
     ) {
-        let (generation, state, capacity) = (pool.sort_key, pool.current, pool.capacity);
-        let (window, layout) = (pool.window, pool.layout);
-        if window.len == 0 {
+        let members = &job.members[..job.members.len().min(MAX_MEMBERS)];
+        let elements = job.width * members.len() as u32;
+        if elements == 0 {
             return;
         }
-        let size = self.buffers(ctx, generation, capacity).size;
-        let count = window.len.max(2).next_power_of_two().min(size);
+        let size = self
+            .buffers(ctx, job.key, job.capacity * members.len() as u32)
+            .size;
+        let count = elements.max(2).next_power_of_two().min(size);
         let split = self.split_network;
-        let Some(b) = self.buffers.get_mut(&generation) else {
+        let Some(b) = self.buffers.get_mut(&job.key) else {
             return;
         };
         if count != b.count || b.split != split {
-            Self::write_steps(ctx, &b.steps, &network(count, split), count, capacity);
+            Self::write_steps(ctx, &b.steps, &network(count, split), count, job.capacity);
             b.count = count;
             b.split = split;
         }
+        let state = &job.state;
         if !b.state_groups.iter().any(|(s, _)| s == state) {
             let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("SortPass::state_group"),
@@ -442,24 +490,26 @@ impl SortPass {
             }
             b.state_groups.push((state.clone(), group));
         }
-        let Some(b) = self.buffers.get(&generation) else {
+        let Some(b) = self.buffers.get(&job.key) else {
             return;
         };
         let head = SortStep {
             k: 0,
             j: 0,
             count,
-            capacity,
-            eye: eye.extend(0.0).to_array(),
+            capacity: job.capacity,
+            eye: [0.0; 4],
             forward: forward.extend(0.0).to_array(),
-            window: [window.first_slot, window.len, 0, pool.slot_base],
+            window: [job.width, members.len() as u32, 0, 0],
         };
         ctx.queue
             .write_buffer(&b.steps, 0, bytemuck::bytes_of(&head));
+        ctx.queue
+            .write_buffer(&b.members, 0, bytemuck::cast_slice(members));
         let Some((_, state_group)) = b.state_groups.iter().find(|(s, _)| s == state) else {
             return;
         };
-        let Some(keys) = self.keys.get(layout.index() as usize) else {
+        let Some(keys) = self.keys.get(job.layout.index() as usize) else {
             return;
         };
         let pass = pass.get_or_insert_with(|| {
@@ -515,6 +565,10 @@ impl SortPass {
                 wgpu::BindGroupEntry {
                     binding: 2,
                     resource: b.values.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: b.members.as_entire_binding(),
                 },
             ],
         });
@@ -595,27 +649,12 @@ impl SortPass {
         &mut self,
         ctx: &GpuContext,
         enc: &mut wgpu::CommandEncoder,
-        scenes: &[crate::render::Scene<'_>],
         items: &[crate::render::DrawItem],
         camera: &crate::render::Camera,
     ) {
         let mut pass = None;
-        for d in items.iter().filter(|d| d.key.2) {
-            let Some(sim) = scenes.get(d.scene).map(|s| s.sim) else {
-                continue;
-            };
-            if let Some(mut b) = sim.emitter_buffers(d.index) {
-                // The window the draw visits (the whole pool when asked).
-                b.window = d.window;
-                let origin = sim
-                    .planner()
-                    .emitters
-                    .get(d.index)
-                    .map(|p| p.origin())
-                    .unwrap_or_default();
-                let eye = (camera.eye_f64() - origin).as_vec3();
-                self.record(ctx, enc, &mut pass, &b, eye, camera.forward());
-            }
+        for job in items.iter().filter_map(|d| d.sort.as_ref()) {
+            self.record(ctx, enc, &mut pass, job, camera.forward());
         }
         drop(pass);
         let live: std::collections::HashSet<u64> = items.iter().map(|d| d.key.0).collect();

@@ -317,14 +317,17 @@ impl SplatPass {
                 continue;
             };
             pass.set_pipeline(pipeline);
-            pass.set_bind_group(
-                0,
-                &frame.splat_group,
-                &[FrameResources::look_offset(d.look_slot)],
-            );
             pass.set_bind_group(1, particles, &[]);
-            let (x, y) = dispatch_size(d.window.len);
-            pass.dispatch_workgroups(x, y, 1);
+            // One dispatch per instance: the splat reads one look as a uniform.
+            for k in 0..d.members as usize {
+                pass.set_bind_group(
+                    0,
+                    &frame.splat_group,
+                    &[FrameResources::look_offset(d.look_slot + k)],
+                );
+                let (x, y) = dispatch_size(d.width);
+                pass.dispatch_workgroups(x, y, 1);
+            }
         }
         true
     }

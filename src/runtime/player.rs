@@ -14,7 +14,7 @@ use crate::runtime::Layers;
 use crate::runtime::instances::{Backing, Instance, InstanceId, Slab};
 use crate::shaders::{ShaderError, ShaderLibrary};
 use crate::sim::batch::{BatchMember, InstanceBatch, batchable};
-use crate::sim::gpu_sim::{SharedUpdate, SimError, SimState, UpdateMode};
+use crate::sim::gpu_sim::{SharedUpdate, SimError, UpdateMode};
 use crate::sim::{GpuSim, Stepper};
 
 /// How a [`Player`] draws into the host's render pass.
@@ -354,34 +354,16 @@ impl Player {
         // The splat tests the host's depth itself: without the view, billboards (tested by
         // the pass's depth attachment) draw every particle.
         self.frame.allow_splat = depth.is_some() || self.settings.depth_format.is_none();
-        let order = Self::draw_order(&self.instances, camera);
-        let members: Vec<Option<BatchMember<'_>>> = order
+        let members: Vec<Vec<Option<BatchMember<'_>>>> = self
+            .batches
             .iter()
-            .map(|i| match i.state {
-                Backing::Batched { batch, slot } => {
-                    self.batches.get(batch).and_then(|b| b.member(slot))
-                }
-                Backing::Own(_) => None,
-            })
+            .map(|b| (0..b.active()).map(|slot| b.member(slot)).collect())
             .collect();
-        let scenes: Vec<Scene<'_>> = order
-            .iter()
-            .zip(&members)
-            .filter_map(|(i, member)| {
-                let sim: &dyn SimState = match (&i.state, member) {
-                    (Backing::Own(sim), _) => sim.as_ref(),
-                    (_, Some(m)) => m,
-                    _ => return None,
-                };
-                Some(Scene {
-                    sim,
-                    effect: &i.effect,
-                })
-            })
-            .collect();
+        let groups = Self::draw_groups(&self.instances, &members, camera);
+        let groups: Vec<&[Option<Scene<'_>>]> = groups.iter().map(Vec::as_slice).collect();
         self.items = self.frame.prepare(
             &self.ctx,
-            &scenes,
+            &groups,
             camera,
             self.alpha,
             &mut self.sort,
@@ -390,7 +372,7 @@ impl Player {
         self.billboard
             .prepare(&self.ctx, &self.items, &self.frame.sprites.sampler);
         self.sort
-            .record_items(&self.ctx, encoder, &scenes, &self.items, camera);
+            .record_items(&self.ctx, encoder, &self.items, camera);
         self.splatted = self.splat.splat(
             &self.ctx,
             encoder,
@@ -401,15 +383,54 @@ impl Player {
         );
     }
 
-    /// The instances far to near, by depth along the view: far instances' smoke lies
-    /// under nearer instances' smoke.
-    fn draw_order<'a>(instances: &'a Slab<Instance>, camera: &Camera) -> Vec<&'a Instance> {
+    /// The groups of instances drawn together, far to near by their mean depth along
+    /// the view (a far group's smoke lies under a nearer group's): each batch is one
+    /// group (its members by segment; one sort orders their smoke together), each
+    /// instance with a simulation of its own another.
+    fn draw_groups<'a>(
+        instances: &'a Slab<Instance>,
+        members: &'a [Vec<Option<BatchMember<'a>>>],
+        camera: &Camera,
+    ) -> Vec<Vec<Option<Scene<'a>>>> {
         let (eye, forward) = (camera.eye_f64(), camera.forward().as_dvec3());
         let depth =
             |i: &Instance| (i.world_from_effect.w_axis.truncate().as_dvec3() - eye).dot(forward);
-        let mut order: Vec<&Instance> = instances.iter().collect();
-        order.sort_by(|a, b| depth(b).total_cmp(&depth(a)));
-        order
+        let mut groups: Vec<(f64, Vec<Option<Scene<'a>>>)> =
+            members.iter().map(|m| (0.0, vec![None; m.len()])).collect();
+        let mut counts = vec![0u32; groups.len()];
+        for i in instances.iter() {
+            match &i.state {
+                Backing::Own(sim) => groups.push((
+                    depth(i),
+                    vec![Some(Scene {
+                        sim: sim.as_ref(),
+                        effect: &i.effect,
+                    })],
+                )),
+                Backing::Batched { batch, slot } => {
+                    let (Some(g), Some(Some(m))) = (
+                        groups.get_mut(*batch),
+                        members.get(*batch).and_then(|m| m.get(*slot as usize)),
+                    ) else {
+                        continue;
+                    };
+                    g.0 += depth(i);
+                    counts[*batch] += 1;
+                    if let Some(s) = g.1.get_mut(*slot as usize) {
+                        *s = Some(Scene {
+                            sim: m,
+                            effect: &i.effect,
+                        });
+                    }
+                }
+            }
+        }
+        for (g, n) in groups.iter_mut().zip(&counts) {
+            g.0 /= f64::from((*n).max(1));
+        }
+        groups.retain(|g| g.1.iter().any(Option::is_some));
+        groups.sort_by(|a, b| b.0.total_cmp(&a.0));
+        groups.into_iter().map(|g| g.1).collect()
     }
 
     /// Records only the steps [`Player::advance`] planned for every instance, with no sort

@@ -220,6 +220,14 @@ impl InstanceBatch {
         }
     }
 
+    /// Segments up to the last taken one (what an update or a draw covers).
+    pub fn active(&self) -> u32 {
+        self.members
+            .iter()
+            .rposition(Option::is_some)
+            .map_or(0, |i| i as u32 + 1)
+    }
+
     /// Instances this batch holds.
     pub fn slots(&self) -> u32 {
         self.slots
@@ -252,11 +260,7 @@ impl InstanceBatch {
     ) {
         let steps = steps.min(MAX_STEPS);
         let n = self.pools.len();
-        let active = self
-            .members
-            .iter()
-            .rposition(Option::is_some)
-            .map_or(0, |i| i + 1);
+        let active = self.active() as usize;
         if steps == 0 || active == 0 {
             return;
         }
