@@ -17,12 +17,6 @@
 #import "common.wgsl"
 #import "look.wgsl"
 
-// A look at the 512-byte stride of the looks buffer (src/render/frame.rs).
-struct LookSlot {
-    look: LookUniform,
-    pad: array<vec4<u32>, 14>,
-}
-
 @group(0) @binding(0) var<uniform> camera: CameraUniform;
 // Storage, not uniform: see params.wgsl (lavapipe's uniform inlining).
 @group(0) @binding(1) var<storage, read> looks: array<LookSlot>;

@@ -2,7 +2,7 @@
 // compute splat) so they render the same fire. A designer hook: `particle_color`.
 //
 // Contract: the including file declares `camera: CameraUniform`, `look: LookUniform` (the
-// instance being drawn; keep both in sync with `src/gpu/types.rs`), `ramps: texture_2d<f32>` (one
+// instance being drawn, a private copy of its `LookSlot`; keep both in sync with `src/gpu/types.rs`), `ramps: texture_2d<f32>` (one
 // Rgba32Float colour ramp row per emitter) and the state: `prev`, `cur`
 // (array<Particle>) and the same buffers as `prev_packed`, `cur_packed`
 // (array<PackedParticle>, read when `STATE_LAYOUT` says the state is packed or tiny),
@@ -67,6 +67,13 @@ struct LookUniform {
     // Tiny state: x: the counters from the oldest entry's first to the last step's first
     // spawn (a slot's previous state holds its particle only below it), yzw: unused.
     tiny_c: vec4<u32>,
+}
+
+// A look at the 512-byte stride of the looks buffer (src/render/frame.rs; the draws
+// read their instances' looks as `array<LookSlot>`).
+struct LookSlot {
+    look: LookUniform,
+    pad: array<vec4<u32>, 14>,
 }
 
 override INTERPOLATE: bool = true;

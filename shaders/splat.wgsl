@@ -18,9 +18,10 @@
 #import "look.wgsl"
 
 @group(0) @binding(0) var<uniform> camera: CameraUniform;
-// A uniform here (storage in billboard.wgsl): one per-emitter recompile on lavapipe (see
-// params.wgsl) costs less than a million per-particle storage loads.
-@group(0) @binding(1) var<uniform> look: LookUniform;
+// The looks of the dispatch's instances (workgroup z is the instance), as billboard.wgsl.
+@group(0) @binding(1) var<storage, read> looks: array<LookSlot>;
+// The look of the instance this invocation splats (look.wgsl reads it).
+var<private> look: LookUniform;
 @group(0) @binding(2) var ramps: texture_2d<f32>;
 @group(1) @binding(0) var<storage, read> prev: array<Particle>;
 @group(1) @binding(1) var<storage, read> cur: array<Particle>;
@@ -74,6 +75,7 @@ fn splat(
 ) {
     // One invocation per slot of the live window: the last ring_b.w slots before the
     // ring's head (ring.x), wrapping at the capacity (ring_b.z).
+    look = looks[wg.z].look;
     let i = (wg.y * nwg.x + wg.x) * 256u + lid;
     if i >= look.ring_b.w {
         return;

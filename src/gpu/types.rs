@@ -329,5 +329,5 @@ const _: () = assert!(std::mem::size_of::<Particle>() == 32);
 const _: () = assert!(std::mem::size_of::<PackedParticle>() == 20);
 const _: () = assert!(std::mem::size_of::<Birth>() == 32);
 const _: () = assert!(std::mem::size_of::<LookUniform>() as u64 <= PARAMS_STRIDE);
-// billboard.wgsl's `LookSlot` pads a look to PARAMS_STRIDE with 14 vec4s: keep in sync.
+// look.wgsl's `LookSlot` pads a look to PARAMS_STRIDE with 14 vec4s: keep in sync.
 const _: () = assert!(std::mem::size_of::<LookUniform>() as u64 + 14 * 16 == PARAMS_STRIDE);

@@ -89,12 +89,9 @@ struct GroupView<'g, 'a> {
 
 /// Uniform buffers, layouts and bind groups for the draw passes.
 pub struct FrameResources {
-    /// Group 0 of the billboards: camera + look (storage, dynamic offset).
+    /// Group 0 of both draw paths: camera + the looks of a draw's instances (storage,
+    /// dynamic offset) + ramps.
     pub frame_layout: wgpu::BindGroupLayout,
-    /// Group 0 of the splat: camera + look (uniform, dynamic offset).
-    pub splat_layout: wgpu::BindGroupLayout,
-    /// The splat's group 0 (the same buffers as `frame_group`).
-    pub splat_group: wgpu::BindGroup,
     /// Group 1: previous and current state.
     pub particle_layout: wgpu::BindGroupLayout,
     camera: wgpu::Buffer,
@@ -278,11 +275,10 @@ impl FrameResources {
     pub fn new(ctx: &GpuContext) -> Self {
         let d = &ctx.device;
         let all = wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        // The billboards read the per-emitter look as read-only *storage*: lavapipe
-        // (Mesa 22.3) inlines uniform-buffer values that steer branches into the shader
-        // and recompiles it on every bind of a new offset — ~3 ms per emitter draw. The
-        // splat reads it as a uniform: per-particle storage loads cost lavapipe more there
-        // (a million-spark frame 85–117 → 106–161 ms) than one recompile per emitter.
+        // Both draw paths read the looks as read-only *storage*: an array of a draw's
+        // instances, and lavapipe (Mesa 22.3) inlines uniform-buffer values that steer
+        // branches into the shader and recompiles it on every bind of a new offset — ~3 ms
+        // per emitter and instance.
         let buffer = |binding, ty, dynamic| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: all,
@@ -303,33 +299,27 @@ impl FrameResources {
             },
             count: None,
         };
-        let look_layout = |label, look_type| {
-            d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some(label),
-                entries: &[
-                    buffer(0, wgpu::BufferBindingType::Uniform, false),
-                    buffer(1, look_type, true),
-                    wgpu::BindGroupLayoutEntry {
-                        binding: 2,
-                        visibility: all,
-                        ty: wgpu::BindingType::Texture {
-                            sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                            view_dimension: wgpu::TextureViewDimension::D2,
-                            multisampled: false,
-                        },
-                        count: None,
+        let frame_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("FrameResources::frame_layout"),
+            entries: &[
+                buffer(0, wgpu::BufferBindingType::Uniform, false),
+                buffer(
+                    1,
+                    wgpu::BufferBindingType::Storage { read_only: true },
+                    true,
+                ),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: all,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
                     },
-                ],
-            })
-        };
-        let frame_layout = look_layout(
-            "FrameResources::frame_layout",
-            wgpu::BufferBindingType::Storage { read_only: true },
-        );
-        let splat_layout = look_layout(
-            "FrameResources::splat_layout",
-            wgpu::BufferBindingType::Uniform,
-        );
+                    count: None,
+                },
+            ],
+        });
         let particle_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("FrameResources::particle_layout"),
             // 3, 4: the same state buffers as 0, 1, seen as packed (or tiny) state; 5: the
@@ -349,12 +339,9 @@ impl FrameResources {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let (looks, ramps, [frame_group, splat_group]) =
-            Self::look_buffer(ctx, [&frame_layout, &splat_layout], &camera, (4, 4));
+        let (looks, ramps, frame_group) = Self::look_buffer(ctx, &frame_layout, &camera, (4, 4));
         Self {
             frame_layout,
-            splat_layout,
-            splat_group,
             particle_layout,
             camera,
             looks,
@@ -384,17 +371,15 @@ impl FrameResources {
     /// over them for each of `layouts`.
     fn look_buffer(
         ctx: &GpuContext,
-        layouts: [&wgpu::BindGroupLayout; 2],
+        layout: &wgpu::BindGroupLayout,
         camera: &wgpu::Buffer,
         (slots, rows): (usize, usize),
-    ) -> (wgpu::Buffer, wgpu::Texture, [wgpu::BindGroup; 2]) {
+    ) -> (wgpu::Buffer, wgpu::Texture, wgpu::BindGroup) {
         let looks = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("FrameResources::looks"),
             // Room for a full draw's array from the last slot.
             size: (slots + LOOKS_PER_DRAW) as u64 * PARAMS_STRIDE,
-            usage: wgpu::BufferUsages::UNIFORM
-                | wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let ramps = crate::gpu::texture_2d(
@@ -406,37 +391,30 @@ impl FrameResources {
             wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
         );
         let ramp_view = ramps.create_view(&Default::default());
-        // The billboards read a draw's instances' looks as an array; the splat one look.
-        let sizes = [
-            LOOKS_PER_DRAW as u64 * PARAMS_STRIDE,
-            size_of::<LookUniform>() as u64,
-        ];
-        let groups = [0, 1].map(|g| {
-            let (layout, binding_bytes) = (layouts[g], sizes[g]);
-            ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("FrameResources::frame_group"),
-                layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: camera.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                            buffer: &looks,
-                            offset: 0,
-                            size: wgpu::BufferSize::new(binding_bytes),
-                        }),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: wgpu::BindingResource::TextureView(&ramp_view),
-                    },
-                ],
-            })
+        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("FrameResources::frame_group"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: camera.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    // A draw's instances' looks, as an array from the dynamic offset.
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &looks,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(LOOKS_PER_DRAW as u64 * PARAMS_STRIDE),
+                    }),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&ramp_view),
+                },
+            ],
         });
-        (looks, ramps, groups)
+        (looks, ramps, group)
     }
 
     /// The dynamic offset of emitter `index`'s look uniform.
@@ -492,9 +470,9 @@ impl FrameResources {
         }
         self.look_slots = self.look_slots.max(slots.next_power_of_two());
         self.ramp_rows = self.ramp_rows.max(rows.next_power_of_two());
-        let (looks, ramps, [group, splat_group]) = Self::look_buffer(
+        let (looks, ramps, group) = Self::look_buffer(
             ctx,
-            [&self.frame_layout, &self.splat_layout],
+            &self.frame_layout,
             &self.camera,
             (self.look_slots, self.ramp_rows),
         );
@@ -502,7 +480,6 @@ impl FrameResources {
         self.ramps = ramps;
         self.ramp_keys = vec![None; self.ramp_rows];
         self.frame_group = group;
-        self.splat_group = splat_group;
     }
 
     /// Uploads this frame's uniforms and returns what to draw, with each emitter's path:
@@ -561,24 +538,11 @@ impl FrameResources {
         items
     }
 
-    /// Emitter `i`'s look uniform of one instance, and its pool (`None`: no pool).
-    fn member_look<'s>(
-        &mut self,
-        view: &GroupView<'_, '_>,
-        scene: &Scene<'s>,
-        i: usize,
-        sprite: &SpriteTexture,
-    ) -> Option<(LookUniform, crate::sim::gpu_sim::EmitterBuffers<'s>)> {
-        let (sim, effect) = (scene.sim, scene.effect);
-        let e = effect.emitters.get(i)?;
-        let origin = sim
-            .planner()
-            .emitters
-            .get(i)
-            .map(|p| p.origin())
-            .unwrap_or_default();
-        let salt = crate::rng::pcg4d([effect.seed, i as u32, e.seed_offset, 0x5EED_100C])[0];
-        let mut u = look_uniform(&e.look, i as u32, salt, sprite.integral);
+    /// Emitter `i`'s look of every instance (its salt, place and ring are set per
+    /// instance by `member_look`): the look's settings and the sprite's trim.
+    fn base_look(&mut self, effect: &Effect, i: usize, sprite: &SpriteTexture) -> LookUniform {
+        let e = &effect.emitters[i];
+        let mut u = look_uniform(&e.look, i as u32, 0, sprite.integral);
         if self.trim_sprites && e.look.streak.is_none() {
             let (rows, cols) = e
                 .look
@@ -593,6 +557,28 @@ impl FrameResources {
                 .entry((sprite.id, rows, cols, threshold.to_bits()))
                 .or_insert_with(|| sprite.trim_rect(rows, cols, threshold));
         }
+        u
+    }
+
+    /// Emitter `i`'s look uniform of one instance, from the group's `base`, and its pool
+    /// (`None`: no pool).
+    fn member_look<'s>(
+        &self,
+        view: &GroupView<'_, '_>,
+        scene: &Scene<'s>,
+        i: usize,
+        base: &LookUniform,
+    ) -> Option<(LookUniform, crate::sim::gpu_sim::EmitterBuffers<'s>)> {
+        let (sim, effect) = (scene.sim, scene.effect);
+        let e = effect.emitters.get(i)?;
+        let origin = sim
+            .planner()
+            .emitters
+            .get(i)
+            .map(|p| p.origin())
+            .unwrap_or_default();
+        let mut u = *base;
+        u.flags[2] = crate::rng::pcg4d([effect.seed, i as u32, e.seed_offset, 0x5EED_100C])[0];
         u.clip_from_sim = view.camera.clip_from_sim(origin).to_cols_array_2d();
         let ground = e.collisions.ground.as_ref().map_or(0.0, |g| g.height_m);
         u.soft[0] = (f64::from(ground) - origin.y) as f32;
@@ -648,6 +634,7 @@ impl FrameResources {
             self.upload_ramp(ctx, i, &e.look);
         }
         let eye = view.camera.eye_f64();
+        let base = self.base_look(first.effect, i, &sprite);
         let mut looks = Vec::with_capacity(view.group.len());
         let mut pool = None;
         let mut members = Vec::new();
@@ -659,7 +646,7 @@ impl FrameResources {
                 members.push(SortMember::default());
                 continue;
             };
-            let Some((u, b)) = self.member_look(view, scene, i, &sprite) else {
+            let Some((u, b)) = self.member_look(view, scene, i, &base) else {
                 looks.push(None);
                 members.push(SortMember::default());
                 continue;

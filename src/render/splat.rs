@@ -98,7 +98,7 @@ impl SplatPass {
             .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("SplatPass::pipeline_layout"),
                 bind_group_layouts: &[
-                    Some(&frame.splat_layout),
+                    Some(&frame.frame_layout),
                     Some(&frame.particle_layout),
                     Some(&accum_layout),
                 ],
@@ -121,7 +121,7 @@ impl SplatPass {
             .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("SplatPass::resolve_layout"),
                 bind_group_layouts: &[
-                    Some(&frame.splat_layout),
+                    Some(&frame.frame_layout),
                     Some(&empty_layout),
                     Some(&accum_layout),
                 ],
@@ -317,17 +317,15 @@ impl SplatPass {
                 continue;
             };
             pass.set_pipeline(pipeline);
+            pass.set_bind_group(
+                0,
+                &frame.frame_group,
+                &[FrameResources::look_offset(d.look_slot)],
+            );
             pass.set_bind_group(1, particles, &[]);
-            // One dispatch per instance: the splat reads one look as a uniform.
-            for k in 0..d.members as usize {
-                pass.set_bind_group(
-                    0,
-                    &frame.splat_group,
-                    &[FrameResources::look_offset(d.look_slot + k)],
-                );
-                let (x, y) = dispatch_size(d.width);
-                pass.dispatch_workgroups(x, y, 1);
-            }
+            // Workgroup z is the instance.
+            let (x, y) = dispatch_size(d.width);
+            pass.dispatch_workgroups(x, y, d.members);
         }
         true
     }
@@ -375,7 +373,7 @@ impl SplatPass {
             return;
         };
         pass.set_pipeline(&self.resolve);
-        pass.set_bind_group(0, &frame.splat_group, &[0]);
+        pass.set_bind_group(0, &frame.frame_group, &[0]);
         pass.set_bind_group(1, &self.empty_group, &[]);
         pass.set_bind_group(2, group, &[]);
         pass.draw(0..3, 0..1);

@@ -398,7 +398,6 @@ impl SimState for BatchMember<'_> {
                 p.live_window(pool.capacity, pool.life_range.1)
             }),
             slot_base: self.slot * pool.capacity,
-            sort_key: pool.generation | (u64::from(self.slot) + 1) << 48,
         })
     }
 

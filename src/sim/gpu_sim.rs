@@ -367,8 +367,6 @@ pub struct EmitterBuffers<'a> {
     pub window: LiveWindow,
     /// Where this pool's slots start in the buffers (a batched instance's segment; else 0).
     pub slot_base: u32,
-    /// Keys this pool's sort buffers (the generation, or a batched instance's own key).
-    pub sort_key: u64,
 }
 
 /// What the draw passes read of a simulation: its pools and its planner (a
@@ -964,7 +962,6 @@ impl GpuSim {
                 _ => LiveWindow::all(s.capacity),
             },
             slot_base: 0,
-            sort_key: s.generation,
         })
     }
 

@@ -208,9 +208,16 @@ impl EmitterPlanner {
         };
         self.last_dt_secs = dt;
         let max_life_now = e.lifetime_secs.max as f64;
-        // A raised range stretches the lives of packed particles already born.
-        for b in &mut self.history {
-            b.max_life_secs = b.max_life_secs.max(max_life_now);
+        // A raised range stretches the lives of packed particles already born. Every
+        // batch holds at least the last step's maximum: only a raise changes any.
+        if self
+            .history
+            .back()
+            .is_some_and(|b| b.max_life_secs < max_life_now)
+        {
+            for b in &mut self.history {
+                b.max_life_secs = b.max_life_secs.max(max_life_now);
+            }
         }
         // The older of the two state buffers holds the state at the last step's start:
         // a batch dead by then is dead (and identical) in both, and need not be visited.
@@ -356,19 +363,28 @@ impl EmitterPlanner {
             let Some(old) = j.checked_sub(capacity) else {
                 continue;
             };
-            let Some(batch) = self
-                .history
-                .iter()
-                .find(|b| old >= b.first_index && old < b.first_index + b.count as u64)
+            // The batches are in spawn order: the last one starting at or before `old`.
+            let at = self.history.partition_point(|b| b.first_index <= old);
+            let Some(batch) = at
+                .checked_sub(1)
+                .and_then(|i| self.history.get(i))
+                .filter(|b| old < b.first_index + b.count as u64)
             else {
                 continue;
             };
-            let slot = (old % capacity) as u32;
-            let r1 = rng::unorm4(rng::rand_block(rng::spawn_key(seed, salt, slot, old), 1));
-            let life = mix(e.lifetime_secs.min, e.lifetime_secs.max, r1[3]) as f64;
-            if t0 - batch.birth_secs < life {
-                self.stats.recycled_alive += 1;
-            }
+            // Younger than the shortest lifetime: alive; older than the longest: dead;
+            // in between, the particle's own lifetime decides.
+            let age = t0 - batch.birth_secs;
+            let alive = if age < f64::from(e.lifetime_secs.min) {
+                true
+            } else if age >= f64::from(e.lifetime_secs.max) {
+                false
+            } else {
+                let slot = (old % capacity) as u32;
+                let r1 = rng::unorm4(rng::rand_block(rng::spawn_key(seed, salt, slot, old), 1));
+                age < mix(e.lifetime_secs.min, e.lifetime_secs.max, r1[3]) as f64
+            };
+            self.stats.recycled_alive += u64::from(alive);
         }
     }
 
