@@ -4,16 +4,14 @@ use std::path::PathBuf;
 
 use anyhow::{Context as _, anyhow};
 
-use crate::gpu::GpuContext;
+use crate::gpu::{GpuContext, TextureReadback};
 use crate::sim::gpu_sim::map_read;
 
 /// A copy of a frame on its way to the CPU.
 pub struct Screenshot {
     /// Where the PNG goes.
     pub path: PathBuf,
-    buffer: wgpu::Buffer,
-    size: (u32, u32),
-    bytes_per_row: u32,
+    copy: TextureReadback,
     format: wgpu::TextureFormat,
 }
 
@@ -25,32 +23,9 @@ impl Screenshot {
         texture: &wgpu::Texture,
         path: PathBuf,
     ) -> Self {
-        let (w, h) = (texture.width(), texture.height());
-        let bytes_per_row = (w * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
-            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("editor::screenshot"),
-            size: bytes_per_row as u64 * h as u64,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        encoder.copy_texture_to_buffer(
-            texture.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(bytes_per_row),
-                    rows_per_image: Some(h),
-                },
-            },
-            texture.size(),
-        );
         Self {
             path,
-            buffer,
-            size: (w, h),
-            bytes_per_row,
+            copy: TextureReadback::record(&ctx.device, encoder, texture, "editor::screenshot"),
             format: texture.format(),
         }
     }
@@ -58,19 +33,19 @@ impl Screenshot {
 
 /// Waits for the copy (submitted by the caller), converts to RGBA8 and writes the PNG.
 pub fn read_back(ctx: &GpuContext, shot: Screenshot) -> anyhow::Result<image::RgbaImage> {
-    let bytes = map_read(ctx, &shot.buffer)?;
-    let (w, h) = shot.size;
+    let bytes = map_read(ctx, &shot.copy.buffer)?;
+    let (w, h) = shot.copy.size;
     let swap_red_blue = match shot.format {
         wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb => true,
         wgpu::TextureFormat::Rgba8Unorm | wgpu::TextureFormat::Rgba8UnormSrgb => false,
         other => return Err(anyhow!("cannot save a screenshot of a {other:?} surface")),
     };
+    let rows = shot
+        .copy
+        .rows(&bytes)
+        .ok_or_else(|| anyhow!("screenshot readback is too short"))?;
     let mut pixels = Vec::with_capacity((w * h * 4) as usize);
-    for y in 0..h as usize {
-        let start = y * shot.bytes_per_row as usize;
-        let row = bytes
-            .get(start..start + (w * 4) as usize)
-            .ok_or_else(|| anyhow!("screenshot readback is too short"))?;
+    for row in rows {
         for px in row.chunks_exact(4) {
             let (r, b) = if swap_red_blue {
                 (px[2], px[0])

@@ -1,10 +1,42 @@
 //! GPU plumbing: the device context and the structs shared with WGSL.
 
 pub mod context;
+pub mod readback;
 pub mod timer;
 pub mod types;
 
 pub use context::{GpuContext, GpuError};
+pub use readback::TextureReadback;
+
+/// A 2-D depth texture binding (a host's depth, sampled with `textureLoad`).
+pub fn depth_texture_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Depth,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// A 1×1 depth texture's view, bound where no host depth is (shaders test its size).
+pub fn placeholder_depth(device: &wgpu::Device, label: &str) -> wgpu::TextureView {
+    texture_2d(
+        device,
+        label,
+        (1, 1),
+        1,
+        wgpu::TextureFormat::Depth32Float,
+        wgpu::TextureUsages::TEXTURE_BINDING,
+    )
+    .create_view(&Default::default())
+}
 
 /// A single-sample 2-D texture of `size` (each side at least 1) with `mips` levels.
 pub fn texture_2d(

@@ -73,26 +73,12 @@ impl BillboardPass {
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("BillboardPass::depth_layout"),
-                entries: &[wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                }],
+                entries: &[crate::gpu::depth_texture_entry(
+                    0,
+                    wgpu::ShaderStages::FRAGMENT,
+                )],
             });
-        let placeholder = crate::gpu::texture_2d(
-            &ctx.device,
-            "BillboardPass::no_depth",
-            (1, 1),
-            1,
-            wgpu::TextureFormat::Depth32Float,
-            wgpu::TextureUsages::TEXTURE_BINDING,
-        );
-        let no_depth = placeholder.create_view(&Default::default());
+        let no_depth = crate::gpu::placeholder_depth(&ctx.device, "BillboardPass::no_depth");
         let depth_group = Self::depth_group(ctx, &depth_layout, &no_depth);
         let sprite_layout = ctx
             .device

@@ -4,7 +4,7 @@
 //! resolution when the preset or draft quality asks), then its bloom and tonemap into a
 //! display image.
 
-use crate::gpu::GpuContext;
+use crate::gpu::{GpuContext, TextureReadback};
 use crate::render::bloom::BloomPass;
 use crate::render::{
     Camera, HDR_FORMAT, Targets, TonemapPass, begin_hdr_pass, ensure_layer, reduced,
@@ -168,38 +168,15 @@ impl Composite {
         let Some(targets) = self.targets.as_ref() else {
             return Err(SimError::Readback("no render target".into()));
         };
-        let (w, h) = targets.size;
-        let row = (w * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
-            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("Composite::readback"),
-            size: row as u64 * h as u64,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        enc.copy_texture_to_buffer(
-            targets.ldr.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &staging,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row),
-                    rows_per_image: Some(h),
-                },
-            },
-            wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-        );
+        let copy =
+            TextureReadback::record(&ctx.device, &mut enc, &targets.ldr, "Composite::readback");
         ctx.queue.submit([enc.finish()]);
-        let bytes = map_read(ctx, &staging)?;
-        let mut pixels = Vec::with_capacity((w * h * 4) as usize);
-        for y in 0..h as usize {
-            let start = y * row as usize;
-            pixels.extend_from_slice(&bytes[start..start + (w * 4) as usize]);
-        }
+        let bytes = map_read(ctx, &copy.buffer)?;
+        let rows = copy
+            .rows(&bytes)
+            .ok_or_else(|| SimError::Readback("the image readback is too short".into()))?;
+        let (w, h) = copy.size;
+        let pixels = rows.concat();
         image::RgbaImage::from_raw(w, h, pixels)
             .ok_or_else(|| SimError::Readback("image size mismatch".into()))
     }

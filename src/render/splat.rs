@@ -72,27 +72,10 @@ impl SplatPass {
                         },
                         count: None,
                     },
-                    wgpu::BindGroupLayoutEntry {
-                        binding: 1,
-                        visibility: wgpu::ShaderStages::COMPUTE,
-                        ty: wgpu::BindingType::Texture {
-                            sample_type: wgpu::TextureSampleType::Depth,
-                            view_dimension: wgpu::TextureViewDimension::D2,
-                            multisampled: false,
-                        },
-                        count: None,
-                    },
+                    crate::gpu::depth_texture_entry(1, wgpu::ShaderStages::COMPUTE),
                 ],
             });
-        let no_depth = crate::gpu::texture_2d(
-            &ctx.device,
-            "SplatPass::no_depth",
-            (1, 1),
-            1,
-            wgpu::TextureFormat::Depth32Float,
-            wgpu::TextureUsages::TEXTURE_BINDING,
-        )
-        .create_view(&Default::default());
+        let no_depth = crate::gpu::placeholder_depth(&ctx.device, "SplatPass::no_depth");
         let pipeline_layout = ctx
             .device
             .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
