@@ -123,6 +123,8 @@ pub struct FrameResources {
     pub allow_splat: bool,
     /// Soft edges read the host's depth buffer instead of the preset's ground plane.
     pub soft_depth: bool,
+    /// This frame's look blocks on their way to `looks`.
+    look_bytes: Vec<u8>,
 }
 
 /// The look uniform of an emitter (everything but the matrices, the ground height and
@@ -364,6 +366,7 @@ impl FrameResources {
             trims: HashMap::new(),
             allow_splat: true,
             soft_depth: false,
+            look_bytes: Vec::new(),
         }
     }
 
@@ -508,7 +511,10 @@ impl FrameResources {
         let rows = groups.iter().map(|g| emitters(g)).max().unwrap_or(0);
         self.reserve(ctx, slots, rows);
         self.sprite_errors.clear();
-        let mut blocks = vec![0u8; slots * PARAMS_STRIDE as usize];
+        // Reused from frame to frame: a fresh allocation of this size is fresh pages.
+        let mut blocks = std::mem::take(&mut self.look_bytes);
+        blocks.clear();
+        blocks.resize(slots * PARAMS_STRIDE as usize, 0);
         let mut items = Vec::new();
         let mut slot = 0;
         for (n, group) in groups.iter().enumerate() {
@@ -533,6 +539,7 @@ impl FrameResources {
         if !blocks.is_empty() {
             ctx.queue.write_buffer(&self.looks, 0, &blocks);
         }
+        self.look_bytes = blocks;
         let live: std::collections::HashSet<u64> = items.iter().map(|d| d.key.0).collect();
         self.particle_groups.retain(|k, _| live.contains(&k.0));
         items

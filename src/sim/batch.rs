@@ -27,6 +27,9 @@ const _: () = assert!(size_of::<SimParams>().is_multiple_of(16));
 /// emitter's pool times this would not fit one storage binding).
 pub const BATCH_SLOTS: u32 = 16;
 
+/// Written for an empty segment or a disabled emitter.
+const ZERO_BLOCK: [u8; size_of::<SimParams>()] = [0; size_of::<SimParams>()];
+
 /// Steps one record may plan (the parameter blocks of a record live side by side).
 const MAX_STEPS: usize = 32;
 
@@ -264,29 +267,41 @@ impl InstanceBatch {
         if steps == 0 || active == 0 {
             return;
         }
-        let mut blocks = vec![0u8; self.block_bytes as usize * steps * n];
+        let bytes = self.block_bytes * (steps * n) as u64;
+        // Written straight into the upload's staging memory (no copy of its own).
+        let Some(mut blocks) = wgpu::BufferSize::new(bytes)
+            .and_then(|size| self.ctx.queue.write_buffer_with(&self.params, 0, size))
+        else {
+            return;
+        };
         // The invocations each (step, emitter) needs: the largest window of its instances.
         let mut widest = vec![0u32; steps * n];
-        for (slot, member) in self.members.iter_mut().enumerate() {
-            let (Some(m), Some(Some(effect))) = (member.as_mut(), effects.get(slot)) else {
-                continue;
-            };
+        let stride = size_of::<SimParams>();
+        for (slot, member) in self.members.iter_mut().enumerate().take(active) {
+            let mut m = member.as_mut().zip(effects.get(slot).copied().flatten());
             for s in 0..steps {
-                for (e, p) in m.planner.plan_step(effect, dt_secs).into_iter().enumerate() {
-                    let (Some(mut p), Some(pool)) = (p, self.pools.get(e)) else {
+                let mut plans = m
+                    .as_mut()
+                    .map(|(m, effect)| m.planner.plan_step(effect, dt_secs));
+                for e in 0..n {
+                    let at = (s * n + e) * self.block_bytes as usize + slot * stride;
+                    let mut block = blocks.slice(at..at + stride);
+                    let plan = plans.as_mut().and_then(|p| p.get_mut(e)?.take());
+                    let (Some(mut p), Some(pool)) = (plan, self.pools.get(e)) else {
+                        // An empty segment or a disabled emitter: a zero block updates no
+                        // slot (its window is empty).
+                        block.copy_from_slice(&ZERO_BLOCK[..stride]);
                         continue;
                     };
                     if p.update_window[1] > pool.capacity {
                         p.update_window = [0, pool.capacity, 0, 0];
                     }
-                    let block = (s * n + e) * self.block_bytes as usize;
-                    let at = block + slot * size_of::<SimParams>();
-                    blocks[at..at + size_of::<SimParams>()].copy_from_slice(bytemuck::bytes_of(&p));
+                    block.copy_from_slice(bytemuck::bytes_of(&p));
                     widest[s * n + e] = widest[s * n + e].max(p.update_window[1]);
                 }
             }
         }
-        self.ctx.queue.write_buffer(&self.params, 0, &blocks);
+        drop(blocks);
         let update = lock(&self.update);
         // Every instance runs the same emitters: one pipeline per emitter for the batch.
         let effect = effects.iter().flatten().next();

@@ -359,17 +359,25 @@ impl EmitterPlanner {
         if self.history.is_empty() || count == 0 {
             return;
         }
+        // The overwritten counters are consecutive, and so are the batches (in spawn
+        // order): one binary search for the first, then a walk.
+        let first_old = self.spawned_total.saturating_sub(capacity);
+        let mut at = self
+            .history
+            .partition_point(|b| b.first_index <= first_old)
+            .saturating_sub(1);
         for j in self.spawned_total..self.spawned_total + count {
             let Some(old) = j.checked_sub(capacity) else {
                 continue;
             };
-            // The batches are in spawn order: the last one starting at or before `old`.
-            let at = self.history.partition_point(|b| b.first_index <= old);
-            let Some(batch) = at
-                .checked_sub(1)
-                .and_then(|i| self.history.get(i))
-                .filter(|b| old < b.first_index + b.count as u64)
-            else {
+            while self
+                .history
+                .get(at)
+                .is_some_and(|b| old >= b.first_index + b.count as u64)
+            {
+                at += 1;
+            }
+            let Some(batch) = self.history.get(at).filter(|b| old >= b.first_index) else {
                 continue;
             };
             // Younger than the shortest lifetime: alive; older than the longest: dead;
