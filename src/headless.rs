@@ -43,6 +43,7 @@ impl Headless {
         };
         let settings = PlayerSettings {
             shader_dir,
+            adapter_profile: Some(ctx.profile),
             ..settings
         };
         let mut player = Player::new(&ctx.device, &ctx.queue, &effect, settings)?;

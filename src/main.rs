@@ -9,7 +9,7 @@ use clap::{Parser, Subcommand};
 use ignis::editor::EditOptions;
 use ignis::editor::ui_painter::UiPainterKind;
 use ignis::effect::Effect;
-use ignis::gpu::GpuContext;
+use ignis::gpu::{AdapterProfile, GpuContext, ProfileKind};
 use ignis::headless::Headless;
 use ignis::shaders::{ENTRY_FILES, ShaderLibrary};
 
@@ -18,6 +18,32 @@ use ignis::shaders::{ENTRY_FILES, ShaderLibrary};
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
+    /// The choices that differ between GPUs and software adapters (render scale, draft
+    /// layers, parameter bindings, quad topology, UI painter): gpu or software (default:
+    /// from the adapter's type).
+    #[arg(long, global = true)]
+    adapter_profile: Option<ProfileArg>,
+}
+
+/// `--adapter-profile`'s values.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum ProfileArg {
+    Gpu,
+    Software,
+}
+
+impl From<ProfileArg> for ProfileKind {
+    fn from(p: ProfileArg) -> Self {
+        match p {
+            ProfileArg::Gpu => ProfileKind::Gpu,
+            ProfileArg::Software => ProfileKind::Software,
+        }
+    }
+}
+
+/// The headless context, with the profile asked for on the command line.
+fn context(profile: Option<ProfileKind>) -> anyhow::Result<GpuContext> {
+    Ok(GpuContext::headless()?.with_profile(profile.map(AdapterProfile::of_kind)))
 }
 
 #[derive(Subcommand)]
@@ -42,8 +68,8 @@ enum Command {
         /// egui painter: auto (lean on software adapters), egui-wgpu or lean.
         #[arg(long, default_value = "auto")]
         ui_painter: UiPainterKind,
-        /// Render the viewport at this fraction of its size, 0.1..=1 (default: 1, or 0.5
-        /// on software adapters).
+        /// Render the viewport at this fraction of its size, 0.1..=1 (default: the
+        /// adapter profile's: 1 on GPUs, 0.5 on software adapters).
         #[arg(long)]
         render_scale: Option<f32>,
         /// With --frames: drain the GPU after each frame stage and print the median time
@@ -194,9 +220,11 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
 fn main() {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
+    let adapter_profile = cli.adapter_profile.map(ProfileKind::from);
     let result = match cli.command {
         None => edit(EditOptions {
             window_size: (1280, 720),
+            adapter_profile,
             ..Default::default()
         }),
         Some(Command::Edit {
@@ -223,6 +251,7 @@ fn main() {
             sections,
             select,
             draft,
+            adapter_profile,
         }),
         Some(Command::Render {
             preset,
@@ -242,10 +271,11 @@ fn main() {
             fps,
             last_only,
             shader_dir.as_deref(),
+            adapter_profile,
         ),
         Some(Command::Check { paths }) => check(&paths),
         Some(Command::Sprites { out }) => write_sprites(&out),
-        Some(Command::Bench { kind }) => bench(kind),
+        Some(Command::Bench { kind }) => bench(kind, adapter_profile),
     };
     if let Err(err) = result {
         eprintln!("error: {err:#}");
@@ -285,6 +315,7 @@ fn render(
     fps: f64,
     last_only: bool,
     shader_dir: Option<&Path>,
+    profile: Option<ProfileKind>,
 ) -> anyhow::Result<()> {
     if !(fps.is_finite() && fps > 0.0) {
         bail!("--fps must be a positive number, got {fps}");
@@ -293,7 +324,7 @@ fn render(
     if let Some(s) = seed {
         effect.seed = s;
     }
-    let ctx = GpuContext::headless()?;
+    let ctx = context(profile)?;
     let lib = ShaderLibrary::discover(shader_dir);
     // PNG sprites are relative to the preset file.
     let settings = ignis::PlayerSettings {
@@ -360,8 +391,8 @@ fn adapter_tag(ctx: &GpuContext) -> String {
         .join("-")
 }
 
-fn bench(kind: BenchKind) -> anyhow::Result<()> {
-    let ctx = GpuContext::headless()?;
+fn bench(kind: BenchKind, profile: Option<ProfileKind>) -> anyhow::Result<()> {
+    let ctx = context(profile)?;
     match kind {
         BenchKind::Runtime {
             preset,
@@ -413,7 +444,7 @@ fn bench(kind: BenchKind) -> anyhow::Result<()> {
             out,
             name,
         } => {
-            let cpu = ctx.is_cpu_adapter();
+            let cpu = ctx.profile.is_software();
             let sides = if sides.is_empty() {
                 let mut s = vec![64, 128, 256, 512, 1024, 2048];
                 if !cpu {

@@ -602,3 +602,34 @@ fn draft_glow_layer_renders_like_full_resolution() {
         "draft vs full: mean {mean} (max {max}), light {ld} vs {lf}"
     );
 }
+
+/// The adapter profile changes how the work is issued (parameters in storage or uniforms,
+/// indexed or instanced quads, counts in the update or on demand), never the result: the
+/// campfire renders the same frame and keeps the same particles under either profile.
+#[test]
+fn both_adapter_profiles_render_the_same_frame() {
+    use ignis::gpu::AdapterProfile;
+    let render = |profile: AdapterProfile| {
+        let ctx = gpu().with_profile(Some(profile));
+        let mut effect = Effect::default_campfire();
+        effect.post.bloom = None;
+        let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+        for _ in 0..45 {
+            run.advance(1.0 / 60.0);
+        }
+        (
+            run.render(SIZE).expect("render"),
+            run.alive().expect("alive"),
+        )
+    };
+    let (gpu_frame, gpu_alive) = render(AdapterProfile::GPU);
+    let (soft_frame, soft_alive) = render(AdapterProfile::SOFTWARE);
+    assert_eq!(gpu_alive, soft_alive, "the same particles");
+    let (mean, max) = image_diff(&gpu_frame, &soft_frame);
+    let lit = gpu_frame.pixels().filter(|p| p[0] > 40).count();
+    assert!(lit > 500, "{lit} lit pixels");
+    assert!(
+        mean < 0.02 && max <= 2,
+        "gpu vs software profile: mean {mean}, max {max}"
+    );
+}

@@ -498,7 +498,7 @@ pub fn run(
     let timer = GpuTimer::new(ctx);
     let cost_capacity = if opts.cost_capacity > 0 {
         opts.cost_capacity
-    } else if ctx.is_cpu_adapter() {
+    } else if ctx.profile.is_software() {
         1 << 20
     } else {
         1 << 24

@@ -547,7 +547,7 @@ fn sort_costs(
     opts: &PerfOptions,
     timer: &GpuTimer,
 ) -> Result<Vec<SortRow>, SimError> {
-    let largest = if ctx.is_cpu_adapter() {
+    let largest = if ctx.profile.is_software() {
         1 << 18
     } else {
         1 << 24

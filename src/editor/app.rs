@@ -17,7 +17,7 @@ use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::window::{Window, WindowId};
 
 use crate::effect::Effect;
-use crate::gpu::GpuContext;
+use crate::gpu::{AdapterProfile, GpuContext, ProfileKind};
 use crate::hot_reload::{FileWatcher, ShaderReloader, wgsl_names};
 use crate::render::{Composite, OrbitCamera};
 use crate::runtime::{InstanceId, Player, PlayerSettings};
@@ -67,8 +67,10 @@ pub struct EditOptions {
     pub window_size: (u32, u32),
     /// Which egui painter to use.
     pub ui_painter: UiPainterKind,
-    /// Viewport render scale (default: 1, or 0.5 on software adapters).
+    /// Viewport render scale (default: the adapter profile's).
     pub render_scale: Option<f32>,
+    /// The adapter profile to use instead of the adapter's own.
+    pub adapter_profile: Option<ProfileKind>,
     /// Drain the GPU after each frame stage and report where the time goes.
     pub profile: bool,
     /// Open exactly these panel sections at start (ids: emitter, look, …).
@@ -291,6 +293,7 @@ fn editor_player(
             .as_deref()
             .and_then(std::path::Path::parent)
             .map(std::path::Path::to_path_buf),
+        adapter_profile: Some(ctx.profile),
         ..Composite::player_settings()
     };
     let mut player = Player::new(&ctx.device, &ctx.queue, &state.running, settings)?;
@@ -309,14 +312,14 @@ impl ApplicationHandler for App {
                 self.state.stats.ui_painter = gfx.ui_painter.name();
                 // Software rasterisers pay for every pixel of every billboard: render the
                 // soft fire at half resolution there unless asked otherwise.
-                let default_scale = if gfx.ctx.is_cpu_adapter() { 0.5 } else { 1.0 };
+                let default_scale = gfx.ctx.profile.render_scale;
                 self.state.view.render_scale = self
                     .options
                     .render_scale
                     .unwrap_or(default_scale)
                     .clamp(0.1, 1.0);
                 // … and draw the large additive sprites at half of that.
-                self.state.view.draft = self.options.draft.unwrap_or(gfx.ctx.is_cpu_adapter());
+                self.state.view.draft = self.options.draft.unwrap_or(gfx.ctx.profile.draft);
                 gfx.window.request_redraw();
                 self.gfx = Some(gfx);
             }
@@ -386,7 +389,8 @@ impl Gfx {
             Some(&surface),
         ))
         .map_err(|e| anyhow!("no GPU adapter can draw to this window: {e}"))?;
-        let ctx = GpuContext::from_adapter(adapter)?;
+        let ctx = GpuContext::from_adapter(adapter)?
+            .with_profile(options.adapter_profile.map(AdapterProfile::of_kind));
         let adapter = ctx
             .adapter
             .clone()
@@ -431,12 +435,8 @@ impl Gfx {
             window.theme(),
             Some(max_texture_side),
         );
-        let ui_painter = UiPainter::new(
-            &ctx.device,
-            format,
-            options.ui_painter,
-            ctx.is_cpu_adapter(),
-        );
+        let ui_painter =
+            UiPainter::new(&ctx.device, format, options.ui_painter, ctx.profile.lean_ui);
         // Software adapters keep the window's image between frames (see retained.rs).
         let retained = (ui_painter.name() == "lean" && surface_can_receive).then(|| {
             config.usage |= wgpu::TextureUsages::COPY_DST;

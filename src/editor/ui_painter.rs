@@ -57,10 +57,10 @@ impl UiPainter {
         device: &wgpu::Device,
         format: wgpu::TextureFormat,
         kind: UiPainterKind,
-        is_cpu_adapter: bool,
+        lean_by_default: bool,
     ) -> Self {
         let lean = match kind {
-            UiPainterKind::Auto => is_cpu_adapter,
+            UiPainterKind::Auto => lean_by_default,
             UiPainterKind::EguiWgpu => false,
             UiPainterKind::Lean => true,
         };

@@ -44,6 +44,9 @@ pub struct GpuContext {
     pub queue: wgpu::Queue,
     /// Adapter description for logs and bench files.
     pub info: wgpu::AdapterInfo,
+    /// What differs between GPUs and software adapters (from the adapter's type unless
+    /// overridden with [`GpuContext::with_profile`] before anything is built).
+    pub profile: crate::gpu::AdapterProfile,
 }
 
 impl GpuContext {
@@ -90,6 +93,7 @@ impl GpuContext {
             adapter: Some(Arc::new(adapter)),
             device,
             queue,
+            profile: crate::gpu::AdapterProfile::for_device_type(info.device_type),
             info,
         })
     }
@@ -97,17 +101,23 @@ impl GpuContext {
     /// A context over a host's device and queue (the runtime player). The host's error
     /// handling is left alone.
     pub fn from_device(device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
+        let info = device.adapter_info();
         Self {
             adapter: None,
             device: device.clone(),
             queue: queue.clone(),
-            info: device.adapter_info(),
+            profile: crate::gpu::AdapterProfile::for_device_type(info.device_type),
+            info,
         }
     }
 
-    /// True on software adapters (lavapipe), whose timestamps are not trustworthy.
-    pub fn is_cpu_adapter(&self) -> bool {
-        self.info.device_type == wgpu::DeviceType::Cpu
+    /// The same context with `profile` instead of the adapter's own (call it before
+    /// building pipelines: they are specialised by it).
+    pub fn with_profile(mut self, profile: Option<crate::gpu::AdapterProfile>) -> Self {
+        if let Some(p) = profile {
+            self.profile = p;
+        }
+        self
     }
 
     /// The largest particle pool one state buffer can hold on this device.

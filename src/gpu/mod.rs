@@ -1,11 +1,13 @@
 //! GPU plumbing: the device context and the structs shared with WGSL.
 
 pub mod context;
+pub mod profile;
 pub mod readback;
 pub mod timer;
 pub mod types;
 
 pub use context::{GpuContext, GpuError};
+pub use profile::{AdapterProfile, ProfileKind};
 pub use readback::TextureReadback;
 
 /// A 2-D depth texture binding (a host's depth, sampled with `textureLoad`).

@@ -43,7 +43,7 @@ impl GpuTimer {
     pub fn new(ctx: &GpuContext) -> Self {
         let wanted =
             wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
-        if ctx.device.features().contains(wanted) && !ctx.is_cpu_adapter() {
+        if ctx.device.features().contains(wanted) && ctx.profile.timestamps {
             let set = ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("GpuTimer::queries"),
                 ty: wgpu::QueryType::Timestamp,
@@ -158,7 +158,7 @@ pub struct PassTimer {
 impl PassTimer {
     /// A pass timer when the device has trustworthy timestamps (not a CPU adapter).
     pub fn new(ctx: &GpuContext) -> Option<Self> {
-        if ctx.is_cpu_adapter() {
+        if !ctx.profile.timestamps {
             return None;
         }
         Self::new_even_on_cpu(ctx)

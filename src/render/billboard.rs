@@ -119,7 +119,7 @@ impl BillboardPass {
             depth_view: None,
             no_depth,
             quad_indices,
-            indexed: ctx.is_cpu_adapter(),
+            indexed: ctx.profile.indexed_quads,
             pipeline_layout,
             sprite_layout,
             module,

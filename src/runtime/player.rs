@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use glam::Mat4;
 
 use crate::effect::{Effect, TimeMode, ValidationError};
-use crate::gpu::GpuContext;
+use crate::gpu::{AdapterProfile, GpuContext};
 use crate::render::billboard::{BillboardPass, DrawTarget};
 use crate::render::sort::SortPass;
 use crate::render::{Camera, DrawItem, FrameResources, Scene, SplatPass};
@@ -42,6 +42,9 @@ pub struct PlayerSettings {
     /// A folder of WGSL files to build the pipelines from instead of the shaders built
     /// into the library (a host that edits them; see [`Player::reload_shader`]).
     pub shader_dir: Option<PathBuf>,
+    /// The choices that differ between GPUs and software adapters; `None`: from the
+    /// device's adapter type.
+    pub adapter_profile: Option<AdapterProfile>,
 }
 
 impl PlayerSettings {
@@ -55,6 +58,7 @@ impl PlayerSettings {
             asset_dir: None,
             batch_instances: true,
             shader_dir: None,
+            adapter_profile: None,
         }
     }
 }
@@ -136,7 +140,7 @@ impl Player {
         settings: PlayerSettings,
     ) -> Result<Self, PlayerError> {
         effect.validate().map_err(PlayerError::Invalid)?;
-        let ctx = GpuContext::from_device(device, queue);
+        let ctx = GpuContext::from_device(device, queue).with_profile(settings.adapter_profile);
         let library = match &settings.shader_dir {
             Some(dir) => ShaderLibrary::from_dir(dir),
             None => ShaderLibrary::embedded(),

@@ -87,7 +87,7 @@ impl UpdatePass {
                         ty: wgpu::BindingType::Buffer {
                             // See params.wgsl: storage on CPU adapters (lavapipe), and
                             // an array of blocks for batched instances.
-                            ty: if ctx.is_cpu_adapter() || batched {
+                            ty: if ctx.profile.params_in_storage || batched {
                                 wgpu::BufferBindingType::Storage { read_only: true }
                             } else {
                                 wgpu::BufferBindingType::Uniform
@@ -135,7 +135,7 @@ impl UpdatePass {
             count: None,
             files: Vec::new(),
             // Workgroup reductions cost CPU adapters more than a count on demand.
-            count_alive: mode == UpdateMode::Counted && !ctx.is_cpu_adapter(),
+            count_alive: mode == UpdateMode::Counted && ctx.profile.count_in_update,
             batched,
         }
     }
@@ -157,12 +157,11 @@ impl UpdatePass {
         lib: &ShaderLibrary,
         keys: &[PipelineKey],
     ) -> Result<(), ShaderError> {
-        // CPU adapters read the parameters from storage (params.wgsl says why).
-        let cpu = ctx.is_cpu_adapter();
+        // Software adapters read the parameters from storage (params.wgsl says why).
         let params = if self.batched {
             Some(PARAMS_INSTANCED)
         } else {
-            cpu.then_some(PARAMS_STORAGE)
+            ctx.profile.params_in_storage.then_some(PARAMS_STORAGE)
         };
         let compose = |io: Option<(&str, &str)>| {
             let aliases: Vec<(&str, &str)> = io.into_iter().chain(params).collect();
@@ -205,7 +204,11 @@ impl UpdatePass {
         // (lavapipe runs each invocation of a barrier-split shader separately): plain
         // atomics there.
         let count_src = lib.compose("count.wgsl")?;
-        let direct = if ctx.is_cpu_adapter() { 1.0 } else { 0.0 };
+        let direct = if ctx.profile.direct_atomic_counts {
+            1.0
+        } else {
+            0.0
+        };
         let count = create_checked(&ctx.device, &count_src, lib, |module| {
             [0.0, 1.0].map(|packed| {
                 ctx.device
