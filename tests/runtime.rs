@@ -814,3 +814,37 @@ fn edits_reach_every_batched_instance() {
     let stats = player.emitter_stats(ids[1]).expect("there");
     assert_eq!(stats[0].capacity, larger.emitters[0].capacity);
 }
+
+/// A batch's smoke is sorted together: an instance added to a batch that already draws
+/// sorted smoke shows its own smoke (the sort's buffers grow with the batch, and the draw
+/// follows them), and the smoke of every instance is drawn once.
+#[test]
+fn an_instance_added_to_a_sorted_batch_shows_its_smoke() {
+    let host = Host::new(vec3(0.0, 1.5, 4.0), vec3(0.0, 1.2, 0.0));
+    let mut smoke = preset("torch");
+    smoke.emitters.retain(|e| e.look.blend == BlendMode::Alpha);
+    assert!(!smoke.emitters.is_empty(), "the torch has smoke");
+    let at = |x: f32| Mat4::from_translation(vec3(x, 0.0, 0.0));
+    let mut player = host.player(&smoke);
+    player.add_instance(at(-1.2), 1).expect("instance");
+    player.add_instance(at(0.0), 2).expect("instance");
+    advance(&mut [&mut player], &host, 90);
+    let bg = [0.0; 3];
+    // Pixels of the right third of the frame that hold smoke.
+    let right_third = |f: &Frame| {
+        (0..f.rgba.len())
+            .filter(|i| (i % SIZE.0 as usize) * 3 / SIZE.0 as usize == 2)
+            .filter(|i| differs(f.rgba[*i], [0.0, 0.0, 0.0, 1.0], 0.01))
+            .count()
+    };
+    let before = host.frame(bg, &[], &mut [&mut player], false);
+    assert_eq!(right_third(&before), 0, "nothing is drawn on the right yet");
+    player.add_instance(at(1.2), 3).expect("instance");
+    advance(&mut [&mut player], &host, 90);
+    let after = host.frame(bg, &[], &mut [&mut player], false);
+    let shown = right_third(&after);
+    assert!(
+        shown > 100,
+        "the new instance's smoke covers only {shown} pixels"
+    );
+}

@@ -107,7 +107,9 @@ pub struct FrameResources {
     pub sprite_errors: Vec<(usize, SpriteError)>,
     /// The group-0 bind group.
     pub frame_group: wgpu::BindGroup,
-    particle_groups: HashMap<(u64, usize, bool), wgpu::BindGroup>,
+    /// Particle bind groups with the order buffer each was made over (a sort's buffers
+    /// are replaced when its batch's instance count changes).
+    particle_groups: HashMap<(u64, usize, bool), (wgpu::Buffer, wgpu::BindGroup)>,
     /// Bound as the draw order of emitters that are not sorted.
     no_order: wgpu::Buffer,
     /// Cut billboards to the occupied part of their sprite (on by default; off draws the
@@ -427,7 +429,7 @@ impl FrameResources {
 
     /// The particle bind group for a draw item.
     pub fn particle_group(&self, key: (u64, usize, bool)) -> Option<&wgpu::BindGroup> {
-        self.particle_groups.get(&key)
+        self.particle_groups.get(&key).map(|(_, g)| g)
     }
 
     /// Bakes and uploads emitter `i`'s colour ramp when its gradient changed.
@@ -761,38 +763,44 @@ impl FrameResources {
         b: &crate::sim::gpu_sim::EmitterBuffers<'_>,
         order: Option<wgpu::Buffer>,
     ) {
-        let order = order.as_ref().unwrap_or(&self.no_order);
-        self.particle_groups.entry(key).or_insert_with(|| {
-            ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("FrameResources::particle_group"),
-                layout: &self.particle_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: b.previous.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: b.current.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: order.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: b.previous.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 4,
-                        resource: b.current.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 5,
-                        resource: b.births.as_entire_binding(),
-                    },
-                ],
-            })
+        let order = order.unwrap_or_else(|| self.no_order.clone());
+        if self
+            .particle_groups
+            .get(&key)
+            .is_some_and(|(bound, _)| *bound == order)
+        {
+            return;
+        }
+        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("FrameResources::particle_group"),
+            layout: &self.particle_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: b.previous.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: b.current.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: order.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: b.previous.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: b.current.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: b.births.as_entire_binding(),
+                },
+            ],
         });
+        self.particle_groups.insert(key, (order, group));
     }
 }

@@ -257,12 +257,25 @@ impl SplatPass {
             self.accum = None;
             return false;
         }
-        if self
-            .accum
-            .as_ref()
-            .is_none_or(|a| a.size != size || a.depth.as_ref() != depth)
-        {
-            self.accum = Some(self.accum_for(ctx, size, depth));
+        match self.accum.take() {
+            // The same buffer over another depth view: a new bind group only.
+            Some(a) if a.size == size => {
+                let fresh = a.depth.as_ref() != depth;
+                self.accum = Some(if fresh {
+                    self.accum_over(ctx, a.size, a.buffer, depth)
+                } else {
+                    a
+                });
+            }
+            _ => {
+                let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("SplatPass::accum"),
+                    size: (size.0 as u64 * size.1 as u64 * 12).max(12),
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                });
+                self.accum = Some(self.accum_over(ctx, size, buffer, depth));
+            }
         }
         let Some(Accum { buffer, group, .. }) = self.accum.as_ref() else {
             return false;
@@ -313,20 +326,15 @@ impl SplatPass {
         true
     }
 
-    /// A cleared-on-use accumulation buffer of `size` and its bind group over `depth`
+    /// The accumulation `buffer` (cleared on use) of `size` and its bind group over `depth`
     /// (the placeholder when `None`: the shader then tests nothing).
-    fn accum_for(
+    fn accum_over(
         &self,
         ctx: &GpuContext,
         size: (u32, u32),
+        buffer: wgpu::Buffer,
         depth: Option<&wgpu::TextureView>,
     ) -> Accum {
-        let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("SplatPass::accum"),
-            size: (size.0 as u64 * size.1 as u64 * 12).max(12),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("SplatPass::accum_group"),
             layout: &self.accum_layout,

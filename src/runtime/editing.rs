@@ -4,6 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
+use glam::Mat4;
+
 use crate::effect::Effect;
 use crate::gpu::types::StateLayout;
 use crate::runtime::instances::{Backing, Instance};
@@ -12,7 +14,7 @@ use crate::runtime::remap::emitter_sources;
 use crate::runtime::{InstanceId, Player, PlayerError};
 use crate::shaders::{ShaderError, ShaderLibrary};
 use crate::sim::Modules;
-use crate::sim::batch::batchable;
+use crate::sim::batch::{InstanceBatch, batchable};
 use crate::sim::gpu_sim::{lock, used_keys};
 use crate::sim::{GpuSim, SimError};
 
@@ -39,34 +41,64 @@ impl Player {
         }
         effect.validate().map_err(PlayerError::Invalid)?;
         let batched = self.settings.batch_instances && batchable(effect);
-        if batched != self.batched {
-            self.update =
-                GpuSim::shared_update(&self.ctx, &self.library, effect, update_mode(batched))?;
-        } else {
+        // The pipelines the edit needs (built now; extra pipelines change nothing else).
+        let update = if batched == self.batched {
             let mut update = lock(&self.update);
             for key in used_keys(effect) {
                 update
                     .ensure(&self.ctx, &self.library, key)
                     .map_err(SimError::from)?;
             }
-        }
-        if batched {
-            let keep = self.batched && batch_shape(&self.effect) == batch_shape(effect);
+            drop(update);
+            self.update.clone()
+        } else {
+            GpuSim::shared_update(&self.ctx, &self.library, effect, update_mode(batched))?
+        };
+        let same_pools = batch_shape(&self.effect) == batch_shape(effect)
+            && emitter_sources(&self.effect, effect).is_none();
+        if batched && self.batched && same_pools {
             self.effect = effect.clone();
-            self.batched = true;
-            if keep {
-                self.replace_effects();
-            } else {
-                self.rebuild_instances()?;
+            self.replace_effects();
+            for b in &mut self.batches {
+                b.follow(effect);
             }
             return Ok(());
         }
-        if !self.batched {
+        if !batched && !self.batched {
             return self.edit_own(effect);
         }
+        // New buffers for every instance, all made before anything changes.
+        let placed: Vec<(Mat4, u32)> = self
+            .instances
+            .iter()
+            .map(|i| (i.world_from_effect, i.effect.seed))
+            .collect();
+        let mut batches = Vec::new();
+        let mut backings = Vec::with_capacity(placed.len());
+        for (world, seed) in placed {
+            let instance = Instance::effect_for(effect, world, seed);
+            let backing = if batched {
+                batch_slot(&self.ctx, &update, effect, &mut batches, seed)?
+            } else {
+                let sim = GpuSim::with_update(
+                    &self.ctx,
+                    self.library.clone(),
+                    update.clone(),
+                    &instance,
+                )?;
+                Backing::Own(Box::new(sim))
+            };
+            backings.push(backing);
+        }
+        self.update = update;
+        self.batches = batches;
+        self.batched = batched;
         self.effect = effect.clone();
-        self.batched = false;
-        self.rebuild_instances()
+        self.replace_effects();
+        for (i, b) in self.instances.iter_mut().zip(backings) {
+            i.state = b;
+        }
+        Ok(())
     }
 
     /// Every instance's copy of the effect follows the player's (seed and place kept).
@@ -74,21 +106,6 @@ impl Player {
         for i in self.instances.iter_mut() {
             i.effect = Instance::effect_for(&self.effect, i.world_from_effect, i.effect.seed);
         }
-    }
-
-    /// New buffers for every instance (each starts empty, its clock at 0).
-    fn rebuild_instances(&mut self) -> Result<(), PlayerError> {
-        self.batches.clear();
-        self.replace_effects();
-        let placed: Vec<Effect> = self.instances.iter().map(|i| i.effect.clone()).collect();
-        let mut backings = Vec::with_capacity(placed.len());
-        for p in &placed {
-            backings.push(self.backing(p)?);
-        }
-        for (i, b) in self.instances.iter_mut().zip(backings) {
-            i.state = b;
-        }
-        Ok(())
     }
 
     /// Instances with simulations of their own follow an edit in place; if any refuses
@@ -198,6 +215,31 @@ impl Player {
     pub fn reload_sprites(&mut self, changed: &[PathBuf]) -> bool {
         self.frame.sprites.invalidate(changed)
     }
+}
+
+/// A slot for a new instance with `seed` in `batches` of `template`'s instances: a free one,
+/// or one of a new batch when every one is full (the others are not touched).
+pub(super) fn batch_slot(
+    ctx: &crate::gpu::GpuContext,
+    update: &crate::sim::gpu_sim::SharedUpdate,
+    template: &Effect,
+    batches: &mut Vec<InstanceBatch>,
+    seed: u32,
+) -> Result<Backing, PlayerError> {
+    for (batch, b) in batches.iter_mut().enumerate() {
+        if let Some(slot) = b.insert(seed) {
+            return Ok(Backing::Batched { batch, slot });
+        }
+    }
+    let mut b = InstanceBatch::new(ctx, update.clone(), template)?;
+    let slot = b
+        .insert(seed)
+        .ok_or_else(|| SimError::Readback("a new batch is full".into()))?;
+    batches.push(b);
+    Ok(Backing::Batched {
+        batch: batches.len() - 1,
+        slot,
+    })
 }
 
 /// What lays out a batch's buffers: each emitter's pool size and state layout.

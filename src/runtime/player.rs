@@ -211,26 +211,19 @@ impl Player {
     /// Where a new instance running `placed` (its seed and place) keeps its particles: a
     /// free batch slot (a new batch when every one is full; the others are not touched),
     /// or a simulation of its own.
-    pub(super) fn backing(&mut self, placed: &Effect) -> Result<Backing, PlayerError> {
+    fn backing(&mut self, placed: &Effect) -> Result<Backing, PlayerError> {
         if !self.batched {
             let update = self.update.clone();
             let sim = GpuSim::with_update(&self.ctx, self.library.clone(), update, placed)?;
             return Ok(Backing::Own(Box::new(sim)));
         }
-        for (batch, b) in self.batches.iter_mut().enumerate() {
-            if let Some(slot) = b.insert(placed.seed) {
-                return Ok(Backing::Batched { batch, slot });
-            }
-        }
-        let mut b = InstanceBatch::new(&self.ctx, self.update.clone(), &self.effect)?;
-        let slot = b
-            .insert(placed.seed)
-            .ok_or_else(|| SimError::Readback("a new batch is full".into()))?;
-        self.batches.push(b);
-        Ok(Backing::Batched {
-            batch: self.batches.len() - 1,
-            slot,
-        })
+        super::editing::batch_slot(
+            &self.ctx,
+            &self.update,
+            &self.effect,
+            &mut self.batches,
+            placed.seed,
+        )
     }
 
     /// Removes an instance; its buffers are freed once the GPU is done with them. Returns

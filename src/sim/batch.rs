@@ -209,6 +209,15 @@ impl InstanceBatch {
         }
     }
 
+    /// Follows an edit of `effect` that keeps every pool's size and layout: the lifetime
+    /// ranges and random salts the draws and readbacks re-derive packed lifetimes from.
+    pub fn follow(&mut self, effect: &Effect) {
+        for (i, (p, e)) in self.pools.iter_mut().zip(&effect.emitters).enumerate() {
+            p.life_range = (e.lifetime_secs.min, e.lifetime_secs.max);
+            p.salt = crate::rng::emitter_salt(i as u32, e.seed_offset);
+        }
+    }
+
     /// Gives `slot`'s instance a new seed (for particles born from now on).
     pub fn set_seed(&mut self, slot: u32, seed: u32) {
         if let Some(Some(m)) = self.members.get_mut(slot as usize) {

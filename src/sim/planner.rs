@@ -380,12 +380,13 @@ impl EmitterPlanner {
             let Some(batch) = self.history.get(at).filter(|b| old >= b.first_index) else {
                 continue;
             };
-            // Younger than the shortest lifetime: alive; older than the longest: dead;
-            // in between, the particle's own lifetime decides.
+            // Clearly younger than the shortest lifetime: alive; clearly older than the
+            // longest: dead (margins for the f32 rounding of the lifetime's mix); in
+            // between, the particle's own lifetime decides.
             let age = t0 - batch.birth_secs;
-            let alive = if age < f64::from(e.lifetime_secs.min) {
+            let alive = if age < f64::from(e.lifetime_secs.min) * (1.0 - 1e-5) {
                 true
-            } else if age >= f64::from(e.lifetime_secs.max) {
+            } else if age >= f64::from(e.lifetime_secs.max) * (1.0 + 1e-5) {
                 false
             } else {
                 let slot = (old % capacity) as u32;
