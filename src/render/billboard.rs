@@ -36,6 +36,29 @@ impl DrawTarget {
             sample_count: 1,
         }
     }
+
+    /// The depth state of a draw into this target: tested with `compare` (the target's
+    /// own test when `None`), never written.
+    pub fn read_only_depth(
+        &self,
+        compare: Option<wgpu::CompareFunction>,
+    ) -> Option<wgpu::DepthStencilState> {
+        self.depth.map(|(format, own)| wgpu::DepthStencilState {
+            format,
+            depth_write_enabled: Some(false),
+            depth_compare: Some(compare.unwrap_or(own)),
+            stencil: Default::default(),
+            bias: Default::default(),
+        })
+    }
+
+    /// The multisample state of a draw into this target.
+    pub fn multisample(&self) -> wgpu::MultisampleState {
+        wgpu::MultisampleState {
+            count: self.sample_count.max(1),
+            ..Default::default()
+        }
+    }
 }
 
 /// Instanced billboards into the HDR target, one pipeline per look variant (built on
@@ -157,19 +180,8 @@ impl BillboardPass {
                 },
                 primitive: wgpu::PrimitiveState::default(),
                 // Particles test against the host's depth and never write it.
-                depth_stencil: target
-                    .depth
-                    .map(|(format, compare)| wgpu::DepthStencilState {
-                        format,
-                        depth_write_enabled: Some(false),
-                        depth_compare: Some(compare),
-                        stencil: Default::default(),
-                        bias: Default::default(),
-                    }),
-                multisample: wgpu::MultisampleState {
-                    count: target.sample_count.max(1),
-                    ..Default::default()
-                },
+                depth_stencil: target.read_only_depth(None),
+                multisample: target.multisample(),
                 fragment: Some(wgpu::FragmentState {
                     module,
                     entry_point: Some("fs_main"),

@@ -201,17 +201,8 @@ impl SplatPass {
                     buffers: &[],
                 },
                 primitive: wgpu::PrimitiveState::default(),
-                depth_stencil: target.depth.map(|(format, _)| wgpu::DepthStencilState {
-                    format,
-                    depth_write_enabled: Some(false),
-                    depth_compare: Some(wgpu::CompareFunction::Always),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: wgpu::MultisampleState {
-                    count: target.sample_count.max(1),
-                    ..Default::default()
-                },
+                depth_stencil: target.read_only_depth(Some(wgpu::CompareFunction::Always)),
+                multisample: target.multisample(),
                 fragment: Some(wgpu::FragmentState {
                     module,
                     entry_point: Some("fs_resolve"),
