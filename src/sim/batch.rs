@@ -27,6 +27,9 @@ const _: () = assert!(size_of::<SimParams>().is_multiple_of(16));
 /// emitter's pool times this would not fit one storage binding).
 pub const BATCH_SLOTS: u32 = 16;
 
+/// Written for an empty segment or a disabled emitter.
+const ZERO_BLOCK: [u8; size_of::<SimParams>()] = [0; size_of::<SimParams>()];
+
 /// Steps one record may plan (the parameter blocks of a record live side by side).
 const MAX_STEPS: usize = 32;
 
@@ -70,8 +73,6 @@ pub struct InstanceBatch {
     members: Vec<Option<Member>>,
     /// Slots taken since the last record, whose segments it clears first.
     pending_clears: Vec<u32>,
-    /// This record's parameter blocks on their way to `params` (reused).
-    plans: Vec<SimParams>,
 }
 
 impl InstanceBatch {
@@ -103,7 +104,6 @@ impl InstanceBatch {
             block_bytes,
             slots,
             pending_clears: Vec::new(),
-            plans: Vec::new(),
             members: (0..slots).map(|_| None).collect(),
         };
         for (i, e) in effect.emitters.iter().enumerate() {
@@ -276,40 +276,41 @@ impl InstanceBatch {
         if steps == 0 || active == 0 {
             return;
         }
-        // The plans of the active segments, block by block ((step, emitter), then the
-        // segment); empty segments and disabled emitters keep a zero block, which updates
-        // no slot (its window is empty).
-        let mut plans = std::mem::take(&mut self.plans);
-        plans.clear();
-        plans.resize(steps * n * active, bytemuck::Zeroable::zeroed());
+        let bytes = self.block_bytes * (steps * n) as u64;
+        // Written straight into the upload's staging memory (no copy of its own).
+        let Some(mut blocks) = wgpu::BufferSize::new(bytes)
+            .and_then(|size| self.ctx.queue.write_buffer_with(&self.params, 0, size))
+        else {
+            return;
+        };
         // The invocations each (step, emitter) needs: the largest window of its instances.
         let mut widest = vec![0u32; steps * n];
+        let stride = size_of::<SimParams>();
         for (slot, member) in self.members.iter_mut().enumerate().take(active) {
-            let Some((m, effect)) = member.as_mut().zip(effects.get(slot).copied().flatten())
-            else {
-                continue;
-            };
+            let mut m = member.as_mut().zip(effects.get(slot).copied().flatten());
             for s in 0..steps {
-                for (e, plan) in m.planner.plan_step(effect, dt_secs).into_iter().enumerate() {
+                let mut plans = m
+                    .as_mut()
+                    .map(|(m, effect)| m.planner.plan_step(effect, dt_secs));
+                for e in 0..n {
+                    let at = (s * n + e) * self.block_bytes as usize + slot * stride;
+                    let mut block = blocks.slice(at..at + stride);
+                    let plan = plans.as_mut().and_then(|p| p.get_mut(e)?.take());
                     let (Some(mut p), Some(pool)) = (plan, self.pools.get(e)) else {
+                        // An empty segment or a disabled emitter: a zero block updates no
+                        // slot (its window is empty).
+                        block.copy_from_slice(&ZERO_BLOCK[..stride]);
                         continue;
                     };
                     if p.update_window[1] > pool.capacity {
                         p.update_window = [0, pool.capacity, 0, 0];
                     }
+                    block.copy_from_slice(bytemuck::bytes_of(&p));
                     widest[s * n + e] = widest[s * n + e].max(p.update_window[1]);
-                    plans[(s * n + e) * active + slot] = p;
                 }
             }
         }
-        // Only the active segments' part of each block is uploaded.
-        for (b, block) in plans.chunks_exact(active).enumerate() {
-            let offset = b as u64 * self.block_bytes;
-            self.ctx
-                .queue
-                .write_buffer(&self.params, offset, bytemuck::cast_slice(block));
-        }
-        self.plans = plans;
+        drop(blocks);
         let update = lock(&self.update);
         // Every instance runs the same emitters: one pipeline per emitter for the batch.
         let effect = effects.iter().flatten().next();
