@@ -651,8 +651,8 @@ fn a_batched_instance_steps_exactly_as_a_simulation_of_its_own() {
 #[test]
 fn large_pools_batch_as_many_instances_as_a_binding_holds() {
     // 2^20 slots of 32 bytes per instance: the test host's device has wgpu's default
-    // limits (128 MiB per storage binding), which hold four, so five instances take two
-    // batches.
+    // limits (128 MiB per storage binding), which hold four, and a batch allocates at most
+    // 64 MiB of state (an instance's two buffers here): each instance has a batch.
     let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
     let mut effect = still_disc(0.0);
     effect.emitters[0].capacity = 1 << 20;

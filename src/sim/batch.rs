@@ -30,6 +30,10 @@ pub const BATCH_SLOTS: u32 = 16;
 /// Written for an empty segment or a disabled emitter.
 const ZERO_BLOCK: [u8; size_of::<SimParams>()] = [0; size_of::<SimParams>()];
 
+/// The state one batch allocates at most (unless one instance needs more): a large effect
+/// is batched by few instances, so that a single one does not allocate sixteen.
+pub const BATCH_STATE_BYTES: u64 = 64 << 20;
+
 /// Steps one record may plan (the parameter blocks of a record live side by side).
 const MAX_STEPS: usize = 32;
 
@@ -77,7 +81,8 @@ pub struct InstanceBatch {
 
 impl InstanceBatch {
     /// Buffers for up to [`BATCH_SLOTS`] instances of `effect` (as many as one storage
-    /// binding holds of its largest pool, at least one) on batched update pipelines.
+    /// binding holds of its largest pool, and as [`BATCH_STATE_BYTES`] of state hold; at
+    /// least one) on batched update pipelines.
     pub fn new(ctx: &GpuContext, update: SharedUpdate, effect: &Effect) -> Result<Self, SimError> {
         let largest = effect
             .emitters
@@ -85,8 +90,15 @@ impl InstanceBatch {
             .map(|e| e.capacity.max(1))
             .max()
             .unwrap_or(1);
-        let slots =
-            (ctx.max_capacity() / u64::from(largest)).clamp(1, u64::from(BATCH_SLOTS)) as u32;
+        // Bytes of one instance's state buffers (both of each ping-pong pair).
+        let instance_bytes: u64 = effect
+            .emitters
+            .iter()
+            .map(|e| 2 * StateLayout::of(Modules::of(e)).bytes(e.capacity.max(1)))
+            .sum();
+        let slots = (ctx.max_capacity() / u64::from(largest))
+            .min(BATCH_STATE_BYTES / instance_bytes.max(1))
+            .clamp(1, u64::from(BATCH_SLOTS)) as u32;
         let block_bytes = (u64::from(slots) * size_of::<SimParams>() as u64).next_multiple_of(
             u64::from(ctx.device.limits().min_storage_buffer_offset_alignment),
         );
