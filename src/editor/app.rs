@@ -288,11 +288,7 @@ fn editor_player(
             ShaderSourceDir::Dir(dir) => Some(dir.clone()),
             ShaderSourceDir::Embedded => None,
         },
-        asset_dir: state
-            .loaded_path
-            .as_deref()
-            .and_then(std::path::Path::parent)
-            .map(std::path::Path::to_path_buf),
+        asset_dir: state.asset_dir(),
         adapter_profile: Some(ctx.profile),
         ..Composite::player_settings()
     };
@@ -791,13 +787,7 @@ impl App {
         gfx.profiler.end_stage(&gfx.ctx);
         gfx.composite.exposure = self.state.view.exposure;
         gfx.composite.draft = self.state.view.draft;
-        gfx.player.set_asset_dir(
-            self.state
-                .loaded_path
-                .as_deref()
-                .and_then(std::path::Path::parent)
-                .map(std::path::Path::to_path_buf),
-        );
+        gfx.player.set_asset_dir(self.state.asset_dir());
         let mut encoder = gfx
             .ctx
             .device

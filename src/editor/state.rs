@@ -187,6 +187,15 @@ impl EditorState {
         }
     }
 
+    /// The folder the loaded preset's PNG sprite paths are relative to (`None`: the
+    /// working directory).
+    pub fn asset_dir(&self) -> Option<std::path::PathBuf> {
+        self.loaded_path
+            .as_deref()
+            .and_then(std::path::Path::parent)
+            .map(std::path::Path::to_path_buf)
+    }
+
     /// Saves the edited effect to `preset_path` (atomically; only a valid effect).
     pub fn save_preset(&mut self) {
         let path = std::path::PathBuf::from(self.preset_path.trim());

@@ -10,6 +10,22 @@ pub use context::{GpuContext, GpuError};
 pub use profile::{AdapterProfile, ProfileKind};
 pub use readback::TextureReadback;
 
+/// The compute pass open in `pass`, begun in `enc` (labelled `label`) on first need: the
+/// steps and the sorts of a frame each share one pass.
+pub fn compute_pass<'p>(
+    pass: &'p mut Option<wgpu::ComputePass<'static>>,
+    enc: &mut wgpu::CommandEncoder,
+    label: &str,
+) -> &'p mut wgpu::ComputePass<'static> {
+    pass.get_or_insert_with(|| {
+        enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(label),
+            timestamp_writes: None,
+        })
+        .forget_lifetime()
+    })
+}
+
 /// A 2-D depth texture binding (a host's depth, sampled with `textureLoad`).
 pub fn depth_texture_entry(
     binding: u32,

@@ -569,15 +569,19 @@ impl FrameResources {
         u
     }
 
-    /// Emitter `i`'s look uniform of one instance, from the group's `base`, and its pool
-    /// (`None`: no pool).
+    /// Emitter `i`'s look uniform of one instance, from the group's `base`, its pool and
+    /// its part of the group's sort (`None`: no pool).
     fn member_look<'s>(
         &self,
         view: &GroupView<'_, '_>,
         scene: &Scene<'s>,
         i: usize,
         base: &LookUniform,
-    ) -> Option<(LookUniform, crate::sim::gpu_sim::EmitterBuffers<'s>)> {
+    ) -> Option<(
+        LookUniform,
+        crate::sim::gpu_sim::EmitterBuffers<'s>,
+        SortMember,
+    )> {
         let (sim, effect) = (scene.sim, scene.effect);
         let e = effect.emitters.get(i)?;
         let origin = sim
@@ -618,7 +622,21 @@ impl FrameResources {
         u.ring_b = [b.seed_salt.0, b.seed_salt.1, b.capacity, b.window.len];
         [u.tiny, u.tiny_b, u.tiny_c] = b.tiny;
         u.flags[3] = b.slot_base;
-        Some((u, b))
+        // The window ends at the ring's head (u.ring[0]).
+        let cap = b.capacity.max(1);
+        let sort = SortMember {
+            eye: (view.camera.eye_f64() - origin)
+                .as_vec3()
+                .extend(0.0)
+                .to_array(),
+            window: [
+                (u.ring[0] + cap - b.window.len.min(cap)) % cap,
+                b.window.len,
+                b.slot_base,
+                0,
+            ],
+        };
+        Some((u, b, sort))
     }
 
     /// Writes emitter `i`'s look uniform of every instance of a group into `block` and
@@ -642,7 +660,6 @@ impl FrameResources {
             // Emitter i of every instance shares ramp row i: the first group's look bakes it.
             self.upload_ramp(ctx, i, &e.look);
         }
-        let eye = view.camera.eye_f64();
         let base = self.base_look(first.effect, i, &sprite);
         let mut looks = Vec::with_capacity(view.group.len());
         let mut pool = None;
@@ -655,30 +672,14 @@ impl FrameResources {
                 members.push(SortMember::default());
                 continue;
             };
-            let Some((u, b)) = self.member_look(view, scene, i, &base) else {
+            let Some((u, b, sort)) = self.member_look(view, scene, i, &base) else {
                 looks.push(None);
                 members.push(SortMember::default());
                 continue;
             };
             let placed = glam::Vec3::from(scene.effect.emitters[i].transform.position_m);
             distance = distance.min((view.camera.eye() - placed).length());
-            let origin = scene
-                .sim
-                .planner()
-                .emitters
-                .get(i)
-                .map(|p| p.origin())
-                .unwrap_or_default();
-            let cap = b.capacity.max(1);
-            members.push(SortMember {
-                eye: (eye - origin).as_vec3().extend(0.0).to_array(),
-                window: [
-                    (u.ring[0] + cap - b.window.len.min(cap)) % cap,
-                    b.window.len,
-                    b.slot_base,
-                    0,
-                ],
-            });
+            members.push(sort);
             looks.push(Some(u));
             pool.get_or_insert(b);
         }

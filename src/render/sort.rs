@@ -512,13 +512,7 @@ impl SortPass {
         let Some(keys) = self.keys.get(job.layout.index() as usize) else {
             return;
         };
-        let pass = pass.get_or_insert_with(|| {
-            enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("SortPass::sort"),
-                timestamp_writes: None,
-            })
-            .forget_lifetime()
-        });
+        let pass = crate::gpu::compute_pass(pass, enc, "SortPass::sort");
         pass.set_pipeline(keys);
         pass.set_bind_group(0, &b.group, &[0]);
         pass.set_bind_group(1, state_group, &[]);

@@ -75,16 +75,21 @@ impl Player {
     pub fn emitter_stats(&self, id: InstanceId) -> Option<Vec<EmitterStats>> {
         self.with_state(id, |s| {
             (0..self.effect.emitters.len())
-                .map(|i| EmitterStats {
-                    capacity: s.emitter_buffers(i).map_or(0, |b| b.capacity),
-                    visited: s.emitter_buffers(i).map_or(0, |b| b.window.len),
-                    first_visited: s.emitter_buffers(i).map_or(0, |b| b.window.first_slot),
-                    spawn: s
-                        .planner()
-                        .emitters
-                        .get(i)
-                        .map(|p| p.stats)
-                        .unwrap_or_default(),
+                .map(|i| {
+                    let (capacity, window) = s
+                        .emitter_buffers(i)
+                        .map_or((0, Default::default()), |b| (b.capacity, b.window));
+                    EmitterStats {
+                        capacity,
+                        visited: window.len,
+                        first_visited: window.first_slot,
+                        spawn: s
+                            .planner()
+                            .emitters
+                            .get(i)
+                            .map(|p| p.stats)
+                            .unwrap_or_default(),
+                    }
                 })
                 .collect()
         })

@@ -333,8 +333,9 @@ impl Player {
     /// target (with `TEXTURE_BINDING` usage): soft edges fade where particles meet the
     /// host's geometry, and the splat hides particles behind it. Without it the preset's
     /// ground plane softens them, and a player with a depth format draws every particle
-    /// as a billboard (the pass's depth test is then the only one). Call it once per submitted encoder (its
-    /// uploads go through the queue); draw the result in as many passes as needed.
+    /// as a billboard (the pass's depth test is then the only one). Call it once per
+    /// submitted encoder (its uploads go through the queue); draw the result in as many
+    /// passes as needed.
     pub fn record(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
@@ -342,8 +343,7 @@ impl Player {
         scene_depth: Option<&wgpu::TextureView>,
     ) {
         if !std::mem::take(&mut self.simulated) {
-            self.simulate(encoder);
-            self.simulated = false;
+            self.record_steps(encoder);
         }
         let depth = scene_depth.filter(|_| self.settings.depth_format.is_some());
         self.billboard.set_scene_depth(&self.ctx, depth);
@@ -435,13 +435,18 @@ impl Player {
     /// warm-up), or to time the update on its own. [`Player::record`] does this first
     /// unless it was called since the last record.
     pub fn simulate(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        self.record_steps(encoder);
+        self.simulated = true;
+    }
+
+    /// Records the planned steps of every instance into `encoder`.
+    fn record_steps(&mut self, encoder: &mut wgpu::CommandEncoder) {
         // New instances' segments are cleared before any step of this record.
         for batch in &mut self.batches {
             batch.clear_taken(encoder);
         }
         let (steps, dt_secs) = std::mem::take(&mut self.pending);
         self.last_steps = (steps, dt_secs);
-        self.simulated = true;
         if steps == 0 {
             return;
         }

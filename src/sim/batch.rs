@@ -344,13 +344,7 @@ impl InstanceBatch {
                     // Every window is empty: the swap above is all a step does.
                     continue;
                 }
-                let pass = pass.get_or_insert_with(|| {
-                    enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                        label: Some("InstanceBatch::update"),
-                        timestamp_writes: None,
-                    })
-                    .forget_lifetime()
-                });
+                let pass = crate::gpu::compute_pass(pass, enc, "InstanceBatch::update");
                 pass.set_pipeline(pipeline);
                 let offset = ((s * n + e) as u64 * self.block_bytes) as u32;
                 pass.set_bind_group(0, group, &[offset]);

@@ -815,13 +815,7 @@ impl GpuSim {
                     // cleared counter says zero).
                     continue;
                 }
-                let pass = pass.get_or_insert_with(|| {
-                    enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                        label: Some("GpuSim::update"),
-                        timestamp_writes: None,
-                    })
-                    .forget_lifetime()
-                });
+                let pass = crate::gpu::compute_pass(pass, enc, "GpuSim::update");
                 pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, group, &[offset]);
                 let (x, y) = dispatch_size(invocations);
