@@ -3,6 +3,8 @@
 // The editor, the `ignis` binary or the benches: the default `editor` feature.
 #![cfg(feature = "editor")]
 
+mod common;
+
 use egui::{Key, Modifiers, Role};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable as _;
@@ -440,16 +442,6 @@ fn a_smaller_capacity_keeps_the_particles_that_fit() {
     assert_eq!(&after[..], &before[..1024]);
 }
 
-/// Runs `steps` single steps of `player` on the GPU.
-fn play_steps(ctx: &GpuContext, player: &mut Player, steps: u32) {
-    for _ in 0..steps {
-        player.step();
-        let mut enc = ctx.device.create_command_encoder(&Default::default());
-        player.simulate(&mut enc);
-        ctx.queue.submit([enc.finish()]);
-    }
-}
-
 #[test]
 fn reordering_emitters_moves_their_particles_along() {
     let ctx = GpuContext::headless().expect("a GPU adapter (lavapipe is fine)");
@@ -464,7 +456,7 @@ fn reordering_emitters_moves_their_particles_along() {
     let id = player
         .add_instance(glam::Mat4::IDENTITY, state.running.seed)
         .expect("instance");
-    play_steps(&ctx, &mut player, 60);
+    common::play_steps(&ctx, &mut player, 60);
     let smoke = player.particles(id, 0).expect("read");
     let flames = player.particles(id, 1).expect("read");
     let spawned = |p: &Player, e: usize| p.emitter_stats(id).expect("stats")[e].spawn.spawned;
@@ -490,7 +482,7 @@ fn reordering_emitters_moves_their_particles_along() {
     assert_eq!(player.particles(id, 1).expect("read"), smoke);
     assert_eq!(alive(&player.particles(id, 2).expect("read")), 0);
     assert_eq!(spawned(&player, 1), spawned_smoke);
-    play_steps(&ctx, &mut player, 30);
+    common::play_steps(&ctx, &mut player, 30);
     assert!(
         alive(&player.particles(id, 2).expect("read")) > 0,
         "the copy spawns"

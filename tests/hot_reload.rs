@@ -44,16 +44,6 @@ fn player(ctx: &GpuContext, dir: &Path, effect: &Effect) -> (Player, InstanceId)
     (player, id)
 }
 
-/// Runs `steps` fixed steps of `player` on the GPU.
-fn play(ctx: &GpuContext, player: &mut Player, steps: u32) {
-    for _ in 0..steps {
-        player.step();
-        let mut enc = ctx.device.create_command_encoder(&Default::default());
-        player.simulate(&mut enc);
-        ctx.queue.submit([enc.finish()]);
-    }
-}
-
 impl Rig {
     fn new() -> Self {
         let ctx = gpu();
@@ -71,8 +61,8 @@ impl Rig {
         effect.time.step_secs = 1.0 / 120.0;
         let mut live = player(&ctx, dir.path(), &effect);
         let mut control = player(&ctx, dir.path(), &effect);
-        play(&ctx, &mut live.0, 30);
-        play(&ctx, &mut control.0, 30);
+        play_steps(&ctx, &mut live.0, 30);
+        play_steps(&ctx, &mut control.0, 30);
         let composite = Composite::new(&ctx, &lib).expect("composite");
         let reloader = ShaderReloader::new(&lib);
         Self {
@@ -118,8 +108,8 @@ impl Rig {
 
     /// Steps both players and returns their states.
     fn step_both(&mut self, steps: u32) -> (Vec<Particle>, Vec<Particle>) {
-        play(&self.ctx, &mut self.live.0, steps);
-        play(&self.ctx, &mut self.control.0, steps);
+        play_steps(&self.ctx, &mut self.live.0, steps);
+        play_steps(&self.ctx, &mut self.control.0, steps);
         (
             self.live_particles(),
             self.control.0.particles(self.control.1, 0).expect("read"),

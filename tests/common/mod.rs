@@ -107,3 +107,13 @@ pub fn total_light(img: &image::RgbaImage) -> f64 {
         .map(|p| p[0] as f64 + p[1] as f64 + p[2] as f64)
         .sum()
 }
+
+/// Runs `steps` single steps of `player` on the GPU (one submission each).
+pub fn play_steps(ctx: &GpuContext, player: &mut ignis::Player, steps: u32) {
+    for _ in 0..steps {
+        player.step();
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        player.simulate(&mut enc);
+        ctx.queue.submit([enc.finish()]);
+    }
+}
