@@ -324,6 +324,11 @@ fn measure_row(
         effect: &effect,
     })];
     let items = frame.prepare(ctx, &[&scene], &camera.view(size), 1.0, &mut sort, None);
+    let mut uploads = crate::gpu::Uploads::new(&ctx.device);
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    frame.upload_looks(&mut uploads, &mut enc);
+    uploads.finish(&enc);
+    ctx.queue.submit([enc.finish()]);
     let auto_splat = items.iter().all(|d| d.splat);
     let with_path = |splat: bool| -> Vec<DrawItem> {
         items

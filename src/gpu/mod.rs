@@ -5,10 +5,12 @@ pub mod profile;
 pub mod readback;
 pub mod timer;
 pub mod types;
+pub mod upload;
 
 pub use context::{GpuContext, GpuError};
 pub use profile::{AdapterProfile, ProfileKind};
 pub use readback::TextureReadback;
+pub use upload::Uploads;
 
 /// The compute pass open in `pass`, begun in `enc` (labelled `label`) on first need: the
 /// steps and the sorts of a frame each share one pass.

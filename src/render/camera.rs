@@ -137,6 +137,9 @@ pub struct Camera {
     view_from_world: DMat4,
     clip_from_view: DMat4,
     size: (u32, u32),
+    /// Derived once (every instance and emitter of a frame reads them).
+    clip_from_world: DMat4,
+    eye: glam::DVec3,
 }
 
 impl Camera {
@@ -158,6 +161,8 @@ impl Camera {
             view_from_world,
             clip_from_view,
             size: (size.0.max(1), size.1.max(1)),
+            clip_from_world: clip_from_view * view_from_world,
+            eye: view_from_world.inverse().w_axis.truncate(),
         }
     }
 
@@ -168,12 +173,12 @@ impl Camera {
 
     /// The eye position in world space.
     pub fn eye(&self) -> Vec3 {
-        self.view_from_world.inverse().w_axis.truncate().as_vec3()
+        self.eye.as_vec3()
     }
 
     /// The eye position in world space, f64.
     pub(crate) fn eye_f64(&self) -> glam::DVec3 {
-        self.view_from_world.inverse().w_axis.truncate()
+        self.eye
     }
 
     /// The viewing direction in world space.
@@ -186,7 +191,7 @@ impl Camera {
 
     /// World → clip, f64.
     pub(crate) fn clip_from_world(&self) -> DMat4 {
-        self.clip_from_view * self.view_from_world
+        self.clip_from_world
     }
 
     /// Simulation space with origin `origin` → clip, composed in f64 and rounded once.

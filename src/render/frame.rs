@@ -487,7 +487,8 @@ impl FrameResources {
         self.frame_group = group;
     }
 
-    /// Uploads this frame's uniforms and returns what to draw, with each emitter's path:
+    /// Uploads this frame's camera, builds its looks ([`FrameResources::upload_looks`]
+    /// uploads them) and returns what to draw, with each emitter's path:
     /// one item per group and emitter. A group's instances take consecutive look slots
     /// for each emitter; emitter `i` of every instance shares ramp row `i` (the groups
     /// are instances of one effect).
@@ -538,13 +539,19 @@ impl FrameResources {
                 slot += group.len();
             }
         }
-        if !blocks.is_empty() {
-            ctx.queue.write_buffer(&self.looks, 0, &blocks);
-        }
         self.look_bytes = blocks;
         let live: std::collections::HashSet<u64> = items.iter().map(|d| d.key.0).collect();
         self.particle_groups.retain(|k, _| live.contains(&k.0));
         items
+    }
+
+    /// Uploads the looks the last [`FrameResources::prepare`] built, through `uploads`
+    /// with a copy recorded into `enc` (outside a pass).
+    pub fn upload_looks(&self, uploads: &mut crate::gpu::Uploads, enc: &mut wgpu::CommandEncoder) {
+        let bytes = &self.look_bytes;
+        if let Some(mut view) = uploads.write(enc, &self.looks, 0, bytes.len() as u64) {
+            view.copy_from_slice(bytes);
+        }
     }
 
     /// Emitter `i`'s look of every instance (its salt, place and ring are set per

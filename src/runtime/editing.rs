@@ -71,7 +71,7 @@ impl Player {
         let placed: Vec<(Mat4, u32)> = self
             .instances
             .iter()
-            .map(|i| (i.world_from_effect, i.effect.seed))
+            .map(|i| (i.world_from_effect, i.effect().seed))
             .collect();
         let mut batches = Vec::new();
         let mut backings = Vec::with_capacity(placed.len());
@@ -104,7 +104,8 @@ impl Player {
     /// Every instance's copy of the effect follows the player's (seed and place kept).
     fn replace_effects(&mut self) {
         for i in self.instances.iter_mut() {
-            i.effect = Instance::effect_for(&self.effect, i.world_from_effect, i.effect.seed);
+            let placed = Instance::effect_for(&self.effect, i.world_from_effect, i.effect().seed);
+            *i.effect_mut() = placed;
         }
     }
 
@@ -118,31 +119,32 @@ impl Player {
         let mut touched = 0;
         let mut failure = None;
         for i in self.instances.iter_mut() {
-            let Backing::Own(sim) = &mut i.state else {
+            let (world, seed) = (i.world_from_effect, i.effect().seed);
+            let (Backing::Own(sim), _) = i.state_mut() else {
                 continue;
             };
             touched += 1;
             if let Some(sources) = &forward {
                 sim.remap_emitters(sources);
             }
-            let placed = Instance::effect_for(effect, i.world_from_effect, i.effect.seed);
+            let placed = Instance::effect_for(effect, world, seed);
             if let Err(err) = sim.sync(&placed) {
                 failure = Some(err);
                 break;
             }
-            i.effect = placed;
+            *i.effect_mut() = placed;
         }
         let Some(err) = failure else {
             return Ok(());
         };
         self.effect = old;
-        let own = self
-            .instances
-            .iter_mut()
-            .filter_map(|i| match &mut i.state {
-                Backing::Own(sim) => Some((sim, &mut i.effect, i.world_from_effect)),
-                Backing::Batched { .. } => None,
-            });
+        let own = self.instances.iter_mut().filter_map(|i| {
+            let world = i.world_from_effect;
+            match i.parts_mut() {
+                (Backing::Own(sim), placed) => Some((sim, placed, world)),
+                (Backing::Batched { .. }, _) => None,
+            }
+        });
         for (sim, placed, world) in own.take(touched) {
             if let Some(sources) = &back {
                 sim.remap_emitters(sources);
@@ -181,11 +183,12 @@ impl Player {
         let Some(i) = self.instances.get_mut(id) else {
             return false;
         };
-        if i.effect.seed != seed {
-            i.effect.seed = seed;
-            match &mut i.state {
+        if i.effect().seed != seed {
+            let (state, effect) = i.parts_mut();
+            effect.seed = seed;
+            match state {
                 Backing::Own(sim) => {
-                    if let Err(err) = sim.sync(&i.effect) {
+                    if let Err(err) = sim.sync(effect) {
                         log::error!("ignis: a new seed was refused: {err}");
                     }
                 }
@@ -231,7 +234,8 @@ pub(super) fn batch_slot(
             return Ok(Backing::Batched { batch, slot });
         }
     }
-    let mut b = InstanceBatch::new(ctx, update.clone(), template)?;
+    let slots = crate::sim::batch::batch_slots(batches.len());
+    let mut b = InstanceBatch::new(ctx, update.clone(), template, slots)?;
     let slot = b
         .insert(seed)
         .ok_or_else(|| SimError::Readback("a new batch is full".into()))?;

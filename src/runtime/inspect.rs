@@ -170,7 +170,7 @@ impl Player {
     /// emitters placed in the world (tests compare it with a simulation of its own).
     #[doc(hidden)]
     pub fn instance_effect(&self, id: InstanceId) -> Option<&crate::Effect> {
-        self.instances.get(id).map(|i| &i.effect)
+        self.instances.get(id).map(|i| i.effect())
     }
 
     /// The draws prepared by the last record (tests look at the paths and layers chosen).

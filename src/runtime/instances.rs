@@ -28,12 +28,51 @@ pub(crate) struct Instance {
     /// The particles.
     pub state: Backing,
     /// The effect with this instance's seed and its emitters' world transforms.
-    pub effect: Effect,
+    effect: Effect,
+    /// Changes whenever `effect` does (the planner rebuilds its cached parameter blocks).
+    revision: u64,
     /// Where the effect's origin is in the world.
     pub world_from_effect: Mat4,
 }
 
 impl Instance {
+    /// An instance of `effect` (already placed) backed by `state`.
+    pub fn new(state: Backing, effect: Effect, world_from_effect: Mat4) -> Self {
+        Self {
+            state,
+            effect,
+            revision: crate::sim::gpu_sim::next_generation(),
+            world_from_effect,
+        }
+    }
+
+    /// The effect with this instance's seed and place.
+    pub fn effect(&self) -> &Effect {
+        &self.effect
+    }
+
+    /// The effect, to change (a new revision).
+    pub fn effect_mut(&mut self) -> &mut Effect {
+        self.revision = crate::sim::gpu_sim::next_generation();
+        &mut self.effect
+    }
+
+    /// The state, to change, and the effect.
+    pub fn state_mut(&mut self) -> (&mut Backing, &Effect) {
+        (&mut self.state, &self.effect)
+    }
+
+    /// The state and the effect, to change (a new revision).
+    pub fn parts_mut(&mut self) -> (&mut Backing, &mut Effect) {
+        self.revision = crate::sim::gpu_sim::next_generation();
+        (&mut self.state, &mut self.effect)
+    }
+
+    /// The effect and its revision, a value that changes whenever the effect does.
+    pub fn revised_effect(&self) -> (&Effect, u64) {
+        (&self.effect, self.revision)
+    }
+
     /// `template` placed by `world_from_effect`, with `seed`.
     pub fn effect_for(template: &Effect, world_from_effect: Mat4, seed: u32) -> Effect {
         let mut effect = template.clone();
@@ -46,7 +85,7 @@ impl Instance {
     /// world-space motion.
     pub fn set_transform(&mut self, template: &Effect, world_from_effect: Mat4) {
         self.world_from_effect = world_from_effect;
-        place(&mut self.effect, template, world_from_effect);
+        place(self.effect_mut(), template, world_from_effect);
     }
 }
 

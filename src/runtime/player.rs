@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use glam::Mat4;
 
 use crate::effect::{Effect, TimeMode, ValidationError};
-use crate::gpu::{AdapterProfile, GpuContext};
+use crate::gpu::{AdapterProfile, GpuContext, Uploads};
 use crate::render::billboard::{BillboardPass, DrawTarget};
 use crate::render::sort::SortPass;
 use crate::render::{Camera, DrawItem, FrameResources, Scene, SplatPass};
@@ -120,6 +120,8 @@ pub struct Player {
     alpha: f32,
     pub(super) settings: PlayerSettings,
     pub(super) items: Vec<DrawItem>,
+    /// This frame's parameter and look uploads (reused staging memory).
+    uploads: Uploads,
     /// Whether the last record splatted light that `draw` resolves.
     splatted: bool,
     /// `simulate` ran since the last `record`, which then does not run it again.
@@ -176,6 +178,7 @@ impl Player {
             alpha: 1.0,
             settings,
             items: Vec::new(),
+            uploads: Uploads::new(device),
             splatted: false,
             simulated: false,
         })
@@ -201,11 +204,9 @@ impl Player {
     ) -> Result<InstanceId, PlayerError> {
         let effect = Instance::effect_for(&self.effect, world_from_effect, seed);
         let state = self.backing(&effect)?;
-        Ok(self.instances.insert(Instance {
-            state,
-            effect,
-            world_from_effect,
-        }))
+        Ok(self
+            .instances
+            .insert(Instance::new(state, effect, world_from_effect)))
     }
 
     /// Where a new instance running `placed` (its seed and place) keeps its particles: a
@@ -366,6 +367,7 @@ impl Player {
             &mut self.sort,
             self.settings.asset_dir.as_deref(),
         );
+        self.frame.upload_looks(&mut self.uploads, encoder);
         self.billboard
             .prepare(&self.ctx, &self.items, &self.frame.sprites.sampler);
         self.sort
@@ -378,6 +380,7 @@ impl Player {
             camera.size_px(),
             depth,
         );
+        self.uploads.finish(encoder);
     }
 
     /// The groups of instances drawn together, far to near by their mean depth along
@@ -401,7 +404,7 @@ impl Player {
                     depth(i),
                     vec![Some(Scene {
                         sim: sim.as_ref(),
-                        effect: &i.effect,
+                        effect: i.effect(),
                     })],
                 )),
                 Backing::Batched { batch, slot } => {
@@ -416,7 +419,7 @@ impl Player {
                     if let Some(s) = g.1.get_mut(*slot as usize) {
                         *s = Some(Scene {
                             sim: m,
-                            effect: &i.effect,
+                            effect: i.effect(),
                         });
                     }
                 }
@@ -436,6 +439,7 @@ impl Player {
     /// unless it was called since the last record.
     pub fn simulate(&mut self, encoder: &mut wgpu::CommandEncoder) {
         self.record_steps(encoder);
+        self.uploads.finish(encoder);
         self.simulated = true;
     }
 
@@ -451,26 +455,38 @@ impl Player {
             return;
         }
         encoder.push_debug_group("ignis: update particles");
-        // One compute pass for every instance's steps.
-        let mut pass = None;
+        // Every batch's parameter blocks first (their copies precede the pass), then one
+        // compute pass for every instance's steps.
+        let mut effects: Vec<Option<(&Effect, u64)>> = Vec::new();
         for (b, batch) in self.batches.iter_mut().enumerate() {
-            let mut effects: Vec<Option<&Effect>> = vec![None; batch.slots() as usize];
+            effects.clear();
+            effects.resize(batch.slots() as usize, None);
             for i in self.instances.iter() {
                 if let Backing::Batched { batch, slot } = i.state
                     && batch == b
                     && let Some(e) = effects.get_mut(slot as usize)
                 {
-                    *e = Some(&i.effect);
+                    *e = Some(i.revised_effect());
                 }
             }
-            batch.record_into(encoder, &mut pass, &effects, dt_secs, steps as usize);
+            batch.plan(
+                &mut self.uploads,
+                encoder,
+                &effects,
+                dt_secs,
+                steps as usize,
+            );
+        }
+        let mut pass = None;
+        for batch in &mut self.batches {
+            batch.dispatch(encoder, &mut pass, &self.effect);
         }
         for instance in self.instances.iter_mut() {
-            let Backing::Own(sim) = &mut instance.state else {
+            let (Backing::Own(sim), effect) = instance.state_mut() else {
                 continue;
             };
-            let plans = sim.plan(&instance.effect, dt_secs, steps as usize);
-            sim.record_into(encoder, &mut pass, &instance.effect, &plans);
+            let plans = sim.plan(effect, dt_secs, steps as usize);
+            sim.record_into(encoder, &mut pass, effect, &plans);
         }
         drop(pass);
         encoder.pop_debug_group();

@@ -10,8 +10,8 @@
 //! simulation (a player with such an emitter runs one simulation per instance).
 
 use crate::effect::Effect;
-use crate::gpu::GpuContext;
 use crate::gpu::types::{PackedParticle, Particle, SimParams, StateLayout};
+use crate::gpu::{GpuContext, Uploads};
 use crate::sim::gpu_sim::{
     EmitterBuffers, SLOTS_PER_INVOCATION, SharedUpdate, SimError, SimState, dispatch_size, lock,
     packed_life, pipeline_key, read_buffer,
@@ -25,7 +25,20 @@ const _: () = assert!(size_of::<SimParams>().is_multiple_of(16));
 
 /// Instances per batch at most: the segments of one set of buffers (fewer when an
 /// emitter's pool times this would not fit one storage binding).
-pub const BATCH_SLOTS: u32 = 16;
+pub const BATCH_SLOTS: u32 = 128;
+
+/// Instances the first batch of a player holds; each further batch holds twice as many
+/// as the one before (up to [`BATCH_SLOTS`]): one instance allocates few pools, a
+/// hundred take three batches.
+pub const FIRST_BATCH_SLOTS: u32 = 16;
+
+/// The instances the `index`-th batch of a player holds at most.
+pub fn batch_slots(index: usize) -> u32 {
+    FIRST_BATCH_SLOTS
+        .checked_shl(index.min(31) as u32)
+        .unwrap_or(BATCH_SLOTS)
+        .min(BATCH_SLOTS)
+}
 
 /// Written for an empty segment or a disabled emitter.
 const ZERO_BLOCK: [u8; size_of::<SimParams>()] = [0; size_of::<SimParams>()];
@@ -77,13 +90,21 @@ pub struct InstanceBatch {
     members: Vec<Option<Member>>,
     /// Slots taken since the last record, whose segments it clears first.
     pending_clears: Vec<u32>,
+    /// The steps planned and not yet dispatched: the invocations each (step, emitter)
+    /// needs (the widest window of its instances), step-major.
+    planned: Vec<u32>,
 }
 
 impl InstanceBatch {
-    /// Buffers for up to [`BATCH_SLOTS`] instances of `effect` (as many as one storage
-    /// binding holds of its largest pool, and as [`BATCH_STATE_BYTES`] of state hold; at
-    /// least one) on batched update pipelines.
-    pub fn new(ctx: &GpuContext, update: SharedUpdate, effect: &Effect) -> Result<Self, SimError> {
+    /// Buffers for up to `max_slots` instances of `effect` (at most [`BATCH_SLOTS`]; as
+    /// many as one storage binding holds of its largest pool, and as
+    /// [`BATCH_STATE_BYTES`] of state hold; at least one) on batched update pipelines.
+    pub fn new(
+        ctx: &GpuContext,
+        update: SharedUpdate,
+        effect: &Effect,
+        max_slots: u32,
+    ) -> Result<Self, SimError> {
         let largest = effect
             .emitters
             .iter()
@@ -98,7 +119,7 @@ impl InstanceBatch {
             .sum();
         let slots = (ctx.max_capacity() / u64::from(largest))
             .min(BATCH_STATE_BYTES / instance_bytes.max(1))
-            .clamp(1, u64::from(BATCH_SLOTS)) as u32;
+            .clamp(1, u64::from(max_slots.clamp(1, BATCH_SLOTS))) as u32;
         let block_bytes = (u64::from(slots) * size_of::<SimParams>() as u64).next_multiple_of(
             u64::from(ctx.device.limits().min_storage_buffer_offset_alignment),
         );
@@ -116,6 +137,7 @@ impl InstanceBatch {
             block_bytes,
             slots,
             pending_clears: Vec::new(),
+            planned: Vec::new(),
             members: (0..slots).map(|_| None).collect(),
         };
         for (i, e) in effect.emitters.iter().enumerate() {
@@ -272,16 +294,18 @@ impl InstanceBatch {
     }
 
     /// Plans `steps` steps of `dt_secs` for every instance (`effects[slot]`: the slot's
-    /// placed effect) and records them into the open compute pass of `enc`: one dispatch
-    /// per emitter and step for the whole batch.
-    pub fn record_into(
+    /// placed effect and its revision, a value that changes whenever that effect does)
+    /// and uploads their parameter blocks through `uploads`, recorded into `enc` (outside
+    /// a pass); [`InstanceBatch::dispatch`] then records the steps.
+    pub fn plan(
         &mut self,
+        uploads: &mut Uploads,
         enc: &mut wgpu::CommandEncoder,
-        pass: &mut Option<wgpu::ComputePass<'static>>,
-        effects: &[Option<&Effect>],
+        effects: &[Option<(&Effect, u64)>],
         dt_secs: f32,
         steps: usize,
     ) {
+        self.planned.clear();
         let steps = steps.min(MAX_STEPS);
         let n = self.pools.len();
         let active = self.active() as usize;
@@ -289,57 +313,82 @@ impl InstanceBatch {
             return;
         }
         let bytes = self.block_bytes * (steps * n) as u64;
-        // Written straight into the upload's staging memory (no copy of its own).
-        let Some(mut blocks) = wgpu::BufferSize::new(bytes)
-            .and_then(|size| self.ctx.queue.write_buffer_with(&self.params, 0, size))
-        else {
+        // Written straight into mapped staging memory (no copy of its own).
+        let Some(mut blocks) = uploads.write(enc, &self.params, 0, bytes) else {
             return;
         };
         // The invocations each (step, emitter) needs: the largest window of its instances.
-        let mut widest = vec![0u32; steps * n];
+        let mut widest = std::mem::take(&mut self.planned);
+        widest.resize(steps * n, 0);
         let stride = size_of::<SimParams>();
+        let block_bytes = self.block_bytes as usize;
+        let capacities: Vec<u32> = self.pools.iter().map(|p| p.capacity).collect();
         for (slot, member) in self.members.iter_mut().enumerate().take(active) {
-            let mut m = member.as_mut().zip(effects.get(slot).copied().flatten());
-            for s in 0..steps {
-                let mut plans = m
-                    .as_mut()
-                    .map(|(m, effect)| m.planner.plan_step(effect, dt_secs));
-                for e in 0..n {
-                    let at = (s * n + e) * self.block_bytes as usize + slot * stride;
-                    let mut block = blocks.slice(at..at + stride);
-                    let plan = plans.as_mut().and_then(|p| p.get_mut(e)?.take());
-                    let (Some(mut p), Some(pool)) = (plan, self.pools.get(e)) else {
-                        // An empty segment or a disabled emitter: a zero block updates no
-                        // slot (its window is empty).
-                        block.copy_from_slice(&ZERO_BLOCK[..stride]);
-                        continue;
-                    };
-                    if p.update_window[1] > pool.capacity {
-                        p.update_window = [0, pool.capacity, 0, 0];
-                    }
-                    block.copy_from_slice(bytemuck::bytes_of(&p));
-                    widest[s * n + e] = widest[s * n + e].max(p.update_window[1]);
+            let planned = member.as_mut().zip(effects.get(slot).copied().flatten());
+            let Some((m, (effect, revision))) = planned else {
+                // An empty segment: zero blocks update no slot (their windows are empty).
+                for at in (0..steps * n).map(|b| b * block_bytes + slot * stride) {
+                    blocks
+                        .slice(at..at + stride)
+                        .copy_from_slice(&ZERO_BLOCK[..stride]);
                 }
+                continue;
+            };
+            for s in 0..steps {
+                m.planner
+                    .plan_step_with(effect, Some(revision), dt_secs, |e, plan| {
+                        let at = (s * n + e) * block_bytes + slot * stride;
+                        let mut block = blocks.slice(at..at + stride);
+                        let (Some(p), Some(&capacity)) = (plan, capacities.get(e)) else {
+                            // A disabled emitter: a zero block.
+                            block.copy_from_slice(&ZERO_BLOCK[..stride]);
+                            return;
+                        };
+                        let width = if p.update_window[1] > capacity {
+                            let mut whole = *p;
+                            whole.update_window = [0, capacity, 0, 0];
+                            block.copy_from_slice(bytemuck::bytes_of(&whole));
+                            capacity
+                        } else {
+                            block.copy_from_slice(bytemuck::bytes_of(p));
+                            p.update_window[1]
+                        };
+                        let w = &mut widest[s * n + e];
+                        *w = (*w).max(width);
+                    });
             }
         }
         drop(blocks);
+        self.planned = widest;
+    }
+
+    /// Records the steps [`InstanceBatch::plan`] planned into the compute pass open in
+    /// `pass` (begun in `enc` on first need): one dispatch per emitter and step for the
+    /// whole batch. `effect`: any instance's effect (they run the same emitters).
+    pub fn dispatch(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        pass: &mut Option<wgpu::ComputePass<'static>>,
+        effect: &Effect,
+    ) {
+        let n = self.pools.len();
+        let active = self.active();
+        if n == 0 || self.planned.is_empty() {
+            return;
+        }
         let update = lock(&self.update);
-        // Every instance runs the same emitters: one pipeline per emitter for the batch.
-        let effect = effects.iter().flatten().next();
+        // One pipeline per emitter for the batch.
         let pipelines: Vec<Option<&wgpu::ComputePipeline>> = (0..n)
-            .map(|e| {
-                let em = effect.and_then(|fx| fx.emitters.get(e))?;
-                update.pipeline(&pipeline_key(em))
-            })
+            .map(|e| update.pipeline(&pipeline_key(effect.emitters.get(e)?)))
             .collect();
-        for s in 0..steps {
+        for (s, widths) in self.planned.chunks(n).enumerate() {
             for (e, pool) in self.pools.iter_mut().enumerate() {
                 let Some(pipeline) = pipelines[e] else {
                     continue;
                 };
                 let group = &pool.groups[pool.current];
                 pool.current = 1 - pool.current;
-                let invocations = widest[s * n + e].div_ceil(SLOTS_PER_INVOCATION);
+                let invocations = widths[e].div_ceil(SLOTS_PER_INVOCATION);
                 if invocations == 0 {
                     // Every window is empty: the swap above is all a step does.
                     continue;
@@ -349,9 +398,10 @@ impl InstanceBatch {
                 let offset = ((s * n + e) as u64 * self.block_bytes) as u32;
                 pass.set_bind_group(0, group, &[offset]);
                 let (x, y) = dispatch_size(invocations);
-                pass.dispatch_workgroups(x, y, active as u32);
+                pass.dispatch_workgroups(x, y, active);
             }
         }
+        self.planned.clear();
     }
 
     /// Instance `slot` as the draw passes see it.

@@ -105,6 +105,9 @@ pub struct EmitterPlanner {
     next_seq: u64,
     /// Particles the last planned step spawned.
     last_count: u64,
+    /// The step-independent part of this emitter's `SimParams` and the revision of the
+    /// emitter it was built from ([`EffectPlanner::plan_step_with`]); patched per step.
+    template: Option<(u64, SimParams)>,
 }
 
 /// Plans every emitter of an effect, step after step.
@@ -123,23 +126,43 @@ pub struct EffectPlanner {
 impl EffectPlanner {
     /// Plans one step of `dt_secs` for every emitter (disabled emitters get `None`).
     pub fn plan_step(&mut self, effect: &Effect, dt_secs: f32) -> Vec<Option<SimParams>> {
+        let mut params = vec![None; effect.emitters.len()];
+        self.plan_step_with(effect, None, dt_secs, |i, p| params[i] = p.copied());
+        params
+    }
+
+    /// Plans one step of `dt_secs` and hands each emitter's block to `sink` (emitter
+    /// index, `None` when disabled) without collecting them. With a `revision` (a value
+    /// that changes whenever `effect` does: its seed, place or settings), each emitter's
+    /// step-independent part is built once per revision and patched per step — the
+    /// blocks are bit-identical to building them anew.
+    pub fn plan_step_with(
+        &mut self,
+        effect: &Effect,
+        revision: Option<u64>,
+        dt_secs: f32,
+        mut sink: impl FnMut(usize, Option<&SimParams>),
+    ) {
         self.emitters
             .resize_with(effect.emitters.len(), Default::default);
         let t0 = self.time_secs;
-        let params = effect
+        let mut params = SimParams::default();
+        for (i, (e, p)) in effect
             .emitters
             .iter()
             .zip(self.emitters.iter_mut())
             .enumerate()
-            .map(|(i, (e, p))| {
-                e.enabled
-                    .then(|| p.plan_step(e, effect.seed, i as u32, t0, dt_secs))
-            })
-            .collect();
+        {
+            if !e.enabled {
+                sink(i, None);
+                continue;
+            }
+            p.plan_step_into(e, effect.seed, i as u32, t0, dt_secs, revision, &mut params);
+            sink(i, Some(&params));
+        }
         self.time_secs += dt_secs as f64;
         self.step_index += 1;
         self.last_dt_secs = dt_secs;
-        params
     }
 
     /// Back to time zero with empty pools.
@@ -158,6 +181,24 @@ impl EmitterPlanner {
         t0_secs: f64,
         dt_secs: f32,
     ) -> SimParams {
+        let mut params = SimParams::default();
+        self.plan_step_into(e, seed, emitter_index, t0_secs, dt_secs, None, &mut params);
+        params
+    }
+
+    /// [`EmitterPlanner::plan_step`] into `out`, reusing the step-independent part of the
+    /// block while `revision` (of the emitter, its seed and place) stays the same.
+    #[allow(clippy::too_many_arguments)]
+    fn plan_step_into(
+        &mut self,
+        e: &Emitter,
+        seed: u32,
+        emitter_index: u32,
+        t0_secs: f64,
+        dt_secs: f32,
+        revision: Option<u64>,
+        out: &mut SimParams,
+    ) {
         let dt = dt_secs as f64;
         let rate = e.spawn_rate_per_sec.max(0.0) as f64;
         let acc_before = self.accumulator;
@@ -262,23 +303,20 @@ impl EmitterPlanner {
         self.last_count = count;
 
         let origin = *self.origin.get_or_insert_with(|| sim_origin_for(e));
-        build_params(
-            e,
-            origin,
-            seed,
-            salt,
-            dt_secs,
-            t0_secs,
-            capacity as u32,
-            base,
-            count as u32,
-        )
-        .with_spawn_fractions(frac0 as f32, frac_step as f32)
-        .with_update_window(update_window)
-        .with_births(
-            [t0_hi.to_bits(), t0_lo.to_bits(), first_seq as u32, entries],
-            [oldest, span, 0, 0],
-        )
+        *out = match (revision, &self.template) {
+            (Some(r), Some((built, t))) if *built == r => *t,
+            _ => {
+                let t = static_params(e, origin, seed, salt, capacity as u32);
+                self.template = revision.map(|r| (r, t));
+                t
+            }
+        };
+        out.set_step(dt_secs, t0_secs, base, count as u32);
+        out.spawn_frac0 = frac0 as f32;
+        out.spawn_frac_step = frac_step as f32;
+        out.update_window = update_window;
+        out.tiny = [t0_hi.to_bits(), t0_lo.to_bits(), first_seq as u32, entries];
+        out.tiny_b = [oldest, span, 0, 0];
     }
 
     /// The birth table's oldest entry's first spawn counter (low 32 bits) and the counters
@@ -302,6 +340,7 @@ impl EmitterPlanner {
     pub fn forget_births(&mut self) {
         self.history.clear();
         self.origin = None;
+        self.template = None;
     }
 
     /// The batches of the birth table (tiny state): the first sequence number and how
@@ -357,6 +396,12 @@ impl EmitterPlanner {
             }
         }
         if self.history.is_empty() || count == 0 {
+            return;
+        }
+        // Nothing this step overwrites is tracked (older batches are forgotten, hence
+        // dead): the usual case of a pool sized for rate × lifetime.
+        let newest_old = (self.spawned_total + count - 1).checked_sub(capacity);
+        if newest_old.is_none_or(|old| self.history.front().is_some_and(|b| old < b.first_index)) {
             return;
         }
         // The overwritten counters are consecutive, and so are the batches (in spawn
@@ -455,21 +500,15 @@ pub fn mix(a: f32, b: f32, t: f32) -> f32 {
 }
 
 impl SimParams {
-    fn with_spawn_fractions(mut self, frac0: f32, frac_step: f32) -> Self {
-        self.spawn_frac0 = frac0;
-        self.spawn_frac_step = frac_step;
-        self
-    }
-
-    fn with_update_window(mut self, window: [u32; 4]) -> Self {
-        self.update_window = window;
-        self
-    }
-
-    fn with_births(mut self, tiny: [u32; 4], tiny_b: [u32; 4]) -> Self {
-        self.tiny = tiny;
-        self.tiny_b = tiny_b;
-        self
+    /// The fields one step sets: its size, start time (the noise's), and spawns.
+    fn set_step(&mut self, dt_secs: f32, t0_secs: f64, spawn_base: u64, spawn_count: u32) {
+        self.dt_secs = dt_secs;
+        // Noise time wraps every 4096 s so the f32 never grows large.
+        self.wind_time[3] = t0_secs.rem_euclid(4096.0) as f32;
+        self.spawn_head = (spawn_base % u64::from(self.capacity.max(1))) as u32;
+        self.spawn_count = spawn_count;
+        self.spawn_base_lo = spawn_base as u32;
+        self.spawn_base_hi = (spawn_base >> 32) as u32;
     }
 }
 
@@ -491,6 +530,20 @@ pub fn build_params(
     capacity: u32,
     spawn_base: u64,
     spawn_count: u32,
+) -> SimParams {
+    let mut params = static_params(e, origin, seed, salt, capacity);
+    params.set_step(dt_secs, t0_secs, spawn_base, spawn_count);
+    params
+}
+
+/// The part of an emitter's block that no step changes (its step fields are zero; see
+/// `SimParams::set_step`).
+fn static_params(
+    e: &Emitter,
+    origin: glam::DVec3,
+    seed: u32,
+    salt: u32,
+    capacity: u32,
 ) -> SimParams {
     let (shape_a, shape_b) = match &e.shape {
         Shape::Point => ([0.0; 4], [0.0; 4]),
@@ -572,8 +625,6 @@ pub fn build_params(
     let accel = e.forces.constant_acceleration();
     let wind = e.forces.wind_m_per_s;
     let n = &e.spawn_noise;
-    // Noise time wraps every 4096 s so the f32 never grows large.
-    let noise_time = t0_secs.rem_euclid(4096.0) as f32;
     SimParams {
         world_from_emitter: world.to_cols_array_2d(),
         shape_a,
@@ -586,22 +637,22 @@ pub fn build_params(
             e.lifetime_secs.max,
         ],
         accel_drag: [accel.x, accel.y, accel.z, e.forces.drag_per_sec],
-        wind_time: [wind[0], wind[1], wind[2], noise_time],
+        wind_time: [wind[0], wind[1], wind[2], 0.0],
         noise: [
             n.frequency_per_m,
             n.position_amplitude_m,
             n.direction_amplitude,
             n.scroll_per_sec,
         ],
-        dt_secs,
+        dt_secs: 0.0,
         seed,
         emitter_salt: salt,
         shape_kind: e.shape.kind_index(),
         capacity,
-        spawn_head: (spawn_base % capacity.max(1) as u64) as u32,
-        spawn_count,
-        spawn_base_lo: spawn_base as u32,
-        spawn_base_hi: (spawn_base >> 32) as u32,
+        spawn_head: 0,
+        spawn_count: 0,
+        spawn_base_lo: 0,
+        spawn_base_hi: 0,
         flags: 0,
         spawn_frac0: 0.0,
         spawn_frac_step: 0.0,
