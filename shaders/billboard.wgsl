@@ -47,6 +47,11 @@ override STREAK: bool = false;
 override SOFT: bool = false;
 // Soft edges against the host's depth buffer (replaces SOFT's ground plane).
 override SOFT_DEPTH: bool = false;
+// The motion pass (flipbook export): each fragment adds (motion · w, 0, w), with w the
+// particle's visible weight (its coverage, or its light when additive) and motion its
+// screen-space motion in pixels over `camera.up.w` seconds; the sums' ratio is the
+// weighted mean motion of the particles seen at a pixel.
+override MOTION: bool = false;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -181,6 +186,20 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u3
         gain *= look.size_intensity.z;
     }
     out.color = vec4<f32>(c.rgb * gain, c.a);
+    if MOTION {
+        // Where this corner's particle is `camera.up.w` seconds later, at its velocity.
+        let now = look.clip_from_sim * vec4<f32>(d.pos, 1.0);
+        let later = look.clip_from_sim * vec4<f32>(d.pos + d.vel * camera.up.w, 1.0);
+        var px = vec2<f32>(0.0);
+        if now.w > 1e-4 && later.w > 1e-4 {
+            // Clip y points up, pixel rows down.
+            px = (later.xy / later.w - now.xy / now.w) * vec2<f32>(0.5, -0.5) * camera.viewport.xy;
+        }
+        // The weight: coverage for alpha-blended layers, the brightest channel of the
+        // light for additive ones.
+        let w = select(max(max(out.color.r, out.color.g), out.color.b), c.a, SORTED);
+        out.color = vec4<f32>(px, 0.0, w);
+    }
     return out;
 }
 
@@ -193,6 +212,10 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     // The sprite is premultiplied: its rgb already carries its alpha (and the colour its
     // own alpha and, additive, the intensity).
     var a = in.color.a * tex.a;
+    if MOTION {
+        // The weight times the sprite's coverage (the motion's weight, in alpha).
+        a = in.color.a * select(max(max(tex.r, tex.g), tex.b), tex.a, SORTED);
+    }
     var rgb = in.color.rgb * tex.rgb;
     if SOFT {
         // Soft particles: fade out towards the ground plane instead of a hard cut.
@@ -207,6 +230,12 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
         let fade = clamp((view_distance(scene) - view_distance(in.clip.z)) * in.blend_height.y, 0.0, 1.0);
         a *= fade;
         rgb *= fade;
+    }
+    if MOTION {
+        // Weighted by the cube of the visible weight: where sparks cross, the brightest
+        // one's motion wins rather than a mean that fits neither.
+        let k = a * a * a;
+        return vec4<f32>(in.color.xy * k, 0.0, k);
     }
     return vec4<f32>(rgb, a);
 }

@@ -92,5 +92,7 @@ pub mod bench;
 #[doc(hidden)]
 pub mod editor;
 #[cfg(feature = "editor")]
+pub mod export;
+#[cfg(feature = "editor")]
 #[doc(hidden)]
 pub mod hot_reload;

@@ -337,7 +337,7 @@ fn measure_row(
             .collect()
     };
     let (all_billboard, all_splat) = (with_path(false), with_path(true));
-    billboard.prepare(ctx, &all_billboard, &frame.sprites.sampler);
+    billboard.prepare(ctx, &all_billboard, &frame.sprites.sampler, false);
     let billboard_ms = (n <= opts.billboard_limit).then(|| {
         time_median(&timer, ctx, opts.repeats.min(3), |enc| {
             let mut pass = begin_hdr_pass(enc, &targets.hdr_view);

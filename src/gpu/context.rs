@@ -69,7 +69,10 @@ impl GpuContext {
         let mut limits = wgpu::Limits::default().using_resolution(supported.clone());
         limits.max_storage_buffer_binding_size = supported.max_storage_buffer_binding_size;
         limits.max_buffer_size = supported.max_buffer_size;
-        let features = crate::gpu::timer::timing_features(&adapter);
+        // Blending into 32-bit float targets where the adapter can (the export's
+        // accumulation of bright additive light; f16 rounds it by a few percent).
+        let features = crate::gpu::timer::timing_features(&adapter)
+            | (adapter.features() & wgpu::Features::FLOAT32_BLENDABLE);
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("ignis device"),
             required_features: features,

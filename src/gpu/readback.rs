@@ -1,7 +1,7 @@
 //! Reading a texture back: a copy into a mappable buffer with rows padded to wgpu's
 //! alignment, and the rows without their padding.
 
-/// A 4-byte-per-texel texture's copy on its way to the CPU.
+/// A texture's copy on its way to the CPU.
 pub struct TextureReadback {
     /// The mappable buffer the copy lands in.
     pub buffer: wgpu::Buffer,
@@ -9,10 +9,13 @@ pub struct TextureReadback {
     pub size: (u32, u32),
     /// Bytes per padded row.
     pub bytes_per_row: u32,
+    /// Bytes per texel.
+    pub texel_bytes: u32,
 }
 
 impl TextureReadback {
-    /// Records a copy of `texture` (4 bytes per texel, `COPY_SRC`) into a new buffer.
+    /// Records a copy of `texture` (an uncompressed colour format, `COPY_SRC`) into a new
+    /// buffer.
     pub fn record(
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
@@ -20,7 +23,8 @@ impl TextureReadback {
         label: &str,
     ) -> Self {
         let (w, h) = (texture.width(), texture.height());
-        let bytes_per_row = (w * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+        let texel_bytes = texture.format().block_copy_size(None).unwrap_or(4);
+        let bytes_per_row = (w * texel_bytes).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
             * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
@@ -44,6 +48,7 @@ impl TextureReadback {
             buffer,
             size: (w, h),
             bytes_per_row,
+            texel_bytes,
         }
     }
 
@@ -52,7 +57,7 @@ impl TextureReadback {
         (0..self.size.1 as usize)
             .map(|y| {
                 let start = y * self.bytes_per_row as usize;
-                bytes.get(start..start + self.size.0 as usize * 4)
+                bytes.get(start..start + (self.size.0 * self.texel_bytes) as usize)
             })
             .collect()
     }

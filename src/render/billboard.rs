@@ -158,7 +158,9 @@ impl BillboardPass {
         v: LookVariant,
         target: DrawTarget,
     ) -> wgpu::RenderPipeline {
-        let blend = if v.alpha {
+        let blend = if v.motion {
+            SUMMED
+        } else if v.alpha {
             wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING
         } else {
             ADDITIVE
@@ -259,24 +261,19 @@ impl BillboardPass {
         Ok(())
     }
 
-    /// Creates the pipelines and sprite bind groups `items` need (call before `draw`).
-    pub fn prepare(&mut self, ctx: &GpuContext, items: &[DrawItem], sampler: &wgpu::Sampler) {
+    /// Creates the pipelines and sprite bind groups `items` need (call before `draw`);
+    /// with `motion`, also their motion-pass pipelines (for `draw_motion`).
+    pub fn prepare(
+        &mut self,
+        ctx: &GpuContext,
+        items: &[DrawItem],
+        sampler: &wgpu::Sampler,
+        motion: bool,
+    ) {
         for d in items.iter().filter(|d| !d.splat) {
-            if !self.pipelines.contains_key(&d.variant) {
-                let p = crate::render::scoped_variant(
-                    ctx,
-                    format_args!("billboard variant {:?}", d.variant),
-                    || {
-                        Self::pipeline(
-                            ctx,
-                            &self.pipeline_layout,
-                            &self.module,
-                            d.variant,
-                            self.target,
-                        )
-                    },
-                );
-                self.pipelines.insert(d.variant, p);
+            self.ensure_pipeline(ctx, d.variant);
+            if motion {
+                self.ensure_pipeline(ctx, d.variant.with_motion());
             }
             self.sprite_groups.entry(d.sprite.id).or_insert_with(|| {
                 ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -302,6 +299,40 @@ impl BillboardPass {
         }
     }
 
+    /// Creates the pipeline of `variant` unless it exists (an invalid one is remembered
+    /// as missing and skipped by the draws).
+    fn ensure_pipeline(&mut self, ctx: &GpuContext, variant: LookVariant) {
+        if self.pipelines.contains_key(&variant) {
+            return;
+        }
+        let p = crate::render::scoped_variant(
+            ctx,
+            format_args!("billboard variant {variant:?}"),
+            || {
+                Self::pipeline(
+                    ctx,
+                    &self.pipeline_layout,
+                    &self.module,
+                    variant,
+                    self.target,
+                )
+            },
+        );
+        self.pipelines.insert(variant, p);
+    }
+
+    /// Draws the motion pass of `items` into an open render pass whose colour target was
+    /// cleared to zero: per pixel (Σ w·motion_px, 0, Σ w), `w` each particle's visible
+    /// weight (needs `prepare` with `motion`).
+    pub fn draw_motion(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        frame: &FrameResources,
+        items: &[DrawItem],
+    ) {
+        self.draw_as(pass, frame, items, |_| true, LookVariant::with_motion);
+    }
+
     /// Draws the billboard items that `wanted` accepts into an open render pass
     /// (alpha-blended layers first, then additive ones on top). Items whose pipeline or
     /// sprite was not prepared are skipped.
@@ -311,6 +342,18 @@ impl BillboardPass {
         frame: &FrameResources,
         items: &[DrawItem],
         wanted: impl Fn(&DrawItem) -> bool,
+    ) {
+        self.draw_as(pass, frame, items, wanted, |v| v);
+    }
+
+    /// [`BillboardPass::draw`] with each item's pipeline variant mapped by `variant`.
+    fn draw_as(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        frame: &FrameResources,
+        items: &[DrawItem],
+        wanted: impl Fn(&DrawItem) -> bool,
+        variant: impl Fn(LookVariant) -> LookVariant,
     ) {
         let mut sorted: Vec<&DrawItem> = items.iter().filter(|d| !d.splat && wanted(d)).collect();
         // Alpha-blended layers in the given order (back to front), then the additive light
@@ -324,20 +367,21 @@ impl BillboardPass {
         pass.set_bind_group(3, &self.depth_group, &[]);
         let mut bound: Option<(LookVariant, u64)> = None;
         for d in sorted {
+            let v = variant(d.variant);
             let (Some(group), Some(Some(pipeline)), Some(sprite)) = (
                 frame.particle_group(d.key),
-                self.pipelines.get(&d.variant),
+                self.pipelines.get(&v),
                 self.sprite_groups.get(&d.sprite.id),
             ) else {
                 continue;
             };
-            if bound.is_none_or(|(v, _)| v != d.variant) {
+            if bound.is_none_or(|(b, _)| b != v) {
                 pass.set_pipeline(pipeline);
             }
             if bound.is_none_or(|(_, id)| id != d.sprite.id) {
                 pass.set_bind_group(2, sprite, &[]);
             }
-            bound = Some((d.variant, d.sprite.id));
+            bound = Some((v, d.sprite.id));
             pass.set_bind_group(
                 0,
                 &frame.frame_group,
@@ -365,6 +409,20 @@ impl BillboardPass {
 
 /// Quads per indexed draw (the shared index buffer's length / 6).
 pub const QUADS_PER_DRAW: u32 = 1 << 16;
+
+/// Everything adds up, alpha too (the motion pass's weighted sums).
+const SUMMED: wgpu::BlendState = wgpu::BlendState {
+    color: wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::One,
+        dst_factor: wgpu::BlendFactor::One,
+        operation: wgpu::BlendOperation::Add,
+    },
+    alpha: wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::One,
+        dst_factor: wgpu::BlendFactor::One,
+        operation: wgpu::BlendOperation::Add,
+    },
+};
 
 /// Light adds up: colour One + One, destination alpha kept.
 pub const ADDITIVE: wgpu::BlendState = wgpu::BlendState {

@@ -140,6 +140,8 @@ pub struct Camera {
     /// Derived once (every instance and emitter of a frame reads them).
     clip_from_world: DMat4,
     eye: glam::DVec3,
+    /// The interval a motion pass measures motion over, seconds.
+    motion_secs: f32,
 }
 
 impl Camera {
@@ -163,7 +165,36 @@ impl Camera {
             size: (size.0.max(1), size.1.max(1)),
             clip_from_world: clip_from_view * view_from_world,
             eye: view_from_world.inverse().w_axis.truncate(),
+            motion_secs: 0.0,
         }
+    }
+
+    /// The same camera, for a motion pass that measures the motion of `secs` seconds
+    /// (the export's frame interval).
+    #[doc(hidden)]
+    pub fn with_motion_secs(self, secs: f32) -> Self {
+        Self {
+            motion_secs: secs,
+            ..self
+        }
+    }
+
+    /// World → view, rounded to f32.
+    #[doc(hidden)]
+    pub fn view_from_world_mat4(&self) -> Mat4 {
+        self.view_from_world.as_mat4()
+    }
+
+    /// View → clip, rounded to f32.
+    #[doc(hidden)]
+    pub fn clip_from_view_mat4(&self) -> Mat4 {
+        self.clip_from_view.as_mat4()
+    }
+
+    /// World → clip, rounded to f32 (projecting points on the CPU).
+    #[doc(hidden)]
+    pub fn clip_from_world_mat4(&self) -> Mat4 {
+        self.clip_from_world.as_mat4()
     }
 
     /// The target size in pixels.
@@ -220,7 +251,7 @@ impl Camera {
         CameraUniform {
             clip_from_world: self.clip_from_world().as_mat4().to_cols_array_2d(),
             right_alpha: [right.x, right.y, right.z, alpha],
-            up: [up.x, up.y, up.z, 0.0],
+            up: [up.x, up.y, up.z, self.motion_secs],
             viewport: [
                 self.size.0 as f32,
                 self.size.1 as f32,

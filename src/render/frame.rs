@@ -205,6 +205,8 @@ pub struct LookVariant {
     pub soft: bool,
     /// Fade against the host's depth buffer (replaces the ground-plane fade).
     pub soft_depth: bool,
+    /// The motion pass: screen-space motion weighted by visibility, added up.
+    pub motion: bool,
     /// How the shaders read the emitter's state (both draw paths).
     pub state: StateVariant,
 }
@@ -240,7 +242,16 @@ impl LookVariant {
             streak: look.streak.is_some(),
             soft: look.soft_ground_m > 0.0,
             soft_depth: false,
+            motion: false,
             state,
+        }
+    }
+
+    /// This variant's motion pass.
+    pub fn with_motion(self) -> Self {
+        Self {
+            motion: true,
+            ..self
         }
     }
 
@@ -253,12 +264,13 @@ impl LookVariant {
             streak: false,
             soft: false,
             soft_depth: false,
+            motion: false,
             state: StateVariant::default(),
         }
     }
 
     /// The override constants of this variant's billboard pipeline.
-    pub fn constants(self) -> [(&'static str, f64); 8] {
+    pub fn constants(self) -> [(&'static str, f64); 9] {
         let b = |v: bool| if v { 1.0 } else { 0.0 };
         let [layout, stateless] = self.state.constants();
         [
@@ -268,6 +280,7 @@ impl LookVariant {
             ("STREAK", b(self.streak)),
             ("SOFT", b(self.soft && !self.soft_depth)),
             ("SOFT_DEPTH", b(self.soft && self.soft_depth)),
+            ("MOTION", b(self.motion)),
             layout,
             stateless,
         ]

@@ -125,6 +125,18 @@ impl Player {
     /// The world-space positions of an instance's living particles, over every emitter
     /// with particles of its own (a blocking readback; to frame a camera, say).
     pub fn particle_positions(&self, id: InstanceId) -> Result<Vec<Vec3>, PlayerError> {
+        Ok(self
+            .particle_motion(id)?
+            .into_iter()
+            .map(|(p, _)| p)
+            .collect())
+    }
+
+    /// The world-space position and velocity (m/s) of an instance's living particles,
+    /// over every emitter with particles of its own (a blocking readback: the export's
+    /// framing and motion scale).
+    #[doc(hidden)]
+    pub fn particle_motion(&self, id: InstanceId) -> Result<Vec<(Vec3, Vec3)>, PlayerError> {
         let origins: Vec<Vec3> = self
             .with_state(id, |s| {
                 (0..self.effect.emitters.len())
@@ -146,7 +158,7 @@ impl Player {
                 .particles(id, i)?
                 .into_iter()
                 .filter(Particle::is_alive);
-            out.extend(alive.map(|p| p.position() + origin));
+            out.extend(alive.map(|p| (p.position() + origin, p.velocity())));
         }
         Ok(out)
     }

@@ -124,6 +124,8 @@ pub struct Player {
     uploads: Uploads,
     /// Whether the last record splatted light that `draw` resolves.
     splatted: bool,
+    /// Whether records prepare the motion pass ([`Player::draw_motion`]).
+    motion_pass: bool,
     /// `simulate` ran since the last `record`, which then does not run it again.
     simulated: bool,
 }
@@ -180,6 +182,7 @@ impl Player {
             items: Vec::new(),
             uploads: Uploads::new(device),
             splatted: false,
+            motion_pass: false,
             simulated: false,
         })
     }
@@ -368,8 +371,12 @@ impl Player {
             self.settings.asset_dir.as_deref(),
         );
         self.frame.upload_looks(&mut self.uploads, encoder);
-        self.billboard
-            .prepare(&self.ctx, &self.items, &self.frame.sprites.sampler);
+        self.billboard.prepare(
+            &self.ctx,
+            &self.items,
+            &self.frame.sprites.sampler,
+            self.motion_pass,
+        );
         self.sort
             .record_items(&self.ctx, encoder, &self.items, camera);
         self.splatted = self.splat.splat(
@@ -510,6 +517,24 @@ impl Player {
         });
         if self.splatted && layers.contains(Layers::LIGHT) {
             self.splat.resolve(pass, &self.frame);
+        }
+    }
+
+    /// Prepares the motion pass from the next [`Player::record`] on (the export's
+    /// motion vectors; billboards only: splatted particles have none).
+    #[doc(hidden)]
+    pub fn set_motion_pass(&mut self, on: bool) {
+        self.motion_pass = on;
+    }
+
+    /// Draws the motion pass of every billboard, as last recorded, into an open pass
+    /// whose colour target was cleared to zero: per pixel (Σ w·motion, 0, Σ w), with
+    /// motion in pixels over the camera's motion interval
+    /// ([`Camera::with_motion_secs`]) and `w` each particle's visible weight.
+    #[doc(hidden)]
+    pub fn draw_motion(&self, pass: &mut wgpu::RenderPass<'_>) {
+        if self.motion_pass {
+            self.billboard.draw_motion(pass, &self.frame, &self.items);
         }
     }
 

@@ -1,0 +1,416 @@
+//! Turning rendered frames into files: each pass's pixels in its stored form (sRGB or
+//! linear colour, straight or premultiplied alpha, encoded motion), quantised to 8- or
+//! 16-bit PNG or half-float EXR, one file per frame or one atlas per pass. Files are
+//! written beside their final name and renamed into place: none is left half-written.
+
+use std::path::{Path, PathBuf};
+
+use super::frames::RawFrame;
+use super::settings::{AlphaMode, ExportSettings, Format, Layout};
+use super::{ExportError, Sidecar};
+
+/// The passes' files of one export.
+pub(super) struct Writer {
+    settings: ExportSettings,
+    /// The file names' stem (the preset's name).
+    stem: String,
+    /// Decoded motion in frame UV = (value − 0.5) × this (set before the first frame).
+    pub motion_scale: f32,
+    /// Flipbook: one atlas per pass, in stored values (0..1 or linear).
+    atlases: Vec<(&'static str, Vec<[f32; 4]>)>,
+    /// The colour of the last sequence frame (the preview of a sequence).
+    last_color: Option<Vec<[f32; 4]>>,
+    /// Sequence frames written under hidden names, not yet renamed.
+    pending: Vec<PathBuf>,
+    files: Vec<PathBuf>,
+}
+
+impl Drop for Writer {
+    /// A cancelled or failed export leaves no frames under hidden names behind.
+    fn drop(&mut self) {
+        for p in &self.pending {
+            let _ = std::fs::remove_file(p);
+        }
+    }
+}
+
+impl Writer {
+    /// A writer into `settings.out_dir` (created) for `frames` frames of `preset`.
+    pub fn new(settings: &ExportSettings, preset: &str, frames: u32) -> Result<Self, ExportError> {
+        let dir = &settings.out_dir;
+        std::fs::create_dir_all(dir).map_err(|e| ExportError::Write {
+            path: dir.clone(),
+            message: format!("{e} (choose another --out folder)"),
+        })?;
+        let (w, h) = settings.frame_size;
+        let atlases = match settings.layout {
+            Layout::Flipbook { cols, rows } => settings
+                .passes
+                .names()
+                .into_iter()
+                .map(|p| (p, vec![[0.0; 4]; (cols * w * rows * h) as usize]))
+                .collect(),
+            Layout::Sequence => Vec::new(),
+        };
+        let _ = frames;
+        Ok(Self {
+            settings: settings.clone(),
+            stem: file_stem(preset),
+            motion_scale: 1.0,
+            atlases,
+            last_color: None,
+            pending: Vec::new(),
+            files: Vec::new(),
+        })
+    }
+
+    /// The colour pass of `frame` in stored values.
+    pub fn color_pixels(&self, frame: &RawFrame) -> Vec<[f32; 4]> {
+        let alpha = self.settings.alpha;
+        let format = self.settings.format;
+        frame
+            .color
+            .iter()
+            .map(|&c| store_color(c, alpha, format))
+            .collect()
+    }
+
+    /// The stored values of pass `name` of `frame`.
+    fn pass_pixels(&self, name: &str, frame: &RawFrame) -> Vec<[f32; 4]> {
+        let format = self.settings.format;
+        match name {
+            "emissive" => frame
+                .emissive
+                .iter()
+                .map(|&[r, g, b, _]| store_light([r, g, b], format))
+                .collect(),
+            "motion" => {
+                let (w, h) = self.settings.frame_size;
+                let to_uv = [1.0 / w as f32, 1.0 / h as f32];
+                frame
+                    .motion
+                    .iter()
+                    .map(|m| {
+                        let e =
+                            |k: usize| (0.5 + m[k] * to_uv[k] / self.motion_scale).clamp(0.0, 1.0);
+                        [e(0), e(1), 0.0, 1.0]
+                    })
+                    .collect()
+            }
+            _ => self.color_pixels(frame),
+        }
+    }
+
+    /// Writes output frame `j` (a sequence's files, or the flipbook's cells).
+    pub fn write_frame(&mut self, j: u32, frame: &RawFrame) -> Result<(), ExportError> {
+        let (w, h) = self.settings.frame_size;
+        for name in self.settings.passes.names() {
+            let pixels = self.pass_pixels(name, frame);
+            match self.settings.layout {
+                Layout::Sequence => {
+                    // Under a hidden name until `finish` numbers the frames (a loop may
+                    // start at another frame).
+                    let path = self.pending(name, j);
+                    write_image(&path, (w, h), &pixels, self.settings.format)?;
+                    self.pending.push(path);
+                    if name == "color" {
+                        self.last_color = Some(pixels);
+                    }
+                }
+                Layout::Flipbook { cols, .. } => {
+                    let Some((_, atlas)) = self.atlases.iter_mut().find(|(n, _)| *n == name) else {
+                        continue;
+                    };
+                    let (cx, cy) = ((j % cols) * w, (j / cols) * h);
+                    let stride = (cols * w) as usize;
+                    for (y, row) in pixels.chunks(w as usize).enumerate() {
+                        let at = (cy as usize + y) * stride + cx as usize;
+                        atlas[at..at + w as usize].copy_from_slice(row);
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Where output frame `j` of pass `name` of a sequence waits for `finish`.
+    fn pending(&self, name: &str, j: u32) -> PathBuf {
+        let ext = self.settings.format.extension();
+        self.settings
+            .out_dir
+            .join(format!(".{}_{name}_{j:04}.{ext}.pending", self.stem))
+    }
+
+    /// Writes the atlases (flipbook) or names the sequence's files, with frame `first`
+    /// of the `frames` written as frame 0 (a loop's rotation), and the sidecar; returns
+    /// every file written.
+    pub fn finish(
+        &mut self,
+        sidecar: &Sidecar,
+        frames: u32,
+        first: u32,
+    ) -> Result<Vec<PathBuf>, ExportError> {
+        let (w, h) = self.settings.frame_size;
+        let source = |k: u32| (k + first) % frames.max(1);
+        match self.settings.layout {
+            Layout::Flipbook { cols, rows } => {
+                for (name, atlas) in &self.atlases {
+                    let rotated = rotate_cells(atlas, (w, h), cols, frames, source);
+                    let path = self.path(&format!("{}_{name}", self.stem));
+                    write_image(&path, (cols * w, rows * h), &rotated, self.settings.format)?;
+                    self.files.push(path);
+                }
+            }
+            Layout::Sequence => {
+                for name in self.settings.passes.names() {
+                    for k in 0..frames {
+                        let path = self.path(&format!("{}_{name}_{k:04}", self.stem));
+                        std::fs::rename(self.pending(name, source(k)), &path).map_err(|e| {
+                            ExportError::Write {
+                                path: path.clone(),
+                                message: e.to_string(),
+                            }
+                        })?;
+                        self.files.push(path);
+                    }
+                }
+                self.pending.clear();
+            }
+        }
+        let path = self.settings.out_dir.join(format!("{}.json", self.stem));
+        let text = sidecar.to_json();
+        write_atomic(&path, |tmp| {
+            std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
+        })?;
+        self.files.push(path);
+        Ok(self.files.clone())
+    }
+
+    /// The colour atlas so far (flipbook) or the last frame (sequence), 8-bit.
+    pub fn preview(&self) -> Option<image::RgbaImage> {
+        let (w, h) = self.settings.frame_size;
+        let (size, pixels) = match self.settings.layout {
+            Layout::Flipbook { cols, rows } => (
+                (cols * w, rows * h),
+                &self.atlases.iter().find(|(n, _)| *n == "color")?.1,
+            ),
+            Layout::Sequence => ((w, h), self.last_color.as_ref()?),
+        };
+        let to8 = |v: f32| {
+            let v = if self.settings.format == Format::Exr {
+                linear_to_srgb(v)
+            } else {
+                v
+            };
+            (v.clamp(0.0, 1.0) * 255.0).round() as u8
+        };
+        let bytes = pixels
+            .iter()
+            .flat_map(|p| {
+                [
+                    to8(p[0]),
+                    to8(p[1]),
+                    to8(p[2]),
+                    (p[3].clamp(0.0, 1.0) * 255.0).round() as u8,
+                ]
+            })
+            .collect();
+        image::RgbaImage::from_raw(size.0, size.1, bytes)
+    }
+
+    fn path(&self, stem: &str) -> PathBuf {
+        self.settings
+            .out_dir
+            .join(format!("{stem}.{}", self.settings.format.extension()))
+    }
+}
+
+/// `atlas` (cells of `size`, `cols` a row) with cell k taken from cell `source(k)`, for
+/// the first `frames` cells.
+fn rotate_cells(
+    atlas: &[[f32; 4]],
+    size: (u32, u32),
+    cols: u32,
+    frames: u32,
+    source: impl Fn(u32) -> u32,
+) -> Vec<[f32; 4]> {
+    let mut out = atlas.to_vec();
+    let (w, h) = (size.0 as usize, size.1 as usize);
+    let stride = cols as usize * w;
+    let origin = |k: u32| ((k % cols) as usize * w, (k / cols) as usize * h);
+    for k in 0..frames {
+        let ((dx, dy), (sx, sy)) = (origin(k), origin(source(k)));
+        for y in 0..h {
+            let (d, s) = ((dy + y) * stride + dx, (sy + y) * stride + sx);
+            out[d..d + w].copy_from_slice(&atlas[s..s + w]);
+        }
+    }
+    out
+}
+
+/// A file-name-safe stem from a preset's name.
+fn file_stem(name: &str) -> String {
+    let s: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' {
+                c.to_ascii_lowercase()
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if s.is_empty() { "effect".into() } else { s }
+}
+
+/// A premultiplied linear colour in its stored form.
+fn store_color(c: [f32; 4], alpha: AlphaMode, format: Format) -> [f32; 4] {
+    let a = c[3].clamp(0.0, 1.0);
+    let (rgb, a) = match alpha {
+        AlphaMode::Premultiplied => ([c[0], c[1], c[2]], a),
+        AlphaMode::Straight => {
+            // Coverage that also counts the light: additive light alone gets alpha.
+            let a = a.max(c[0].max(c[1]).max(c[2]).clamp(0.0, 1.0));
+            let inv = if a > 0.0 { 1.0 / a } else { 0.0 };
+            ([c[0] * inv, c[1] * inv, c[2] * inv], a)
+        }
+    };
+    let [r, g, b, _] = store_light(rgb, format);
+    [r, g, b, a]
+}
+
+/// Linear light in its stored form: sRGB-encoded and clipped at 1 for PNG, linear for
+/// EXR; opaque.
+fn store_light(rgb: [f32; 3], format: Format) -> [f32; 4] {
+    let e = |v: f32| match format {
+        Format::Exr => v.max(0.0),
+        Format::Png8 | Format::Png16 => linear_to_srgb(v.clamp(0.0, 1.0)),
+    };
+    [e(rgb[0]), e(rgb[1]), e(rgb[2]), 1.0]
+}
+
+/// The sRGB transfer function (linear 0..1 → encoded 0..1).
+pub fn linear_to_srgb(v: f32) -> f32 {
+    if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// The inverse sRGB transfer function (encoded 0..1 → linear).
+pub fn srgb_to_linear(v: f32) -> f32 {
+    if v <= 0.040_45 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Motion in frame UV units (x right, y down) from a motion pass's stored RG.
+pub fn decode_motion(rg: [f32; 2], motion_scale: f32) -> [f32; 2] {
+    rg.map(|v| (v - 0.5) * motion_scale)
+}
+
+/// Writes `pixels` (stored values) as an image of `size` in `format`.
+fn write_image(
+    path: &Path,
+    size: (u32, u32),
+    pixels: &[[f32; 4]],
+    format: Format,
+) -> Result<(), ExportError> {
+    let (w, h) = size;
+    write_atomic(path, |tmp| match format {
+        Format::Png8 => {
+            let q = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+            let raw = pixels.iter().flat_map(|p| p.map(q)).collect();
+            image::RgbaImage::from_raw(w, h, raw)
+                .ok_or("size mismatch")?
+                .save_with_format(tmp, image::ImageFormat::Png)
+                .map_err(|e| e.to_string())
+        }
+        Format::Png16 => {
+            let q = |v: f32| (v.clamp(0.0, 1.0) * 65535.0).round() as u16;
+            let raw = pixels.iter().flat_map(|p| p.map(q)).collect();
+            image::ImageBuffer::<image::Rgba<u16>, Vec<u16>>::from_raw(w, h, raw)
+                .ok_or("size mismatch")?
+                .save_with_format(tmp, image::ImageFormat::Png)
+                .map_err(|e| e.to_string())
+        }
+        Format::Exr => {
+            use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage, f16};
+            let at = |x: usize, y: usize| pixels[y * w as usize + x].map(f16::from_f32);
+            let channels = SpecificChannels::rgba(|Vec2(x, y)| {
+                let [r, g, b, a] = at(x, y);
+                (r, g, b, a)
+            });
+            // One thread: blocks in a fixed order, so the same frames give the same bytes.
+            Image::from_channels((w as usize, h as usize), channels)
+                .write()
+                .non_parallel()
+                .to_file(tmp)
+                .map_err(|e| e.to_string())
+        }
+    })
+}
+
+/// Writes through `write` into a temporary file beside `path`, then renames it into
+/// place (an interrupted export leaves no half-written file under the final name).
+fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<(), ExportError> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy())
+        .unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{name}.partial"));
+    let fail = |message: String| ExportError::Write {
+        path: path.to_path_buf(),
+        message,
+    };
+    if let Err(e) = write(&tmp) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(fail(e));
+    }
+    std::fs::rename(&tmp, path).map_err(|e| fail(e.to_string()))
+}
+
+/// Box-filters a frame's stored colour down to at most 64×64 (seam statistics).
+pub(super) fn thumbnail(pixels: &[[f32; 4]], size: (u32, u32)) -> Vec<[f32; 4]> {
+    let (w, h) = (size.0 as usize, size.1 as usize);
+    let (tw, th) = (w.min(64), h.min(64));
+    let mut out = vec![[0.0f32; 4]; tw * th];
+    let mut counts = vec![0u32; tw * th];
+    for (i, p) in pixels.iter().enumerate() {
+        let (x, y) = (i % w, i / w);
+        let t = (y * th / h) * tw + x * tw / w;
+        for k in 0..4 {
+            out[t][k] += p[k];
+        }
+        counts[t] += 1;
+    }
+    for (o, n) in out.iter_mut().zip(counts) {
+        *o = o.map(|v| v / n.max(1) as f32);
+    }
+    out
+}
+
+/// The mean absolute difference of two images' channels, in 8-bit steps.
+pub(super) fn mean_difference(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
+    let sum: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(p, q)| (0..4).map(|k| f64::from((p[k] - q[k]).abs())).sum::<f64>())
+        .sum();
+    255.0 * sum / (4 * a.len().max(1)) as f64
+}
+
+/// The median of `v` (0 when empty).
+pub(super) fn median(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}

@@ -1,0 +1,242 @@
+//! Rendering one export frame: the player's layers into targets of the export's own —
+//! the colour (transparent, or over an opaque background), the additive light alone,
+//! and the motion pass — read back as linear floats.
+
+use crate::gpu::{GpuContext, TextureReadback};
+use crate::render::{Camera, begin_hdr_pass};
+use crate::runtime::{Layers, Player};
+use crate::sim::gpu_sim::map_read;
+
+use super::ExportError;
+use super::settings::ExportSettings;
+
+/// One rendered frame, linear and premultiplied, exposure applied.
+#[derive(Clone, Debug, Default)]
+pub(super) struct RawFrame {
+    /// Light and coverage (RGBA).
+    pub color: Vec<[f32; 4]>,
+    /// The additive layers' light alone (RGB; empty when the pass is off).
+    pub emissive: Vec<[f32; 4]>,
+    /// Weighted mean motion in pixels over the frame interval (empty when off).
+    pub motion: Vec<[f32; 2]>,
+}
+
+impl RawFrame {
+    /// Moves every pass a fraction `t` of the way towards `other` (a loop's fade).
+    pub fn blend_towards(&mut self, other: &RawFrame, t: f32) {
+        let mix = |a: &mut f32, b: f32| *a += (b - *a) * t;
+        for (a, b) in self.color.iter_mut().zip(&other.color) {
+            (0..4).for_each(|k| mix(&mut a[k], b[k]));
+        }
+        for (a, b) in self.emissive.iter_mut().zip(&other.emissive) {
+            (0..4).for_each(|k| mix(&mut a[k], b[k]));
+        }
+        for (a, b) in self.motion.iter_mut().zip(&other.motion) {
+            (0..2).for_each(|k| mix(&mut a[k], b[k]));
+        }
+    }
+}
+
+/// The export's targets and camera.
+pub(super) struct FrameRenderer {
+    camera: Camera,
+    size: (u32, u32),
+    background: Option<[f32; 3]>,
+    color: wgpu::Texture,
+    emissive: Option<wgpu::Texture>,
+    motion: Option<wgpu::Texture>,
+}
+
+impl FrameRenderer {
+    /// Targets of the settings' frame size for the passes they ask for.
+    pub fn new(ctx: &GpuContext, camera: Camera, settings: &ExportSettings) -> Self {
+        let size = settings.frame_size;
+        let texture = |label| {
+            crate::gpu::texture_2d(
+                &ctx.device,
+                label,
+                size,
+                1,
+                target_format(&ctx.device),
+                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            )
+        };
+        let target = |on: bool, label| on.then(|| texture(label));
+        Self {
+            camera,
+            size,
+            background: settings.background,
+            color: texture("Export::color"),
+            emissive: target(settings.passes.emissive, "Export::emissive"),
+            motion: target(settings.passes.motion, "Export::motion"),
+        }
+    }
+
+    /// The frame size.
+    pub fn size(&self) -> (u32, u32) {
+        self.size
+    }
+
+    /// Renders the player's current state and reads it back (blocking). A GPU error (a
+    /// device limit, say) fails the frame rather than writing an empty one.
+    pub fn render(
+        &mut self,
+        ctx: &GpuContext,
+        player: &mut Player,
+    ) -> Result<RawFrame, ExportError> {
+        let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let frame = self.render_unchecked(ctx, player);
+        if let Some(err) = pollster::block_on(scope.pop()) {
+            return Err(ExportError::Invalid(format!(
+                "the GPU refused an export frame: {err}"
+            )));
+        }
+        frame
+    }
+
+    fn render_unchecked(
+        &mut self,
+        ctx: &GpuContext,
+        player: &mut Player,
+    ) -> Result<RawFrame, ExportError> {
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        player.record(&mut enc, &self.camera, None);
+        let view = self.color.create_view(&Default::default());
+        {
+            let mut pass = match self.background {
+                Some(b) => begin_clear_pass(&mut enc, &view, b),
+                None => begin_hdr_pass(&mut enc, &view),
+            };
+            player.draw(&mut pass);
+        }
+        if let Some(t) = &self.emissive {
+            let view = t.create_view(&Default::default());
+            player.draw_layers(
+                &mut begin_hdr_pass(&mut enc, &view),
+                Layers::LIGHT | Layers::GLOW,
+            );
+        }
+        if let Some(t) = &self.motion {
+            let view = t.create_view(&Default::default());
+            player.draw_motion(&mut begin_hdr_pass(&mut enc, &view));
+        }
+        let read = |enc: &mut wgpu::CommandEncoder, t: &wgpu::Texture| {
+            TextureReadback::record(&ctx.device, enc, t, "Export::readback")
+        };
+        let color = read(&mut enc, &self.color);
+        let emissive = self.emissive.as_ref().map(|t| read(&mut enc, t));
+        let motion = self.motion.as_ref().map(|t| read(&mut enc, t));
+        ctx.queue.submit([enc.finish()]);
+        let exposure = player.effect().post.exposure;
+        let lit = |p: [f32; 4]| [p[0] * exposure, p[1] * exposure, p[2] * exposure, p[3]];
+        let mut frame = RawFrame {
+            color: texels(ctx, &color)?.into_iter().map(lit).collect(),
+            ..RawFrame::default()
+        };
+        if self.background.is_some() {
+            // Over an opaque background the image is already composited; exposure
+            // scales the whole of it, as the editor's tonemap does.
+            frame.color = texels(ctx, &color)?
+                .into_iter()
+                .map(|p| [p[0] * exposure, p[1] * exposure, p[2] * exposure, 1.0])
+                .collect();
+        }
+        if let Some(e) = &emissive {
+            frame.emissive = texels(ctx, e)?.into_iter().map(lit).collect();
+        }
+        if let Some(m) = &motion {
+            frame.motion = texels(ctx, m)?
+                .into_iter()
+                .map(|p| {
+                    if p[3] > 1e-6 {
+                        [p[0] / p[3], p[1] / p[3]]
+                    } else {
+                        [0.0; 2]
+                    }
+                })
+                .collect();
+        }
+        Ok(frame)
+    }
+}
+
+/// The export's target format: 32-bit float where the device blends it (bright light
+/// adds up without f16's rounding), else `Rgba16Float`.
+pub(super) fn target_format(device: &wgpu::Device) -> wgpu::TextureFormat {
+    if device
+        .features()
+        .contains(wgpu::Features::FLOAT32_BLENDABLE)
+    {
+        wgpu::TextureFormat::Rgba32Float
+    } else {
+        crate::render::HDR_FORMAT
+    }
+}
+
+/// A pass over `view` cleared to the opaque linear colour `b`.
+fn begin_clear_pass<'a>(
+    enc: &'a mut wgpu::CommandEncoder,
+    view: &'a wgpu::TextureView,
+    b: [f32; 3],
+) -> wgpu::RenderPass<'a> {
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("Export::background"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color {
+                    r: f64::from(b[0]),
+                    g: f64::from(b[1]),
+                    b: f64::from(b[2]),
+                    a: 1.0,
+                }),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        ..Default::default()
+    })
+}
+
+/// An `Rgba16Float` or `Rgba32Float` readback's texels as f32.
+fn texels(ctx: &GpuContext, copy: &TextureReadback) -> Result<Vec<[f32; 4]>, ExportError> {
+    let bytes = map_read(ctx, &copy.buffer)?;
+    let rows = copy
+        .rows(&bytes)
+        .ok_or_else(|| ExportError::Invalid("the frame readback is too short".into()))?;
+    let wide = copy.texel_bytes == 16;
+    Ok(rows
+        .iter()
+        .flat_map(|row| {
+            row.chunks_exact(copy.texel_bytes as usize).map(move |t| {
+                let v = |i: usize| {
+                    if wide {
+                        f32::from_le_bytes([t[4 * i], t[4 * i + 1], t[4 * i + 2], t[4 * i + 3]])
+                    } else {
+                        half::f16::from_le_bytes([t[2 * i], t[2 * i + 1]]).to_f32()
+                    }
+                };
+                [v(0), v(1), v(2), v(3)]
+            })
+        })
+        .collect())
+}
+
+/// Advances `player` from `*now` to `t` seconds of effect time in chunks of at most a
+/// 60th of a second (a long frame interval must not trip the hitch guard), simulating
+/// each; `*now` becomes `t`.
+pub(super) fn advance_to(ctx: &GpuContext, player: &mut Player, now: &mut f64, t: f64) {
+    let remaining = t - *now;
+    if remaining > 1e-12 {
+        let n = (remaining * 60.0).ceil().max(1.0) as u32;
+        let dt = remaining / f64::from(n);
+        for _ in 0..n {
+            player.advance(dt);
+            let mut enc = ctx.device.create_command_encoder(&Default::default());
+            player.simulate(&mut enc);
+            ctx.queue.submit([enc.finish()]);
+        }
+    }
+    *now = t;
+}

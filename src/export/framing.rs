@@ -1,0 +1,257 @@
+//! Framing an export: the particles of the whole span, sampled, fix the camera (nothing
+//! cropped at any frame, a margin around) and the motion pass's scale.
+
+use glam::{Mat4, Vec3};
+
+use crate::effect::Effect;
+use crate::render::{Camera, OrbitCamera};
+
+use super::settings::CameraMode;
+
+/// Particles kept per frame at most (every k-th one beyond).
+const PER_FRAME: usize = 20_000;
+
+/// The margin left around the particles, as a fraction of the frame.
+const MARGIN: f32 = 0.06;
+
+/// Particles (world position and velocity) seen over the span.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Samples {
+    points: Vec<(Vec3, Vec3)>,
+}
+
+impl Samples {
+    /// Adds one frame's particles (evenly thinned to `PER_FRAME`).
+    pub fn add(&mut self, frame: &[(Vec3, Vec3)]) {
+        let step = frame.len().div_ceil(PER_FRAME).max(1);
+        self.points.extend(frame.iter().step_by(step).copied());
+    }
+
+    /// The largest motion of a sampled particle over `interval` seconds, in frame UV
+    /// units, times two and a margin: the motion pass's scale (decoded motion =
+    /// (value − 0.5) × scale).
+    pub fn motion_scale(&self, camera: &Camera, interval: f32) -> f32 {
+        let clip: Mat4 = camera.clip_from_world_mat4();
+        let uv = |p: Vec3| {
+            let c = clip * p.extend(1.0);
+            (c.w > 1e-4).then(|| glam::vec2(c.x / c.w * 0.5, -c.y / c.w * 0.5))
+        };
+        let largest = self
+            .points
+            .iter()
+            .filter_map(|&(p, v)| Some((uv(p + v * interval)? - uv(p)?).abs().max_element()))
+            .fold(0.0f32, f32::max);
+        (2.0 * largest * 1.05).max(1e-3)
+    }
+}
+
+/// The largest distance a particle's drawn quad reaches from its centre, over the
+/// effect's emitters (size with its randomness, rotation, streak tails).
+fn reach(effect: &Effect) -> f32 {
+    effect
+        .emitters
+        .iter()
+        .filter(|e| e.enabled)
+        .map(|e| {
+            let l = &e.look;
+            let size = l.size_start_m.max(l.size_end_m) * (1.0 + l.size_random.abs());
+            let streak = l.streak.as_ref().map_or(0.0, |s| s.max_length_m);
+            0.5 * size * std::f32::consts::SQRT_2 + streak
+        })
+        .fold(0.0, f32::max)
+}
+
+/// A camera that sees every particle of the span whole: the preset's, or one along the
+/// preset's view that encloses the sampled particles (each grown by its quad's reach).
+#[derive(Clone, Debug)]
+pub(super) enum Wide {
+    /// The preset's camera as it is.
+    Preset(OrbitCamera),
+    /// Orthographic: half extents of the particles' box on the view plane about `centre`.
+    Ortho {
+        centre: Vec3,
+        forward: Vec3,
+        half: glam::Vec2,
+        depth: f32,
+    },
+    /// The preset's field of view from `eye`, far enough back.
+    Perspective {
+        eye: Vec3,
+        centre: Vec3,
+        fov_y: f32,
+        distance: f32,
+    },
+}
+
+/// The enclosing camera for `mode`.
+pub(super) fn enclosing(effect: &Effect, samples: &Samples, mode: CameraMode) -> Wide {
+    let preset = OrbitCamera::from_hint(&effect.camera);
+    if mode == CameraMode::Preset || samples.points.is_empty() {
+        return Wide::Preset(preset);
+    }
+    let forward = (preset.target - preset.eye()).normalize_or(Vec3::NEG_Z);
+    let right = forward.cross(Vec3::Y).normalize_or(Vec3::X);
+    let up = right.cross(forward);
+    let r = reach(effect);
+    // The particles in the view's basis about the preset's target (z towards the eye).
+    let basis: Vec<Vec3> = samples
+        .points
+        .iter()
+        .map(|&(p, _)| {
+            let d = p - preset.target;
+            Vec3::new(d.dot(right), d.dot(up), -d.dot(forward))
+        })
+        .collect();
+    let lo = basis
+        .iter()
+        .fold(Vec3::splat(f32::INFINITY), |a, &b| a.min(b))
+        - r;
+    let hi = basis
+        .iter()
+        .fold(Vec3::splat(f32::NEG_INFINITY), |a, &b| a.max(b))
+        + r;
+    let mid = 0.5 * (lo + hi);
+    let centre = preset.target + right * mid.x + up * mid.y - forward * mid.z;
+    if mode == CameraMode::Ortho {
+        let half = 0.5 * (hi - lo);
+        return Wide::Ortho {
+            centre,
+            forward,
+            half: glam::vec2(half.x, half.y) * 1.1,
+            depth: half.z + 1.0,
+        };
+    }
+    // Back off along the view until every particle's sphere is inside a square frame (the
+    // frame's aspect only widens it).
+    let t = (0.5 * preset.fov_y).tan() * 0.9;
+    let grow = (1.0 + t * t).sqrt();
+    let distance = basis
+        .iter()
+        .map(|b| {
+            let b = *b - mid;
+            b.z + (b.x.abs().max(b.y.abs()) + r * grow) / t
+        })
+        .fold(r + 0.05, f32::max);
+    Wide::Perspective {
+        eye: centre - forward * distance,
+        centre,
+        fov_y: preset.fov_y,
+        distance,
+    }
+}
+
+impl Wide {
+    /// This camera for frames of `size` (a wider frame sees more, never less).
+    pub fn camera(&self, size: (u32, u32)) -> Camera {
+        let aspect = size.0 as f32 / size.1.max(1) as f32;
+        match *self {
+            Wide::Preset(ref orbit) => orbit.view(size),
+            Wide::Ortho {
+                centre,
+                forward,
+                half,
+                depth,
+            } => {
+                let hx = half.x.max(half.y * aspect);
+                let hy = hx / aspect;
+                let view =
+                    glam::camera::rh::view::look_at_mat4(centre - forward * depth, centre, Vec3::Y);
+                let proj = glam::camera::rh::proj::directx::orthographic(
+                    -hx,
+                    hx,
+                    -hy,
+                    hy,
+                    0.01,
+                    2.0 * depth + 1.0,
+                );
+                Camera::new(view, proj, size)
+            }
+            Wide::Perspective {
+                eye,
+                centre,
+                fov_y,
+                distance,
+            } => {
+                // Keep the square frame's horizontal reach when the frame is narrower.
+                let fov_y = if aspect < 1.0 {
+                    2.0 * ((0.5 * fov_y).tan() / aspect).atan()
+                } else {
+                    fov_y
+                };
+                let view = glam::camera::rh::view::look_at_mat4(eye, centre, Vec3::Y);
+                let near = (distance * 0.01).max(1e-3);
+                let proj = glam::camera::rh::proj::directx::perspective(
+                    fov_y.min(3.0),
+                    aspect,
+                    near,
+                    distance * 4.0 + 10.0,
+                );
+                Camera::new(view, proj, size)
+            }
+        }
+    }
+
+    /// This camera for frames of `size`, cropped to `bounds` (what was visible through
+    /// it, in its clip space) with a margin: an off-centre crop of the same view.
+    pub fn cropped(&self, bounds: Bounds, size: (u32, u32)) -> Camera {
+        let wide = self.camera(size);
+        let Some((lo, hi)) = bounds.rect() else {
+            return wide;
+        };
+        let c = 0.5 * (lo + hi);
+        let s = (0.5 * (hi - lo).max_element() / (1.0 - 2.0 * MARGIN)).clamp(1e-3, 1.0);
+        // x' = (x − c.x·w) / s in clip space: the crop as a projection.
+        let crop = Mat4::from_cols(
+            glam::vec4(1.0 / s, 0.0, 0.0, 0.0),
+            glam::vec4(0.0, 1.0 / s, 0.0, 0.0),
+            glam::vec4(0.0, 0.0, 1.0, 0.0),
+            glam::vec4(-c.x / s, -c.y / s, 0.0, 1.0),
+        );
+        Camera::new(
+            wide.view_from_world_mat4(),
+            crop * wide.clip_from_view_mat4(),
+            size,
+        )
+    }
+}
+
+/// The probe's frame size: the export's aspect, 256 pixels on the long side.
+pub(super) fn probe_size(size: (u32, u32)) -> (u32, u32) {
+    let long = size.0.max(size.1).max(1) as f32;
+    let k = 256.0 / long;
+    (
+        ((size.0 as f32 * k).round() as u32).max(8),
+        ((size.1 as f32 * k).round() as u32).max(8),
+    )
+}
+
+/// Where anything was visible over the probe's frames, in clip space (x right, y up).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Bounds {
+    rect: Option<(glam::Vec2, glam::Vec2)>,
+}
+
+impl Bounds {
+    /// Grows by the pixels of `frame` (of `size`) that hold any light or coverage, by
+    /// their whole extent.
+    pub fn add(&mut self, frame: &super::frames::RawFrame, size: (u32, u32)) {
+        let (w, h) = (size.0 as usize, size.1 as usize);
+        for (i, p) in frame.color.iter().enumerate() {
+            if p.iter().all(|&v| v.abs() < 1e-4) {
+                continue;
+            }
+            let (x, y) = ((i % w) as f32, (i / w) as f32);
+            let lo = glam::vec2(2.0 * x / w as f32 - 1.0, 1.0 - 2.0 * (y + 1.0) / h as f32);
+            let hi = glam::vec2(2.0 * (x + 1.0) / w as f32 - 1.0, 1.0 - 2.0 * y / h as f32);
+            self.rect = Some(match self.rect {
+                Some((a, b)) => (a.min(lo), b.max(hi)),
+                None => (lo, hi),
+            });
+        }
+    }
+
+    /// The rectangle, if anything was visible.
+    pub fn rect(&self) -> Option<(glam::Vec2, glam::Vec2)> {
+        self.rect
+    }
+}
