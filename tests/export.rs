@@ -1,5 +1,6 @@
 //! `ignis export`: compositing, flipbook = sequence, loops, motion vectors, framing and
 //! determinism, on the real adapter (lavapipe in CI) at small sizes.
+#![cfg(feature = "editor")]
 
 mod common;
 
