@@ -1177,3 +1177,106 @@ fn retained_ui_repaints_match_full_repaints() {
     // only the panel text change (frame 3) does.
     assert_eq!(kinds, [false, false, true, false, true]);
 }
+
+/// Steps the export the panel asks for, with the panel drawn between steps, until it
+/// ends; returns whether the Cancel button and a progress bar showed while it ran.
+fn run_export(harness: &mut Harness<'_, EditorState>, ctx: &GpuContext) -> (bool, u32) {
+    let mut running = None;
+    let (mut saw_cancel, mut frames) = (false, 0);
+    loop {
+        {
+            let state = harness.state_mut();
+            let effect = state.running.clone();
+            ignis::editor::export_ui::drive(
+                ctx,
+                &effect,
+                None,
+                &mut state.export,
+                &mut running,
+                std::time::Duration::from_millis(1),
+            );
+        }
+        // The panel asks for frames while an export runs: one step each.
+        harness.step();
+        frames += 1;
+        if running.is_none() {
+            return (saw_cancel, frames);
+        }
+        saw_cancel |= harness.query_by_label("Cancel").is_some();
+    }
+}
+
+/// The Export section exports the running effect with its settings through the same
+/// code as `ignis export`: a progress bar and Cancel while it runs, the files and a
+/// preview of the atlas after; Cancel drops an export and writes nothing.
+#[test]
+fn the_export_section_exports_with_progress_and_cancels() {
+    let ctx = common::gpu();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut state = campfire_state();
+    state.export.out_dir = dir.path().join("book").display().to_string();
+    state.export.cols = 2;
+    state.export.rows = 2;
+    state.export.settings.frame_size = (32, 32);
+    let mut harness = panel_harness(state);
+    open_section(&mut harness, "Export");
+    harness.get_by_label("Start export").click_accesskit();
+    harness.run();
+    assert!(harness.state().export.start_requested);
+    let (saw_cancel, frames) = run_export(&mut harness, &ctx);
+    assert!(
+        saw_cancel && frames > 3,
+        "no progress shown ({frames} frames)"
+    );
+    let message = harness.state().export.message.clone();
+    assert!(
+        matches!(&message, Some(Ok(m)) if m.contains("wrote 2 files")),
+        "{message:?}"
+    );
+    let atlas = image::open(dir.path().join("book/campfire_color.png")).expect("atlas");
+    assert_eq!((atlas.width(), atlas.height()), (64, 64));
+    assert!(dir.path().join("book/campfire.json").exists());
+    assert!(
+        harness.query_by_role(Role::Image).is_some(),
+        "no preview of the atlas"
+    );
+
+    // A sequence cancelled after its first step leaves no file behind.
+    let seq = dir.path().join("seq");
+    harness.state_mut().export.sequence = true;
+    harness.state_mut().export.out_dir = seq.display().to_string();
+    harness.get_by_label("Start export").click_accesskit();
+    harness.step();
+    let mut running = None;
+    let state = harness.state_mut();
+    let effect = state.running.clone();
+    let step = |state: &mut EditorState, running: &mut Option<_>| {
+        ignis::editor::export_ui::drive(
+            &ctx,
+            &effect,
+            None,
+            &mut state.export,
+            running,
+            std::time::Duration::from_millis(1),
+        )
+    };
+    for _ in 0..150 {
+        step(state, &mut running);
+    }
+    assert!(
+        running.is_some(),
+        "the export ended before it was cancelled"
+    );
+    state.export.cancel_requested = true;
+    step(state, &mut running);
+    assert!(running.is_none());
+    let message = state.export.message.clone();
+    assert!(
+        matches!(&message, Some(Err(m)) if m.contains("cancelled")),
+        "{message:?}"
+    );
+    let left: Vec<_> = std::fs::read_dir(&seq)
+        .map(|d| d.flatten().map(|e| e.file_name()).collect())
+        .unwrap_or_default();
+    assert!(left.is_empty(), "a cancelled export left {left:?}");
+}

@@ -245,6 +245,8 @@ struct Gfx {
     /// Watches the folders of the PNG sprites in use: a changed file is reloaded.
     /// (folders, their watcher).
     sprite_watch: Option<(Vec<PathBuf>, Option<FileWatcher>)>,
+    /// The export the Export section started, stepped a little every frame.
+    export: Option<crate::export::Export>,
 }
 
 /// The shader folder's watcher and the reloader that rebuilds affected pipelines.
@@ -277,6 +279,9 @@ impl ShaderWatch {
 /// The editor's player: the running effect as one instance at the origin, drawn into the
 /// composite's HDR target, built from the shader folder when there is one. Not batched:
 /// an edit that resizes a pool keeps the particles that fit.
+/// The time an export may take of each editor frame.
+const EXPORT_BUDGET: Duration = Duration::from_millis(40);
+
 fn editor_player(
     ctx: &GpuContext,
     lib: &ShaderLibrary,
@@ -475,6 +480,7 @@ impl Gfx {
             profiler: StageProfiler::new(options.profile),
             shader_watch,
             sprite_watch: None,
+            export: None,
         })
     }
 
@@ -781,6 +787,14 @@ impl App {
         gfx.apply_running(&mut self.state);
         let cpu_start = Instant::now();
         gfx.simulate(&mut self.state, frame_dt_secs);
+        super::export_ui::drive(
+            &gfx.ctx,
+            &self.state.running,
+            self.state.asset_dir(),
+            &mut self.state.export,
+            &mut gfx.export,
+            EXPORT_BUDGET,
+        );
 
         // 3. The viewport image: the player's frame → HDR → tonemap, then a copy egui can
         // show.

@@ -5,6 +5,7 @@
 //! with an `egui::Context`); [`app`] owns the window, the surface and the frame loop.
 
 pub mod app;
+pub mod export_ui;
 pub mod look;
 pub mod panel;
 pub mod profile;

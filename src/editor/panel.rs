@@ -93,6 +93,9 @@ pub fn panel_ui(ui: &mut Ui, state: &mut EditorState) {
             section_ui(ui, "stats", "Stats", "", (true, open("stats")), |ui| {
                 stats_ui(ui, &state.stats, &state.running);
             });
+            section_ui(ui, "export", "Export", "", (false, open("export")), |ui| {
+                super::export_ui::export_ui(ui, &mut state.export);
+            });
         });
 }
 
@@ -307,7 +310,12 @@ fn error_box_ui(ui: &mut Ui, add: impl FnOnce(&mut Ui)) {
 
 /// A labelled grid row: the label names the widget for accessibility (and tests) and
 /// both carry the tooltip.
-fn row_ui(ui: &mut Ui, label: &str, tip: &str, add: impl FnOnce(&mut Ui) -> Response) -> Response {
+pub(crate) fn row_ui(
+    ui: &mut Ui,
+    label: &str,
+    tip: &str,
+    add: impl FnOnce(&mut Ui) -> Response,
+) -> Response {
     let label = ui.label(label).on_hover_text(tip);
     let response = add(ui).labelled_by(label.id).on_hover_text(tip);
     ui.end_row();

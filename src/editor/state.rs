@@ -96,6 +96,8 @@ pub struct EditorState {
     pub loaded_path: Option<std::path::PathBuf>,
     /// An action that would discard unsaved edits, waiting for the user's confirmation.
     pub pending: Option<PendingAction>,
+    /// The Export section and the export it runs.
+    pub export: super::export_ui::ExportPanel,
 }
 
 /// Actions that discard unsaved edits, so they ask first.
@@ -135,6 +137,7 @@ impl EditorState {
             saved: effect_for_saved,
             loaded_path: None,
             pending: None,
+            export: Default::default(),
             source: source.into(),
         }
     }
