@@ -139,6 +139,18 @@ enum Command {
 
 #[derive(Subcommand)]
 enum BenchKind {
+    /// How long exports take: an 8×8 flipbook of 256² frames, 120 frames at 1080p.
+    Export {
+        /// The effect exported (default: presets/campfire.ron).
+        #[arg(long, default_value = "presets/campfire.ron")]
+        preset: PathBuf,
+        /// Output folder.
+        #[arg(long, default_value = "bench/results")]
+        out: PathBuf,
+        /// File name stem (default: export-<adapter>).
+        #[arg(long)]
+        name: Option<String>,
+    },
     /// The runtime's cost in a host frame for 1, 10, 100 instances, and 100 instances
     /// against one emitter with the same particles.
     Runtime {
@@ -449,6 +461,15 @@ fn adapter_tag(ctx: &GpuContext) -> String {
 fn bench(kind: BenchKind, profile: Option<ProfileKind>) -> anyhow::Result<()> {
     let ctx = context(profile)?;
     match kind {
+        BenchKind::Export { preset, out, name } => {
+            let effect = ignis::preset::load(&preset)?;
+            let asset_dir = preset.parent().map(Path::to_path_buf);
+            let report = ignis::bench::export::run(&ctx, &effect, asset_dir)?;
+            let name = name.unwrap_or_else(|| format!("export-{}", adapter_tag(&ctx)));
+            report.save(&out, &name)?;
+            println!("{}", report.markdown);
+            println!("wrote {}/{name}.md and .json", out.display());
+        }
         BenchKind::Runtime {
             preset,
             counts,

@@ -232,12 +232,14 @@ pub(super) struct Bounds {
 }
 
 impl Bounds {
-    /// Grows by the pixels of `frame` (of `size`) that hold any light or coverage, by
-    /// their whole extent.
+    /// Grows by the pixels of `frame` (of `size`) that hold visible light or coverage,
+    /// by their whole extent.
     pub fn add(&mut self, frame: &super::frames::RawFrame, size: (u32, u32)) {
         let (w, h) = (size.0 as usize, size.1 as usize);
         for (i, p) in frame.color.iter().enumerate() {
-            if p.iter().all(|&v| v.abs() < 1e-4) {
+            // What an 8-bit image would show: coverage of half a step, or light whose
+            // sRGB encoding reaches half a step (linear 0.5 / 255 / 12.92).
+            if p[3] < 0.5 / 255.0 && p[0].max(p[1]).max(p[2]) < 1.5e-4 {
                 continue;
             }
             let (x, y) = ((i % w) as f32, (i / w) as f32);
