@@ -30,7 +30,14 @@ pub fn run(
         motion: true,
     };
     let mut configs = Vec::new();
-    for passes in [Passes { color: true, emissive: false, motion: false }, all] {
+    for passes in [
+        Passes {
+            color: true,
+            emissive: false,
+            motion: false,
+        },
+        all,
+    ] {
         let names = passes.names().join(" + ");
         let mut book = ExportSettings::new(dir.join("book"));
         book.passes = passes;
@@ -70,9 +77,10 @@ pub fn run(
         })
         .collect();
     r.table(&["export", "seconds", "ms per frame"], &table);
-    r.json["export"] = serde_json::json!(rows
-        .iter()
-        .map(|x| serde_json::json!({"export": x.label, "frames": x.frames, "secs": x.secs}))
-        .collect::<Vec<_>>());
+    r.json["export"] = serde_json::json!(
+        rows.iter()
+            .map(|x| serde_json::json!({"export": x.label, "frames": x.frames, "secs": x.secs}))
+            .collect::<Vec<_>>()
+    );
     Ok(r)
 }

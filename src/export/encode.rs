@@ -101,11 +101,21 @@ impl Writer {
         }
     }
 
-    /// Writes output frame `j` (a sequence's files, or the flipbook's cells).
-    pub fn write_frame(&mut self, j: u32, frame: &RawFrame) -> Result<(), ExportError> {
+    /// Writes output frame `j` (a sequence's files, or the flipbook's cells); `color` is
+    /// its colour pass as [`Writer::color_pixels`] gives it.
+    pub fn write_frame(
+        &mut self,
+        j: u32,
+        frame: &RawFrame,
+        color: Vec<[f32; 4]>,
+    ) -> Result<(), ExportError> {
         let (w, h) = self.settings.frame_size;
+        let mut color = Some(color);
         for name in self.settings.passes.names() {
-            let pixels = self.pass_pixels(name, frame);
+            let pixels = match (name, color.take()) {
+                ("color", Some(c)) => c,
+                _ => self.pass_pixels(name, frame),
+            };
             match self.settings.layout {
                 Layout::Sequence => {
                     // Under a hidden name until `finish` numbers the frames (a loop may
@@ -279,14 +289,32 @@ fn store_color(c: [f32; 4], alpha: AlphaMode, format: Format) -> [f32; 4] {
     [r, g, b, a]
 }
 
-/// Linear light in its stored form: sRGB-encoded and clipped at 1 for PNG, linear for
-/// EXR; opaque.
+/// Linear light in its stored form: sRGB-encoded and clipped at 1 for PNG (through a
+/// table for 8 bits: within a hundredth of a step), linear for EXR; opaque.
 fn store_light(rgb: [f32; 3], format: Format) -> [f32; 4] {
     let e = |v: f32| match format {
         Format::Exr => v.max(0.0),
-        Format::Png8 | Format::Png16 => linear_to_srgb(v.clamp(0.0, 1.0)),
+        Format::Png8 => srgb_table(v.clamp(0.0, 1.0)),
+        Format::Png16 => linear_to_srgb(v.clamp(0.0, 1.0)),
     };
     [e(rgb[0]), e(rgb[1]), e(rgb[2]), 1.0]
+}
+
+/// Entries of the sRGB table over linear 0..1.
+const SRGB_STEPS: usize = 4096;
+
+/// `linear_to_srgb` interpolated in a table (`v` in 0..1).
+fn srgb_table(v: f32) -> f32 {
+    static TABLE: std::sync::OnceLock<Vec<f32>> = std::sync::OnceLock::new();
+    let t = TABLE.get_or_init(|| {
+        (0..=SRGB_STEPS)
+            .map(|i| linear_to_srgb(i as f32 / SRGB_STEPS as f32))
+            .collect()
+    });
+    let x = v * SRGB_STEPS as f32;
+    let i = (x as usize).min(SRGB_STEPS - 1);
+    let f = x - i as f32;
+    t[i] + (t[i + 1] - t[i]) * f
 }
 
 /// The sRGB transfer function (linear 0..1 → encoded 0..1).
@@ -322,7 +350,8 @@ fn write_image(
     let (w, h) = size;
     write_atomic(path, |tmp| match format {
         Format::Png8 => {
-            let q = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+            // Non-negative: + 0.5 and truncation round as `round` would.
+            let q = |v: f32| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
             let raw = pixels.iter().flat_map(|p| p.map(q)).collect();
             image::RgbaImage::from_raw(w, h, raw)
                 .ok_or("size mismatch")?
@@ -330,7 +359,7 @@ fn write_image(
                 .map_err(|e| e.to_string())
         }
         Format::Png16 => {
-            let q = |v: f32| (v.clamp(0.0, 1.0) * 65535.0).round() as u16;
+            let q = |v: f32| (v.clamp(0.0, 1.0) * 65535.0 + 0.5) as u16;
             let raw = pixels.iter().flat_map(|p| p.map(q)).collect();
             image::ImageBuffer::<image::Rgba<u16>, Vec<u16>>::from_raw(w, h, raw)
                 .ok_or("size mismatch")?
@@ -382,13 +411,16 @@ pub(super) fn thumbnail(pixels: &[[f32; 4]], size: (u32, u32)) -> Vec<[f32; 4]> 
     let (tw, th) = (w.min(64), h.min(64));
     let mut out = vec![[0.0f32; 4]; tw * th];
     let mut counts = vec![0u32; tw * th];
-    for (i, p) in pixels.iter().enumerate() {
-        let (x, y) = (i % w, i / w);
-        let t = (y * th / h) * tw + x * tw / w;
-        for k in 0..4 {
-            out[t][k] += p[k];
+    let column: Vec<usize> = (0..w).map(|x| x * tw / w).collect();
+    for (y, row) in pixels.chunks(w.max(1)).enumerate() {
+        let base = (y * th / h.max(1)) * tw;
+        for (p, &c) in row.iter().zip(&column) {
+            let o = &mut out[base + c];
+            for k in 0..4 {
+                o[k] += p[k];
+            }
+            counts[base + c] += 1;
         }
-        counts[t] += 1;
     }
     for (o, n) in out.iter_mut().zip(counts) {
         *o = o.map(|v| v / n.max(1) as f32);

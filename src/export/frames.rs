@@ -129,18 +129,19 @@ impl FrameRenderer {
         ctx.queue.submit([enc.finish()]);
         let exposure = player.effect().post.exposure;
         let lit = |p: [f32; 4]| [p[0] * exposure, p[1] * exposure, p[2] * exposure, p[3]];
+        // Over an opaque background the image is already composited: exposure scales the
+        // whole of it, as the editor's tonemap does.
+        let opaque = self.background.is_some();
         let mut frame = RawFrame {
-            color: texels(ctx, &color)?.into_iter().map(lit).collect(),
+            color: texels(ctx, &color)?
+                .into_iter()
+                .map(|p| {
+                    let p = lit(p);
+                    if opaque { [p[0], p[1], p[2], 1.0] } else { p }
+                })
+                .collect(),
             ..RawFrame::default()
         };
-        if self.background.is_some() {
-            // Over an opaque background the image is already composited; exposure
-            // scales the whole of it, as the editor's tonemap does.
-            frame.color = texels(ctx, &color)?
-                .into_iter()
-                .map(|p| [p[0] * exposure, p[1] * exposure, p[2] * exposure, 1.0])
-                .collect();
-        }
         if let Some(e) = &emissive {
             frame.emissive = texels(ctx, e)?.into_iter().map(lit).collect();
         }
@@ -205,18 +206,17 @@ fn texels(ctx: &GpuContext, copy: &TextureReadback) -> Result<Vec<[f32; 4]>, Exp
     let rows = copy
         .rows(&bytes)
         .ok_or_else(|| ExportError::Invalid("the frame readback is too short".into()))?;
-    let wide = copy.texel_bytes == 16;
+    if copy.texel_bytes == 16 {
+        return Ok(rows
+            .iter()
+            .flat_map(|row| bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(row))
+            .collect());
+    }
     Ok(rows
         .iter()
         .flat_map(|row| {
-            row.chunks_exact(copy.texel_bytes as usize).map(move |t| {
-                let v = |i: usize| {
-                    if wide {
-                        f32::from_le_bytes([t[4 * i], t[4 * i + 1], t[4 * i + 2], t[4 * i + 3]])
-                    } else {
-                        half::f16::from_le_bytes([t[2 * i], t[2 * i + 1]]).to_f32()
-                    }
-                };
+            row.chunks_exact(8).map(|t| {
+                let v = |i: usize| half::f16::from_le_bytes([t[2 * i], t[2 * i + 1]]).to_f32();
                 [v(0), v(1), v(2), v(3)]
             })
         })

@@ -352,7 +352,7 @@ impl Export {
         if let Some(t) = self.thumbs.get_mut(j as usize) {
             *t = encode::thumbnail(&color, self.settings.frame_size);
         }
-        self.writer.write_frame(j, frame)
+        self.writer.write_frame(j, frame, color)
     }
 
     /// Writes the atlases and the sidecar. A loop starts after its smallest step
