@@ -774,6 +774,25 @@ fn write_text(path: &Path, text: &str) -> Result<(), PresetError> {
     })
 }
 
+/// A file-name-safe version of an effect name.
+pub fn file_stem(name: &str) -> String {
+    let stem: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' {
+                c.to_ascii_lowercase()
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if stem.is_empty() {
+        "effect".to_owned()
+    } else {
+        stem
+    }
+}
+
 /// Writes `bytes` to `path` via a temporary sibling file, fsync and rename.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     write_atomic_with(path, |w| w.write_all(bytes))

@@ -211,15 +211,15 @@ fn settings_ui(ui: &mut Ui, panel: &mut ExportPanel) {
                 );
             }
             if panel.sequence {
-            let frames = s.frames.get_or_insert(60);
-            row(ui, "Frames", "How many frames the sequence holds", |ui| {
-                ui.add(drag(frames, 100_000))
-            });
-        } else {
-            // A flipbook holds as many frames as it has cells.
-            s.frames = None;
-        }
-        row(ui, "Width", "One frame's width in pixels", |ui| {
+                let frames = s.frames.get_or_insert(60);
+                row(ui, "Frames", "How many frames the sequence holds", |ui| {
+                    ui.add(drag(frames, 100_000))
+                });
+            } else {
+                // A flipbook holds as many frames as it has cells.
+                s.frames = None;
+            }
+            row(ui, "Width", "One frame's width in pixels", |ui| {
                 ui.add(drag(&mut s.frame_size.0, 4096))
             });
             row(ui, "Height", "One frame's height in pixels", |ui| {

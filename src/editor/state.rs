@@ -132,7 +132,7 @@ impl EditorState {
             stats: Stats::default(),
             frame_requested: false,
             mouse_point: None,
-            preset_path: format!("presets/my_{}.ron", file_stem(&effect_name)),
+            preset_path: format!("presets/my_{}.ron", crate::preset::file_stem(&effect_name)),
             preset_message: None,
             saved: effect_for_saved,
             loaded_path: None,
@@ -346,25 +346,6 @@ impl EditorState {
         if frame {
             self.frame_requested = true;
         }
-    }
-}
-
-/// A file-name-safe version of an effect name.
-fn file_stem(name: &str) -> String {
-    let stem: String = name
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' {
-                c.to_ascii_lowercase()
-            } else {
-                '_'
-            }
-        })
-        .collect();
-    if stem.is_empty() {
-        "effect".to_owned()
-    } else {
-        stem
     }
 }
 

@@ -55,7 +55,7 @@ impl Writer {
         let _ = frames;
         Ok(Self {
             settings: settings.clone(),
-            stem: file_stem(preset),
+            stem: crate::preset::file_stem(preset),
             motion_scale: 1.0,
             atlases,
             last_color: None,
@@ -188,9 +188,11 @@ impl Writer {
             }
         }
         let path = self.settings.out_dir.join(format!("{}.json", self.stem));
-        let text = sidecar.to_json();
-        write_atomic(&path, |tmp| {
-            std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
+        crate::preset::write_atomic(&path, sidecar.to_json().as_bytes()).map_err(|e| {
+            ExportError::Write {
+                path: path.clone(),
+                message: e.to_string(),
+            }
         })?;
         self.files.push(path);
         Ok(self.files.clone())
@@ -256,21 +258,6 @@ fn rotate_cells(
         }
     }
     out
-}
-
-/// A file-name-safe stem from a preset's name.
-fn file_stem(name: &str) -> String {
-    let s: String = name
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' {
-                c.to_ascii_lowercase()
-            } else {
-                '_'
-            }
-        })
-        .collect();
-    if s.is_empty() { "effect".into() } else { s }
 }
 
 /// A premultiplied linear colour in its stored form.
@@ -340,31 +327,43 @@ pub fn decode_motion(rg: [f32; 2], motion_scale: f32) -> [f32; 2] {
     rg.map(|v| (v - 0.5) * motion_scale)
 }
 
-/// Writes `pixels` (stored values) as an image of `size` in `format`.
+/// Writes `pixels` (stored values) as an image of `size` in `format`, atomically
+/// (`preset::write_atomic`: no half-written file under `path`).
 fn write_image(
     path: &Path,
     size: (u32, u32),
     pixels: &[[f32; 4]],
     format: Format,
 ) -> Result<(), ExportError> {
+    let fail = |message: String| ExportError::Write {
+        path: path.to_path_buf(),
+        message,
+    };
+    let bytes = encode_image(size, pixels, format).map_err(fail)?;
+    crate::preset::write_atomic(path, &bytes).map_err(|e| fail(e.to_string()))
+}
+
+/// `pixels` (stored values) encoded as a file of `format`.
+fn encode_image(size: (u32, u32), pixels: &[[f32; 4]], format: Format) -> Result<Vec<u8>, String> {
     let (w, h) = size;
-    write_atomic(path, |tmp| match format {
+    let mut out = std::io::Cursor::new(Vec::new());
+    match format {
         Format::Png8 => {
             // Non-negative: + 0.5 and truncation round as `round` would.
             let q = |v: f32| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
             let raw = pixels.iter().flat_map(|p| p.map(q)).collect();
             image::RgbaImage::from_raw(w, h, raw)
                 .ok_or("size mismatch")?
-                .save_with_format(tmp, image::ImageFormat::Png)
-                .map_err(|e| e.to_string())
+                .write_to(&mut out, image::ImageFormat::Png)
+                .map_err(|e| e.to_string())?;
         }
         Format::Png16 => {
             let q = |v: f32| (v.clamp(0.0, 1.0) * 65535.0 + 0.5) as u16;
             let raw = pixels.iter().flat_map(|p| p.map(q)).collect();
             image::ImageBuffer::<image::Rgba<u16>, Vec<u16>>::from_raw(w, h, raw)
                 .ok_or("size mismatch")?
-                .save_with_format(tmp, image::ImageFormat::Png)
-                .map_err(|e| e.to_string())
+                .write_to(&mut out, image::ImageFormat::Png)
+                .map_err(|e| e.to_string())?;
         }
         Format::Exr => {
             use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage, f16};
@@ -377,32 +376,11 @@ fn write_image(
             Image::from_channels((w as usize, h as usize), channels)
                 .write()
                 .non_parallel()
-                .to_file(tmp)
-                .map_err(|e| e.to_string())
+                .to_buffered(&mut out)
+                .map_err(|e| e.to_string())?;
         }
-    })
-}
-
-/// Writes through `write` into a temporary file beside `path`, then renames it into
-/// place (an interrupted export leaves no half-written file under the final name).
-fn write_atomic(
-    path: &Path,
-    write: impl FnOnce(&Path) -> Result<(), String>,
-) -> Result<(), ExportError> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.partial"));
-    let fail = |message: String| ExportError::Write {
-        path: path.to_path_buf(),
-        message,
-    };
-    if let Err(e) = write(&tmp) {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(fail(e));
     }
-    std::fs::rename(&tmp, path).map_err(|e| fail(e.to_string()))
+    Ok(out.into_inner())
 }
 
 /// Box-filters a frame's stored colour down to at most 64×64 (seam statistics).
