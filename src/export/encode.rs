@@ -1,69 +1,26 @@
 //! Turning rendered frames into files: each pass's pixels in its stored form (sRGB or
 //! linear colour, straight or premultiplied alpha, encoded motion), quantised to 8- or
-//! 16-bit PNG or half-float EXR, one file per frame or one atlas per pass. Files are
-//! written beside their final name and renamed into place: none is left half-written.
+//! 16-bit PNG or half-float EXR (`writer.rs` lays them out as files). Files are written
+//! beside their final name and renamed into place: none is left half-written.
 
 use std::path::{Path, PathBuf};
 
+use super::ExportError;
 use super::frames::RawFrame;
-use super::settings::{AlphaMode, ExportSettings, Format, Layout};
-use super::{ExportError, Sidecar};
+use super::settings::{AlphaMode, ExportSettings, Format};
 
-/// The passes' files of one export.
-pub(super) struct Writer {
-    settings: ExportSettings,
+/// What turns a rendered frame into stored pixels and file names (shared by the
+/// writer's threads).
+#[derive(Clone, Debug)]
+pub(super) struct Encoder {
+    pub settings: ExportSettings,
     /// The file names' stem (the preset's name).
-    stem: String,
-    /// Decoded motion in frame UV = (value − 0.5) × this (set before the first frame).
+    pub stem: String,
+    /// Decoded motion in frame UV = (value − 0.5) × this.
     pub motion_scale: f32,
-    /// Flipbook: one atlas per pass, in stored values (0..1 or linear).
-    atlases: Vec<(&'static str, Vec<[f32; 4]>)>,
-    /// The colour of the last sequence frame (the preview of a sequence).
-    last_color: Option<Vec<[f32; 4]>>,
-    /// Sequence frames written under hidden names, not yet renamed.
-    pending: Vec<PathBuf>,
-    files: Vec<PathBuf>,
 }
 
-impl Drop for Writer {
-    /// A cancelled or failed export leaves no frames under hidden names behind.
-    fn drop(&mut self) {
-        for p in &self.pending {
-            let _ = std::fs::remove_file(p);
-        }
-    }
-}
-
-impl Writer {
-    /// A writer into `settings.out_dir` (created) for `frames` frames of `preset`.
-    pub fn new(settings: &ExportSettings, preset: &str, frames: u32) -> Result<Self, ExportError> {
-        let dir = &settings.out_dir;
-        std::fs::create_dir_all(dir).map_err(|e| ExportError::Write {
-            path: dir.clone(),
-            message: format!("{e} (choose another --out folder)"),
-        })?;
-        let (w, h) = settings.frame_size;
-        let atlases = match settings.layout {
-            Layout::Flipbook { cols, rows } => settings
-                .passes
-                .names()
-                .into_iter()
-                .map(|p| (p, vec![[0.0; 4]; (cols * w * rows * h) as usize]))
-                .collect(),
-            Layout::Sequence => Vec::new(),
-        };
-        let _ = frames;
-        Ok(Self {
-            settings: settings.clone(),
-            stem: crate::preset::file_stem(preset),
-            motion_scale: 1.0,
-            atlases,
-            last_color: None,
-            pending: Vec::new(),
-            files: Vec::new(),
-        })
-    }
-
+impl Encoder {
     /// The colour pass of `frame` in stored values.
     pub fn color_pixels(&self, frame: &RawFrame) -> Vec<[f32; 4]> {
         let alpha = self.settings.alpha;
@@ -76,7 +33,7 @@ impl Writer {
     }
 
     /// The stored values of pass `name` of `frame`.
-    fn pass_pixels(&self, name: &str, frame: &RawFrame) -> Vec<[f32; 4]> {
+    pub fn pass_pixels(&self, name: &str, frame: &RawFrame) -> Vec<[f32; 4]> {
         let format = self.settings.format;
         match name {
             "emissive" => frame
@@ -101,145 +58,53 @@ impl Writer {
         }
     }
 
-    /// Writes output frame `j` (a sequence's files, or the flipbook's cells); `color` is
-    /// its colour pass as [`Writer::color_pixels`] gives it.
-    pub fn write_frame(
-        &mut self,
-        j: u32,
-        frame: &RawFrame,
-        color: Vec<[f32; 4]>,
-    ) -> Result<(), ExportError> {
-        let (w, h) = self.settings.frame_size;
-        let mut color = Some(color);
-        for name in self.settings.passes.names() {
-            let pixels = match (name, color.take()) {
-                ("color", Some(c)) => c,
-                _ => self.pass_pixels(name, frame),
-            };
-            match self.settings.layout {
-                Layout::Sequence => {
-                    // Under a hidden name until `finish` numbers the frames (a loop may
-                    // start at another frame).
-                    let path = self.pending(name, j);
-                    write_image(&path, (w, h), &pixels, self.settings.format)?;
-                    self.pending.push(path);
-                    if name == "color" {
-                        self.last_color = Some(pixels);
-                    }
-                }
-                Layout::Flipbook { cols, .. } => {
-                    let Some((_, atlas)) = self.atlases.iter_mut().find(|(n, _)| *n == name) else {
-                        continue;
-                    };
-                    let (cx, cy) = ((j % cols) * w, (j / cols) * h);
-                    let stride = (cols * w) as usize;
-                    for (y, row) in pixels.chunks(w as usize).enumerate() {
-                        let at = (cy as usize + y) * stride + cx as usize;
-                        atlas[at..at + w as usize].copy_from_slice(row);
-                    }
-                }
-            }
-        }
-        Ok(())
-    }
-
-    /// Where output frame `j` of pass `name` of a sequence waits for `finish`.
-    fn pending(&self, name: &str, j: u32) -> PathBuf {
+    /// Where output frame `j` of pass `name` of a sequence waits for its final name.
+    pub fn pending(&self, name: &str, j: u32) -> PathBuf {
         let ext = self.settings.format.extension();
         self.settings
             .out_dir
             .join(format!(".{}_{name}_{j:04}.{ext}.pending", self.stem))
     }
 
-    /// Writes the atlases (flipbook) or names the sequence's files, with frame `first`
-    /// of the `frames` written as frame 0 (a loop's rotation), and the sidecar; returns
-    /// every file written.
-    pub fn finish(
-        &mut self,
-        sidecar: &Sidecar,
-        frames: u32,
-        first: u32,
-    ) -> Result<Vec<PathBuf>, ExportError> {
-        let (w, h) = self.settings.frame_size;
-        let source = |k: u32| (k + first) % frames.max(1);
-        match self.settings.layout {
-            Layout::Flipbook { cols, rows } => {
-                for (name, atlas) in &self.atlases {
-                    let rotated = rotate_cells(atlas, (w, h), cols, frames, source);
-                    let path = self.path(&format!("{}_{name}", self.stem));
-                    write_image(&path, (cols * w, rows * h), &rotated, self.settings.format)?;
-                    self.files.push(path);
-                }
-            }
-            Layout::Sequence => {
-                for name in self.settings.passes.names() {
-                    for k in 0..frames {
-                        let path = self.path(&format!("{}_{name}_{k:04}", self.stem));
-                        std::fs::rename(self.pending(name, source(k)), &path).map_err(|e| {
-                            ExportError::Write {
-                                path: path.clone(),
-                                message: e.to_string(),
-                            }
-                        })?;
-                        self.files.push(path);
-                    }
-                }
-                self.pending.clear();
-            }
-        }
-        let path = self.settings.out_dir.join(format!("{}.json", self.stem));
-        crate::preset::write_atomic(&path, sidecar.to_json().as_bytes()).map_err(|e| {
-            ExportError::Write {
-                path: path.clone(),
-                message: e.to_string(),
-            }
-        })?;
-        self.files.push(path);
-        Ok(self.files.clone())
-    }
-
-    /// The colour atlas so far (flipbook) or the last frame (sequence), 8-bit.
-    pub fn preview(&self) -> Option<image::RgbaImage> {
-        let (w, h) = self.settings.frame_size;
-        let (size, pixels) = match self.settings.layout {
-            Layout::Flipbook { cols, rows } => (
-                (cols * w, rows * h),
-                &self.atlases.iter().find(|(n, _)| *n == "color")?.1,
-            ),
-            Layout::Sequence => ((w, h), self.last_color.as_ref()?),
-        };
-        let to8 = |v: f32| {
-            let v = if self.settings.format == Format::Exr {
-                linear_to_srgb(v)
-            } else {
-                v
-            };
-            (v.clamp(0.0, 1.0) * 255.0).round() as u8
-        };
-        let bytes = pixels
-            .iter()
-            .flat_map(|p| {
-                [
-                    to8(p[0]),
-                    to8(p[1]),
-                    to8(p[2]),
-                    (p[3].clamp(0.0, 1.0) * 255.0).round() as u8,
-                ]
-            })
-            .collect();
-        image::RgbaImage::from_raw(size.0, size.1, bytes)
-    }
-
-    fn path(&self, stem: &str) -> PathBuf {
+    /// The path of the file called `stem`.
+    pub fn path(&self, stem: &str) -> PathBuf {
         self.settings
             .out_dir
             .join(format!("{stem}.{}", self.settings.format.extension()))
     }
 }
 
+/// Stored pixels as an 8-bit sRGB image (previews).
+pub(super) fn preview_image(
+    size: (u32, u32),
+    pixels: &[[f32; 4]],
+    format: Format,
+) -> Option<image::RgbaImage> {
+    let to8 = |v: f32| {
+        let v = if format == Format::Exr {
+            linear_to_srgb(v)
+        } else {
+            v
+        };
+        (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+    };
+    let bytes = pixels
+        .iter()
+        .flat_map(|p| {
+            [
+                to8(p[0]),
+                to8(p[1]),
+                to8(p[2]),
+                (p[3].clamp(0.0, 1.0) * 255.0 + 0.5) as u8,
+            ]
+        })
+        .collect();
+    image::RgbaImage::from_raw(size.0, size.1, bytes)
+}
+
 /// `atlas` (cells of `size`, `cols` a row) with cell k taken from cell `source(k)`, for
 /// the first `frames` cells.
-fn rotate_cells(
+pub(super) fn rotate_cells(
     atlas: &[[f32; 4]],
     size: (u32, u32),
     cols: u32,
@@ -329,7 +194,7 @@ pub fn decode_motion(rg: [f32; 2], motion_scale: f32) -> [f32; 2] {
 
 /// Writes `pixels` (stored values) as an image of `size` in `format`, atomically
 /// (`preset::write_atomic`: no half-written file under `path`).
-fn write_image(
+pub(super) fn write_image(
     path: &Path,
     size: (u32, u32),
     pixels: &[[f32; 4]],

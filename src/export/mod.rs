@@ -22,6 +22,7 @@ mod frames;
 mod framing;
 mod settings;
 mod sidecar;
+mod writer;
 
 use std::path::PathBuf;
 
@@ -33,8 +34,8 @@ pub use encode::{decode_motion, linear_to_srgb, srgb_to_linear};
 pub use settings::{AlphaMode, CameraMode, ExportSettings, Format, Layout, Passes};
 pub use sidecar::Sidecar;
 
-use encode::Writer;
 use frames::{FrameRenderer, RawFrame};
+use writer::Writer;
 
 /// Why an export could not run or finish.
 #[derive(Debug, thiserror::Error)]
@@ -156,8 +157,6 @@ pub struct Export {
     /// Loop: frames from the other side of the seam, by the output frame they fade
     /// into, kept until that frame is rendered.
     held: std::collections::HashMap<u32, RawFrame>,
-    /// Each output frame's colour, box-filtered small (the seam statistics).
-    thumbs: Vec<Vec<[f32; 4]>>,
     summary: Option<Summary>,
 }
 
@@ -196,7 +195,6 @@ impl Export {
             wide: None,
             writer,
             held: std::collections::HashMap::new(),
-            thumbs: vec![Vec::new(); timeline.frames as usize],
             summary: None,
             settings,
         })
@@ -297,8 +295,8 @@ impl Export {
                 crate::render::OrbitCamera::from_hint(&self.player.effect().camera).view(size)
             }
         };
-        self.writer.motion_scale =
-            samples.motion_scale(&camera, self.timeline.interval_secs as f32);
+        let scale = samples.motion_scale(&camera, self.timeline.interval_secs as f32);
+        self.writer.set_motion_scale(scale);
         let camera = camera.with_motion_secs(self.timeline.interval_secs as f32);
         self.renderer = Some(FrameRenderer::new(&self.ctx, camera, &self.settings));
         self.player.set_motion_pass(self.settings.passes.motion);
@@ -334,7 +332,7 @@ impl Export {
         let j = j as u32;
         let w = tl.wrap_weight(j);
         if w == 0.0 {
-            return self.output(j, &frame);
+            return self.output(j, frame);
         }
         // Whichever of the pair comes second completes output frame j.
         let Some(first) = self.held.remove(&j) else {
@@ -343,23 +341,19 @@ impl Export {
         };
         let (mut own_frame, other) = if own { (frame, first) } else { (first, frame) };
         own_frame.blend_towards(&other, w);
-        self.output(j, &own_frame)
+        self.output(j, own_frame)
     }
 
-    /// Writes output frame `j` and keeps the seam statistics.
-    fn output(&mut self, j: u32, frame: &RawFrame) -> Result<(), ExportError> {
-        let color = self.writer.color_pixels(frame);
-        if let Some(t) = self.thumbs.get_mut(j as usize) {
-            *t = encode::thumbnail(&color, self.settings.frame_size);
-        }
-        self.writer.write_frame(j, frame, color)
+    /// Hands output frame `j` to the writer.
+    fn output(&mut self, j: u32, frame: RawFrame) -> Result<(), ExportError> {
+        self.writer.write_frame(j, frame)
     }
 
     /// Writes the atlases and the sidecar. A loop starts after its smallest step
     /// between consecutive frames (every step of a loop is continuous; its seam — last
     /// frame to first — is then its smoothest one).
     fn finish(&mut self) -> Result<(), ExportError> {
-        let t = &self.thumbs;
+        let t = self.writer.drain()?.to_vec();
         let n = t.len();
         // steps[j]: frame j → frame j + 1 (around the loop).
         let steps: Vec<f64> = (0..n)
@@ -389,7 +383,7 @@ impl Export {
             self.timeline.frames,
             start_secs,
             self.timeline.interval_secs,
-            self.writer.motion_scale,
+            self.writer.motion_scale(),
             self.settings.seed.unwrap_or(effect.seed),
             seam,
         );
