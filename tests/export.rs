@@ -353,4 +353,20 @@ fn the_export_command_writes_a_flipbook_and_refuses_bad_settings() {
         !bad.path().join("x").exists(),
         "a refused export wrote files"
     );
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_ignis"))
+        .args([
+            "export",
+            "presets/torch.ron",
+            "--sequence",
+            "--frames",
+            "1",
+            "--loop",
+        ])
+        .arg("--out")
+        .arg(bad.path().join("y"))
+        .output()
+        .expect("run ignis");
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--loop needs at least 2 frames"), "{err}");
 }

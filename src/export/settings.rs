@@ -223,6 +223,9 @@ impl ExportSettings {
                 ));
             }
         }
+        if self.looped && n < 2 {
+            return bad(format!("--loop needs at least 2 frames, got --frames {n}"));
+        }
         if !(self.start_secs.is_finite() && self.start_secs >= 0.0) {
             return bad(format!(
                 "--start {}: must be 0 or more seconds",
