@@ -1372,22 +1372,7 @@ impl Effect {
             Err(c.errors)
         }
     }
-
-    /// The embedded default effect (a campfire: flames, embers and smoke).
-    pub fn default_campfire() -> Effect {
-        // The default preset file is the source of truth; it is embedded so `ignis` runs anywhere.
-        match crate::preset::parse_str(DEFAULT_PRESET_RON, "presets/campfire.ron") {
-            Ok(effect) => effect,
-            Err(err) => {
-                log::error!("embedded default preset is invalid ({err}); using built-in defaults");
-                Effect::default()
-            }
-        }
-    }
 }
-
-/// The default campfire preset, embedded in the binary.
-pub const DEFAULT_PRESET_RON: &str = include_str!("../presets/campfire.ron");
 
 impl Emitter {
     /// Why this emitter cannot run stateless (empty = it can): every module beyond

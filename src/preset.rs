@@ -1423,6 +1423,23 @@ fn parse_group(tokens: &[Token], text: &str, i: &mut usize, depth: usize) -> Opt
     })
 }
 
+impl Effect {
+    /// The embedded default effect (a campfire: flames, embers and smoke).
+    pub fn default_campfire() -> Effect {
+        // The default preset file is the source of truth; it is embedded so `ignis` runs anywhere.
+        match parse_str(DEFAULT_PRESET_RON, "presets/campfire.ron") {
+            Ok(effect) => effect,
+            Err(err) => {
+                log::error!("embedded default preset is invalid ({err}); using built-in defaults");
+                Effect::default()
+            }
+        }
+    }
+}
+
+/// The default campfire preset, embedded in the binary.
+pub const DEFAULT_PRESET_RON: &str = include_str!("../presets/campfire.ron");
+
 #[cfg(test)]
 mod tests {
     use super::*;

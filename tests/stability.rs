@@ -539,14 +539,16 @@ fn fixed_step_is_frame_rate_independent() {
 #[test]
 fn embedded_bench_figures_cover_every_integrator() {
     for integrator in Integrator::ALL {
-        let m = accuracy::measured_for(integrator, 1.0 / 60.0);
+        let m = ignis::editor::measured::measured_for(integrator, 1.0 / 60.0);
         assert_eq!(m.len(), 2, "{integrator:?}");
         assert!(
             m.iter()
                 .all(|x| (x.dt_secs - 1.0 / 60.0).abs() < 1e-9 && x.cost_ns > 0.0)
         );
     }
-    let euler = accuracy::measured_for(Integrator::ExplicitEuler, 1.0 / 60.0)[0].rms_rel_error;
-    let exp = accuracy::measured_for(Integrator::Exponential, 1.0 / 60.0)[0].rms_rel_error;
+    let euler = ignis::editor::measured::measured_for(Integrator::ExplicitEuler, 1.0 / 60.0)[0]
+        .rms_rel_error;
+    let exp =
+        ignis::editor::measured::measured_for(Integrator::Exponential, 1.0 / 60.0)[0].rms_rel_error;
     assert!(exp * 100.0 < euler);
 }

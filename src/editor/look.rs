@@ -8,7 +8,6 @@ use crate::effect::{
 };
 pub use crate::render::look::sample_gradient;
 
-use super::panel::blend_label;
 use super::state::ViewSettings;
 
 /// The selected emitter's look, the effect's composite (exposure, bloom) and the
@@ -552,6 +551,14 @@ pub fn add_stop(stops: &mut Vec<ColorStop>) {
     let rgba = sample_gradient(stops, t);
     // `gap` is the index of the first stop after the insertion point.
     stops.insert(gap.min(stops.len()), ColorStop { t, rgba });
+}
+
+/// UI name of a blend mode.
+pub fn blend_label(b: BlendMode) -> &'static str {
+    match b {
+        BlendMode::Additive => "additive",
+        BlendMode::Alpha => "alpha",
+    }
 }
 
 #[cfg(test)]

@@ -7,6 +7,7 @@
 pub mod app;
 pub mod export_ui;
 pub mod look;
+pub mod measured;
 pub mod panel;
 pub mod profile;
 pub mod retained;

@@ -10,7 +10,7 @@ use std::ops::RangeInclusive;
 use egui::{Color32, DragValue, Response, RichText, Ui};
 
 use crate::effect::{
-    BlendMode, Burst, Collisions, Effect, Emitter, Falloff, Integrator, MAX_SPHERES, Range, Shape,
+    Burst, Collisions, Effect, Emitter, Falloff, Integrator, MAX_SPHERES, Range, Shape,
     SphereCollider, TimeMode,
 };
 
@@ -1325,13 +1325,13 @@ pub fn step_secs(effect: &Effect) -> f32 {
 /// What the accuracy bench measured for `integrator` near `dt_secs` (the committed H100
 /// results embedded in the binary), cached because the figures are parsed from JSON.
 fn measured_ui(ui: &mut Ui, integrator: Integrator, dt_secs: f32) {
-    type Cache = Option<((Integrator, u32), Vec<crate::bench::accuracy::Measured>)>;
+    type Cache = Option<((Integrator, u32), Vec<super::measured::Measured>)>;
     static CACHE: std::sync::Mutex<Cache> = std::sync::Mutex::new(None);
     let key = (integrator, dt_secs.to_bits());
     let figures = match CACHE.lock() {
         Ok(mut cache) => {
             if cache.as_ref().is_none_or(|(k, _)| *k != key) {
-                let figures = crate::bench::accuracy::measured_for(integrator, dt_secs as f64);
+                let figures = super::measured::measured_for(integrator, dt_secs as f64);
                 *cache = Some((key, figures));
             }
             cache.as_ref().map(|(_, f)| f.clone()).unwrap_or_default()
@@ -1440,12 +1440,4 @@ ui,
         }
     });
     ui.weak("Drag: orbit · Shift/middle/right-drag: pan · Wheel: zoom · Double-click: frame");
-}
-
-/// UI name of a blend mode.
-pub fn blend_label(b: BlendMode) -> &'static str {
-    match b {
-        BlendMode::Additive => "additive",
-        BlendMode::Alpha => "alpha",
-    }
 }
