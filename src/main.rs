@@ -215,17 +215,7 @@ enum BenchKind {
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("expected WxH like 640x480, got {s:?}"))?;
-    let w: u32 = w
-        .trim()
-        .parse()
-        .map_err(|_| format!("bad width in {s:?}"))?;
-    let h: u32 = h
-        .trim()
-        .parse()
-        .map_err(|_| format!("bad height in {s:?}"))?;
+    let (w, h) = ignis::export::cli::parse_pair(s)?;
     if w == 0 || h == 0 || w > 16384 || h > 16384 {
         return Err(format!("size {s} must be between 1x1 and 16384x16384"));
     }

@@ -10,13 +10,13 @@ pub struct ExportArgs {
     /// Preset file (default: the embedded campfire).
     pub preset: Option<PathBuf>,
     /// One atlas of COLSxROWS frames, row-major from the top left (the default, 8x8).
-    #[arg(long, value_parser = parse_grid, conflicts_with = "sequence")]
+    #[arg(long, value_parser = parse_pair, conflicts_with = "sequence")]
     pub flipbook: Option<(u32, u32)>,
     /// One file per frame instead of an atlas.
     #[arg(long)]
     pub sequence: bool,
     /// One frame's size, WxH.
-    #[arg(long, default_value = "256x256", value_parser = parse_grid)]
+    #[arg(long, default_value = "256x256", value_parser = parse_pair)]
     pub frame_size: (u32, u32),
     /// Effect time of the first frame, seconds (a loop starts past the longest lifetime).
     #[arg(long, default_value_t = 0.0)]
@@ -34,20 +34,20 @@ pub struct ExportArgs {
     #[arg(long = "loop")]
     pub looped: bool,
     /// png (8-bit sRGB), png16 (16-bit sRGB) or exr (half-float linear).
-    #[arg(long, default_value = "png", value_parser = ["png", "png16", "exr"])]
-    pub format: String,
+    #[arg(long, value_enum, default_value = "png")]
+    pub format: Format,
     /// straight or premultiplied.
-    #[arg(long, default_value = "premultiplied", value_parser = ["straight", "premultiplied"])]
-    pub alpha: String,
+    #[arg(long, value_enum, default_value = "premultiplied")]
+    pub alpha: AlphaMode,
     /// Passes, comma-separated: color, emissive, motion.
     #[arg(long, default_value = "color", value_delimiter = ',')]
     pub passes: Vec<String>,
     /// The instance's seed (default: the preset's).
     #[arg(long)]
     pub seed: Option<u32>,
-    /// fit (the preset's view, backed off to fit the whole span), preset or ortho.
-    #[arg(long, default_value = "fit", value_parser = ["fit", "preset", "ortho"])]
-    pub camera: String,
+    /// fit (the preset's view, cropped to the whole span), preset or ortho.
+    #[arg(long, value_enum, default_value = "fit")]
+    pub camera: CameraMode,
     /// Render over this opaque linear colour R,G,B (0..1) instead of transparency.
     #[arg(long, value_delimiter = ',')]
     pub background: Option<Vec<f32>>,
@@ -56,7 +56,9 @@ pub struct ExportArgs {
     pub out: PathBuf,
 }
 
-fn parse_grid(s: &str) -> Result<(u32, u32), String> {
+/// Two whole numbers written `AxB` (`640x480`, `8x8`), as the command line takes sizes
+/// and grids.
+pub fn parse_pair(s: &str) -> Result<(u32, u32), String> {
     let (a, b) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("expected AxB like 8x8, got {s:?}"))?;
@@ -83,15 +85,8 @@ impl ExportArgs {
         s.frames = self.frames;
         s.fps = self.fps;
         s.looped = self.looped;
-        s.format = match self.format.as_str() {
-            "png16" => Format::Png16,
-            "exr" => Format::Exr,
-            _ => Format::Png8,
-        };
-        s.alpha = match self.alpha.as_str() {
-            "straight" => AlphaMode::Straight,
-            _ => AlphaMode::Premultiplied,
-        };
+        s.format = self.format;
+        s.alpha = self.alpha;
         let mut passes = Passes {
             color: false,
             emissive: false,
@@ -111,11 +106,7 @@ impl ExportArgs {
         }
         s.passes = passes;
         s.seed = self.seed;
-        s.camera = match self.camera.as_str() {
-            "preset" => CameraMode::Preset,
-            "ortho" => CameraMode::Ortho,
-            _ => CameraMode::Fit,
-        };
+        s.camera = self.camera;
         s.background = match self.background.as_deref() {
             Some(&[r, g, b]) => Some([r, g, b]),
             Some(other) => return Err(format!("--background wants R,G,B, got {other:?}")),

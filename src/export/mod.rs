@@ -132,6 +132,8 @@ enum Phase {
         next: u32,
         samples: framing::Samples,
         bounds: framing::Bounds,
+        /// The camera that sees every particle of the span.
+        wide: framing::Wide,
     },
     /// Rendering frame `next`.
     Rendering {
@@ -151,8 +153,6 @@ pub struct Export {
     now: f64,
     phase: Phase,
     renderer: Option<FrameRenderer>,
-    /// The camera that sees every particle of the span (framing).
-    wide: Option<framing::Wide>,
     writer: Writer,
     /// Loop: frames from the other side of the seam, by the output frame they fade
     /// into, kept until that frame is rendered.
@@ -176,7 +176,6 @@ impl Export {
             ..PlayerSettings::new(frames::target_format(&ctx.device))
         };
         let mut player = Player::new(&ctx.device, &ctx.queue, &effect, player_settings)?;
-        player.set_motion_pass(settings.passes.motion);
         let seed = settings.seed.unwrap_or(effect.seed);
         let instance = player.add_instance(glam::Mat4::IDENTITY, seed)?;
         let timeline = timeline(&effect, &settings);
@@ -192,7 +191,6 @@ impl Export {
                 samples: framing::Samples::default(),
             },
             renderer: None,
-            wide: None,
             writer,
             held: std::collections::HashMap::new(),
             summary: None,
@@ -227,6 +225,7 @@ impl Export {
                 next,
                 samples,
                 bounds,
+                wide,
             } => {
                 frames::advance_to(&self.ctx, &mut self.player, &mut self.now, time(*next));
                 if let Some(probe) = self.renderer.as_mut() {
@@ -235,8 +234,14 @@ impl Export {
                 *next += 1;
                 let done = n + *next;
                 if *next == n {
-                    let (samples, bounds) = (std::mem::take(samples), *bounds);
-                    self.begin_rendering(&samples, bounds);
+                    let camera = match self.settings.camera {
+                        CameraMode::Preset => wide.camera(self.settings.frame_size),
+                        CameraMode::Fit | CameraMode::Ortho => {
+                            wide.cropped(*bounds, self.settings.frame_size)
+                        }
+                    };
+                    let samples = std::mem::take(samples);
+                    self.begin_rendering(&samples, camera);
                 }
                 done
             }
@@ -273,36 +278,33 @@ impl Export {
         };
         let camera = wide.camera(probe.frame_size);
         self.renderer = Some(FrameRenderer::new(&self.ctx, camera, &probe));
-        self.player.set_motion_pass(false);
-        self.player.restart();
-        self.now = 0.0;
+        self.rewind(false);
         self.phase = Phase::Framing {
             next: 0,
             samples,
             bounds: framing::Bounds::default(),
+            wide,
         };
-        self.wide = Some(wide);
     }
 
-    /// The export's camera (the wide one cropped to what was visible, with a margin) and
-    /// motion scale; restarts the player.
-    fn begin_rendering(&mut self, samples: &framing::Samples, bounds: framing::Bounds) {
-        let size = self.settings.frame_size;
-        let camera = match (&self.wide, self.settings.camera) {
-            (Some(wide), CameraMode::Fit | CameraMode::Ortho) => wide.cropped(bounds, size),
-            (Some(wide), CameraMode::Preset) => wide.camera(size),
-            (None, _) => {
-                crate::render::OrbitCamera::from_hint(&self.player.effect().camera).view(size)
-            }
-        };
-        let scale = samples.motion_scale(&camera, self.timeline.interval_secs as f32);
-        self.writer.set_motion_scale(scale);
-        let camera = camera.with_motion_secs(self.timeline.interval_secs as f32);
+    /// The export's `camera` (for `Fit` and `Ortho`, the wide one cropped to what was
+    /// visible, with a margin) and the motion scale; restarts the player.
+    fn begin_rendering(&mut self, samples: &framing::Samples, camera: crate::render::Camera) {
+        let interval = self.timeline.interval_secs as f32;
+        self.writer
+            .set_motion_scale(samples.motion_scale(&camera, interval));
+        let camera = camera.with_motion_secs(interval);
         self.renderer = Some(FrameRenderer::new(&self.ctx, camera, &self.settings));
-        self.player.set_motion_pass(self.settings.passes.motion);
+        self.rewind(self.settings.passes.motion);
+        self.phase = Phase::Rendering { next: 0 };
+    }
+
+    /// Back to effect time 0 for the next pass over the span, with or without the
+    /// motion pass.
+    fn rewind(&mut self, motion: bool) {
+        self.player.set_motion_pass(motion);
         self.player.restart();
         self.now = 0.0;
-        self.phase = Phase::Rendering { next: 0 };
     }
 
     /// Renders rendered frame `r` and writes the output frame it completes, if any.
@@ -400,8 +402,8 @@ impl Export {
         self.summary.as_ref()
     }
 
-    /// The colour atlas (flipbook) or the last frame (sequence) so far, 8-bit sRGB
-    /// over a checkerboard-free transparent background: the editor's preview.
+    /// The colour atlas (flipbook) or the last frame (sequence) so far, 8-bit sRGB with
+    /// its alpha: the editor's preview.
     pub fn preview(&self) -> Option<image::RgbaImage> {
         self.writer.preview()
     }

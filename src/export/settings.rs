@@ -18,9 +18,10 @@ pub enum Layout {
 }
 
 /// The image format.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Format {
     /// 8-bit sRGB PNG.
+    #[value(name = "png")]
     Png8,
     /// 16-bit sRGB PNG.
     Png16,
@@ -48,7 +49,7 @@ impl Format {
 }
 
 /// How colour and alpha are stored.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum AlphaMode {
     /// Colour divided by a coverage that also counts additive light (see the module doc).
     Straight,
@@ -67,7 +68,7 @@ impl AlphaMode {
 }
 
 /// Where the frames are seen from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum CameraMode {
     /// The preset's perspective camera's direction, backed off to fit every particle of
     /// the whole span with a margin.

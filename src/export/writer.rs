@@ -27,7 +27,8 @@ type Job = (u32, RawFrame, Arc<Encoder>);
 
 /// The passes' files of one export.
 pub(super) struct Writer {
-    encoder: Encoder,
+    /// Shared with the threads; its motion scale is set before the first frame.
+    encoder: Arc<Encoder>,
     /// Flipbook: one atlas per pass, in stored values (0..1 or linear).
     atlases: Vec<(&'static str, Vec<[f32; 4]>)>,
     /// The colour of the last sequence frame converted (the preview of a sequence).
@@ -89,11 +90,11 @@ impl Writer {
             })
             .collect();
         Ok(Self {
-            encoder: Encoder {
+            encoder: Arc::new(Encoder {
                 settings: settings.clone(),
                 stem: crate::preset::file_stem(preset),
                 motion_scale: 1.0,
-            },
+            }),
             atlases,
             last_color: None,
             thumbs: vec![Vec::new(); frames as usize],
@@ -108,7 +109,7 @@ impl Writer {
 
     /// The motion pass's scale (set before the first frame).
     pub fn set_motion_scale(&mut self, scale: f32) {
-        self.encoder.motion_scale = scale;
+        Arc::make_mut(&mut self.encoder).motion_scale = scale;
     }
 
     /// The motion pass's scale.
@@ -121,8 +122,7 @@ impl Writer {
         let Some(jobs) = &self.jobs else {
             return Ok(());
         };
-        let encoder = Arc::new(self.encoder.clone());
-        jobs.send((j, frame, encoder))
+        jobs.send((j, frame, self.encoder.clone()))
             .map_err(|_| ExportError::Invalid("the export's writer threads stopped".into()))?;
         self.in_flight += 1;
         while let Ok(result) = self.done.try_recv() {
