@@ -95,8 +95,7 @@ fn quad_slot(q: u32) -> vec2<u32> {
 @vertex
 fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u32) -> VsOut {
     var out: VsOut;
-    // Quad q, corner `vi` (two triangles: 0 1 2, 2 1 3). Quads come as instances (vertex
-    // 0…3) or as indexed lists (vertex 4q…4q+3, one instance).
+    // Quad q (one instance each), corner `vi` (two triangles: 0 1 2, 2 1 3).
     let q = (vertex >> 2u) + inst;
     let vi = vertex & 3u;
     let ks = quad_slot(q);

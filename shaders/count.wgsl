@@ -1,6 +1,5 @@
 // count.wgsl — counts alive particles on demand (the stats panel, tests): one invocation
-// per slot, a workgroup reduction (GPUs) or one atomic per alive particle (CPU adapters,
-// where a workgroup barrier splits the shader per invocation). Plumbing, not a hook.
+// per slot, a workgroup reduction. Plumbing, not a hook.
 //
 // Contract: group 0 binding 0 `state` (read), binding 1 `counters` ([0] += alive),
 // binding 2 `state_packed` (the same buffer as packed state, read when PACKED is on).
@@ -12,7 +11,6 @@
 
 #import "alive_count.wgsl"
 
-override DIRECT_ATOMICS: bool = false;
 override PACKED: bool = false;
 
 @compute @workgroup_size(256)
@@ -28,11 +26,5 @@ fn main(
     } else {
         alive = slot < arrayLength(&state) && is_alive(state[slot]);
     }
-    if DIRECT_ATOMICS {
-        if alive {
-            atomicAdd(&counters[0], 1u);
-        }
-    } else {
-        add_alive_in_workgroup(select(0u, 1u, alive), lid);
-    }
+    add_alive_in_workgroup(select(0u, 1u, alive), lid);
 }

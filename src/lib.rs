@@ -61,7 +61,7 @@
 pub(crate) mod runtime;
 
 pub use effect::Effect;
-pub use gpu::{AdapterProfile, ProfileKind};
+pub use gpu::{AdapterProfile, ProfileKind, ProfileRequest, ProfileSetting};
 pub use runtime::{
     Camera, ClockStats, EmitterStats, InstanceId, Layers, PLAYER_SHADERS, ParticleCount, Player,
     PlayerError, PlayerSettings,

@@ -7,9 +7,8 @@ use anyhow::{Context as _, bail};
 use clap::{Parser, Subcommand};
 
 use ignis::editor::EditOptions;
-use ignis::editor::ui_painter::UiPainterKind;
 use ignis::effect::Effect;
-use ignis::gpu::{AdapterProfile, GpuContext, ProfileKind};
+use ignis::gpu::{GpuContext, ProfileKind, ProfileRequest, ProfileSetting};
 use ignis::headless::Headless;
 use ignis::shaders::{ENTRY_FILES, ShaderLibrary};
 
@@ -23,6 +22,11 @@ struct Cli {
     /// from the adapter's type).
     #[arg(long, global = true)]
     adapter_profile: Option<ProfileArg>,
+    /// Set single fields of the adapter profile, comma-separated FIELD=VALUE (fields:
+    /// params_in_storage, count_in_update, direct_atomic_counts, indexed_quads,
+    /// timestamps, render_scale, draft, lean_painter, retained_window, reuse_ui).
+    #[arg(long, global = true, value_delimiter = ',')]
+    adapt: Vec<ProfileSetting>,
 }
 
 /// `--adapter-profile`'s values.
@@ -42,8 +46,8 @@ impl From<ProfileArg> for ProfileKind {
 }
 
 /// The headless context, with the profile asked for on the command line.
-fn context(profile: Option<ProfileKind>) -> anyhow::Result<GpuContext> {
-    Ok(GpuContext::headless()?.with_profile(profile.map(AdapterProfile::of_kind)))
+fn context(profile: &ProfileRequest) -> anyhow::Result<GpuContext> {
+    Ok(GpuContext::headless()?.with_request(profile))
 }
 
 #[derive(Subcommand)]
@@ -65,9 +69,6 @@ enum Command {
         /// Shader folder (default: ./shaders if present, else the embedded copies).
         #[arg(long)]
         shader_dir: Option<PathBuf>,
-        /// egui painter: auto (lean on software adapters), egui-wgpu or lean.
-        #[arg(long, default_value = "auto")]
-        ui_painter: UiPainterKind,
         /// Render the viewport at this fraction of its size, 0.1..=1 (default: the
         /// adapter profile's: 1 on GPUs, 0.5 on software adapters).
         #[arg(long)]
@@ -87,6 +88,10 @@ enum Command {
         /// layers at half theirs (default: on for software adapters, off elsewhere).
         #[arg(long)]
         draft: Option<bool>,
+        /// Destroy the GPU device after this frame, to test the recovery (the editor
+        /// recreates it and keeps the effect).
+        #[arg(long, hide = true)]
+        lose_device_at: Option<u32>,
     },
     /// Write the built-in procedural sprites as PNGs (straight alpha), to start a
     /// texture from.
@@ -124,8 +129,8 @@ enum Command {
     /// Export a flipbook or an image sequence for game engines: real alpha, emissive and
     /// motion-vector passes, seamless loops, a JSON sidecar.
     Export(ignis::export::cli::ExportArgs),
-    /// Measure: `accuracy` (integrators' error vs cost), `perf` (throughput) or `runtime`
-    /// (instances in a host's frame).
+    /// Measure: `accuracy` (integrators' error vs cost), `perf` (throughput), `runtime`
+    /// (instances in a host's frame), `export` or `adapters` (software adaptations).
     Bench {
         #[command(subcommand)]
         kind: BenchKind,
@@ -139,6 +144,27 @@ enum Command {
 
 #[derive(Subcommand)]
 enum BenchKind {
+    /// What each software-adapter adaptation takes off the editor's frame: interleaved
+    /// editor runs with and without it (needs a display: run under xvfb-run).
+    Adapters {
+        /// The preset the editor opens (default: the embedded campfire).
+        preset: Option<PathBuf>,
+        /// Frames per editor run.
+        #[arg(long, default_value_t = 90)]
+        frames: u32,
+        /// Interleaved rounds.
+        #[arg(long, default_value_t = 5)]
+        rounds: usize,
+        /// Window size, WxH.
+        #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+        size: (u32, u32),
+        /// Output folder.
+        #[arg(long, default_value = "bench/results")]
+        out: PathBuf,
+        /// File name stem (default: adapters-<adapter>).
+        #[arg(long)]
+        name: Option<String>,
+    },
     /// How long exports take: an 8×8 flipbook of 256² frames, 120 frames at 1080p.
     Export {
         /// The effect exported (default: presets/campfire.ron).
@@ -225,7 +251,10 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
 fn main() {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
-    let adapter_profile = cli.adapter_profile.map(ProfileKind::from);
+    let adapter_profile = ProfileRequest {
+        kind: cli.adapter_profile.map(ProfileKind::from),
+        settings: cli.adapt,
+    };
     let result = match cli.command {
         None => edit(EditOptions {
             window_size: (1280, 720),
@@ -238,24 +267,24 @@ fn main() {
             screenshot,
             size,
             shader_dir,
-            ui_painter,
             render_scale,
             profile,
             sections,
             select,
             draft,
+            lose_device_at,
         }) => edit(EditOptions {
             frames: frames.or(screenshot.as_ref().map(|_| 60)),
             preset,
             screenshot,
             shader_dir,
             window_size: size,
-            ui_painter,
             render_scale,
             profile,
             sections,
             select,
             draft,
+            lose_device_at,
             adapter_profile,
         }),
         Some(Command::Render {
@@ -276,12 +305,12 @@ fn main() {
             fps,
             last_only,
             shader_dir.as_deref(),
-            adapter_profile,
+            &adapter_profile,
         ),
-        Some(Command::Export(args)) => export(&args, adapter_profile),
+        Some(Command::Export(args)) => export(&args, &adapter_profile),
         Some(Command::Check { paths }) => check(&paths),
         Some(Command::Sprites { out }) => write_sprites(&out),
-        Some(Command::Bench { kind }) => bench(kind, adapter_profile),
+        Some(Command::Bench { kind }) => bench(kind, &adapter_profile),
     };
     if let Err(err) = result {
         eprintln!("error: {err:#}");
@@ -321,7 +350,7 @@ fn render(
     fps: f64,
     last_only: bool,
     shader_dir: Option<&Path>,
-    profile: Option<ProfileKind>,
+    profile: &ProfileRequest,
 ) -> anyhow::Result<()> {
     if !(fps.is_finite() && fps > 0.0) {
         bail!("--fps must be a positive number, got {fps}");
@@ -381,10 +410,7 @@ fn render(
     Ok(())
 }
 
-fn export(
-    args: &ignis::export::cli::ExportArgs,
-    profile: Option<ProfileKind>,
-) -> anyhow::Result<()> {
+fn export(args: &ignis::export::cli::ExportArgs, profile: &ProfileRequest) -> anyhow::Result<()> {
     let settings = args.settings().map_err(anyhow::Error::msg)?;
     let effect = load_effect(args.preset.as_deref())?;
     let ctx = context(profile)?;
@@ -448,9 +474,29 @@ fn adapter_tag(ctx: &GpuContext) -> String {
         .join("-")
 }
 
-fn bench(kind: BenchKind, profile: Option<ProfileKind>) -> anyhow::Result<()> {
+fn bench(kind: BenchKind, profile: &ProfileRequest) -> anyhow::Result<()> {
     let ctx = context(profile)?;
     match kind {
+        BenchKind::Adapters {
+            preset,
+            frames,
+            rounds,
+            size,
+            out,
+            name,
+        } => {
+            let opts = ignis::bench::adapters::AdaptersOptions {
+                preset,
+                frames: frames.max(10),
+                rounds: rounds.max(1),
+                size,
+            };
+            let report = ignis::bench::adapters::run(&ctx, &opts)?;
+            let name = name.unwrap_or_else(|| format!("adapters-{}", adapter_tag(&ctx)));
+            report.save(&out, &name)?;
+            println!("{}", report.markdown);
+            println!("wrote {}/{name}.md and .json", out.display());
+        }
         BenchKind::Export { preset, out, name } => {
             let effect = ignis::preset::load(&preset)?;
             let asset_dir = preset.parent().map(Path::to_path_buf);

@@ -32,10 +32,6 @@ pub const EMBEDDED: &[(&str, &str)] = &[
         include_str!("../shaders/params_instanced.wgsl"),
     ),
     (
-        "params_storage.wgsl",
-        include_str!("../shaders/params_storage.wgsl"),
-    ),
-    (
         "state_full.wgsl",
         include_str!("../shaders/state_full.wgsl"),
     ),
@@ -64,22 +60,13 @@ pub const PACKED_STATE_IO: (&str, &str) = ("state_full.wgsl", "state_packed.wgsl
 /// The tiny-state update: update.wgsl with state_tiny.wgsl as the state I/O.
 pub const TINY_STATE_IO: (&str, &str) = ("state_full.wgsl", "state_tiny.wgsl");
 
-/// The update pass on CPU adapters: its parameters as read-only storage, not a uniform
-/// buffer (see `params.wgsl`).
-pub const PARAMS_STORAGE: (&str, &str) = ("params.wgsl", "params_storage.wgsl");
-
 /// The batched update of a runtime player's instances: one SimParams per instance, each
 /// instance's pool a segment of shared buffers (see `params_instanced.wgsl`).
 pub const PARAMS_INSTANCED: (&str, &str) = ("params.wgsl", "params_instanced.wgsl");
 
 /// Imports that some pipelines replace by another file (see
 /// [`ShaderLibrary::compose_with`]).
-pub const IMPORT_VARIANTS: &[(&str, &str)] = &[
-    PACKED_STATE_IO,
-    TINY_STATE_IO,
-    PARAMS_STORAGE,
-    PARAMS_INSTANCED,
-];
+pub const IMPORT_VARIANTS: &[(&str, &str)] = &[PACKED_STATE_IO, TINY_STATE_IO, PARAMS_INSTANCED];
 
 /// The entry files, one per pipeline family; the others are imported by them.
 pub const ENTRY_FILES: &[&str] = &[

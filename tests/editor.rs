@@ -1089,11 +1089,11 @@ fn retained_test_frame(
 fn retained_ui_repaints_match_full_repaints() {
     use ignis::editor::retained::{Repaint, RetainedUi};
     use ignis::editor::screenshot::{Screenshot, read_back};
-    use ignis::editor::ui_painter::{UiPainter, UiPainterKind};
+    use ignis::editor::ui_painter::UiPainter;
 
     let ctx = GpuContext::headless().expect("a GPU adapter (lavapipe is fine)");
     let format = wgpu::TextureFormat::Rgba8Unorm;
-    let mut painter = UiPainter::new(&ctx.device, format, UiPainterKind::Lean, true);
+    let mut painter = UiPainter::new(&ctx.device, format, true);
     let egui_ctx = egui::Context::default();
     let background = egui::Color32::from_rgb(9, 9, 11);
     let clear = wgpu::Color {
@@ -1151,7 +1151,7 @@ fn retained_ui_repaints_match_full_repaints() {
             .image(&ctx.device, (480, 270), format)
             .texture
             .clone();
-        let plan = retained.plan(&jobs, true, live, [480, 270], changed, background, None);
+        let plan = retained.plan(&jobs, live, [480, 270], changed, background, None);
         let got = match &plan {
             Repaint::Full => paint(&mut painter, &image, &jobs, wgpu::LoadOp::Clear(clear)),
             Repaint::Live(live_jobs) => paint(&mut painter, &image, live_jobs, wgpu::LoadOp::Load),

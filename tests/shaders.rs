@@ -36,17 +36,11 @@ fn every_entry_validates() {
         .unwrap_or_else(|e| panic!("tiny update: {e}"));
     assert!(tiny.files.iter().any(|f| f == "state_tiny.wgsl"));
     assert!(!tiny.files.iter().any(|f| f == "state_full.wgsl"));
-    // CPU adapters: the parameters as read-only storage (params_storage.wgsl).
-    let storage = project_shaders()
-        .compose_with("update.wgsl", &[ignis::shaders::PARAMS_STORAGE])
-        .unwrap_or_else(|e| panic!("update with storage parameters: {e}"));
-    assert!(storage.files.iter().any(|f| f == "params_storage.wgsl"));
-    assert!(!storage.files.iter().any(|f| f == "params.wgsl"));
     // Hot reload's dependencies of the update pass include the variants.
     let deps = project_shaders().dependencies("update.wgsl").expect("deps");
     assert!(deps.iter().any(|f| f == "state_packed.wgsl"));
     assert!(deps.iter().any(|f| f == "state_tiny.wgsl"));
-    assert!(deps.iter().any(|f| f == "params_storage.wgsl"));
+    assert!(deps.iter().any(|f| f == "params_instanced.wgsl"));
     // A runtime player's batched instances: an array of parameters (params_instanced.wgsl).
     let instanced = project_shaders()
         .compose_with("update.wgsl", &[ignis::shaders::PARAMS_INSTANCED])
@@ -55,7 +49,6 @@ fn every_entry_validates() {
     assert!(!instanced.files.iter().any(|f| f == "params.wgsl"));
     reached.extend(packed.files);
     reached.extend(tiny.files);
-    reached.extend(storage.files);
     reached.extend(instanced.files);
     for f in std::fs::read_dir(dir).expect("shaders/") {
         let name = f.expect("entry").file_name().to_string_lossy().into_owned();

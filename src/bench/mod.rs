@@ -2,6 +2,7 @@
 //! under `bench/results/`, with the adapter, driver and command line that produced them.
 
 pub mod accuracy;
+pub mod adapters;
 pub mod export;
 pub mod perf;
 pub mod report;

@@ -2,14 +2,17 @@
 //! effect.
 //!
 //! The UI is plain functions over [`EditorState`] (no GPU needed, so tests drive them
-//! with an `egui::Context`); [`app`] owns the window, the surface and the frame loop.
+//! with an `egui::Context`); [`app`] owns the window and the frame loop.
 
 pub mod app;
 pub mod export_ui;
+mod gfx;
 pub mod look;
 pub mod measured;
 pub mod panel;
+mod present;
 pub mod profile;
+pub mod report;
 pub mod retained;
 pub mod screenshot;
 pub mod state;

@@ -246,6 +246,14 @@ pub fn header_ui(ui: &mut Ui, state: &mut EditorState) {
             ui.label(err);
         });
     }
+    if let Some(notice) = state.device_notice.clone() {
+        error_box_ui(ui, |ui| {
+            ui.label(notice);
+            if ui.button("Dismiss").clicked() {
+                state.device_notice = None;
+            }
+        });
+    }
     if let Some((_, reason)) = &state.gpu_rejected {
         error_box_ui(ui, |ui| {
             ui.label(

@@ -7,79 +7,11 @@
 //! into a persistent image: when every paint job outside the viewport is the same as last
 //! frame (and no egui texture changed), only the jobs over the viewport are drawn again,
 //! scissored to it; the image is then copied to the window's frame (a plain copy, ~0.3 ms).
-//!
-//! Building the UI costs the CPU too (~2–3 ms of layout and tessellation a frame on the
-//! 2-core machine, while lavapipe's threads wait). Without input the panel only changes
-//! through its read-outs, so [`UiReuse`] keeps the last UI pass's paint jobs: a frame
-//! without input, and without a repaint egui asked for, paints them again (the viewport
-//! image egui shows is new every frame) and builds the UI only every [`UI_REFRESH`].
 
 use std::hash::{Hash, Hasher};
-use std::time::Duration;
 
 use egui::epaint::{Mesh, Primitive, Vertex};
 use egui::{ClippedPrimitive, Color32, Rect, TextureId};
-
-/// How often the UI is rebuilt without input (the panel's read-outs: frame times,
-/// particle counts, messages from the shader watcher).
-pub const UI_REFRESH: Duration = Duration::from_millis(250);
-
-/// The last UI pass, painted again while nothing asks for a new one.
-#[derive(Debug, Default)]
-pub struct UiReuse {
-    /// Its paint jobs (the frame loop keeps them here after painting).
-    pub jobs: Vec<ClippedPrimitive>,
-    /// Pixels per point of `jobs`.
-    pub pixels_per_point: f32,
-    /// Time since it was built, when egui wants the next one (`Duration::MAX`: never).
-    age: Duration,
-    repaint_after: Duration,
-    /// Input (anything but a redraw request) arrived since it was built.
-    pub input: bool,
-    /// Whether there is a pass to reuse.
-    is_built: bool,
-    /// UI passes built.
-    pub builds: u64,
-    /// Frames that reused the last UI pass.
-    pub reuses: u64,
-}
-
-impl UiReuse {
-    /// Whether this frame must build the UI: nothing to reuse yet, input arrived, egui's
-    /// own repaint is due (animations ask for one at once), or [`UI_REFRESH`] passed.
-    /// `force` for frames that must be exact (the last one, with its screenshot).
-    pub fn due(&self, force: bool) -> bool {
-        force || !self.is_built || self.input || self.age >= self.repaint_after.min(UI_REFRESH)
-    }
-
-    /// Records that a fresh UI pass was built (its jobs are stored in [`Self::jobs`] once
-    /// painted) and when egui wants the next one.
-    pub fn built(&mut self, pixels_per_point: f32, repaint_after: Duration) {
-        self.pixels_per_point = pixels_per_point;
-        self.repaint_after = repaint_after;
-        self.age = Duration::ZERO;
-        self.input = false;
-        self.is_built = true;
-        self.builds += 1;
-    }
-
-    /// The last pass's jobs and pixels per point, for a frame that reuses it (hand the
-    /// jobs back to [`Self::jobs`] after painting).
-    pub fn take(&mut self) -> (Vec<ClippedPrimitive>, f32) {
-        self.reuses += 1;
-        (std::mem::take(&mut self.jobs), self.pixels_per_point)
-    }
-
-    /// Advances the clock by a frame's `dt` (call once per frame, before [`Self::due`]).
-    pub fn tick(&mut self, dt: Duration) {
-        self.age = self.age.saturating_add(dt);
-    }
-
-    /// Forgets the last pass (a resize or a lost frame: it must be built again).
-    pub fn invalidate(&mut self) {
-        self.is_built = false;
-    }
-}
 
 /// What to paint this frame.
 #[derive(Debug)]
@@ -143,26 +75,20 @@ impl RetainedUi {
     }
 
     /// Decides this frame's repaint. `live` is the rectangle (points) repainted every
-    /// frame (the viewport); `rebuilt` is false when `jobs` are last frame's again (a
-    /// reused UI pass: nothing to compare); `textures_changed` is true when egui set or
+    /// frame (the viewport); `textures_changed` is true when egui set or
     /// freed a texture; `background` fills the live rectangle first unless an
     /// `opaque_cover` mesh (a texture drawn opaque) covers it (see [`live_jobs`]).
     #[allow(clippy::too_many_arguments)]
     pub fn plan(
         &mut self,
         jobs: &[ClippedPrimitive],
-        rebuilt: bool,
         live: Rect,
         screen: [u32; 2],
         textures_changed: bool,
         background: Color32,
         opaque_cover: Option<TextureId>,
     ) -> Repaint {
-        let key = if rebuilt {
-            panel_key(jobs, live, screen)
-        } else {
-            self.key
-        };
+        let key = panel_key(jobs, live, screen);
         let same = key.is_some() && self.key == key && !textures_changed && self.image.is_some();
         self.key = key;
         if same {
@@ -275,42 +201,6 @@ mod tests {
         let live = Rect::from_min_size(pos2(0.0, 0.0), vec2(600.0, 400.0));
         let panel = Rect::from_min_size(pos2(600.0, 0.0), vec2(200.0, 400.0));
         (live, panel)
-    }
-
-    #[test]
-    fn the_ui_is_rebuilt_on_input_on_egui_repaints_and_every_refresh() {
-        let frame = Duration::from_millis(30);
-        let mut r = UiReuse::default();
-        assert!(r.due(false), "nothing to reuse yet");
-        r.built(1.0, Duration::MAX);
-        assert!(!r.due(false));
-        assert!(r.due(true), "forced");
-        // Without input: reused until the refresh interval has passed.
-        let mut reused = 0;
-        while !r.due(false) {
-            r.take();
-            reused += 1;
-            r.tick(frame);
-        }
-        assert_eq!(
-            reused,
-            UI_REFRESH.as_millis().div_ceil(frame.as_millis()) as u32
-        );
-        r.built(1.0, Duration::MAX);
-        r.input = true;
-        assert!(r.due(false), "input");
-        // egui asks for a repaint at once (an animation) or a little later.
-        r.built(1.0, Duration::ZERO);
-        assert!(r.due(false));
-        r.built(1.0, Duration::from_millis(50));
-        r.tick(frame);
-        assert!(!r.due(false));
-        r.tick(frame);
-        assert!(r.due(false));
-        r.built(1.0, Duration::MAX);
-        r.invalidate();
-        assert!(r.due(false), "invalidated");
-        assert_eq!(r.builds, 5);
     }
 
     #[test]

@@ -69,6 +69,8 @@ pub struct EditorState {
     pub open_sections: Option<Vec<String>>,
     /// The last simulation failure (the simulation pauses), until playback resumes.
     pub sim_error: Option<String>,
+    /// The GPU device was lost and recreated (shown until dismissed).
+    pub device_notice: Option<String>,
     /// Index of the emitter shown in the emitter-specific sections.
     pub selected: usize,
     /// Undo/redo of `effect`.
@@ -125,6 +127,7 @@ impl EditorState {
             sprite_errors: Vec::new(),
             open_sections: None,
             sim_error: None,
+            device_notice: None,
             shader_errors: Vec::new(),
             selected: 0,
             playback: Playback::default(),

@@ -6,7 +6,8 @@
 //! (`predictable_texture_filtering`) and llvmpipe runs both sides, including four
 //! `textureLoad`s and integer modulos, for every pixel; a full 1280×720 editor frame
 //! then takes ~170 ms in egui alone. [`LeanPainter`] draws the same meshes with a
-//! branch-free shader. Real GPUs keep egui-wgpu's renderer (see [`UiPainterKind`]).
+//! branch-free shader. Real GPUs keep egui-wgpu's renderer
+//! ([`crate::gpu::AdapterProfile::lean_painter`]).
 
 use std::collections::HashMap;
 
@@ -15,33 +16,6 @@ use egui::epaint::{ImageDelta, Primitive};
 use egui::{
     ClippedPrimitive, ImageData, TextureFilter, TextureId, TextureOptions, TextureWrapMode,
 };
-
-/// Which egui painter to use.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum UiPainterKind {
-    /// Lean on CPU adapters, egui-wgpu's renderer elsewhere.
-    #[default]
-    Auto,
-    /// egui-wgpu's renderer.
-    EguiWgpu,
-    /// The branch-free [`LeanPainter`].
-    Lean,
-}
-
-impl std::str::FromStr for UiPainterKind {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "auto" => Ok(Self::Auto),
-            "egui-wgpu" => Ok(Self::EguiWgpu),
-            "lean" => Ok(Self::Lean),
-            other => Err(format!(
-                "unknown UI painter {other:?}: expected auto, egui-wgpu or lean"
-            )),
-        }
-    }
-}
 
 /// The painter in use.
 pub enum UiPainter {
@@ -52,18 +26,8 @@ pub enum UiPainter {
 }
 
 impl UiPainter {
-    /// A painter drawing into `format` targets.
-    pub fn new(
-        device: &wgpu::Device,
-        format: wgpu::TextureFormat,
-        kind: UiPainterKind,
-        lean_by_default: bool,
-    ) -> Self {
-        let lean = match kind {
-            UiPainterKind::Auto => lean_by_default,
-            UiPainterKind::EguiWgpu => false,
-            UiPainterKind::Lean => true,
-        };
+    /// A painter drawing into `format` targets: the lean one, or egui-wgpu's.
+    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat, lean: bool) -> Self {
         if lean {
             Self::Lean(Box::new(LeanPainter::new(device, format)))
         } else {

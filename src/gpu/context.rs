@@ -47,6 +47,9 @@ pub struct GpuContext {
     /// What differs between GPUs and software adapters (from the adapter's type unless
     /// overridden with [`GpuContext::with_profile`] before anything is built).
     pub profile: crate::gpu::AdapterProfile,
+    /// Why the device was lost, once it was (set by wgpu's device-lost callback; never
+    /// on a host's device, whose loss is the host's to handle).
+    lost: Arc<std::sync::Mutex<Option<String>>>,
 }
 
 impl GpuContext {
@@ -84,6 +87,18 @@ impl GpuContext {
         device.on_uncaptured_error(Arc::new(|err| {
             log::error!("uncaptured GPU error: {err}");
         }));
+        let lost = Arc::new(std::sync::Mutex::new(None));
+        let flag = lost.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            log::error!("GPU device lost ({reason:?}): {message}");
+            if let Ok(mut l) = flag.lock() {
+                *l = Some(if message.is_empty() {
+                    format!("{reason:?}")
+                } else {
+                    format!("{reason:?}: {message}")
+                });
+            }
+        });
         log::info!(
             "GPU: {} ({:?}, {:?}, driver {} {})",
             info.name,
@@ -98,6 +113,7 @@ impl GpuContext {
             queue,
             profile: crate::gpu::AdapterProfile::for_device_type(info.device_type),
             info,
+            lost,
         })
     }
 
@@ -111,7 +127,14 @@ impl GpuContext {
             queue: queue.clone(),
             profile: crate::gpu::AdapterProfile::for_device_type(info.device_type),
             info,
+            lost: Arc::default(),
         }
+    }
+
+    /// Why the device was lost, if it was (a context of its own only; see
+    /// [`Self::from_adapter`]).
+    pub fn lost(&self) -> Option<String> {
+        self.lost.lock().ok().and_then(|l| l.clone())
     }
 
     /// The same context with `profile` instead of the adapter's own (call it before
@@ -120,6 +143,12 @@ impl GpuContext {
         if let Some(p) = profile {
             self.profile = p;
         }
+        self
+    }
+
+    /// The same context with the profile `request` asks for (see [`Self::with_profile`]).
+    pub fn with_request(mut self, request: &crate::gpu::profile::ProfileRequest) -> Self {
+        self.profile = request.resolve(self.profile);
         self
     }
 

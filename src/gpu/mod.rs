@@ -8,7 +8,7 @@ pub mod types;
 pub mod upload;
 
 pub use context::{GpuContext, GpuError};
-pub use profile::{AdapterProfile, ProfileKind};
+pub use profile::{AdapterProfile, ProfileKind, ProfileRequest, ProfileSetting};
 pub use readback::TextureReadback;
 pub use upload::Uploads;
 

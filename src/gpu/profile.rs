@@ -1,8 +1,12 @@
 //! [`AdapterProfile`]: every decision that differs between GPUs and software adapters
 //! (lavapipe: the CI machine's and GPU-less machines' "GPU"), made once from the adapter
-//! and overridable (`--adapter-profile`). Code elsewhere asks the profile; nothing else
-//! looks at the adapter's type. Each software choice was measured on lavapipe; the
-//! reasons are in `docs/architecture.md` ("Software adapters").
+//! and overridable (`--adapter-profile`, one field at a time with `--adapt`). Code
+//! elsewhere asks the profile; nothing else looks at the adapter's type. Each software
+//! choice is measured by `ignis bench adapters` (kept only where it takes ≥ 10 % off the
+//! editor's software frame); the reasons are in `docs/architecture.md` ("Software
+//! adapters").
+
+use std::str::FromStr;
 
 /// Which set of choices.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -18,53 +22,38 @@ pub enum ProfileKind {
 pub struct AdapterProfile {
     /// Which set this is.
     pub kind: ProfileKind,
-    /// The update's per-step parameters are read-only storage, not a uniform buffer
-    /// (lavapipe recompiles a shader at every new uniform offset).
-    pub params_in_storage: bool,
-    /// The update counts alive particles as it goes (a workgroup reduction); otherwise
-    /// they are counted on demand.
-    pub count_in_update: bool,
-    /// On-demand counts add with one atomic per particle instead of a workgroup
-    /// reduction (barriers are very expensive on a software adapter).
-    pub direct_atomic_counts: bool,
-    /// Billboard quads are indexed triangle lists over a shared index buffer rather than
-    /// one instance per quad.
-    pub indexed_quads: bool,
     /// GPU timestamps are trustworthy (per-pass timings in the editor and the benches).
     pub timestamps: bool,
     /// The editor renders its viewport at this fraction of its size by default.
     pub render_scale: f32,
     /// The editor draws large glow at half resolution by default (draft quality).
     pub draft: bool,
-    /// The editor paints its UI with its lean painter and keeps a retained window image.
-    pub lean_ui: bool,
+    /// The editor paints its UI with its branch-free lean painter instead of egui-wgpu's.
+    pub lean_painter: bool,
+    /// The editor keeps the window's image and repaints only the viewport while the
+    /// panel is unchanged.
+    pub retained_window: bool,
 }
 
 impl AdapterProfile {
     /// The choices for a hardware GPU.
     pub const GPU: Self = Self {
         kind: ProfileKind::Gpu,
-        params_in_storage: false,
-        count_in_update: true,
-        direct_atomic_counts: false,
-        indexed_quads: false,
         timestamps: true,
         render_scale: 1.0,
         draft: false,
-        lean_ui: false,
+        lean_painter: false,
+        retained_window: false,
     };
 
     /// The choices for a software adapter.
     pub const SOFTWARE: Self = Self {
         kind: ProfileKind::Software,
-        params_in_storage: true,
-        count_in_update: false,
-        direct_atomic_counts: true,
-        indexed_quads: true,
         timestamps: false,
         render_scale: 0.5,
         draft: true,
-        lean_ui: true,
+        lean_painter: true,
+        retained_window: true,
     };
 
     /// The profile for an adapter of `device_type`.
@@ -87,6 +76,148 @@ impl AdapterProfile {
     pub fn is_software(&self) -> bool {
         self.kind == ProfileKind::Software
     }
+
+    /// Every field but the kind, as settings (in declaration order).
+    pub fn settings(&self) -> [ProfileSetting; 5] {
+        use ProfileSetting as S;
+        [
+            S::Timestamps(self.timestamps),
+            S::RenderScale(self.render_scale),
+            S::Draft(self.draft),
+            S::LeanPainter(self.lean_painter),
+            S::RetainedWindow(self.retained_window),
+        ]
+    }
+
+    /// The settings that turn `self` into `other` (the fields where they differ).
+    pub fn differences(&self, other: &Self) -> Vec<ProfileSetting> {
+        self.settings()
+            .into_iter()
+            .zip(other.settings())
+            .filter(|(a, b)| a != b)
+            .map(|(_, b)| b)
+            .collect()
+    }
+
+    /// This profile with `settings` applied in order.
+    pub fn with(mut self, settings: &[ProfileSetting]) -> Self {
+        for s in settings {
+            s.apply(&mut self);
+        }
+        self
+    }
+}
+
+/// A profile asked for (the command line's `--adapter-profile` and `--adapt`): a set, or
+/// the adapter's own, then fields set one by one.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ProfileRequest {
+    /// The set to start from (`None`: the adapter's own).
+    pub kind: Option<ProfileKind>,
+    /// Fields set on top, in order.
+    pub settings: Vec<ProfileSetting>,
+}
+
+impl ProfileRequest {
+    /// The profile asked for, on an adapter whose own profile is `adapters`.
+    pub fn resolve(&self, adapters: AdapterProfile) -> AdapterProfile {
+        self.kind
+            .map_or(adapters, AdapterProfile::of_kind)
+            .with(&self.settings)
+    }
+}
+
+/// One field of an [`AdapterProfile`] set on its own: `--adapt FIELD=VALUE` (the field's
+/// name as in the struct, a bool or, for `render_scale`, a number in 0.1..=1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[allow(missing_docs)] // each variant is the field of the same name
+pub enum ProfileSetting {
+    Timestamps(bool),
+    RenderScale(f32),
+    Draft(bool),
+    LeanPainter(bool),
+    RetainedWindow(bool),
+}
+
+impl ProfileSetting {
+    /// The field names `--adapt` accepts.
+    pub const FIELDS: [&'static str; 5] = [
+        "timestamps",
+        "render_scale",
+        "draft",
+        "lean_painter",
+        "retained_window",
+    ];
+
+    /// Sets the field in `profile`.
+    pub fn apply(&self, p: &mut AdapterProfile) {
+        match *self {
+            Self::Timestamps(v) => p.timestamps = v,
+            Self::RenderScale(v) => p.render_scale = v,
+            Self::Draft(v) => p.draft = v,
+            Self::LeanPainter(v) => p.lean_painter = v,
+            Self::RetainedWindow(v) => p.retained_window = v,
+        }
+    }
+
+    /// The field's name.
+    pub fn field(&self) -> &'static str {
+        let i = AdapterProfile::GPU
+            .settings()
+            .iter()
+            .position(|s| std::mem::discriminant(s) == std::mem::discriminant(self))
+            .unwrap_or(0);
+        Self::FIELDS[i]
+    }
+}
+
+impl std::fmt::Display for ProfileSetting {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let value = match *self {
+            Self::RenderScale(v) => v.to_string(),
+            Self::Timestamps(v)
+            | Self::Draft(v)
+            | Self::LeanPainter(v)
+            | Self::RetainedWindow(v) => v.to_string(),
+        };
+        write!(f, "{}={value}", self.field())
+    }
+}
+
+impl FromStr for ProfileSetting {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let (name, value) = s
+            .split_once('=')
+            .ok_or_else(|| format!("{s:?}: expected FIELD=VALUE, e.g. draft=false"))?;
+        let (name, value) = (name.trim(), value.trim());
+        let flag = || {
+            value
+                .parse::<bool>()
+                .map_err(|_| format!("{name}: {value:?} is not a bool (expected true or false)"))
+        };
+        Ok(match name {
+            "timestamps" => Self::Timestamps(flag()?),
+            "render_scale" => match value.parse::<f32>() {
+                Ok(v) if (0.1..=1.0).contains(&v) => Self::RenderScale(v),
+                _ => {
+                    return Err(format!(
+                        "render_scale: {value:?} is not a number in 0.1..=1"
+                    ));
+                }
+            },
+            "draft" => Self::Draft(flag()?),
+            "lean_painter" => Self::LeanPainter(flag()?),
+            "retained_window" => Self::RetainedWindow(flag()?),
+            other => {
+                return Err(format!(
+                    "unknown adapter profile field {other:?}: expected one of {}",
+                    Self::FIELDS.join(", ")
+                ));
+            }
+        })
+    }
 }
 
 #[cfg(test)]
@@ -108,5 +239,34 @@ mod tests {
             assert_eq!(AdapterProfile::for_device_type(t), AdapterProfile::GPU);
         }
         assert!(AdapterProfile::of_kind(ProfileKind::Software).is_software());
+    }
+
+    /// Every decision lives in the profile: the two sets differ in exactly the listed
+    /// fields, each field round-trips through its `--adapt` text, and setting the
+    /// differences turns one set into the other.
+    #[test]
+    fn the_two_sets_differ_in_exactly_the_listed_fields() {
+        let (gpu, soft) = (AdapterProfile::GPU, AdapterProfile::SOFTWARE);
+        let differ: Vec<&str> = gpu.differences(&soft).iter().map(|s| s.field()).collect();
+        assert_eq!(
+            differ,
+            [
+                "timestamps",
+                "render_scale",
+                "draft",
+                "lean_painter",
+                "retained_window",
+            ]
+        );
+        let mut turned = gpu.with(&gpu.differences(&soft));
+        assert_ne!(turned, soft, "the kind is not a setting");
+        turned.kind = ProfileKind::Software;
+        assert_eq!(turned, soft);
+        for s in soft.settings().into_iter().chain(gpu.settings()) {
+            assert_eq!(s.to_string().parse::<ProfileSetting>(), Ok(s));
+        }
+        for bad in ["draft", "draft=maybe", "render_scale=2", "colour=true"] {
+            assert!(bad.parse::<ProfileSetting>().is_err(), "{bad}");
+        }
     }
 }

@@ -1,10 +1,7 @@
 //! The billboard pass: camera-facing quads, four vertices each, pulled from the state
-//! buffer the update pass just wrote. Two ways to issue them, one pipeline: one
-//! instance per quad (GPUs: on the H100 1M billboards take 38 ms this way, 50 ms the
-//! other), or indexed triangle lists over a shared index buffer (CPU adapters: llvmpipe
-//! shades vertices eight at a time and sets up every instance on its own, so a 4-vertex
-//! instance wasted half its lanes and paid the set-up per particle — a 13K-billboard scene
-//! 46–58 → 37–39 ms). The shader reads quad = vertex / 4 + instance either way.
+//! buffer the update pass just wrote: one instance per quad over a six-index buffer
+//! (two triangles on four shared vertices; the shader reads quad = vertex / 4 +
+//! instance).
 
 use std::collections::HashMap;
 
@@ -73,10 +70,8 @@ pub struct BillboardPass {
     depth_view: Option<wgpu::TextureView>,
     /// The 1×1 placeholder bound when no host depth is sampled.
     no_depth: wgpu::TextureView,
-    /// Two triangles per quad, `QUADS_PER_DRAW` quads: 4q, 4q+1, 4q+2, 4q+2, 4q+1, 4q+3.
+    /// Two triangles over a quad's four vertices: 0 1 2, 2 1 3.
     quad_indices: wgpu::Buffer,
-    /// Issue quads as indexed lists (default on CPU adapters) rather than instances.
-    pub indexed: bool,
     pipeline_layout: wgpu::PipelineLayout,
     sprite_layout: wgpu::BindGroupLayout,
     module: wgpu::ShaderModule,
@@ -125,14 +120,11 @@ impl BillboardPass {
                 immediate_size: 0,
             });
         let (module, pipelines) = Self::build(ctx, lib, &pipeline_layout, target)?;
-        let indices: Vec<u32> = (0..QUADS_PER_DRAW)
-            .flat_map(|q| [0, 1, 2, 2, 1, 3].map(|c| 4 * q + c))
-            .collect();
         let quad_indices = ctx
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("BillboardPass::quad_indices"),
-                contents: bytemuck::cast_slice(&indices),
+                contents: bytemuck::cast_slice(&[0u32, 1, 2, 2, 1, 3]),
                 usage: wgpu::BufferUsages::INDEX,
             });
         Ok(Self {
@@ -142,7 +134,6 @@ impl BillboardPass {
             depth_view: None,
             no_depth,
             quad_indices,
-            indexed: ctx.profile.indexed_quads,
             pipeline_layout,
             sprite_layout,
             module,
@@ -389,26 +380,11 @@ impl BillboardPass {
             );
             pass.set_bind_group(1, group, &[]);
             // One quad per slot of each instance's live window (`width` per instance), or
-            // sorted, through the sort's order; quad q of a draw is vertices 4q … 4q + 3
-            // after its base vertex.
-            let quads = d.width * d.members;
-            if !self.indexed {
-                pass.draw_indexed(0..6, 0, 0..quads);
-                continue;
-            }
-            let mut done = 0;
-            while done < quads {
-                let n = (quads - done).min(QUADS_PER_DRAW);
-                let base = u64::from(done) * 4;
-                pass.draw_indexed(0..n * 6, base.min(i32::MAX as u64) as i32, 0..1);
-                done += n;
-            }
+            // sorted, through the sort's order.
+            pass.draw_indexed(0..6, 0, 0..d.width * d.members);
         }
     }
 }
-
-/// Quads per indexed draw (the shared index buffer's length / 6).
-pub const QUADS_PER_DRAW: u32 = 1 << 16;
 
 /// Everything adds up, alpha too (the motion pass's weighted sums).
 const SUMMED: wgpu::BlendState = wgpu::BlendState {

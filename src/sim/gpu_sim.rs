@@ -11,8 +11,7 @@ use crate::gpu::types::{
 };
 use crate::gpu::{GpuContext, GpuError};
 use crate::shaders::{
-    PACKED_STATE_IO, PARAMS_INSTANCED, PARAMS_STORAGE, ShaderError, ShaderLibrary, TINY_STATE_IO,
-    create_checked,
+    PACKED_STATE_IO, PARAMS_INSTANCED, ShaderError, ShaderLibrary, TINY_STATE_IO, create_checked,
 };
 use crate::sim::modules::Modules;
 use crate::sim::planner::{EffectPlanner, LiveWindow};
@@ -85,9 +84,8 @@ impl UpdatePass {
                         binding: 0,
                         visibility: wgpu::ShaderStages::COMPUTE,
                         ty: wgpu::BindingType::Buffer {
-                            // See params.wgsl: storage on CPU adapters (lavapipe), and
-                            // an array of blocks for batched instances.
-                            ty: if ctx.profile.params_in_storage || batched {
+                            // See params.wgsl: an array of blocks for batched instances.
+                            ty: if batched {
                                 wgpu::BufferBindingType::Storage { read_only: true }
                             } else {
                                 wgpu::BufferBindingType::Uniform
@@ -134,8 +132,7 @@ impl UpdatePass {
             count_pipeline_layout,
             count: None,
             files: Vec::new(),
-            // Workgroup reductions cost CPU adapters more than a count on demand.
-            count_alive: mode == UpdateMode::Counted && ctx.profile.count_in_update,
+            count_alive: mode == UpdateMode::Counted,
             batched,
         }
     }
@@ -157,12 +154,7 @@ impl UpdatePass {
         lib: &ShaderLibrary,
         keys: &[PipelineKey],
     ) -> Result<(), ShaderError> {
-        // Software adapters read the parameters from storage (params.wgsl says why).
-        let params = if self.batched {
-            Some(PARAMS_INSTANCED)
-        } else {
-            ctx.profile.params_in_storage.then_some(PARAMS_STORAGE)
-        };
+        let params = self.batched.then_some(PARAMS_INSTANCED);
         let compose = |io: Option<(&str, &str)>| {
             let aliases: Vec<(&str, &str)> = io.into_iter().chain(params).collect();
             lib.compose_with("update.wgsl", &aliases)
@@ -200,15 +192,8 @@ impl UpdatePass {
             })?;
             fresh.insert((integrator, modules), pipeline);
         }
-        // The on-demand alive count. Workgroup barriers are very expensive on CPU adapters
-        // (lavapipe runs each invocation of a barrier-split shader separately): plain
-        // atomics there.
+        // The on-demand alive count.
         let count_src = lib.compose("count.wgsl")?;
-        let direct = if ctx.profile.direct_atomic_counts {
-            1.0
-        } else {
-            0.0
-        };
         let count = create_checked(&ctx.device, &count_src, lib, |module| {
             [0.0, 1.0].map(|packed| {
                 ctx.device
@@ -218,7 +203,7 @@ impl UpdatePass {
                         module,
                         entry_point: Some("main"),
                         compilation_options: wgpu::PipelineCompilationOptions {
-                            constants: &[("DIRECT_ATOMICS", direct), ("PACKED", packed)],
+                            constants: &[("PACKED", packed)],
                             zero_initialize_workgroup_memory: true,
                         },
                         cache: None,
