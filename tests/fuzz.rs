@@ -86,3 +86,82 @@ proptest! {
         }
     }
 }
+
+/// The text at a 1-based line and character column.
+fn text_at(text: &str, line: usize, column: usize) -> &str {
+    let start: usize = text
+        .split_inclusive('\n')
+        .take(line - 1)
+        .map(str::len)
+        .sum();
+    let rest = &text[start..];
+    let offset = rest
+        .char_indices()
+        .nth(column - 1)
+        .map_or(rest.len(), |(i, _)| i);
+    &rest[offset..]
+}
+
+/// Inputs of the kinds that break hand-written parsers and position arithmetic, kept as
+/// regressions: every one gives an effect or a located error, and every value validation
+/// refuses is located exactly where its text is — after CRLF line ends, multi-byte
+/// characters, comments, signs and exponents.
+#[test]
+fn loader_regressions_locate_values_exactly_or_fail_cleanly() {
+    let campfire = PRESETS[0];
+    let rate = "spawn_rate_per_sec: 90.0";
+    assert!(campfire.contains(rate), "the campfire's smoke rate");
+    let negative = campfire.replacen(rate, "spawn_rate_per_sec: -5", 1);
+    let variants = [
+        negative.clone(),
+        negative.replace('\n', "\r\n"),
+        negative.replacen("(\n", "( // ünïcödé ✓ 🔥\n", 1),
+        negative.replacen("-5", "/* was 90 */ -5", 1),
+        negative.replacen("-5", "-5e0", 1),
+        campfire.replacen(rate, "spawn_rate_per_sec: 1e39", 1),
+    ];
+    for text in &variants {
+        let err = ignis::preset::parse_str(text, "r.ron").expect_err("invalid");
+        let ignis::preset::PresetError::Invalid {
+            errors, positions, ..
+        } = &err
+        else {
+            panic!("not a validation error: {err}");
+        };
+        let p = positions[0].unwrap_or_else(|| panic!("unlocated: {err}"));
+        let at = text_at(text, p.line, p.column);
+        assert!(
+            at.starts_with(errors[0].value.as_str()),
+            "{err}: the text at {p} is {:?}",
+            &at[..at.len().min(20)]
+        );
+    }
+    // Broken text: an error with a position inside the text, never a panic.
+    let deep = format!(
+        "(version: 1, emitters: {}{})",
+        "[".repeat(300),
+        "]".repeat(300)
+    );
+    let broken = [
+        String::new(),
+        "\u{feff}".to_owned(),
+        "\0".to_owned(),
+        deep,
+        "(version: 99999999999999999999999, emitters: [])".to_owned(),
+        "(version: -1, emitters: [])".to_owned(),
+        "(version: \"1\", emitters: [])".to_owned(),
+        "(inner: (version: 9), emitters: [".to_owned(),
+        "(version: 1, name: r##\"a\"#, emitters: [])".to_owned(),
+        "(version: 1, /* never closed".to_owned(),
+        "(version: 1, name: \"runs\n over\n lines, emitters: [])".to_owned(),
+        "(version: 1, emitters: [Some((name: \"x\"".to_owned(),
+        "#![enable(implicit_some)] (version: 2)".to_owned(),
+    ];
+    for text in &broken {
+        let err = ignis::preset::parse_str(text, "r.ron").expect_err("broken");
+        if let Some(p) = err.position() {
+            let lines = text.split('\n').count().max(1);
+            assert!(p.line >= 1 && p.line <= lines && p.column >= 1, "{err}");
+        }
+    }
+}
