@@ -80,6 +80,11 @@ impl Headless {
         self.ctx.queue.submit([enc.finish()]);
     }
 
+    /// Plays from the start to `secs` in frames of `frame_dt_secs` ([`Player::seek`]).
+    pub fn seek(&mut self, secs: f64, frame_dt_secs: f64) -> u64 {
+        self.player.seek(secs, frame_dt_secs)
+    }
+
     /// Renders the current state to an image.
     pub fn render(&mut self, size: (u32, u32)) -> Result<image::RgbaImage, SimError> {
         let camera = self.camera.view(size);

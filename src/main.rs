@@ -119,6 +119,10 @@ enum Command {
         /// Simulated frame rate (frames per simulated second).
         #[arg(long, default_value_t = 60.0)]
         fps: f64,
+        /// Start at this time (seconds): the frames before it are simulated as fast as
+        /// the GPU goes and not written (frame numbers count from time 0).
+        #[arg(long, default_value_t = 0.0)]
+        start: f64,
         /// Write only the last frame (after simulating all of them).
         #[arg(long)]
         last_only: bool,
@@ -294,6 +298,7 @@ fn main() {
             out,
             seed,
             fps,
+            start,
             last_only,
             shader_dir,
         }) => render(
@@ -302,7 +307,7 @@ fn main() {
             size,
             &out,
             seed,
-            fps,
+            (fps, start),
             last_only,
             shader_dir.as_deref(),
             &adapter_profile,
@@ -347,13 +352,16 @@ fn render(
     size: (u32, u32),
     out: &Path,
     seed: Option<u32>,
-    fps: f64,
+    (fps, start): (f64, f64),
     last_only: bool,
     shader_dir: Option<&Path>,
     profile: &ProfileRequest,
 ) -> anyhow::Result<()> {
     if !(fps.is_finite() && fps > 0.0) {
         bail!("--fps must be a positive number, got {fps}");
+    }
+    if !(start.is_finite() && (0.0..=86_400.0).contains(&start)) {
+        bail!("--start must be a time in seconds between 0 and 86400, got {start}");
     }
     let mut effect = load_effect(preset)?;
     if let Some(s) = seed {
@@ -368,6 +376,8 @@ fn render(
     };
     let mut run = Headless::with_settings(&ctx, effect, lib, settings)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    // The frames before --start: simulated, not written.
+    let skipped = run.seek(start, 1.0 / fps);
     let start = Instant::now();
     let mut written = 0;
     // Simulate + draw + read back, per written frame (PNG encoding excluded).
@@ -378,7 +388,7 @@ fn render(
         if !last_only || f + 1 == frames {
             let image = run.render(size)?;
             frame_ms.push(t.elapsed().as_secs_f64() * 1000.0);
-            let path = out.join(format!("frame_{f:04}.png"));
+            let path = out.join(format!("frame_{:04}.png", skipped + u64::from(f)));
             image
                 .save(&path)
                 .with_context(|| format!("writing {}", path.display()))?;

@@ -134,6 +134,10 @@ pub struct Player {
 /// are dropped like the stepper's hitch guard.
 const MAX_STEPS_PER_RECORD: u32 = 32;
 
+/// [`Player::seek`] waits for the GPU after this many frames (bounding the staging memory
+/// in flight).
+const SEEK_FRAMES_PER_WAIT: u64 = 32;
+
 impl Player {
     /// A player for `effect` on the host's device: builds its pipelines for the host's
     /// formats. No instance yet.
@@ -328,6 +332,40 @@ impl Player {
         self.stepper.reset();
         self.pending = (0, 0.0);
         self.alpha = 1.0;
+    }
+
+    /// Plays the clock from the start to `secs` as fast as the GPU goes: a restart, then
+    /// the frames of `frame_dt_secs` that playing to `secs` would have taken (the nearest
+    /// whole number), each frame's steps recorded and submitted at once, with no sort or
+    /// draw. The state after it is bit-identical to playing those frames one by one —
+    /// with fixed steps, to playing to `secs` at any frame rate — and so is the next
+    /// frame's interpolation. Runs paused or not (the pause is kept). Returns the frames
+    /// replayed.
+    pub fn seek(&mut self, secs: f64, frame_dt_secs: f64) -> u64 {
+        self.restart();
+        if !(secs > 0.0 && frame_dt_secs > 0.0) {
+            return 0;
+        }
+        let frames = (secs / frame_dt_secs).round() as u64;
+        let was_paused = std::mem::replace(&mut self.is_paused, false);
+        for frame in 0..frames {
+            self.advance(frame_dt_secs);
+            let mut enc = self
+                .ctx
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("ignis::seek"),
+                });
+            self.simulate(&mut enc);
+            self.ctx.queue.submit([enc.finish()]);
+            // Let the staging memory of finished frames be reused.
+            if frame % SEEK_FRAMES_PER_WAIT == SEEK_FRAMES_PER_WAIT - 1 {
+                let _ = self.ctx.device.poll(wgpu::PollType::wait_indefinitely());
+            }
+        }
+        self.simulated = false;
+        self.is_paused = was_paused;
+        frames
     }
 
     /// Records this frame's compute work into the host's encoder — the planned steps of

@@ -1,0 +1,105 @@
+//! Seeking: the state at time t is the state playing to t reaches. `Player::seek` replays
+//! the frames from the start as fast as the GPU goes; these tests hold it to playing frame
+//! by frame, bit for bit, for every shipped preset, forwards and backwards, and hold
+//! `ignis render --start` to the frame a full render writes at that time.
+// `ignis render` is the binary: the default `editor` feature.
+#![cfg(feature = "editor")]
+
+mod common;
+
+use common::gpu;
+use ignis::headless::Headless;
+use ignis::shaders::ShaderLibrary;
+
+const FPS: f64 = 60.0;
+
+/// Every emitter's particles of the headless instance, as bytes.
+fn state(run: &Headless) -> Vec<Vec<u8>> {
+    (0..run.effect().emitters.len())
+        .map(|e| {
+            let particles = run
+                .player
+                .particles(run.instance, e)
+                .unwrap_or_else(|err| panic!("reading emitter {e}: {err}"));
+            bytemuck::cast_slice(&particles).to_vec()
+        })
+        .collect()
+}
+
+/// For every shipped preset: the states at 1 s and 2 s played frame by frame at 60 fps;
+/// then from 2 s a seek back to 1 s, and from there a seek forward to 2 s, each
+/// bit-identical to the played state. Frame-delta presets replay the same frame times.
+#[test]
+fn seeking_gives_the_played_state_bit_for_bit_for_every_shipped_preset() {
+    let ctx = gpu();
+    let presets = ignis::preset::list(std::path::Path::new("presets"));
+    assert!(presets.len() >= 7, "the shipped presets: {presets:?}");
+    for path in presets {
+        let effect = ignis::preset::load(&path).expect("a shipped preset loads");
+        let settings = ignis::PlayerSettings {
+            asset_dir: path.parent().map(std::path::Path::to_path_buf),
+            ..ignis::render::Composite::player_settings()
+        };
+        let mut run = Headless::with_settings(&ctx, effect, ShaderLibrary::embedded(), settings)
+            .expect("headless");
+        let mut played = Vec::new();
+        for second in 1..=2 {
+            for _ in 0..FPS as usize {
+                run.advance(1.0 / FPS);
+            }
+            played.push((second, state(&run)));
+        }
+        let name = path.display();
+        for (second, want) in &played {
+            let frames = run.seek(f64::from(*second), 1.0 / FPS);
+            assert_eq!(frames, *second as u64 * FPS as u64, "{name}");
+            let got = state(&run);
+            assert!(
+                got.iter().zip(want).all(|(a, b)| a == b) && got.len() == want.len(),
+                "{name}: the state after seeking to {second} s differs from the played one"
+            );
+            assert!(
+                want.iter().any(|bytes| bytes.iter().any(|&b| b != 0)),
+                "{name}: nothing alive at {second} s"
+            );
+        }
+    }
+}
+
+/// `ignis render --start 2.0 --frames 1` writes the image the 121st frame of
+/// `ignis render --frames 121` is (both at 60 fps), under the same frame number.
+#[test]
+fn render_start_writes_the_frame_a_full_render_writes_then() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let run = |out: &str, extra: &[&str]| {
+        let status = std::process::Command::new(env!("CARGO_BIN_EXE_ignis"))
+            .args(["render", "--size", "160x120", "--out"])
+            .arg(dir.path().join(out))
+            .args(extra)
+            .output()
+            .expect("running ignis render");
+        assert!(
+            status.status.success(),
+            "ignis render {extra:?}: {}",
+            String::from_utf8_lossy(&status.stderr)
+        );
+    };
+    run("full", &["--frames", "121"]);
+    run("start", &["--start", "2.0", "--frames", "1"]);
+    let written: Vec<_> = std::fs::read_dir(dir.path().join("start"))
+        .expect("the --start frames")
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(written, ["frame_0120.png"]);
+    let a = std::fs::read(dir.path().join("full/frame_0120.png")).expect("frame 121");
+    let b = std::fs::read(dir.path().join("start/frame_0120.png")).expect("--start frame");
+    assert!(a == b, "--start 2.0 wrote a different image from the 121st frame");
+    let lit = image::load_from_memory(&b)
+        .expect("a PNG")
+        .to_rgba8()
+        .pixels()
+        .filter(|p| p[0] > 60)
+        .count();
+    assert!(lit > 100, "the frame shows the fire ({lit} lit pixels)");
+}
