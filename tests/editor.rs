@@ -1280,3 +1280,41 @@ fn the_export_section_exports_with_progress_and_cancels() {
         .unwrap_or_default();
     assert!(left.is_empty(), "a cancelled export left {left:?}");
 }
+
+/// The timeline: a click on the bar asks for a seek to that time (in whole steps of the
+/// effect's clock), the step back to one step before the current time; a restart clears.
+#[test]
+fn the_timeline_seeks_in_whole_steps() {
+    use ignis::editor::timeline::{span_secs, timeline_ui};
+    let mut state = campfire_state();
+    state.stats.sim_time_secs = 1.0;
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(900.0, 40.0))
+        .build_ui_state(|ui, state: &mut EditorState| timeline_ui(ui, state), state);
+    harness.run();
+    let bar = harness.get_by_label("Timeline").rect();
+    harness.state_mut().playback.seek_to = None;
+    let at = bar.left_center() + egui::vec2(bar.width() * 0.5, 0.0);
+    harness.hover_at(at);
+    harness.run();
+    harness.drag_at(at);
+    harness.run();
+    harness.drop_at(at);
+    harness.run();
+    let step = f64::from(harness.state().running.time.step_secs);
+    let span = span_secs(&harness.state().running);
+    let t = harness.state().playback.seek_to.expect("a seek");
+    assert!(
+        (t - span / 2.0).abs() < span / 50.0,
+        "seek to {t}, span {span}"
+    );
+    assert!(
+        ((t / step) - (t / step).round()).abs() < 1e-6,
+        "{t} is a whole step"
+    );
+    harness.state_mut().playback.seek_to = None;
+    harness.get_by_label("< Step").click();
+    harness.run();
+    let back = harness.state().playback.seek_to.expect("a step back");
+    assert!((back - (1.0 - step)).abs() < 1e-9, "{back}");
+}

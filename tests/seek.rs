@@ -94,7 +94,10 @@ fn render_start_writes_the_frame_a_full_render_writes_then() {
     assert_eq!(written, ["frame_0120.png"]);
     let a = std::fs::read(dir.path().join("full/frame_0120.png")).expect("frame 121");
     let b = std::fs::read(dir.path().join("start/frame_0120.png")).expect("--start frame");
-    assert!(a == b, "--start 2.0 wrote a different image from the 121st frame");
+    assert!(
+        a == b,
+        "--start 2.0 wrote a different image from the 121st frame"
+    );
     let lit = image::load_from_memory(&b)
         .expect("a PNG")
         .to_rgba8()

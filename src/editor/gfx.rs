@@ -254,6 +254,9 @@ impl Gfx {
                 .default_size(PANEL_WIDTH)
                 .size_range(300.0..=640.0)
                 .show(ui, |ui| panel_ui(ui, state));
+            egui::Panel::bottom("timeline").show(ui, |ui| {
+                super::timeline::timeline_ui(ui, state);
+            });
             egui::CentralPanel::no_frame().show(ui, |ui| {
                 viewport = viewport_ui(ui, camera, state, texture);
             });
@@ -367,11 +370,11 @@ impl Gfx {
         }
     }
     /// Makes the player follow `state.running` (plus the mouse collider); on a GPU
-    /// refusal, goes back to the last effect that worked.
-    pub(super) fn apply_running(&mut self, state: &mut EditorState) {
+    /// refusal, goes back to the last effect that worked. Returns whether it changed.
+    pub(super) fn apply_running(&mut self, state: &mut EditorState) -> bool {
         let wanted = super::state::with_mouse_collider(&state.running, state.mouse_point);
         if wanted == *self.player.effect() {
-            return;
+            return false;
         }
         match self.player.set_effect(&wanted) {
             Ok(()) => self.gpu_effect.clone_from(&state.running),
@@ -385,6 +388,7 @@ impl Gfx {
             }
         }
         self.player.set_seed(self.instance, self.gpu_effect.seed);
+        true
     }
 
     /// Rebuilds the pipelines whose shaders changed on disk; a failure keeps the last
@@ -435,11 +439,25 @@ impl Gfx {
     /// its share of the frame.
     pub(super) fn simulate(&mut self, state: &mut EditorState, frame_dt_secs: f64) {
         self.reload_changed_shaders(state);
-        self.apply_running(state);
+        let edited = self.apply_running(state);
         let playback = &mut state.playback;
         if playback.restart_requested {
             playback.restart_requested = false;
+            playback.parked_at = None;
             self.player.restart();
+        }
+        if !playback.is_paused {
+            playback.parked_at = None;
+        }
+        // The timeline's seek, or an edit while parked: replayed to that time.
+        let seek = playback
+            .seek_to
+            .take()
+            .or(playback.parked_at.filter(|_| edited));
+        if let Some(t) = seek {
+            playback.is_paused = true;
+            playback.parked_at = Some(t);
+            self.player.seek(t, super::timeline::SEEK_FRAME_DT_SECS);
         }
         if playback.step_requested {
             playback.step_requested = false;

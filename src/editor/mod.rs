@@ -17,6 +17,7 @@ pub mod retained;
 pub mod screenshot;
 pub mod state;
 pub mod stats;
+pub mod timeline;
 pub mod ui_painter;
 pub mod undo;
 pub mod viewport;

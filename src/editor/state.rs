@@ -47,6 +47,10 @@ pub struct Playback {
     pub step_requested: bool,
     /// Kill every particle and restart time on the next frame.
     pub restart_requested: bool,
+    /// Seek to this time on the next frame (the timeline; pauses there).
+    pub seek_to: Option<f64>,
+    /// The time the last seek parked at, while paused there: an edit re-simulates to it.
+    pub parked_at: Option<f64>,
 }
 
 /// The editor's model: the effect under edit, the last valid one that runs, undo

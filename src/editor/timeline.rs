@@ -1,0 +1,130 @@
+//! The timeline under the viewport: play/pause, restart, a step back and forward, and a
+//! scrub bar over the effect's time with its bursts marked. Dragging or clicking the bar
+//! seeks: the player replays from the start to that time as fast as the GPU goes
+//! (`Player::seek`), so the state shown is exactly the one playing would reach. While
+//! parked (paused after a seek), an edit re-simulates to the same time.
+
+use egui::{Color32, Sense, Stroke, Ui, vec2};
+
+use crate::effect::{Effect, TimeMode};
+
+use super::state::EditorState;
+
+/// The frame rate seeks replay at (the frame-delta mode's frame time).
+pub const SEEK_FRAME_DT_SECS: f64 = 1.0 / 60.0;
+
+/// The timeline's length: the last burst plus the longest lifetime (at least 1 s).
+pub fn span_secs(effect: &Effect) -> f64 {
+    let longest = effect
+        .emitters
+        .iter()
+        .map(|e| f64::from(e.lifetime_secs.max))
+        .fold(0.0, f64::max);
+    let last_burst = effect
+        .emitters
+        .iter()
+        .flat_map(|e| &e.bursts)
+        .map(|b| f64::from(b.time_secs))
+        .fold(0.0, f64::max);
+    (last_burst + longest).max(1.0)
+}
+
+/// One step of the effect's clock (a frame in frame-delta mode).
+fn step_secs(effect: &Effect) -> f64 {
+    match effect.time.mode {
+        TimeMode::FixedStep => f64::from(effect.time.step_secs),
+        TimeMode::FrameDelta => SEEK_FRAME_DT_SECS,
+    }
+}
+
+/// The timeline strip.
+pub fn timeline_ui(ui: &mut Ui, state: &mut EditorState) {
+    let now = state.stats.sim_time_secs;
+    let span = span_secs(&state.running).max(now);
+    let step = step_secs(&state.running);
+    let playback = &mut state.playback;
+    ui.horizontal(|ui| {
+        if ui.button("Restart").on_hover_text("Restart (R)").clicked() {
+            playback.restart_requested = true;
+        }
+        if ui
+            .button("< Step")
+            .on_hover_text("One step back (replayed from the start)")
+            .clicked()
+        {
+            playback.seek_to = Some((now - step).max(0.0));
+        }
+        let play = if playback.is_paused { "Play" } else { "Pause" };
+        if ui
+            .button(play)
+            .on_hover_text("Play or pause (Space)")
+            .clicked()
+        {
+            playback.is_paused = !playback.is_paused;
+        }
+        if ui
+            .button("Step >")
+            .on_hover_text("One step forward (.)")
+            .clicked()
+        {
+            playback.step_requested = true;
+        }
+        ui.monospace(format!("{now:6.2} s"));
+        let width = ui.available_width() - 8.0;
+        let (rect, response) =
+            ui.allocate_exact_size(vec2(width.max(40.0), 18.0), Sense::click_and_drag());
+        response
+            .widget_info(|| egui::WidgetInfo::labeled(egui::WidgetType::Slider, true, "Timeline"));
+        let painter = ui.painter_at(rect);
+        painter.rect_filled(rect, 3.0, Color32::from_gray(40));
+        let x_of = |t: f64| rect.left() + (t / span).clamp(0.0, 1.0) as f32 * rect.width();
+        for burst in state.running.emitters.iter().flat_map(|e| &e.bursts) {
+            let x = x_of(f64::from(burst.time_secs));
+            painter.line_segment(
+                [egui::pos2(x, rect.top()), egui::pos2(x, rect.bottom())],
+                Stroke::new(2.0, Color32::from_rgb(240, 150, 60)),
+            );
+        }
+        let x = x_of(now);
+        painter.rect_filled(
+            egui::Rect::from_min_max(rect.left_top(), egui::pos2(x, rect.bottom())),
+            3.0,
+            Color32::from_rgb(120, 70, 30),
+        );
+        painter.line_segment(
+            [egui::pos2(x, rect.top()), egui::pos2(x, rect.bottom())],
+            Stroke::new(2.0, Color32::WHITE),
+        );
+        if let Some(p) = response.interact_pointer_pos()
+            && (response.clicked() || response.dragged())
+        {
+            let t = f64::from((p.x - rect.left()) / rect.width()).clamp(0.0, 1.0) * span;
+            // Whole steps: the state at a step is what a seek can reproduce exactly.
+            playback.seek_to = Some((t / step).round() * step);
+        }
+        response.on_hover_text(format!(
+            "Seek: click or drag (0 – {span:.2} s: the last burst plus the longest lifetime)"
+        ));
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_span_is_the_last_burst_plus_the_longest_lifetime() {
+        let mut effect = Effect::default_campfire();
+        let longest = effect
+            .emitters
+            .iter()
+            .map(|e| e.lifetime_secs.max)
+            .fold(0.0, f32::max);
+        assert!((span_secs(&effect) - f64::from(longest)).abs() < 1e-9);
+        effect.emitters[0].bursts.push(crate::effect::Burst {
+            time_secs: 3.0,
+            count: 10,
+        });
+        assert!((span_secs(&effect) - (3.0 + f64::from(longest))).abs() < 1e-6);
+    }
+}
