@@ -13,6 +13,16 @@ use ignis::shaders::ShaderLibrary;
 
 const FPS: f64 = 60.0;
 
+/// A headless run whose instance has a simulation of its own (as the editor's): the
+/// player keeps seek snapshots for those.
+fn unbatched(ctx: &ignis::gpu::GpuContext, effect: ignis::Effect) -> Headless {
+    let settings = ignis::PlayerSettings {
+        batch_instances: false,
+        ..ignis::render::Composite::player_settings()
+    };
+    Headless::with_settings(ctx, effect, ShaderLibrary::embedded(), settings).expect("headless")
+}
+
 /// Every emitter's particles of the headless instance, as bytes.
 fn state(run: &Headless) -> Vec<Vec<u8>> {
     (0..run.effect().emitters.len())
@@ -105,4 +115,70 @@ fn render_start_writes_the_frame_a_full_render_writes_then() {
         .filter(|p| p[0] > 60)
         .count();
     assert!(lit > 100, "the frame shows the fire ({lit} lit pixels)");
+}
+
+/// With snapshots every 0.5 s (taken while playing), seeks start from the latest snapshot
+/// at or before the target — between two of them, exactly on one, backwards — and still
+/// give the played state bit for bit, for full, packed and tiny state alike.
+#[test]
+fn seeks_from_snapshots_give_the_played_state() {
+    let ctx = gpu();
+    for layout in ["full", "packed", "tiny"] {
+        let mut effect = ignis::Effect::default_campfire();
+        for e in &mut effect.emitters {
+            e.packed_state = layout == "packed";
+            e.tiny_state = layout == "tiny";
+        }
+        let mut run = unbatched(&ctx, effect);
+        run.player.keep_seek_snapshots(0.5, 64 << 20);
+        let mut played = Vec::new();
+        for frame in 1..=150u32 {
+            run.advance(1.0 / FPS);
+            if frame % 45 == 0 || frame == 150 {
+                played.push((f64::from(frame) / FPS, state(&run)));
+            }
+        }
+        let (bytes, count) = run.player.seek_snapshot_bytes();
+        assert!(
+            count >= 4 && bytes > 0,
+            "{layout}: {count} snapshots, {bytes} bytes"
+        );
+        for (t, want) in played.iter().rev() {
+            run.seek(*t, 1.0 / FPS);
+            assert!(
+                state(&run) == *want,
+                "{layout}: the state after seeking to {t:.2} s differs from the played one"
+            );
+        }
+        // Seeking forward past the last snapshot takes more as it goes, and agrees too.
+        run.seek(0.0, 1.0 / FPS);
+        for _ in 0..30 {
+            run.advance(1.0 / FPS);
+        }
+        let half = state(&run);
+        run.seek(3.0, 1.0 / FPS);
+        run.seek(0.5, 1.0 / FPS);
+        assert!(
+            state(&run) == half,
+            "{layout}: 0.5 s after a seek to 3 s and back"
+        );
+    }
+}
+
+/// The snapshots stay within their memory bound: when more would be needed, every other
+/// one goes and the interval doubles.
+#[test]
+fn seek_snapshots_stay_within_their_memory_bound() {
+    let ctx = gpu();
+    let mut run = unbatched(&ctx, ignis::Effect::default_campfire());
+    let bound = 2 << 20;
+    run.player.keep_seek_snapshots(0.05, bound);
+    for _ in 0..240 {
+        run.advance(1.0 / FPS);
+    }
+    let (bytes, count) = run.player.seek_snapshot_bytes();
+    assert!(
+        bytes <= bound && count >= 2,
+        "{count} snapshots, {bytes} bytes"
+    );
 }

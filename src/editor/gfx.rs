@@ -28,6 +28,13 @@ use super::viewport::{ViewportOutput, emitter_bounds, frame_bounds, viewport_ui}
 /// Read the GPU's alive counters every this many frames (a blocking readback).
 const COUNTER_INTERVAL_FRAMES: u64 = 15;
 
+/// Simulated time between the timeline's snapshots (a seek replays at most this much
+/// until the memory bound thins them out).
+const SEEK_SNAPSHOT_SECS: f64 = 2.0;
+
+/// GPU memory the timeline's snapshots may take.
+const SEEK_SNAPSHOT_BYTES: u64 = 256 << 20;
+
 /// The time an export may take of each editor frame.
 const EXPORT_BUDGET: Duration = Duration::from_millis(40);
 
@@ -118,6 +125,8 @@ fn editor_player(
         ..Composite::player_settings()
     };
     let mut player = Player::new(&ctx.device, &ctx.queue, &state.running, settings)?;
+    // The timeline's seeks start from the snapshot before them.
+    player.keep_seek_snapshots(SEEK_SNAPSHOT_SECS, SEEK_SNAPSHOT_BYTES);
     let instance = player.add_instance(glam::Mat4::IDENTITY, state.running.seed)?;
     Ok((player, instance))
 }

@@ -73,8 +73,7 @@ pub fn timeline_ui(ui: &mut Ui, state: &mut EditorState) {
         let width = ui.available_width() - 8.0;
         let (rect, response) =
             ui.allocate_exact_size(vec2(width.max(40.0), 18.0), Sense::click_and_drag());
-        response
-            .widget_info(|| egui::WidgetInfo::labeled(egui::Role::Slider, true, "Timeline"));
+        response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Slider, true, "Timeline"));
         let painter = ui.painter_at(rect);
         painter.rect_filled(rect, 3.0, Color32::from_gray(40));
         let x_of = |t: f64| rect.left() + (t / span).clamp(0.0, 1.0) as f32 * rect.width();

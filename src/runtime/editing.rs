@@ -40,6 +40,7 @@ impl Player {
             return Ok(());
         }
         effect.validate().map_err(PlayerError::Invalid)?;
+        self.snapshots.clear();
         let batched = self.settings.batch_instances && batchable(effect);
         // The pipelines the edit needs (built now; extra pipelines change nothing else).
         let update = if batched == self.batched {
@@ -184,6 +185,7 @@ impl Player {
             return false;
         };
         if i.effect().seed != seed {
+            self.snapshots.clear();
             let (state, effect) = i.parts_mut();
             effect.seed = seed;
             match state {

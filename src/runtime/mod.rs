@@ -8,6 +8,7 @@ mod instances;
 mod layers;
 mod player;
 mod remap;
+mod seeking;
 
 pub use crate::render::Camera;
 pub use editing::PLAYER_SHADERS;

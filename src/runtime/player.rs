@@ -111,13 +111,13 @@ pub struct Player {
     pub(super) batches: Vec<InstanceBatch>,
     pub(super) batched: bool,
     pub(super) stepper: Stepper,
-    is_paused: bool,
+    pub(super) is_paused: bool,
     /// Steps planned by `advance` and not yet recorded, and their size.
-    pending: (u32, f32),
+    pub(super) pending: (u32, f32),
     /// The steps the last record ran, and their size.
     pub(super) last_steps: (u32, f32),
     /// Where frames are drawn between the last two steps (fixed step).
-    alpha: f32,
+    pub(super) alpha: f32,
     pub(super) settings: PlayerSettings,
     pub(super) items: Vec<DrawItem>,
     /// This frame's parameter and look uploads (reused staging memory).
@@ -127,16 +127,14 @@ pub struct Player {
     /// Whether records prepare the motion pass ([`Player::draw_motion`]).
     motion_pass: bool,
     /// `simulate` ran since the last `record`, which then does not run it again.
-    simulated: bool,
+    pub(super) simulated: bool,
+    /// Snapshots a seek can start from (`Player::keep_seek_snapshots`).
+    pub(super) snapshots: super::seeking::SeekSnapshots,
 }
 
 /// Steps one `record` runs at most (the simulation's per-submit parameter ring); more
 /// are dropped like the stepper's hitch guard.
-const MAX_STEPS_PER_RECORD: u32 = 32;
-
-/// [`Player::seek`] waits for the GPU after this many frames (bounding the staging memory
-/// in flight).
-const SEEK_FRAMES_PER_WAIT: u64 = 32;
+pub(super) const MAX_STEPS_PER_RECORD: u32 = 32;
 
 impl Player {
     /// A player for `effect` on the host's device: builds its pipelines for the host's
@@ -188,6 +186,7 @@ impl Player {
             splatted: false,
             motion_pass: false,
             simulated: false,
+            snapshots: Default::default(),
         })
     }
 
@@ -211,6 +210,7 @@ impl Player {
     ) -> Result<InstanceId, PlayerError> {
         let effect = Instance::effect_for(&self.effect, world_from_effect, seed);
         let state = self.backing(&effect)?;
+        self.snapshots.clear();
         Ok(self
             .instances
             .insert(Instance::new(state, effect, world_from_effect)))
@@ -240,6 +240,7 @@ impl Player {
         let Some(instance) = self.instances.remove(id) else {
             return false;
         };
+        self.snapshots.clear();
         if let Backing::Batched { batch, slot } = instance.state
             && let Some(b) = self.batches.get_mut(batch)
         {
@@ -255,6 +256,9 @@ impl Player {
         let Some(instance) = self.instances.get_mut(id) else {
             return false;
         };
+        if instance.world_from_effect != world_from_effect {
+            self.snapshots.clear();
+        }
         instance.set_transform(&self.effect, world_from_effect);
         true
     }
@@ -332,40 +336,6 @@ impl Player {
         self.stepper.reset();
         self.pending = (0, 0.0);
         self.alpha = 1.0;
-    }
-
-    /// Plays the clock from the start to `secs` as fast as the GPU goes: a restart, then
-    /// the frames of `frame_dt_secs` that playing to `secs` would have taken (the nearest
-    /// whole number), each frame's steps recorded and submitted at once, with no sort or
-    /// draw. The state after it is bit-identical to playing those frames one by one —
-    /// with fixed steps, to playing to `secs` at any frame rate — and so is the next
-    /// frame's interpolation. Runs paused or not (the pause is kept). Returns the frames
-    /// replayed.
-    pub fn seek(&mut self, secs: f64, frame_dt_secs: f64) -> u64 {
-        self.restart();
-        if !(secs > 0.0 && frame_dt_secs > 0.0) {
-            return 0;
-        }
-        let frames = (secs / frame_dt_secs).round() as u64;
-        let was_paused = std::mem::replace(&mut self.is_paused, false);
-        for frame in 0..frames {
-            self.advance(frame_dt_secs);
-            let mut enc = self
-                .ctx
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("ignis::seek"),
-                });
-            self.simulate(&mut enc);
-            self.ctx.queue.submit([enc.finish()]);
-            // Let the staging memory of finished frames be reused.
-            if frame % SEEK_FRAMES_PER_WAIT == SEEK_FRAMES_PER_WAIT - 1 {
-                let _ = self.ctx.device.poll(wgpu::PollType::wait_indefinitely());
-            }
-        }
-        self.simulated = false;
-        self.is_paused = was_paused;
-        frames
     }
 
     /// Records this frame's compute work into the host's encoder — the planned steps of
@@ -535,6 +505,7 @@ impl Player {
         }
         drop(pass);
         encoder.pop_debug_group();
+        self.take_snapshot_if_due(encoder);
     }
 
     /// Draws every instance's particles into the host's open render pass (alpha-blended

@@ -242,37 +242,37 @@ impl UpdatePass {
 }
 
 /// One emitter's pool on the GPU.
-struct EmitterState {
-    capacity: u32,
-    buffers: [wgpu::Buffer; 2],
-    counters: wgpu::Buffer,
-    bind_groups: [wgpu::BindGroup; 2],
+pub(super) struct EmitterState {
+    pub(super) capacity: u32,
+    pub(super) buffers: [wgpu::Buffer; 2],
+    pub(super) counters: wgpu::Buffer,
+    pub(super) bind_groups: [wgpu::BindGroup; 2],
     /// Which buffer holds the current state (the thesis's `mFlip`).
-    current: usize,
-    generation: u64,
+    pub(super) current: usize,
+    pub(super) generation: u64,
     /// Holds stateless spawn records (no ping-pong: buffer 0 only).
-    stateless: bool,
+    pub(super) stateless: bool,
     /// How the state is stored.
-    layout: StateLayout,
+    pub(super) layout: StateLayout,
     /// Tiny state's birth table: a ring of entries, entry `seq` at `seq & births_mask`
     /// (one placeholder entry for the other layouts).
-    births: wgpu::Buffer,
-    births_mask: u32,
+    pub(super) births: wgpu::Buffer,
+    pub(super) births_mask: u32,
     /// The entries the steps recorded last may read (sequence number, entry), oldest
     /// first: what a larger table must be filled with.
-    births_mirror: VecDeque<(u64, Birth)>,
+    pub(super) births_mirror: VecDeque<(u64, Birth)>,
     /// Lifetime range, seed and salt of the last sync (packed state re-derives lifetimes).
-    life_range: (f32, f32),
-    seed: u32,
-    salt: u32,
+    pub(super) life_range: (f32, f32),
+    pub(super) seed: u32,
+    pub(super) salt: u32,
     /// Until this time on the emitter's planner clock every slot may be alive, and the
     /// update and the draws visit the whole pool: state written from outside the planner
     /// (`write_particles`: forever, until a restart), or particles kept at their old slots
     /// by a capacity change (until they have all died).
-    whole_pool_until: f64,
+    pub(super) whole_pool_until: f64,
     /// The spawn counter after the last recorded step (equal to the planner's when the
     /// steps came from it; otherwise the live window is unknown).
-    spawned_end: u64,
+    pub(super) spawned_end: u64,
 }
 
 /// The spawn counter and lifetime of `slot` in a ring of `capacity` slots after `total`
@@ -314,12 +314,12 @@ fn update_counts(update: &SharedUpdate) -> bool {
 
 /// The GPU simulation of an effect.
 pub struct GpuSim {
-    ctx: GpuContext,
+    pub(super) ctx: GpuContext,
     library: ShaderLibrary,
     update: SharedUpdate,
     params_buffer: wgpu::Buffer,
     params_slots: usize,
-    emitters: Vec<EmitterState>,
+    pub(super) emitters: Vec<EmitterState>,
     /// CPU planning (time, spawn counts).
     pub planner: EffectPlanner,
 }

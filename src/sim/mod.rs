@@ -6,6 +6,7 @@ pub mod cpu_reference;
 pub mod gpu_sim;
 pub mod modules;
 pub mod planner;
+pub mod snapshot;
 pub mod stepper;
 
 pub use cpu_reference::CpuSim;

@@ -1,0 +1,114 @@
+//! Snapshots of a [`GpuSim`]: its particle state copied on the GPU and its planning cloned
+//! on the CPU, so that a seek can start from the nearest earlier moment instead of time 0.
+//! With fixed steps a simulation's state after `n` steps does not depend on how the steps
+//! were grouped into frames, so a snapshot stands for "after step `n`" whatever frame
+//! rate produced it.
+
+use std::collections::VecDeque;
+
+use crate::gpu::types::Birth;
+
+use super::gpu_sim::GpuSim;
+use super::planner::EffectPlanner;
+
+/// A simulation's state after some step.
+pub struct SimSnapshot {
+    planner: EffectPlanner,
+    emitters: Vec<EmitterSnapshot>,
+    bytes: u64,
+}
+
+/// One emitter's part: copies of both state buffers (the draws read the older one too)
+/// and the CPU side of its pool.
+struct EmitterSnapshot {
+    /// The pool it was taken from (a restore into another pool is refused).
+    generation: u64,
+    buffers: [wgpu::Buffer; 2],
+    current: usize,
+    births_mirror: VecDeque<(u64, Birth)>,
+    whole_pool_until: f64,
+    spawned_end: u64,
+}
+
+impl SimSnapshot {
+    /// Steps simulated when it was taken.
+    pub fn step_index(&self) -> u64 {
+        self.planner.step_index
+    }
+
+    /// GPU memory it holds.
+    pub fn bytes(&self) -> u64 {
+        self.bytes
+    }
+}
+
+impl GpuSim {
+    /// Records copies of the state into `enc` (valid once `enc` is submitted) and clones
+    /// the planning: the simulation after its last recorded step.
+    pub fn snapshot(&self, enc: &mut wgpu::CommandEncoder) -> SimSnapshot {
+        let mut bytes = 0;
+        let emitters = self
+            .emitters
+            .iter()
+            .map(|s| {
+                let buffers = s.buffers.each_ref().map(|b| {
+                    let copy = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("SimSnapshot::state"),
+                        size: b.size(),
+                        usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                        mapped_at_creation: false,
+                    });
+                    enc.copy_buffer_to_buffer(b, 0, &copy, 0, b.size());
+                    bytes += b.size();
+                    copy
+                });
+                EmitterSnapshot {
+                    generation: s.generation,
+                    buffers,
+                    current: s.current,
+                    births_mirror: s.births_mirror.clone(),
+                    whole_pool_until: s.whole_pool_until,
+                    spawned_end: s.spawned_end,
+                }
+            })
+            .collect();
+        SimSnapshot {
+            planner: self.planner.clone(),
+            emitters,
+            bytes,
+        }
+    }
+
+    /// Puts the simulation back to `snapshot` (copies recorded into `enc`); false, and
+    /// nothing changed, when a pool was rebuilt since it was taken.
+    pub fn restore(&mut self, enc: &mut wgpu::CommandEncoder, snapshot: &SimSnapshot) -> bool {
+        let same = self.emitters.len() == snapshot.emitters.len()
+            && self
+                .emitters
+                .iter()
+                .zip(&snapshot.emitters)
+                .all(|(s, k)| s.generation == k.generation);
+        if !same {
+            return false;
+        }
+        for (s, k) in self.emitters.iter_mut().zip(&snapshot.emitters) {
+            for (b, copy) in s.buffers.iter().zip(&k.buffers) {
+                enc.copy_buffer_to_buffer(copy, 0, b, 0, b.size());
+            }
+            enc.clear_buffer(&s.counters, 0, None);
+            s.current = k.current;
+            s.whole_pool_until = k.whole_pool_until;
+            s.spawned_end = k.spawned_end;
+            // The tiny state's birth table: the entries the next steps may read.
+            s.births_mirror.clone_from(&k.births_mirror);
+            for (seq, entry) in &s.births_mirror {
+                let at = (seq & u64::from(s.births_mask)) * size_of::<Birth>() as u64;
+                self.ctx
+                    .queue
+                    .write_buffer(&s.births, at, bytemuck::bytes_of(entry));
+            }
+        }
+        self.planner.clone_from(&snapshot.planner);
+        true
+    }
+}
