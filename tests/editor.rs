@@ -1317,4 +1317,8 @@ fn the_timeline_seeks_in_whole_steps() {
     harness.run();
     let back = harness.state().playback.seek_to.expect("a step back");
     assert!((back - (1.0 - step)).abs() < 1e-9, "{back}");
+    // The loop region starts as the whole span.
+    harness.get_by_label("Loop").click();
+    harness.run();
+    assert_eq!(harness.state().playback.loop_region, Some((0.0, span)));
 }

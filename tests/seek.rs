@@ -182,3 +182,34 @@ fn seek_snapshots_stay_within_their_memory_bound() {
         "{count} snapshots, {bytes} bytes"
     );
 }
+
+/// A frame-delta effect's state depends on every frame's duration: replaying the frames
+/// played (jittered here) reaches the played state bit for bit, at any point of them.
+#[test]
+fn replaying_the_played_frames_reaches_the_played_state_in_frame_delta_mode() {
+    let ctx = gpu();
+    let effect = ignis::preset::load(std::path::Path::new("presets/thesis_2006.ron"))
+        .expect("the thesis preset");
+    assert_eq!(effect.time.mode, ignis::effect::TimeMode::FrameDelta);
+    let mut run = unbatched(&ctx, effect);
+    let frames: Vec<f64> = (0..120)
+        .map(|i| [1.0 / 60.0, 1.0 / 45.0, 1.0 / 90.0, 1.0 / 30.0][i % 4])
+        .collect();
+    let mut played = Vec::new();
+    for (i, dt) in frames.iter().enumerate() {
+        run.advance(*dt);
+        if i == 59 || i == 119 {
+            played.push((i + 1, state(&run)));
+        }
+    }
+    for (n, want) in played.iter().rev() {
+        run.player.replay(&frames[..*n]);
+        assert!(state(&run) == *want, "after replaying {n} frames");
+    }
+    // Uniform frames instead reach another state: the durations matter.
+    run.player.replay(&vec![1.0 / 60.0; 60]);
+    assert!(
+        state(&run) != played[0].1,
+        "frame times must matter in frame-delta mode"
+    );
+}

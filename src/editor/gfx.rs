@@ -453,6 +453,7 @@ impl Gfx {
         if playback.restart_requested {
             playback.restart_requested = false;
             playback.parked_at = None;
+            playback.frame_times.clear();
             self.player.restart();
         }
         if !playback.is_paused {
@@ -466,7 +467,7 @@ impl Gfx {
         if let Some(t) = seek {
             playback.is_paused = true;
             playback.parked_at = Some(t);
-            self.player.seek(t, super::timeline::SEEK_FRAME_DT_SECS);
+            self.seek(playback, t);
         }
         if playback.step_requested {
             playback.step_requested = false;
@@ -474,7 +475,16 @@ impl Gfx {
             self.player.step();
         }
         self.player.set_paused(playback.is_paused);
-        self.player.advance(frame_dt_secs);
+        let dt = frame_dt_secs * f64::from(playback.speed.clamp(0.05, 8.0));
+        self.player.advance(dt);
+        if !playback.is_paused {
+            playback.frame_times.push(dt);
+            // The loop region: back to its start once the clock passes its end.
+            let now = self.player.time_secs(self.instance).unwrap_or_default();
+            if let Some((a, _)) = playback.loop_region.filter(|(a, b)| b > a && now >= *b) {
+                self.seek(playback, a);
+            }
+        }
         super::export_ui::drive(
             &self.ctx,
             &state.running,
@@ -484,6 +494,21 @@ impl Gfx {
             EXPORT_BUDGET,
         );
         self.profiler.end_stage(&self.ctx);
+    }
+
+    /// Puts the player at `t`: a fixed-step effect seeks (from the snapshot before it);
+    /// a frame-delta effect replays the frames played so far up to `t` (then 1/60 s
+    /// frames), the only way to reach the same state.
+    fn seek(&mut self, playback: &mut super::state::Playback, t: f64) {
+        let dt = super::timeline::SEEK_FRAME_DT_SECS;
+        if self.player.effect().time.mode == crate::effect::TimeMode::FixedStep {
+            self.player.seek(t, dt);
+            playback.frame_times.clear();
+            return;
+        }
+        let frames = super::timeline::frames_until(&playback.frame_times, t, dt);
+        self.player.replay(&frames);
+        playback.frame_times = frames;
     }
 
     /// Copies the player's clock and per-emitter figures into the stats (the alive counts

@@ -39,7 +39,7 @@ impl Default for ViewSettings {
 }
 
 /// Playback requests from the panel and the keyboard, consumed by the frame loop.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Playback {
     /// The simulation is frozen (rendering goes on).
     pub is_paused: bool,
@@ -51,6 +51,28 @@ pub struct Playback {
     pub seek_to: Option<f64>,
     /// The time the last seek parked at, while paused there: an edit re-simulates to it.
     pub parked_at: Option<f64>,
+    /// Playback speed (the viewer's: the effect's own time settings are not changed).
+    pub speed: f32,
+    /// Play this span of the effect's time over and over (seconds).
+    pub loop_region: Option<(f64, f64)>,
+    /// The frames played since the last restart or seek (their durations, speed
+    /// included): a frame-delta effect seeks by replaying them.
+    pub frame_times: Vec<f64>,
+}
+
+impl Default for Playback {
+    fn default() -> Self {
+        Self {
+            is_paused: false,
+            step_requested: false,
+            restart_requested: false,
+            seek_to: None,
+            parked_at: None,
+            speed: 1.0,
+            loop_region: None,
+            frame_times: Vec::new(),
+        }
+    }
 }
 
 /// The editor's model: the effect under edit, the last valid one that runs, undo

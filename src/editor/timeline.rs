@@ -1,5 +1,6 @@
-//! The timeline under the viewport: play/pause, restart, a step back and forward, and a
-//! scrub bar over the effect's time with its bursts marked. Dragging or clicking the bar
+//! The timeline under the viewport: play/pause, restart, a step back and forward, the
+//! playback speed, a loop region, and a scrub bar over the effect's time with its bursts
+//! marked. Dragging or clicking the bar
 //! seeks: the player replays from the start to that time as fast as the GPU goes
 //! (`Player::seek`), so the state shown is exactly the one playing would reach. While
 //! parked (paused after a seek), an edit re-simulates to the same time.
@@ -27,6 +28,25 @@ pub fn span_secs(effect: &Effect) -> f64 {
         .map(|b| f64::from(b.time_secs))
         .fold(0.0, f64::max);
     (last_burst + longest).max(1.0)
+}
+
+/// The frames of `played` whose end is at or before `t` (to within a microsecond), then
+/// frames of `dt` up to `t`: what a frame-delta effect replays to reach `t`.
+pub fn frames_until(played: &[f64], t: f64, dt: f64) -> Vec<f64> {
+    let mut out = Vec::new();
+    let mut end = 0.0;
+    for &d in played {
+        if end + d > t + 1e-6 {
+            break;
+        }
+        end += d;
+        out.push(d);
+    }
+    while end + dt <= t + 1e-6 {
+        end += dt;
+        out.push(dt);
+    }
+    out
 }
 
 /// One step of the effect's clock (a frame in frame-delta mode).
@@ -69,6 +89,36 @@ pub fn timeline_ui(ui: &mut Ui, state: &mut EditorState) {
         {
             playback.step_requested = true;
         }
+        ui.add(
+            egui::DragValue::new(&mut playback.speed)
+                .range(0.1..=4.0)
+                .speed(0.01)
+                .fixed_decimals(2)
+                .suffix("×"),
+        )
+        .on_hover_text("Playback speed (the viewer's; the effect's time settings stay)");
+        let mut looping = playback.loop_region.is_some();
+        if ui
+            .checkbox(&mut looping, "Loop")
+            .on_hover_text("Play a span of the effect's time over and over")
+            .changed()
+        {
+            playback.loop_region = looping.then_some((0.0, span));
+        }
+        if let Some((a, b)) = &mut playback.loop_region {
+            ui.add(
+                egui::DragValue::new(a)
+                    .range(0.0..=*b)
+                    .speed(0.01)
+                    .suffix(" s"),
+            );
+            ui.add(
+                egui::DragValue::new(b)
+                    .range(*a..=3600.0)
+                    .speed(0.01)
+                    .suffix(" s"),
+            );
+        }
         ui.monospace(format!("{now:6.2} s"));
         let width = ui.available_width() - 8.0;
         let (rect, response) =
@@ -77,6 +127,13 @@ pub fn timeline_ui(ui: &mut Ui, state: &mut EditorState) {
         let painter = ui.painter_at(rect);
         painter.rect_filled(rect, 3.0, Color32::from_gray(40));
         let x_of = |t: f64| rect.left() + (t / span).clamp(0.0, 1.0) as f32 * rect.width();
+        if let Some((a, b)) = playback.loop_region {
+            painter.rect_filled(
+                egui::Rect::from_x_y_ranges(x_of(a)..=x_of(b), rect.y_range()),
+                3.0,
+                Color32::from_rgb(45, 60, 80),
+            );
+        }
         for burst in state.running.emitters.iter().flat_map(|e| &e.bursts) {
             let x = x_of(f64::from(burst.time_secs));
             painter.line_segment(
@@ -110,6 +167,16 @@ pub fn timeline_ui(ui: &mut Ui, state: &mut EditorState) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn frame_delta_seeks_replay_the_played_frames_then_sixtieths() {
+        let played = [0.02, 0.015, 0.03, 0.01];
+        assert_eq!(frames_until(&played, 0.035, 0.5), [0.02, 0.015]);
+        assert_eq!(frames_until(&played, 0.0, 0.5), Vec::<f64>::new());
+        let beyond = frames_until(&played, 0.075 + 2.0 / 60.0, 1.0 / 60.0);
+        assert_eq!(&beyond[..4], &played);
+        assert_eq!(beyond.len(), 6);
+    }
 
     #[test]
     fn the_span_is_the_last_burst_plus_the_longest_lifetime() {

@@ -135,15 +135,28 @@ impl Player {
         if self.snapshots_apply() {
             self.seek_fixed_steps(frames, frame_dt_secs);
         } else {
-            self.restart();
-            for frame in 0..frames {
-                self.advance(frame_dt_secs);
-                self.submit_steps(frame);
-            }
+            self.is_paused = was_paused;
+            let frame_dts = vec![frame_dt_secs; frames as usize];
+            self.replay(&frame_dts);
         }
         self.simulated = false;
         self.is_paused = was_paused;
         frames
+    }
+
+    /// Plays the clock from the start through exactly these frames (their wall-clock
+    /// durations), as fast as the GPU goes: the state playing them one by one reaches,
+    /// bit for bit, whatever the time mode — the way to seek a frame-delta effect, whose
+    /// state depends on every frame's duration. The pause is kept.
+    pub fn replay(&mut self, frame_dts_secs: &[f64]) {
+        let was_paused = std::mem::replace(&mut self.is_paused, false);
+        self.restart();
+        for (frame, dt) in frame_dts_secs.iter().enumerate() {
+            self.advance(*dt);
+            self.submit_steps(frame as u64);
+        }
+        self.simulated = false;
+        self.is_paused = was_paused;
     }
 
     /// [`Player::seek`] with fixed steps: the steps those frames take (counted on the CPU),
