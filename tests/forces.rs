@@ -497,3 +497,73 @@ fn stick_on_contact_stops_particles_where_they_touch() {
     assert_eq!(out[0].position().y, 0.0, "{:?}", out[0]);
     assert_eq!(out[0].velocity(), Vec3::ZERO);
 }
+
+/// The Inspect view's look inside: the particle under a pixel is found (the nearest one
+/// projected within the radius), and the forces reported on it are the force model's —
+/// the constant part, the drag toward the wind from its own velocity, and their sum.
+#[test]
+fn an_inspected_particle_reports_its_state_and_the_forces_on_it() {
+    let ctx = gpu();
+    let mut e = plain_emitter();
+    e.capacity = 256;
+    e.spawn_rate_per_sec = 50.0;
+    e.speed_m_per_s = Range::new(1.0, 2.0);
+    e.spread_deg = 30.0;
+    e.forces.gravity_m_per_s2 = [0.0, -9.81, 0.0];
+    e.forces.buoyancy_m_per_s2 = 4.0;
+    e.forces.drag_per_sec = 1.5;
+    e.forces.wind_m_per_s = [0.5, 0.0, 0.0];
+    e.transform.position_m = [3.0, 1.0, -2.0];
+    let effect = bare_effect(e);
+    let mut run =
+        ignis::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    for _ in 0..30 {
+        run.advance(1.0 / 60.0);
+    }
+    let camera = run.camera.view((640, 480));
+    let particles = run.player.particles(run.instance, 0).expect("particles");
+    let (slot, p) = particles
+        .iter()
+        .enumerate()
+        .find(|(_, p)| p.is_alive())
+        .expect("a living particle");
+    let info = run
+        .player
+        .inspect_particle(run.instance, 0, slot as u32)
+        .expect("inspect")
+        .expect("alive");
+    assert_eq!((info.emitter, info.slot), (0, slot as u32));
+    assert_eq!(info.age_secs, p.pos_age[3]);
+    assert_eq!(info.lifetime_secs, p.vel_life[3]);
+    assert_eq!(info.velocity_m_per_s, p.velocity());
+    // Positions are reported in the world (the pool is relative to the emitter).
+    assert!((info.position_m - (p.position() + Vec3::new(3.0, 1.0, -2.0))).length() < 1e-5);
+    let force = |name: &str| {
+        info.forces
+            .iter()
+            .find(|(n, _)| *n == name)
+            .unwrap_or_else(|| panic!("no {name} in {:?}", info.forces))
+            .1
+    };
+    let constant = Vec3::new(0.0, -9.81 + 4.0, 0.0);
+    let drag = -1.5 * (p.velocity() - Vec3::new(0.5, 0.0, 0.0));
+    assert!((force("gravity + buoyancy") - constant).length() < 1e-5);
+    assert!((force("drag") - drag).length() < 1e-4, "{:?}", info.forces);
+    assert!((force("total") - (constant + drag)).length() < 1e-4);
+    assert_eq!(info.forces.len(), 3, "{:?}", info.forces);
+    // Picking: the pixel the particle projects to finds it; far from every particle, none.
+    let clip = camera.clip_from_world_mat4() * info.position_m.extend(1.0);
+    let ndc = clip.truncate() / clip.w;
+    let pixel = glam::Vec2::new((ndc.x + 1.0) * 320.0, (1.0 - ndc.y) * 240.0);
+    let picked = run
+        .player
+        .pick_particle(run.instance, &camera, pixel, 0.5)
+        .expect("pick")
+        .expect("the particle under its pixel");
+    assert_eq!(picked.slot, slot as u32);
+    let none = run
+        .player
+        .pick_particle(run.instance, &camera, glam::Vec2::new(-500.0, -500.0), 8.0)
+        .expect("pick");
+    assert!(none.is_none());
+}

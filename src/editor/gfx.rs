@@ -345,6 +345,7 @@ impl Gfx {
             self.frame_camera(camera);
         }
         self.refresh_stats(state, false);
+        self.update_inspect(state, camera);
         self.log.record(tick, cpu);
         if self.log.index > 1 {
             state

@@ -7,6 +7,7 @@
 pub mod app;
 pub mod export_ui;
 mod gfx;
+pub mod inspect;
 pub mod look;
 pub mod measured;
 pub mod panel;

@@ -1422,6 +1422,12 @@ ui, "Ground grid", "Draw the y = 0 grid (0.5 m cells)", |ui| {
             |ui| ui.checkbox(&mut view.mouse_collider, ""),
         );
         row_ui(
+            ui,
+            "Inspect",
+            "Show the particle under the pointer — its slot, age, lifetime, position, velocity and the forces on it now; click one to pin it",
+            |ui| ui.checkbox(&mut view.inspect, ""),
+        );
+        row_ui(
 ui, "Shape gizmos", "Draw every emitter's spawn shape as a wireframe", |ui| {
             ui.checkbox(&mut view.show_gizmos, "")
         });

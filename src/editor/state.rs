@@ -23,6 +23,8 @@ pub struct ViewSettings {
     pub draft: bool,
     /// A sphere collider follows the pointer over the viewport: push the fire around.
     pub mouse_collider: bool,
+    /// Show the particle under the pointer (or the one clicked) and the forces on it.
+    pub inspect: bool,
 }
 
 impl Default for ViewSettings {
@@ -34,6 +36,7 @@ impl Default for ViewSettings {
             render_scale: 1.0,
             draft: false,
             mouse_collider: false,
+            inspect: false,
         }
     }
 }
@@ -97,6 +100,8 @@ pub struct EditorState {
     pub sim_error: Option<String>,
     /// The GPU device was lost and recreated (shown until dismissed).
     pub device_notice: Option<String>,
+    /// View ▸ Inspect: the particle looked at.
+    pub inspect: super::inspect::Inspect,
     /// Index of the emitter shown in the emitter-specific sections.
     pub selected: usize,
     /// Undo/redo of `effect`.
@@ -154,6 +159,7 @@ impl EditorState {
             open_sections: None,
             sim_error: None,
             device_notice: None,
+            inspect: Default::default(),
             shader_errors: Vec::new(),
             selected: 0,
             playback: Playback::default(),

@@ -99,6 +99,25 @@ pub fn viewport_ui(
         }
     }
     hud_ui(&painter, rect, state);
+    if state.view.inspect {
+        state.inspect.pointer = response.hover_pos().map(|p| {
+            let f = (p - rect.min) / rect.size().max(egui::vec2(1.0, 1.0));
+            [f.x, f.y]
+        });
+        if response.clicked() {
+            state.inspect.pin_requested = true;
+        }
+        if let Some(info) = &state.inspect.shown
+            && let Some(at) = projector.point(info.position_m)
+        {
+            painter.circle_stroke(
+                at,
+                7.0,
+                egui::Stroke::new(1.5, Color32::from_rgb(120, 220, 255)),
+            );
+        }
+        super::inspect::inspect_overlay(&painter, rect, state);
+    }
 
     let ppp = ui.ctx().pixels_per_point();
     let scale = state.view.render_scale.clamp(0.1, 1.0);
@@ -216,6 +235,12 @@ impl Projector {
             self.rect.left() + (ndc.x * 0.5 + 0.5) * self.rect.width(),
             self.rect.top() + (0.5 - ndc.y * 0.5) * self.rect.height(),
         )
+    }
+
+    /// Where a world point is on screen (`None` behind the camera).
+    pub fn point(&self, p: Vec3) -> Option<Pos2> {
+        let c = self.clip(p);
+        (c.w > 1e-6 && c.z >= 0.0).then(|| self.to_screen(c))
     }
 
     /// The screen segment of the world segment `a`–`b`, clipped at the near plane

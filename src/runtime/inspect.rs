@@ -199,7 +199,11 @@ impl Player {
     }
 
     /// `f` of the instance's state as the draw passes see it.
-    fn with_state<T>(&self, id: InstanceId, f: impl FnOnce(&dyn SimState) -> T) -> Option<T> {
+    pub(super) fn with_state<T>(
+        &self,
+        id: InstanceId,
+        f: impl FnOnce(&dyn SimState) -> T,
+    ) -> Option<T> {
         match &self.instances.get(id)?.state {
             Backing::Own(sim) => Some(f(sim.as_ref())),
             Backing::Batched { batch, slot } => {

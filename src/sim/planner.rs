@@ -450,6 +450,16 @@ impl EmitterPlanner {
         self.origin.unwrap_or_default()
     }
 
+    /// The parameter block a step of `e` starting at effect time `t_secs` would read (the
+    /// forces' settings, in this emitter's simulation space): what an inspection of a
+    /// particle evaluates the forces with.
+    pub fn params_now(&self, e: &Emitter, seed: u32, emitter_index: u32, t_secs: f64) -> SimParams {
+        let salt = rng::emitter_salt(emitter_index, e.seed_offset);
+        let mut p = static_params(e, self.origin(), seed, salt, e.capacity.max(1));
+        p.set_step(self.last_dt_secs as f32, t_secs, self.spawned_total, 0);
+        p
+    }
+
     /// The live window of the ring for drawing the last step: the last `len` spawns
     /// (slots `first_slot`, `first_slot + 1`, … modulo `capacity`) are the only ones that
     /// can hold a living particle — every earlier batch has outlived the longest lifetime
