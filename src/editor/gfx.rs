@@ -75,6 +75,8 @@ pub(super) struct Gfx {
     /// Watches the folders of the PNG sprites in use: a changed file is reloaded.
     /// (folders, their watcher).
     pub(super) sprite_watch: Option<(Vec<PathBuf>, Option<FileWatcher>)>,
+    /// The state view's textures (View ▸ State view).
+    pub(super) state_textures: Option<[egui::TextureHandle; 3]>,
     /// The export the Export section started, stepped a little every frame.
     pub(super) export: Option<crate::export::Export>,
 }
@@ -234,6 +236,7 @@ impl Gfx {
             shader_watch,
             sprite_watch: None,
             export: None,
+            state_textures: None,
         })
     }
 
@@ -256,6 +259,7 @@ impl Gfx {
         self.profiler.begin(&self.ctx);
         let raw_input = self.egui_state.take_egui_input(&self.window);
         let texture = self.viewport_texture;
+        let state_textures = &mut self.state_textures;
         let mut viewport = ViewportOutput::default();
         let mut output = self.egui_ctx.run_ui(raw_input, |ui| {
             egui::Panel::right("inspector")
@@ -269,6 +273,7 @@ impl Gfx {
             egui::CentralPanel::no_frame().show(ui, |ui| {
                 viewport = viewport_ui(ui, camera, state, texture);
             });
+            super::inspect::state_view_ui(ui.ctx(), state, state_textures);
             state.end_frame(ui.ctx());
         });
         let platform = std::mem::take(&mut output.platform_output);

@@ -1428,6 +1428,12 @@ ui, "Ground grid", "Draw the y = 0 grid (0.5 m cells)", |ui| {
             |ui| ui.checkbox(&mut view.inspect, ""),
         );
         row_ui(
+            ui,
+            "State view",
+            "The selected emitter's state buffer as images, one texel per slot: position, velocity and age as colours",
+            |ui| ui.checkbox(&mut view.state_view, ""),
+        );
+        row_ui(
 ui, "Shape gizmos", "Draw every emitter's spawn shape as a wireframe", |ui| {
             ui.checkbox(&mut view.show_gizmos, "")
         });

@@ -25,6 +25,8 @@ pub struct ViewSettings {
     pub mouse_collider: bool,
     /// Show the particle under the pointer (or the one clicked) and the forces on it.
     pub inspect: bool,
+    /// Show the selected emitter's state buffer as images.
+    pub state_view: bool,
 }
 
 impl Default for ViewSettings {
@@ -37,6 +39,7 @@ impl Default for ViewSettings {
             draft: false,
             mouse_collider: false,
             inspect: false,
+            state_view: false,
         }
     }
 }
