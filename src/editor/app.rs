@@ -1,11 +1,11 @@
 //! The editor window: winit's event loop and the frame loop.
 //!
-//! One frame, top to bottom ([`App::frame`]): the UI runs (edits land in
+//! One frame, top to bottom (`App::frame`): the UI runs (edits land in
 //! `EditorState::effect`, the valid ones in `running`); the player follows them and
 //! plans its steps; the viewport is drawn — the player's compute and draws into the
 //! composite's HDR target, bloom and tonemap, as `ignis render` does; egui's output is
 //! painted and presented. The viewport is a host of the public runtime API, as any
-//! program that embeds ignis. The steps live on [`Gfx`] (`gfx.rs`, `present.rs`); a lost
+//! program that embeds ignis. The steps live on `Gfx` (`gfx.rs`, `present.rs`); a lost
 //! GPU device is recreated here, keeping the effect and its undo history.
 
 use std::path::PathBuf;

@@ -48,7 +48,7 @@ pub enum PresetError {
         column: usize,
         /// The version the file declares.
         found: u64,
-        /// The newest version this build reads ([`CURRENT_VERSION`]).
+        /// The newest version this build reads ([`crate::effect::CURRENT_VERSION`]).
         supported: u32,
     },
     /// Values out of range. Every problem is listed, each on its own line, located in the

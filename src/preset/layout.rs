@@ -15,7 +15,7 @@ pub(super) const LINE_WIDTH: usize = 100;
 /// The RON text of an effect, laid out like a hand-written preset: named fields, enums by
 /// name, `Option`s without `Some(…)`, every field written out (so the file's meaning never
 /// depends on this build's defaults), small groups on one line and larger ones one field per
-/// line. [`parse_str`] reads it back to an equal effect.
+/// line. [`super::parse_str`] reads it back to an equal effect.
 pub fn to_ron(effect: &Effect) -> Result<String, PresetError> {
     let compact = ron_options()
         .to_string(effect)
