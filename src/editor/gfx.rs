@@ -315,8 +315,11 @@ impl Gfx {
         match pass_timer.as_mut().filter(|_| timing) {
             Some(t) => {
                 t.scope(&mut encoder, "update", |enc| player.simulate(enc));
+                t.scope(&mut encoder, "sort + splat", |enc| {
+                    player.record(enc, &camera, None)
+                });
                 t.scope(&mut encoder, "draw + composite", |enc| {
-                    composite.record(ctx, enc, player, &camera)
+                    composite.draw(ctx, enc, player, &camera)
                 });
                 t.end_frame(&mut encoder);
             }
@@ -332,6 +335,16 @@ impl Gfx {
             }
             t.poll(&self.ctx);
             state.stats.gpu_pass_ms = t.latest.clone();
+            if let Some(probe) = state.cost_probe.as_mut() {
+                match probe.frame(&state.stats.gpu_pass_ms) {
+                    super::emitter_cost::ProbeStep::Play(e) => state.probe_effect = Some(e),
+                    super::emitter_cost::ProbeStep::Done(_, costs) => {
+                        state.emitter_costs = costs;
+                        state.cost_probe = None;
+                        state.probe_effect = None;
+                    }
+                }
+            }
         }
         self.profiler.end_stage(&self.ctx);
         cpu
@@ -387,7 +400,8 @@ impl Gfx {
     /// Makes the player follow `state.running` (plus the mouse collider); on a GPU
     /// refusal, goes back to the last effect that worked. Returns whether it changed.
     pub(super) fn apply_running(&mut self, state: &mut EditorState) -> bool {
-        let wanted = super::state::with_mouse_collider(&state.running, state.mouse_point);
+        let base = state.probe_effect.as_ref().unwrap_or(&state.running);
+        let wanted = super::state::with_mouse_collider(base, state.mouse_point);
         if wanted == *self.player.effect() {
             return false;
         }

@@ -92,6 +92,13 @@ pub fn panel_ui(ui: &mut Ui, state: &mut EditorState) {
             });
             section_ui(ui, "stats", "Stats", "", (true, open("stats")), |ui| {
                 stats_ui(ui, &state.stats, &state.running);
+                super::emitter_cost::emitter_cost_ui(
+                    ui,
+                    &mut state.cost_probe,
+                    &state.emitter_costs,
+                    &state.running,
+                    !state.stats.gpu_pass_ms.is_empty(),
+                );
             });
             section_ui(ui, "export", "Export", "", (false, open("export")), |ui| {
                 super::export_ui::export_ui(ui, &mut state.export);

@@ -105,6 +105,12 @@ pub struct EditorState {
     pub device_notice: Option<String>,
     /// View ▸ Inspect: the particle looked at.
     pub inspect: super::inspect::Inspect,
+    /// Stats ▸ cost per emitter: the measurement in progress.
+    pub cost_probe: Option<super::emitter_cost::CostProbe>,
+    /// The effect the measurement plays now (instead of `running`).
+    pub probe_effect: Option<crate::effect::Effect>,
+    /// The last measurement's results.
+    pub emitter_costs: Vec<super::emitter_cost::EmitterCost>,
     /// Index of the emitter shown in the emitter-specific sections.
     pub selected: usize,
     /// Undo/redo of `effect`.
@@ -163,6 +169,9 @@ impl EditorState {
             sim_error: None,
             device_notice: None,
             inspect: Default::default(),
+            cost_probe: None,
+            probe_effect: None,
+            emitter_costs: Vec::new(),
             shader_errors: Vec::new(),
             selected: 0,
             playback: Playback::default(),

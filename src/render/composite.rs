@@ -93,6 +93,18 @@ impl Composite {
         camera: &Camera,
     ) {
         player.record(enc, camera, None);
+        self.draw(ctx, enc, player, camera);
+    }
+
+    /// [`Composite::record`] after the player's `record` for `camera` (timed apart by
+    /// the editor): its layers into the HDR target, then the bloom and tonemap.
+    pub fn draw(
+        &mut self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        player: &mut Player,
+        camera: &Camera,
+    ) {
         let size = self.targets(ctx, camera.size_px()).size;
         let post = player.effect().post.clone();
         let drawn = player.drawn_layers();
