@@ -36,9 +36,11 @@ fn state(run: &Headless) -> Vec<Vec<u8>> {
         .collect()
 }
 
-/// For every shipped preset: the states at 1 s and 2 s played frame by frame at 60 fps;
-/// then from 2 s a seek back to 1 s, and from there a seek forward to 2 s, each
-/// bit-identical to the played state. Frame-delta presets replay the same frame times.
+/// For every shipped preset: the states at 1 s, 2 s and 3 s played frame by frame at
+/// 60 fps, with snapshots every 0.75 s (a fixed-step seek starts from the latest one at or
+/// before its target); then, from 3 s, seeks back to each — across snapshot boundaries
+/// and between them — each bit-identical to the played state. Frame-delta presets
+/// replay the same frame times.
 #[test]
 fn seeking_gives_the_played_state_bit_for_bit_for_every_shipped_preset() {
     let ctx = gpu();
@@ -48,19 +50,21 @@ fn seeking_gives_the_played_state_bit_for_bit_for_every_shipped_preset() {
         let effect = ignis::preset::load(&path).expect("a shipped preset loads");
         let settings = ignis::PlayerSettings {
             asset_dir: path.parent().map(std::path::Path::to_path_buf),
+            batch_instances: false,
             ..ignis::render::Composite::player_settings()
         };
         let mut run = Headless::with_settings(&ctx, effect, ShaderLibrary::embedded(), settings)
             .expect("headless");
+        run.player.keep_seek_snapshots(0.75, 256 << 20);
         let mut played = Vec::new();
-        for second in 1..=2 {
+        for second in 1..=3 {
             for _ in 0..FPS as usize {
                 run.advance(1.0 / FPS);
             }
             played.push((second, state(&run)));
         }
         let name = path.display();
-        for (second, want) in &played {
+        for (second, want) in played.iter().rev() {
             let frames = run.seek(f64::from(*second), 1.0 / FPS);
             assert_eq!(frames, *second as u64 * FPS as u64, "{name}");
             let got = state(&run);
