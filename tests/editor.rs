@@ -1313,7 +1313,7 @@ fn the_timeline_seeks_in_whole_steps() {
         "{t} is a whole step"
     );
     harness.state_mut().playback.seek_to = None;
-    harness.get_by_label("< Step").click();
+    harness.get_by_label("Step back").click();
     harness.run();
     let back = harness.state().playback.seek_to.expect("a step back");
     assert!((back - (1.0 - step)).abs() < 1e-9, "{back}");

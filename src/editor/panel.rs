@@ -1188,28 +1188,7 @@ fn collisions_ui(ui: &mut Ui, col: &mut Collisions) {
 /// Time stepping, playback and the integrator of each emitter with its stability hint.
 pub fn time_ui(ui: &mut Ui, effect: &mut Effect, playback: &mut Playback, selected: usize) {
     ui.horizontal(|ui| {
-        let pause_text = if playback.is_paused { "Play" } else { "Pause" };
-        if ui
-            .button(pause_text)
-            .on_hover_text("Pause or resume the simulation (Space)")
-            .clicked()
-        {
-            playback.is_paused = !playback.is_paused;
-        }
-        if ui
-            .button("Step")
-            .on_hover_text("Run one step and pause (.)")
-            .clicked()
-        {
-            playback.step_requested = true;
-        }
-        if ui
-            .button("Restart")
-            .on_hover_text("Kill every particle and restart time (R)")
-            .clicked()
-        {
-            playback.restart_requested = true;
-        }
+        super::timeline::playback_buttons_ui(ui, playback);
         if playback.is_paused {
             ui.colored_label(Color32::from_rgb(240, 200, 90), "paused");
         }

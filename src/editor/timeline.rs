@@ -57,6 +57,32 @@ fn step_secs(effect: &Effect) -> f64 {
     }
 }
 
+/// Play/Pause, Step and Restart (the timeline's and the Time section's).
+pub fn playback_buttons_ui(ui: &mut Ui, playback: &mut super::state::Playback) {
+    let pause_text = if playback.is_paused { "Play" } else { "Pause" };
+    if ui
+        .button(pause_text)
+        .on_hover_text("Pause or resume the simulation (Space)")
+        .clicked()
+    {
+        playback.is_paused = !playback.is_paused;
+    }
+    if ui
+        .button("Step")
+        .on_hover_text("Run one step and pause (.)")
+        .clicked()
+    {
+        playback.step_requested = true;
+    }
+    if ui
+        .button("Restart")
+        .on_hover_text("Kill every particle and restart time (R)")
+        .clicked()
+    {
+        playback.restart_requested = true;
+    }
+}
+
 /// The timeline strip.
 pub fn timeline_ui(ui: &mut Ui, state: &mut EditorState) {
     let now = state.stats.sim_time_secs;
@@ -64,30 +90,13 @@ pub fn timeline_ui(ui: &mut Ui, state: &mut EditorState) {
     let step = step_secs(&state.running);
     let playback = &mut state.playback;
     ui.horizontal(|ui| {
-        if ui.button("Restart").on_hover_text("Restart (R)").clicked() {
-            playback.restart_requested = true;
-        }
+        playback_buttons_ui(ui, playback);
         if ui
-            .button("< Step")
+            .button("Step back")
             .on_hover_text("One step back (replayed from the start)")
             .clicked()
         {
             playback.seek_to = Some((now - step).max(0.0));
-        }
-        let play = if playback.is_paused { "Play" } else { "Pause" };
-        if ui
-            .button(play)
-            .on_hover_text("Play or pause (Space)")
-            .clicked()
-        {
-            playback.is_paused = !playback.is_paused;
-        }
-        if ui
-            .button("Step >")
-            .on_hover_text("One step forward (.)")
-            .clicked()
-        {
-            playback.step_requested = true;
         }
         ui.add(
             egui::DragValue::new(&mut playback.speed)
