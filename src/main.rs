@@ -18,13 +18,12 @@ struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
     /// The choices that differ between GPUs and software adapters (render scale, draft
-    /// layers, parameter bindings, quad topology, UI painter): gpu or software (default:
+    /// glow, UI painter, retained window, timestamps): gpu or software (default:
     /// from the adapter's type).
     #[arg(long, global = true)]
     adapter_profile: Option<ProfileArg>,
     /// Set single fields of the adapter profile, comma-separated FIELD=VALUE (fields:
-    /// params_in_storage, count_in_update, direct_atomic_counts, indexed_quads,
-    /// timestamps, render_scale, draft, lean_painter, retained_window, reuse_ui).
+    /// timestamps, render_scale, draft, lean_painter, retained_window).
     #[arg(long, global = true, value_delimiter = ',')]
     adapt: Vec<ProfileSetting>,
 }
@@ -362,6 +361,9 @@ fn render(
     }
     if !(start.is_finite() && (0.0..=86_400.0).contains(&start)) {
         bail!("--start must be a time in seconds between 0 and 86400, got {start}");
+    }
+    if start * fps > 10_000_000.0 {
+        bail!("--start {start} at --fps {fps} is more than 10 million frames to simulate");
     }
     let mut effect = load_effect(preset)?;
     if let Some(s) = seed {

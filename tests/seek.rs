@@ -217,3 +217,36 @@ fn replaying_the_played_frames_reaches_the_played_state_in_frame_delta_mode() {
         "frame times must matter in frame-delta mode"
     );
 }
+
+/// An edit forgets the snapshots and takes none of the state simulated before it: a later
+/// seek gives what playing the edited effect from the start gives. Seeking in frames of
+/// one step lands on every step (the editor's step back).
+#[test]
+fn an_edit_forgets_the_snapshots_and_seeks_land_on_steps() {
+    let ctx = gpu();
+    let effect = ignis::Effect::default_campfire();
+    let mut edited = effect.clone();
+    edited.emitters[1].spawn_rate_per_sec *= 1.5;
+    let mut run = unbatched(&ctx, effect);
+    run.player.keep_seek_snapshots(0.25, 64 << 20);
+    for _ in 0..120 {
+        run.advance(1.0 / FPS);
+    }
+    run.player.set_effect(&edited).expect("the edit");
+    for _ in 0..60 {
+        run.advance(1.0 / FPS);
+    }
+    run.seek(2.5, 1.0 / FPS);
+    let mut fresh = unbatched(&ctx, edited);
+    for _ in 0..150 {
+        fresh.advance(1.0 / FPS);
+    }
+    assert!(state(&run) == state(&fresh), "a seek after an edit");
+
+    let step = f64::from(run.effect().time.step_secs);
+    for k in [1u32, 119, 120, 121] {
+        run.seek(f64::from(k) * step, step);
+        let t = run.player.time_secs(run.instance).expect("time");
+        assert!((t - f64::from(k) * step).abs() < 1e-9, "step {k}: at {t} s");
+    }
+}

@@ -244,6 +244,9 @@ impl App {
             .context("recreating the GPU device after it was lost")?;
         gfx.log = log;
         self.devices_recreated += 1;
+        // The new player starts at time 0: nothing is parked, no frames were played.
+        self.state.playback.parked_at = None;
+        self.state.playback.frame_times.clear();
         self.state.device_notice = Some(format!(
             "The GPU device was lost ({reason}) and has been recreated; the effect and its \
              undo history were kept."

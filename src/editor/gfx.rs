@@ -28,8 +28,8 @@ use super::viewport::{ViewportOutput, emitter_bounds, frame_bounds, viewport_ui}
 /// Read the GPU's alive counters every this many frames (a blocking readback).
 const COUNTER_INTERVAL_FRAMES: u64 = 15;
 
-/// Simulated time between the timeline's snapshots (a seek replays at most this much
-/// until the memory bound thins them out).
+/// Simulated time between the timeline's snapshots (a seek replays about this much at
+/// most, once the state has been played or replayed since the last edit).
 const SEEK_SNAPSHOT_SECS: f64 = 2.0;
 
 /// GPU memory the timeline's snapshots may take.
@@ -76,7 +76,7 @@ pub(super) struct Gfx {
     /// (folders, their watcher).
     pub(super) sprite_watch: Option<(Vec<PathBuf>, Option<FileWatcher>)>,
     /// The state view's textures (View ▸ State view).
-    pub(super) state_textures: Option<[egui::TextureHandle; 3]>,
+    pub(super) state_textures: Option<([egui::TextureHandle; 3], u64)>,
     /// The export the Export section started, stepped a little every frame.
     pub(super) export: Option<crate::export::Export>,
 }
@@ -406,6 +406,8 @@ impl Gfx {
             return false;
         }
         match self.player.set_effect(&wanted) {
+            // A cost measurement's effect is not one to fall back to.
+            Ok(()) if state.probe_effect.is_some() => {}
             Ok(()) => self.gpu_effect.clone_from(&state.running),
             Err(err) => {
                 log::warn!("effect refused by the GPU: {err}");
@@ -422,13 +424,14 @@ impl Gfx {
 
     /// Rebuilds the pipelines whose shaders changed on disk; a failure keeps the last
     /// good pipeline and shows the error (file, line, caret) in the panel.
-    pub(super) fn reload_changed_shaders(&mut self, state: &mut EditorState) {
+    /// Returns whether a pipeline was rebuilt.
+    pub(super) fn reload_changed_shaders(&mut self, state: &mut EditorState) -> bool {
         let Some(watch) = &mut self.shader_watch else {
-            return;
+            return false;
         };
         let changed = wgsl_names(&watch.watcher.poll());
         if changed.is_empty() {
-            return;
+            return false;
         }
         let noticed = Instant::now();
         let report = watch.reloader.reload(
@@ -452,6 +455,7 @@ impl Gfx {
             .map(|e| e.to_string())
             .collect();
         let succeeded = report.failed.is_empty() && !report.rebuilt.is_empty();
+        let rebuilt = !report.rebuilt.is_empty();
         state.stats.shader_reload = Some(ShaderReloadStats {
             changed,
             latency_secs: succeeded
@@ -461,14 +465,15 @@ impl Gfx {
             rebuilt: report.rebuilt,
             failed: report.failed,
         });
+        rebuilt
     }
 
     /// Step 2, simulate: the player follows the running effect (and changed shaders) and
     /// plans this frame's steps, recorded with the viewport; an export in progress takes
     /// its share of the frame.
     pub(super) fn simulate(&mut self, state: &mut EditorState, frame_dt_secs: f64) {
-        self.reload_changed_shaders(state);
-        let edited = self.apply_running(state);
+        let reloaded = self.reload_changed_shaders(state);
+        let edited = self.apply_running(state) || reloaded;
         let playback = &mut state.playback;
         if playback.restart_requested {
             playback.restart_requested = false;
@@ -492,7 +497,15 @@ impl Gfx {
         if playback.step_requested {
             playback.step_requested = false;
             playback.is_paused = true;
-            self.player.step();
+            match playback.parked_at {
+                // Parked after a seek: a seek one step later (an edit then keeps it).
+                Some(t) => {
+                    let t = t + super::timeline::step_secs(self.player.effect());
+                    playback.parked_at = Some(t);
+                    self.seek(playback, t);
+                }
+                None => self.player.step(),
+            }
         }
         self.player.set_paused(playback.is_paused);
         let dt = frame_dt_secs * f64::from(playback.speed.clamp(0.05, 8.0));
@@ -520,13 +533,16 @@ impl Gfx {
     /// a frame-delta effect replays the frames played so far up to `t` (then 1/60 s
     /// frames), the only way to reach the same state.
     fn seek(&mut self, playback: &mut super::state::Playback, t: f64) {
-        let dt = super::timeline::SEEK_FRAME_DT_SECS;
-        if self.player.effect().time.mode == crate::effect::TimeMode::FixedStep {
-            self.player.seek(t, dt);
+        let time = self.player.effect().time.clone();
+        let speed = f64::from(time.speed).max(1e-6);
+        if time.mode == crate::effect::TimeMode::FixedStep {
+            // One frame per step: the seek lands on the step nearest `t`.
+            let step = f64::from(time.step_secs);
+            self.player.seek(t / speed, step / speed);
             playback.frame_times.clear();
             return;
         }
-        let frames = super::timeline::frames_until(&playback.frame_times, t, dt);
+        let frames = super::timeline::frames_until(&playback.frame_times, t, &time);
         self.player.replay(&frames);
         playback.frame_times = frames;
     }

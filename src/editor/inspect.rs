@@ -25,6 +25,8 @@ const STATE_VIEW_EVERY_FRAMES: u64 = 10;
 pub struct StateImages {
     /// The emitter shown.
     pub emitter: usize,
+    /// The frame it was read back on (the textures are uploaded once per readback).
+    pub frame: u64,
     /// Position (each axis scaled over the living particles' extent), velocity (0.5 + v /
     /// 2·max speed) and age as a fraction of the lifetime; dead slots dark.
     pub images: [egui::ColorImage; 3],
@@ -35,7 +37,7 @@ const DEAD: Color32 = Color32::from_rgb(18, 18, 26);
 
 impl StateImages {
     /// The images of `particles` (emitter `emitter`'s pool, in slot order).
-    pub fn of(emitter: usize, particles: &[crate::gpu::types::Particle]) -> Self {
+    pub fn of(emitter: usize, frame: u64, particles: &[crate::gpu::types::Particle]) -> Self {
         let n = particles.len().max(1);
         let w = (n as f64).sqrt().ceil() as usize;
         let h = n.div_ceil(w);
@@ -67,7 +69,11 @@ impl StateImages {
                 image.pixels[k] = t;
             }
         }
-        Self { emitter, images }
+        Self {
+            emitter,
+            frame,
+            images,
+        }
     }
 }
 
@@ -146,7 +152,9 @@ impl Gfx {
             return;
         }
         match self.player.particles(self.instance, e) {
-            Ok(particles) => state.inspect.state_images = Some(StateImages::of(e, &particles)),
+            Ok(particles) => {
+                state.inspect.state_images = Some(StateImages::of(e, self.log.index, &particles));
+            }
             Err(err) => log::warn!("reading the state of emitter {e}: {err}"),
         }
     }
@@ -156,7 +164,7 @@ impl Gfx {
 pub fn state_view_ui(
     ctx: &egui::Context,
     state: &mut EditorState,
-    textures: &mut Option<[egui::TextureHandle; 3]>,
+    textures: &mut Option<([egui::TextureHandle; 3], u64)>,
 ) {
     let Some(images) = &state.inspect.state_images else {
         *textures = None;
@@ -164,11 +172,16 @@ pub fn state_view_ui(
     };
     let names = ["position", "velocity", "age"];
     let options = egui::TextureOptions::NEAREST;
-    let handles = textures.get_or_insert_with(|| {
-        std::array::from_fn(|i| ctx.load_texture(names[i], images.images[i].clone(), options))
+    let (handles, uploaded) = textures.get_or_insert_with(|| {
+        let handles =
+            std::array::from_fn(|i| ctx.load_texture(names[i], images.images[i].clone(), options));
+        (handles, images.frame)
     });
-    for (h, image) in handles.iter_mut().zip(&images.images) {
-        h.set(image.clone(), options);
+    if *uploaded != images.frame {
+        for (h, image) in handles.iter_mut().zip(&images.images) {
+            h.set(image.clone(), options);
+        }
+        *uploaded = images.frame;
     }
     let name = state
         .running
@@ -264,7 +277,7 @@ mod tests {
             dead,
             particle([0.5, 1.0, 2.0], [0.0, -1.0, 0.0], 1.5, 2.0),
         ];
-        let s = StateImages::of(3, &particles);
+        let s = StateImages::of(3, 7, &particles);
         let [pos, vel, age] = &s.images;
         assert_eq!((s.emitter, pos.size), (3, [3, 2]));
         assert_eq!(pos.pixels[0], Color32::from_rgb(0, 0, 0));

@@ -1,9 +1,9 @@
-//! The timeline under the viewport: play/pause, restart, a step back and forward, the
-//! playback speed, a loop region, and a scrub bar over the effect's time with its bursts
-//! marked. Dragging or clicking the bar
-//! seeks: the player replays from the start to that time as fast as the GPU goes
-//! (`Player::seek`), so the state shown is exactly the one playing would reach. While
-//! parked (paused after a seek), an edit re-simulates to the same time.
+//! The timeline under the viewport: play/pause, step, restart, a step back, the playback
+//! speed, a loop region, and a scrub bar over the effect's time with its bursts marked.
+//! Dragging or clicking the bar seeks: the player replays to that time as fast as the GPU
+//! goes (`Player::seek`: from the nearest earlier snapshot with fixed steps; a frame-delta
+//! effect replays the frames played), so the state shown is exactly the one playing would
+//! reach. While parked (paused after a seek), an edit re-simulates to the same time.
 
 use egui::{Color32, Sense, Stroke, Ui, vec2};
 
@@ -30,27 +30,33 @@ pub fn span_secs(effect: &Effect) -> f64 {
     (last_burst + longest).max(1.0)
 }
 
-/// The frames of `played` whose end is at or before `t` (to within a microsecond), then
-/// frames of `dt` up to `t`: what a frame-delta effect replays to reach `t`.
-pub fn frames_until(played: &[f64], t: f64, dt: f64) -> Vec<f64> {
+/// The frames of `played` (wall-clock durations) that end at or before simulated time `t`
+/// (to within a microsecond), then 1/60 s frames up to `t`: what a frame-delta effect
+/// replays to reach `t`. A frame's simulated time is its duration times the effect's
+/// speed, clamped to its longest frame (as the player steps it).
+pub fn frames_until(played: &[f64], t: f64, time: &crate::effect::TimeSettings) -> Vec<f64> {
+    let sim = |d: f64| (d * f64::from(time.speed)).min(f64::from(time.max_frame_dt_secs));
     let mut out = Vec::new();
     let mut end = 0.0;
     for &d in played {
-        if end + d > t + 1e-6 {
+        if end + sim(d) > t + 1e-6 {
             break;
         }
-        end += d;
+        end += sim(d);
         out.push(d);
     }
-    while end + dt <= t + 1e-6 {
-        end += dt;
-        out.push(dt);
+    let dt = SEEK_FRAME_DT_SECS;
+    if sim(dt) > 0.0 {
+        while end + sim(dt) <= t + 1e-6 && out.len() < 10_000_000 {
+            end += sim(dt);
+            out.push(dt);
+        }
     }
     out
 }
 
 /// One step of the effect's clock (a frame in frame-delta mode).
-fn step_secs(effect: &Effect) -> f64 {
+pub fn step_secs(effect: &Effect) -> f64 {
     match effect.time.mode {
         TimeMode::FixedStep => f64::from(effect.time.step_secs),
         TimeMode::FrameDelta => SEEK_FRAME_DT_SECS,
@@ -164,7 +170,7 @@ pub fn timeline_ui(ui: &mut Ui, state: &mut EditorState) {
             && (response.clicked() || response.dragged())
         {
             let t = f64::from((p.x - rect.left()) / rect.width()).clamp(0.0, 1.0) * span;
-            // Whole steps: the state at a step is what a seek can reproduce exactly.
+            // Whole steps (the editor's seeks land on steps).
             playback.seek_to = Some((t / step).round() * step);
         }
         response.on_hover_text(format!(
@@ -179,12 +185,24 @@ mod tests {
 
     #[test]
     fn frame_delta_seeks_replay_the_played_frames_then_sixtieths() {
+        let mut time = crate::effect::TimeSettings {
+            mode: TimeMode::FrameDelta,
+            ..Default::default()
+        };
+        time.speed = 1.0;
+        time.max_frame_dt_secs = 1.0;
         let played = [0.02, 0.015, 0.03, 0.01];
-        assert_eq!(frames_until(&played, 0.035, 0.5), [0.02, 0.015]);
-        assert_eq!(frames_until(&played, 0.0, 0.5), Vec::<f64>::new());
-        let beyond = frames_until(&played, 0.075 + 2.0 / 60.0, 1.0 / 60.0);
+        assert_eq!(frames_until(&played, 0.035, &time), [0.02, 0.015]);
+        assert_eq!(frames_until(&played, 0.0, &time), Vec::<f64>::new());
+        let beyond = frames_until(&played, 0.075 + 2.0 / 60.0, &time);
         assert_eq!(&beyond[..4], &played);
         assert_eq!(beyond.len(), 6);
+        // Simulated time: the speed scales each frame, the longest frame clamps it.
+        time.speed = 2.0;
+        assert_eq!(frames_until(&played, 0.07, &time), [0.02, 0.015]);
+        time.speed = 1.0;
+        time.max_frame_dt_secs = 0.012;
+        assert_eq!(frames_until(&played, 0.036, &time), [0.02, 0.015, 0.03]);
     }
 
     #[test]

@@ -166,7 +166,9 @@ impl Player {
         let lib = ShaderLibrary::from_dir(dir);
         match entry {
             "update.wgsl" | "count.wgsl" => {
-                lock(&self.update).rebuild(&self.ctx, &lib, &used_keys(&self.effect))?
+                lock(&self.update).rebuild(&self.ctx, &lib, &used_keys(&self.effect))?;
+                // The state snapshots were simulated by the old update.
+                self.snapshots.clear();
             }
             "billboard.wgsl" => self.billboard.rebuild(&self.ctx, &lib)?,
             "splat.wgsl" => self.splat.rebuild(&self.ctx, &lib)?,

@@ -80,23 +80,24 @@ impl Player {
         }
     }
 
-    /// Particle `slot` of emitter `emitter` in instance `id`, if it is alive.
+    /// Particle `slot` of emitter `emitter` in instance `id`, if it is alive (`None` also
+    /// for an emitter or slot the effect does not have).
     pub fn inspect_particle(
         &self,
         id: InstanceId,
         emitter: usize,
         slot: u32,
     ) -> Result<Option<ParticleInfo>, PlayerError> {
-        let e = self
-            .effect
-            .emitters
-            .get(emitter)
-            .ok_or(PlayerError::NoInstance)?;
+        // The instance's own emitter: its seed, and its place in the world.
+        let placed = self.instance_effect(id).ok_or(PlayerError::NoInstance)?;
+        let Some(e) = placed.emitters.get(emitter) else {
+            return Ok(None);
+        };
         let particles = self.particles(id, emitter)?;
         let Some(p) = particles.get(slot as usize).filter(|p| p.is_alive()) else {
             return Ok(None);
         };
-        let seed = self.instance_effect(id).map_or(0, |i| i.seed);
+        let seed = placed.seed;
         let params = self
             .with_state(id, |s| {
                 let planner = s.planner();

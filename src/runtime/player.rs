@@ -336,6 +336,7 @@ impl Player {
         self.stepper.reset();
         self.pending = (0, 0.0);
         self.alpha = 1.0;
+        self.snapshots.restarted();
     }
 
     /// Records this frame's compute work into the host's encoder — the planned steps of

@@ -1,7 +1,8 @@
 //! Seeking: [`Player::seek`] puts the clock at any time with the state playing there would
 //! reach. It replays the steps as fast as the GPU goes, from the start or — with fixed
 //! steps and [`Player::keep_seek_snapshots`] — from the latest snapshot at or before the
-//! target. A snapshot is every instance's state after a step (GPU copies of its buffers
+//! target. Snapshots are taken only of a state simulated from time 0 under the current
+//! effect (after a restart or a seek, until the next change). A snapshot is every instance's state after a step (GPU copies of its buffers
 //! and its planning); with fixed steps the state after step `n` does not depend on the
 //! frames that got there, so snapshots taken while playing at any rate serve any seek.
 
@@ -16,11 +17,19 @@ use super::player::{MAX_STEPS_PER_RECORD, Player};
 /// flight).
 const SUBMITS_PER_WAIT: u64 = 32;
 
+/// Frames one seek replays at most (a seek beyond is cut there).
+const MAX_SEEK_FRAMES: u64 = 10_000_000;
+
 /// The snapshots a player keeps, and when the next is due.
 #[derive(Default)]
 pub(super) struct SeekSnapshots {
     /// Steps between snapshots (0: none are kept).
     every_steps: u64,
+    /// `every_steps` as asked (the memory bound doubles `every_steps`; a clear resets it).
+    asked_steps: u64,
+    /// The state is all of the current effect: simulated from time 0 (a restart or a
+    /// seek) since the last change. Snapshots are taken only then.
+    clean: bool,
     /// GPU memory the snapshots may take.
     max_bytes: u64,
     /// Oldest first, each with the step after which it was taken.
@@ -28,9 +37,17 @@ pub(super) struct SeekSnapshots {
 }
 
 impl SeekSnapshots {
-    /// Forgets every snapshot (the effect, a seed or the instances changed).
+    /// Forgets every snapshot (the effect, a seed, a shader or the instances changed):
+    /// none is taken again until the clock restarts from time 0.
     pub(super) fn clear(&mut self) {
         self.list.clear();
+        self.every_steps = self.asked_steps;
+        self.clean = false;
+    }
+
+    /// The clock went back to time 0 under the current effect: snapshots may be taken.
+    pub(super) fn restarted(&mut self) {
+        self.clean = true;
     }
 
     fn bytes(&self) -> u64 {
@@ -50,15 +67,22 @@ impl Player {
     /// forgotten when the effect, a seed or the instances change.
     pub fn keep_seek_snapshots(&mut self, every_secs: f64, max_bytes: u64) {
         let step = f64::from(self.effect.time.step_secs).max(1e-6);
+        let every_steps = if every_secs > 0.0 && every_secs.is_finite() {
+            (every_secs / step).round().clamp(1.0, 1e12) as u64
+        } else {
+            0
+        };
         self.snapshots = SeekSnapshots {
-            every_steps: if every_secs > 0.0 {
-                (every_secs / step).round().max(1.0) as u64
-            } else {
-                0
-            },
+            every_steps,
+            asked_steps: every_steps,
+            clean: false,
             max_bytes,
             list: Vec::new(),
         };
+        // A player still at time 0 may take snapshots from now; else from its next restart.
+        if self.steps_done().is_none_or(|s| s == 0) {
+            self.snapshots.restarted();
+        }
     }
 
     /// GPU memory the seek snapshots hold now, and how many there are.
@@ -69,7 +93,7 @@ impl Player {
     /// Whether snapshots can stand for this player's state: fixed steps, and every
     /// instance with a simulation of its own.
     fn snapshots_apply(&self) -> bool {
-        self.snapshots.every_steps > 0
+        self.snapshots.asked_steps > 0
             && self.effect.time.mode == TimeMode::FixedStep
             && self
                 .instances
@@ -87,7 +111,7 @@ impl Player {
 
     /// After a record's steps: a snapshot when one is due (copies recorded into `enc`).
     pub(super) fn take_snapshot_if_due(&mut self, enc: &mut wgpu::CommandEncoder) {
-        if !self.snapshots_apply() {
+        if !self.snapshots_apply() || !self.snapshots.clean {
             return;
         }
         let Some(step) = self.steps_done() else {
@@ -127,17 +151,15 @@ impl Player {
     /// interpolation. The pause is kept. Returns the frames the seek stands for.
     pub fn seek(&mut self, secs: f64, frame_dt_secs: f64) -> u64 {
         let was_paused = std::mem::replace(&mut self.is_paused, false);
-        let frames = if secs > 0.0 && frame_dt_secs > 0.0 {
-            (secs / frame_dt_secs).round() as u64
+        let frames = if secs > 0.0 && frame_dt_secs > 0.0 && secs.is_finite() {
+            ((secs / frame_dt_secs).round() as u64).min(MAX_SEEK_FRAMES)
         } else {
             0
         };
         if self.snapshots_apply() {
             self.seek_fixed_steps(frames, frame_dt_secs);
         } else {
-            self.is_paused = was_paused;
-            let frame_dts = vec![frame_dt_secs; frames as usize];
-            self.replay(&frame_dts);
+            self.replay_frames((0..frames).map(|_| frame_dt_secs));
         }
         self.simulated = false;
         self.is_paused = was_paused;
@@ -149,10 +171,16 @@ impl Player {
     /// bit for bit, whatever the time mode — the way to seek a frame-delta effect, whose
     /// state depends on every frame's duration. The pause is kept.
     pub fn replay(&mut self, frame_dts_secs: &[f64]) {
+        self.replay_frames(frame_dts_secs.iter().copied());
+    }
+
+    /// [`Player::replay`] over any sequence of frame durations.
+    fn replay_frames(&mut self, frame_dts_secs: impl Iterator<Item = f64>) {
         let was_paused = std::mem::replace(&mut self.is_paused, false);
         self.restart();
-        for (frame, dt) in frame_dts_secs.iter().enumerate() {
-            self.advance(*dt);
+        self.snapshots.clean = true;
+        for (frame, dt) in frame_dts_secs.enumerate() {
+            self.advance(dt);
             self.submit_steps(frame as u64);
         }
         self.simulated = false;
@@ -162,14 +190,16 @@ impl Player {
     /// [`Player::seek`] with fixed steps: the steps those frames take (counted on the CPU),
     /// replayed from the latest snapshot at or before them.
     fn seek_fixed_steps(&mut self, frames: u64, frame_dt_secs: f64) {
+        // Each frame runs its steps, as many as a record takes (as playing does).
         let mut stepper = Stepper::default();
         let (mut steps, mut alpha) = (0u64, 1.0);
         for _ in 0..frames {
             let plan = stepper.advance(frame_dt_secs, &self.effect.time);
-            steps += u64::from(plan.steps);
+            steps += u64::from(plan.steps.min(MAX_STEPS_PER_RECORD));
             alpha = plan.alpha;
         }
         self.restart();
+        self.snapshots.clean = true;
         let from = self.restore_latest(steps);
         let dt = self.effect.time.step_secs;
         let mut done = from;
