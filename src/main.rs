@@ -132,8 +132,9 @@ enum Command {
     /// Export a flipbook or an image sequence for game engines: real alpha, emissive and
     /// motion-vector passes, seamless loops, a JSON sidecar.
     Export(ignis::export::cli::ExportArgs),
-    /// Measure: `accuracy` (integrators' error vs cost), `perf` (throughput), `runtime`
-    /// (instances in a host's frame), `export` or `adapters` (software adaptations).
+    /// Measure: `accuracy` (integrators' error vs cost), `perf` (throughput), `presets`
+    /// (the shipped effects), `runtime` (instances in a host's frame), `export` or
+    /// `adapters` (software adaptations).
     Bench {
         #[command(subcommand)]
         kind: BenchKind,
@@ -147,6 +148,24 @@ enum Command {
 
 #[derive(Subcommand)]
 enum BenchKind {
+    /// Every shipped preset in steady state at 1080p and 4K: update, sort, draw and
+    /// composite times, with each draw path forced in the same run.
+    Presets {
+        /// Preset files or folders (default: presets/).
+        paths: Vec<PathBuf>,
+        /// Render sizes, comma-separated WxH.
+        #[arg(long, value_delimiter = ',', default_value = "1920x1080,3840x2160", value_parser = parse_size)]
+        sizes: Vec<(u32, u32)>,
+        /// Timed frames per row (medians are reported).
+        #[arg(long, default_value_t = 15)]
+        frames: usize,
+        /// Output folder.
+        #[arg(long, default_value = "bench/results")]
+        out: PathBuf,
+        /// File name stem (default: presets-<adapter>).
+        #[arg(long)]
+        name: Option<String>,
+    },
     /// What each software-adapter adaptation takes off the editor's frame: interleaved
     /// editor runs with and without it (needs a display: run under xvfb-run).
     Adapters {
@@ -489,6 +508,39 @@ fn adapter_tag(ctx: &GpuContext) -> String {
 fn bench(kind: BenchKind, profile: &ProfileRequest) -> anyhow::Result<()> {
     let ctx = context(profile)?;
     match kind {
+        BenchKind::Presets {
+            paths,
+            sizes,
+            frames,
+            out,
+            name,
+        } => {
+            let paths = if paths.is_empty() {
+                vec![PathBuf::from("presets")]
+            } else {
+                paths
+            };
+            let presets = paths
+                .iter()
+                .flat_map(|p| {
+                    if p.is_dir() {
+                        ignis::preset::list(p)
+                    } else {
+                        vec![p.clone()]
+                    }
+                })
+                .collect();
+            let opts = ignis::bench::presets::PresetsOptions {
+                presets,
+                sizes,
+                frames: frames.max(1),
+            };
+            let report = ignis::bench::presets::run(&ctx, &opts)?;
+            let name = name.unwrap_or_else(|| format!("presets-{}", adapter_tag(&ctx)));
+            report.save(&out, &name)?;
+            println!("{}", report.markdown);
+            println!("wrote {}/{name}.md and .json", out.display());
+        }
         BenchKind::Adapters {
             preset,
             frames,

@@ -5,6 +5,7 @@ pub mod accuracy;
 pub mod adapters;
 pub mod export;
 pub mod perf;
+pub mod presets;
 pub mod report;
 pub mod runtime;
 

@@ -105,6 +105,19 @@ impl Composite {
         player: &mut Player,
         camera: &Camera,
     ) {
+        let layered = self.draw_particles(ctx, enc, player, camera);
+        self.post(ctx, enc, player, layered);
+    }
+
+    /// The particle draws of [`Composite::draw`] (into the HDR target and the reduced
+    /// layers); returns the layers drawn into a layer of their own, for [`Composite::post`].
+    pub fn draw_particles(
+        &mut self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        player: &mut Player,
+        camera: &Camera,
+    ) -> Layers {
         let size = self.targets(ctx, camera.size_px()).size;
         let post = player.effect().post.clone();
         let drawn = player.drawn_layers();
@@ -128,13 +141,28 @@ impl Composite {
                 layered |= Layers::GLOW;
             }
         }
+        if let Some(targets) = self.targets.as_ref() {
+            player.draw_layers(
+                &mut begin_hdr_pass(enc, &targets.hdr_view),
+                Layers::ALL.without(layered),
+            );
+        }
+        layered
+    }
+
+    /// The bloom and tonemap of [`Composite::draw`] after [`Composite::draw_particles`]
+    /// (`layered`: what it returned).
+    pub fn post(
+        &mut self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        player: &Player,
+        layered: Layers,
+    ) {
         let Some(targets) = self.targets.as_ref() else {
             return;
         };
-        player.draw_layers(
-            &mut begin_hdr_pass(enc, &targets.hdr_view),
-            Layers::ALL.without(layered),
-        );
+        let post = player.effect().post.clone();
         let low_alpha = layer_view(&self.alpha_layer, layered.contains(Layers::BLENDED));
         let glow = layer_view(&self.glow_layer, layered.contains(Layers::GLOW));
         // The glow layer joins the image in the bloom's prefilter and in the tonemap
