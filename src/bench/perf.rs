@@ -607,7 +607,9 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
          pull: ALU-bound); bandwidth = 64 B per particle-step (32 read + 32 written) / the update time of the same \
          pools without those two modules (memory-bound); the copy is a compute shader moving the same bytes, in the \
          same run. Pools larger than {} particles are split into several emitters \
-         (one storage binding each).",
+         (one storage binding each). Each row runs on a GPU device of its own, as in a fresh \
+         process (after a large pool is freed, small work on the same device can run several \
+         times slower).",
         opts.size.0,
         opts.size.1,
         opts.repeats,
@@ -618,8 +620,6 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
     // rows have been allocated and freed.
     eprintln!("bench perf: module costs");
     let costs = module_costs(ctx, opts)?;
-    let copy = copy_pipeline(ctx, COPY_WGSL);
-    let copy20 = copy_pipeline(ctx, COPY20_WGSL);
     // Per compact layout: its table and JSON rows.
     let compact = [(StateLayout::Packed, "packed"), (StateLayout::Tiny, "tiny")];
     let mut compact_tables = [Vec::new(), Vec::new()];
@@ -636,6 +636,13 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
             continue;
         }
         eprintln!("bench perf: {side}² = {n} particles");
+        // Each row on a device of its own, as a fresh process has: after a large pool is
+        // freed, small work on the same device runs 2–5× slower on the H100 (not memory
+        // we keep: its allocator holds nothing then; a new device is fast again).
+        let row_ctx = GpuContext::headless()?.with_profile(Some(ctx.profile));
+        let ctx = &row_ctx;
+        let copy = copy_pipeline(ctx, COPY_WGSL);
+        let copy20 = copy_pipeline(ctx, COPY20_WGSL);
         let row = match measure_row(ctx, opts, n, &copy) {
             Ok(r) => r,
             Err(e) => {
