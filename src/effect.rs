@@ -1030,6 +1030,25 @@ impl Checker {
 }
 
 impl Effect {
+    /// The longest lifetime any emitter can give a particle, seconds.
+    pub fn longest_lifetime_secs(&self) -> f64 {
+        self.emitters
+            .iter()
+            .map(|e| f64::from(e.lifetime_secs.max))
+            .fold(0.0, f64::max)
+    }
+
+    /// When the last burst of any emitter fires, seconds (0 without bursts).
+    pub fn last_burst_secs(&self) -> f64 {
+        self.emitters
+            .iter()
+            .flat_map(|e| &e.bursts)
+            .map(|b| f64::from(b.time_secs))
+            .fold(0.0, f64::max)
+    }
+}
+
+impl Effect {
     /// Checks every field; returns all problems found (empty = valid).
     pub fn validate(&self) -> Result<(), Vec<ValidationError>> {
         let mut c = Checker { errors: Vec::new() };

@@ -505,6 +505,22 @@ fn adapter_tag(ctx: &GpuContext) -> String {
         .join("-")
 }
 
+/// Prints a bench report and writes it as `out/NAME.md` and `.json` (NAME defaults to
+/// `KIND-<adapter>`).
+fn save_report(
+    report: &ignis::bench::Report,
+    out: &Path,
+    name: Option<String>,
+    kind: &str,
+    ctx: &GpuContext,
+) -> anyhow::Result<()> {
+    let name = name.unwrap_or_else(|| format!("{kind}-{}", adapter_tag(ctx)));
+    report.save(out, &name)?;
+    println!("{}", report.markdown);
+    println!("wrote {}/{name}.md and .json", out.display());
+    Ok(())
+}
+
 fn bench(kind: BenchKind, profile: &ProfileRequest) -> anyhow::Result<()> {
     let ctx = context(profile)?;
     match kind {
@@ -536,10 +552,7 @@ fn bench(kind: BenchKind, profile: &ProfileRequest) -> anyhow::Result<()> {
                 frames: frames.max(1),
             };
             let report = ignis::bench::presets::run(&ctx, &opts)?;
-            let name = name.unwrap_or_else(|| format!("presets-{}", adapter_tag(&ctx)));
-            report.save(&out, &name)?;
-            println!("{}", report.markdown);
-            println!("wrote {}/{name}.md and .json", out.display());
+            save_report(&report, &out, name, "presets", &ctx)?;
         }
         BenchKind::Adapters {
             preset,
@@ -556,19 +569,13 @@ fn bench(kind: BenchKind, profile: &ProfileRequest) -> anyhow::Result<()> {
                 size,
             };
             let report = ignis::bench::adapters::run(&ctx, &opts)?;
-            let name = name.unwrap_or_else(|| format!("adapters-{}", adapter_tag(&ctx)));
-            report.save(&out, &name)?;
-            println!("{}", report.markdown);
-            println!("wrote {}/{name}.md and .json", out.display());
+            save_report(&report, &out, name, "adapters", &ctx)?;
         }
         BenchKind::Export { preset, out, name } => {
             let effect = ignis::preset::load(&preset)?;
             let asset_dir = preset.parent().map(Path::to_path_buf);
             let report = ignis::bench::export::run(&ctx, &effect, asset_dir)?;
-            let name = name.unwrap_or_else(|| format!("export-{}", adapter_tag(&ctx)));
-            report.save(&out, &name)?;
-            println!("{}", report.markdown);
-            println!("wrote {}/{name}.md and .json", out.display());
+            save_report(&report, &out, name, "export", &ctx)?;
         }
         BenchKind::Runtime {
             preset,
@@ -586,10 +593,7 @@ fn bench(kind: BenchKind, profile: &ProfileRequest) -> anyhow::Result<()> {
                 frames: frames.max(1),
             };
             let report = ignis::bench::runtime::run(&ctx, &opts)?;
-            let name = name.unwrap_or_else(|| format!("runtime-{}", adapter_tag(&ctx)));
-            report.save(&out, &name)?;
-            println!("{}", report.markdown);
-            println!("wrote {}/{name}.md and .json", out.display());
+            save_report(&report, &out, name, "runtime", &ctx)?;
         }
         BenchKind::Accuracy {
             particles,
@@ -644,10 +648,7 @@ fn bench(kind: BenchKind, profile: &ProfileRequest) -> anyhow::Result<()> {
                 },
             };
             let report = ignis::bench::perf::run(&ctx, &opts)?;
-            let name = name.unwrap_or_else(|| format!("perf-{}", adapter_tag(&ctx)));
-            report.save(&out, &name)?;
-            println!("{}", report.markdown);
-            println!("wrote {}/{name}.md and .json", out.display());
+            save_report(&report, &out, name, "perf", &ctx)?;
         }
     }
     Ok(())

@@ -78,17 +78,7 @@ pub fn run(ctx: &GpuContext, opts: &PresetsOptions) -> Result<Report, PlayerErro
 /// longest lifetime; an effect of bursts alone (nothing left then) is measured a quarter
 /// of its longest lifetime after its last burst, in full bloom.
 fn warm_up_frames(effect: &Effect) -> usize {
-    let longest = effect
-        .emitters
-        .iter()
-        .map(|e| f64::from(e.lifetime_secs.max))
-        .fold(0.0, f64::max);
-    let last_burst = effect
-        .emitters
-        .iter()
-        .flat_map(|e| &e.bursts)
-        .map(|b| f64::from(b.time_secs))
-        .fold(0.0, f64::max);
+    let (longest, last_burst) = (effect.longest_lifetime_secs(), effect.last_burst_secs());
     let continuous = effect
         .emitters
         .iter()

@@ -16,18 +16,7 @@ pub const SEEK_FRAME_DT_SECS: f64 = 1.0 / 60.0;
 
 /// The timeline's length: the last burst plus the longest lifetime (at least 1 s).
 pub fn span_secs(effect: &Effect) -> f64 {
-    let longest = effect
-        .emitters
-        .iter()
-        .map(|e| f64::from(e.lifetime_secs.max))
-        .fold(0.0, f64::max);
-    let last_burst = effect
-        .emitters
-        .iter()
-        .flat_map(|e| &e.bursts)
-        .map(|b| f64::from(b.time_secs))
-        .fold(0.0, f64::max);
-    (last_burst + longest).max(1.0)
+    (effect.last_burst_secs() + effect.longest_lifetime_secs()).max(1.0)
 }
 
 /// The frames of `played` (wall-clock durations) that end at or before simulated time `t`
