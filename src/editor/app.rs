@@ -212,7 +212,11 @@ impl App {
         let shot = gfx.present(painted, &self.instance, wanted)?;
         self.lose_device_when_asked();
         if let Some(reason) = self.gfx.as_ref().and_then(|g| g.ctx.lost()) {
-            self.recreate_gpu(&reason)?;
+            self.recreate_gpu(Some(&reason))?;
+            return Ok(false);
+        }
+        if self.gfx.as_ref().is_some_and(|g| g.wants_fresh_device) {
+            self.recreate_gpu(None)?;
             return Ok(false);
         }
         self.finish(tick, shot)
@@ -231,26 +235,33 @@ impl App {
         }
     }
 
-    /// The device was lost: a new one in the same window, with new pipelines, player and
-    /// painter; the effect, the undo history and the rest of the editor's state are kept.
-    fn recreate_gpu(&mut self, reason: &str) -> anyhow::Result<()> {
+    /// A new device in the same window, with new pipelines, player and painter; the
+    /// effect, the undo history and the rest of the editor's state are kept. After a loss
+    /// (`lost`: why) the panel says so; without one the old device had held a large pool
+    /// the effect no longer needs (small work on it stays slow), and the move is silent.
+    fn recreate_gpu(&mut self, lost: Option<&str>) -> anyhow::Result<()> {
         let Some(old) = self.gfx.take() else {
             return Ok(());
         };
-        log::warn!("the GPU device was lost ({reason}); recreating it");
+        match lost {
+            Some(reason) => log::warn!("the GPU device was lost ({reason}); recreating it"),
+            None => log::info!("moving to a fresh GPU device after a large pool was freed"),
+        }
         let window = old.window.clone();
         let log = std::mem::take(&mut { old }.log);
         let mut gfx = Gfx::new(window, &self.instance, &self.options, &self.state)
-            .context("recreating the GPU device after it was lost")?;
+            .context("recreating the GPU device")?;
         gfx.log = log;
-        self.devices_recreated += 1;
         // The new player starts at time 0: nothing is parked, no frames were played.
         self.state.playback.parked_at = None;
         self.state.playback.frame_times.clear();
-        self.state.device_notice = Some(format!(
-            "The GPU device was lost ({reason}) and has been recreated; the effect and its \
-             undo history were kept."
-        ));
+        if let Some(reason) = lost {
+            self.devices_recreated += 1;
+            self.state.device_notice = Some(format!(
+                "The GPU device was lost ({reason}) and has been recreated; the effect and \
+                 its undo history were kept."
+            ));
+        }
         gfx.window.request_redraw();
         self.gfx = Some(gfx);
         Ok(())

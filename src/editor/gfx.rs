@@ -35,6 +35,23 @@ const SEEK_SNAPSHOT_SECS: f64 = 2.0;
 /// GPU memory the timeline's snapshots may take.
 const SEEK_SNAPSHOT_BYTES: u64 = 256 << 20;
 
+/// Pools at least this large (particle slots in all) leave the device slow for small work
+/// once freed (`docs/performance.md`): going back far below them moves to a new device.
+const LARGE_POOL_SLOTS: u64 = 4 << 20;
+
+/// Every emitter's slots.
+fn total_slots(effect: &Effect) -> u64 {
+    effect.emitters.iter().map(|e| u64::from(e.capacity)).sum()
+}
+
+/// Whether an effect of `slots` particle slots, after a peak of `peak` on this device,
+/// should move to a fresh device: the peak was a large pool and the effect is now a
+/// sixteenth of it or less. On the H100 small work on a device that held a large pool
+/// runs 2–5× slower; a new device is fast again.
+pub(super) fn wants_fresh_device(peak: u64, slots: u64) -> bool {
+    peak >= LARGE_POOL_SLOTS && slots.saturating_mul(16) <= peak
+}
+
 /// The time an export may take of each editor frame.
 const EXPORT_BUDGET: Duration = Duration::from_millis(40);
 
@@ -75,6 +92,11 @@ pub(super) struct Gfx {
     /// Watches the folders of the PNG sprites in use: a changed file is reloaded.
     /// (folders, their watcher).
     pub(super) sprite_watch: Option<(Vec<PathBuf>, Option<FileWatcher>)>,
+    /// The most particle slots the effect has had on this device (see
+    /// [`wants_fresh_device`]).
+    pub(super) peak_slots: u64,
+    /// The effect shrank far below that peak: the frame loop moves to a new device.
+    pub(super) wants_fresh_device: bool,
     /// The state view's textures (View ▸ State view).
     pub(super) state_textures: Option<([egui::TextureHandle; 3], u64)>,
     /// The export the Export section started, stepped a little every frame.
@@ -237,6 +259,8 @@ impl Gfx {
             sprite_watch: None,
             export: None,
             state_textures: None,
+            peak_slots: 0,
+            wants_fresh_device: false,
         })
     }
 
@@ -408,7 +432,12 @@ impl Gfx {
         match self.player.set_effect(&wanted) {
             // A cost measurement's effect is not one to fall back to.
             Ok(()) if state.probe_effect.is_some() => {}
-            Ok(()) => self.gpu_effect.clone_from(&state.running),
+            Ok(()) => {
+                self.gpu_effect.clone_from(&state.running);
+                let slots = total_slots(&wanted);
+                self.peak_slots = self.peak_slots.max(slots);
+                self.wants_fresh_device = wants_fresh_device(self.peak_slots, slots);
+            }
             Err(err) => {
                 log::warn!("effect refused by the GPU: {err}");
                 state.reject_running(&self.gpu_effect, err.to_string());
@@ -659,5 +688,20 @@ impl Gfx {
         if !changed.is_empty() && gfx.player.reload_sprites(&changed) {
             log::info!("sprite changed on disk, reloading");
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_large_pool_given_up_asks_for_a_fresh_device() {
+        let large = LARGE_POOL_SLOTS;
+        assert!(!wants_fresh_device(7168, 7168), "the campfire");
+        assert!(!wants_fresh_device(large, large), "still large");
+        assert!(!wants_fresh_device(large - 1, 1), "never large");
+        assert!(wants_fresh_device(16 * large, 7168), "back to the campfire");
+        assert!(!wants_fresh_device(16 * large, large + 1));
     }
 }
