@@ -151,12 +151,7 @@ fn measure(
         player.add_instance(Mat4::from_translation(*spot), i as u32 + 1)?;
     }
     let camera = host.camera(spots);
-    let longest = effect
-        .emitters
-        .iter()
-        .map(|e| e.lifetime_secs.max)
-        .fold(0.0, f32::max);
-    let warm_up = (f64::from(longest) * 60.0).ceil() as usize + 10;
+    let warm_up = (effect.longest_lifetime_secs() * 60.0).ceil() as usize + 10;
     let (mut record, mut draw) = (Vec::new(), Vec::new());
     let (mut cpu, mut cpu_draw) = (Vec::new(), Vec::new());
     for frame in 0..warm_up + opts.frames {

@@ -109,14 +109,12 @@ impl CostProbe {
     }
 }
 
+/// The median of a run's samples (0 when no timing arrived).
 fn median(v: &[f64]) -> f64 {
-    let mut v = v.to_vec();
-    v.sort_by(f64::total_cmp);
-    match v.len() {
-        0 => 0.0,
-        n if n % 2 == 1 => v[n / 2],
-        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    if v.is_empty() {
+        return 0.0;
     }
+    crate::gpu::timer::median(&mut v.to_vec())
 }
 
 /// The Stats section's block: a button that starts a measurement, its progress, and the

@@ -503,50 +503,7 @@ impl Gfx {
     pub(super) fn simulate(&mut self, state: &mut EditorState, frame_dt_secs: f64) {
         let reloaded = self.reload_changed_shaders(state);
         let edited = self.apply_running(state) || reloaded;
-        let playback = &mut state.playback;
-        if playback.restart_requested {
-            playback.restart_requested = false;
-            playback.parked_at = None;
-            playback.frame_times.clear();
-            self.player.restart();
-        }
-        if !playback.is_paused {
-            playback.parked_at = None;
-        }
-        // The timeline's seek, or an edit while parked: replayed to that time.
-        let seek = playback
-            .seek_to
-            .take()
-            .or(playback.parked_at.filter(|_| edited));
-        if let Some(t) = seek {
-            playback.is_paused = true;
-            playback.parked_at = Some(t);
-            self.seek(playback, t);
-        }
-        if playback.step_requested {
-            playback.step_requested = false;
-            playback.is_paused = true;
-            match playback.parked_at {
-                // Parked after a seek: a seek one step later (an edit then keeps it).
-                Some(t) => {
-                    let t = t + super::timeline::step_secs(self.player.effect());
-                    playback.parked_at = Some(t);
-                    self.seek(playback, t);
-                }
-                None => self.player.step(),
-            }
-        }
-        self.player.set_paused(playback.is_paused);
-        let dt = frame_dt_secs * f64::from(playback.speed.clamp(0.05, 8.0));
-        self.player.advance(dt);
-        if !playback.is_paused {
-            playback.frame_times.push(dt);
-            // The loop region: back to its start once the clock passes its end.
-            let now = self.player.time_secs(self.instance).unwrap_or_default();
-            if let Some((a, _)) = playback.loop_region.filter(|(a, b)| b > a && now >= *b) {
-                self.seek(playback, a);
-            }
-        }
+        self.play(&mut state.playback, edited, frame_dt_secs);
         super::export_ui::drive(
             &self.ctx,
             &state.running,
@@ -556,24 +513,6 @@ impl Gfx {
             EXPORT_BUDGET,
         );
         self.profiler.end_stage(&self.ctx);
-    }
-
-    /// Puts the player at `t`: a fixed-step effect seeks (from the snapshot before it);
-    /// a frame-delta effect replays the frames played so far up to `t` (then 1/60 s
-    /// frames), the only way to reach the same state.
-    fn seek(&mut self, playback: &mut super::state::Playback, t: f64) {
-        let time = self.player.effect().time.clone();
-        let speed = f64::from(time.speed).max(1e-6);
-        if time.mode == crate::effect::TimeMode::FixedStep {
-            // One frame per step: the seek lands on the step nearest `t`.
-            let step = f64::from(time.step_secs);
-            self.player.seek(t / speed, step / speed);
-            playback.frame_times.clear();
-            return;
-        }
-        let frames = super::timeline::frames_until(&playback.frame_times, t, &time);
-        self.player.replay(&frames);
-        playback.frame_times = frames;
     }
 
     /// Copies the player's clock and per-emitter figures into the stats (the alive counts

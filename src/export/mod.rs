@@ -448,11 +448,7 @@ const HELD_BYTES: u64 = 1 << 30;
 fn timeline(effect: &Effect, settings: &ExportSettings) -> Timeline {
     let frames = settings.frame_count();
     let interval_secs = settings.interval_secs();
-    let longest = effect
-        .emitters
-        .iter()
-        .map(|e| f64::from(e.lifetime_secs.max))
-        .fold(0.0, f64::max);
+    let longest = effect.longest_lifetime_secs();
     // Frames held at once: up to 2·fade, each 16 bytes a pixel and pass.
     let (w, h) = settings.frame_size;
     let passes = settings.passes.names().len().max(1) as u64;

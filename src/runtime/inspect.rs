@@ -137,16 +137,7 @@ impl Player {
     /// framing and motion scale).
     #[doc(hidden)]
     pub fn particle_motion(&self, id: InstanceId) -> Result<Vec<(Vec3, Vec3)>, PlayerError> {
-        let origins: Vec<Vec3> = self
-            .with_state(id, |s| {
-                (0..self.effect.emitters.len())
-                    .map(|i| {
-                        let p = s.planner().emitters.get(i);
-                        p.map_or(Vec3::ZERO, |p| p.origin().as_vec3())
-                    })
-                    .collect()
-            })
-            .ok_or(PlayerError::NoInstance)?;
+        let origins = self.origins(id)?;
         let mut out = Vec::new();
         for (i, e) in self.effect.emitters.iter().enumerate() {
             // Stateless pools hold spawn records, not positions.

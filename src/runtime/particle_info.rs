@@ -121,7 +121,7 @@ impl Player {
     }
 
     /// Each emitter's simulation-space origin in instance `id`.
-    fn origins(&self, id: InstanceId) -> Result<Vec<Vec3>, PlayerError> {
+    pub(super) fn origins(&self, id: InstanceId) -> Result<Vec<Vec3>, PlayerError> {
         self.with_state(id, |s| {
             (0..self.effect.emitters.len())
                 .map(|i| {

@@ -150,7 +150,6 @@ impl Player {
     /// steps, to playing to `secs` at any frame rate), and so is the next frame's
     /// interpolation. The pause is kept. Returns the frames the seek stands for.
     pub fn seek(&mut self, secs: f64, frame_dt_secs: f64) -> u64 {
-        let was_paused = std::mem::replace(&mut self.is_paused, false);
         let frames = if secs > 0.0 && frame_dt_secs > 0.0 && secs.is_finite() {
             ((secs / frame_dt_secs).round() as u64).min(MAX_SEEK_FRAMES)
         } else {
@@ -161,8 +160,6 @@ impl Player {
         } else {
             self.replay_frames((0..frames).map(|_| frame_dt_secs));
         }
-        self.simulated = false;
-        self.is_paused = was_paused;
         frames
     }
 
@@ -214,6 +211,8 @@ impl Player {
         self.stepper = stepper;
         self.alpha = alpha;
         self.pending = (0, 0.0);
+        // Every step is recorded and nothing is pending: the next `record` steps nothing.
+        self.simulated = false;
     }
 
     /// Restores the latest snapshot taken at or before step `steps` into every instance;
