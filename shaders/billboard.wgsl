@@ -113,7 +113,8 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u3
     }
     let t = age_fraction(d.age, d.life);
     let rnd = particle_random(slot, d.life);
-    let size = size_at(t, rnd.x);
+    let lc = look_curves(t, curve_random(slot, d.life, rnd));
+    let size = lc.x;
     // Four shared vertices over the corners (-1,-1) (1,-1) (-1,1) (1,1): a third fewer
     // vertex invocations than two separate triangles.
     var corner = vec2<f32>(f32(vi & 1u), f32(vi >> 1u)) * 2.0 - 1.0;
@@ -156,14 +157,14 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u3
         world = select(d.pos - tail, d.pos, corner.x > 0.0);
     } else {
         // Random initial rotation plus spin over the particle's age.
-        let angle = (rnd.y - 0.5) * look.extra.z + mix(look.spin_streak.x, look.spin_streak.y, rnd.z) * d.age;
+        let angle = (rnd.y - 0.5) * look.extra.z + lc.z * d.life;
         let cs = vec2<f32>(cos(angle), sin(angle));
         let c = vec2<f32>(corner.x * cs.x - corner.y * cs.y, corner.x * cs.y + corner.y * cs.x);
         world = d.pos + (camera.right_alpha.xyz * c.x + camera.up.xyz * c.y) * (0.5 * size);
         out.clip = look.clip_from_sim * vec4<f32>(world, 1.0);
     }
     if FLIPBOOK {
-        let f = flipbook_frames(d.age, d.life, rnd.w, FLIP_BLEND);
+        let f = flipbook_frames(d.age, d.life, rnd.w, FLIP_BLEND, lc.w);
         out.uv0 = atlas_uv(f.x, corner);
         out.uv1 = atlas_uv(f.y, corner);
         out.blend_height.x = f.z;
@@ -180,11 +181,12 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u3
     // Premultiplied here, once per vertex, and scaled by the intensity when additive:
     // the fragment shader reads nothing from the look.
     let c = particle_color(t);
-    var gain = c.a;
+    let alpha = c.a * lc.y;
+    var gain = alpha;
     if !SORTED {
         gain *= look.size_intensity.z;
     }
-    out.color = vec4<f32>(c.rgb * gain, c.a);
+    out.color = vec4<f32>(c.rgb * gain, alpha);
     if MOTION {
         // Where this corner's particle is `camera.up.w` seconds later, at its velocity.
         let now = look.clip_from_sim * vec4<f32>(d.pos, 1.0);
@@ -196,7 +198,7 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u3
         }
         // The weight: coverage for alpha-blended layers, the brightest channel of the
         // light for additive ones.
-        let w = select(max(max(out.color.r, out.color.g), out.color.b), c.a, SORTED);
+        let w = select(max(max(out.color.r, out.color.g), out.color.b), alpha, SORTED);
         out.color = vec4<f32>(px, 0.0, w);
     }
     return out;

@@ -13,6 +13,9 @@
 // the pipeline is built and costs nothing. Keep `MOD_*` in sync with `Modules` in
 // `src/sim/modules.rs`.
 //
+// `over_life` (update.wgsl) holds the particle's over-life multipliers for this step: y
+// scales both drags, z the turbulence, w the flame pull (1 when the emitter has none).
+//
 // The exponential integrator assumes the drag part is `-k (vel - wind)` with
 // k = `linear_drag_k()` and treats the rest (`acceleration + k·vel`) as constant over a
 // step; it is exact when that rest is constant.
@@ -28,7 +31,7 @@ override MOD_ATTRACTOR: bool = false;
 override MOD_FLAME_PULL: bool = false;
 
 fn linear_drag_k() -> f32 {
-    return select(0.0, params.accel_drag.w, MOD_DRAG);
+    return select(0.0, params.accel_drag.w * over_life.y, MOD_DRAG);
 }
 
 // Wind, optionally modulated by smooth 1-D noise in time (gusts).
@@ -95,15 +98,15 @@ fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age: f32, life: f32, time: f32) 
     var a = params.accel_drag.xyz;
     let wind = wind_at(time);
     if MOD_DRAG {
-        a -= params.accel_drag.w * (vel - wind);
+        a -= params.accel_drag.w * over_life.y * (vel - wind);
     }
     // module-begin
     if MOD_QUADRATIC_DRAG {
         let rel = vel - wind;
-        a -= params.gusts_qdrag_pull.z * length(rel) * rel;
+        a -= params.gusts_qdrag_pull.z * over_life.y * length(rel) * rel;
     }
     if MOD_TURBULENCE {
-        a += turbulence_accel(pos, time);
+        a += turbulence_accel(pos, time) * over_life.z;
     }
     if MOD_VORTEX {
         a += vortex_accel(pos);
@@ -112,7 +115,7 @@ fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age: f32, life: f32, time: f32) 
         a += attractor_accel(pos);
     }
     if MOD_FLAME_PULL {
-        a += flame_pull_accel(pos, age, life);
+        a += flame_pull_accel(pos, age, life) * over_life.w;
     }
     // module-end
     return a;

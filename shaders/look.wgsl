@@ -3,13 +3,15 @@
 //
 // Contract: the including file declares `camera: CameraUniform`, `look: LookUniform` (the
 // instance being drawn, a private copy of its `LookSlot`; keep both in sync with `src/gpu/types.rs`), `ramps: texture_2d<f32>` (one
-// Rgba32Float colour ramp row per emitter) and the state: `prev`, `cur`
+// Rgba32Float colour ramp row per emitter, each followed by its two curve rows; see
+// curves.wgsl) and the state: `prev`, `cur`
 // (array<Particle>) and the same buffers as `prev_packed`, `cur_packed`
 // (array<PackedParticle>, read when `STATE_LAYOUT` says the state is packed or tiny),
 // and `births: array<Birth>` (a tiny-state emitter's birth table, births.wgsl).
 #import "common.wgsl"
 #import "rng.wgsl"
 #import "births.wgsl"
+#import "curves.wgsl"
 
 struct CameraUniform {
     clip_from_world: mat4x4<f32>,
@@ -28,18 +30,19 @@ struct LookUniform {
     // The emitter's simulation space → clip, composed in f64 on the CPU so effects far
     // from the world origin render without f32 jitter.
     clip_from_sim: mat4x4<f32>,
-    // size start (m), size end (m), intensity, per-particle random size (fraction).
+    // x, y, w: unused, z: intensity.
     size_intensity: vec4<f32>,
-    // x: colour ramp row, y: blend (0 additive, 1 alpha), z: flipbook rows, w: columns.
+    // x: colour ramp row (the curve rows A and B follow it), y: blend (0 additive,
+    // 1 alpha), z: flipbook rows, w: columns.
     ids: vec4<u32>,
-    // x: flipbook mode (0 over life, 1 frame rate), y: random start frame (0/1),
+    // x: flipbook mode (0 over life, 1 frame rate, 2 frame curve), y: random start frame (0/1),
     // z: per-emitter random salt, w: the first slot of the pool's segment in the state
     // buffers (a batched instance's; else 0).
     flags: vec4<u32>,
     // x: ∫ sprite brightness over the quad (the splat's energy), y: unused (STATELESS
     // below), z: random rotation spread (rad), w: flipbook frames per second.
     extra: vec4<f32>,
-    // x, y: angular velocity range (rad/s), z: streak length (s), w: longest streak (m).
+    // x, y: unused (the spin is a curve), z: streak length (s), w: longest streak (m).
     spin_streak: vec4<f32>,
     // x: ground height in simulation space (m), y: 1 / soft-edge distance (1/m),
     // z, w: lifetime range (s; packed state re-derives lifetimes from it).
@@ -106,14 +109,41 @@ fn particle_random(slot: u32, life: f32) -> vec4<f32> {
     return unorm4(pcg4d(vec4<u32>(slot, bitcast<u32>(life), look.flags.z, 0x1007u)));
 }
 
+// The look's curves at normalised age t for random numbers u: x size (m), y opacity,
+// z spin angle turned since birth per second of lifetime (rad; × life is the angle),
+// w flipbook frame (frame curve mode).
+fn look_curves(t: f32, u: vec4<f32>) -> vec4<f32> {
+    let c = curve_texels(t);
+    let row = i32(look.ids.x) + 1;
+    let a = mix(textureLoad(ramps, vec2<i32>(i32(c.i), row), 0), textureLoad(ramps, vec2<i32>(i32(c.j), row), 0), c.f);
+    let b = mix(textureLoad(ramps, vec2<i32>(i32(c.i), row + 1), 0), textureLoad(ramps, vec2<i32>(i32(c.j), row + 1), 0), c.f);
+    return mix(a, b, u);
+}
+
+// The random numbers blending a particle's curves (size, opacity, spin, frame): the size
+// and spin keep `particle_random`'s x and z (a range of sizes or spins draws what the
+// start-to-end size's random factor and the spin range always drew); opacity and frame
+// have a hash of their own.
+fn curve_random(slot: u32, life: f32, rnd: vec4<f32>) -> vec4<f32> {
+    let own = unorm4(pcg4d(vec4<u32>(slot, bitcast<u32>(life), look.flags.z, 0xC0u)));
+    return vec4<f32>(rnd.x, own.y, rnd.z, own.w);
+}
+
 // Flipbook frame selection: x = frame, y = next frame, z = weight of y (0 without
 // blending). Over life: frame 0 at birth, the last frame at death. Frame rate: loops.
-fn flipbook_frames(age: f32, life: f32, start01: f32, blend: bool) -> vec3<f32> {
+// Frame curve: `curve_frame` (fractional frames blend), clamped to the last.
+fn flipbook_frames(age: f32, life: f32, start01: f32, blend: bool, curve_frame: f32) -> vec3<f32> {
     let count = max(look.ids.z * look.ids.w, 1u);
     let n = f32(count);
     var start = 0u;
     if look.flags.y != 0u {
         start = min(u32(start01 * n), count - 1u);
+    }
+    if look.flags.x == 2u {
+        let pos = clamp(curve_frame, 0.0, n - 1.0);
+        let f0 = min(u32(pos), count - 1u);
+        let f1 = min(f0 + 1u, count - 1u);
+        return vec3<f32>(f32((f0 + start) % count), f32((f1 + start) % count), select(0.0, pos - f32(f0), blend));
     }
     if look.flags.x == 0u {
         let t = age_fraction(age, life);
@@ -232,11 +262,4 @@ fn drawn(p: Particle, q: Particle) -> Drawn {
 // Normalised age and billboard size of a drawn state.
 fn age_fraction(age: f32, life: f32) -> f32 {
     return clamp(age / life, 0.0, 1.0);
-}
-
-// Billboard diameter at normalised age t, scaled by the particle's random factor
-// `r` ∈ [0, 1) (size × [1 − random, 1 + random]).
-fn size_at(t: f32, r: f32) -> f32 {
-    let scale = 1.0 + look.size_intensity.w * (2.0 * r - 1.0);
-    return mix(look.size_intensity.x, look.size_intensity.y, t) * scale;
 }

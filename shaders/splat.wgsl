@@ -96,9 +96,10 @@ fn splat(
     let t = age_fraction(d.age, d.life);
     let color = particle_color(t);
     let rnd = particle_random(slot, d.life);
-    let size_px = size_at(t, rnd.x) * camera.viewport.z / clip.w;
+    let lc = look_curves(t, curve_random(slot, d.life, rnd));
+    let size_px = lc.x * camera.viewport.z / clip.w;
     let half = 0.5 * size_px;
-    var energy = color.rgb * (color.a * look.size_intensity.z * look.extra.x * half * half);
+    var energy = color.rgb * (color.a * lc.y * look.size_intensity.z * look.extra.x * half * half);
     if look.soft.y > 0.0 {
         // The billboard's ground fade, taken at the particle's centre.
         energy *= clamp((d.pos.y - look.soft.x) * look.soft.y, 0.0, 1.0);

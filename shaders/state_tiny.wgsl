@@ -50,10 +50,11 @@ fn load_state(slot: u32) -> Particle {
     let age = birth_age(entry, c.x, bitcast<vec2<f32>>(params.tiny.xy));
     // The lifetime (two hashes) only where it matters: a particle younger than the range's
     // minimum by more than this step survives it whatever its lifetime, and only the flame
-    // pull reads the lifetime otherwise. Elsewhere "longer than any age" stands in for it.
+    // pull and the over-life curves read the lifetime otherwise. Elsewhere "longer than
+    // any age" stands in for it.
     // (The minimum with a margin: `mix` may round a lifetime an ulp below it.)
     var life = 3.4e38;
-    if MOD_FLAME_PULL || age + params.dt_secs >= params.speed_life.z * 0.9999 {
+    if MOD_FLAME_PULL || MOD_CURVES || age + params.dt_secs >= params.speed_life.z * 0.9999 {
         let key = spawn_key(params.seed, params.emitter_salt, slot, c.x, c.y);
         life = spawn_life(key, params.speed_life.z, params.speed_life.w);
     }

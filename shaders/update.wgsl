@@ -6,7 +6,12 @@
 //   2 `dst` (write; both declared in state_full.wgsl / state_packed.wgsl /
 //   state_tiny.wgsl), 3 `counters` ([0] alive after this step when COUNT_ALIVE is on,
 //   [1] non-finite kills, total), 4 the tiny state's birth table (read by
-//   state_tiny.wgsl only).
+//   state_tiny.wgsl only), 5 `sim_curves`: the emitter's over-life multipliers baked
+//   (curves.wgsl; row A then row B, texels of (speed, drag, turbulence, flame pull)),
+//   read only when MOD_CURVES is on.
+// - MOD_CURVES: each alive particle's multipliers are looked up once per step, at its
+//   age at the step's start, into `over_life` (forces.wgsl reads y, z, w; the step's
+//   displacement is scaled by x). Off, they are 1 and nothing is read.
 // - COUNT_ALIVE (GPUs): a workgroup reduction, one global atomic per workgroup. On CPU
 //   adapters it is off — a workgroup barrier makes lavapipe run every invocation
 //   separately — and count.wgsl counts on demand instead. (On the H100 the update with the
@@ -25,6 +30,7 @@
 // `params` (binding 0): a uniform on GPUs, read-only storage on CPU adapters.
 #import "params.wgsl"
 @group(0) @binding(3) var<storage, read_write> counters: array<atomic<u32>, 2>;
+@group(0) @binding(5) var<storage, read> sim_curves: array<vec4<f32>>;
 
 // The state's bindings (1 `src`, 2 `dst`) and `load_state` / `store_state`: full 32-byte
 // particles, or — for packed_state / tiny_state pipelines — state_packed.wgsl /
@@ -34,6 +40,7 @@
 #import "integrators.wgsl"
 #import "collide.wgsl"
 #import "alive_count.wgsl"
+#import "curves.wgsl"
 
 // Stateless mode: this pass only writes the spawn records of this step's window (one
 // invocation per spawn, no other slot is touched); the draw passes evaluate positions in
@@ -41,6 +48,25 @@
 // pos_age.w the birth time on the 4096 s clock.
 override MOD_STATELESS: bool = false;
 override COUNT_ALIVE: bool = true;
+override MOD_CURVES: bool = false;
+
+// This particle's multipliers for the step: x displacement (speed), y drag (linear and
+// quadratic), z turbulence, w flame pull. All 1 unless MOD_CURVES.
+var<private> over_life: vec4<f32> = vec4<f32>(1.0);
+
+// The multipliers at normalised age t for the particle's random numbers u.
+fn over_life_at(t: f32, u: vec4<f32>) -> vec4<f32> {
+    let c = curve_texels(t);
+    let a = mix(sim_curves[c.i], sim_curves[c.j], c.f);
+    let b = mix(sim_curves[CURVE_WIDTH + c.i], sim_curves[CURVE_WIDTH + c.j], c.f);
+    return mix(a, b, u);
+}
+
+// The random numbers blending a particle's over-life curves: fixed for its life (its
+// slot and lifetime bits, like the look's), one per multiplier.
+fn over_life_random(slot: u32, life: f32) -> vec4<f32> {
+    return unorm4(pcg4d(vec4<u32>(slot, bitcast<u32>(life), params.emitter_salt, params.seed ^ 0x5C0u)));
+}
 
 fn stateless_spawn(i: u32) {
     if i >= params.spawn_count {
@@ -135,6 +161,7 @@ fn update_slot(i: u32) -> bool {
 fn update_at(slot: u32) -> bool {
     var alive = false;
     var p = load_state(slot);
+    over_life = vec4<f32>(1.0);
     // Position of this slot in the ring relative to the spawn head (capacity ≤ 2^28; both
     // are below it, so no integer division).
     var rel = slot + params.capacity - params.spawn_head;
@@ -152,18 +179,31 @@ fn update_at(slot: u32) -> bool {
         // the other modules act from its first full step).
         let f = clamp(params.spawn_frac0 + f32(rel) * params.spawn_frac_step, 0.0, 1.0);
         let age0 = (1.0 - f) * params.dt_secs;
+        if MOD_CURVES {
+            over_life = over_life_at(0.0, over_life_random(slot, p.vel_life.w));
+        }
         let k = linear_drag_k();
         let pp = exp_phi_psi(k, age0);
         let c = params.accel_drag.xyz + k * params.wind_time.xyz;
         let v0 = p.vel_life.xyz;
+        var x = p.pos_age.xyz + v0 * pp.x + c * pp.y;
+        if MOD_CURVES {
+            x = p.pos_age.xyz + (v0 * pp.x + c * pp.y) * over_life.x;
+        }
         p = Particle(
-            vec4<f32>(p.pos_age.xyz + v0 * pp.x + c * pp.y, age0),
+            vec4<f32>(x, age0),
             vec4<f32>(v0 * (1.0 - k * pp.x) + c * pp.x, p.vel_life.w),
         );
         alive = is_alive(p);
     } else if is_alive(p) {
         let life = p.vel_life.w;
+        if MOD_CURVES {
+            over_life = over_life_at(p.pos_age.w / life, over_life_random(slot, life));
+        }
         var s = integrate(p.pos_age.xyz, p.vel_life.xyz, p.pos_age.w, life, params.wind_time.w, params.dt_secs);
+        if MOD_CURVES {
+            s.pos = p.pos_age.xyz + (s.pos - p.pos_age.xyz) * over_life.x;
+        }
         var age = p.pos_age.w + params.dt_secs;
         // module-begin
         if MOD_COLLISIONS {

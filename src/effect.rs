@@ -6,8 +6,15 @@
 
 use serde::{Deserialize, Serialize};
 
+mod curve;
+
+pub use curve::{
+    CURVE_WIDTH, Curve, MAX_CURVE_KEYS, Param, ParamMode, SHAPES, bake_rows, lookup, lookup_blend,
+    rows_key,
+};
+
 /// The preset format version this build writes (and the newest it reads).
-pub const CURRENT_VERSION: u32 = 1;
+pub const CURRENT_VERSION: u32 = 2;
 
 /// A whole fire effect: a seed, time settings and a list of emitter layers.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -125,8 +132,10 @@ pub struct Emitter {
     pub enabled: bool,
     /// Number of particle slots in this emitter's ring.
     pub capacity: u32,
-    /// Continuous emission rate, particles per second.
-    pub spawn_rate_per_sec: f32,
+    /// Continuous emission rate, particles per second, over the effect's time in seconds
+    /// (a curve's keys are `(seconds, rate)`; a range or two curves pick one rate or one
+    /// blend per instance, from its seed).
+    pub spawn_rate_per_sec: Param,
     /// At most this many spawns per step (a long step can't cause a burst). 0 = automatic:
     /// enough for the rate at a step of 1/15 s.
     pub max_spawn_per_step: u32,
@@ -328,6 +337,11 @@ pub struct Forces {
     pub drag_per_sec: f32,
     /// The flow velocity drag pulls toward, m/s.
     pub wind_m_per_s: [f32; 3],
+    /// Multiplies both drags over each particle's normalised age (1 = unchanged).
+    pub drag_over_life: Param,
+    /// Multiplies each step's displacement over each particle's normalised age: the
+    /// particle moves this much faster than its velocity says (1 = unchanged).
+    pub speed_over_life: Param,
     /// Quadratic drag c, 1/m: a = −c·|v − wind|·(v − wind). 0 = off.
     pub quadratic_drag_per_m: f32,
     /// Noise-modulated wind strength (off when absent).
@@ -364,6 +378,8 @@ pub struct Turbulence {
     pub octaves: u32,
     /// Upward scroll of the field, m/s.
     pub scroll_m_per_s: f32,
+    /// Multiplies the strength over each particle's normalised age (1 = unchanged).
+    pub over_life: Param,
 }
 
 /// A vortex: tangential acceleration around an axis with a Gaussian falloff.
@@ -411,6 +427,8 @@ pub struct FlamePull {
     pub strength_per_s2: f32,
     /// Growth with normalised age (1 = linear).
     pub exponent: f32,
+    /// Multiplies the strength over each particle's normalised age (1 = unchanged).
+    pub over_life: Param,
 }
 
 /// Colliders an emitter's particles bounce off (or die on).
@@ -474,6 +492,7 @@ impl Default for Turbulence {
             frequency_per_m: 2.5,
             octaves: 2,
             scroll_m_per_s: 0.8,
+            over_life: Param::Constant(1.0),
         }
     }
 }
@@ -505,6 +524,7 @@ impl Default for FlamePull {
         Self {
             strength_per_s2: 6.0,
             exponent: 1.0,
+            over_life: Param::Constant(1.0),
         }
     }
 }
@@ -637,17 +657,16 @@ pub struct Look {
     pub sprite: Sprite,
     /// Animate the sprite as an atlas of frames (`None`: the whole texture is one sprite).
     pub flipbook: Option<Flipbook>,
-    /// Billboard size (diameter) at birth, metres.
-    pub size_start_m: f32,
-    /// Billboard size at death, metres.
-    pub size_end_m: f32,
-    /// Per-particle random size: each particle's size is scaled by a factor in
-    /// [1 − r, 1 + r] (0 = all the same).
-    pub size_random: f32,
+    /// Billboard size (diameter) over normalised age, metres.
+    pub size_m: Param,
+    /// Multiplies each particle's contribution over normalised age: its light when
+    /// additive, its coverage (alpha) when alpha-blended (1 = as the colour says).
+    pub opacity: Param,
     /// Per-particle random initial rotation, 0..=360 degrees of spread.
     pub rotation_random_deg: f32,
-    /// Per-particle angular velocity, degrees per second (uniform in the range).
-    pub spin_deg_per_s: Range,
+    /// Angular velocity over normalised age, degrees per second (a range: each particle
+    /// spins at its own constant rate).
+    pub spin_deg_per_s: Param,
     /// Stretch the billboard along the screen-space velocity (sparks).
     pub streak: Option<Streak>,
     /// Fade the sprite where it meets the ground plane over this distance, metres (0 =
@@ -725,7 +744,7 @@ impl Sprite {
 }
 
 /// A sprite atlas of `rows` × `cols` frames (row-major, top-left first), animated.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Flipbook {
     /// Frame rows in the atlas.
@@ -753,7 +772,7 @@ impl Default for Flipbook {
 }
 
 /// How a flipbook's frame advances.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum FlipbookMode {
     /// Frame 0 at birth to the last frame at death.
     OverLife,
@@ -762,6 +781,9 @@ pub enum FlipbookMode {
         /// Frames per second.
         fps: f32,
     },
+    /// The frame over normalised age (0 = the first frame; a fraction blends toward the
+    /// next when `blend_frames`; clamped to the last).
+    Frames(Param),
 }
 
 /// Spark streaks: the billboard runs from the particle back along its velocity.
@@ -851,7 +873,7 @@ impl Default for Emitter {
             name: "flames".to_owned(),
             enabled: true,
             capacity: 4096,
-            spawn_rate_per_sec: 1800.0,
+            spawn_rate_per_sec: Param::Constant(1800.0),
             max_spawn_per_step: 0,
             bursts: Vec::new(),
             lifetime_secs: Range::new(0.6, 1.4),
@@ -892,6 +914,8 @@ impl Default for Forces {
             buoyancy_m_per_s2: 11.5,
             drag_per_sec: 1.2,
             wind_m_per_s: [0.1, 0.0, 0.0],
+            drag_over_life: Param::Constant(1.0),
+            speed_over_life: Param::Constant(1.0),
             quadratic_drag_per_m: 0.0,
             gusts: None,
             turbulence: None,
@@ -918,11 +942,13 @@ impl Default for Look {
         Self {
             sprite: Sprite::SoftDisc,
             flipbook: None,
-            size_start_m: 0.22,
-            size_end_m: 0.06,
-            size_random: 0.0,
+            size_m: Param::Curve {
+                keys: vec![(0.0, 0.22), (1.0, 0.06)],
+                smooth: false,
+            },
+            opacity: Param::Constant(1.0),
             rotation_random_deg: 0.0,
-            spin_deg_per_s: Range::new(0.0, 0.0),
+            spin_deg_per_s: Param::Constant(0.0),
             streak: None,
             soft_ground_m: 0.0,
             color_over_life: vec![
@@ -1013,6 +1039,58 @@ impl Checker {
                 format!("{v:?}"),
                 "must not be the zero vector (it is a direction)",
             );
+        }
+    }
+
+    /// A parameter whose values lie in `values` and whose curve keys' times lie in
+    /// `[0, t_max]`, strictly increasing.
+    fn param(&mut self, path: impl Fn() -> String, v: &Param, values: (f32, f32), t_max: f32) {
+        let (lo, hi) = values;
+        match v {
+            Param::Constant(x) => self.num(&path, *x, lo, hi),
+            Param::Range { min, max } => self.range(&path, Range::new(*min, *max), lo, hi),
+            Param::Curve { keys, .. } => {
+                self.keys(|| format!("{}.keys", path()), keys, values, t_max)
+            }
+            Param::TwoCurves { a, b } => {
+                self.keys(|| format!("{}.a.keys", path()), &a.keys, values, t_max);
+                self.keys(|| format!("{}.b.keys", path()), &b.keys, values, t_max);
+            }
+        }
+    }
+
+    fn keys(
+        &mut self,
+        path: impl Fn() -> String,
+        keys: &[(f32, f32)],
+        values: (f32, f32),
+        t_max: f32,
+    ) {
+        if keys.is_empty() || keys.len() > MAX_CURVE_KEYS {
+            self.push(
+                path(),
+                format!("{} keys", keys.len()),
+                &format!("a curve needs 1..={MAX_CURVE_KEYS} keys"),
+            );
+        }
+        let mut last = f32::NEG_INFINITY;
+        let (lo, hi) = values;
+        for (k, &(t, v)) in keys.iter().enumerate() {
+            let problem = if !t.is_finite() || !v.is_finite() {
+                "a key's time and value must be finite numbers".to_owned()
+            } else if !(0.0..=t_max).contains(&t) {
+                format!("a key's time must be in 0..={t_max}")
+            } else if v < lo || v > hi {
+                format!("a key's value must be in {lo}..={hi}")
+            } else if t <= last {
+                "keys must be sorted by strictly increasing time".to_owned()
+            } else {
+                String::new()
+            };
+            if !problem.is_empty() {
+                self.push(format!("{}[{k}]", path()), format!("({t}, {v})"), &problem);
+            }
+            last = t;
         }
     }
 
@@ -1119,7 +1197,12 @@ impl Effect {
                     &format!("must be in 1..={MAX_CAPACITY}"),
                 );
             }
-            c.num(|| p("spawn_rate_per_sec"), e.spawn_rate_per_sec, 0.0, 1e9);
+            c.param(
+                || p("spawn_rate_per_sec"),
+                &e.spawn_rate_per_sec,
+                (0.0, 1e9),
+                1e7,
+            );
             for (b, burst) in e.bursts.iter().enumerate() {
                 c.num(
                     || p(&format!("bursts[{b}].time_secs")),
@@ -1173,6 +1256,18 @@ impl Effect {
                 1e5,
             );
             c.num(|| p("forces.drag_per_sec"), f.drag_per_sec, 0.0, 1e4);
+            c.param(
+                || p("forces.drag_over_life"),
+                &f.drag_over_life,
+                (0.0, 1e3),
+                1.0,
+            );
+            c.param(
+                || p("forces.speed_over_life"),
+                &f.speed_over_life,
+                (0.0, 1e3),
+                1.0,
+            );
             c.vec3(|| p("forces.wind_m_per_s"), f.wind_m_per_s, 1e5);
             c.num(
                 || p("forces.quadratic_drag_per_m"),
@@ -1208,6 +1303,12 @@ impl Effect {
                     -1e3,
                     1e3,
                 );
+                c.param(
+                    || p("forces.turbulence.over_life"),
+                    &t.over_life,
+                    (-1e3, 1e3),
+                    1.0,
+                );
                 if !(1..=4).contains(&t.octaves) {
                     c.push(
                         p("forces.turbulence.octaves"),
@@ -1240,6 +1341,12 @@ impl Effect {
                     1e4,
                 );
                 c.num(|| p("forces.flame_pull.exponent"), fp.exponent, 0.0, 16.0);
+                c.param(
+                    || p("forces.flame_pull.over_life"),
+                    &fp.over_life,
+                    (0.0, 1e3),
+                    1.0,
+                );
             }
             if e.stateless && !e.stateless_blockers().is_empty() {
                 c.push(
@@ -1309,8 +1416,8 @@ impl Effect {
                 1e3,
             );
             let l = &e.look;
-            c.num(|| p("look.size_start_m"), l.size_start_m, 0.0, 1e3);
-            c.num(|| p("look.size_end_m"), l.size_end_m, 0.0, 1e3);
+            c.param(|| p("look.size_m"), &l.size_m, (0.0, 1e3), 1.0);
+            c.param(|| p("look.opacity"), &l.opacity, (0.0, 1e3), 1.0);
             c.num(|| p("look.intensity"), l.intensity, 0.0, 1e4);
             if e.packed_state && e.stateless {
                 c.push(
@@ -1333,14 +1440,18 @@ impl Effect {
                     "cannot be combined with `packed_state` (one state layout per emitter: 20 or 10 bytes); turn one off",
                 );
             }
-            c.num(|| p("look.size_random"), l.size_random, 0.0, 1.0);
             c.num(
                 || p("look.rotation_random_deg"),
                 l.rotation_random_deg,
                 0.0,
                 360.0,
             );
-            c.range(|| p("look.spin_deg_per_s"), l.spin_deg_per_s, -1e5, 1e5);
+            c.param(
+                || p("look.spin_deg_per_s"),
+                &l.spin_deg_per_s,
+                (-1e5, 1e5),
+                1.0,
+            );
             c.num(|| p("look.soft_ground_m"), l.soft_ground_m, 0.0, 100.0);
             if let Sprite::Image(path) = &l.sprite
                 && path.trim().is_empty()
@@ -1357,8 +1468,14 @@ impl Effect {
                         c.push(p(&format!("look.flipbook.{name}")), v, "must be 1..=64");
                     }
                 }
-                if let FlipbookMode::FrameRate { fps } = f.mode {
-                    c.num(|| p("look.flipbook.mode.fps"), fps, 0.0, 1000.0);
+                match &f.mode {
+                    FlipbookMode::FrameRate { fps } => {
+                        c.num(|| p("look.flipbook.mode.fps"), *fps, 0.0, 1000.0)
+                    }
+                    FlipbookMode::Frames(frames) => {
+                        c.param(|| p("look.flipbook.mode"), frames, (0.0, 4096.0), 1.0)
+                    }
+                    FlipbookMode::OverLife => {}
                 }
             }
             if let Some(s) = &l.streak {
@@ -1420,6 +1537,12 @@ impl Emitter {
         if self.collisions.any() {
             v.push("collisions");
         }
+        if !f.drag_over_life.is_constant(1.0) {
+            v.push("drag over life");
+        }
+        if !f.speed_over_life.is_constant(1.0) {
+            v.push("speed over life");
+        }
         v
     }
 
@@ -1430,7 +1553,7 @@ impl Emitter {
         } else {
             // Enough for the continuous rate at a 1/15 s step, plus any burst.
             let burst_max = self.bursts.iter().map(|b| b.count).max().unwrap_or(0);
-            let per_step = (self.spawn_rate_per_sec as f64 / 15.0).ceil() as u64;
+            let per_step = (f64::from(self.spawn_rate_per_sec.bounds().1) / 15.0).ceil() as u64;
             (per_step.max(1) + burst_max as u64).min(u32::MAX as u64) as u32
         }
     }

@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 pub const EMBEDDED: &[(&str, &str)] = &[
     ("common.wgsl", include_str!("../shaders/common.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
+    ("curves.wgsl", include_str!("../shaders/curves.wgsl")),
     ("noise.wgsl", include_str!("../shaders/noise.wgsl")),
     ("spawn.wgsl", include_str!("../shaders/spawn.wgsl")),
     ("forces.wgsl", include_str!("../shaders/forces.wgsl")),

@@ -19,7 +19,7 @@ fn gpu_matches_cpu_reference_for_every_integrator() {
     for integrator in Integrator::ALL {
         let mut e = Emitter {
             capacity: 1500,
-            spawn_rate_per_sec: 700.0,
+            spawn_rate_per_sec: ignis::effect::Param::Constant(700.0),
             lifetime_secs: Range::new(0.5, 1.6),
             integrator,
             transform: Transform {
@@ -71,14 +71,17 @@ fn gpu_matches_cpu_reference_for_every_integrator() {
 fn gpu_matches_cpu_reference_with_every_module() {
     use ignis::effect::*;
     let ctx = gpu();
-    for integrator in [
-        Integrator::SemiImplicitEuler,
-        Integrator::Rk4,
-        Integrator::Exponential,
+    // Each integrator, then two with every over-life multiplier on, one in each mode.
+    for (integrator, curves) in [
+        (Integrator::SemiImplicitEuler, false),
+        (Integrator::Rk4, false),
+        (Integrator::Exponential, false),
+        (Integrator::SemiImplicitEuler, true),
+        (Integrator::Exponential, true),
     ] {
         let mut e = Emitter {
             capacity: 1200,
-            spawn_rate_per_sec: 600.0,
+            spawn_rate_per_sec: ignis::effect::Param::Constant(600.0),
             lifetime_secs: Range::new(0.5, 1.6),
             integrator,
             ..Emitter::default()
@@ -94,6 +97,27 @@ fn gpu_matches_cpu_reference_with_every_module() {
             ..Attractor::default()
         });
         f.flame_pull = Some(FlamePull::default());
+        if curves {
+            f.speed_over_life = Param::Curve {
+                keys: vec![(0.0, 1.5), (0.5, 0.6), (1.0, 1.0)],
+                smooth: true,
+            };
+            f.drag_over_life = Param::Range { min: 0.5, max: 2.0 };
+            f.turbulence = Some(Turbulence {
+                over_life: Param::TwoCurves {
+                    a: Curve::line(0.0, 2.0),
+                    b: Curve {
+                        keys: vec![(0.0, 1.0), (0.3, 3.0), (1.0, 0.5)],
+                        smooth: true,
+                    },
+                },
+                ..Turbulence::default()
+            });
+            f.flame_pull = Some(FlamePull {
+                over_life: Param::Constant(2.0),
+                ..FlamePull::default()
+            });
+        }
         e.collisions.ground = Some(GroundPlane {
             height_m: -0.05,
             kill_on_contact: false,
@@ -122,7 +146,7 @@ fn gpu_matches_cpu_reference_with_every_module() {
             }
         }
         eprintln!(
-            "{integrator:?}: {alive} alive, worst position error {worst:e}, {bad} beyond 2e-4"
+            "{integrator:?} (curves {curves}): {alive} alive, worst position error {worst:e}, {bad} beyond 2e-4"
         );
         assert!(alive > 300);
         // Allow a handful of contact-amplified outliers, never a systematic mismatch.
@@ -145,7 +169,7 @@ fn exact_spawn_counts_over_time() {
         (50.0, 1.0 / 240.0),
     ] {
         let e = Emitter {
-            spawn_rate_per_sec: rate,
+            spawn_rate_per_sec: ignis::effect::Param::Constant(rate),
             lifetime_secs: Range::new(1.0, 1.0),
             ..plain_emitter()
         };
@@ -180,7 +204,7 @@ fn exact_spawn_counts_over_time() {
 fn spawn_cap_per_step_is_enforced_and_counted() {
     let ctx = gpu();
     let e = Emitter {
-        spawn_rate_per_sec: 12_000.0,
+        spawn_rate_per_sec: ignis::effect::Param::Constant(12_000.0),
         max_spawn_per_step: 40,
         ..plain_emitter()
     };
@@ -216,7 +240,7 @@ fn capacity_exhaustion_is_reported() {
     let ctx = gpu();
     let e = Emitter {
         capacity: 100,
-        spawn_rate_per_sec: 1000.0,
+        spawn_rate_per_sec: ignis::effect::Param::Constant(1000.0),
         ..plain_emitter()
     };
     let sim = run_gpu(&ctx, &bare_effect(e), 1.0 / 120.0, 120);
@@ -344,7 +368,7 @@ fn every_shape_spawns_inside_itself() {
     for (shape, inside) in cases {
         let e = Emitter {
             capacity: 4000,
-            spawn_rate_per_sec: 3000.0 * 120.0,
+            spawn_rate_per_sec: ignis::effect::Param::Constant(3000.0 * 120.0),
             max_spawn_per_step: 3000,
             shape: shape.clone(),
             transform: transform.clone(),
@@ -385,7 +409,7 @@ fn direction_spread_is_respected() {
     ] {
         let e = Emitter {
             capacity: 4000,
-            spawn_rate_per_sec: 3000.0 * 120.0,
+            spawn_rate_per_sec: ignis::effect::Param::Constant(3000.0 * 120.0),
             max_spawn_per_step: 3000,
             shape: shape.clone(),
             direction,
@@ -442,7 +466,7 @@ fn deterministic_state_for_a_seed() {
 fn bursts_fire_once() {
     let ctx = gpu();
     let e = Emitter {
-        spawn_rate_per_sec: 0.0,
+        spawn_rate_per_sec: ignis::effect::Param::Constant(0.0),
         bursts: vec![
             Burst {
                 time_secs: 0.1,
@@ -555,7 +579,7 @@ fn packed_state_follows_the_full_state() {
     let (dt, steps) = (1.0 / 120.0, 240);
     let mut e = fountain();
     e.capacity = 3000;
-    e.spawn_rate_per_sec = 2000.0;
+    e.spawn_rate_per_sec = ignis::effect::Param::Constant(2000.0);
     let (a, b) = run_full_and_compact(&ctx, e, |e| e.packed_state = true, dt, steps);
     let pa = a.read_particles(0).expect("full");
     let pb = b.read_particles(0).expect("packed");
@@ -633,7 +657,7 @@ fn tiny_state_follows_the_full_state() {
     let (dt, steps) = (1.0 / 120.0, 240);
     let mut e = fountain();
     e.capacity = 3001;
-    e.spawn_rate_per_sec = 1200.0;
+    e.spawn_rate_per_sec = ignis::effect::Param::Constant(1200.0);
     // An uneven birth table: bursts between the steady steps (the lookup's guess from the
     // mean rate misses, its search must not).
     e.bursts = vec![
@@ -713,7 +737,7 @@ fn tiny_birth_table_grows_and_restarts() {
     let ctx = gpu();
     let mut e = plain_emitter();
     e.capacity = 4000;
-    e.spawn_rate_per_sec = 1500.0;
+    e.spawn_rate_per_sec = ignis::effect::Param::Constant(1500.0);
     e.lifetime_secs = ignis::effect::Range::new(1.5, 2.5);
     e.speed_m_per_s = ignis::effect::Range::new(0.5, 1.0);
     e.spread_deg = 20.0;
@@ -801,7 +825,7 @@ fn update_window_skips_only_dead_slots() {
     let ctx = gpu();
     let e = Emitter {
         capacity: 8192,
-        spawn_rate_per_sec: 900.0,
+        spawn_rate_per_sec: ignis::effect::Param::Constant(900.0),
         lifetime_secs: Range::new(0.2, 1.0),
         ..plain_emitter()
     };
@@ -815,7 +839,7 @@ fn update_window_skips_only_dead_slots() {
         match step {
             100 => {
                 // Equal lifetimes: the youngest of a batch dies last, exactly at the bound.
-                effect.emitters[0].spawn_rate_per_sec = 2500.0;
+                effect.emitters[0].spawn_rate_per_sec = ignis::effect::Param::Constant(2500.0);
                 effect.emitters[0].lifetime_secs = Range::new(0.4, 0.4);
             }
             180 => effect.emitters[0].lifetime_secs = Range::new(0.05, 0.1),

@@ -55,8 +55,10 @@ fn open_section(harness: &mut Harness<'_, EditorState>, title: &str) {
 fn a_widget_edits_the_effect_and_the_running_copy() {
     let mut harness = panel_harness(campfire_state());
     assert_eq!(harness.state().selected, 0);
-    let before = harness.state().effect.emitters[0].spawn_rate_per_sec;
-    assert_eq!(before, 90.0);
+    let before = harness.state().effect.emitters[0]
+        .spawn_rate_per_sec
+        .clone();
+    assert_eq!(before, ignis::effect::Param::Constant(90.0));
 
     harness
         .get_by_label("Spawn rate")
@@ -64,8 +66,14 @@ fn a_widget_edits_the_effect_and_the_running_copy() {
     harness.run();
 
     let state = harness.state();
-    assert_eq!(state.effect.emitters[0].spawn_rate_per_sec, 500.0);
-    assert_eq!(state.running.emitters[0].spawn_rate_per_sec, 500.0);
+    assert_eq!(
+        state.effect.emitters[0].spawn_rate_per_sec,
+        ignis::effect::Param::Constant(500.0)
+    );
+    assert_eq!(
+        state.running.emitters[0].spawn_rate_per_sec,
+        ignis::effect::Param::Constant(500.0)
+    );
     assert!(state.validation_errors.is_empty());
     assert_eq!(state.history.undo_len(), 1);
 }
@@ -85,7 +93,10 @@ fn undo_and_redo_restore_the_effect_with_the_keyboard() {
     harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     harness.run();
     assert_eq!(harness.state().effect.emitters[0].capacity, 2048);
-    assert_eq!(harness.state().effect.emitters[0].spawn_rate_per_sec, 500.0);
+    assert_eq!(
+        harness.state().effect.emitters[0].spawn_rate_per_sec,
+        ignis::effect::Param::Constant(500.0)
+    );
     harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     harness.run();
     assert_eq!(harness.state().effect, original);
@@ -97,7 +108,10 @@ fn undo_and_redo_restore_the_effect_with_the_keyboard() {
 
     harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
     harness.run();
-    assert_eq!(harness.state().effect.emitters[0].spawn_rate_per_sec, 500.0);
+    assert_eq!(
+        harness.state().effect.emitters[0].spawn_rate_per_sec,
+        ignis::effect::Param::Constant(500.0)
+    );
     assert_eq!(harness.state().effect.emitters[0].capacity, 2048);
     assert_eq!(harness.state().history.redo_len(), 1);
 }
@@ -120,8 +134,13 @@ fn one_drag_is_one_undo_step() {
     }
     harness.drop_at(start + egui::vec2(80.0, 0.0));
     harness.run();
-    let rate = harness.state().effect.emitters[0].spawn_rate_per_sec;
-    assert!(rate > 90.0, "the drag changed the rate ({rate})");
+    let rate = harness.state().effect.emitters[0]
+        .spawn_rate_per_sec
+        .clone();
+    assert!(
+        rate.bounds().0 > 90.0,
+        "the drag changed the rate ({rate:?})"
+    );
     assert_eq!(harness.state().history.undo_len(), 1, "one drag, one step");
     assert!(harness.state_mut().undo());
     harness.run();
@@ -176,7 +195,7 @@ fn widgets_clamp_out_of_range_values() {
     harness.run();
     let state = harness.state();
     let e = &state.effect.emitters[0];
-    assert_eq!(e.spawn_rate_per_sec, 0.0);
+    assert_eq!(e.spawn_rate_per_sec, ignis::effect::Param::Constant(0.0));
     assert!(e.spread_deg.is_finite() && (0.0..=180.0).contains(&e.spread_deg));
     assert!(state.effect.validate().is_ok());
 }
@@ -743,13 +762,19 @@ fn presets_are_saved_and_loaded_from_the_header() {
     harness.get_by_label("Load").click_accesskit();
     harness.run();
     // Unsaved edits: the load asks first.
-    assert_eq!(harness.state().effect.emitters[0].spawn_rate_per_sec, 7.0);
+    assert_eq!(
+        harness.state().effect.emitters[0].spawn_rate_per_sec,
+        ignis::effect::Param::Constant(7.0)
+    );
     harness.get_by_label("Discard edits").click_accesskit();
     harness.run();
-    assert_eq!(harness.state().effect.emitters[0].spawn_rate_per_sec, 321.0);
+    assert_eq!(
+        harness.state().effect.emitters[0].spawn_rate_per_sec,
+        ignis::effect::Param::Constant(321.0)
+    );
     assert_eq!(
         harness.state().running.emitters[0].spawn_rate_per_sec,
-        321.0
+        ignis::effect::Param::Constant(321.0)
     );
     assert_eq!(harness.state().history.undo_len(), undo_before + 1);
 
@@ -758,7 +783,10 @@ fn presets_are_saved_and_loaded_from_the_header() {
     harness.get_by_label("Load").click_accesskit();
     harness.run();
     assert!(matches!(harness.state().preset_message, Some(Err(_))));
-    assert_eq!(harness.state().effect.emitters[0].spawn_rate_per_sec, 321.0);
+    assert_eq!(
+        harness.state().effect.emitters[0].spawn_rate_per_sec,
+        ignis::effect::Param::Constant(321.0)
+    );
 }
 
 #[test]

@@ -24,7 +24,7 @@ fn particle(pos: Vec3, vel: Vec3) -> Particle {
 /// A force-free emitter (no gravity, drag or noise), rate 0: add the module under test.
 fn quiet(integrator: Integrator) -> Emitter {
     Emitter {
-        spawn_rate_per_sec: 0.0,
+        spawn_rate_per_sec: ignis::effect::Param::Constant(0.0),
         capacity: 256,
         integrator,
         ..plain_emitter()
@@ -83,6 +83,7 @@ fn gpu_turbulence_matches_cpu_field() {
         frequency_per_m: 1.7,
         octaves: 3,
         scroll_m_per_s: 0.0,
+        ..Turbulence::default()
     });
     let initial: Vec<Particle> = (0..256)
         .map(|i| {
@@ -105,6 +106,7 @@ fn gpu_turbulence_matches_cpu_field() {
     let forces = CpuForces {
         params: &params,
         modules: Modules::of(&e),
+        over_life: [1.0; 4],
     };
     let mut worst: f64 = 0.0;
     for (p0, p1) in initial.iter().zip(&out) {
@@ -385,7 +387,7 @@ fn modules_off_are_bit_identical_to_a_pipeline_without_them() {
         let effect = bare_effect(Emitter {
             integrator,
             capacity: 2000,
-            spawn_rate_per_sec: 900.0,
+            spawn_rate_per_sec: ignis::effect::Param::Constant(900.0),
             ..Emitter::default()
         });
         let mut states = Vec::new();
@@ -413,7 +415,7 @@ fn stateless_matches_stateful_and_is_refused_when_ineligible() {
     let ctx = gpu();
     let mut base = Emitter {
         capacity: 3000,
-        spawn_rate_per_sec: 1500.0,
+        spawn_rate_per_sec: ignis::effect::Param::Constant(1500.0),
         lifetime_secs: Range::new(0.8, 1.6),
         integrator: Integrator::Exponential,
         ..Emitter::default()
@@ -506,7 +508,7 @@ fn an_inspected_particle_reports_its_state_and_the_forces_on_it() {
     let ctx = gpu();
     let mut e = plain_emitter();
     e.capacity = 256;
-    e.spawn_rate_per_sec = 50.0;
+    e.spawn_rate_per_sec = ignis::effect::Param::Constant(50.0);
     e.speed_m_per_s = Range::new(1.0, 2.0);
     e.spread_deg = 30.0;
     e.forces.gravity_m_per_s2 = [0.0, -9.81, 0.0];

@@ -15,14 +15,16 @@ use std::path::Path;
 use common::*;
 use glam::Vec3;
 use ignis::effect::{
-    BlendMode, ColorStop, DrawPath, Effect, Flipbook, FlipbookMode, GroundPlane, Look, Range,
-    Sprite, Streak,
+    BlendMode, CURVE_WIDTH, ColorStop, Curve, DrawPath, Effect, Flipbook, FlipbookMode,
+    GroundPlane, Look, Param, Range, Sprite, Streak, lookup_blend,
 };
 use ignis::gpu::GpuContext;
 use ignis::gpu::types::{CameraUniform, LookUniform};
 use ignis::headless::Headless;
 use ignis::render::frame::look_uniform;
-use ignis::render::look::{RAMP_WIDTH, bake_ramp, flipbook_frame, sample_gradient};
+use ignis::render::look::{
+    RAMP_WIDTH, bake_look_curves, bake_ramp, flipbook_frame, sample_gradient,
+};
 use ignis::render::sprites::SpriteLibrary;
 use ignis::shaders::{EMBEDDED, ShaderLibrary};
 use wgpu::util::DeviceExt;
@@ -47,15 +49,30 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
     _ = camera.viewport;
     let v = inputs[i];
-    outputs[2u * i] = vec4<f32>(flipbook_frames(v.x, v.y, v.z, v.w > 0.5), 0.0);
-    outputs[2u * i + 1u] = particle_color(age_fraction(v.x, v.y));
+    let curves = look_curves(age_fraction(v.x, v.y), vec4<f32>(v.z));
+    outputs[3u * i] = vec4<f32>(flipbook_frames(v.x, v.y, v.z, v.w > 0.5, curves.w), 0.0);
+    outputs[3u * i + 1u] = particle_color(age_fraction(v.x, v.y));
+    outputs[3u * i + 2u] = curves;
 }
 "#;
 
-/// Runs look.wgsl's `flipbook_frames` and `particle_color` on the GPU for `inputs`
-/// (age, life, start01, blend) with `look`'s uniform and ramp. Returns per input
-/// (frame, next, weight) and the colour.
+/// Runs look.wgsl's `flipbook_frames`, `particle_color` and `look_curves` on the GPU for
+/// `inputs` (age, life, start01 — also every curve's random number —, blend) with
+/// `look`'s uniform, ramp and curve rows. Returns per input (frame, next, weight), the
+/// colour and the curves.
 fn probe(ctx: &GpuContext, look: &Look, inputs: &[[f32; 4]]) -> Vec<([f32; 3], [f32; 4])> {
+    probe_all(ctx, look, inputs)
+        .into_iter()
+        .map(|(f, c, _)| (f, c))
+        .collect()
+}
+
+/// [`probe`] with each input's curves.
+fn probe_all(
+    ctx: &GpuContext,
+    look: &Look,
+    inputs: &[[f32; 4]],
+) -> Vec<([f32; 3], [f32; 4], [f32; 4])> {
     let dir = tempfile::tempdir().expect("tempdir");
     for (name, text) in EMBEDDED {
         std::fs::write(dir.path().join(name), text).expect("write shader");
@@ -87,14 +104,17 @@ fn probe(ctx: &GpuContext, look: &Look, inputs: &[[f32; 4]]) -> Vec<([f32; 3], [
         contents: bytemuck::bytes_of::<LookUniform>(&uniform),
         usage: wgpu::BufferUsages::UNIFORM,
     });
-    let ramp = bake_ramp(&look.color_over_life);
+    let mut ramp = bake_ramp(&look.color_over_life);
+    let [a, b] = bake_look_curves(look);
+    ramp.extend(a);
+    ramp.extend(b);
     let ramps = d.create_texture_with_data(
         &ctx.queue,
         &wgpu::TextureDescriptor {
             label: None,
             size: wgpu::Extent3d {
                 width: RAMP_WIDTH,
-                height: 1,
+                height: 3,
                 depth_or_array_layers: 1,
             },
             mip_level_count: 1,
@@ -112,7 +132,7 @@ fn probe(ctx: &GpuContext, look: &Look, inputs: &[[f32; 4]]) -> Vec<([f32; 3], [
         contents: bytemuck::cast_slice(inputs),
         usage: wgpu::BufferUsages::STORAGE,
     });
-    let out_size = (inputs.len() * 32) as u64;
+    let out_size = (inputs.len() * 48) as u64;
     let out = d.create_buffer(&wgpu::BufferDescriptor {
         label: None,
         size: out_size,
@@ -164,8 +184,8 @@ fn probe(ctx: &GpuContext, look: &Look, inputs: &[[f32; 4]]) -> Vec<([f32; 3], [
     let bytes = ignis::sim::gpu_sim::map_read(ctx, &staging).expect("readback");
     let values: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
     values
-        .chunks(2)
-        .map(|c| ([c[0][0], c[0][1], c[0][2]], c[1]))
+        .chunks(3)
+        .map(|c| ([c[0][0], c[0][1], c[0][2]], c[1], c[2]))
         .collect()
 }
 
@@ -174,6 +194,100 @@ fn flip_look(flipbook: Flipbook) -> Look {
         flipbook: Some(flipbook),
         ..Look::default()
     }
+}
+
+/// A look with a curve in every channel, each in another mode: size from two curves,
+/// opacity a smooth curve, spin a random range, the flipbook frame a curve.
+fn curved_look() -> Look {
+    Look {
+        size_m: Param::TwoCurves {
+            a: Curve {
+                keys: vec![(0.0, 0.1), (0.3, 0.6), (1.0, 0.2)],
+                smooth: true,
+            },
+            b: Curve::line(0.3, 1.2),
+        },
+        opacity: Param::Curve {
+            keys: ignis::effect::SHAPES[3].1.to_vec(),
+            smooth: true,
+        },
+        spin_deg_per_s: Param::Range {
+            min: -90.0,
+            max: 200.0,
+        },
+        flipbook: Some(Flipbook {
+            rows: 4,
+            cols: 4,
+            mode: FlipbookMode::Frames(Param::Curve {
+                keys: vec![(0.0, 0.0), (0.5, 15.0), (1.0, 3.0)],
+                smooth: true,
+            }),
+            blend_frames: true,
+            random_start: false,
+        }),
+        ..Look::default()
+    }
+}
+
+/// `look_curves` on the GPU equals the CPU reference (`lookup_blend` of the baked rows) at
+/// every texel and between texels within 1e-4, and both equal the curves themselves
+/// (`Param::eval`, the spin's integral) within 1e-4; the frame curve drives the flipbook.
+#[test]
+fn look_curves_on_the_gpu_match_the_cpu_reference_at_every_texel_and_between() {
+    let ctx = gpu();
+    let look = curved_look();
+    let life = 2.0f32;
+    let n = CURVE_WIDTH as usize;
+    let mut inputs = Vec::new();
+    for i in 0..n {
+        let u = (i as f32 * 0.618_034).fract();
+        inputs.push([life * i as f32 / (n - 1) as f32, life, u, 1.0]);
+    }
+    for k in 0..1001 {
+        let u = (k as f32 * 0.381_966).fract();
+        inputs.push([life * (k as f32 + 0.37) / 1001.0, life, u, 1.0]);
+    }
+    let got = probe_all(&ctx, &look, &inputs);
+    let rows = bake_look_curves(&look);
+    let params = ignis::render::look::look_curve_params(&look);
+    let mut worst = [0.0f32; 4];
+    for (input, (frames, _, curves)) in inputs.iter().zip(&got) {
+        let t = (input[0] / input[1]).clamp(0.0, 1.0);
+        let u = input[2];
+        let cpu = lookup_blend(&rows, t, [u; 4]);
+        let (t64, u64) = (f64::from(t), f64::from(u));
+        let exact = [
+            params[0].eval(t64, u64),
+            params[1].eval(t64, u64),
+            params[2].integral(u64, 0.0, t64).to_radians(),
+            params[3].eval(t64, u64),
+        ];
+        for c in 0..4 {
+            let d = (curves[c] - cpu[c]).abs();
+            worst[c] = worst[c].max(d);
+            assert!(
+                d <= 1e-4,
+                "channel {c} at t {t}, u {u}: GPU {} vs CPU {}",
+                curves[c],
+                cpu[c]
+            );
+            let e = (f64::from(curves[c]) - exact[c]).abs();
+            assert!(
+                e <= 1e-4,
+                "channel {c} at t {t}, u {u}: GPU {} vs exact {}",
+                curves[c],
+                exact[c]
+            );
+        }
+        // The frame curve picks the flipbook frame (CPU mirror of flipbook_frames).
+        let flip = look.flipbook.as_ref().expect("flipbook");
+        let choice = flipbook_frame(flip, input[0], input[1], input[2], cpu[3]);
+        assert_eq!(
+            [frames[0], frames[1]],
+            [choice.frame as f32, choice.next as f32]
+        );
+    }
+    eprintln!("worst GPU − CPU per channel (size, opacity, spin, frame): {worst:?}");
 }
 
 #[test]
@@ -196,48 +310,48 @@ fn flipbook_frames_match_hand_computed_values_at_the_ends_and_between() {
         random_start,
     };
     let cut = fb(4, 4, FlipbookMode::OverLife, false, false);
-    let fps10 = FlipbookMode::FrameRate { fps: 10.0 };
+    let fps10 = || FlipbookMode::FrameRate { fps: 10.0 };
     let cases: Vec<(Flipbook, [f32; 4], [f32; 3])> = vec![
         // Blending: position t·(16 − 1).
-        (over_life, [0.0, life, 0.0, 1.0], [0.0, 1.0, 0.0]),
-        (over_life, [life, life, 0.0, 1.0], [15.0, 15.0, 0.0]),
-        (over_life, [1.0, life, 0.0, 1.0], [7.0, 8.0, 0.5]),
+        (over_life.clone(), [0.0, life, 0.0, 1.0], [0.0, 1.0, 0.0]),
+        (over_life.clone(), [life, life, 0.0, 1.0], [15.0, 15.0, 0.0]),
+        (over_life.clone(), [1.0, life, 0.0, 1.0], [7.0, 8.0, 0.5]),
         // Cutting: each frame an equal share of life.
-        (cut, [0.0, life, 0.0, 0.0], [0.0, 0.0, 0.0]),
-        (cut, [life, life, 0.0, 0.0], [15.0, 15.0, 0.0]),
-        (cut, [1.0, life, 0.0, 0.0], [8.0, 8.0, 0.0]),
+        (cut.clone(), [0.0, life, 0.0, 0.0], [0.0, 0.0, 0.0]),
+        (cut.clone(), [life, life, 0.0, 0.0], [15.0, 15.0, 0.0]),
+        (cut.clone(), [1.0, life, 0.0, 0.0], [8.0, 8.0, 0.0]),
         // 2 × 3 at 10 fps from a random start: start01 0.5 → frame 3 of 6.
         (
-            fb(2, 3, fps10, false, true),
+            fb(2, 3, fps10(), false, true),
             [0.0, life, 0.5, 0.0],
             [3.0, 4.0, 0.0],
         ),
         (
-            fb(2, 3, fps10, false, true),
+            fb(2, 3, fps10(), false, true),
             [0.25, life, 0.5, 0.0],
             [5.0, 0.0, 0.0],
         ),
         // Looping past the last frame, with blending: 0.35 s × 10 = 3.5 → frames 3, 4.
         (
-            fb(2, 3, fps10, true, false),
+            fb(2, 3, fps10(), true, false),
             [0.35, life, 0.9, 1.0],
             [3.0, 4.0, 0.5],
         ),
         (
-            fb(2, 3, fps10, true, false),
+            fb(2, 3, fps10(), true, false),
             [0.55, life, 0.0, 1.0],
             [5.0, 0.0, 0.5],
         ),
     ];
     for (flip, input, want) in cases {
-        let got = probe(&ctx, &flip_look(flip), &[input])[0].0;
+        let got = probe(&ctx, &flip_look(flip.clone()), &[input])[0].0;
         for k in 0..3 {
             assert!(
                 (got[k] - want[k]).abs() < 1e-4,
                 "{flip:?} at {input:?}: GPU {got:?}, hand-computed {want:?}"
             );
         }
-        let cpu = flipbook_frame(&flip, input[0], input[1], input[2]);
+        let cpu = flipbook_frame(&flip, input[0], input[1], input[2], 0.0);
         assert_eq!(
             [cpu.frame as f32, cpu.next as f32],
             [want[0], want[1]],
@@ -413,7 +527,7 @@ fn missing_or_broken_pngs_fall_back_with_a_clear_error_and_changed_files_reload(
 fn single(pos: Vec3, vel: Vec3, look: Look) -> Effect {
     let mut em = plain_emitter();
     em.capacity = 64;
-    em.spawn_rate_per_sec = 0.0;
+    em.spawn_rate_per_sec = ignis::effect::Param::Constant(0.0);
     em.bursts = vec![ignis::effect::Burst {
         time_secs: 0.0,
         count: 1,
@@ -470,8 +584,7 @@ fn lit_extent(img: &image::RgbaImage, threshold: u8) -> (u32, u32) {
 fn streaks_stretch_along_the_screen_velocity() {
     let ctx = gpu();
     let look = Look {
-        size_start_m: 0.05,
-        size_end_m: 0.05,
+        size_m: Param::Constant(0.05),
         ..Look::default()
     };
     let still = render_after(&ctx, single(Vec3::ZERO, Vec3::ZERO, look.clone()), 2);
@@ -509,8 +622,7 @@ fn streaks_stretch_along_the_screen_velocity() {
 fn soft_ground_fades_sprites_towards_the_ground_plane() {
     let ctx = gpu();
     let look = Look {
-        size_start_m: 0.8,
-        size_end_m: 0.8,
+        size_m: Param::Constant(0.8),
         ..Look::default()
     };
     let mut hard = single(Vec3::ZERO, Vec3::ZERO, look.clone());
@@ -544,8 +656,7 @@ fn soft_ground_fades_sprites_towards_the_ground_plane() {
 fn bloom_spreads_light_and_exposure_scales_it() {
     let ctx = gpu();
     let look = Look {
-        size_start_m: 0.1,
-        size_end_m: 0.1,
+        size_m: Param::Constant(0.1),
         intensity: 8.0,
         ..Look::default()
     };
@@ -593,7 +704,7 @@ fn random_size_rotation_and_spin_vary_per_particle_deterministically() {
         a_m: [-1.0, 0.0, 0.0],
         b_m: [1.0, 0.0, 0.0],
     };
-    em.spawn_rate_per_sec = 0.0;
+    em.spawn_rate_per_sec = ignis::effect::Param::Constant(0.0);
     em.bursts = vec![ignis::effect::Burst {
         time_secs: 0.0,
         count: 12,
@@ -601,11 +712,15 @@ fn random_size_rotation_and_spin_vary_per_particle_deterministically() {
     em.lifetime_secs = Range::new(5.0, 9.0);
     em.look = Look {
         draw_path: DrawPath::Billboard,
-        size_start_m: 0.12,
-        size_end_m: 0.12,
-        size_random: 0.6,
+        size_m: Param::Range {
+            min: 0.12 * 0.4,
+            max: 0.12 * 1.6,
+        },
         rotation_random_deg: 360.0,
-        spin_deg_per_s: Range::new(-90.0, 90.0),
+        spin_deg_per_s: Param::Range {
+            min: -90.0,
+            max: 90.0,
+        },
         blend: BlendMode::Additive,
         sprite: Sprite::FlameWisp,
         ..Look::default()
@@ -618,9 +733,9 @@ fn random_size_rotation_and_spin_vary_per_particle_deterministically() {
     let b = render_after(&ctx, e.clone(), 10);
     assert_eq!(a.as_raw(), b.as_raw(), "same preset + seed ⇒ same frame");
     let mut uniform = e.clone();
-    uniform.emitters[0].look.size_random = 0.0;
+    uniform.emitters[0].look.size_m = Param::Constant(0.12);
     uniform.emitters[0].look.rotation_random_deg = 0.0;
-    uniform.emitters[0].look.spin_deg_per_s = Range::new(0.0, 0.0);
+    uniform.emitters[0].look.spin_deg_per_s = Param::Constant(0.0);
     let c = render_after(&ctx, uniform, 10);
     assert_ne!(a.as_raw(), c.as_raw(), "randomness changes the frame");
     let mut reseeded = e;

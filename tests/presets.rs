@@ -13,8 +13,8 @@ use common::*;
 use ignis::effect::{
     Attractor, BlendMode, Bloom, CURRENT_VERSION, CameraHint, Collisions, ColorStop, Effect,
     Emitter, Falloff, FlamePull, Flipbook, FlipbookMode, Forces, GroundPlane, Gusts, Integrator,
-    Look, MAX_CAPACITY, Post, Range, Shape, SpawnNoise, SphereCollider, Sprite, Streak, TimeMode,
-    TimeSettings, Transform, Turbulence, Vortex,
+    Look, MAX_CAPACITY, Param, Post, Range, Shape, SpawnNoise, SphereCollider, Sprite, Streak,
+    TimeMode, TimeSettings, Transform, Turbulence, Vortex,
 };
 use ignis::headless::Headless;
 use ignis::preset::{self, PresetError};
@@ -142,7 +142,7 @@ fn shipped_presets_differ() {
         fireball
             .emitters
             .iter()
-            .all(|e| e.spawn_rate_per_sec == 0.0 && !e.bursts.is_empty())
+            .all(|e| e.spawn_rate_per_sec.is_constant(0.0) && !e.bursts.is_empty())
     );
     // Candles and torches taper with flame_pull.
     for n in ["candle", "torch"] {
@@ -177,7 +177,7 @@ fn thesis_preset_replicates_the_2006_setup() {
     for em in &e.emitters {
         assert_eq!(em.integrator, Integrator::ExplicitEuler);
         assert_eq!(em.look.sprite, Sprite::Point);
-        assert!(em.look.size_start_m <= 0.02 && em.look.size_end_m <= 0.02);
+        assert!(em.look.size_m.bounds().1 <= 0.02);
         assert_eq!(em.spawn_noise.position_amplitude_m, 0.0);
         assert_eq!(em.spawn_noise.direction_amplitude, 0.0);
         assert!(em.forces.turbulence.is_none() && em.forces.flame_pull.is_none());
@@ -208,7 +208,7 @@ fn thesis_preset_is_frame_rate_dependent_and_a_fixed_step_is_not() {
     let ctx = gpu();
     let mut e = preset::load(&presets_dir().join("thesis_2006.ron")).expect("loads");
     let em = &mut e.emitters[0];
-    em.spawn_rate_per_sec = 0.0;
+    em.spawn_rate_per_sec = ignis::effect::Param::Constant(0.0);
     em.bursts = vec![ignis::effect::Burst {
         time_secs: 0.0,
         count: 2000,
@@ -401,13 +401,16 @@ fn malformed_cases() -> Vec<Case> {
         )],
     ));
 
-    let t = edit(&base, "size_start_m: 0.35", "size_start_m: -inf");
+    // A curve key of a version-2 preset: the key is found in the text.
+    let campfire = std::fs::read_to_string(presets_dir().join("campfire.ron")).expect("campfire");
+    let t = edit(&campfire, "(0.0, 0.245)", "(0.0, -inf)");
     cases.push(case(
         "negative_inf.ron",
         t.clone(),
         &[&format!(
-            "negative_inf.ron:{}: emitters[0].look.size_start_m = -inf: must be a finite number",
-            pos_of(&t, "-inf")
+            "negative_inf.ron:{}: emitters[0].look.size_m.a.keys[0] = (0, -inf): a key's time \
+             and value must be finite numbers",
+            pos_of(&t, "(0.0, -inf)")
         )],
     ));
 
@@ -799,7 +802,10 @@ fn version_1_fixture_keeps_loading() {
     assert_eq!(e.camera.distance_m, 2.6);
     let flames = &e.emitters[1];
     assert_eq!(flames.capacity, 4096);
-    assert_eq!(flames.spawn_rate_per_sec, 2000.0);
+    assert_eq!(
+        flames.spawn_rate_per_sec,
+        ignis::effect::Param::Constant(2000.0)
+    );
     assert_eq!(flames.forces.buoyancy_m_per_s2, 11.6);
     assert_eq!(flames.look.color_over_life.len(), 5);
     assert_eq!(e.emitters[0].look.blend, BlendMode::Alpha);
@@ -813,6 +819,27 @@ fn version_1_fixture_keeps_loading() {
     assert_eq!(flames.collisions.elasticity, 0.4);
     let saved = preset::load(&fixture("v1_campfire_saved.ron")).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(saved, e);
+}
+
+/// Every shipped preset as it was in version 1 (`tests/fixtures/v1/`, frozen) migrates
+/// to exactly the version-2 preset shipped now: the size's line and random factor become
+/// the curves that give the same sizes, spins and rates become ranges and constants.
+/// (The committed reference images, rendered from the version-1 presets, still match the
+/// version-2 frames: `looks.rs`.)
+#[test]
+fn every_version_1_preset_migrates_to_the_shipped_version_2() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/v1");
+    let mut n = 0;
+    for path in preset::list(&dir) {
+        let old = preset::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let text = std::fs::read_to_string(&path).expect("read");
+        assert!(text.contains("version: 1,"), "{}", path.display());
+        let name = path.file_name().expect("name");
+        let new = preset::load(&presets_dir().join(name)).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(old, new, "{}", path.display());
+        n += 1;
+    }
+    assert_eq!(n, 7, "the seven presets shipped in version 1");
 }
 
 /// Saving over a preset while the write fails midway (a full disk) or the process dies
@@ -889,8 +916,8 @@ fn saving_an_invalid_effect_refuses_and_keeps_the_file() {
     preset::save(&good, &path).expect("save");
     let before = std::fs::read(&path).expect("read");
     let mut bad = good.clone();
-    bad.emitters[1].spawn_rate_per_sec = -5.0;
-    bad.emitters[0].look.size_end_m = f32::NAN;
+    bad.emitters[1].spawn_rate_per_sec = ignis::effect::Param::Constant(-5.0);
+    bad.emitters[0].look.size_m = ignis::effect::Param::Constant(f32::NAN);
     let err = preset::save(&bad, &path).expect_err("invalid");
     let msg = err.to_string();
     assert!(
@@ -898,7 +925,7 @@ fn saving_an_invalid_effect_refuses_and_keeps_the_file() {
         "{msg}"
     );
     assert!(
-        msg.contains("emitters[0].look.size_end_m = NaN: must be a finite number"),
+        msg.contains("emitters[0].look.size_m = NaN: must be a finite number"),
         "{msg}"
     );
     match err {
@@ -956,12 +983,12 @@ fn saved_text_is_readable() {
     let effect = preset::load(&presets_dir().join("torch.ron")).expect("torch");
     preset::save(&effect, &path).expect("save");
     let text = std::fs::read_to_string(&path).expect("read");
-    assert!(text.starts_with("// ignis effect preset, format version 1."));
+    assert!(text.starts_with("// ignis effect preset, format version 2."));
     assert!(!text.contains("Some("), "{text}");
     assert!(!text.contains("Effect("), "{text}");
     assert!(!text.contains("#![enable"), "{text}");
     for needle in [
-        "\n    version: 1,\n",
+        "\n    version: 2,\n",
         "\n    name: \"torch\",\n",
         "mode: FixedStep",
         "shape: Disc(radius_m: 0.055, normal: (0.0, 1.0, 0.0)),",
@@ -1118,19 +1145,58 @@ fn shape() -> BoxedStrategy<Shape> {
     .boxed()
 }
 
+/// A curve of 1..=5 keys: times in [0, t_max] (strictly increasing), values in [lo, hi].
+fn curve(lo: f32, hi: f32, t_max: f32) -> BoxedStrategy<ignis::effect::Curve> {
+    (
+        proptest::collection::vec((fl(0.0, t_max), fl(lo, hi)), 1..=5),
+        any::<bool>(),
+    )
+        .prop_map(|(mut keys, smooth)| {
+            keys.sort_by(|a, b| a.0.total_cmp(&b.0));
+            keys.dedup_by(|b, a| b.0 <= a.0);
+            ignis::effect::Curve { keys, smooth }
+        })
+        .boxed()
+}
+
+/// A parameter in any of the four modes.
+fn param(lo: f32, hi: f32, t_max: f32) -> BoxedStrategy<Param> {
+    prop_oneof![
+        fl(lo, hi).prop_map(Param::Constant),
+        (fl(lo, hi), fl(lo, hi)).prop_map(|(a, b)| Param::Range {
+            min: a.min(b),
+            max: a.max(b),
+        }),
+        curve(lo, hi, t_max).prop_map(|c| Param::Curve {
+            keys: c.keys,
+            smooth: c.smooth,
+        }),
+        (curve(lo, hi, t_max), curve(lo, hi, t_max)).prop_map(|(a, b)| Param::TwoCurves { a, b }),
+    ]
+    .boxed()
+}
+
 fn forces() -> BoxedStrategy<Forces> {
     let gusts = (fl(0.0, 10.0), fl(0.0, 100.0)).prop_map(|(strength, frequency_hz)| Gusts {
         strength,
         frequency_hz,
     });
-    let turbulence = (fl(0.0, 1e4), fl(0.0, 1e3), 1u32..=4, fl(-1e3, 1e3)).prop_map(
-        |(strength_m_per_s2, frequency_per_m, octaves, scroll_m_per_s)| Turbulence {
-            strength_m_per_s2,
-            frequency_per_m,
-            octaves,
-            scroll_m_per_s,
-        },
-    );
+    let turbulence = (
+        fl(0.0, 1e4),
+        fl(0.0, 1e3),
+        1u32..=4,
+        fl(-1e3, 1e3),
+        param(-1e3, 1e3, 1.0),
+    )
+        .prop_map(
+            |(strength_m_per_s2, frequency_per_m, octaves, scroll_m_per_s, over_life)| Turbulence {
+                strength_m_per_s2,
+                frequency_per_m,
+                octaves,
+                scroll_m_per_s,
+                over_life,
+            },
+        );
     let vortex = (v3(1e7), dir3(), fl(-1e4, 1e4), fl(1e-3, 1e4)).prop_map(
         |(center_m, axis, swirl_m_per_s2, radius_m)| Vortex {
             center_m,
@@ -1154,11 +1220,13 @@ fn forces() -> BoxedStrategy<Forces> {
             radius_m,
             falloff,
         });
-    let flame_pull =
-        (fl(0.0, 1e4), fl(0.0, 16.0)).prop_map(|(strength_per_s2, exponent)| FlamePull {
+    let flame_pull = (fl(0.0, 1e4), fl(0.0, 16.0), param(0.0, 1e3, 1.0)).prop_map(
+        |(strength_per_s2, exponent, over_life)| FlamePull {
             strength_per_s2,
             exponent,
-        });
+            over_life,
+        },
+    );
     (
         (v3(1e5), fl(-1e5, 1e5), fl(0.0, 1e4), v3(1e5), fl(0.0, 1e4)),
         (
@@ -1168,16 +1236,20 @@ fn forces() -> BoxedStrategy<Forces> {
             proptest::option::of(attractor),
             proptest::option::of(flame_pull),
         ),
+        (param(0.0, 1e3, 1.0), param(0.0, 1e3, 1.0)),
     )
         .prop_map(
             |(
                 (gravity, buoyancy, drag, wind, quadratic),
                 (gusts, turbulence, vortex, attractor, flame_pull),
+                (drag_over_life, speed_over_life),
             )| Forces {
                 gravity_m_per_s2: gravity,
                 buoyancy_m_per_s2: buoyancy,
                 drag_per_sec: drag,
                 wind_m_per_s: wind,
+                drag_over_life,
+                speed_over_life,
                 quadratic_drag_per_m: quadratic,
                 gusts,
                 turbulence,
@@ -1235,27 +1307,28 @@ fn look() -> BoxedStrategy<Look> {
             Just(Sprite::FlameSheet),
             "[a-z]{1,8}(/[a-z]{1,8})?\\.png".prop_map(Sprite::Image),
         ],
-        fl(0.0, 1e3),
-        fl(0.0, 1e3),
+        param(0.0, 1e3, 1.0),
+        param(0.0, 1e3, 1.0),
         proptest::collection::vec(stop, 1..=8),
         fl(0.0, 1e4),
         prop_oneof![Just(BlendMode::Additive), Just(BlendMode::Alpha)],
         (
             proptest::option::of((1u32..=64, 1u32..=64, fl(0.0, 1000.0), any::<bool>())),
-            fl(0.0, 1.0),
+            param(-1e5, 1e5, 1.0),
             fl(0.0, 360.0),
             proptest::option::of((fl(0.0, 10.0), fl(0.0, 1e3))),
         ),
     )
         .prop_map(
-            |(sprite, size_start_m, size_end_m, mut stops, intensity, blend, extra)| {
-                let (flip, size_random, rotation_random_deg, streak) = extra;
+            |(sprite, size_m, opacity, mut stops, intensity, blend, extra)| {
+                let (flip, spin_deg_per_s, rotation_random_deg, streak) = extra;
                 stops.sort_by(|a, b| a.t.total_cmp(&b.t));
                 // -0.0 sorts before 0.0 but the validator compares with <, so both orders pass.
                 Look {
                     sprite,
-                    size_start_m,
-                    size_end_m,
+                    size_m,
+                    opacity,
+                    spin_deg_per_s,
                     color_over_life: stops,
                     intensity,
                     blend,
@@ -1270,7 +1343,6 @@ fn look() -> BoxedStrategy<Look> {
                         blend_frames: over_life,
                         random_start: !over_life,
                     }),
-                    size_random,
                     rotation_random_deg,
                     streak: streak.map(|(length_secs, max_length_m)| Streak {
                         length_secs,
@@ -1341,7 +1413,7 @@ fn emitter() -> BoxedStrategy<Emitter> {
                 name,
                 enabled,
                 capacity,
-                spawn_rate_per_sec: rate,
+                spawn_rate_per_sec: ignis::effect::Param::Constant(rate),
                 max_spawn_per_step: cap,
                 bursts,
                 lifetime_secs: lifetime,

@@ -123,7 +123,7 @@ fn all_dead_frame_is_black() {
     }
     run.edit(|fx| {
         for e in &mut fx.emitters {
-            e.spawn_rate_per_sec = 0.0;
+            e.spawn_rate_per_sec = ignis::effect::Param::Constant(0.0);
         }
     })
     .expect("edit");
@@ -220,8 +220,10 @@ fn billboard_and_splat_paths_agree() {
         let mut effect = Effect::default_campfire();
         effect.emitters.retain(|e| e.name == "flames");
         let e = &mut effect.emitters[0];
-        e.look.size_start_m = 0.03;
-        e.look.size_end_m = 0.02;
+        e.look.size_m = ignis::effect::Param::Curve {
+            keys: vec![(0.0, 0.03), (1.0, 0.02)],
+            smooth: false,
+        };
         e.look.intensity = 0.6;
         e.look.draw_path = path;
         let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
@@ -366,7 +368,7 @@ fn live_window_draws_what_the_whole_pool_draws() {
     let bounds: Vec<f32> = effect
         .emitters
         .iter()
-        .map(|e| e.spawn_rate_per_sec * (e.lifetime_secs.max + 2.0 / 60.0))
+        .map(|e| e.spawn_rate_per_sec.bounds().1 * (e.lifetime_secs.max + 2.0 / 60.0))
         .collect();
     let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
     for f in 0..150 {
@@ -454,7 +456,7 @@ fn live_windows_survive_capacity_changes_and_disabled_emitters() {
     let ctx = gpu();
     let e = ignis::effect::Emitter {
         capacity: 1000,
-        spawn_rate_per_sec: 600.0,
+        spawn_rate_per_sec: ignis::effect::Param::Constant(600.0),
         lifetime_secs: ignis::effect::Range::new(0.5, 1.0),
         ..plain_emitter()
     };
@@ -513,10 +515,12 @@ fn billboards_beyond_one_draw_carry_all_their_light() {
         effect.emitters.retain(|e| e.name == "flames");
         let e = &mut effect.emitters[0];
         e.capacity = 150_000;
-        e.spawn_rate_per_sec = 120_000.0;
+        e.spawn_rate_per_sec = ignis::effect::Param::Constant(120_000.0);
         e.lifetime_secs = ignis::effect::Range::new(0.8, 1.0);
-        e.look.size_start_m = 0.012;
-        e.look.size_end_m = 0.008;
+        e.look.size_m = ignis::effect::Param::Curve {
+            keys: vec![(0.0, 0.012), (1.0, 0.008)],
+            smooth: false,
+        };
         e.look.intensity = 0.08;
         e.look.draw_path = path;
         let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");

@@ -416,17 +416,15 @@ fn hides_the_fire_exactly(effect: &Effect, depth: bool) {
 fn still_disc(soft_m: f32) -> Effect {
     let mut e = common::plain_emitter();
     e.capacity = 16;
-    e.spawn_rate_per_sec = 4.0;
+    e.spawn_rate_per_sec = ignis::effect::Param::Constant(4.0);
     e.lifetime_secs = ignis::effect::Range::new(100.0, 100.0);
     e.transform.position_m = [0.0, 0.2, 0.0];
     e.look.sprite = Sprite::SoftDisc;
     e.look.flipbook = None;
     e.look.streak = None;
-    e.look.size_start_m = 1.0;
-    e.look.size_end_m = 1.0;
-    e.look.size_random = 0.0;
+    e.look.size_m = ignis::effect::Param::Constant(1.0);
     e.look.rotation_random_deg = 0.0;
-    e.look.spin_deg_per_s = ignis::effect::Range::new(0.0, 0.0);
+    e.look.spin_deg_per_s = ignis::effect::Param::Constant(0.0);
     e.look.blend = BlendMode::Additive;
     e.look.intensity = 1.0;
     e.look.color_over_life = vec![
@@ -777,7 +775,7 @@ fn edits_reach_every_batched_instance() {
     );
 
     let mut brighter = effect.clone();
-    brighter.emitters[0].spawn_rate_per_sec *= 2.0;
+    brighter.emitters[0].spawn_rate_per_sec = brighter.emitters[0].spawn_rate_per_sec.scaled(2.0);
     brighter.emitters[0].look.intensity *= 1.5;
     player.set_effect(&brighter).expect("a parameter edit");
     for (id, b) in ids.iter().zip(&before) {

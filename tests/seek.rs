@@ -226,7 +226,7 @@ fn an_edit_forgets_the_snapshots_and_seeks_land_on_steps() {
     let ctx = gpu();
     let effect = ignis::Effect::default_campfire();
     let mut edited = effect.clone();
-    edited.emitters[1].spawn_rate_per_sec *= 1.5;
+    edited.emitters[1].spawn_rate_per_sec = edited.emitters[1].spawn_rate_per_sec.scaled(1.5);
     let mut run = unbatched(&ctx, effect);
     run.player.keep_seek_snapshots(0.25, 64 << 20);
     for _ in 0..120 {

@@ -36,7 +36,7 @@ fn run_drag(
 ) -> (Vec<Particle>, u32) {
     let mut e = Emitter {
         capacity: initial.len() as u32,
-        spawn_rate_per_sec: 0.0,
+        spawn_rate_per_sec: ignis::effect::Param::Constant(0.0),
         integrator,
         lifetime_secs: Range::new(1e4, 1e4),
         ..plain_emitter()
@@ -131,7 +131,7 @@ fn nonfinite_guard_kills_and_counts_without_poisoning_others() {
     let mut bad = Emitter {
         name: "unstable".into(),
         capacity: 100,
-        spawn_rate_per_sec: 0.0,
+        spawn_rate_per_sec: ignis::effect::Param::Constant(0.0),
         integrator: Integrator::ExplicitEuler,
         ..plain_emitter()
     };
@@ -139,7 +139,7 @@ fn nonfinite_guard_kills_and_counts_without_poisoning_others() {
     let good = Emitter {
         name: "stable".into(),
         capacity: 100,
-        spawn_rate_per_sec: 0.0,
+        spawn_rate_per_sec: ignis::effect::Param::Constant(0.0),
         ..plain_emitter()
     };
     let effect = Effect {
@@ -269,7 +269,7 @@ fn far_from_the_origin_motion_still_resolves() {
 #[test]
 fn a_million_steps_do_not_drift() {
     let e = Emitter {
-        spawn_rate_per_sec: 333.3,
+        spawn_rate_per_sec: ignis::effect::Param::Constant(333.3),
         capacity: 2048,
         ..plain_emitter()
     };
@@ -323,7 +323,7 @@ fn a_million_steps_do_not_drift() {
 fn long_gpu_run_keeps_ages_and_counts() {
     let ctx = gpu();
     let e = Emitter {
-        spawn_rate_per_sec: 400.0,
+        spawn_rate_per_sec: ignis::effect::Param::Constant(400.0),
         capacity: 512,
         ..plain_emitter()
     };
@@ -350,7 +350,7 @@ fn long_gpu_run_keeps_ages_and_counts() {
 fn tiny_ages_stay_exact_late_in_a_run() {
     let ctx = gpu();
     let e = Emitter {
-        spawn_rate_per_sec: 400.0,
+        spawn_rate_per_sec: ignis::effect::Param::Constant(400.0),
         capacity: 1024,
         lifetime_secs: ignis::effect::Range::new(0.5, 1.0),
         ..plain_emitter()
@@ -396,7 +396,7 @@ fn odd_capacities_and_zero_rate() {
     ] {
         let e = Emitter {
             capacity,
-            spawn_rate_per_sec: rate,
+            spawn_rate_per_sec: ignis::effect::Param::Constant(rate),
             ..plain_emitter()
         };
         let sim = run_gpu(&ctx, &bare_effect(e), 1.0 / 120.0, 240);

@@ -10,7 +10,7 @@ use serde::Serialize;
 
 use crate::PlayerError;
 use crate::effect::{
-    Burst, Effect, Emitter, Integrator, Range, Shape, SpawnNoise, TimeMode, Turbulence,
+    Burst, Effect, Emitter, Integrator, Param, Range, Shape, SpawnNoise, TimeMode, Turbulence,
 };
 use crate::gpu::GpuContext;
 use crate::gpu::timer::{GpuTimer, median};
@@ -56,7 +56,7 @@ pub fn scene_emitter(scene: Scene, integrator: Integrator, n: u32) -> Emitter {
     let mut e = Emitter {
         name: "bench".into(),
         capacity: n,
-        spawn_rate_per_sec: 0.0,
+        spawn_rate_per_sec: Param::Constant(0.0),
         max_spawn_per_step: n,
         bursts: vec![Burst {
             time_secs: 0.0,
@@ -87,6 +87,7 @@ pub fn scene_emitter(scene: Scene, integrator: Integrator, n: u32) -> Emitter {
             frequency_per_m: 1.5,
             octaves: 2,
             scroll_m_per_s: 0.5,
+            ..Turbulence::default()
         });
     }
     e
@@ -181,6 +182,7 @@ pub fn setup_scene(ctx: &GpuContext, scene: Scene, n: u32) -> Result<SceneSetup,
     let forces = Forces {
         params: &params,
         modules: Modules::of(&e),
+        over_life: [1.0; 4],
     };
     let a = e.forces.constant_acceleration().as_dvec3();
     let wind = glam::Vec3::from(e.forces.wind_m_per_s).as_dvec3();

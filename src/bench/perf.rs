@@ -5,7 +5,7 @@
 
 use crate::bench::Report;
 use crate::bench::report::sci;
-use crate::effect::{DrawPath, Effect, Emitter, Range};
+use crate::effect::{DrawPath, Effect, Emitter, Param, Range};
 use crate::gpu::GpuContext;
 use crate::gpu::timer::{GpuTimer, median};
 use crate::gpu::types::StateLayout;
@@ -62,13 +62,12 @@ pub fn scaled_campfire(n: u64, max_pool: u64) -> Effect {
                 name: format!("flames {i}"),
                 capacity: per_pool,
                 lifetime_secs: Range::new(1.0, 1.0),
-                spawn_rate_per_sec: per_pool as f32,
+                spawn_rate_per_sec: Param::Constant(per_pool as f32),
                 seed_offset: i as u32,
                 ..flames.clone()
             };
             e.max_spawn_per_step = 0;
-            e.look.size_start_m *= scale.min(1.0);
-            e.look.size_end_m *= scale.min(1.0);
+            e.look.size_m = e.look.size_m.scaled(scale.min(1.0));
             e
         })
         .collect();

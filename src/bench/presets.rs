@@ -82,7 +82,7 @@ fn warm_up_frames(effect: &Effect) -> usize {
     let continuous = effect
         .emitters
         .iter()
-        .any(|e| e.enabled && e.spawn_rate_per_sec > 0.0);
+        .any(|e| e.enabled && e.spawn_rate_per_sec.bounds().1 > 0.0);
     let secs = if continuous {
         longest + last_burst
     } else {

@@ -127,7 +127,7 @@ fn scaled(effect: &Effect, n: u32) -> Effect {
     let mut e = effect.clone();
     for em in &mut e.emitters {
         em.capacity *= n;
-        em.spawn_rate_per_sec *= n as f32;
+        em.spawn_rate_per_sec = em.spawn_rate_per_sec.scaled(n as f32);
     }
     e
 }

@@ -4,11 +4,45 @@ use egui::{Color32, DragValue, Rgba, RichText, Sense, Ui};
 
 use crate::effect::{
     BlendMode, Bloom, ColorStop, DrawPath, Effect, Flipbook, FlipbookMode, Look, MAX_COLOR_STOPS,
-    Post, SPLAT_BELOW_PX, Sprite, Streak,
+    Param, Post, SPLAT_BELOW_PX, Sprite, Streak,
 };
 pub use crate::render::look::sample_gradient;
 
+use super::curve_editor::{ParamSpec, param_row};
 use super::state::ViewSettings;
+
+const SIZE: ParamSpec = ParamSpec {
+    name: "Size curve",
+    unit: " m",
+    values: 0.0..=100.0,
+    speed: 0.002,
+    t_max: 1.0,
+    t_unit: "of life",
+};
+const OPACITY: ParamSpec = ParamSpec {
+    name: "Opacity curve",
+    unit: "×",
+    values: 0.0..=100.0,
+    speed: 0.005,
+    t_max: 1.0,
+    t_unit: "of life",
+};
+const SPIN: ParamSpec = ParamSpec {
+    name: "Spin curve",
+    unit: " °/s",
+    values: -3600.0..=3600.0,
+    speed: 1.0,
+    t_max: 1.0,
+    t_unit: "of life",
+};
+const FRAME: ParamSpec = ParamSpec {
+    name: "Frame curve",
+    unit: "",
+    values: 0.0..=4095.0,
+    speed: 0.05,
+    t_max: 1.0,
+    t_unit: "of life",
+};
 
 /// The selected emitter's look, the effect's composite (exposure, bloom) and the
 /// viewport exposure. `sprite_error` is the selected emitter's sprite load error.
@@ -137,55 +171,33 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
                 .response
                 .labelled_by(label.id);
             ui.end_row();
-            let label = ui
-                .label("Size")
-                .on_hover_text("Billboard diameter at birth and at death, metres (linear in between)");
-            ui.horizontal(|ui| {
-                ui.add(
-                    DragValue::new(&mut look.size_start_m)
-                        .range(0.0..=100.0)
-                        .speed(0.002)
-                        .prefix("start ")
-                        .suffix(" m")
-                        .min_decimals(3),
-                )
-                .labelled_by(label.id);
-                ui.add(
-                    DragValue::new(&mut look.size_end_m)
-                        .range(0.0..=100.0)
-                        .speed(0.002)
-                        .prefix("end ")
-                        .suffix(" m")
-                        .min_decimals(3),
-                )
-                .labelled_by(label.id);
-            });
-            ui.end_row();
-            let label = ui
-                .label("Random size")
-                .on_hover_text("Each particle's size is scaled by a random factor in [1 − r, 1 + r]");
-            ui.add(DragValue::new(&mut look.size_random).range(0.0..=1.0).speed(0.005).prefix("± "))
-                .labelled_by(label.id);
-            ui.end_row();
+            param_row(ui, "Size", "Billboard diameter over the particle's life, metres", &mut look.size_m, &SIZE);
+            param_row(
+                ui,
+                "Opacity",
+                "Multiplies the particle's contribution over its life: its light when additive, its coverage when alpha",
+                &mut look.opacity,
+                &OPACITY,
+            );
             let label = ui
                 .label("Rotation")
-                .on_hover_text("Random initial rotation spread (degrees) and angular velocity range (degrees per second)");
-            ui.horizontal(|ui| {
-                ui.add(
-                    DragValue::new(&mut look.rotation_random_deg)
-                        .range(0.0..=360.0)
-                        .speed(1.0)
-                        .prefix("random ")
-                        .suffix("°"),
-                )
-                .labelled_by(label.id);
-                let spin = &mut look.spin_deg_per_s;
-                ui.add(DragValue::new(&mut spin.min).range(-3600.0..=spin.max).speed(1.0).prefix("spin "))
-                    .labelled_by(label.id);
-                ui.add(DragValue::new(&mut spin.max).range(spin.min..=3600.0).speed(1.0).prefix("… ").suffix(" °/s"))
-                    .labelled_by(label.id);
-            });
+                .on_hover_text("Random initial rotation spread, degrees");
+            ui.add(
+                DragValue::new(&mut look.rotation_random_deg)
+                    .range(0.0..=360.0)
+                    .speed(1.0)
+                    .prefix("random ")
+                    .suffix("°"),
+            )
+            .labelled_by(label.id);
             ui.end_row();
+            param_row(
+                ui,
+                "Spin",
+                "Angular velocity over the particle's life, degrees per second (a range: each particle spins at its own rate)",
+                &mut look.spin_deg_per_s,
+                &SPIN,
+            );
             let label = ui
                 .label("Streak")
                 .on_hover_text("Stretch each billboard from where the particle was (length seconds ago) to where it is: spark trails");
@@ -287,37 +299,49 @@ fn sprite_rows_ui(ui: &mut Ui, look: &mut Look) {
     });
     ui.end_row();
     let label = ui.label("Frame timing").on_hover_text(
-        "Over life: first frame at birth, last at death. Frame rate: a fixed rate, looping",
+        "Over life: first frame at birth, last at death. Frame rate: a fixed rate, looping. Curve: the frame over life, as a parameter",
     );
+    let frames = f.rows * f.cols;
     ui.horizontal(|ui| {
-        let mut fps = match f.mode {
-            FlipbookMode::FrameRate { fps } => Some(fps),
-            FlipbookMode::OverLife => None,
-        };
+        let over_life = matches!(f.mode, FlipbookMode::OverLife);
         if ui
-            .radio(fps.is_none(), "over life")
+            .radio(over_life, "over life")
             .labelled_by(label.id)
             .clicked()
         {
-            fps = None;
+            f.mode = FlipbookMode::OverLife;
         }
-        if ui
-            .radio(fps.is_some(), "fps")
-            .labelled_by(label.id)
-            .clicked()
-            && fps.is_none()
-        {
-            fps = Some(24.0);
+        let rate = matches!(f.mode, FlipbookMode::FrameRate { .. });
+        if ui.radio(rate, "fps").labelled_by(label.id).clicked() && !rate {
+            f.mode = FlipbookMode::FrameRate { fps: 24.0 };
         }
-        if let Some(v) = &mut fps {
-            ui.add(DragValue::new(v).range(0.0..=240.0).speed(0.1))
+        if let FlipbookMode::FrameRate { fps } = &mut f.mode {
+            ui.add(DragValue::new(fps).range(0.0..=240.0).speed(0.1))
                 .labelled_by(label.id);
         }
-        f.mode = fps.map_or(FlipbookMode::OverLife, |fps| FlipbookMode::FrameRate {
-            fps,
-        });
+        let curve = matches!(f.mode, FlipbookMode::Frames(_));
+        if ui.radio(curve, "curve").labelled_by(label.id).clicked() && !curve {
+            let last = frames.saturating_sub(1) as f32;
+            f.mode = FlipbookMode::Frames(Param::Curve {
+                keys: vec![(0.0, 0.0), (1.0, last)],
+                smooth: false,
+            });
+        }
     });
     ui.end_row();
+    if let FlipbookMode::Frames(p) = &mut f.mode {
+        let spec = ParamSpec {
+            values: 0.0..=frames.saturating_sub(1) as f32,
+            ..FRAME
+        };
+        param_row(
+            ui,
+            "Frame",
+            "The flipbook frame over the particle's life (0 = first; fractions blend when blending frames)",
+            p,
+            &spec,
+        );
+    }
     ui.label("");
     ui.horizontal(|ui| {
         ui.checkbox(&mut f.blend_frames, "blend frames")

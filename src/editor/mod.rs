@@ -5,6 +5,7 @@
 //! with an `egui::Context`); [`app`] owns the window and the frame loop.
 
 pub mod app;
+pub mod curve_editor;
 pub mod emitter_cost;
 pub mod export_ui;
 mod gfx;

@@ -14,6 +14,7 @@ use crate::effect::{
     SphereCollider, TimeMode,
 };
 
+use super::curve_editor::{ParamSpec, param_row};
 use super::look::look_ui;
 use super::state::{EditorState, Playback, ViewSettings};
 use super::stats::stats_ui;
@@ -337,6 +338,28 @@ pub(crate) fn row_ui(
     response
 }
 
+/// The spawn rate: particles per second over the effect's time, in seconds.
+const SPAWN_RATE: ParamSpec = ParamSpec {
+    name: "Spawn rate curve",
+    unit: " /s",
+    values: 0.0..=1.0e6,
+    speed: 5.0,
+    t_max: 3600.0,
+    t_unit: "s",
+};
+
+/// A multiplier over the particle's life.
+fn multiplier(name: &'static str) -> ParamSpec {
+    ParamSpec {
+        name,
+        unit: "×",
+        values: 0.0..=100.0,
+        speed: 0.01,
+        t_max: 1.0,
+        t_unit: "of life",
+    }
+}
+
 /// A float drag value clamped to `range`.
 fn drag<'a>(v: &'a mut f32, range: RangeInclusive<f32>, speed: f64, suffix: &str) -> DragValue<'a> {
     DragValue::new(v)
@@ -472,11 +495,12 @@ ui, "Name", "Unique name of this layer", |ui| {
             0.5,
             "°",
         );
-        row_ui(
-ui,
+        param_row(
+            ui,
             "Spawn rate",
-            "Continuous emission, particles per second",
-            |ui| ui.add(drag(&mut e.spawn_rate_per_sec, 0.0..=1.0e6, 5.0, " /s")),
+            "Continuous emission, particles per second, over the effect's time (a range or two curves: one rate or blend per instance, from its seed)",
+            &mut e.spawn_rate_per_sec,
+            &SPAWN_RATE,
         );
         row_ui(
 ui,
@@ -497,7 +521,7 @@ ui,
                 )
             },
         );
-        let needed = e.spawn_rate_per_sec * e.lifetime_secs.max;
+        let needed = e.spawn_rate_per_sec.bounds().1 * e.lifetime_secs.max;
         if needed > e.capacity as f32 * 1.02 {
             ui.label("");
             ui.colored_label(
@@ -885,6 +909,20 @@ ui,
             "Linear drag rate k, per second: the velocity relaxes toward the wind with time constant 1/k",
             |ui| ui.add(drag(&mut f.drag_per_sec, 0.0..=1000.0, 0.01, " /s")),
         );
+        param_row(
+            ui,
+            "Drag over life",
+            "Multiplies both drags over the particle's life (1 = unchanged)",
+            &mut f.drag_over_life,
+            &multiplier("Drag over life curve"),
+        );
+        param_row(
+            ui,
+            "Speed over life",
+            "Multiplies how far the particle moves each step over its life (1 = as its velocity says)",
+            &mut f.speed_over_life,
+            &multiplier("Speed over life curve"),
+        );
         vec3_ui(
             ui,
             "Wind m/s",
@@ -984,6 +1022,13 @@ fn force_modules_ui(ui: &mut Ui, f: &mut crate::effect::Forces) {
                 "Upward scroll of the field, m/s",
                 |ui| ui.add(drag(&mut t.scroll_m_per_s, -100.0..=100.0, 0.01, " m/s")),
             );
+            param_row(
+                ui,
+                "Turb. over life",
+                "Multiplies the turbulence over the particle's life (1 = unchanged)",
+                &mut t.over_life,
+                &multiplier("Turbulence over life curve"),
+            );
         },
     );
     module_ui(
@@ -1081,6 +1126,13 @@ fn force_modules_ui(ui: &mut Ui, f: &mut crate::effect::Forces) {
                 "Pull exponent",
                 "Growth with normalised age (1 = linear)",
                 |ui| ui.add(drag(&mut p.exponent, 0.0..=16.0, 0.01, "")),
+            );
+            param_row(
+                ui,
+                "Pull over life",
+                "Multiplies the pull over the particle's life (1 = unchanged)",
+                &mut p.over_life,
+                &multiplier("Pull over life curve"),
             );
         },
     );

@@ -54,7 +54,7 @@ fn reach(effect: &Effect) -> f32 {
         .filter(|e| e.enabled)
         .map(|e| {
             let l = &e.look;
-            let size = l.size_start_m.max(l.size_end_m) * (1.0 + l.size_random.abs());
+            let size = l.size_m.bounds().1;
             let streak = l.streak.as_ref().map_or(0.0, |s| s.max_length_m);
             0.5 * size * std::f32::consts::SQRT_2 + streak
         })

@@ -40,6 +40,7 @@ mod errors;
 mod layout;
 mod locate;
 mod tokens;
+mod v1;
 
 pub use atomic::{write_atomic, write_atomic_with};
 pub use errors::PresetError;
@@ -104,8 +105,11 @@ pub fn parse_str(text: &str, path: &str) -> Result<Effect, PresetError> {
         // Not a plain integer: the deserialiser says what is wrong with it.
         Some((None, _)) => deserialize::<Effect>(text, path, &tokens)?,
         None => {
-            // Syntax errors first (a truncated file may have lost more than its version).
-            deserialize::<Effect>(text, path, &tokens)?;
+            // Syntax errors first (a truncated file may have lost more than its version),
+            // worded for a preset; any format's fields are fine, as the version is unknown.
+            if deserialize::<serde::de::IgnoredAny>(text, path, &tokens).is_err() {
+                deserialize::<Effect>(text, path, &tokens)?;
+            }
             let pos = locate::value_at(text, "").map_or(TextPos { line: 1, column: 1 }, |d| d.pos);
             return Err(parse_err(
                 pos,
@@ -156,23 +160,20 @@ pub fn parse_str(text: &str, path: &str) -> Result<Effect, PresetError> {
 /// Reads a file of format `version` (1..=[`CURRENT_VERSION`]) and brings it up to the current
 /// format.
 ///
-/// Version 1 is the first format, so there is nothing to convert yet. When the format
-/// changes (version 2):
+/// Version 1 is read through its frozen types (`v1.rs`) and converted field by field into
+/// the same effect in today's model. When the format changes again (version 3):
 ///
-/// 1. copy today's serde types into a frozen `mod v1` (only the parts that change need their
-///    own types) and keep them unchanged from then on;
-/// 2. add `1 => deserialize::<v1::Effect>(…).map(Effect::from)` below, with the conversion
+/// 1. copy the version-2 types that change into a frozen `mod v2` and keep them unchanged
+///    from then on (and point `v1`'s conversion at them, or chain the two);
+/// 2. add `2 => deserialize::<v2::Effect>(…).map(Effect::from)` below, with the conversion
 ///    written out field by field (renamed fields, new fields with the value that reproduces
 ///    the old look, changed units);
-/// 3. keep `tests/fixtures/v1_campfire.ron` loading (its test compares it with what the
-///    conversion should give), and add a `v2_…` fixture for the next change.
+/// 3. keep `tests/fixtures/v1_campfire.ron` and `v2_…` loading (their tests compare them
+///    with what the conversion should give).
 fn migrate(version: u64, text: &str, path: &str, tokens: &[Token]) -> Result<Effect, PresetError> {
     match version {
-        1 => {
-            let mut effect = deserialize::<Effect>(text, path, tokens)?;
-            effect.version = CURRENT_VERSION;
-            Ok(effect)
-        }
+        1 => deserialize::<v1::Effect>(text, path, tokens).map(Effect::from),
+        2 => deserialize::<Effect>(text, path, tokens),
         // `parse_str` refuses 0 and versions above CURRENT_VERSION before calling this.
         other => Err(PresetError::Parse {
             path: path.to_owned(),

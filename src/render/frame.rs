@@ -7,11 +7,14 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
+use crate::effect::rows_key;
 use crate::effect::{BlendMode, DrawPath, Effect, FlipbookMode, Look, SPLAT_BELOW_PX, Streak};
 use crate::gpu::GpuContext;
 use crate::gpu::types::{CameraUniform, LookUniform, PARAMS_STRIDE, StateLayout};
 use crate::render::camera::Camera;
-use crate::render::look::{RAMP_WIDTH, bake_ramp, gradient_key};
+use crate::render::look::{
+    RAMP_WIDTH, ROWS_PER_EMITTER, bake_look_curves, bake_ramp, gradient_key, look_curve_params,
+};
 use crate::render::sort::{SortJob, SortMember};
 use crate::render::sprites::{SpriteError, SpriteLibrary, SpriteTexture};
 use crate::sim::Modules;
@@ -131,13 +134,14 @@ pub struct FrameResources {
 
 /// The look uniform of an emitter (everything but the matrices, the ground height and
 /// stateless motion, which depend on the frame). `ramp_row` is the emitter's colour ramp
-/// row, `salt` its per-particle random salt, `sprite_integral` the sprite's ∫ brightness.
+/// row (its curve rows follow it), `salt` its per-particle random salt, `sprite_integral` the sprite's ∫ brightness.
 pub fn look_uniform(look: &Look, ramp_row: u32, salt: u32, sprite_integral: f32) -> LookUniform {
     let (rows, cols, mode, fps, random_start) = match &look.flipbook {
         Some(f) => {
             let (mode, fps) = match f.mode {
                 FlipbookMode::OverLife => (0, 0.0),
                 FlipbookMode::FrameRate { fps } => (1, fps),
+                FlipbookMode::Frames(_) => (2, 0.0),
             };
             (
                 f.rows.max(1),
@@ -163,12 +167,7 @@ pub fn look_uniform(look: &Look, ramp_row: u32, salt: u32, sprite_integral: f32)
         0.0
     };
     LookUniform {
-        size_intensity: [
-            look.size_start_m,
-            look.size_end_m,
-            look.intensity,
-            look.size_random,
-        ],
+        size_intensity: [0.0, 0.0, look.intensity, 0.0],
         ids: [ramp_row, blend, rows, cols],
         flags: [mode, random_start, salt, 0],
         extra: [
@@ -177,12 +176,7 @@ pub fn look_uniform(look: &Look, ramp_row: u32, salt: u32, sprite_integral: f32)
             look.rotation_random_deg.to_radians(),
             fps,
         ],
-        spin_streak: [
-            look.spin_deg_per_s.min.to_radians(),
-            look.spin_deg_per_s.max.to_radians(),
-            streak.length_secs,
-            streak.max_length_m,
-        ],
+        spin_streak: [0.0, 0.0, streak.length_secs, streak.max_length_m],
         soft: [0.0, inv_soft, 0.0, 0.0],
         trim: [0.0, 0.0, 1.0, 1.0],
         ..LookUniform::default()
@@ -238,7 +232,7 @@ impl LookVariant {
         Self {
             alpha: look.blend == BlendMode::Alpha,
             flipbook: look.flipbook.is_some(),
-            flip_blend: look.flipbook.is_some_and(|f| f.blend_frames),
+            flip_blend: look.flipbook.as_ref().is_some_and(|f| f.blend_frames),
             streak: look.streak.is_some(),
             soft: look.soft_ground_m > 0.0,
             soft_depth: false,
@@ -445,33 +439,37 @@ impl FrameResources {
         self.particle_groups.get(&key).map(|(_, g)| g)
     }
 
-    /// Bakes and uploads emitter `i`'s colour ramp when its gradient changed.
+    /// Bakes and uploads emitter `i`'s colour ramp and curve rows (rows
+    /// `ROWS_PER_EMITTER · i` on) when its gradient or curves changed.
     fn upload_ramp(&mut self, ctx: &GpuContext, i: usize, look: &Look) {
-        let key = gradient_key(look);
+        let key = gradient_key(look) ^ rows_key(&look_curve_params(look)).rotate_left(1);
         if self.ramp_keys.get(i).copied().flatten() == Some(key) {
             return;
         }
-        let row = bake_ramp(&look.color_over_life);
+        let mut rows = bake_ramp(&look.color_over_life);
+        let [a, b] = bake_look_curves(look);
+        rows.extend(a);
+        rows.extend(b);
         ctx.queue.write_texture(
             wgpu::TexelCopyTextureInfo {
                 texture: &self.ramps,
                 mip_level: 0,
                 origin: wgpu::Origin3d {
                     x: 0,
-                    y: i as u32,
+                    y: ROWS_PER_EMITTER * i as u32,
                     z: 0,
                 },
                 aspect: wgpu::TextureAspect::All,
             },
-            bytemuck::cast_slice(&row),
+            bytemuck::cast_slice(&rows),
             wgpu::TexelCopyBufferLayout {
                 offset: 0,
                 bytes_per_row: Some(RAMP_WIDTH * 16),
-                rows_per_image: Some(1),
+                rows_per_image: Some(ROWS_PER_EMITTER),
             },
             wgpu::Extent3d {
                 width: RAMP_WIDTH,
-                height: 1,
+                height: ROWS_PER_EMITTER,
                 depth_or_array_layers: 1,
             },
         );
@@ -524,7 +522,8 @@ impl FrameResources {
                 .map_or(0, |s| s.effect.emitters.len())
         };
         let slots: usize = groups.iter().map(|g| g.len() * emitters(g)).sum();
-        let rows = groups.iter().map(|g| emitters(g)).max().unwrap_or(0);
+        let rows =
+            ROWS_PER_EMITTER as usize * groups.iter().map(|g| emitters(g)).max().unwrap_or(0);
         self.reserve(ctx, slots, rows);
         self.sprite_errors.clear();
         // Reused from frame to frame: a fresh allocation of this size is fresh pages.
@@ -571,7 +570,7 @@ impl FrameResources {
     /// instance by `member_look`): the look's settings and the sprite's trim.
     fn base_look(&mut self, effect: &Effect, i: usize, sprite: &SpriteTexture) -> LookUniform {
         let e = &effect.emitters[i];
-        let mut u = look_uniform(&e.look, i as u32, 0, sprite.integral);
+        let mut u = look_uniform(&e.look, ROWS_PER_EMITTER * i as u32, 0, sprite.integral);
         if self.trim_sprites && e.look.streak.is_none() {
             let (rows, cols) = e
                 .look
@@ -740,7 +739,7 @@ impl FrameResources {
             .map(|j| sort.buffers(ctx, j.key, b.capacity * n).values.clone());
         let key = (b.generation, b.parity, sorted);
         self.ensure_particle_group(ctx, key, &b, order_buffer);
-        let size_m = e.look.size_start_m.max(e.look.size_end_m);
+        let size_m = e.look.size_m.bounds().1;
         let size_px = size_m * view.camera.pixels_per_unit() / distance.max(1e-3);
         let additive = e.look.blend == BlendMode::Additive;
         let splat = self.allow_splat

@@ -1,10 +1,40 @@
 //! The look's data as the GPU sees it, with CPU mirrors of the shader functions in
 //! `shaders/look.wgsl` (colour ramps, flipbook frame selection) for tests and tools.
 
-use crate::effect::{ColorStop, Flipbook, FlipbookMode, Look};
+use crate::effect::{CURVE_WIDTH, ColorStop, Flipbook, FlipbookMode, Look, Param, bake_rows};
 
 /// Texels per colour ramp row (keep in sync with `RAMP_WIDTH` in `shaders/look.wgsl`).
 pub const RAMP_WIDTH: u32 = 1024;
+
+/// Rows of the ramp texture per emitter: its colour ramp, then its curve rows A and B
+/// (`look_curves` in look.wgsl).
+pub const ROWS_PER_EMITTER: u32 = 3;
+
+const _: () = assert!(
+    CURVE_WIDTH == RAMP_WIDTH,
+    "curve rows share the ramp texture"
+);
+
+/// The look's curves, the channels of its curve rows: size (m), opacity, spin (deg/s,
+/// baked as the angle integral in radians), flipbook frame (0 unless the frame is a curve).
+pub fn look_curve_params(look: &Look) -> [&Param; 4] {
+    const ZERO: &Param = &Param::Constant(0.0);
+    let frame = match look.flipbook.as_ref().map(|f| &f.mode) {
+        Some(FlipbookMode::Frames(p)) => p,
+        _ => ZERO,
+    };
+    [&look.size_m, &look.opacity, &look.spin_deg_per_s, frame]
+}
+
+/// The look's curve rows A and B: channel z holds `∫₀ᵗ spin` in radians per second of
+/// lifetime, so the angle a particle has turned is its lifetime times the row's value.
+pub fn bake_look_curves(look: &Look) -> [Vec<[f32; 4]>; 2] {
+    bake_rows(
+        look_curve_params(look),
+        [false, false, true, false],
+        [1.0, 1.0, 1f64.to_radians(), 1.0],
+    )
+}
 
 /// The gradient's value at `t`: linear between stops, clamped at the ends.
 pub fn sample_gradient(stops: &[ColorStop], t: f32) -> [f32; 4] {
@@ -60,8 +90,14 @@ pub struct FrameChoice {
 }
 
 /// `flipbook_frames` of look.wgsl: `start01` is the particle's random number for its
-/// start frame.
-pub fn flipbook_frame(f: &Flipbook, age: f32, life: f32, start01: f32) -> FrameChoice {
+/// start frame, `curve_frame` the frame curve's value (read in the frame curve mode).
+pub fn flipbook_frame(
+    f: &Flipbook,
+    age: f32,
+    life: f32,
+    start01: f32,
+    curve_frame: f32,
+) -> FrameChoice {
     let count = (f.rows * f.cols).max(1);
     let n = count as f32;
     let start = if f.random_start {
@@ -70,6 +106,16 @@ pub fn flipbook_frame(f: &Flipbook, age: f32, life: f32, start01: f32) -> FrameC
         0
     };
     match f.mode {
+        FlipbookMode::Frames(_) => {
+            let pos = curve_frame.clamp(0.0, n - 1.0);
+            let f0 = (pos as u32).min(count - 1);
+            let f1 = (f0 + 1).min(count - 1);
+            FrameChoice {
+                frame: (f0 + start) % count,
+                next: (f1 + start) % count,
+                weight: if f.blend_frames { pos - f0 as f32 } else { 0.0 },
+            }
+        }
         FlipbookMode::OverLife => {
             let t = (age / life).clamp(0.0, 1.0);
             if f.blend_frames {

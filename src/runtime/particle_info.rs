@@ -116,7 +116,12 @@ impl Player {
             lifetime_secs: p.vel_life[3],
             position_m: p.position() + origin,
             velocity_m_per_s: p.velocity(),
-            forces: forces_on(p, &params, Modules::of(e)),
+            forces: forces_on(
+                p,
+                &params,
+                Modules::of(e),
+                over_life_now(e, p, &params, slot),
+            ),
         }))
     }
 
@@ -134,19 +139,42 @@ impl Player {
     }
 }
 
+/// The particle's over-life multipliers at its age now (as the update's next step reads
+/// them), or 1 where the emitter has no curves.
+fn over_life_now(
+    e: &crate::effect::Emitter,
+    p: &Particle,
+    params: &crate::gpu::types::SimParams,
+    slot: u32,
+) -> [f32; 4] {
+    if !Modules::of(e).contains(Modules::CURVES) {
+        return [1.0; 4];
+    }
+    let rows = crate::sim::modules::bake_over_life(e);
+    let life = p.vel_life[3];
+    crate::sim::cpu_reference::over_life_at(&rows, p.pos_age[3] / life, params, slot, life)
+}
+
 /// Each force's share of `p`'s acceleration: the constant part (gravity and buoyancy),
-/// then every module on (gusts ride on the drag), then the sum.
+/// then every module on (gusts ride on the drag), then the sum; `over_life` scales them
+/// as the update does.
 fn forces_on(
     p: &Particle,
     params: &crate::gpu::types::SimParams,
     on: Modules,
+    over_life: [f32; 4],
 ) -> Vec<(&'static str, Vec3)> {
     let pos = p.position().as_dvec3();
     let vel = p.velocity().as_dvec3();
     let (age, life) = (f64::from(p.pos_age[3]), f64::from(p.vel_life[3]));
     let time = f64::from(params.wind_time[3]);
     let accel = |modules: Modules| -> DVec3 {
-        Forces { params, modules }.acceleration(pos, vel, age, life, time)
+        Forces {
+            params,
+            modules,
+            over_life,
+        }
+        .acceleration(pos, vel, age, life, time)
     };
     let base = accel(Modules::default());
     let gusts = if on.contains(Modules::GUSTS) {

@@ -14,7 +14,7 @@ use crate::gpu::types::{PackedParticle, Particle, SimParams, StateLayout};
 use crate::gpu::{GpuContext, Uploads};
 use crate::sim::gpu_sim::{
     EmitterBuffers, SLOTS_PER_INVOCATION, SharedUpdate, SimError, SimState, dispatch_size, lock,
-    packed_life, pipeline_key, read_buffer,
+    over_life_buffer, packed_life, pipeline_key, read_buffer, upload_over_life,
 };
 use crate::sim::modules::Modules;
 use crate::sim::planner::{EffectPlanner, LiveWindow};
@@ -69,6 +69,9 @@ struct Pool {
     life_range: (f32, f32),
     /// The emitter's random salt (`rng::emitter_salt`).
     salt: u32,
+    /// The emitter's over-life curves baked, and what they hold (see `GpuSim`).
+    curves: wgpu::Buffer,
+    curves_key: Option<u64>,
 }
 
 /// One instance in a batch: its planner and seed.
@@ -148,7 +151,17 @@ impl InstanceBatch {
             pool.salt = crate::rng::emitter_salt(i as u32, e.seed_offset);
             batch.pools.push(pool);
         }
+        batch.follow(effect);
         Ok(batch)
+    }
+
+    /// Re-bakes the pools' over-life curves that `effect` changed.
+    fn upload_curves(&mut self, effect: &Effect) {
+        for (p, e) in self.pools.iter_mut().zip(&effect.emitters) {
+            if Modules::of(e).contains(Modules::CURVES) {
+                upload_over_life(&self.ctx.queue, &p.curves, &mut p.curves_key, e);
+            }
+        }
     }
 
     fn pool(&self, capacity: u32, layout: StateLayout) -> Pool {
@@ -182,6 +195,7 @@ impl InstanceBatch {
             spare("InstanceBatch::counters"),
             spare("InstanceBatch::births"),
         );
+        let curves = over_life_buffer(d);
         let update = lock(&self.update);
         let group = |src: usize| {
             let entry = |binding, resource| wgpu::BindGroupEntry { binding, resource };
@@ -201,6 +215,7 @@ impl InstanceBatch {
                     entry(2, buffers[1 - src].as_entire_binding()),
                     entry(3, counters.as_entire_binding()),
                     entry(4, births.as_entire_binding()),
+                    entry(5, curves.as_entire_binding()),
                 ],
             })
         };
@@ -213,6 +228,8 @@ impl InstanceBatch {
             current: 0,
             generation: crate::sim::gpu_sim::next_generation(),
             life_range: (0.0, 0.0),
+            curves,
+            curves_key: None,
             salt: 0,
         }
     }
@@ -250,6 +267,7 @@ impl InstanceBatch {
             p.life_range = (e.lifetime_secs.min, e.lifetime_secs.max);
             p.salt = crate::rng::emitter_salt(i as u32, e.seed_offset);
         }
+        self.upload_curves(effect);
     }
 
     /// Gives `slot`'s instance a new seed (for particles born from now on).

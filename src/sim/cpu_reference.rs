@@ -21,6 +21,26 @@ pub struct CpuSim {
     pub nonfinite_killed: u64,
     /// Modules compiled in (the GPU's `MOD_*` constants).
     pub modules: Modules,
+    /// The over-life curves baked (rows A and B; read with `Modules::CURVES`).
+    pub over_life: [Vec<[f32; 4]>; 2],
+}
+
+/// A particle's over-life multipliers for a step (`over_life_at` in update.wgsl): the
+/// baked rows at normalised age `t`, blended by the particle's random numbers.
+pub fn over_life_at(
+    rows: &[Vec<[f32; 4]>; 2],
+    t: f32,
+    params: &SimParams,
+    slot: u32,
+    life: f32,
+) -> [f32; 4] {
+    let u = rng::unorm4(rng::pcg4d([
+        slot,
+        life.to_bits(),
+        params.emitter_salt,
+        params.seed ^ 0x5C0,
+    ]));
+    crate::effect::lookup_blend(rows, t, u)
 }
 
 impl CpuSim {
@@ -31,6 +51,7 @@ impl CpuSim {
             integrator,
             nonfinite_killed: 0,
             modules: Modules::DRAG,
+            over_life: [Vec::new(), Vec::new()],
         }
     }
 
@@ -38,6 +59,7 @@ impl CpuSim {
     pub fn for_emitter(e: &Emitter) -> Self {
         Self {
             modules: Modules::of(e),
+            over_life: crate::sim::modules::bake_over_life(e),
             ..Self::new(e.capacity, e.integrator)
         }
     }
@@ -55,25 +77,41 @@ impl CpuSim {
                 let mut q = spawn_particle(params, key);
                 let f = (params.spawn_frac0 + rel as f32 * params.spawn_frac_step).clamp(0.0, 1.0);
                 let age0 = (1.0 - f) * params.dt_secs;
+                let curves = self.modules.contains(Modules::CURVES);
                 let forces = Forces {
                     params,
                     modules: self.modules,
+                    over_life: if curves {
+                        over_life_at(&self.over_life, 0.0, params, slot, q.vel_life[3])
+                    } else {
+                        [1.0; 4]
+                    },
                 };
                 let k = forces.linear_drag_k() as f32;
                 let (phi, psi) = exp_phi_psi(k, age0);
                 let c = Vec3::from_slice(&params.accel_drag[..3])
                     + k * Vec3::from_slice(&params.wind_time[..3]);
                 let v0 = q.velocity();
-                let x = q.position() + v0 * phi + c * psi;
+                let x = if curves {
+                    q.position() + (v0 * phi + c * psi) * forces.over_life[0]
+                } else {
+                    q.position() + v0 * phi + c * psi
+                };
                 let v = v0 * (1.0 - k * phi) + c * phi;
                 q.pos_age = [x.x, x.y, x.z, age0];
                 q.vel_life = [v.x, v.y, v.z, q.vel_life[3]];
                 *p = q;
             } else if p.is_alive() {
                 let life = p.vel_life[3];
+                let curves = self.modules.contains(Modules::CURVES);
                 let forces = Forces {
                     params,
                     modules: self.modules,
+                    over_life: if curves {
+                        over_life_at(&self.over_life, p.pos_age[3] / life, params, slot, life)
+                    } else {
+                        [1.0; 4]
+                    },
                 };
                 let (mut x, mut v) = integrate(
                     self.integrator,
@@ -85,6 +123,9 @@ impl CpuSim {
                     params.wind_time[3],
                     params.dt_secs,
                 );
+                if curves {
+                    x = p.position() + (x - p.position()) * forces.over_life[0];
+                }
                 let mut age = p.pos_age[3] + params.dt_secs;
                 if self.modules.contains(Modules::COLLISIONS) {
                     let c = collide(params, p.position(), x, v);
@@ -241,6 +282,9 @@ pub struct Forces<'a> {
     pub params: &'a SimParams,
     /// Modules compiled in.
     pub modules: Modules,
+    /// The particle's over-life multipliers for the step: x speed (applied by the caller
+    /// to the step's displacement), y both drags, z turbulence, w flame pull.
+    pub over_life: [f32; 4],
 }
 
 fn d3(v: [f32; 4]) -> DVec3 {
@@ -251,7 +295,7 @@ impl Forces<'_> {
     /// The linear drag rate k the exponential integrator uses.
     pub fn linear_drag_k(&self) -> f64 {
         if self.modules.contains(Modules::DRAG) {
-            self.params.accel_drag[3] as f64
+            (self.params.accel_drag[3] * self.over_life[1]) as f64
         } else {
             0.0
         }
@@ -270,17 +314,18 @@ impl Forces<'_> {
                 - 1.0;
             wind *= 1.0 + g[0] as f64 * n;
         }
+        let s = self.over_life.map(f64::from);
         if m.contains(Modules::DRAG) {
-            a -= p.accel_drag[3] as f64 * (vel - wind);
+            a -= p.accel_drag[3] as f64 * s[1] * (vel - wind);
         }
         if m.contains(Modules::QUADRATIC_DRAG) {
             let rel = vel - wind;
-            a -= p.gusts_qdrag_pull[2] as f64 * rel.length() * rel;
+            a -= p.gusts_qdrag_pull[2] as f64 * s[1] * rel.length() * rel;
         }
         if m.contains(Modules::TURBULENCE) {
             let t = p.turbulence;
             let q = (pos - DVec3::new(0.0, t[3] as f64 * time, 0.0)) * t[1] as f64;
-            a += t[0] as f64 * curl_noise(q, p.seed ^ p.emitter_salt, t[2] as u32) / 1.5;
+            a += t[0] as f64 * curl_noise(q, p.seed ^ p.emitter_salt, t[2] as u32) / 1.5 * s[2];
         }
         if m.contains(Modules::VORTEX) {
             let axis = d3(p.vortex_axis);
@@ -312,7 +357,7 @@ impl Forces<'_> {
             let axis = d3(p.axis_dir);
             let radial = r - axis * r.dot(axis);
             let t = (age / life.max(1e-6)).clamp(0.0, 1.0);
-            a -= p.gusts_qdrag_pull[3] as f64 * t.powf(p.attractor_b[2] as f64) * radial;
+            a -= p.gusts_qdrag_pull[3] as f64 * t.powf(p.attractor_b[2] as f64) * radial * s[3];
         }
         a
     }

@@ -4,7 +4,7 @@ use std::collections::{HashMap, VecDeque};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
-use crate::effect::{Effect, Integrator};
+use crate::effect::{CURVE_WIDTH, Effect, Integrator, rows_key};
 use crate::gpu::types::{
     Birth, PARAMS_STRIDE, PackedParticle, Particle, SimParams, StateLayout, double_single,
     slot_counter, tiny_decode,
@@ -102,6 +102,8 @@ impl UpdatePass {
                     storage(3, false),
                     // The birth table (tiny state; a placeholder for the others).
                     storage(4, true),
+                    // The over-life curves (read with MOD_CURVES).
+                    storage(5, true),
                 ],
             });
         let pipeline_layout = ctx
@@ -258,6 +260,9 @@ pub(super) struct EmitterState {
     /// (one placeholder entry for the other layouts).
     pub(super) births: wgpu::Buffer,
     pub(super) births_mask: u32,
+    /// The emitter's over-life curves baked (`Modules::CURVES`), and what they hold.
+    pub(super) curves: wgpu::Buffer,
+    pub(super) curves_key: Option<u64>,
     /// The entries the steps recorded last may read (sequence number, entry), oldest
     /// first: what a larger table must be filled with.
     pub(super) births_mirror: VecDeque<(u64, Birth)>,
@@ -273,6 +278,39 @@ pub(super) struct EmitterState {
     /// The spawn counter after the last recorded step (equal to the planner's when the
     /// steps came from it; otherwise the live window is unknown).
     pub(super) spawned_end: u64,
+}
+
+/// A buffer for an emitter's baked over-life curves (rows A and B, [`CURVE_WIDTH`]
+/// texels of four f32 each; see `shaders/curves.wgsl`).
+pub(crate) fn over_life_buffer(device: &wgpu::Device) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("over_life_curves"),
+        size: 2 * u64::from(CURVE_WIDTH) * 16,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+/// Bakes and uploads `e`'s over-life curves into `buffer` when they differ from what
+/// `key` says it holds.
+pub(crate) fn upload_over_life(
+    queue: &wgpu::Queue,
+    buffer: &wgpu::Buffer,
+    key: &mut Option<u64>,
+    e: &crate::effect::Emitter,
+) {
+    let k = rows_key(&crate::sim::modules::over_life_params(e));
+    if *key == Some(k) {
+        return;
+    }
+    let [a, b] = crate::sim::modules::bake_over_life(e);
+    queue.write_buffer(buffer, 0, bytemuck::cast_slice(&a));
+    queue.write_buffer(
+        buffer,
+        16 * u64::from(CURVE_WIDTH),
+        bytemuck::cast_slice(&b),
+    );
+    *key = Some(k);
 }
 
 /// The spawn counter and lifetime of `slot` in a ring of `capacity` slots after `total`
@@ -514,7 +552,11 @@ impl GpuSim {
             s.life_range = (e.lifetime_secs.min, e.lifetime_secs.max);
             s.seed = effect.seed;
             s.salt = crate::rng::emitter_salt(i as u32, e.seed_offset);
-            let stateless = Modules::of(e).contains(Modules::STATELESS);
+            let modules = Modules::of(e);
+            if modules.contains(Modules::CURVES) {
+                upload_over_life(&self.ctx.queue, &s.curves, &mut s.curves_key, e);
+            }
+            let stateless = modules.contains(Modules::STATELESS);
             if s.stateless != stateless {
                 let enc = enc.get_or_insert_with(|| {
                     self.ctx.device.create_command_encoder(&Default::default())
@@ -542,7 +584,8 @@ impl GpuSim {
             });
             for i in 0..self.emitters.len() {
                 let s = &self.emitters[i];
-                self.emitters[i].bind_groups = self.bind_groups(&s.buffers, &s.counters, &s.births);
+                self.emitters[i].bind_groups =
+                    self.bind_groups(&s.buffers, &s.counters, &s.births, &s.curves);
             }
         }
         for key in used_keys(effect) {
@@ -575,7 +618,8 @@ impl GpuSim {
         });
         let entries = if layout == StateLayout::Tiny { 1024 } else { 1 };
         let births = self.births_buffer(entries);
-        let bind_groups = self.bind_groups(&buffers, &counters, &births);
+        let curves = over_life_buffer(&self.ctx.device);
+        let bind_groups = self.bind_groups(&buffers, &counters, &births, &curves);
         let generation = next_generation();
         EmitterState {
             capacity,
@@ -588,6 +632,8 @@ impl GpuSim {
             layout,
             births,
             births_mask: entries - 1,
+            curves,
+            curves_key: None,
             births_mirror: VecDeque::new(),
             life_range: (0.0, 0.0),
             seed: 0,
@@ -611,6 +657,7 @@ impl GpuSim {
         buffers: &[wgpu::Buffer; 2],
         counters: &wgpu::Buffer,
         births: &wgpu::Buffer,
+        curves: &wgpu::Buffer,
     ) -> [wgpu::BindGroup; 2] {
         let layout = lock(&self.update).layout.clone();
         let make = |src: usize| {
@@ -643,6 +690,10 @@ impl GpuSim {
                         wgpu::BindGroupEntry {
                             binding: 4,
                             resource: births.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 5,
+                            resource: curves.as_entire_binding(),
                         },
                     ],
                 })
@@ -849,7 +900,7 @@ impl GpuSim {
                 .min(u64::from(u32::MAX / 2 + 1)) as u32;
             let births = self.births_buffer(entries);
             let s = &self.emitters[e];
-            let bind_groups = self.bind_groups(&s.buffers, &s.counters, &births);
+            let bind_groups = self.bind_groups(&s.buffers, &s.counters, &births, &s.curves);
             let generation = next_generation();
             let s = &mut self.emitters[e];
             s.births = births;

@@ -2,7 +2,7 @@
 //! WGSL `override` constant (keep in sync with `MOD_*` in `shaders/forces.wgsl` and
 //! `shaders/collide.wgsl`), so a module that is off is compiled out of the pipeline.
 
-use crate::effect::Emitter;
+use crate::effect::{Emitter, Param};
 
 /// A set of modules, as bits.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -31,9 +31,11 @@ impl Modules {
     pub const PACKED: Modules = Modules(512);
     /// Tiny 10-byte state.
     pub const TINY: Modules = Modules(1024);
+    /// Over-life multipliers (speed, drag, turbulence, flame pull) read from baked curves.
+    pub const CURVES: Modules = Modules(2048);
 
     /// Every module with its override-constant name.
-    pub const ALL: [(Modules, &'static str); 11] = [
+    pub const ALL: [(Modules, &'static str); 12] = [
         (Self::DRAG, "MOD_DRAG"),
         (Self::GUSTS, "MOD_GUSTS"),
         (Self::QUADRATIC_DRAG, "MOD_QUADRATIC_DRAG"),
@@ -45,6 +47,7 @@ impl Modules {
         (Self::STATELESS, "MOD_STATELESS"),
         (Self::PACKED, "MOD_PACKED"),
         (Self::TINY, "MOD_TINY"),
+        (Self::CURVES, "MOD_CURVES"),
     ];
 
     /// The modules an emitter's settings need.
@@ -82,6 +85,9 @@ impl Modules {
         if e.collisions.any() {
             m.0 |= Self::COLLISIONS.0;
         }
+        if over_life_params(e).iter().any(|p| !p.is_constant(1.0)) {
+            m.0 |= Self::CURVES.0;
+        }
         if e.stateless && e.stateless_blockers().is_empty() {
             m.0 |= Self::STATELESS.0;
         } else if e.tiny_state {
@@ -118,4 +124,23 @@ impl Modules {
             .map(|(_, n)| &n[4..])
             .collect()
     }
+}
+
+/// The over-life multipliers the update reads (speed, drag, turbulence, flame pull), each
+/// 1 where its force is off: the channels of the emitter's baked simulation curves.
+pub fn over_life_params(e: &Emitter) -> [&Param; 4] {
+    const ONE: &Param = &Param::Constant(1.0);
+    let f = &e.forces;
+    let drag_on = f.drag_per_sec > 0.0 || f.quadratic_drag_per_m > 0.0;
+    [
+        &f.speed_over_life,
+        if drag_on { &f.drag_over_life } else { ONE },
+        f.turbulence.as_ref().map_or(ONE, |t| &t.over_life),
+        f.flame_pull.as_ref().map_or(ONE, |p| &p.over_life),
+    ]
+}
+
+/// The emitter's simulation curves baked (rows A and B of `over_life_params`).
+pub fn bake_over_life(e: &Emitter) -> [Vec<[f32; 4]>; 2] {
+    crate::effect::bake_rows(over_life_params(e), [false; 4], [1.0; 4])
 }

@@ -3,7 +3,7 @@
 
 use std::collections::VecDeque;
 
-use crate::effect::{Effect, Emitter, Shape};
+use crate::effect::{Effect, Emitter, Param, Shape};
 use crate::gpu::types::{SimParams, double_single};
 use crate::rng;
 
@@ -200,9 +200,13 @@ impl EmitterPlanner {
         out: &mut SimParams,
     ) {
         let dt = dt_secs as f64;
-        let rate = e.spawn_rate_per_sec.max(0.0) as f64;
+        let salt = rng::emitter_salt(emitter_index, e.seed_offset);
+        // The emitter's own clock (it stands still while the emitter is disabled).
+        let c0 = self.clock_secs;
+        // Spawns the continuous rate asks for over [c0, c0 + dt].
+        let expected = expected_spawns(&e.spawn_rate_per_sec, seed, salt, c0, dt);
         let acc_before = self.accumulator;
-        self.accumulator += rate * dt;
+        self.accumulator += expected;
         let continuous = self.accumulator.floor();
         self.accumulator -= continuous;
         let mut continuous = continuous as u64;
@@ -229,8 +233,8 @@ impl EmitterPlanner {
         }
 
         // Birth fractions within the step: the k-th integer crossing of the accumulator.
-        let (frac0, frac_step) = if burst == 0 && !capped && rate * dt > 0.0 {
-            let per = 1.0 / (rate * dt);
+        let (frac0, frac_step) = if burst == 0 && !capped && expected > 0.0 {
+            let per = 1.0 / expected;
             ((1.0 - acc_before) * per, per)
         } else if count > 0 {
             (0.5 / count as f64, 1.0 / count as f64)
@@ -238,9 +242,6 @@ impl EmitterPlanner {
             (0.0, 0.0)
         };
 
-        let salt = rng::emitter_salt(emitter_index, e.seed_offset);
-        // The emitter's own clock (it stands still while the emitter is disabled).
-        let c0 = self.clock_secs;
         self.clock_secs += dt;
         self.min_dt_secs = if self.min_dt_secs > 0.0 {
             self.min_dt_secs.min(dt)
@@ -525,6 +526,24 @@ impl SimParams {
 /// The simulation-space origin an emitter gets: its position, in f64.
 pub fn sim_origin_for(e: &Emitter) -> glam::DVec3 {
     glam::Vec3::from(e.transform.position_m).as_dvec3()
+}
+
+/// The spawns a continuous `rate` asks for over `[t0, t0 + dt]` on the emitter's clock:
+/// rate × dt for a constant; otherwise the rate's integral, its random number drawn once
+/// per instance from (seed, emitter salt).
+pub fn expected_spawns(rate: &Param, seed: u32, salt: u32, t0: f64, dt: f64) -> f64 {
+    match rate {
+        Param::Constant(r) => f64::from(r.max(0.0)) * dt,
+        _ => rate
+            .integral(instance_random(seed, salt), t0, t0 + dt)
+            .max(0.0),
+    }
+}
+
+/// An emitter's random number for its per-instance parameters (the spawn rate's range or
+/// blend of two curves): fixed by the instance's seed.
+pub fn instance_random(seed: u32, salt: u32) -> f64 {
+    f64::from(rng::unorm(rng::pcg4d([seed, salt, 0x5A7E, 0])[0]))
 }
 
 /// Builds the uniform block for one emitter and one step. Every position in it is

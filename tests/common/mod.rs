@@ -29,7 +29,7 @@ pub fn plain_emitter() -> Emitter {
     Emitter {
         name: "test".into(),
         capacity: 4096,
-        spawn_rate_per_sec: 1000.0,
+        spawn_rate_per_sec: ignis::effect::Param::Constant(1000.0),
         lifetime_secs: Range::new(1.0, 1.0),
         shape: Shape::Point,
         spread_deg: 0.0,
