@@ -1350,3 +1350,93 @@ fn the_timeline_seeks_in_whole_steps() {
     harness.run();
     assert_eq!(harness.state().playback.loop_region, Some((0.0, span)));
 }
+
+/// The size curve editor: dragging a key moves it (one undo step; the running effect
+/// follows), a click away from the keys adds one where it is, a right-click deletes one.
+#[test]
+fn the_curve_editor_drags_adds_and_deletes_keys() {
+    use ignis::editor::curve_editor::{View, plot_area};
+    use ignis::effect::Param;
+    let mut harness = panel_harness(campfire_state());
+    open_section(&mut harness, "Look");
+    // Let the section's opening animation settle: the plot must stay where it is found.
+    for _ in 0..30 {
+        harness.run();
+    }
+    let size = |h: &Harness<'_, EditorState>| h.state().effect.emitters[0].look.size_m.clone();
+    let before = size(&harness);
+    let Param::TwoCurves { a, .. } = &before else {
+        panic!("the campfire smoke's size is two curves: {before:?}");
+    };
+    let rect = plot_area(harness.get_by_label("Size curve").rect());
+    let view = View::fit(&before, &ignis::editor::look::SIZE);
+    // Row a's last key, (1.0, 0.91): drag it down by 20 points.
+    let key = a.keys[1];
+    let start = view.to_screen(rect, key);
+    harness.hover_at(start);
+    harness.run();
+    harness.drag_at(start);
+    harness.run();
+    for k in 1..=4 {
+        harness.hover_at(start + egui::vec2(-3.0 * k as f32, 5.0 * k as f32));
+        harness.run();
+    }
+    harness.drop_at(start + egui::vec2(-12.0, 20.0));
+    harness.run();
+    let after = size(&harness);
+    let Param::TwoCurves { a: moved, b } = &after else {
+        panic!("still two curves: {after:?}");
+    };
+    let want = view.from_screen(rect, start + egui::vec2(-12.0, 20.0));
+    assert!(
+        (moved.keys[1].1 - want.1).abs() < 1e-3,
+        "{:?} vs {want:?}",
+        moved.keys[1]
+    );
+    assert!(
+        (moved.keys[1].0 - want.0).abs() < 1e-3,
+        "{:?} vs {want:?}",
+        moved.keys[1]
+    );
+    assert!(
+        moved.keys[1].1 < key.1 - 0.05,
+        "the key moved down: {:?}",
+        moved.keys[1]
+    );
+    assert_eq!(moved.keys[0], a.keys[0], "the other key stays");
+    assert_eq!(b, &before.rows()[1], "the other curve stays");
+    assert_eq!(harness.state().running.emitters[0].look.size_m, after);
+    assert_eq!(harness.state().history.undo_len(), 1, "one drag, one step");
+
+    // A click in the middle, away from the keys, adds a key to the nearer curve there.
+    let rect = plot_area(harness.get_by_label("Size curve").rect());
+    let view = View::fit(&after, &ignis::editor::look::SIZE);
+    let mid = view.to_screen(rect, (0.5, moved.eval(0.5) as f32));
+    harness.hover_at(mid);
+    harness.run();
+    for pressed in [true, false] {
+        harness.event(egui::Event::PointerButton {
+            pos: mid,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: Modifiers::NONE,
+        });
+        harness.run();
+    }
+    let added = size(&harness).rows()[0].clone();
+    assert_eq!(added.keys.len(), 3, "{added:?}");
+    assert!((added.keys[1].0 - 0.5).abs() < 0.02, "{added:?}");
+
+    // A right-click on it deletes it again.
+    for pressed in [true, false] {
+        harness.event(egui::Event::PointerButton {
+            pos: mid,
+            button: egui::PointerButton::Secondary,
+            pressed,
+            modifiers: Modifiers::NONE,
+        });
+        harness.run();
+    }
+    assert_eq!(size(&harness).rows()[0].keys.len(), 2);
+    assert!(harness.state().validation_errors.is_empty());
+}

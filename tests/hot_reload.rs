@@ -172,8 +172,8 @@ fn broken_edits_keep_the_last_good_pipeline() {
         // (file, from, to, expected "file:line" substring)
         (
             "forces.wgsl",
-            "a -= params.accel_drag.w * (vel - wind);",
-            "a -= params.accel_drag.w * (vel - wind;",
+            "a -= params.accel_drag.w * over_life.y * (vel - wind);",
+            "a -= params.accel_drag.w * over_life.y * (vel - wind;",
             Some("forces.wgsl:"),
         ),
         (

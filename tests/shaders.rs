@@ -119,8 +119,8 @@ fn errors_point_at_the_imported_file() {
     let path = dir.path().join("forces.wgsl");
     let text = std::fs::read_to_string(&path).expect("read");
     let broken = text.replace(
-        "a -= params.accel_drag.w * (vel - wind);",
-        "a -= params.accel_drag.w * (vel - wind;",
+        "a -= params.accel_drag.w * over_life.y * (vel - wind);",
+        "a -= params.accel_drag.w * over_life.y * (vel - wind;",
     );
     assert_ne!(text, broken);
     std::fs::write(&path, &broken).expect("write");

@@ -1,6 +1,6 @@
 //! The editor for a [`Param`]: its mode (constant, random range, curve, two curves) and,
-//! for curves, a plot whose keys are dragged, added (double-click) and deleted
-//! (right-click), with smooth or linear segments, starting shapes and zoom to fit.
+//! for curves, a plot whose keys are dragged, added (a click away from the keys) and
+//! deleted (right-click), with smooth or linear segments, starting shapes and zoom to fit.
 
 use std::ops::RangeInclusive;
 
@@ -97,13 +97,19 @@ pub fn param_row(ui: &mut Ui, label: &str, tip: &str, p: &mut Param, spec: &Para
 /// Height of a curve plot, points.
 pub const PLOT_HEIGHT: f32 = 96.0;
 
+/// Where a plot widget of `rect` draws its window: inset so that keys at the ends can be
+/// grabbed whole.
+pub fn plot_area(rect: Rect) -> Rect {
+    rect.shrink2(vec2(7.0, 6.0))
+}
+
 /// A parameter's editor: the mode menu and the mode's fields (a plot for curves); the
 /// number fields are labelled by `label`.
 pub fn param_ui(ui: &mut Ui, id: egui::Id, p: &mut Param, spec: &ParamSpec, label: egui::Id) {
     ui.vertical(|ui| {
         ui.horizontal(|ui| {
             let mut mode = p.mode();
-            egui::ComboBox::from_id_salt(id.with("mode"))
+            let menu = egui::ComboBox::from_id_salt(id.with("mode"))
                 .selected_text(mode.label())
                 .width(86.0)
                 .show_ui(ui, |ui| {
@@ -111,6 +117,9 @@ pub fn param_ui(ui: &mut Ui, id: egui::Id, p: &mut Param, spec: &ParamSpec, labe
                         ui.selectable_value(&mut mode, m, m.label());
                     }
                 });
+            let name = format!("{} mode", spec.name.trim_end_matches(" curve"));
+            menu.response
+                .widget_info(|| egui::WidgetInfo::labeled(egui::Role::ComboBox, true, &name));
             if mode != p.mode() {
                 *p = p.to_mode(mode);
                 reset_view(ui, id);
@@ -194,8 +203,10 @@ fn rows_in(p: &Param) -> usize {
 
 /// The plot: both rows drawn (the band between two curves shaded), keys as handles.
 fn curve_plot(ui: &mut Ui, id: egui::Id, p: &mut Param, spec: &ParamSpec) {
-    let width = ui.available_width().clamp(120.0, 420.0);
-    let (rect, resp) = ui.allocate_exact_size(vec2(width, PLOT_HEIGHT), Sense::click_and_drag());
+    // Clear of the panel's scroll bar, which covers the right edge while it is hovered.
+    let width = (ui.available_width() - 14.0).clamp(120.0, 420.0);
+    let (outer, resp) = ui.allocate_exact_size(vec2(width, PLOT_HEIGHT), Sense::click_and_drag());
+    let rect = plot_area(outer);
     let name = spec.name;
     resp.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, name));
     let mut st: PlotState = ui.data(|d| d.get_temp(id)).unwrap_or_default();
@@ -216,7 +227,8 @@ fn curve_plot(ui: &mut Ui, id: egui::Id, p: &mut Param, spec: &ParamSpec) {
             let (t, v) = view.from_screen(rect, pos);
             move_key(p, (r, k), (t, v), spec);
         }
-        if resp.double_clicked() {
+        // A click away from every key adds one there (a click on a key only selects it).
+        if resp.clicked() && nearest_key(p, &view, rect, pos, 10.0).is_none() {
             let (t, v) = view.from_screen(rect, pos);
             add_key(p, (t, v), spec);
         }
@@ -239,9 +251,9 @@ fn curve_plot(ui: &mut Ui, id: egui::Id, p: &mut Param, spec: &ParamSpec) {
             st.view = Some(View::fit(p, spec));
         }
     }
-    paint_plot(ui, rect, &view, p, spec, resp.hover_pos());
+    paint_plot(ui, outer, rect, &view, p, spec, resp.hover_pos());
     resp.on_hover_text(format!(
-        "{name}: drag a key to move it, double-click to add one, right-click a key to delete it (time: {})",
+        "{name}: drag a key to move it, click elsewhere to add one, right-click a key to delete it (time: {})",
         spec.t_unit
     ));
     ui.data_mut(|d| d.insert_temp(id, st));
@@ -286,10 +298,18 @@ fn add_key(p: &mut Param, (t, v): (f32, f32), spec: &ParamSpec) {
     }
 }
 
-fn paint_plot(ui: &Ui, rect: Rect, view: &View, p: &Param, spec: &ParamSpec, hover: Option<Pos2>) {
-    let painter = ui.painter_at(rect.expand(4.0));
+fn paint_plot(
+    ui: &Ui,
+    outer: Rect,
+    rect: Rect,
+    view: &View,
+    p: &Param,
+    spec: &ParamSpec,
+    hover: Option<Pos2>,
+) {
+    let painter = ui.painter_at(outer);
     let visuals = ui.visuals();
-    painter.rect_filled(rect, 2.0, visuals.extreme_bg_color);
+    painter.rect_filled(outer, 2.0, visuals.extreme_bg_color);
     let grid = Stroke::new(1.0, visuals.faint_bg_color.gamma_multiply(2.0));
     for q in 1..4 {
         let x = rect.left() + rect.width() * q as f32 / 4.0;
@@ -373,7 +393,7 @@ fn curve_tools(ui: &mut Ui, id: egui::Id, p: &mut Param, spec: &ParamSpec) {
                 _ => {}
             }
         }
-        egui::ComboBox::from_id_salt(id.with("shape"))
+        let shapes = egui::ComboBox::from_id_salt(id.with("shape"))
             .selected_text("shape…")
             .width(80.0)
             .show_ui(ui, |ui| {
@@ -384,6 +404,10 @@ fn curve_tools(ui: &mut Ui, id: egui::Id, p: &mut Param, spec: &ParamSpec) {
                     }
                 }
             });
+        let name = format!("{} shape", spec.name.trim_end_matches(" curve"));
+        shapes
+            .response
+            .widget_info(|| egui::WidgetInfo::labeled(egui::Role::ComboBox, true, &name));
         if ui
             .button("fit")
             .on_hover_text("Zoom to show every key")

@@ -11,7 +11,8 @@ pub use crate::render::look::sample_gradient;
 use super::curve_editor::{ParamSpec, param_row};
 use super::state::ViewSettings;
 
-const SIZE: ParamSpec = ParamSpec {
+/// The size parameter's editor: metres over normalised age.
+pub const SIZE: ParamSpec = ParamSpec {
     name: "Size curve",
     unit: " m",
     values: 0.0..=100.0,

@@ -71,6 +71,21 @@ pub(super) fn value_at(text: &str, path: &str) -> Option<Located> {
             None => start,
         },
     };
+    // A newtype variant's span (`Constant(-5)`) starts at its parenthesis: a scalar inside
+    // starts after it.
+    let (start, end) = match text[start..].strip_prefix('(') {
+        Some(rest) => {
+            let inner = skip_blank(rest);
+            let token = &inner[..inner.find([',', ')']).unwrap_or(inner.len())];
+            if token.trim().is_empty() || token.contains([':', '(', '[', '"']) {
+                (start, end)
+            } else {
+                let at = text.len() - inner.len();
+                (at, at + token.trim_end().len())
+            }
+        }
+        None => (start, end),
+    };
     let literal = text
         .get(start..end)
         .map(str::trim)
@@ -80,6 +95,20 @@ pub(super) fn value_at(text: &str, path: &str) -> Option<Located> {
         pos: text_pos(text, start),
         literal,
     })
+}
+
+/// `s` after its leading whitespace and comments.
+fn skip_blank(mut s: &str) -> &str {
+    loop {
+        s = s.trim_start();
+        if let Some(rest) = s.strip_prefix("/*") {
+            s = rest.find("*/").map_or("", |i| &rest[i + 2..]);
+        } else if let Some(rest) = s.strip_prefix("//") {
+            s = rest.find('\n').map_or("", |i| &rest[i..]);
+        } else {
+            return s;
+        }
+    }
 }
 
 /// The line and column of byte `offset`.
