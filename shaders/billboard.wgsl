@@ -15,7 +15,7 @@
 // - The fragment output is premultiplied: additive blending adds it, alpha blending
 //   composites it "over". The look itself lives in look.wgsl (shared with splat.wgsl).
 #import "common.wgsl"
-#import "look.wgsl"
+#import "quad.wgsl"
 
 @group(0) @binding(0) var<uniform> camera: CameraUniform;
 // Storage, not uniform: see params.wgsl (lavapipe's uniform inlining).
@@ -39,14 +39,6 @@ var<private> look: LookUniform;
 // SOFT_DEPTH is off.
 @group(3) @binding(0) var scene_depth: texture_depth_2d;
 
-// Pipeline variants: each look module is compiled in only when an emitter uses it.
-override SORTED: bool = false;
-override FLIPBOOK: bool = false;
-override FLIP_BLEND: bool = false;
-override STREAK: bool = false;
-override SOFT: bool = false;
-// Soft edges against the host's depth buffer (replaces SOFT's ground plane).
-override SOFT_DEPTH: bool = false;
 // The motion pass (flipbook export): each fragment adds (motion · w, 0, w), with w the
 // particle's visible weight (its coverage, or its light when additive) and motion its
 // screen-space motion in pixels over `camera.up.w` seconds; the sums' ratio is the
@@ -66,129 +58,38 @@ struct VsOut {
     @location(3) blend_height: vec2<f32>,
 }
 
-// Which instance of the draw and which slot of its pool quad `q` is, or none.
-fn quad_slot(q: u32) -> vec2<u32> {
-    if SORTED {
-        // A buffer index (instance k's segment starts at k · capacity); padding has none.
-        let v = order[q];
-        if v == 0xFFFFFFFFu {
-            return vec2<u32>(0xFFFFFFFFu);
-        }
-        let capacity = looks[0].look.ring_b.z;
-        return vec2<u32>(v / capacity, v % capacity);
-    }
-    let width = max(looks[0].look.ring.w, 1u);
-    let k = q / width;
-    let i = q - k * width;
-    // The window: the last `len` slots before the ring's head, wrapping at the capacity.
-    let l = looks[k].look;
-    if i >= l.ring_b.w {
-        return vec2<u32>(0xFFFFFFFFu);
-    }
-    var slot = l.ring.x + l.ring_b.z - l.ring_b.w + i;
-    if slot >= l.ring_b.z {
-        slot -= l.ring_b.z;
-    }
-    return vec2<u32>(k, slot);
-}
-
 @vertex
 fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u32) -> VsOut {
     var out: VsOut;
-    // Quad q (one instance each), corner `vi` (two triangles: 0 1 2, 2 1 3).
-    let q = (vertex >> 2u) + inst;
-    let vi = vertex & 3u;
-    let ks = quad_slot(q);
-    if ks.x == 0xFFFFFFFFu {
+    // Quad q (one instance each), corner `vi` (two triangles: 0 1 2, 2 1 3) of four
+    // shared vertices over the corners (-1,-1) (1,-1) (-1,1) (1,1): a third fewer vertex
+    // invocations than two separate triangles.
+    let qd = load_quad((vertex >> 2u) + inst);
+    if !qd.d.alive {
         out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
         return out;
     }
-    look = looks[ks.x].look;
-    let slot = ks.y;
-    let pair = load_pair(slot);
-    let d = drawn(pair[0], pair[1]);
-    if !d.alive {
-        out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
-        return out;
-    }
-    let t = age_fraction(d.age, d.life);
-    let rnd = particle_random(slot, d.life);
-    let lc = look_curves(t, curve_random(slot, d.life, rnd));
-    let size = lc.x;
-    // Four shared vertices over the corners (-1,-1) (1,-1) (-1,1) (1,1): a third fewer
-    // vertex invocations than two separate triangles.
-    var corner = vec2<f32>(f32(vi & 1u), f32(vi >> 1u)) * 2.0 - 1.0;
-    if !STREAK {
-        // Cut the quad to the sprite's occupied rectangle (look.trim, frame texture
-        // coordinates), grown by 3 screen pixels: the mip the sampler picks blurs the
-        // edge by about two of its texels, which are about one pixel each.
-        let w = dot(transpose(look.clip_from_sim)[3], vec4<f32>(d.pos, 1.0));
-        let px = size * camera.viewport.z / max(w, 1e-4);
-        let m = 3.0 / max(px, 1e-3);
-        let lo = max(look.trim.xy - m, vec2<f32>(0.0));
-        let hi = min(look.trim.zw + m, vec2<f32>(1.0));
-        let u = mix(lo.x, hi.x, corner.x * 0.5 + 0.5);
-        let v = mix(lo.y, hi.y, 0.5 - corner.y * 0.5);
-        corner = vec2<f32>(2.0 * u - 1.0, 1.0 - 2.0 * v);
-    }
-    var world = d.pos;
-    if STREAK {
-        // Stretched from where the particle was `length` seconds ago (tail, corner.x = -1)
-        // to where it is (head), `size` wide on screen.
-        var tail = d.vel * look.spin_streak.z;
-        let len = length(tail);
-        if len > look.spin_streak.w {
-            tail *= look.spin_streak.w / len;
-        }
-        let head_clip = look.clip_from_sim * vec4<f32>(d.pos, 1.0);
-        var tail_clip = look.clip_from_sim * vec4<f32>(d.pos - tail, 1.0);
-        if tail_clip.w <= 1e-4 || head_clip.w <= 1e-4 {
-            tail_clip = head_clip;
-        }
-        let half_vp = 0.5 * camera.viewport.xy;
-        let dir_px = (head_clip.xy / head_clip.w - tail_clip.xy / tail_clip.w) * half_vp;
-        let l = length(dir_px);
-        let dir = select(vec2<f32>(1.0, 0.0), dir_px / l, l > 1e-3);
-        let perp = vec2<f32>(-dir.y, dir.x);
-        let end = select(tail_clip, head_clip, corner.x > 0.0);
-        // The half-width in pixels is 0.5·size·viewport.z / w; in clip units the w cancels.
-        let off_px = (dir * corner.x + perp * corner.y) * (0.5 * size * camera.viewport.z);
-        out.clip = vec4<f32>(end.xy + off_px / half_vp, end.z, end.w);
-        world = select(d.pos - tail, d.pos, corner.x > 0.0);
-    } else {
-        // Random initial rotation plus spin over the particle's age.
-        let angle = (rnd.y - 0.5) * look.extra.z + lc.z * d.life;
-        let cs = vec2<f32>(cos(angle), sin(angle));
-        let c = vec2<f32>(corner.x * cs.x - corner.y * cs.y, corner.x * cs.y + corner.y * cs.x);
-        world = d.pos + (camera.right_alpha.xyz * c.x + camera.up.xyz * c.y) * (0.5 * size);
-        out.clip = look.clip_from_sim * vec4<f32>(world, 1.0);
-    }
+    let corner = quad_corner(qd, vertex & 3u);
+    out.clip = corner.clip;
     if FLIPBOOK {
-        let f = flipbook_frames(d.age, d.life, rnd.w, FLIP_BLEND, lc.w);
-        out.uv0 = atlas_uv(f.x, corner);
-        out.uv1 = atlas_uv(f.y, corner);
+        let f = quad_frames(qd);
+        out.uv0 = atlas_uv(f.x, corner.uv);
+        out.uv1 = atlas_uv(f.y, corner.uv);
         out.blend_height.x = f.z;
     } else {
-        out.uv0 = vec2<f32>(corner.x * 0.5 + 0.5, 0.5 - corner.y * 0.5);
+        out.uv0 = vec2<f32>(corner.uv.x * 0.5 + 0.5, 0.5 - corner.uv.y * 0.5);
         out.uv1 = out.uv0;
     }
     // Soft particles: the ground fade's argument (linear in world.y, so interpolating it
     // is exact).
-    out.blend_height.y = (world.y - look.soft.x) * look.soft.y;
+    out.blend_height.y = ground_fade_arg(corner.world);
     if SOFT_DEPTH {
         out.blend_height.y = look.soft.y;
     }
-    // Premultiplied here, once per vertex, and scaled by the intensity when additive:
-    // the fragment shader reads nothing from the look.
-    let c = particle_color(t);
-    let alpha = c.a * lc.y;
-    var gain = alpha;
-    if !SORTED {
-        gain *= look.size_intensity.z;
-    }
-    out.color = vec4<f32>(c.rgb * gain, alpha);
+    out.color = qd.color;
     if MOTION {
         // Where this corner's particle is `camera.up.w` seconds later, at its velocity.
+        let d = qd.d;
         let now = look.clip_from_sim * vec4<f32>(d.pos, 1.0);
         let later = look.clip_from_sim * vec4<f32>(d.pos + d.vel * camera.up.w, 1.0);
         var px = vec2<f32>(0.0);
@@ -198,7 +99,7 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u3
         }
         // The weight: coverage for alpha-blended layers, the brightest channel of the
         // light for additive ones.
-        let w = select(max(max(out.color.r, out.color.g), out.color.b), alpha, SORTED);
+        let w = select(max(max(out.color.r, out.color.g), out.color.b), out.color.a, SORTED);
         out.color = vec4<f32>(px, 0.0, w);
     }
     return out;

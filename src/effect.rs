@@ -686,7 +686,8 @@ pub struct Look {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum DrawPath {
     /// Splat when the particles project smaller than [`SPLAT_BELOW_PX`] and blend
-    /// additively; billboards otherwise.
+    /// additively; on GPUs (the adapter profile's `tile_raster`) the tile rasteriser from
+    /// [`TILES_ABOVE_PX`]; billboards otherwise.
     #[default]
     Auto,
     /// Always instanced billboards (textured quads through the rasteriser).
@@ -694,10 +695,19 @@ pub enum DrawPath {
     /// Always the compute splat (additive emitters only; alpha emitters fall back to
     /// billboards, which they need for ordering).
     Splat,
+    /// Always the compute tile rasteriser: the billboards' quads, binned into screen
+    /// tiles and blended per tile on the compute units (the look of the billboards; in a
+    /// host's pass only with its depth view). Alpha-blended emitters take it together or
+    /// not at all.
+    Tiles,
 }
 
 /// Auto draw path: below this projected particle size (pixels), splat.
 pub const SPLAT_BELOW_PX: f32 = 4.0;
+
+/// Auto draw path on adapters whose profile allows the tile rasteriser: particles that
+/// project at least this large (pixels) take it; billboards between the two sizes.
+pub const TILES_ABOVE_PX: f32 = 8.0;
 
 /// A sprite texture: one of the procedural set generated at start, or a PNG with alpha.
 #[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]

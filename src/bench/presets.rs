@@ -42,10 +42,11 @@ struct Row {
 }
 
 /// The path choices measured.
-const PATHS: [(&str, Option<DrawPath>); 3] = [
+const PATHS: [(&str, Option<DrawPath>); 4] = [
     ("auto", None),
     ("billboard", Some(DrawPath::Billboard)),
     ("splat", Some(DrawPath::Splat)),
+    ("tiles", Some(DrawPath::Tiles)),
 ];
 
 /// Runs every preset, size and path.

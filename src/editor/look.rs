@@ -4,7 +4,7 @@ use egui::{Color32, DragValue, Rgba, RichText, Sense, Ui};
 
 use crate::effect::{
     BlendMode, Bloom, ColorStop, DrawPath, Effect, Flipbook, FlipbookMode, Look, MAX_COLOR_STOPS,
-    Param, Post, SPLAT_BELOW_PX, Sprite, Streak,
+    Param, Post, SPLAT_BELOW_PX, Sprite, Streak, TILES_ABOVE_PX,
 };
 pub use crate::render::look::sample_gradient;
 
@@ -160,12 +160,12 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
             });
             ui.end_row();
             let label = ui.label("Draw path").on_hover_text(format!(
-                "auto: compute splat when particles project below {SPLAT_BELOW_PX} px, blend additively and have no streak; billboards otherwise. billboard: instanced quads. splat: compute splat (additive only; alpha falls back to billboards)"
+                "auto: compute splat when particles project below {SPLAT_BELOW_PX} px, blend additively and have no streak; on GPUs the tile rasteriser from {TILES_ABOVE_PX} px; billboards otherwise. billboard: instanced quads. splat: compute splat (additive only; alpha falls back to billboards). tiles: the compute tile rasteriser (alpha-blended emitters take it together or not at all)"
             ));
             egui::ComboBox::from_id_salt("draw_path")
                 .selected_text(draw_path_label(look.draw_path))
                 .show_ui(ui, |ui| {
-                    for d in [DrawPath::Auto, DrawPath::Billboard, DrawPath::Splat] {
+                    for d in [DrawPath::Auto, DrawPath::Billboard, DrawPath::Splat, DrawPath::Tiles] {
                         ui.selectable_value(&mut look.draw_path, d, draw_path_label(d));
                     }
                 })
@@ -421,6 +421,7 @@ fn draw_path_label(d: DrawPath) -> &'static str {
         DrawPath::Auto => "auto",
         DrawPath::Billboard => "billboard",
         DrawPath::Splat => "splat",
+        DrawPath::Tiles => "tiles",
     }
 }
 

@@ -72,6 +72,12 @@ impl GpuContext {
         let mut limits = wgpu::Limits::default().using_resolution(supported.clone());
         limits.max_storage_buffer_binding_size = supported.max_storage_buffer_binding_size;
         limits.max_buffer_size = supported.max_buffer_size;
+        // The tile rasteriser's passes read the state, the looks and its own lists: more
+        // storage buffers than the default 8 (see `TilePass::supported`).
+        limits.max_storage_buffers_per_shader_stage = supported
+            .max_storage_buffers_per_shader_stage
+            .max(limits.max_storage_buffers_per_shader_stage)
+            .min(crate::render::tiles::STORAGE_BUFFERS_NEEDED);
         // Blending into 32-bit float targets where the adapter can (the export's
         // accumulation of bright additive light; f16 rounds it by a few percent).
         let features = crate::gpu::timer::timing_features(&adapter)

@@ -33,6 +33,9 @@ pub struct AdapterProfile {
     /// The editor keeps the window's image and repaints only the viewport while the
     /// panel is unchanged.
     pub retained_window: bool,
+    /// The automatic draw path sends large sprites to the compute tile rasteriser
+    /// (`tiles.wgsl`) instead of the billboards.
+    pub tile_raster: bool,
 }
 
 impl AdapterProfile {
@@ -44,6 +47,7 @@ impl AdapterProfile {
         draft: false,
         lean_painter: false,
         retained_window: false,
+        tile_raster: true,
     };
 
     /// The choices for a software adapter.
@@ -54,6 +58,7 @@ impl AdapterProfile {
         draft: true,
         lean_painter: true,
         retained_window: true,
+        tile_raster: false,
     };
 
     /// The profile for an adapter of `device_type`.
@@ -78,7 +83,7 @@ impl AdapterProfile {
     }
 
     /// Every field but the kind, as settings (in declaration order).
-    pub fn settings(&self) -> [ProfileSetting; 5] {
+    pub fn settings(&self) -> [ProfileSetting; 6] {
         use ProfileSetting as S;
         [
             S::Timestamps(self.timestamps),
@@ -86,6 +91,7 @@ impl AdapterProfile {
             S::Draft(self.draft),
             S::LeanPainter(self.lean_painter),
             S::RetainedWindow(self.retained_window),
+            S::TileRaster(self.tile_raster),
         ]
     }
 
@@ -137,16 +143,18 @@ pub enum ProfileSetting {
     Draft(bool),
     LeanPainter(bool),
     RetainedWindow(bool),
+    TileRaster(bool),
 }
 
 impl ProfileSetting {
     /// The field names `--adapt` accepts.
-    pub const FIELDS: [&'static str; 5] = [
+    pub const FIELDS: [&'static str; 6] = [
         "timestamps",
         "render_scale",
         "draft",
         "lean_painter",
         "retained_window",
+        "tile_raster",
     ];
 
     /// Sets the field in `profile`.
@@ -157,6 +165,7 @@ impl ProfileSetting {
             Self::Draft(v) => p.draft = v,
             Self::LeanPainter(v) => p.lean_painter = v,
             Self::RetainedWindow(v) => p.retained_window = v,
+            Self::TileRaster(v) => p.tile_raster = v,
         }
     }
 
@@ -178,7 +187,8 @@ impl std::fmt::Display for ProfileSetting {
             Self::Timestamps(v)
             | Self::Draft(v)
             | Self::LeanPainter(v)
-            | Self::RetainedWindow(v) => v.to_string(),
+            | Self::RetainedWindow(v)
+            | Self::TileRaster(v) => v.to_string(),
         };
         write!(f, "{}={value}", self.field())
     }
@@ -210,6 +220,7 @@ impl FromStr for ProfileSetting {
             "draft" => Self::Draft(flag()?),
             "lean_painter" => Self::LeanPainter(flag()?),
             "retained_window" => Self::RetainedWindow(flag()?),
+            "tile_raster" => Self::TileRaster(flag()?),
             other => {
                 return Err(format!(
                     "unknown adapter profile field {other:?}: expected one of {}",

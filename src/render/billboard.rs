@@ -261,7 +261,7 @@ impl BillboardPass {
         sampler: &wgpu::Sampler,
         motion: bool,
     ) {
-        for d in items.iter().filter(|d| !d.splat) {
+        for d in items.iter().filter(|d| !d.splat && !d.tiles) {
             self.ensure_pipeline(ctx, d.variant);
             if motion {
                 self.ensure_pipeline(ctx, d.variant.with_motion());
@@ -346,7 +346,10 @@ impl BillboardPass {
         wanted: impl Fn(&DrawItem) -> bool,
         variant: impl Fn(LookVariant) -> LookVariant,
     ) {
-        let mut sorted: Vec<&DrawItem> = items.iter().filter(|d| !d.splat && wanted(d)).collect();
+        let mut sorted: Vec<&DrawItem> = items
+            .iter()
+            .filter(|d| !d.splat && !d.tiles && wanted(d))
+            .collect();
         // Alpha-blended layers in the given order (back to front), then the additive light
         // grouped by emitter — each emitter's instances share a pipeline and a sprite, so
         // consecutive draws skip setting them again (light adds up in any order).

@@ -8,7 +8,9 @@ use std::path::Path;
 use std::sync::Arc;
 
 use crate::effect::rows_key;
-use crate::effect::{BlendMode, DrawPath, Effect, FlipbookMode, Look, SPLAT_BELOW_PX, Streak};
+use crate::effect::{
+    BlendMode, DrawPath, Effect, FlipbookMode, Look, SPLAT_BELOW_PX, Streak, TILES_ABOVE_PX,
+};
 use crate::gpu::GpuContext;
 use crate::gpu::types::{CameraUniform, LookUniform, PARAMS_STRIDE, StateLayout};
 use crate::render::camera::Camera;
@@ -56,8 +58,10 @@ pub struct DrawItem {
     pub sort: Option<SortJob>,
     /// Blend mode.
     pub blend: BlendMode,
-    /// The path chosen for this frame.
+    /// The path chosen for this frame: the compute splat.
     pub splat: bool,
+    /// The path chosen for this frame: the compute tile rasteriser (`tiles.rs`).
+    pub tiles: bool,
     /// The billboard pipeline variant.
     pub variant: LookVariant,
     /// The sprite texture.
@@ -71,6 +75,7 @@ impl DrawItem {
     /// (streaks stay sharp: they are thin however long).
     pub fn is_glow(&self) -> bool {
         !self.splat
+            && !self.tiles
             && self.blend == BlendMode::Additive
             && !self.variant.streak
             && self.size_px >= GLOW_MIN_PX
@@ -128,6 +133,11 @@ pub struct FrameResources {
     pub allow_splat: bool,
     /// Soft edges read the host's depth buffer instead of the preset's ground plane.
     pub soft_depth: bool,
+    /// The automatic path sends large sprites to the tile rasteriser (the adapter
+    /// profile's `tile_raster`).
+    pub auto_tiles: bool,
+    /// The tile rasteriser exists (the device's limits allow it).
+    pub allow_tiles: bool,
     /// This frame's look blocks on their way to `looks`.
     look_bytes: Vec<u8>,
 }
@@ -375,6 +385,8 @@ impl FrameResources {
             trims: HashMap::new(),
             allow_splat: true,
             soft_depth: false,
+            auto_tiles: false,
+            allow_tiles: false,
             look_bytes: Vec::new(),
         }
     }
@@ -552,6 +564,16 @@ impl FrameResources {
             }
         }
         self.look_bytes = blocks;
+        // Alpha-blended layers are drawn in one order by one path: all by the tiles or
+        // none.
+        if items
+            .iter()
+            .any(|d| d.blend == BlendMode::Alpha && !d.tiles)
+        {
+            for d in items.iter_mut().filter(|d| d.blend == BlendMode::Alpha) {
+                d.tiles = false;
+            }
+        }
         let live: std::collections::HashSet<u64> = items.iter().map(|d| d.key.0).collect();
         self.particle_groups.retain(|k, _| live.contains(&k.0));
         items
@@ -747,8 +769,17 @@ impl FrameResources {
             && match e.look.draw_path {
                 // Streaks are long even when the particles are small.
                 DrawPath::Auto => size_px < SPLAT_BELOW_PX && e.look.streak.is_none(),
-                DrawPath::Billboard => false,
+                DrawPath::Billboard | DrawPath::Tiles => false,
                 DrawPath::Splat => true,
+            };
+        // The compute paths test the host's depth themselves: they need its view.
+        let tiles = self.allow_splat
+            && self.allow_tiles
+            && !splat
+            && match e.look.draw_path {
+                DrawPath::Auto => self.auto_tiles && size_px >= TILES_ABOVE_PX,
+                DrawPath::Tiles => true,
+                DrawPath::Billboard | DrawPath::Splat => false,
             };
         let mut variant = LookVariant::of(
             &e.look,
@@ -768,6 +799,7 @@ impl FrameResources {
             sort: job,
             blend: e.look.blend,
             splat,
+            tiles,
             variant,
             sprite,
             size_px,

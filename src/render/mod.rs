@@ -9,6 +9,7 @@ pub mod look;
 pub mod sort;
 pub mod splat;
 pub mod sprites;
+pub mod tiles;
 pub mod tonemap;
 
 pub use billboard::BillboardPass;
@@ -17,6 +18,7 @@ pub use camera::OrbitCamera;
 pub use composite::Composite;
 pub use frame::{DrawItem, FrameResources, Scene};
 pub use splat::SplatPass;
+pub use tiles::TilePass;
 pub use tonemap::TonemapPass;
 
 use crate::gpu::GpuContext;

@@ -25,6 +25,7 @@ pub const PLAYER_SHADERS: &[&str] = &[
     "count.wgsl",
     "billboard.wgsl",
     "splat.wgsl",
+    "tiles.wgsl",
     "sort.wgsl",
 ];
 
@@ -172,6 +173,11 @@ impl Player {
             }
             "billboard.wgsl" => self.billboard.rebuild(&self.ctx, &lib)?,
             "splat.wgsl" => self.splat.rebuild(&self.ctx, &lib)?,
+            "tiles.wgsl" => {
+                if let Some(tiles) = &mut self.tiles {
+                    tiles.rebuild(&self.ctx, &lib)?;
+                }
+            }
             "sort.wgsl" => self.sort.rebuild(&self.ctx, &lib)?,
             _ => return Ok(()),
         }

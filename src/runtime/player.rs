@@ -5,11 +5,11 @@ use std::path::PathBuf;
 
 use glam::Mat4;
 
-use crate::effect::{Effect, TimeMode, ValidationError};
+use crate::effect::{BlendMode, Effect, TimeMode, ValidationError};
 use crate::gpu::{AdapterProfile, GpuContext, Uploads};
 use crate::render::billboard::{BillboardPass, DrawTarget};
 use crate::render::sort::SortPass;
-use crate::render::{Camera, DrawItem, FrameResources, Scene, SplatPass};
+use crate::render::{Camera, DrawItem, FrameResources, Scene, SplatPass, TilePass};
 use crate::runtime::Layers;
 use crate::runtime::instances::{Backing, Instance, InstanceId, Slab};
 use crate::shaders::{ShaderError, ShaderLibrary};
@@ -104,6 +104,8 @@ pub struct Player {
     pub(super) frame: FrameResources,
     pub(super) billboard: BillboardPass,
     pub(super) splat: SplatPass,
+    /// The tile rasteriser, where the device's limits allow it.
+    pub(super) tiles: Option<TilePass>,
     pub(super) sort: SortPass,
     pub(super) instances: Slab<Instance>,
     /// The batches of instances (when the effect can be batched; else each instance has
@@ -162,6 +164,10 @@ impl Player {
         let shader = |e: ShaderError| PlayerError::Sim(e.into());
         let billboard = BillboardPass::new(&ctx, &library, &frame, target).map_err(shader)?;
         let splat = SplatPass::new(&ctx, &library, &frame, target).map_err(shader)?;
+        let tiles = TilePass::supported(&ctx.device)
+            .then(|| TilePass::new(&ctx, &library, &frame, target))
+            .transpose()
+            .map_err(shader)?;
         let sort = SortPass::new(&ctx, &library).map_err(shader)?;
         Ok(Self {
             ctx,
@@ -171,6 +177,7 @@ impl Player {
             frame,
             billboard,
             splat,
+            tiles,
             sort,
             instances: Slab::default(),
             batches: Vec::new(),
@@ -364,6 +371,8 @@ impl Player {
         // The splat tests the host's depth itself: without the view, billboards (tested by
         // the pass's depth attachment) draw every particle.
         self.frame.allow_splat = depth.is_some() || self.settings.depth_format.is_none();
+        self.frame.auto_tiles = self.ctx.profile.tile_raster;
+        self.frame.allow_tiles = self.tiles.is_some();
         let members: Vec<Vec<Option<BatchMember<'_>>>> = self
             .batches
             .iter()
@@ -380,12 +389,6 @@ impl Player {
             self.settings.asset_dir.as_deref(),
         );
         self.frame.upload_looks(&mut self.uploads, encoder);
-        self.billboard.prepare(
-            &self.ctx,
-            &self.items,
-            &self.frame.sprites.sampler,
-            self.motion_pass,
-        );
         self.sort
             .record_items(&self.ctx, encoder, &self.items, camera);
         self.splatted = self.splat.splat(
@@ -395,6 +398,28 @@ impl Player {
             &self.items,
             camera.size_px(),
             depth,
+        );
+        let tiled = self.tiles.as_mut().is_some_and(|t| {
+            t.record(
+                &self.ctx,
+                encoder,
+                &self.frame,
+                &self.items,
+                camera.size_px(),
+                depth,
+            )
+        });
+        if !tiled {
+            // Too many quads for the tiles' lists this frame: billboards draw them.
+            for d in &mut self.items {
+                d.tiles = false;
+            }
+        }
+        self.billboard.prepare(
+            &self.ctx,
+            &self.items,
+            &self.frame.sprites.sampler,
+            self.motion_pass,
         );
         self.uploads.finish(encoder);
     }
@@ -522,8 +547,21 @@ impl Player {
     /// (as [`Player::draw`]): a host can send the soft layers to reduced-resolution
     /// targets of its own and draw the rest at full resolution.
     pub fn draw_layers(&self, pass: &mut wgpu::RenderPass<'_>, layers: Layers) {
+        // Alpha-blended billboards, then the tiles (alpha-blended layers are drawn by
+        // one path or the other, never both), then the light.
+        let wanted = |d: &DrawItem| layers.contains(Layers::of(d));
         self.billboard.draw(pass, &self.frame, &self.items, |d| {
-            layers.contains(Layers::of(d))
+            d.blend == BlendMode::Alpha && wanted(d)
+        });
+        if let Some(tiles) = self
+            .tiles
+            .as_ref()
+            .filter(|_| layers.contains(Layers::LIGHT))
+        {
+            tiles.resolve(pass, &self.frame);
+        }
+        self.billboard.draw(pass, &self.frame, &self.items, |d| {
+            d.blend == BlendMode::Additive && wanted(d)
         });
         if self.splatted && layers.contains(Layers::LIGHT) {
             self.splat.resolve(pass, &self.frame);
@@ -551,10 +589,10 @@ impl Player {
     /// The layers that hold particles to draw, as last recorded.
     pub fn drawn_layers(&self) -> Layers {
         let mut layers = Layers::NONE;
-        for d in self.items.iter().filter(|d| !d.splat) {
+        for d in self.items.iter().filter(|d| !d.splat && !d.tiles) {
             layers |= Layers::of(d);
         }
-        if self.splatted {
+        if self.splatted || self.tiles.as_ref().is_some_and(TilePass::drawn) {
             layers |= Layers::LIGHT;
         }
         layers

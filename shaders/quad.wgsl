@@ -1,0 +1,160 @@
+// quad.wgsl — one particle's camera-facing quad, as both quad draw paths build it: the
+// billboards' vertex shader (billboard.wgsl) and the tile rasteriser's projection
+// (tiles.wgsl). One function places a corner, so the two paths draw the same geometry.
+//
+// Contract: as look.wgsl, plus `looks: array<LookSlot>` (a draw's instances) and `order:
+// array<u32>` (the sort's back-to-front buffer indices), and the look modules below.
+#import "look.wgsl"
+
+// Pipeline variants: each look module is compiled in only when an emitter uses it.
+override SORTED: bool = false;
+override FLIPBOOK: bool = false;
+override FLIP_BLEND: bool = false;
+override STREAK: bool = false;
+override SOFT: bool = false;
+// Soft edges against the host's depth buffer (replaces SOFT's ground plane).
+override SOFT_DEPTH: bool = false;
+
+// Which instance of the draw and which slot of its pool quad `q` is, or none.
+// Unsorted, quad q is slot q mod W of instance q / W's live window (W: the widest window
+// of the draw's instances); sorted, quad q is `order[q]`.
+fn quad_slot(q: u32) -> vec2<u32> {
+    if SORTED {
+        // A buffer index (instance k's segment starts at k · capacity); padding has none.
+        let v = order[q];
+        if v == 0xFFFFFFFFu {
+            return vec2<u32>(0xFFFFFFFFu);
+        }
+        let capacity = looks[0].look.ring_b.z;
+        return vec2<u32>(v / capacity, v % capacity);
+    }
+    let width = max(looks[0].look.ring.w, 1u);
+    let k = q / width;
+    let i = q - k * width;
+    // The window: the last `len` slots before the ring's head, wrapping at the capacity.
+    let l = looks[k].look;
+    if i >= l.ring_b.w {
+        return vec2<u32>(0xFFFFFFFFu);
+    }
+    var slot = l.ring.x + l.ring_b.z - l.ring_b.w + i;
+    if slot >= l.ring_b.z {
+        slot -= l.ring_b.z;
+    }
+    return vec2<u32>(k, slot);
+}
+
+// What a particle's corners share.
+struct Quad {
+    d: Drawn,
+    slot: u32,
+    // particle_random's four numbers.
+    rnd: vec4<f32>,
+    // look_curves: size (m), opacity, spin, flipbook frame.
+    lc: vec4<f32>,
+    // Premultiplied colour (and, additive, scaled by the intensity).
+    color: vec4<f32>,
+}
+
+// The quad of quad `q` of the draw; `d.alive` is false for none. Sets `look` to its
+// instance's look.
+fn load_quad(q: u32) -> Quad {
+    var out: Quad;
+    let ks = quad_slot(q);
+    if ks.x == 0xFFFFFFFFu {
+        return out;
+    }
+    look = looks[ks.x].look;
+    let slot = ks.y;
+    let pair = load_pair(slot);
+    out.d = drawn(pair[0], pair[1]);
+    if !out.d.alive {
+        return out;
+    }
+    out.slot = slot;
+    let t = age_fraction(out.d.age, out.d.life);
+    out.rnd = particle_random(slot, out.d.life);
+    out.lc = look_curves(t, curve_random(slot, out.d.life, out.rnd));
+    // Premultiplied once per particle, and scaled by the intensity when additive: the
+    // per-pixel work reads nothing from the look.
+    let c = particle_color(t);
+    let alpha = c.a * out.lc.y;
+    var gain = alpha;
+    if !SORTED {
+        gain *= look.size_intensity.z;
+    }
+    out.color = vec4<f32>(c.rgb * gain, alpha);
+    return out;
+}
+
+// One corner of a quad: where it lands, its coordinates in the sprite's frame ([-1, 1]²,
+// y up; cut to the sprite's occupied part) and its world position.
+struct Corner {
+    clip: vec4<f32>,
+    uv: vec2<f32>,
+    world: vec3<f32>,
+}
+
+// Corner `vi` (0 (-1,-1), 1 (1,-1), 2 (-1,1), 3 (1,1)) of quad `qd`.
+fn quad_corner(qd: Quad, vi: u32) -> Corner {
+    var out: Corner;
+    let d = qd.d;
+    let size = qd.lc.x;
+    var corner = vec2<f32>(f32(vi & 1u), f32(vi >> 1u)) * 2.0 - 1.0;
+    if !STREAK {
+        // Cut the quad to the sprite's occupied rectangle (look.trim, frame texture
+        // coordinates), grown by 3 screen pixels: the mip the sampler picks blurs the
+        // edge by about two of its texels, which are about one pixel each.
+        let w = dot(transpose(look.clip_from_sim)[3], vec4<f32>(d.pos, 1.0));
+        let px = size * camera.viewport.z / max(w, 1e-4);
+        let m = 3.0 / max(px, 1e-3);
+        let lo = max(look.trim.xy - m, vec2<f32>(0.0));
+        let hi = min(look.trim.zw + m, vec2<f32>(1.0));
+        let u = mix(lo.x, hi.x, corner.x * 0.5 + 0.5);
+        let v = mix(lo.y, hi.y, 0.5 - corner.y * 0.5);
+        corner = vec2<f32>(2.0 * u - 1.0, 1.0 - 2.0 * v);
+    }
+    out.uv = corner;
+    if STREAK {
+        // Stretched from where the particle was `length` seconds ago (tail, corner.x = -1)
+        // to where it is (head), `size` wide on screen.
+        var tail = d.vel * look.spin_streak.z;
+        let len = length(tail);
+        if len > look.spin_streak.w {
+            tail *= look.spin_streak.w / len;
+        }
+        let head_clip = look.clip_from_sim * vec4<f32>(d.pos, 1.0);
+        var tail_clip = look.clip_from_sim * vec4<f32>(d.pos - tail, 1.0);
+        if tail_clip.w <= 1e-4 || head_clip.w <= 1e-4 {
+            tail_clip = head_clip;
+        }
+        let half_vp = 0.5 * camera.viewport.xy;
+        let dir_px = (head_clip.xy / head_clip.w - tail_clip.xy / tail_clip.w) * half_vp;
+        let l = length(dir_px);
+        let dir = select(vec2<f32>(1.0, 0.0), dir_px / l, l > 1e-3);
+        let perp = vec2<f32>(-dir.y, dir.x);
+        let end = select(tail_clip, head_clip, corner.x > 0.0);
+        // The half-width in pixels is 0.5·size·viewport.z / w; in clip units the w cancels.
+        let off_px = (dir * corner.x + perp * corner.y) * (0.5 * size * camera.viewport.z);
+        out.clip = vec4<f32>(end.xy + off_px / half_vp, end.z, end.w);
+        out.world = select(d.pos - tail, d.pos, corner.x > 0.0);
+    } else {
+        // Random initial rotation plus spin over the particle's age.
+        let angle = (qd.rnd.y - 0.5) * look.extra.z + qd.lc.z * d.life;
+        let cs = vec2<f32>(cos(angle), sin(angle));
+        let c = vec2<f32>(corner.x * cs.x - corner.y * cs.y, corner.x * cs.y + corner.y * cs.x);
+        out.world = d.pos + (camera.right_alpha.xyz * c.x + camera.up.xyz * c.y) * (0.5 * size);
+        out.clip = look.clip_from_sim * vec4<f32>(out.world, 1.0);
+    }
+    return out;
+}
+
+// The flipbook frames of a quad: x = frame, y = next frame, z = weight of y.
+fn quad_frames(qd: Quad) -> vec3<f32> {
+    return flipbook_frames(qd.d.age, qd.d.life, qd.rnd.w, FLIP_BLEND, qd.lc.w);
+}
+
+// The ground fade's argument at a world position: height above the ground over the
+// soft-edge distance (linear in the position, so interpolating it is exact).
+fn ground_fade_arg(world: vec3<f32>) -> f32 {
+    return (world.y - look.soft.x) * look.soft.y;
+}

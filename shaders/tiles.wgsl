@@ -1,0 +1,371 @@
+// tiles.wgsl — pass 2, large sprites on the compute units: a tile rasteriser. The quads
+// the billboards would draw (quad.wgsl builds both) are projected once, binned into
+// 128-pixel bins in draw order, and each 16×16-pixel tile is shaded by one workgroup:
+// the sprites over it, in order, blended in registers — premultiplied "over" for
+// alpha-blended layers (back to front, the sort's order), added for light — and the
+// tile's colour and coverage written once per emitter. A full-screen draw in the
+// host's pass composites the result: dst · T + C.
+//
+// Contract:
+// - group 0, 1: as billboard.wgsl (camera, looks, ramps; the state and the sort's order).
+// - group 2: the emitter's sprite and sampler (shade).
+// - group 3: 0 `sprites` (one TileSprite per quad of the frame's tile items), 1 `bounds`
+//   (their pixel rectangles), 2 `bin_lists` (per bin, the sprites over it in draw order,
+//   `job.counts.w` entries each), 3 `bin_counts`, 4 `accum` (per pixel: C.rg, C.b and the coverage 1 − T
+//   as f16 pairs; zero is empty), 5 `scene_depth` (the host's depth, when its size is the viewport's),
+//   6 `job` (this dispatch's item: dynamic offset).
+// - DEPTH_TEST: as splat.wgsl (0 none, 1 nearer or level passes, 2 reversed Z).
+#import "common.wgsl"
+#import "quad.wgsl"
+
+@group(0) @binding(0) var<uniform> camera: CameraUniform;
+@group(0) @binding(1) var<storage, read> looks: array<LookSlot>;
+var<private> look: LookUniform;
+@group(0) @binding(2) var ramps: texture_2d<f32>;
+@group(1) @binding(0) var<storage, read> prev: array<Particle>;
+@group(1) @binding(1) var<storage, read> cur: array<Particle>;
+@group(1) @binding(2) var<storage, read> order: array<u32>;
+@group(1) @binding(3) var<storage, read> prev_packed: array<PackedParticle>;
+@group(1) @binding(4) var<storage, read> cur_packed: array<PackedParticle>;
+@group(1) @binding(5) var<storage, read> births: array<Birth>;
+@group(2) @binding(0) var sprite_tex: texture_2d<f32>;
+@group(2) @binding(1) var sprite_sampler: sampler;
+@group(3) @binding(0) var<storage, read_write> sprites: array<TileSprite>;
+@group(3) @binding(1) var<storage, read_write> bounds: array<vec4<i32>>;
+@group(3) @binding(2) var<storage, read_write> bin_lists: array<u32>;
+@group(3) @binding(3) var<storage, read_write> bin_counts: array<u32>;
+@group(3) @binding(4) var<storage, read_write> accum: array<vec2<u32>>;
+@group(3) @binding(5) var scene_depth: texture_depth_2d;
+@group(3) @binding(6) var<storage, read> job: TileJob;
+
+override DEPTH_TEST: u32 = 0u;
+
+// Pixels per tile side (one workgroup each) and tiles per bin side (keep in sync with
+// src/render/tiles.rs).
+const TILE: u32 = 16u;
+const BIN_TILES: u32 = 8u;
+const BIN: u32 = 128u;
+
+// One dispatch's work: x the item's first sprite, y its quads, z sprites this frame,
+// w the bin lists' stride (entries per bin).
+struct TileJob {
+    counts: vec4<u32>,
+}
+
+// A projected quad. Its coordinates in the sprite's frame at a pixel p (pixel units, the
+// origin at the target's top-left corner): h = inv0·p.x + inv1·p.y + inv2, uv = h.xy / h.z
+// (a projective map: the perspective-correct interpolation of the billboard's corners).
+struct TileSprite {
+    inv0: vec4<f32>,
+    inv1: vec4<f32>,
+    inv2: vec4<f32>,
+    // Clip z and w as affine functions of (uv, 1).
+    z_row: vec4<f32>,
+    w_row: vec4<f32>,
+    // The quad: uv0.xy to uv1.xy (the sprite's occupied part).
+    uv_box: vec4<f32>,
+    // Premultiplied colour (× intensity when additive).
+    color: vec4<f32>,
+    // x, y: the flipbook frames, z: the next frame's weight.
+    frames: vec4<f32>,
+    // The ground fade's argument as an affine function of (uv, 1).
+    ground: vec4<f32>,
+    // Atlas coordinates' derivatives along pixel x (xy) and y (zw), at the quad's centre.
+    grad: vec4<f32>,
+}
+
+// Pixel coordinates of a clip position.
+fn to_pixels(c: vec4<f32>) -> vec2<f32> {
+    let n = c.xy / c.w;
+    return vec2<f32>((n.x * 0.5 + 0.5) * camera.viewport.x, (0.5 - n.y * 0.5) * camera.viewport.y);
+}
+
+// The atlas coordinates' scale per unit of frame coordinates.
+fn atlas_scale() -> vec2<f32> {
+    if FLIPBOOK {
+        return vec2<f32>(0.5 / f32(max(look.ids.w, 1u)), -0.5 / f32(max(look.ids.z, 1u)));
+    }
+    return vec2<f32>(0.5, -0.5);
+}
+
+// Projects quad `q` of the job's item into sprite `job.counts.x + q`: its inverse map,
+// colour, frames and pixel bounds (empty when it draws nothing).
+@compute @workgroup_size(256)
+fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    let q = (wg.y * nwg.x + wg.x) * 256u + lid;
+    if q >= job.counts.y {
+        return;
+    }
+    let index = job.counts.x + q;
+    bounds[index] = vec4<i32>(1, 1, 0, 0);
+    let qd = load_quad(q);
+    if !qd.d.alive {
+        return;
+    }
+    // Corners 0 (uv0.x, uv0.y), 1 (uv1.x, uv0.y), 2 (uv0.x, uv1.y), 3: the clip position is
+    // affine in the frame coordinates (both for rotated squares and streaks).
+    let c0 = quad_corner(qd, 0u);
+    let c1 = quad_corner(qd, 1u);
+    let c2 = quad_corner(qd, 2u);
+    let c3 = quad_corner(qd, 3u);
+    if min(min(c0.clip.w, c1.clip.w), min(c2.clip.w, c3.clip.w)) <= 1e-4 {
+        return;
+    }
+    let du = c1.uv.x - c0.uv.x;
+    let dv = c2.uv.y - c0.uv.y;
+    if abs(du) < 1e-12 || abs(dv) < 1e-12 {
+        return;
+    }
+    let col_u = (c1.clip - c0.clip) / du;
+    let col_v = (c2.clip - c0.clip) / dv;
+    let col_1 = c0.clip - col_u * c0.uv.x - col_v * c0.uv.y;
+    // Homogeneous pixels (p·w, w) = P · (x, y, w), P = [W/2 0 W/2; 0 −H/2 H/2; 0 0 1].
+    let hw = 0.5 * camera.viewport.xy;
+    let m = mat3x3<f32>(
+        vec3<f32>(hw.x * (col_u.x + col_u.w), hw.y * (col_u.w - col_u.y), col_u.w),
+        vec3<f32>(hw.x * (col_v.x + col_v.w), hw.y * (col_v.w - col_v.y), col_v.w),
+        vec3<f32>(hw.x * (col_1.x + col_1.w), hw.y * (col_1.w - col_1.y), col_1.w),
+    );
+    // The adjugate: (uv, 1) ∝ adj(m) · (p, 1) (a scale, sign included, cancels in h.xy / h.z).
+    let adj = transpose(mat3x3<f32>(cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1])));
+    var s: TileSprite;
+    s.inv0 = vec4<f32>(adj[0], 0.0);
+    s.inv1 = vec4<f32>(adj[1], 0.0);
+    s.inv2 = vec4<f32>(adj[2], 0.0);
+    s.z_row = vec4<f32>(col_u.z, col_v.z, col_1.z, 0.0);
+    s.w_row = vec4<f32>(col_u.w, col_v.w, col_1.w, 0.0);
+    s.uv_box = vec4<f32>(min(c0.uv, c3.uv), max(c0.uv, c3.uv));
+    s.color = qd.color;
+    if FLIPBOOK {
+        s.frames = vec4<f32>(quad_frames(qd), 0.0);
+    }
+    if SOFT {
+        let g0 = ground_fade_arg(c0.world);
+        let gu = (ground_fade_arg(c1.world) - g0) / du;
+        let gv = (ground_fade_arg(c2.world) - g0) / dv;
+        s.ground = vec4<f32>(gu, gv, g0 - gu * c0.uv.x - gv * c0.uv.y, 0.0);
+    }
+    // Derivatives at the centre: d(uv)/d(p) from h = adj · (p, 1).
+    let centre = 0.25 * (to_pixels(c0.clip) + to_pixels(c1.clip) + to_pixels(c2.clip) + to_pixels(c3.clip));
+    let h = adj * vec3<f32>(centre, 1.0);
+    let duv_dx = (adj[0].xy * h.z - h.xy * adj[0].z) / (h.z * h.z);
+    let duv_dy = (adj[1].xy * h.z - h.xy * adj[1].z) / (h.z * h.z);
+    let k = atlas_scale();
+    s.grad = vec4<f32>(duv_dx * k, duv_dy * k);
+    sprites[index] = s;
+    // Pixel centres (x + 0.5) inside the quad's bounding box, clamped to the target.
+    let p0 = to_pixels(c0.clip);
+    let p1 = to_pixels(c1.clip);
+    let p2 = to_pixels(c2.clip);
+    let p3 = to_pixels(c3.clip);
+    let lo = floor(min(min(p0, p1), min(p2, p3)) - 0.5);
+    let hi = ceil(max(max(p0, p1), max(p2, p3)) - 0.5);
+    let size = vec2<f32>(camera.viewport.xy) - 1.0;
+    if any(hi < vec2<f32>(0.0)) || any(lo > size) {
+        return;
+    }
+    bounds[index] = vec4<i32>(vec2<i32>(max(lo, vec2<f32>(0.0))), vec2<i32>(min(hi, size)));
+}
+
+var<workgroup> scan: array<u32, 256>;
+var<workgroup> hits: array<u32, 256>;
+var<workgroup> shared_count: u32;
+var<workgroup> shared_run: u32;
+
+// An inclusive prefix sum of `v` over the workgroup (Hillis–Steele); every invocation
+// of the workgroup must call it.
+fn workgroup_scan(lid: u32, v: u32) -> u32 {
+    scan[lid] = v;
+    workgroupBarrier();
+    for (var o = 1u; o < 256u; o <<= 1u) {
+        var x = scan[lid];
+        if lid >= o {
+            x += scan[lid - o];
+        }
+        workgroupBarrier();
+        scan[lid] = x;
+        workgroupBarrier();
+    }
+    return scan[lid];
+}
+
+// Whether pixel rectangles `a` and `b` (x0, y0, x1, y1, inclusive) overlap.
+fn overlaps(a: vec4<i32>, b: vec4<i32>) -> bool {
+    return all(a.xy <= b.zw) && all(b.xy <= a.zw);
+}
+
+// Lists, for one bin, the frame's sprites over it in draw order (an order-keeping
+// compaction: deterministic, whatever the scheduling).
+@compute @workgroup_size(256)
+fn bin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    let b = wg.y * nwg.x + wg.x;
+    let lo = vec2<i32>(wg.xy * BIN);
+    let rect = vec4<i32>(lo, lo + i32(BIN) - 1);
+    let n = job.counts.z;
+    let stride = job.counts.w;
+    var count = 0u;
+    for (var base = 0u; base < n; base += 256u) {
+        let i = base + lid;
+        var hit = 0u;
+        if i < n && overlaps(bounds[i], rect) {
+            hit = 1u;
+        }
+        let at = workgroup_scan(lid, hit);
+        if hit == 1u {
+            bin_lists[b * stride + count + at - 1u] = i;
+        }
+        count += workgroupUniformLoad(&scan[255]);
+        workgroupBarrier();
+    }
+    if lid == 0u {
+        bin_counts[b] = count;
+    }
+}
+
+// The first entry of bin `b`'s list (`n` entries) at or after sprite `s`.
+fn lower_bound(b: u32, n: u32, s: u32) -> u32 {
+    var lo = 0u;
+    var hi = n;
+    while lo < hi {
+        let mid = (lo + hi) / 2u;
+        if bin_lists[b * job.counts.w + mid] < s {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
+// Whether a sprite at NDC depth `z` is in front of the host's geometry at pixel `p`.
+fn visible(p: vec2<i32>, z: f32) -> bool {
+    let dims = textureDimensions(scene_depth);
+    if DEPTH_TEST == 0u || dims.x != u32(camera.viewport.x) || dims.y != u32(camera.viewport.y) {
+        return true;
+    }
+    let d = textureLoad(scene_depth, p, 0);
+    return select(z >= d, z <= d, DEPTH_TEST == 1u);
+}
+
+// The view-space distance in front of the camera of a depth-buffer value.
+fn view_distance(depth: f32) -> f32 {
+    let k = camera.depth_to_view;
+    return -(k.x * depth + k.y) / (k.z * depth + k.w);
+}
+
+// Sprite `s` at pixel `p` blended into `acc` (rgb: premultiplied colour, a: coverage,
+// 1 − the transmittance).
+fn shade_sprite(s: TileSprite, p: vec2<i32>, acc: vec4<f32>) -> vec4<f32> {
+    let pc = vec2<f32>(p) + 0.5;
+    let h = s.inv0.xyz * pc.x + s.inv1.xyz * pc.y + s.inv2.xyz;
+    let uv = h.xy / h.z;
+    if any(uv < s.uv_box.xy) || any(uv > s.uv_box.zw) {
+        return acc;
+    }
+    let uv1 = vec3<f32>(uv, 1.0);
+    // Clipped to the depth range as the rasteriser clips the billboard.
+    let z = dot(s.z_row.xyz, uv1) / dot(s.w_row.xyz, uv1);
+    if z < 0.0 || z > 1.0 || !visible(p, z) {
+        return acc;
+    }
+    var t0 = vec2<f32>(uv.x * 0.5 + 0.5, 0.5 - uv.y * 0.5);
+    if FLIPBOOK {
+        t0 = atlas_uv(s.frames.x, uv);
+    }
+    var tex = textureSampleGrad(sprite_tex, sprite_sampler, t0, s.grad.xy, s.grad.zw);
+    if FLIPBOOK && FLIP_BLEND {
+        let t1 = atlas_uv(s.frames.y, uv);
+        tex = mix(tex, textureSampleGrad(sprite_tex, sprite_sampler, t1, s.grad.xy, s.grad.zw), s.frames.z);
+    }
+    var a = s.color.a * tex.a;
+    var rgb = s.color.rgb * tex.rgb;
+    if SOFT {
+        let fade = clamp(dot(s.ground.xyz, uv1), 0.0, 1.0);
+        a *= fade;
+        rgb *= fade;
+    }
+    if SOFT_DEPTH {
+        let scene = textureLoad(scene_depth, p, 0);
+        let fade = clamp((view_distance(scene) - view_distance(z)) * look.soft.y, 0.0, 1.0);
+        a *= fade;
+        rgb *= fade;
+    }
+    if SORTED {
+        return vec4<f32>(acc.rgb * (1.0 - a) + rgb, acc.a + a * (1.0 - acc.a));
+    }
+    return vec4<f32>(acc.rgb + rgb, acc.a);
+}
+
+// Shades one tile with the job's item: its sprites over the tile, in draw order, into the
+// tile's pixels of `accum`.
+@compute @workgroup_size(16, 16)
+fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    look = looks[0].look;
+    let bins_x = (u32(camera.viewport.x) + BIN - 1u) / BIN;
+    let b = (wg.y / BIN_TILES) * bins_x + wg.x / BIN_TILES;
+    if lid == 0u {
+        shared_count = bin_counts[b];
+    }
+    let n = workgroupUniformLoad(&shared_count);
+    // The item's sprites are a run of the bin's sorted list.
+    let first = lower_bound(b, n, job.counts.x);
+    let last = lower_bound(b, n, job.counts.x + job.counts.y);
+    if lid == 0u {
+        shared_run = last - first;
+    }
+    let run = workgroupUniformLoad(&shared_run);
+    if run == 0u {
+        return;
+    }
+    let origin = vec2<i32>(wg.xy * TILE);
+    let tile = vec4<i32>(origin, origin + i32(TILE) - 1);
+    let p = origin + vec2<i32>(l.xy);
+    let inside = all(vec2<f32>(p) < camera.viewport.xy);
+    let pixel = u32(p.y) * u32(camera.viewport.x) + u32(p.x);
+    var acc = vec4<f32>(0.0);
+    if inside {
+        let v = accum[pixel];
+        acc = vec4<f32>(unpack2x16float(v.x), unpack2x16float(v.y));
+    }
+    var touched = false;
+    for (var base = 0u; base < run; base += 256u) {
+        // The chunk's sprites over this tile, in order.
+        var hit = 0u;
+        var s = 0u;
+        if base + lid < run {
+            s = bin_lists[b * job.counts.w + first + base + lid];
+            if overlaps(bounds[s], tile) {
+                hit = 1u;
+            }
+        }
+        let at = workgroup_scan(lid, hit);
+        if hit == 1u {
+            hits[at - 1u] = s;
+        }
+        let total = workgroupUniformLoad(&scan[255]);
+        touched = touched || total > 0u;
+        if inside {
+            for (var k = 0u; k < total; k++) {
+                acc = shade_sprite(sprites[hits[k]], p, acc);
+            }
+        }
+        workgroupBarrier();
+    }
+    if inside && touched {
+        accum[pixel] = vec2<u32>(pack2x16float(acc.rg), pack2x16float(acc.ba));
+    }
+}
+
+// The resolve: a full-screen triangle compositing the tiles' colour over the target
+// (premultiplied: dst · T + C, as `over` blending of (C, 1 − T)).
+@vertex
+fn vs_resolve(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
+    let uv = vec2<f32>(f32((vi << 1u) & 2u), f32(vi & 2u));
+    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+}
+
+@fragment
+fn fs_resolve(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let v = accum[u32(frag.y) * u32(camera.viewport.x) + u32(frag.x)];
+    return vec4<f32>(unpack2x16float(v.x), unpack2x16float(v.y));
+}

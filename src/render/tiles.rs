@@ -1,0 +1,558 @@
+//! The tile draw path for large sprites: a compute rasteriser. Each frame's tile items
+//! (emitters whose quads are drawn on the compute units) are projected once
+//! (`tiles.wgsl` `project`, the quads of `quad.wgsl` that the billboards draw), listed per
+//! 128-pixel bin in draw order (`bin`), and shaded per 16×16 tile and emitter (`shade`):
+//! alpha-blended layers back to front, light added, the tile's pixels read and written
+//! once per emitter. A full-screen draw composites the result into the host's pass.
+//! GPUs that keep only a sliver of their chip for rasterisation (the H100) fill large
+//! sprites far faster this way.
+
+use std::collections::HashMap;
+
+use crate::effect::BlendMode;
+use crate::gpu::GpuContext;
+use crate::render::billboard::DrawTarget;
+use crate::render::frame::{DrawItem, FrameResources, LookVariant};
+use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
+use crate::sim::gpu_sim::dispatch_size;
+
+/// Pixels per tile side (one workgroup each; keep in sync with `TILE` in tiles.wgsl).
+pub const TILE_PX: u32 = 16;
+/// Pixels per bin side (keep in sync with `BIN` in tiles.wgsl).
+pub const BIN_PX: u32 = 128;
+/// Bytes of one projected sprite (`TileSprite` in tiles.wgsl).
+const SPRITE_BYTES: u64 = 160;
+/// Stride of the per-dispatch jobs (the storage offset alignment).
+const JOB_STRIDE: u64 = 256;
+/// The bins' lists may take at most this many bytes: beyond it the frame's tile items
+/// are drawn as billboards.
+const MAX_LIST_BYTES: u64 = 128 << 20;
+
+/// The module, the basic variant's pipelines (built to validate the module), the bin
+/// pipeline and the resolve.
+type Built = (
+    wgpu::ShaderModule,
+    HashMap<LookVariant, Option<[wgpu::ComputePipeline; 2]>>,
+    wgpu::ComputePipeline,
+    wgpu::RenderPipeline,
+);
+
+/// Storage buffers per shader stage the tile passes bind (the looks, the six state
+/// views, the tiles' six): a device created with fewer draws every quad as a billboard.
+pub const STORAGE_BUFFERS_NEEDED: u32 = 13;
+
+/// Project, bin, shade and resolve.
+pub struct TilePass {
+    target: DrawTarget,
+    tile_layout: wgpu::BindGroupLayout,
+    sprite_layout: wgpu::BindGroupLayout,
+    no_depth: wgpu::TextureView,
+    compute_layout: wgpu::PipelineLayout,
+    resolve_layout: wgpu::PipelineLayout,
+    empty_group: wgpu::BindGroup,
+    module: wgpu::ShaderModule,
+    /// (project, shade) per look variant, built on first use (`None`: failed, logged).
+    variants: HashMap<LookVariant, Option<[wgpu::ComputePipeline; 2]>>,
+    bin: wgpu::ComputePipeline,
+    resolve: wgpu::RenderPipeline,
+    /// Compute-visible sprite bind groups by sprite id.
+    sprite_groups: HashMap<u64, wgpu::BindGroup>,
+    buffers: Option<TileBuffers>,
+    /// Whether the last record shaded anything (the resolve draws only then).
+    drawn: bool,
+}
+
+/// The frame's buffers for one target size and sprite capacity.
+struct TileBuffers {
+    size: (u32, u32),
+    /// Sprites the buffers hold (and entries per bin list).
+    capacity: u32,
+    /// Jobs the job buffer holds.
+    jobs: u32,
+    job_buffer: wgpu::Buffer,
+    accum: wgpu::Buffer,
+    group: wgpu::BindGroup,
+    depth: Option<wgpu::TextureView>,
+    /// Everything else the group binds (kept alive with it).
+    _lists: [wgpu::Buffer; 4],
+}
+
+/// The tiles' depth test constant for a target (as the splat's).
+fn depth_test(target: DrawTarget) -> f64 {
+    use wgpu::CompareFunction as C;
+    match target.depth.map(|(_, c)| c) {
+        Some(C::Less | C::LessEqual | C::Equal) => 1.0,
+        Some(C::Greater | C::GreaterEqual) => 2.0,
+        _ => 0.0,
+    }
+}
+
+/// Tiles and bins across a target of `size` pixels.
+pub fn grid(size: (u32, u32), cell: u32) -> (u32, u32) {
+    (size.0.div_ceil(cell).max(1), size.1.div_ceil(cell).max(1))
+}
+
+/// Whether `sprites` quads fit the tile path's lists at `size`.
+pub fn fits(size: (u32, u32), sprites: u64) -> bool {
+    let (bx, by) = grid(size, BIN_PX);
+    u64::from(bx * by) * sprites.next_power_of_two() * 4 <= MAX_LIST_BYTES
+}
+
+/// The frame's tile items in draw order: alpha-blended first (as given: back to front),
+/// then the light by emitter (as the billboards draw them).
+pub fn draw_order(items: &[DrawItem]) -> Vec<&DrawItem> {
+    let mut order: Vec<&DrawItem> = items.iter().filter(|d| d.tiles).collect();
+    order.sort_by_key(|d| match d.blend {
+        BlendMode::Alpha => (0, 0),
+        BlendMode::Additive => (1, d.index),
+    });
+    order
+}
+
+impl TilePass {
+    /// Whether `device` was created with the limits the tile passes need.
+    pub fn supported(device: &wgpu::Device) -> bool {
+        device.limits().max_storage_buffers_per_shader_stage >= STORAGE_BUFFERS_NEEDED
+    }
+
+    /// Builds the pipelines from `lib`; the resolve draws into `target`, and the tiles
+    /// test against its depth when it has one.
+    pub fn new(
+        ctx: &GpuContext,
+        lib: &ShaderLibrary,
+        frame: &FrameResources,
+        target: DrawTarget,
+    ) -> Result<Self, ShaderError> {
+        let d = &ctx.device;
+        let tile_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("TilePass::tile_layout"),
+            entries: &Self::tile_entries(),
+        });
+        let sprite_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("TilePass::sprite_layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
+        });
+        let empty_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("TilePass::empty_layout"),
+            entries: &[],
+        });
+        let empty_group = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("TilePass::empty_group"),
+            layout: &empty_layout,
+            entries: &[],
+        });
+        let compute_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("TilePass::compute_layout"),
+            bind_group_layouts: &[
+                Some(&frame.frame_layout),
+                Some(&frame.particle_layout),
+                Some(&sprite_layout),
+                Some(&tile_layout),
+            ],
+            immediate_size: 0,
+        });
+        let resolve_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("TilePass::resolve_layout"),
+            bind_group_layouts: &[
+                Some(&frame.frame_layout),
+                Some(&empty_layout),
+                Some(&empty_layout),
+                Some(&tile_layout),
+            ],
+            immediate_size: 0,
+        });
+        let (module, variants, bin, resolve) =
+            Self::build(ctx, lib, &compute_layout, &resolve_layout, target)?;
+        Ok(Self {
+            target,
+            tile_layout,
+            sprite_layout,
+            no_depth: crate::gpu::placeholder_depth(d, "TilePass::no_depth"),
+            compute_layout,
+            resolve_layout,
+            empty_group,
+            module,
+            variants,
+            bin,
+            resolve,
+            sprite_groups: HashMap::new(),
+            buffers: None,
+            drawn: false,
+        })
+    }
+
+    /// Group 3: sprites, bounds, bin lists, bin counts, the accumulation (read by the
+    /// resolve too), the host's depth and the dispatch's job.
+    fn tile_entries() -> [wgpu::BindGroupLayoutEntry; 7] {
+        let storage = |binding, visibility, read_only, dynamic| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: dynamic,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let c = wgpu::ShaderStages::COMPUTE;
+        [
+            storage(0, c, false, false),
+            storage(1, c, false, false),
+            storage(2, c, false, false),
+            storage(3, c, false, false),
+            storage(4, c | wgpu::ShaderStages::FRAGMENT, false, false),
+            crate::gpu::depth_texture_entry(5, c),
+            storage(6, c, true, true),
+        ]
+    }
+
+    /// The module (validated with the full-state pipelines), the bin pipeline and the
+    /// resolve.
+    fn build(
+        ctx: &GpuContext,
+        lib: &ShaderLibrary,
+        layout: &wgpu::PipelineLayout,
+        resolve_layout: &wgpu::PipelineLayout,
+        target: DrawTarget,
+    ) -> Result<Built, ShaderError> {
+        let composed = lib.compose("tiles.wgsl")?;
+        create_checked(&ctx.device, &composed, lib, |module| {
+            let bin = Self::compute(ctx, layout, module, "bin", &[]);
+            let basic = LookVariant::basic(false);
+            let variants = HashMap::from([(
+                basic,
+                Some(Self::variant_pipelines(ctx, layout, module, basic, target)),
+            )]);
+            let color = wgpu::ColorTargetState {
+                format: target.color_format,
+                blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
+                write_mask: wgpu::ColorWrites::ALL,
+            };
+            let resolve = ctx
+                .device
+                .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some("TilePass::resolve"),
+                    layout: Some(resolve_layout),
+                    vertex: wgpu::VertexState {
+                        module,
+                        entry_point: Some("vs_resolve"),
+                        compilation_options: Default::default(),
+                        buffers: &[],
+                    },
+                    primitive: wgpu::PrimitiveState::default(),
+                    depth_stencil: target.read_only_depth(Some(wgpu::CompareFunction::Always)),
+                    multisample: target.multisample(),
+                    fragment: Some(wgpu::FragmentState {
+                        module,
+                        entry_point: Some("fs_resolve"),
+                        compilation_options: Default::default(),
+                        targets: &[Some(color)],
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                });
+            (module.clone(), variants, bin, resolve)
+        })
+    }
+
+    fn compute(
+        ctx: &GpuContext,
+        layout: &wgpu::PipelineLayout,
+        module: &wgpu::ShaderModule,
+        entry: &str,
+        constants: &[(&str, f64)],
+    ) -> wgpu::ComputePipeline {
+        ctx.device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(&format!("TilePass::{entry}")),
+                layout: Some(layout),
+                module,
+                entry_point: Some(entry),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants,
+                    ..Default::default()
+                },
+                cache: None,
+            })
+    }
+
+    /// The project and shade pipelines of a look variant.
+    fn variant_pipelines(
+        ctx: &GpuContext,
+        layout: &wgpu::PipelineLayout,
+        module: &wgpu::ShaderModule,
+        v: LookVariant,
+        target: DrawTarget,
+    ) -> [wgpu::ComputePipeline; 2] {
+        // tiles.wgsl has no motion pass.
+        let mut constants: Vec<(&str, f64)> = v
+            .constants()
+            .into_iter()
+            .filter(|(name, _)| *name != "MOTION")
+            .collect();
+        constants.push(("DEPTH_TEST", depth_test(target)));
+        [
+            Self::compute(ctx, layout, module, "project", &constants),
+            Self::compute(ctx, layout, module, "shade", &constants),
+        ]
+    }
+
+    /// Rebuilds the pipelines; keeps the old ones on error. Variants are rebuilt on
+    /// first use.
+    pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
+        let (module, variants, bin, resolve) = Self::build(
+            ctx,
+            lib,
+            &self.compute_layout,
+            &self.resolve_layout,
+            self.target,
+        )?;
+        self.module = module;
+        self.bin = bin;
+        self.resolve = resolve;
+        self.variants = variants;
+        Ok(())
+    }
+
+    /// Builds what the frame's tile items need: pipelines of their variants and sprite
+    /// bind groups.
+    fn prepare(&mut self, ctx: &GpuContext, items: &[&DrawItem], sampler: &wgpu::Sampler) {
+        for d in items {
+            let v = d.variant;
+            if !self.variants.contains_key(&v) {
+                let p =
+                    crate::render::scoped_variant(ctx, format_args!("tile variant {v:?}"), || {
+                        Self::variant_pipelines(
+                            ctx,
+                            &self.compute_layout,
+                            &self.module,
+                            v,
+                            self.target,
+                        )
+                    });
+                self.variants.insert(v, p);
+            }
+            self.sprite_groups.entry(d.sprite.id).or_insert_with(|| {
+                ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("TilePass::sprite_group"),
+                    layout: &self.sprite_layout,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: wgpu::BindingResource::TextureView(&d.sprite.view),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: wgpu::BindingResource::Sampler(sampler),
+                        },
+                    ],
+                })
+            });
+        }
+    }
+
+    /// Projects, bins and shades every tile item of `items` (compute), testing against
+    /// `depth` (the host's, single-sample and `size`) when given. Returns false when
+    /// there was nothing to draw (then `resolve` draws nothing).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &mut self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        frame: &FrameResources,
+        items: &[DrawItem],
+        size: (u32, u32),
+        depth: Option<&wgpu::TextureView>,
+    ) -> bool {
+        let order = draw_order(items);
+        let total: u64 = order
+            .iter()
+            .map(|d| u64::from(d.width) * u64::from(d.members))
+            .sum();
+        self.drawn = false;
+        if total == 0 || !fits(size, total) {
+            self.buffers = None;
+            return false;
+        }
+        self.prepare(ctx, &order, &frame.sprites.sampler);
+        self.ensure_buffers(ctx, size, total as u32, order.len() as u32, depth);
+        let Some(b) = self.buffers.as_ref() else {
+            return false;
+        };
+        // One job per item: its first sprite and quads, the frame's sprites, the lists'
+        // stride.
+        let mut jobs = vec![0u8; order.len() * JOB_STRIDE as usize];
+        let mut first = 0u32;
+        for (k, d) in order.iter().enumerate() {
+            let n = d.width * d.members;
+            let job = [first, n, total as u32, b.capacity];
+            jobs[k * JOB_STRIDE as usize..][..16].copy_from_slice(bytemuck::cast_slice(&job));
+            first += n;
+        }
+        ctx.queue.write_buffer(&b.job_buffer, 0, &jobs);
+        enc.clear_buffer(&b.accum, 0, None);
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("TilePass::tiles"),
+            timestamp_writes: None,
+        });
+        let bins = grid(size, BIN_PX);
+        let tiles = grid(size, TILE_PX);
+        // Project every item, bin once, then shade each item in draw order.
+        for stage in 0..2 {
+            for (k, d) in order.iter().enumerate() {
+                let (Some(particles), Some(Some(pipes)), Some(sprite)) = (
+                    frame.particle_group(d.key),
+                    self.variants.get(&d.variant),
+                    self.sprite_groups.get(&d.sprite.id),
+                ) else {
+                    continue;
+                };
+                pass.set_pipeline(&pipes[stage]);
+                pass.set_bind_group(
+                    0,
+                    &frame.frame_group,
+                    &[FrameResources::look_offset(d.look_slot)],
+                );
+                pass.set_bind_group(1, particles, &[]);
+                pass.set_bind_group(2, sprite, &[]);
+                pass.set_bind_group(3, &b.group, &[(k as u64 * JOB_STRIDE) as u32]);
+                if stage == 0 {
+                    let (x, y) = dispatch_size(d.width * d.members);
+                    pass.dispatch_workgroups(x, y, 1);
+                } else {
+                    pass.dispatch_workgroups(tiles.0, tiles.1, 1);
+                }
+            }
+            if stage == 0 {
+                // Every group of the layout is bound by the projections above.
+                pass.set_pipeline(&self.bin);
+                pass.dispatch_workgroups(bins.0, bins.1, 1);
+            }
+        }
+        drop(pass);
+        self.drawn = true;
+        true
+    }
+
+    /// Creates the buffers for `size` and `sprites` quads (capacity in powers of two) and
+    /// `jobs` dispatches unless the current ones hold them; rebinds a new depth view.
+    fn ensure_buffers(
+        &mut self,
+        ctx: &GpuContext,
+        size: (u32, u32),
+        sprites: u32,
+        jobs: u32,
+        depth: Option<&wgpu::TextureView>,
+    ) {
+        if let Some(b) = &self.buffers
+            && b.size == size
+            && b.capacity >= sprites
+            && b.jobs >= jobs
+            && b.depth.as_ref() == depth
+        {
+            return;
+        }
+        let capacity = sprites.next_power_of_two().max(256);
+        let jobs = jobs.next_power_of_two().max(4);
+        let (bx, by) = grid(size, BIN_PX);
+        let buffer = |label: &str, bytes: u64| {
+            ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes.max(16),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let c = u64::from(capacity);
+        let sprites_buf = buffer("TilePass::sprites", c * SPRITE_BYTES);
+        let bounds = buffer("TilePass::bounds", c * 16);
+        let lists = buffer("TilePass::bin_lists", u64::from(bx * by) * c * 4);
+        let counts = buffer("TilePass::bin_counts", u64::from(bx * by) * 4);
+        let accum = buffer("TilePass::accum", u64::from(size.0) * u64::from(size.1) * 8);
+        let job_buffer = buffer("TilePass::jobs", u64::from(jobs) * JOB_STRIDE);
+        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("TilePass::group"),
+            layout: &self.tile_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: sprites_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: bounds.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: lists.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: counts.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: accum.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::TextureView(depth.unwrap_or(&self.no_depth)),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &job_buffer,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(16),
+                    }),
+                },
+            ],
+        });
+        self.buffers = Some(TileBuffers {
+            size,
+            capacity,
+            jobs,
+            job_buffer,
+            accum,
+            group,
+            depth: depth.cloned(),
+            _lists: [sprites_buf, bounds, lists, counts],
+        });
+    }
+
+    /// Composites the last record's tiles into an open render pass of the target's
+    /// formats (nothing when it drew nothing).
+    pub fn resolve(&self, pass: &mut wgpu::RenderPass<'_>, frame: &FrameResources) {
+        let Some(b) = self.buffers.as_ref().filter(|_| self.drawn) else {
+            return;
+        };
+        pass.set_pipeline(&self.resolve);
+        pass.set_bind_group(0, &frame.frame_group, &[0]);
+        pass.set_bind_group(1, &self.empty_group, &[]);
+        pass.set_bind_group(2, &self.empty_group, &[]);
+        pass.set_bind_group(3, &b.group, &[0]);
+        pass.draw(0..3, 0..1);
+    }
+
+    /// Whether the last record drew anything.
+    pub fn drawn(&self) -> bool {
+        self.drawn
+    }
+}
