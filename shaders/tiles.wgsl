@@ -39,6 +39,8 @@ var<private> look: LookUniform;
 @group(3) @binding(6) var<storage, read> job: TileJob;
 
 override DEPTH_TEST: u32 = 0u;
+// The adapter's blending rounds f16 toward zero (lavapipe), not to nearest.
+override F16_ROUND_DOWN: bool = false;
 
 // Pixels per tile side (one workgroup each) and tiles per bin side (keep in sync with
 // src/render/tiles.rs).
@@ -70,7 +72,7 @@ struct TileSprite {
     frames: vec4<f32>,
     // The ground fade's argument as an affine function of (uv, 1).
     ground: vec4<f32>,
-    // Atlas coordinates' derivatives along pixel x (xy) and y (zw), at the quad's centre.
+    // xy: atlas coordinates per unit of frame coordinates (the derivatives' scale).
     grad: vec4<f32>,
 }
 
@@ -145,13 +147,7 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
         let gv = (ground_fade_arg(c2.world) - g0) / dv;
         s.ground = vec4<f32>(gu, gv, g0 - gu * c0.uv.x - gv * c0.uv.y, 0.0);
     }
-    // Derivatives at the centre: d(uv)/d(p) from h = adj · (p, 1).
-    let centre = 0.25 * (to_pixels(c0.clip) + to_pixels(c1.clip) + to_pixels(c2.clip) + to_pixels(c3.clip));
-    let h = adj * vec3<f32>(centre, 1.0);
-    let duv_dx = (adj[0].xy * h.z - h.xy * adj[0].z) / (h.z * h.z);
-    let duv_dy = (adj[1].xy * h.z - h.xy * adj[1].z) / (h.z * h.z);
-    let k = atlas_scale();
-    s.grad = vec4<f32>(duv_dx * k, duv_dy * k);
+    s.grad = vec4<f32>(atlas_scale(), 0.0, 0.0);
     sprites[index] = s;
     // Pixel centres (x + 0.5) inside the quad's bounding box, clamped to the target.
     let p0 = to_pixels(c0.clip);
@@ -262,6 +258,10 @@ fn shade_sprite(s: TileSprite, p: vec2<i32>, acc: vec4<f32>) -> vec4<f32> {
     if any(uv < s.uv_box.xy) || any(uv > s.uv_box.zw) {
         return acc;
     }
+    // The atlas coordinates' derivatives along pixel x and y, exact at this pixel (the
+    // mip level the billboard's fragment would pick).
+    let ddx = (s.inv0.xy * h.z - h.xy * s.inv0.z) / (h.z * h.z) * s.grad.xy;
+    let ddy = (s.inv1.xy * h.z - h.xy * s.inv1.z) / (h.z * h.z) * s.grad.xy;
     let uv1 = vec3<f32>(uv, 1.0);
     // Clipped to the depth range as the rasteriser clips the billboard.
     let z = dot(s.z_row.xyz, uv1) / dot(s.w_row.xyz, uv1);
@@ -272,10 +272,10 @@ fn shade_sprite(s: TileSprite, p: vec2<i32>, acc: vec4<f32>) -> vec4<f32> {
     if FLIPBOOK {
         t0 = atlas_uv(s.frames.x, uv);
     }
-    var tex = textureSampleGrad(sprite_tex, sprite_sampler, t0, s.grad.xy, s.grad.zw);
+    var tex = textureSampleGrad(sprite_tex, sprite_sampler, t0, ddx, ddy);
     if FLIPBOOK && FLIP_BLEND {
         let t1 = atlas_uv(s.frames.y, uv);
-        tex = mix(tex, textureSampleGrad(sprite_tex, sprite_sampler, t1, s.grad.xy, s.grad.zw), s.frames.z);
+        tex = mix(tex, textureSampleGrad(sprite_tex, sprite_sampler, t1, ddx, ddy), s.frames.z);
     }
     var a = s.color.a * tex.a;
     var rgb = s.color.rgb * tex.rgb;
@@ -290,10 +290,30 @@ fn shade_sprite(s: TileSprite, p: vec2<i32>, acc: vec4<f32>) -> vec4<f32> {
         a *= fade;
         rgb *= fade;
     }
+    var out = vec4<f32>(acc.rgb + rgb, acc.a);
     if SORTED {
-        return vec4<f32>(acc.rgb * (1.0 - a) + rgb, acc.a + a * (1.0 - acc.a));
+        out = vec4<f32>(acc.rgb * (1.0 - a) + rgb, acc.a + a * (1.0 - acc.a));
     }
-    return vec4<f32>(acc.rgb + rgb, acc.a);
+    // Rounded to f16 after every sprite, as the billboards' blending stores each one into
+    // the f16 target: faint light on bright pixels is kept or lost as the billboards' is.
+    return vec4<f32>(to_f16(out.rg), to_f16(out.ba));
+}
+
+// Non-negative values rounded to f16 as the adapter's blending stores them: to nearest,
+// or toward zero where F16_ROUND_DOWN says (lavapipe).
+fn to_f16(v: vec2<f32>) -> vec2<f32> {
+    var bits = pack2x16float(v);
+    if !F16_ROUND_DOWN {
+        return unpack2x16float(bits);
+    }
+    let p = unpack2x16float(bits);
+    if p.x > v.x && (bits & 0xFFFFu) != 0u {
+        bits -= 1u;
+    }
+    if p.y > v.y && (bits >> 16u) != 0u {
+        bits -= 0x10000u;
+    }
+    return unpack2x16float(bits);
 }
 
 // Shades one tile with the job's item: its sprites over the tile, in draw order, into the

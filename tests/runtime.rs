@@ -44,8 +44,15 @@ fn host_device() -> (wgpu::Device, wgpu::Queue) {
         &instance, None,
     ))
     .expect("GPU tests need an adapter (CI installs mesa-vulkan-drivers)");
+    // The storage buffers the tile rasteriser binds (a device with the default 8 draws
+    // every quad as a billboard).
+    let limits = wgpu::Limits {
+        max_storage_buffers_per_shader_stage: ignis::render::tiles::STORAGE_BUFFERS_NEEDED,
+        ..Default::default()
+    };
     pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
         required_features: wgpu::Features::FLOAT32_BLENDABLE,
+        required_limits: limits,
         ..Default::default()
     }))
     .expect("a device with FLOAT32_BLENDABLE")
@@ -359,6 +366,17 @@ fn host_geometry_hides_splatted_particles_exactly() {
     hides_the_fire_exactly(&effect, false);
 }
 
+/// The tile rasteriser tests the host's depth at every pixel it shades, as the splat.
+#[test]
+fn host_geometry_hides_tiled_particles_exactly() {
+    let mut effect = preset("campfire");
+    for e in &mut effect.emitters {
+        e.look.draw_path = ignis::effect::DrawPath::Tiles;
+    }
+    hides_the_fire_exactly(&effect, true);
+    hides_the_fire_exactly(&effect, false);
+}
+
 /// An opaque wall between the camera and the left half of `effect`: the pixels behind it
 /// are exactly the host's, and fire shows beside it. `depth`: the host hands its depth
 /// over.
@@ -410,6 +428,12 @@ fn hides_the_fire_exactly(effect: &Effect, depth: bool) {
         .iter()
         .any(|e| e.look.draw_path == ignis::effect::DrawPath::Splat);
     assert_eq!(splatted, wants_splat && depth, "the splat ran");
+    let tiled = fire.draw_items().iter().any(|d| d.tiles);
+    let wants_tiles = effect
+        .emitters
+        .iter()
+        .any(|e| e.look.draw_path == ignis::effect::DrawPath::Tiles);
+    assert_eq!(tiled, wants_tiles && depth, "the tiles ran");
 }
 
 /// One still, additive disc at (0, 0.2, 0), 1 m wide: its lower part crosses the ground.
@@ -443,11 +467,22 @@ fn still_disc(soft_m: f32) -> Effect {
 
 #[test]
 fn soft_edges_fade_over_the_soft_distance_from_the_host_depth() {
+    soft_edges_fade(ignis::effect::DrawPath::Billboard);
+    soft_edges_fade(ignis::effect::DrawPath::Tiles);
+}
+
+/// A disc crossing the host's ground, drawn by `path`: it fades as the depth says.
+fn soft_edges_fade(path: ignis::effect::DrawPath) {
     let (eye, target) = (vec3(0.0, 0.6, 2.5), vec3(0.0, 0.15, 0.0));
     let host = Host::new(eye, target);
     let soft_m = 0.4;
-    let mut hard = host.player(&still_disc(0.0));
-    let mut soft = host.player(&still_disc(soft_m));
+    let disc = |soft_m| {
+        let mut e = still_disc(soft_m);
+        e.emitters[0].look.draw_path = path;
+        e
+    };
+    let mut hard = host.player(&disc(0.0));
+    let mut soft = host.player(&disc(soft_m));
     hard.add_instance(Mat4::IDENTITY, 1).expect("instance");
     soft.add_instance(Mat4::IDENTITY, 1).expect("instance");
     advance(&mut [&mut hard, &mut soft], &host, 60);
@@ -492,7 +527,7 @@ fn soft_edges_fade_over_the_soft_distance_from_the_host_depth() {
         faded += usize::from(a.rgba[i][0] > 0.05 && (0.1..0.9).contains(&fade));
     }
     assert!(faded > 100, "only {faded} lit pixels are within the fade");
-    eprintln!("soft edges: {faded} pixels in the fade, worst error {worst:.5}");
+    eprintln!("soft edges ({path:?}): {faded} pixels in the fade, worst error {worst:.5}");
 }
 
 /// The torch's additive layers (its smoke is alpha-blended: not a sum).

@@ -39,12 +39,17 @@ struct Row {
     draw_ms: f64,
     composite_ms: f64,
     frame_ms: f64,
+    /// The last frame against the billboards' (8-bit levels): mean and largest
+    /// difference of a channel.
+    diff_mean: f64,
+    diff_max: u8,
 }
 
 /// The path choices measured.
+/// The billboards first: the other paths' images are compared with theirs.
 const PATHS: [(&str, Option<DrawPath>); 4] = [
-    ("auto", None),
     ("billboard", Some(DrawPath::Billboard)),
+    ("auto", None),
     ("splat", Some(DrawPath::Splat)),
     ("tiles", Some(DrawPath::Tiles)),
 ];
@@ -62,11 +67,15 @@ pub fn run(ctx: &GpuContext, opts: &PresetsOptions) -> Result<Report, PlayerErro
             }
         };
         for &size in &opts.sizes {
+            let mut reference = None;
             for (label, forced) in PATHS {
-                let row = measure(ctx, &timer, path, &effect, size, (label, forced), opts)?;
+                let (mut row, image) =
+                    measure(ctx, &timer, path, &effect, size, (label, forced), opts)?;
+                let reference = reference.get_or_insert(image.clone());
+                (row.diff_mean, row.diff_max) = image_diff(reference, &image);
                 println!(
-                    "{} {}x{} {label}: frame {:.3} ms",
-                    row.preset, size.0, size.1, row.frame_ms
+                    "{} {}x{} {label}: frame {:.3} ms, image vs billboards {:.3}/255 mean, {}/255 max",
+                    row.preset, size.0, size.1, row.frame_ms, row.diff_mean, row.diff_max
                 );
                 rows.push(row);
             }
@@ -92,6 +101,18 @@ fn warm_up_frames(effect: &Effect) -> usize {
     (secs * 60.0).ceil() as usize + usize::from(continuous) * 10
 }
 
+/// Mean and largest difference of two images' channels, in 8-bit levels.
+fn image_diff(a: &image::RgbaImage, b: &image::RgbaImage) -> (f64, u8) {
+    let (mut sum, mut max) = (0u64, 0u8);
+    for (x, y) in a.as_raw().iter().zip(b.as_raw()) {
+        let d = x.abs_diff(*y);
+        sum += u64::from(d);
+        max = max.max(d);
+    }
+    (sum as f64 / a.as_raw().len().max(1) as f64, max)
+}
+
+/// One row, and the frame after it (the same simulated moment for every path).
 fn measure(
     ctx: &GpuContext,
     timer: &GpuTimer,
@@ -100,7 +121,7 @@ fn measure(
     size: (u32, u32),
     (label, forced): (&'static str, Option<DrawPath>),
     opts: &PresetsOptions,
-) -> Result<Row, PlayerError> {
+) -> Result<(Row, image::RgbaImage), PlayerError> {
     let mut effect = effect.clone();
     if let Some(p) = forced {
         for e in &mut effect.emitters {
@@ -133,7 +154,8 @@ fn measure(
         parts[3].push(timer.time(ctx, |enc| composite.post(ctx, enc, player, layered)));
     }
     let [update_ms, sort_ms, draw_ms, composite_ms] = parts.map(|mut p| median(&mut p));
-    Ok(Row {
+    let image = run.render(size)?;
+    let row = Row {
         preset: name,
         size: format!("{}x{}", size.0, size.1),
         path: label,
@@ -142,7 +164,10 @@ fn measure(
         draw_ms,
         composite_ms,
         frame_ms: update_ms + sort_ms + draw_ms + composite_ms,
-    })
+        diff_mean: 0.0,
+        diff_max: 0,
+    };
+    Ok((row, image))
 }
 
 fn report(ctx: &GpuContext, timer: &GpuTimer, opts: &PresetsOptions, rows: &[Row]) -> Report {
@@ -151,9 +176,12 @@ fn report(ctx: &GpuContext, timer: &GpuTimer, opts: &PresetsOptions, rows: &[Row
         "Each preset in steady state (played past its last burst and longest lifetime at \
          60 fps; an effect of bursts alone a quarter of its longest lifetime after its last \
          burst), then {} frames; medians of each part, timed apart ({:?}): update, sort + \
-         splat (the player's record), particle draws, composite (bloom + tonemap). `frame` \
-         is their sum. `auto` is the preset's own draw-path choice; `billboard` and `splat` \
-         force every emitter onto one path (same process, same run).",
+         splat + the tiles' project, bin and shade (the player's record), particle draws \
+         (billboards, the splat's and the tiles' composite into the target), composite \
+         (bloom + tonemap). `frame` is their sum. `auto` is the preset's own draw-path \
+         choice; `billboard`, `splat` and `tiles` force every emitter onto one path (same \
+         process, same run). The last column compares the next frame's image with the \
+         billboards' (8-bit levels).",
         opts.frames, timer.source
     ));
     let table: Vec<Vec<String>> = rows
@@ -168,6 +196,7 @@ fn report(ctx: &GpuContext, timer: &GpuTimer, opts: &PresetsOptions, rows: &[Row
                 format!("{:.3}", w.draw_ms),
                 format!("{:.3}", w.composite_ms),
                 format!("{:.3}", w.frame_ms),
+                format!("{:.2} / {}", w.diff_mean, w.diff_max),
             ]
         })
         .collect();
@@ -177,10 +206,11 @@ fn report(ctx: &GpuContext, timer: &GpuTimer, opts: &PresetsOptions, rows: &[Row
             "size",
             "path",
             "update ms",
-            "sort + splat ms",
+            "sort + splat + tiles ms",
             "draw ms",
             "composite ms",
             "frame ms",
+            "vs billboards (mean / max, of 255)",
         ],
         &table,
     );

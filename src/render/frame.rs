@@ -773,9 +773,12 @@ impl FrameResources {
                 DrawPath::Splat => true,
             };
         // The compute paths test the host's depth themselves: they need its view.
+        // Streaks stay billboards: slivers a pixel or two wide, whose coverage and mip
+        // level the rasteriser decides per 2×2 pixels.
         let tiles = self.allow_splat
             && self.allow_tiles
             && !splat
+            && e.look.streak.is_none()
             && match e.look.draw_path {
                 DrawPath::Auto => self.auto_tiles && size_px >= TILES_ABOVE_PX,
                 DrawPath::Tiles => true,

@@ -308,6 +308,9 @@ impl TilePass {
             .filter(|(name, _)| *name != "MOTION")
             .collect();
         constants.push(("DEPTH_TEST", depth_test(target)));
+        // Software blending (lavapipe) rounds f16 toward zero; the tiles round as it does.
+        let round_down = ctx.profile.is_software();
+        constants.push(("F16_ROUND_DOWN", if round_down { 1.0 } else { 0.0 }));
         [
             Self::compute(ctx, layout, module, "project", &constants),
             Self::compute(ctx, layout, module, "shade", &constants),
