@@ -645,6 +645,58 @@ fn drag(
     harness.run();
 }
 
+/// View ▸ Inspect in the viewport: hovering reports where the pointer is, a click asks to
+/// pin the particle under it, and the player picks (as the editor's frame does) a campfire
+/// particle that lies under that pointer.
+#[test]
+fn inspect_follows_the_pointer_and_a_click_pins_the_particle_under_it() {
+    let mut harness = viewport_harness();
+    harness.state_mut().editor.view.inspect = true;
+    harness.run();
+    let (w, h) = harness.state().size_px;
+    let at = egui::pos2(400.0, 300.0);
+    harness.hover_at(at);
+    harness.run();
+    let p = harness.state().editor.inspect.pointer.expect("the pointer");
+    let expected = [(at.x - 8.0) / w as f32, (at.y - 8.0) / h as f32];
+    assert!(
+        (p[0] - expected[0]).abs() < 1e-3 && (p[1] - expected[1]).abs() < 1e-3,
+        "pointer {p:?}, expected {expected:?}"
+    );
+    assert!(!harness.state().editor.inspect.pin_requested);
+    for pressed in [true, false] {
+        harness.event(egui::Event::PointerButton {
+            pos: at,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: Modifiers::NONE,
+        });
+        harness.run();
+    }
+    assert!(harness.state().editor.inspect.pin_requested, "a click pins");
+    // The player's pick at that pointer, with the viewport's camera.
+    let ctx = ignis::gpu::GpuContext::headless().expect("an adapter");
+    let effect = harness.state().editor.running.clone();
+    let mut run = ignis::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
+        .expect("headless");
+    for _ in 0..60 {
+        run.advance(1.0 / 60.0);
+    }
+    run.render((w, h)).expect("render");
+    let view = harness.state().camera.view((w, h));
+    let pixel = glam::Vec2::new(p[0] * w as f32, p[1] * h as f32);
+    let info = run
+        .player
+        .pick_particle(run.instance, &view, pixel, 8.0)
+        .expect("pick")
+        .expect("a particle under the pointer");
+    let clip = view.clip_from_world_mat4() * info.position_m.extend(1.0);
+    let ndc = clip.truncate() / clip.w;
+    let px = glam::Vec2::new((ndc.x * 0.5 + 0.5) * w as f32, (0.5 - ndc.y * 0.5) * h as f32);
+    assert!(px.distance(pixel) <= 8.5, "picked at {px}, pointer at {pixel}");
+    assert!(info.age_secs <= info.lifetime_secs, "{info:?}");
+}
+
 #[test]
 fn the_viewport_orbits_pans_zooms_and_frames() {
     let mut harness = viewport_harness();

@@ -267,6 +267,7 @@ mod tests {
                 "draft",
                 "lean_painter",
                 "retained_window",
+                "tile_raster",
             ]
         );
         let mut turned = gpu.with(&gpu.differences(&soft));
