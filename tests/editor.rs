@@ -677,8 +677,8 @@ fn inspect_follows_the_pointer_and_a_click_pins_the_particle_under_it() {
     // The player's pick at that pointer, with the viewport's camera.
     let ctx = ignis::gpu::GpuContext::headless().expect("an adapter");
     let effect = harness.state().editor.running.clone();
-    let mut run = ignis::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
-        .expect("headless");
+    let mut run =
+        ignis::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
     for _ in 0..60 {
         run.advance(1.0 / 60.0);
     }
@@ -692,8 +692,14 @@ fn inspect_follows_the_pointer_and_a_click_pins_the_particle_under_it() {
         .expect("a particle under the pointer");
     let clip = view.clip_from_world_mat4() * info.position_m.extend(1.0);
     let ndc = clip.truncate() / clip.w;
-    let px = glam::Vec2::new((ndc.x * 0.5 + 0.5) * w as f32, (0.5 - ndc.y * 0.5) * h as f32);
-    assert!(px.distance(pixel) <= 8.5, "picked at {px}, pointer at {pixel}");
+    let px = glam::Vec2::new(
+        (ndc.x * 0.5 + 0.5) * w as f32,
+        (0.5 - ndc.y * 0.5) * h as f32,
+    );
+    assert!(
+        px.distance(pixel) <= 8.5,
+        "picked at {px}, pointer at {pixel}"
+    );
     assert!(info.age_secs <= info.lifetime_secs, "{info:?}");
 }
 

@@ -293,7 +293,7 @@ fn only_dependent_pipelines_rebuild() {
     assert_eq!(rig.reload(&["count.wgsl"]).rebuilt, vec!["count.wgsl"]);
     let mut look = rig.reload(&["look.wgsl"]).rebuilt;
     look.sort();
-    assert_eq!(look, vec!["billboard.wgsl", "splat.wgsl"]);
+    assert_eq!(look, vec!["billboard.wgsl", "splat.wgsl", "tiles.wgsl"]);
     let mut all = rig.reload(&["common.wgsl"]).rebuilt;
     all.sort();
     assert_eq!(
@@ -303,6 +303,7 @@ fn only_dependent_pipelines_rebuild() {
             "count.wgsl",
             "sort.wgsl",
             "splat.wgsl",
+            "tiles.wgsl",
             "update.wgsl"
         ]
     );

@@ -586,6 +586,8 @@ fn draft_glow_layer_renders_like_full_resolution() {
 /// The adapter profile changes how the frame is made (render scale, draft layers, the UI
 /// painter), never what the player draws: the
 /// campfire renders the same frame and keeps the same particles under either profile.
+/// (The draw path the automatic choice takes is the profile's `tile_raster`;
+/// `tests/tiles.rs` holds the tiles to the billboards' image.)
 #[test]
 fn both_adapter_profiles_render_the_same_frame() {
     use ignis::gpu::AdapterProfile;
@@ -602,7 +604,10 @@ fn both_adapter_profiles_render_the_same_frame() {
             run.alive().expect("alive"),
         )
     };
-    let (gpu_frame, gpu_alive) = render(AdapterProfile::GPU);
+    let (gpu_frame, gpu_alive) = render(AdapterProfile {
+        tile_raster: false,
+        ..AdapterProfile::GPU
+    });
     let (soft_frame, soft_alive) = render(AdapterProfile::SOFTWARE);
     assert_eq!(gpu_alive, soft_alive, "the same particles");
     let (mean, max) = image_diff(&gpu_frame, &soft_frame);

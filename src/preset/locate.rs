@@ -76,8 +76,11 @@ pub(super) fn value_at(text: &str, path: &str) -> Option<Located> {
     let (start, end) = match text[start..].strip_prefix('(') {
         Some(rest) => {
             let inner = skip_blank(rest);
-            let token = &inner[..inner.find([',', ')']).unwrap_or(inner.len())];
-            if token.trim().is_empty() || token.contains([':', '(', '[', '"']) {
+            let cut = inner.find([',', ')']).unwrap_or(inner.len());
+            let token = &inner[..cut];
+            // A tuple (`(0.0, -inf)`) is the value itself, not a newtype around a scalar.
+            let tuple = inner[cut..].starts_with(',');
+            if tuple || token.trim().is_empty() || token.contains([':', '(', '[', '"']) {
                 (start, end)
             } else {
                 let at = text.len() - inner.len();

@@ -142,6 +142,57 @@ pub fn simple_pipeline(
         })
 }
 
+/// The full-screen draw of a compute path's image into a host's pass (`vs_resolve`,
+/// `fs_resolve` of `module`): it passes any depth test, writes no depth, and blends with
+/// `blend` into `target`.
+pub fn resolve_pipeline(
+    ctx: &GpuContext,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    target: billboard::DrawTarget,
+    blend: wgpu::BlendState,
+) -> wgpu::RenderPipeline {
+    let color = wgpu::ColorTargetState {
+        format: target.color_format,
+        blend: Some(blend),
+        write_mask: wgpu::ColorWrites::ALL,
+    };
+    ctx.device
+        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(layout),
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some("vs_resolve"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: target.read_only_depth(Some(wgpu::CompareFunction::Always)),
+            multisample: target.multisample(),
+            fragment: Some(wgpu::FragmentState {
+                module,
+                entry_point: Some("fs_resolve"),
+                compilation_options: Default::default(),
+                targets: &[Some(color)],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+}
+
+/// The compute paths' `DEPTH_TEST` constant for a target: 0 none, 1 a particle nearer
+/// than or level with the host's depth passes, 2 the reverse (reversed Z).
+pub fn depth_test(target: billboard::DrawTarget) -> f64 {
+    use wgpu::CompareFunction as C;
+    match target.depth.map(|(_, c)| c) {
+        Some(C::Less | C::LessEqual | C::Equal) => 1.0,
+        Some(C::Greater | C::GreaterEqual) => 2.0,
+        _ => 0.0,
+    }
+}
+
 /// A colour target on the HDR format with `blend`.
 pub fn hdr_target(blend: wgpu::BlendState) -> wgpu::ColorTargetState {
     wgpu::ColorTargetState {

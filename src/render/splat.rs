@@ -38,16 +38,6 @@ struct Accum {
     depth: Option<wgpu::TextureView>,
 }
 
-/// The splat's depth test constant for a target (see splat.wgsl).
-fn depth_test(target: DrawTarget) -> f64 {
-    use wgpu::CompareFunction as C;
-    match target.depth.map(|(_, c)| c) {
-        Some(C::Less | C::LessEqual | C::Equal) => 1.0,
-        Some(C::Greater | C::GreaterEqual) => 2.0,
-        _ => 0.0,
-    }
-}
-
 impl SplatPass {
     /// Builds the pipelines from `lib`; the resolve draws into `target` (a pass with its
     /// formats), and the splat tests against its depth when it has one.
@@ -134,7 +124,7 @@ impl SplatPass {
         target: DrawTarget,
     ) -> wgpu::ComputePipeline {
         let [a, b] = state.constants();
-        let constants = [a, b, ("DEPTH_TEST", depth_test(target))];
+        let constants = [a, b, ("DEPTH_TEST", crate::render::depth_test(target))];
         ctx.device
             .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(&format!("SplatPass::splat {state:?}")),
@@ -172,46 +162,16 @@ impl SplatPass {
                 full,
                 Some(Self::splat_pipeline(ctx, layout, module, full, target)),
             )]);
-            let resolve = Self::resolve_pipeline(ctx, resolve_layout, module, target);
+            let resolve = crate::render::resolve_pipeline(
+                ctx,
+                "SplatPass::resolve",
+                resolve_layout,
+                module,
+                target,
+                ADDITIVE,
+            );
             (module.clone(), splats, resolve)
         })
-    }
-
-    /// The resolve: a full-screen triangle adding the light into `target` (it passes
-    /// any depth test and writes no depth).
-    fn resolve_pipeline(
-        ctx: &GpuContext,
-        layout: &wgpu::PipelineLayout,
-        module: &wgpu::ShaderModule,
-        target: DrawTarget,
-    ) -> wgpu::RenderPipeline {
-        let color = wgpu::ColorTargetState {
-            format: target.color_format,
-            blend: Some(ADDITIVE),
-            write_mask: wgpu::ColorWrites::ALL,
-        };
-        ctx.device
-            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("SplatPass::resolve"),
-                layout: Some(layout),
-                vertex: wgpu::VertexState {
-                    module,
-                    entry_point: Some("vs_resolve"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: wgpu::PrimitiveState::default(),
-                depth_stencil: target.read_only_depth(Some(wgpu::CompareFunction::Always)),
-                multisample: target.multisample(),
-                fragment: Some(wgpu::FragmentState {
-                    module,
-                    entry_point: Some("fs_resolve"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(color)],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
     }
 
     /// Rebuilds the pipelines; keeps the old ones on error. Other state variants are

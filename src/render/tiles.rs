@@ -77,16 +77,6 @@ struct TileBuffers {
     _lists: [wgpu::Buffer; 4],
 }
 
-/// The tiles' depth test constant for a target (as the splat's).
-fn depth_test(target: DrawTarget) -> f64 {
-    use wgpu::CompareFunction as C;
-    match target.depth.map(|(_, c)| c) {
-        Some(C::Less | C::LessEqual | C::Equal) => 1.0,
-        Some(C::Greater | C::GreaterEqual) => 2.0,
-        _ => 0.0,
-    }
-}
-
 /// Tiles and bins across a target of `size` pixels.
 pub fn grid(size: (u32, u32), cell: u32) -> (u32, u32) {
     (size.0.div_ceil(cell).max(1), size.1.div_ceil(cell).max(1))
@@ -240,34 +230,14 @@ impl TilePass {
                 basic,
                 Some(Self::variant_pipelines(ctx, layout, module, basic, target)),
             )]);
-            let color = wgpu::ColorTargetState {
-                format: target.color_format,
-                blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
-                write_mask: wgpu::ColorWrites::ALL,
-            };
-            let resolve = ctx
-                .device
-                .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some("TilePass::resolve"),
-                    layout: Some(resolve_layout),
-                    vertex: wgpu::VertexState {
-                        module,
-                        entry_point: Some("vs_resolve"),
-                        compilation_options: Default::default(),
-                        buffers: &[],
-                    },
-                    primitive: wgpu::PrimitiveState::default(),
-                    depth_stencil: target.read_only_depth(Some(wgpu::CompareFunction::Always)),
-                    multisample: target.multisample(),
-                    fragment: Some(wgpu::FragmentState {
-                        module,
-                        entry_point: Some("fs_resolve"),
-                        compilation_options: Default::default(),
-                        targets: &[Some(color)],
-                    }),
-                    multiview_mask: None,
-                    cache: None,
-                });
+            let resolve = crate::render::resolve_pipeline(
+                ctx,
+                "TilePass::resolve",
+                resolve_layout,
+                module,
+                target,
+                wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING,
+            );
             (module.clone(), variants, bin, resolve)
         })
     }
@@ -307,7 +277,7 @@ impl TilePass {
             .into_iter()
             .filter(|(name, _)| *name != "MOTION")
             .collect();
-        constants.push(("DEPTH_TEST", depth_test(target)));
+        constants.push(("DEPTH_TEST", crate::render::depth_test(target)));
         // Software blending (lavapipe) rounds f16 toward zero; the tiles round as it does.
         let round_down = ctx.profile.is_software();
         constants.push(("F16_ROUND_DOWN", if round_down { 1.0 } else { 0.0 }));
