@@ -9,11 +9,15 @@
 // Contract:
 // - group 0, 1: as billboard.wgsl (camera, looks, ramps; the state and the sort's order).
 // - group 2: the emitter's sprite and sampler (shade).
-// - group 3: 0 `sprites` (one TileSprite per quad of the frame's tile items), 1 `bounds`
-//   (their pixel rectangles), 2 `bin_lists` (per bin, the sprites over it in draw order,
-//   `job.counts.w` entries each), 3 `bin_counts`, 4 `accum` (per pixel: C.rg, C.b and the coverage 1 − T
-//   as f16 pairs; zero is empty), 5 `scene_depth` (the host's depth, when its size is the viewport's),
-//   6 `job` (this dispatch's item: dynamic offset).
+// - group 3 (compute): 0 `sprites` (one TileSprite per quad of the frame's tile items),
+//   2 `bin_lists` (per bin, the sprites over it in draw order, `job.counts.w` entries
+//   each), 3 `bin_meta` (per bin, MAX_ITEMS + 1 entries: where each item's run of the list
+//   starts, then the list's length), 4 `accum` (per pixel: C.rg, C.b and the coverage
+//   1 − T as f16 pairs; zero is empty), 1 `touched` (the resolve's draw arguments, a flag
+//   per tile, the list of tiles shaded this frame), 5 `scene_depth` (the host's depth, when
+//   its size is the viewport's), 6 `job` (this dispatch's item: dynamic offset).
+// - The resolve (a render pipeline): group 0 as above, group 1: 0 `accum_in`, 1
+//   `touched_in` (the same buffers, read-only).
 // - DEPTH_TEST: as splat.wgsl (0 none, 1 nearer or level passes, 2 reversed Z).
 #import "common.wgsl"
 #import "quad.wgsl"
@@ -31,12 +35,15 @@ var<private> look: LookUniform;
 @group(2) @binding(0) var sprite_tex: texture_2d<f32>;
 @group(2) @binding(1) var sprite_sampler: sampler;
 @group(3) @binding(0) var<storage, read_write> sprites: array<TileSprite>;
-@group(3) @binding(1) var<storage, read_write> bounds: array<vec4<i32>>;
+@group(3) @binding(1) var<storage, read_write> touched: array<atomic<u32>>;
 @group(3) @binding(2) var<storage, read_write> bin_lists: array<u32>;
-@group(3) @binding(3) var<storage, read_write> bin_counts: array<u32>;
+@group(3) @binding(3) var<storage, read_write> bin_meta: array<u32>;
 @group(3) @binding(4) var<storage, read_write> accum: array<vec2<u32>>;
 @group(3) @binding(5) var scene_depth: texture_depth_2d;
 @group(3) @binding(6) var<storage, read> job: TileJob;
+// The resolve's view of `accum` and `touched`.
+@group(1) @binding(0) var<storage, read> accum_in: array<vec2<u32>>;
+@group(1) @binding(1) var<storage, read> touched_in: array<u32>;
 
 override DEPTH_TEST: u32 = 0u;
 // The adapter's blending rounds f16 toward zero (lavapipe), not to nearest.
@@ -47,17 +54,31 @@ override F16_ROUND_DOWN: bool = false;
 const TILE: u32 = 16u;
 const BIN_TILES: u32 = 8u;
 const BIN: u32 = 128u;
+// Tile items a frame holds at most (keep in sync with src/render/tiles.rs).
+const MAX_ITEMS: u32 = 55u;
+// `touched`: the draw arguments (4), then a flag per tile, then the shaded tiles' list.
+const TOUCHED_FLAGS: u32 = 4u;
 
 // One dispatch's work: x the item's first sprite, y its quads, z sprites this frame,
-// w the bin lists' stride (entries per bin).
+// w the bin lists' stride (entries per bin); `firsts`: every item's first sprite, then
+// the frame's sprites (`items` + 1 entries; y of `counts2`: items).
 struct TileJob {
     counts: vec4<u32>,
+    counts2: vec4<u32>,
+    firsts: array<vec4<u32>, 14>,
+}
+
+// Item k's first sprite (k = items: the frame's sprite count).
+fn item_first(k: u32) -> u32 {
+    return job.firsts[k >> 2u][k & 3u];
 }
 
 // A projected quad. Its coordinates in the sprite's frame at a pixel p (pixel units, the
 // origin at the target's top-left corner): h = inv0·p.x + inv1·p.y + inv2, uv = h.xy / h.z
 // (a projective map: the perspective-correct interpolation of the billboard's corners).
 struct TileSprite {
+    // Pixel rectangle (x0, y0, x1, y1, inclusive; empty when x0 > x1).
+    bounds: vec4<i32>,
     inv0: vec4<f32>,
     inv1: vec4<f32>,
     inv2: vec4<f32>,
@@ -99,7 +120,7 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
         return;
     }
     let index = job.counts.x + q;
-    bounds[index] = vec4<i32>(1, 1, 0, 0);
+    sprites[index].bounds = vec4<i32>(1, 1, 0, 0);
     let qd = load_quad(q);
     if !qd.d.alive {
         return;
@@ -131,6 +152,7 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
     // The adjugate: (uv, 1) ∝ adj(m) · (p, 1) (a scale, sign included, cancels in h.xy / h.z).
     let adj = transpose(mat3x3<f32>(cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1])));
     var s: TileSprite;
+    s.bounds = vec4<i32>(1, 1, 0, 0);
     s.inv0 = vec4<f32>(adj[0], 0.0);
     s.inv1 = vec4<f32>(adj[1], 0.0);
     s.inv2 = vec4<f32>(adj[2], 0.0);
@@ -160,29 +182,35 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
     if any(hi < vec2<f32>(0.0)) || any(lo > size) {
         return;
     }
-    bounds[index] = vec4<i32>(vec2<i32>(max(lo, vec2<f32>(0.0))), vec2<i32>(min(hi, size)));
+    sprites[index].bounds = vec4<i32>(vec2<i32>(max(lo, vec2<f32>(0.0))), vec2<i32>(min(hi, size)));
 }
 
-var<workgroup> scan: array<u32, 256>;
+var<workgroup> bits: array<atomic<u32>, 8>;
 var<workgroup> hits: array<u32, 256>;
-var<workgroup> shared_count: u32;
-var<workgroup> shared_run: u32;
+var<workgroup> shared_total: u32;
+var<workgroup> shared_run: vec2<u32>;
 
-// An inclusive prefix sum of `v` over the workgroup (Hillis–Steele); every invocation
-// of the workgroup must call it.
-fn workgroup_scan(lid: u32, v: u32) -> u32 {
-    scan[lid] = v;
-    workgroupBarrier();
-    for (var o = 1u; o < 256u; o <<= 1u) {
-        var x = scan[lid];
-        if lid >= o {
-            x += scan[lid - o];
-        }
-        workgroupBarrier();
-        scan[lid] = x;
-        workgroupBarrier();
+// An order-keeping compaction over the workgroup: how many invocations before `lid` have
+// `hit`; `shared_total` gets their number (read it with workgroupUniformLoad). Every
+// invocation of the workgroup must call it; one bit per invocation, two barriers.
+fn compact(lid: u32, hit: bool) -> u32 {
+    if lid < 8u {
+        atomicStore(&bits[lid], 0u);
     }
-    return scan[lid];
+    workgroupBarrier();
+    let w = lid >> 5u;
+    if hit {
+        atomicOr(&bits[w], 1u << (lid & 31u));
+    }
+    workgroupBarrier();
+    var before = countOneBits(atomicLoad(&bits[w]) & ((1u << (lid & 31u)) - 1u));
+    for (var i = 0u; i < w; i++) {
+        before += countOneBits(atomicLoad(&bits[i]));
+    }
+    if lid == 255u {
+        shared_total = before + u32(hit);
+    }
+    return before;
 }
 
 // Whether pixel rectangles `a` and `b` (x0, y0, x1, y1, inclusive) overlap.
@@ -191,7 +219,7 @@ fn overlaps(a: vec4<i32>, b: vec4<i32>) -> bool {
 }
 
 // Lists, for one bin, the frame's sprites over it in draw order (an order-keeping
-// compaction: deterministic, whatever the scheduling).
+// compaction: deterministic, whatever the scheduling), then where each item's run starts.
 @compute @workgroup_size(256)
 fn bin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     let b = wg.y * nwg.x + wg.x;
@@ -202,19 +230,23 @@ fn bin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<
     var count = 0u;
     for (var base = 0u; base < n; base += 256u) {
         let i = base + lid;
-        var hit = 0u;
-        if i < n && overlaps(bounds[i], rect) {
-            hit = 1u;
+        let hit = i < n && overlaps(sprites[i].bounds, rect);
+        let at = compact(lid, hit);
+        if hit {
+            bin_lists[b * stride + count + at] = i;
         }
-        let at = workgroup_scan(lid, hit);
-        if hit == 1u {
-            bin_lists[b * stride + count + at - 1u] = i;
-        }
-        count += workgroupUniformLoad(&scan[255]);
-        workgroupBarrier();
+        count += workgroupUniformLoad(&shared_total);
     }
-    if lid == 0u {
-        bin_counts[b] = count;
+    // The list's entries, written by the whole workgroup, are read below.
+    storageBarrier();
+    // Item k's run starts at the first entry at or after its first sprite.
+    let items = job.counts2.y;
+    if lid <= items {
+        var at = count;
+        if lid < items {
+            at = lower_bound(b, count, item_first(lid));
+        }
+        bin_meta[b * (MAX_ITEMS + 1u) + lid] = at;
     }
 }
 
@@ -323,17 +355,14 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
     look = looks[0].look;
     let bins_x = (u32(camera.viewport.x) + BIN - 1u) / BIN;
     let b = (wg.y / BIN_TILES) * bins_x + wg.x / BIN_TILES;
+    // The item's sprites are a run of the bin's list.
     if lid == 0u {
-        shared_count = bin_counts[b];
+        let at = b * (MAX_ITEMS + 1u) + job.counts2.x;
+        shared_run = vec2<u32>(bin_meta[at], bin_meta[at + 1u]);
     }
-    let n = workgroupUniformLoad(&shared_count);
-    // The item's sprites are a run of the bin's sorted list.
-    let first = lower_bound(b, n, job.counts.x);
-    let last = lower_bound(b, n, job.counts.x + job.counts.y);
-    if lid == 0u {
-        shared_run = last - first;
-    }
-    let run = workgroupUniformLoad(&shared_run);
+    let range = workgroupUniformLoad(&shared_run);
+    let first = range.x;
+    let run = range.y - range.x;
     if run == 0u {
         return;
     }
@@ -347,23 +376,21 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
         let v = accum[pixel];
         acc = vec4<f32>(unpack2x16float(v.x), unpack2x16float(v.y));
     }
-    var touched = false;
+    var shaded = false;
     for (var base = 0u; base < run; base += 256u) {
         // The chunk's sprites over this tile, in order.
-        var hit = 0u;
+        var hit = false;
         var s = 0u;
         if base + lid < run {
             s = bin_lists[b * job.counts.w + first + base + lid];
-            if overlaps(bounds[s], tile) {
-                hit = 1u;
-            }
+            hit = overlaps(sprites[s].bounds, tile);
         }
-        let at = workgroup_scan(lid, hit);
-        if hit == 1u {
-            hits[at - 1u] = s;
+        let at = compact(lid, hit);
+        if hit {
+            hits[at] = s;
         }
-        let total = workgroupUniformLoad(&scan[255]);
-        touched = touched || total > 0u;
+        let total = workgroupUniformLoad(&shared_total);
+        shaded = shaded || total > 0u;
         if inside {
             for (var k = 0u; k < total; k++) {
                 acc = shade_sprite(sprites[hits[k]], p, acc);
@@ -371,21 +398,37 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
         }
         workgroupBarrier();
     }
-    if inside && touched {
+    if inside && shaded {
         accum[pixel] = vec2<u32>(pack2x16float(acc.rg), pack2x16float(acc.ba));
+    }
+    // The first item to shade this tile lists it for the resolve.
+    let tiles_x = (u32(camera.viewport.x) + TILE - 1u) / TILE;
+    let t = wg.y * tiles_x + wg.x;
+    if lid == 0u && shaded && atomicExchange(&touched[TOUCHED_FLAGS + t], 1u) == 0u {
+        let k = atomicAdd(&touched[1], 1u);
+        let tiles = tiles_x * ((u32(camera.viewport.y) + TILE - 1u) / TILE);
+        atomicStore(&touched[TOUCHED_FLAGS + tiles + k], t);
     }
 }
 
-// The resolve: a full-screen triangle compositing the tiles' colour over the target
-// (premultiplied: dst · T + C, as `over` blending of (C, 1 − T)).
+// The resolve: the shaded tiles (one instance each, two triangles) composited over the
+// target (premultiplied: dst · T + C, as `over` blending of (C, 1 − T)). Only tiles some
+// sprite touched are drawn: the GPU's fragment work is the fire's footprint, not the screen.
 @vertex
-fn vs_resolve(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
-    let uv = vec2<f32>(f32((vi << 1u) & 2u), f32(vi & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+fn vs_resolve(@builtin(vertex_index) vi: u32, @builtin(instance_index) inst: u32) -> @builtin(position) vec4<f32> {
+    let size = vec2<u32>(camera.viewport.xy);
+    let tiles_x = (size.x + TILE - 1u) / TILE;
+    let tiles = tiles_x * ((size.y + TILE - 1u) / TILE);
+    let t = touched_in[TOUCHED_FLAGS + tiles + inst];
+    // Corners 0 1 2, 2 1 3 of the tile, clamped to the target.
+    let c = vec2<u32>(u32(vi == 1u || vi >= 4u), u32(vi == 2u || vi == 3u || vi == 5u));
+    let px = min((vec2<u32>(t % tiles_x, t / tiles_x) + c) * TILE, size);
+    let ndc = vec2<f32>(px) / vec2<f32>(size) * vec2<f32>(2.0, -2.0) + vec2<f32>(-1.0, 1.0);
+    return vec4<f32>(ndc, 0.0, 1.0);
 }
 
 @fragment
 fn fs_resolve(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let v = accum[u32(frag.y) * u32(camera.viewport.x) + u32(frag.x)];
+    let v = accum_in[u32(frag.y) * u32(camera.viewport.x) + u32(frag.x)];
     return vec4<f32>(unpack2x16float(v.x), unpack2x16float(v.y));
 }

@@ -21,7 +21,12 @@ pub const TILE_PX: u32 = 16;
 /// Pixels per bin side (keep in sync with `BIN` in tiles.wgsl).
 pub const BIN_PX: u32 = 128;
 /// Bytes of one projected sprite (`TileSprite` in tiles.wgsl).
-const SPRITE_BYTES: u64 = 160;
+const SPRITE_BYTES: u64 = 176;
+/// Tile items (emitters of a group of instances) a frame draws with the tiles at most
+/// (`MAX_ITEMS` in tiles.wgsl); beyond, the frame's tile items are billboards.
+pub const MAX_ITEMS: usize = 55;
+/// The `touched` buffer's header: the resolve's indirect draw arguments.
+const TOUCHED_FLAGS: u64 = 4;
 /// Stride of the per-dispatch jobs (the storage offset alignment).
 const JOB_STRIDE: u64 = 256;
 /// The bins' lists may take at most this many bytes: beyond it the frame's tile items
@@ -45,11 +50,12 @@ pub const STORAGE_BUFFERS_NEEDED: u32 = 13;
 pub struct TilePass {
     target: DrawTarget,
     tile_layout: wgpu::BindGroupLayout,
+    /// The resolve's read-only view of the accumulation and the shaded tiles.
+    resolve_group_layout: wgpu::BindGroupLayout,
     sprite_layout: wgpu::BindGroupLayout,
     no_depth: wgpu::TextureView,
     compute_layout: wgpu::PipelineLayout,
     resolve_layout: wgpu::PipelineLayout,
-    empty_group: wgpu::BindGroup,
     module: wgpu::ShaderModule,
     /// (project, shade) per look variant, built on first use (`None`: failed, logged).
     variants: HashMap<LookVariant, Option<[wgpu::ComputePipeline; 2]>>,
@@ -71,10 +77,13 @@ struct TileBuffers {
     jobs: u32,
     job_buffer: wgpu::Buffer,
     accum: wgpu::Buffer,
+    /// The resolve's draw arguments, a flag per tile and the shaded tiles' list.
+    touched: wgpu::Buffer,
     group: wgpu::BindGroup,
+    resolve_group: wgpu::BindGroup,
     depth: Option<wgpu::TextureView>,
     /// Everything else the group binds (kept alive with it).
-    _lists: [wgpu::Buffer; 4],
+    _lists: [wgpu::Buffer; 3],
 }
 
 /// Tiles and bins across a target of `size` pixels.
@@ -139,14 +148,22 @@ impl TilePass {
                 },
             ],
         });
-        let empty_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("TilePass::empty_layout"),
-            entries: &[],
-        });
-        let empty_group = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("TilePass::empty_group"),
-            layout: &empty_layout,
-            entries: &[],
+        let read = |binding, visibility| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: true },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let resolve_group_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("TilePass::resolve_group_layout"),
+            entries: &[
+                read(0, wgpu::ShaderStages::FRAGMENT),
+                read(1, wgpu::ShaderStages::VERTEX),
+            ],
         });
         let compute_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("TilePass::compute_layout"),
@@ -160,12 +177,7 @@ impl TilePass {
         });
         let resolve_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("TilePass::resolve_layout"),
-            bind_group_layouts: &[
-                Some(&frame.frame_layout),
-                Some(&empty_layout),
-                Some(&empty_layout),
-                Some(&tile_layout),
-            ],
+            bind_group_layouts: &[Some(&frame.frame_layout), Some(&resolve_group_layout)],
             immediate_size: 0,
         });
         let (module, variants, bin, resolve) =
@@ -173,11 +185,11 @@ impl TilePass {
         Ok(Self {
             target,
             tile_layout,
+            resolve_group_layout,
             sprite_layout,
             no_depth: crate::gpu::placeholder_depth(d, "TilePass::no_depth"),
             compute_layout,
             resolve_layout,
-            empty_group,
             module,
             variants,
             bin,
@@ -188,8 +200,8 @@ impl TilePass {
         })
     }
 
-    /// Group 3: sprites, bounds, bin lists, bin counts, the accumulation (read by the
-    /// resolve too), the host's depth and the dispatch's job.
+    /// Group 3: sprites, the shaded tiles, bin lists, bin starts, the accumulation, the
+    /// host's depth and the dispatch's job.
     fn tile_entries() -> [wgpu::BindGroupLayoutEntry; 7] {
         let storage = |binding, visibility, read_only, dynamic| wgpu::BindGroupLayoutEntry {
             binding,
@@ -207,7 +219,7 @@ impl TilePass {
             storage(1, c, false, false),
             storage(2, c, false, false),
             storage(3, c, false, false),
-            storage(4, c | wgpu::ShaderStages::FRAGMENT, false, false),
+            storage(4, c, false, false),
             crate::gpu::depth_texture_entry(5, c),
             storage(6, c, true, true),
         ]
@@ -360,7 +372,7 @@ impl TilePass {
             .map(|d| u64::from(d.width) * u64::from(d.members))
             .sum();
         self.drawn = false;
-        if total == 0 || !fits(size, total) {
+        if total == 0 || !fits(size, total) || order.len() > MAX_ITEMS {
             self.buffers = None;
             return false;
         }
@@ -369,17 +381,34 @@ impl TilePass {
         let Some(b) = self.buffers.as_ref() else {
             return false;
         };
-        // One job per item: its first sprite and quads, the frame's sprites, the lists'
-        // stride.
-        let mut jobs = vec![0u8; order.len() * JOB_STRIDE as usize];
-        let mut first = 0u32;
-        for (k, d) in order.iter().enumerate() {
-            let n = d.width * d.members;
-            let job = [first, n, total as u32, b.capacity];
-            jobs[k * JOB_STRIDE as usize..][..16].copy_from_slice(bytemuck::cast_slice(&job));
-            first += n;
+        // One job per item (`TileJob`): its first sprite and quads, the frame's sprites,
+        // the lists' stride; its index and the item count; every item's first sprite.
+        let mut firsts = Vec::with_capacity(order.len() + 1);
+        firsts.push(0u32);
+        for d in &order {
+            firsts.push(firsts[firsts.len() - 1] + d.width * d.members);
         }
-        ctx.queue.write_buffer(&b.job_buffer, 0, &jobs);
+        let mut jobs = vec![0u32; order.len() * JOB_STRIDE as usize / 4];
+        for (k, job) in jobs.chunks_mut(JOB_STRIDE as usize / 4).enumerate() {
+            let n = firsts[k + 1] - firsts[k];
+            job[..8].copy_from_slice(&[
+                firsts[k],
+                n,
+                total as u32,
+                b.capacity,
+                k as u32,
+                order.len() as u32,
+                0,
+                0,
+            ]);
+            job[8..8 + firsts.len()].copy_from_slice(&firsts);
+        }
+        ctx.queue
+            .write_buffer(&b.job_buffer, 0, bytemuck::cast_slice(&jobs));
+        // The resolve's draw: six vertices per shaded tile, counted by the shade.
+        ctx.queue
+            .write_buffer(&b.touched, 0, bytemuck::cast_slice(&[6u32, 0, 0, 0]));
+        enc.clear_buffer(&b.touched, TOUCHED_FLAGS * 4, None);
         enc.clear_buffer(&b.accum, 0, None);
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("TilePass::tiles"),
@@ -454,12 +483,26 @@ impl TilePass {
             })
         };
         let c = u64::from(capacity);
+        let tiles = {
+            let (tx, ty) = grid(size, TILE_PX);
+            u64::from(tx) * u64::from(ty)
+        };
         let sprites_buf = buffer("TilePass::sprites", c * SPRITE_BYTES);
-        let bounds = buffer("TilePass::bounds", c * 16);
         let lists = buffer("TilePass::bin_lists", u64::from(bx * by) * c * 4);
-        let counts = buffer("TilePass::bin_counts", u64::from(bx * by) * 4);
+        let meta = buffer(
+            "TilePass::bin_meta",
+            u64::from(bx * by) * (MAX_ITEMS as u64 + 1) * 4,
+        );
         let accum = buffer("TilePass::accum", u64::from(size.0) * u64::from(size.1) * 8);
         let job_buffer = buffer("TilePass::jobs", u64::from(jobs) * JOB_STRIDE);
+        let touched = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("TilePass::touched"),
+            size: (TOUCHED_FLAGS + 2 * tiles) * 4,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::INDIRECT
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
         let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("TilePass::group"),
             layout: &self.tile_layout,
@@ -470,7 +513,7 @@ impl TilePass {
                 },
                 wgpu::BindGroupEntry {
                     binding: 1,
-                    resource: bounds.as_entire_binding(),
+                    resource: touched.as_entire_binding(),
                 },
                 wgpu::BindGroupEntry {
                     binding: 2,
@@ -478,7 +521,7 @@ impl TilePass {
                 },
                 wgpu::BindGroupEntry {
                     binding: 3,
-                    resource: counts.as_entire_binding(),
+                    resource: meta.as_entire_binding(),
                 },
                 wgpu::BindGroupEntry {
                     binding: 4,
@@ -493,8 +536,22 @@ impl TilePass {
                     resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                         buffer: &job_buffer,
                         offset: 0,
-                        size: wgpu::BufferSize::new(16),
+                        size: wgpu::BufferSize::new(JOB_STRIDE),
                     }),
+                },
+            ],
+        });
+        let resolve_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("TilePass::resolve_group"),
+            layout: &self.resolve_group_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: accum.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: touched.as_entire_binding(),
                 },
             ],
         });
@@ -504,9 +561,11 @@ impl TilePass {
             jobs,
             job_buffer,
             accum,
+            touched,
             group,
+            resolve_group,
             depth: depth.cloned(),
-            _lists: [sprites_buf, bounds, lists, counts],
+            _lists: [sprites_buf, lists, meta],
         });
     }
 
@@ -518,10 +577,8 @@ impl TilePass {
         };
         pass.set_pipeline(&self.resolve);
         pass.set_bind_group(0, &frame.frame_group, &[0]);
-        pass.set_bind_group(1, &self.empty_group, &[]);
-        pass.set_bind_group(2, &self.empty_group, &[]);
-        pass.set_bind_group(3, &b.group, &[0]);
-        pass.draw(0..3, 0..1);
+        pass.set_bind_group(1, &b.resolve_group, &[]);
+        pass.draw_indirect(&b.touched, 0);
     }
 
     /// Whether the last record drew anything.
