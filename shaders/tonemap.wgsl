@@ -1,11 +1,12 @@
-// tonemap.wgsl — HDR (linear, Rgba16Float) → display (sRGB target does the encoding).
+// tonemap.wgsl — HDR (linear, Rgba16Float) → display (8-bit, sRGB-encoded here), a compute
+// pass (full-screen fragment passes run on a sliver of the H100).
 //
 // Contract: group 0 binding 0 `hdr` texture, binding 1 `tone` (x: exposure, y: bloom
 // intensity), binding 3 `bloom_tex` + 4 `bloom_samp` (level 0 of the bloom chain, read only when
 // BLOOM is on), binding 5 `alpha_tex` (the alpha-blended layers at reduced resolution,
 // read only when LOW_ALPHA is on), binding 6 `glow_tex` (the draft glow layer at half
 // resolution, read only when GLOW is on: upsampled here instead of in a pass of its own).
-// A full-screen triangle; the ACES fit by Krzysztof Narkowicz maps HDR to [0, 1].
+// binding 7 `display`. The ACES fit by Krzysztof Narkowicz maps HDR to [0, 1].
 
 struct ToneUniform {
     // x: exposure multiplier, y: bloom intensity, zw: unused.
@@ -20,16 +21,12 @@ struct ToneUniform {
 @group(0) @binding(5) var alpha_tex: texture_2d<f32>;
 // The draft glow layer (read only when GLOW is on).
 @group(0) @binding(6) var glow_tex: texture_2d<f32>;
+// The display image (8-bit unorm, sRGB-encoded values).
+@group(0) @binding(7) var display: texture_storage_2d<rgba8unorm, write>;
 
 override BLOOM: bool = false;
 override LOW_ALPHA: bool = false;
 override GLOW: bool = false;
-
-@vertex
-fn vs_main(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
-    let uv = vec2<f32>(f32((vi << 1u) & 2u), f32(vi & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
-}
 
 fn aces(x: vec3<f32>) -> vec3<f32> {
     let a = 2.51;
@@ -40,10 +37,24 @@ fn aces(x: vec3<f32>) -> vec3<f32> {
     return clamp((x * (a * x + b)) / (x * (c * x + d) + e), vec3<f32>(0.0), vec3<f32>(1.0));
 }
 
-@fragment
-fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    var c = textureLoad(hdr, vec2<i32>(frag.xy), 0).rgb;
-    let uv = frag.xy / vec2<f32>(textureDimensions(hdr));
+// sRGB encoding of a linear value in [0, 1] (the display image is 8-bit unorm holding
+// sRGB-encoded values: a storage texture cannot be an sRGB format).
+fn srgb(x: vec3<f32>) -> vec3<f32> {
+    let lo = x * 12.92;
+    let hi = 1.055 * pow(x, vec3<f32>(1.0 / 2.4)) - 0.055;
+    return select(hi, lo, x <= vec3<f32>(0.0031308));
+}
+
+// One invocation per pixel of the display image.
+@compute @workgroup_size(8, 8)
+fn tonemap(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = textureDimensions(hdr);
+    if any(id.xy >= size) {
+        return;
+    }
+    let frag = vec2<f32>(id.xy) + 0.5;
+    var c = textureLoad(hdr, vec2<i32>(id.xy), 0).rgb;
+    let uv = frag / vec2<f32>(size);
     if GLOW {
         // Bilinear, as the pass that added it to the HDR image did.
         c += textureSampleLevel(glow_tex, bloom_samp, uv, 0.0).rgb;
@@ -55,5 +66,5 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     if BLOOM {
         c += tone.exposure.y * textureSampleLevel(bloom_tex, bloom_samp, uv, 0.0).rgb;
     }
-    return vec4<f32>(aces(c * tone.exposure.x), 1.0);
+    textureStore(display, vec2<i32>(id.xy), vec4<f32>(srgb(aces(c * tone.exposure.x)), 1.0));
 }

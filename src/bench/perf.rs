@@ -314,7 +314,7 @@ fn measure_row(
     let mut sort = SortPass::new(ctx, &lib)?;
     let mut billboard = BillboardPass::new(ctx, &lib, &frame, DrawTarget::hdr())?;
     let mut splat = SplatPass::new(ctx, &lib, &frame, DrawTarget::hdr())?;
-    let tonemap = TonemapPass::new(ctx, &lib, crate::render::LDR_FORMAT)?;
+    let tonemap = TonemapPass::new(ctx, &lib)?;
     let camera = OrbitCamera::from_hint(&effect.camera);
     let size = opts.size;
     let targets = crate::render::Targets::new(ctx, size);
@@ -363,7 +363,7 @@ fn measure_row(
             None,
             None,
             None,
-            &targets.ldr_view,
+            (&targets.ldr_view, targets.size),
             1.0,
         );
     });

@@ -40,7 +40,7 @@ impl Composite {
     /// Builds the composite's pipelines from `lib`.
     pub fn new(ctx: &GpuContext, lib: &ShaderLibrary) -> Result<Self, ShaderError> {
         Ok(Self {
-            tonemap: TonemapPass::new(ctx, lib, crate::render::LDR_FORMAT)?,
+            tonemap: TonemapPass::new(ctx, lib)?,
             bloom: BloomPass::new(ctx, lib)?,
             targets: None,
             exposure: 1.0,
@@ -186,7 +186,7 @@ impl Composite {
             bloom,
             low_alpha,
             glow,
-            &targets.ldr_view,
+            (&targets.ldr_view, targets.size),
             self.exposure * post.exposure,
         );
     }

@@ -27,6 +27,10 @@ use crate::gpu::GpuContext;
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// The display format of headless frames.
 pub const LDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+/// The format of the display image the tonemap writes (a compute pass: storage textures
+/// cannot be sRGB, so it holds sRGB-encoded values, the bytes an [`LDR_FORMAT`] image
+/// would hold).
+pub const LDR_STORAGE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 /// Offscreen HDR and display targets of one size.
 pub struct Targets {
@@ -50,8 +54,8 @@ impl Targets {
         let hdr = hdr_texture(ctx, "Targets::hdr", size);
         let ldr = make(
             "Targets::ldr",
-            LDR_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT
+            LDR_STORAGE_FORMAT,
+            wgpu::TextureUsages::STORAGE_BINDING
                 | wgpu::TextureUsages::TEXTURE_BINDING
                 | wgpu::TextureUsages::COPY_SRC,
         );

@@ -5,38 +5,52 @@ use crate::gpu::GpuContext;
 use crate::gpu::types::ToneUniform;
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 
-/// A full-screen tonemap pass, in eight variants: with and without the bloom, the
+/// The tonemap, a compute pass over the display image, in eight variants: with and without the bloom, the
 /// reduced-resolution alpha layer and the draft glow layer.
 pub struct TonemapPass {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
     /// Indexed by `bloom + 2 · low_alpha + 4 · glow`.
-    pipelines: [wgpu::RenderPipeline; 8],
+    pipelines: [wgpu::ComputePipeline; 8],
     uniform: wgpu::Buffer,
     /// Bound in place of the bloom chain when there is no bloom.
     no_bloom: wgpu::TextureView,
     sampler: wgpu::Sampler,
-    format: wgpu::TextureFormat,
+}
+
+/// A layout entry seen by the compute stage.
+fn compute(mut e: wgpu::BindGroupLayoutEntry) -> wgpu::BindGroupLayoutEntry {
+    e.visibility = wgpu::ShaderStages::COMPUTE;
+    e
 }
 
 impl TonemapPass {
-    /// Builds the pass for an output `format`.
-    pub fn new(
-        ctx: &GpuContext,
-        lib: &ShaderLibrary,
-        format: wgpu::TextureFormat,
-    ) -> Result<Self, ShaderError> {
+    /// Builds the pass (its output: a [`crate::render::LDR_STORAGE_FORMAT`] storage view).
+    pub fn new(ctx: &GpuContext, lib: &ShaderLibrary) -> Result<Self, ShaderError> {
         let layout = ctx
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("TonemapPass::layout"),
                 entries: &[
-                    crate::gpu::fragment_texture_entry(0, false),
-                    crate::gpu::fragment_buffer_entry(1, wgpu::BufferBindingType::Uniform),
-                    crate::gpu::fragment_texture_entry(3, true),
-                    crate::gpu::fragment_sampler_entry(4),
-                    crate::gpu::fragment_texture_entry(5, true),
-                    crate::gpu::fragment_texture_entry(6, true),
+                    compute(crate::gpu::fragment_texture_entry(0, false)),
+                    compute(crate::gpu::fragment_buffer_entry(
+                        1,
+                        wgpu::BufferBindingType::Uniform,
+                    )),
+                    compute(crate::gpu::fragment_texture_entry(3, true)),
+                    compute(crate::gpu::fragment_sampler_entry(4)),
+                    compute(crate::gpu::fragment_texture_entry(5, true)),
+                    compute(crate::gpu::fragment_texture_entry(6, true)),
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 7,
+                        visibility: wgpu::ShaderStages::COMPUTE,
+                        ty: wgpu::BindingType::StorageTexture {
+                            access: wgpu::StorageTextureAccess::WriteOnly,
+                            format: crate::render::LDR_STORAGE_FORMAT,
+                            view_dimension: wgpu::TextureViewDimension::D2,
+                        },
+                        count: None,
+                    },
                 ],
             });
         let pipeline_layout = ctx
@@ -46,7 +60,7 @@ impl TonemapPass {
                 bind_group_layouts: &[Some(&layout)],
                 immediate_size: 0,
             });
-        let pipelines = Self::build(ctx, lib, &pipeline_layout, format)?;
+        let pipelines = Self::build(ctx, lib, &pipeline_layout)?;
         let uniform = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("TonemapPass::uniform"),
             size: size_of::<ToneUniform>() as u64,
@@ -75,7 +89,6 @@ impl TonemapPass {
             uniform,
             no_bloom,
             sampler,
-            format,
         })
     }
 
@@ -83,8 +96,7 @@ impl TonemapPass {
         ctx: &GpuContext,
         lib: &ShaderLibrary,
         layout: &wgpu::PipelineLayout,
-        format: wgpu::TextureFormat,
-    ) -> Result<[wgpu::RenderPipeline; 8], ShaderError> {
+    ) -> Result<[wgpu::ComputePipeline; 8], ShaderError> {
         let composed = lib.compose("tonemap.wgsl")?;
         create_checked(&ctx.device, &composed, lib, |module| {
             let make = |i: usize| {
@@ -95,16 +107,20 @@ impl TonemapPass {
                     ("LOW_ALPHA", b(low)),
                     ("GLOW", b(glow)),
                 ];
-                crate::render::simple_pipeline(
-                    ctx,
-                    &format!("TonemapPass bloom={bloom} low_alpha={low} glow={glow}"),
-                    layout,
-                    module,
-                    ("vs_main", "fs_main"),
-                    format.into(),
-                    &constants,
-                    wgpu::PrimitiveTopology::TriangleList,
-                )
+                ctx.device
+                    .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                        label: Some(&format!(
+                            "TonemapPass bloom={bloom} low_alpha={low} glow={glow}"
+                        )),
+                        layout: Some(layout),
+                        module,
+                        entry_point: Some("tonemap"),
+                        compilation_options: wgpu::PipelineCompilationOptions {
+                            constants: &constants,
+                            ..Default::default()
+                        },
+                        cache: None,
+                    })
             };
             std::array::from_fn(make)
         })
@@ -112,12 +128,13 @@ impl TonemapPass {
 
     /// Rebuilds the pipelines; keeps the old ones on error.
     pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
-        self.pipelines = Self::build(ctx, lib, &self.pipeline_layout, self.format)?;
+        self.pipelines = Self::build(ctx, lib, &self.pipeline_layout)?;
         Ok(())
     }
 
     /// Records the tonemap from `hdr` (plus `bloom`'s glow × intensity, the `low_alpha`
-    /// layer and the draft `glow` layer, when given) into `out`.
+    /// layer and the draft `glow` layer, when given) into `out` (a storage view of
+    /// `size` pixels, the HDR image's).
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -127,7 +144,7 @@ impl TonemapPass {
         bloom: Option<(&wgpu::TextureView, f32)>,
         low_alpha: Option<&wgpu::TextureView>,
         glow: Option<&wgpu::TextureView>,
-        out: &wgpu::TextureView,
+        (out, size): (&wgpu::TextureView, (u32, u32)),
         exposure: f32,
     ) {
         ctx.queue.write_buffer(
@@ -169,29 +186,21 @@ impl TonemapPass {
                     binding: 6,
                     resource: wgpu::BindingResource::TextureView(glow.unwrap_or(&self.no_bloom)),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: wgpu::BindingResource::TextureView(out),
+                },
             ],
         });
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("TonemapPass::pass"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: out,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
             timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
         });
         let variant = usize::from(bloom.is_some())
             + 2 * usize::from(low_alpha.is_some())
             + 4 * usize::from(glow.is_some());
         pass.set_pipeline(&self.pipelines[variant]);
         pass.set_bind_group(0, &bind_group, &[]);
-        pass.draw(0..3, 0..1);
+        pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
     }
 }
