@@ -54,6 +54,7 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ("sort.wgsl", include_str!("../shaders/sort.wgsl")),
     ("tonemap.wgsl", include_str!("../shaders/tonemap.wgsl")),
     ("bloom.wgsl", include_str!("../shaders/bloom.wgsl")),
+    ("clear.wgsl", include_str!("../shaders/clear.wgsl")),
 ];
 
 /// The packed-state update: update.wgsl with state_packed.wgsl composed in place of
@@ -81,6 +82,7 @@ pub const ENTRY_FILES: &[&str] = &[
     "sort.wgsl",
     "tonemap.wgsl",
     "bloom.wgsl",
+    "clear.wgsl",
 ];
 
 /// A shader problem, located in the file the user edits.

@@ -14,7 +14,7 @@ use crate::shaders::{ShaderError, ShaderLibrary};
 use crate::sim::gpu_sim::{SimError, map_read};
 
 /// The composite's own WGSL entry files (the player's are [`crate::PLAYER_SHADERS`]).
-pub const COMPOSITE_SHADERS: &[&str] = &["tonemap.wgsl", "bloom.wgsl"];
+pub const COMPOSITE_SHADERS: &[&str] = &["tonemap.wgsl", "bloom.wgsl", "clear.wgsl"];
 
 /// HDR target, reduced-resolution layers, bloom and tonemap around a [`Player`].
 pub struct Composite {
@@ -22,6 +22,8 @@ pub struct Composite {
     pub tonemap: TonemapPass,
     /// The bloom passes (recorded only when the effect has bloom).
     pub bloom: BloomPass,
+    /// Zeroes the HDR target (a compute pass) before the particles' pass.
+    pub clear: crate::render::clear::ClearPass,
     targets: Option<Targets>,
     /// Exposure multiplier applied before tonemapping (times the effect's own).
     pub exposure: f32,
@@ -42,6 +44,7 @@ impl Composite {
         Ok(Self {
             tonemap: TonemapPass::new(ctx, lib)?,
             bloom: BloomPass::new(ctx, lib)?,
+            clear: crate::render::clear::ClearPass::new(ctx, lib)?,
             targets: None,
             exposure: 1.0,
             draft: false,
@@ -66,6 +69,7 @@ impl Composite {
         match entry {
             "tonemap.wgsl" => self.tonemap.rebuild(ctx, lib),
             "bloom.wgsl" => self.bloom.rebuild(ctx, lib),
+            "clear.wgsl" => self.clear.rebuild(ctx, lib),
             _ => Ok(()),
         }
     }
@@ -142,8 +146,9 @@ impl Composite {
             }
         }
         if let Some(targets) = self.targets.as_ref() {
+            self.clear.record(ctx, enc, &targets.hdr_view, targets.size);
             player.draw_layers(
-                &mut begin_hdr_pass(enc, &targets.hdr_view),
+                &mut crate::render::load_hdr_pass(enc, &targets.hdr_view),
                 Layers::ALL.without(layered),
             );
         }

@@ -3,6 +3,7 @@
 pub mod billboard;
 pub mod bloom;
 pub mod camera;
+pub mod clear;
 pub mod composite;
 pub mod frame;
 pub mod look;
@@ -76,7 +77,9 @@ pub fn hdr_texture(ctx: &GpuContext, label: &str, size: (u32, u32)) -> wgpu::Tex
         size,
         1,
         HDR_FORMAT,
-        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::STORAGE_BINDING,
     )
 }
 
@@ -232,6 +235,23 @@ pub fn begin_hdr_pass<'a>(
     enc: &'a mut wgpu::CommandEncoder,
     hdr: &'a wgpu::TextureView,
 ) -> wgpu::RenderPass<'a> {
+    hdr_pass(enc, hdr, wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT))
+}
+
+/// A render pass into an HDR target that keeps what it holds (cleared by
+/// [`clear::ClearPass`]).
+pub fn load_hdr_pass<'a>(
+    enc: &'a mut wgpu::CommandEncoder,
+    hdr: &'a wgpu::TextureView,
+) -> wgpu::RenderPass<'a> {
+    hdr_pass(enc, hdr, wgpu::LoadOp::Load)
+}
+
+fn hdr_pass<'a>(
+    enc: &'a mut wgpu::CommandEncoder,
+    hdr: &'a wgpu::TextureView,
+    load: wgpu::LoadOp<wgpu::Color>,
+) -> wgpu::RenderPass<'a> {
     enc.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some("Renderer::hdr_pass"),
         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -239,7 +259,7 @@ pub fn begin_hdr_pass<'a>(
             depth_slice: None,
             resolve_target: None,
             ops: wgpu::Operations {
-                load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                load,
                 store: wgpu::StoreOp::Store,
             },
         })],

@@ -1,0 +1,97 @@
+//! A compute clear of the HDR target (`shaders/clear.wgsl`): the particles' pass then
+//! loads it instead of clearing, which the H100's small raster slice does slowly.
+
+use crate::gpu::GpuContext;
+use crate::render::HDR_FORMAT;
+use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
+
+/// The clear's pipeline.
+pub struct ClearPass {
+    layout: wgpu::BindGroupLayout,
+    pipeline_layout: wgpu::PipelineLayout,
+    pipeline: wgpu::ComputePipeline,
+}
+
+impl ClearPass {
+    /// Builds the pipeline from `lib`.
+    pub fn new(ctx: &GpuContext, lib: &ShaderLibrary) -> Result<Self, ShaderError> {
+        let layout = ctx
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("ClearPass::layout"),
+                entries: &[wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: HDR_FORMAT,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
+                    count: None,
+                }],
+            });
+        let pipeline_layout = ctx
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("ClearPass::pipeline_layout"),
+                bind_group_layouts: &[Some(&layout)],
+                immediate_size: 0,
+            });
+        let pipeline = Self::build(ctx, lib, &pipeline_layout)?;
+        Ok(Self {
+            layout,
+            pipeline_layout,
+            pipeline,
+        })
+    }
+
+    fn build(
+        ctx: &GpuContext,
+        lib: &ShaderLibrary,
+        layout: &wgpu::PipelineLayout,
+    ) -> Result<wgpu::ComputePipeline, ShaderError> {
+        let composed = lib.compose("clear.wgsl")?;
+        create_checked(&ctx.device, &composed, lib, |module| {
+            ctx.device
+                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some("ClearPass::clear"),
+                    layout: Some(layout),
+                    module,
+                    entry_point: Some("clear"),
+                    compilation_options: Default::default(),
+                    cache: None,
+                })
+        })
+    }
+
+    /// Rebuilds the pipeline; keeps the old one on error.
+    pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
+        self.pipeline = Self::build(ctx, lib, &self.pipeline_layout)?;
+        Ok(())
+    }
+
+    /// Zeroes `target` (an HDR texture with storage usage, `size` pixels).
+    pub fn record(
+        &self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        size: (u32, u32),
+    ) {
+        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("ClearPass::group"),
+            layout: &self.layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(target),
+            }],
+        });
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("ClearPass"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+    }
+}
