@@ -158,6 +158,19 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
     s.inv2 = vec4<f32>(adj[2], 0.0);
     s.z_row = vec4<f32>(col_u.z, col_v.z, col_1.z, 0.0);
     s.w_row = vec4<f32>(col_u.w, col_v.w, col_1.w, 0.0);
+    if abs(col_u.w) + abs(col_v.w) <= 1e-6 * abs(col_1.w) {
+        // A quad parallel to the image plane (a camera-facing billboard): one depth, and
+        // the map is affine — uv = inv0.xy · p.x + inv1.xy · p.y + inv2.xy, flagged by
+        // inv0.w = 1, the depth in inv2.w (culled here when outside the depth range).
+        let z = col_1.z / col_1.w;
+        if z < 0.0 || z > 1.0 {
+            return;
+        }
+        let k = 1.0 / adj[2].z;
+        s.inv0 = vec4<f32>(adj[0].xy * k, 0.0, 1.0);
+        s.inv1 = vec4<f32>(adj[1].xy * k, 0.0, 0.0);
+        s.inv2 = vec4<f32>(adj[2].xy * k, 1.0, z);
+    }
     s.uv_box = vec4<f32>(min(c0.uv, c3.uv), max(c0.uv, c3.uv));
     s.color = qd.color;
     if FLIPBOOK {
@@ -281,38 +294,57 @@ fn view_distance(depth: f32) -> f32 {
     return -(k.x * depth + k.y) / (k.z * depth + k.w);
 }
 
-// Sprite `s` at pixel `p` blended into `acc` (rgb: premultiplied colour, a: coverage,
-// 1 − the transmittance).
-fn shade_sprite(s: TileSprite, p: vec2<i32>, acc: vec4<f32>) -> vec4<f32> {
+// Sprite `i` at pixel `p` blended into `acc` (rgb: premultiplied colour, a: coverage,
+// 1 − the transmittance). Fields are read as they are needed.
+fn shade_sprite(i: u32, p: vec2<i32>, acc: vec4<f32>) -> vec4<f32> {
     let pc = vec2<f32>(p) + 0.5;
-    let h = s.inv0.xyz * pc.x + s.inv1.xyz * pc.y + s.inv2.xyz;
-    let uv = h.xy / h.z;
-    if any(uv < s.uv_box.xy) || any(uv > s.uv_box.zw) {
-        return acc;
+    let inv0 = sprites[i].inv0;
+    let inv1 = sprites[i].inv1;
+    let inv2 = sprites[i].inv2;
+    var uv: vec2<f32>;
+    var ddx: vec2<f32>;
+    var ddy: vec2<f32>;
+    var z: f32;
+    if inv0.w != 0.0 {
+        // Affine (a camera-facing quad): derivatives and depth are the quad's.
+        uv = inv0.xy * pc.x + inv1.xy * pc.y + inv2.xy;
+        ddx = inv0.xy;
+        ddy = inv1.xy;
+        z = inv2.w;
+    } else {
+        let h = inv0.xyz * pc.x + inv1.xyz * pc.y + inv2.xyz;
+        uv = h.xy / h.z;
+        // The derivatives exact at this pixel (the mip level the billboard's fragment
+        // would pick).
+        ddx = (inv0.xy * h.z - h.xy * inv0.z) / (h.z * h.z);
+        ddy = (inv1.xy * h.z - h.xy * inv1.z) / (h.z * h.z);
+        let uv1 = vec3<f32>(uv, 1.0);
+        z = dot(sprites[i].z_row.xyz, uv1) / dot(sprites[i].w_row.xyz, uv1);
     }
-    // The atlas coordinates' derivatives along pixel x and y, exact at this pixel (the
-    // mip level the billboard's fragment would pick).
-    let ddx = (s.inv0.xy * h.z - h.xy * s.inv0.z) / (h.z * h.z) * s.grad.xy;
-    let ddy = (s.inv1.xy * h.z - h.xy * s.inv1.z) / (h.z * h.z) * s.grad.xy;
-    let uv1 = vec3<f32>(uv, 1.0);
+    let uv_box = sprites[i].uv_box;
     // Clipped to the depth range as the rasteriser clips the billboard.
-    let z = dot(s.z_row.xyz, uv1) / dot(s.w_row.xyz, uv1);
-    if z < 0.0 || z > 1.0 || !visible(p, z) {
+    if any(uv < uv_box.xy) || any(uv > uv_box.zw) || z < 0.0 || z > 1.0 || !visible(p, z) {
         return acc;
     }
+    let scale = sprites[i].grad.xy;
+    ddx *= scale;
+    ddy *= scale;
+    let uv1 = vec3<f32>(uv, 1.0);
+    let frames = sprites[i].frames;
     var t0 = vec2<f32>(uv.x * 0.5 + 0.5, 0.5 - uv.y * 0.5);
     if FLIPBOOK {
-        t0 = atlas_uv(s.frames.x, uv);
+        t0 = atlas_uv(frames.x, uv);
     }
     var tex = textureSampleGrad(sprite_tex, sprite_sampler, t0, ddx, ddy);
     if FLIPBOOK && FLIP_BLEND {
-        let t1 = atlas_uv(s.frames.y, uv);
-        tex = mix(tex, textureSampleGrad(sprite_tex, sprite_sampler, t1, ddx, ddy), s.frames.z);
+        let t1 = atlas_uv(frames.y, uv);
+        tex = mix(tex, textureSampleGrad(sprite_tex, sprite_sampler, t1, ddx, ddy), frames.z);
     }
-    var a = s.color.a * tex.a;
-    var rgb = s.color.rgb * tex.rgb;
+    let color = sprites[i].color;
+    var a = color.a * tex.a;
+    var rgb = color.rgb * tex.rgb;
     if SOFT {
-        let fade = clamp(dot(s.ground.xyz, uv1), 0.0, 1.0);
+        let fade = clamp(dot(sprites[i].ground.xyz, uv1), 0.0, 1.0);
         a *= fade;
         rgb *= fade;
     }
@@ -393,7 +425,7 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
         shaded = shaded || total > 0u;
         if inside {
             for (var k = 0u; k < total; k++) {
-                acc = shade_sprite(sprites[hits[k]], p, acc);
+                acc = shade_sprite(hits[k], p, acc);
             }
         }
         workgroupBarrier();
