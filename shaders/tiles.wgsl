@@ -58,6 +58,9 @@ const BIN: u32 = 128u;
 const MAX_ITEMS: u32 = 55u;
 // `touched`: the draw arguments (4), then a flag per tile, then the shaded tiles' list.
 const TOUCHED_FLAGS: u32 = 4u;
+// A bin list entry: the sprite (20 bits; src/render/tiles.rs keeps a frame below 2^20
+// sprites), then the first and last tile of the bin it covers (x0, y0, x1, y1, 3 bits each).
+const SPRITE_MASK: u32 = 0xFFFFFu;
 
 // One dispatch's work: x the item's first sprite, y its quads, z sprites this frame,
 // w the bin lists' stride (entries per bin); `firsts`: every item's first sprite, then
@@ -243,10 +246,17 @@ fn bin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<
     var count = 0u;
     for (var base = 0u; base < n; base += 256u) {
         let i = base + lid;
-        let hit = i < n && overlaps(sprites[i].bounds, rect);
+        var r = vec4<i32>(1, 1, 0, 0);
+        if i < n {
+            r = sprites[i].bounds;
+        }
+        let hit = overlaps(r, rect);
         let at = compact(lid, hit);
         if hit {
-            bin_lists[b * stride + count + at] = i;
+            // The tiles of this bin it covers ride along: the shade tests them without
+            // reading the sprite.
+            let t = vec4<u32>(clamp((r - vec4<i32>(lo, lo)) / i32(TILE), vec4<i32>(0), vec4<i32>(i32(BIN_TILES) - 1)));
+            bin_lists[b * stride + count + at] = i | (t.x << 20u) | (t.y << 23u) | (t.z << 26u) | (t.w << 29u);
         }
         count += workgroupUniformLoad(&shared_total);
     }
@@ -269,7 +279,7 @@ fn lower_bound(b: u32, n: u32, s: u32) -> u32 {
     var hi = n;
     while lo < hi {
         let mid = (lo + hi) / 2u;
-        if bin_lists[b * job.counts.w + mid] < s {
+        if (bin_lists[b * job.counts.w + mid] & SPRITE_MASK) < s {
             lo = mid + 1u;
         } else {
             hi = mid;
@@ -399,7 +409,8 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
         return;
     }
     let origin = vec2<i32>(wg.xy * TILE);
-    let tile = vec4<i32>(origin, origin + i32(TILE) - 1);
+    // This tile within its bin.
+    let local = wg.xy % BIN_TILES;
     let p = origin + vec2<i32>(l.xy);
     let inside = all(vec2<f32>(p) < camera.viewport.xy);
     let pixel = u32(p.y) * u32(camera.viewport.x) + u32(p.x);
@@ -414,8 +425,10 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
         var hit = false;
         var s = 0u;
         if base + lid < run {
-            s = bin_lists[b * job.counts.w + first + base + lid];
-            hit = overlaps(sprites[s].bounds, tile);
+            let e = bin_lists[b * job.counts.w + first + base + lid];
+            s = e & SPRITE_MASK;
+            let t = (vec4<u32>(e) >> vec4<u32>(20u, 23u, 26u, 29u)) & vec4<u32>(7u);
+            hit = all(local >= t.xy) && all(local <= t.zw);
         }
         let at = compact(lid, hit);
         if hit {

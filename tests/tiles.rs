@@ -111,7 +111,8 @@ fn flames() -> Effect {
 #[test]
 fn each_look_module_draws_alike_with_tiles_and_billboards() {
     let ctx = gpu();
-    let modules: [(&str, fn(&mut ignis::effect::Look)); 5] = [
+    type Module = (&'static str, fn(&mut ignis::effect::Look));
+    let modules: [Module; 5] = [
         ("plain", |l| {
             l.flipbook = None;
             l.sprite = Sprite::SoftDisc;

@@ -342,7 +342,7 @@ pub fn bake_rows(params: [&Param; 4], integrate: [bool; 4], scale: [f64; 4]) -> 
     for (c, p) in params.iter().enumerate() {
         for (r, curve) in p.rows().iter().enumerate() {
             let mut acc = 0.0;
-            for i in 0..n {
+            for (i, texel) in rows[r].iter_mut().enumerate() {
                 let v = if integrate[c] {
                     if i > 0 {
                         acc += curve.integral(t_at(i - 1), t_at(i));
@@ -351,7 +351,7 @@ pub fn bake_rows(params: [&Param; 4], integrate: [bool; 4], scale: [f64; 4]) -> 
                 } else {
                     curve.eval(t_at(i))
                 };
-                rows[r][i][c] = (v * scale[c]) as f32;
+                texel[c] = (v * scale[c]) as f32;
             }
         }
     }
@@ -391,9 +391,12 @@ pub fn rows_key(params: &[&Param]) -> u64 {
     h.finish()
 }
 
+/// A starting shape for a curve editor: its name, keys and whether it is smooth.
+pub type CurveShape = (&'static str, &'static [(f32, f32)], bool);
+
 /// Starting shapes for a curve editor: (name, keys, smooth), over t ∈ [0, 1] and values in
 /// [0, 1] (scaled by the caller).
-pub const SHAPES: [(&str, &[(f32, f32)], bool); 5] = [
+pub const SHAPES: [CurveShape; 5] = [
     ("linear up", &[(0.0, 0.0), (1.0, 1.0)], false),
     ("ease in/out", &[(0.0, 0.0), (0.5, 0.5), (1.0, 1.0)], true),
     ("fade out", &[(0.0, 1.0), (0.6, 0.8), (1.0, 0.0)], true),

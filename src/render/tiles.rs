@@ -94,7 +94,8 @@ pub fn grid(size: (u32, u32), cell: u32) -> (u32, u32) {
 /// Whether `sprites` quads fit the tile path's lists at `size`.
 pub fn fits(size: (u32, u32), sprites: u64) -> bool {
     let (bx, by) = grid(size, BIN_PX);
-    u64::from(bx * by) * sprites.next_power_of_two() * 4 <= MAX_LIST_BYTES
+    // A bin list entry holds the sprite's index in 20 bits (`SPRITE_MASK` in tiles.wgsl).
+    sprites < 1 << 20 && u64::from(bx * by) * sprites.next_power_of_two() * 4 <= MAX_LIST_BYTES
 }
 
 /// The frame's tile items in draw order: alpha-blended first (as given: back to front),
