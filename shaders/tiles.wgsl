@@ -13,8 +13,9 @@
 //   2 `bin_lists` (per bin, the sprites over it in draw order, `job.counts.w` entries
 //   each), 3 `bin_meta` (per bin, MAX_ITEMS + 1 entries: where each item's run of the list
 //   starts, then the list's length), 4 `accum` (per pixel: C.rg, C.b and the coverage
-//   1 − T as f16 pairs; zero is empty), 1 `touched` (the resolve's draw arguments, a flag
-//   per tile, the list of tiles shaded this frame), 5 `scene_depth` (the host's depth, when
+//   1 − T as f16 pairs; valid in the tiles shaded this frame only), 1 `touched` (the
+//   resolve's draw arguments, a flag per tile, the list of tiles shaded this frame, each
+//   item's shade dispatch arguments and list of bins), 5 `scene_depth` (the host's depth, when
 //   its size is the viewport's), 6 `job` (this dispatch's item: dynamic offset).
 // - The resolve (a render pipeline): group 0 as above, group 1: 0 `accum_in`, 1
 //   `touched_in` (the same buffers, read-only).
@@ -41,6 +42,9 @@ var<private> look: LookUniform;
 @group(3) @binding(4) var<storage, read_write> accum: array<vec2<u32>>;
 @group(3) @binding(5) var scene_depth: texture_depth_2d;
 @group(3) @binding(6) var<storage, read> job: TileJob;
+// `bin` only: each item's shade dispatch arguments (x: its bins, y: 64 tiles each, z: 1),
+// the indirect arguments of the shade.
+@group(3) @binding(7) var<storage, read_write> dispatch_args: array<atomic<u32>>;
 // The resolve's view of `accum` and `touched`.
 @group(1) @binding(0) var<storage, read> accum_in: array<vec2<u32>>;
 @group(1) @binding(1) var<storage, read> touched_in: array<u32>;
@@ -205,6 +209,9 @@ var<workgroup> bits: array<atomic<u32>, 8>;
 var<workgroup> hits: array<u32, 256>;
 var<workgroup> shared_total: u32;
 var<workgroup> shared_run: vec2<u32>;
+var<workgroup> shared_flag: u32;
+var<workgroup> shared_bin: u32;
+var<workgroup> starts: array<u32, 64>;
 
 // An order-keeping compaction over the workgroup: how many invocations before `lid` have
 // `hit`; `shared_total` gets their number (read it with workgroupUniformLoad). Every
@@ -270,7 +277,27 @@ fn bin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<
             at = lower_bound(b, count, item_first(lid));
         }
         bin_meta[b * (MAX_ITEMS + 1u) + lid] = at;
+        starts[lid] = at;
     }
+    workgroupBarrier();
+    // A bin with some of item k's sprites joins item k's shade (its indirect dispatch:
+    // one workgroup row per such bin, one workgroup per tile of it).
+    if lid < items && starts[lid] < starts[lid + 1u] {
+        let slot = atomicAdd(&dispatch_args[4u * lid], 1u);
+        atomicStore(&touched[item_bins(lid) + slot], b);
+    }
+}
+
+// Where item k's list of bins is in `touched`, after the resolve's arguments, the tile
+// flags and the tile list.
+fn item_bins(k: u32) -> u32 {
+    let bins = ((u32(camera.viewport.x) + BIN - 1u) / BIN) * ((u32(camera.viewport.y) + BIN - 1u) / BIN);
+    return TOUCHED_FLAGS + 2u * tile_count() + k * bins;
+}
+
+// Tiles across the target.
+fn tile_count() -> u32 {
+    return ((u32(camera.viewport.x) + TILE - 1u) / TILE) * ((u32(camera.viewport.y) + TILE - 1u) / TILE);
 }
 
 // The first entry of bin `b`'s list (`n` entries) at or after sprite `s`.
@@ -394,9 +421,19 @@ fn to_f16(v: vec2<f32>) -> vec2<f32> {
 // tile's pixels of `accum`.
 @compute @workgroup_size(16, 16)
 fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
-    look = looks[0].look;
+    // Workgroup (x, y): tile y of the x-th bin holding some of this item's sprites.
     let bins_x = (u32(camera.viewport.x) + BIN - 1u) / BIN;
-    let b = (wg.y / BIN_TILES) * bins_x + wg.x / BIN_TILES;
+    if lid == 0u {
+        shared_bin = atomicLoad(&touched[item_bins(job.counts2.x) + wg.x]);
+    }
+    let b = workgroupUniformLoad(&shared_bin);
+    // This tile within its bin, and across the target.
+    let local = vec2<u32>(wg.y % BIN_TILES, wg.y / BIN_TILES);
+    let tile_xy = vec2<u32>(b % bins_x, b / bins_x) * BIN_TILES + local;
+    let tiles_x = (u32(camera.viewport.x) + TILE - 1u) / TILE;
+    if tile_xy.x >= tiles_x || tile_xy.y * TILE >= u32(camera.viewport.y) {
+        return;
+    }
     // The item's sprites are a run of the bin's list.
     if lid == 0u {
         let at = b * (MAX_ITEMS + 1u) + job.counts2.x;
@@ -408,14 +445,23 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
     if run == 0u {
         return;
     }
-    let origin = vec2<i32>(wg.xy * TILE);
-    // This tile within its bin.
-    let local = wg.xy % BIN_TILES;
+    // What the shade reads of the look: the flipbook's layout and the soft distance (not
+    // the whole 320-byte look per invocation).
+    look.ids = looks[0].look.ids;
+    look.soft = looks[0].look.soft;
+    let origin = vec2<i32>(tile_xy * TILE);
     let p = origin + vec2<i32>(l.xy);
     let inside = all(vec2<f32>(p) < camera.viewport.xy);
     let pixel = u32(p.y) * u32(camera.viewport.x) + u32(p.x);
+    // A tile no earlier item shaded starts empty: `accum` is not cleared between frames,
+    // and only shaded tiles are read (here and by the resolve).
+    let t = tile_xy.y * tiles_x + tile_xy.x;
+    if lid == 0u {
+        shared_flag = atomicLoad(&touched[TOUCHED_FLAGS + t]);
+    }
+    let earlier = workgroupUniformLoad(&shared_flag) != 0u;
     var acc = vec4<f32>(0.0);
-    if inside {
+    if inside && earlier {
         let v = accum[pixel];
         acc = vec4<f32>(unpack2x16float(v.x), unpack2x16float(v.y));
     }
@@ -447,12 +493,9 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
         accum[pixel] = vec2<u32>(pack2x16float(acc.rg), pack2x16float(acc.ba));
     }
     // The first item to shade this tile lists it for the resolve.
-    let tiles_x = (u32(camera.viewport.x) + TILE - 1u) / TILE;
-    let t = wg.y * tiles_x + wg.x;
     if lid == 0u && shaded && atomicExchange(&touched[TOUCHED_FLAGS + t], 1u) == 0u {
         let k = atomicAdd(&touched[1], 1u);
-        let tiles = tiles_x * ((u32(camera.viewport.y) + TILE - 1u) / TILE);
-        atomicStore(&touched[TOUCHED_FLAGS + tiles + k], t);
+        atomicStore(&touched[TOUCHED_FLAGS + tile_count() + k], t);
     }
 }
 

@@ -46,6 +46,9 @@ struct Row {
 }
 
 /// The path choices measured.
+/// Frames run before the timed ones of each row.
+const UNTIMED_FRAMES: usize = 10;
+
 /// The billboards first: the other paths' images are compared with theirs.
 const PATHS: [(&str, Option<DrawPath>); 4] = [
     ("billboard", Some(DrawPath::Billboard)),
@@ -140,7 +143,12 @@ fn measure(
     }
     let camera = run.camera.view(size);
     let mut parts: [Vec<f64>; 4] = Default::default();
-    for _ in 0..opts.frames {
+    // Ten frames untimed first: the steps the warm-up planned, and the GPU's clocks up
+    // from idle.
+    for frame in 0..opts.frames + UNTIMED_FRAMES {
+        if frame == UNTIMED_FRAMES {
+            parts = Default::default();
+        }
         run.player.advance(1.0 / 60.0);
         let Headless {
             player, composite, ..
@@ -175,7 +183,7 @@ fn report(ctx: &GpuContext, timer: &GpuTimer, opts: &PresetsOptions, rows: &[Row
     r.para(&format!(
         "Each preset in steady state (played past its last burst and longest lifetime at \
          60 fps; an effect of bursts alone a quarter of its longest lifetime after its last \
-         burst), then {} frames; medians of each part, timed apart ({:?}): update, sort + \
+         burst), then 10 untimed frames, then {} frames; medians of each part, timed apart ({:?}): update, sort + \
          splat + the tiles' project, bin and shade (the player's record), particle draws \
          (billboards, the splat's and the tiles' composite into the target), composite \
          (bloom + tonemap). `frame` is their sum. `auto` is the preset's own draw-path \

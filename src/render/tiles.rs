@@ -55,6 +55,10 @@ pub struct TilePass {
     sprite_layout: wgpu::BindGroupLayout,
     no_depth: wgpu::TextureView,
     compute_layout: wgpu::PipelineLayout,
+    /// The bin's group 3 (the tile group and the shades' dispatch arguments) and layout.
+    bin_group_layout: wgpu::BindGroupLayout,
+    bin_layout: wgpu::PipelineLayout,
+    empty_group: wgpu::BindGroup,
     resolve_layout: wgpu::PipelineLayout,
     module: wgpu::ShaderModule,
     /// (project, shade) per look variant, built on first use (`None`: failed, logged).
@@ -76,19 +80,27 @@ struct TileBuffers {
     /// Jobs the job buffer holds.
     jobs: u32,
     job_buffer: wgpu::Buffer,
-    accum: wgpu::Buffer,
     /// The resolve's draw arguments, a flag per tile and the shaded tiles' list.
     touched: wgpu::Buffer,
+    /// Each item's shade dispatch arguments, written by the bin.
+    dispatch_args: wgpu::Buffer,
     group: wgpu::BindGroup,
+    bin_group: wgpu::BindGroup,
     resolve_group: wgpu::BindGroup,
     depth: Option<wgpu::TextureView>,
     /// Everything else the group binds (kept alive with it).
-    _lists: [wgpu::Buffer; 3],
+    _lists: [wgpu::Buffer; 4],
 }
 
 /// Tiles and bins across a target of `size` pixels.
 pub fn grid(size: (u32, u32), cell: u32) -> (u32, u32) {
     (size.0.div_ceil(cell).max(1), size.1.div_ceil(cell).max(1))
+}
+
+/// Tiles across a target of `size` pixels.
+fn grid_tiles(size: (u32, u32)) -> u64 {
+    let (tx, ty) = grid(size, TILE_PX);
+    u64::from(tx) * u64::from(ty)
 }
 
 /// Whether `sprites` quads fit the tile path's lists at `size`.
@@ -176,13 +188,40 @@ impl TilePass {
             ],
             immediate_size: 0,
         });
+        let bin_group_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("TilePass::bin_group_layout"),
+            entries: &Self::bin_entries(),
+        });
+        let empty_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("TilePass::empty_layout"),
+            entries: &[],
+        });
+        let empty_group = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("TilePass::empty_group"),
+            layout: &empty_layout,
+            entries: &[],
+        });
+        let bin_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("TilePass::bin_layout"),
+            bind_group_layouts: &[
+                Some(&frame.frame_layout),
+                Some(&empty_layout),
+                Some(&empty_layout),
+                Some(&bin_group_layout),
+            ],
+            immediate_size: 0,
+        });
         let resolve_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("TilePass::resolve_layout"),
             bind_group_layouts: &[Some(&frame.frame_layout), Some(&resolve_group_layout)],
             immediate_size: 0,
         });
-        let (module, variants, bin, resolve) =
-            Self::build(ctx, lib, &compute_layout, &resolve_layout, target)?;
+        let (module, variants, bin, resolve) = Self::build(
+            ctx,
+            lib,
+            [&compute_layout, &bin_layout, &resolve_layout],
+            target,
+        )?;
         Ok(Self {
             target,
             tile_layout,
@@ -190,6 +229,9 @@ impl TilePass {
             sprite_layout,
             no_depth: crate::gpu::placeholder_depth(d, "TilePass::no_depth"),
             compute_layout,
+            bin_group_layout,
+            bin_layout,
+            empty_group,
             resolve_layout,
             module,
             variants,
@@ -203,7 +245,7 @@ impl TilePass {
 
     /// Group 3: sprites, the shaded tiles, bin lists, bin starts, the accumulation, the
     /// host's depth and the dispatch's job.
-    fn tile_entries() -> [wgpu::BindGroupLayoutEntry; 7] {
+    fn tile_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         let storage = |binding, visibility, read_only, dynamic| wgpu::BindGroupLayoutEntry {
             binding,
             visibility,
@@ -215,7 +257,7 @@ impl TilePass {
             count: None,
         };
         let c = wgpu::ShaderStages::COMPUTE;
-        [
+        vec![
             storage(0, c, false, false),
             storage(1, c, false, false),
             storage(2, c, false, false),
@@ -226,18 +268,33 @@ impl TilePass {
         ]
     }
 
+    /// The bin's group 3: the tile group and binding 7, the shades' dispatch arguments.
+    fn bin_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
+        let mut entries = Self::tile_entries();
+        entries.push(wgpu::BindGroupLayoutEntry {
+            binding: 7,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: false },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        });
+        entries
+    }
+
     /// The module (validated with the full-state pipelines), the bin pipeline and the
     /// resolve.
     fn build(
         ctx: &GpuContext,
         lib: &ShaderLibrary,
-        layout: &wgpu::PipelineLayout,
-        resolve_layout: &wgpu::PipelineLayout,
+        [layout, bin_layout, resolve_layout]: [&wgpu::PipelineLayout; 3],
         target: DrawTarget,
     ) -> Result<Built, ShaderError> {
         let composed = lib.compose("tiles.wgsl")?;
         create_checked(&ctx.device, &composed, lib, |module| {
-            let bin = Self::compute(ctx, layout, module, "bin", &[]);
+            let bin = Self::compute(ctx, bin_layout, module, "bin", &[]);
             let basic = LookVariant::basic(false);
             let variants = HashMap::from([(
                 basic,
@@ -303,13 +360,8 @@ impl TilePass {
     /// Rebuilds the pipelines; keeps the old ones on error. Variants are rebuilt on
     /// first use.
     pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
-        let (module, variants, bin, resolve) = Self::build(
-            ctx,
-            lib,
-            &self.compute_layout,
-            &self.resolve_layout,
-            self.target,
-        )?;
+        let layouts = [&self.compute_layout, &self.bin_layout, &self.resolve_layout];
+        let (module, variants, bin, resolve) = Self::build(ctx, lib, layouts, self.target)?;
         self.module = module;
         self.bin = bin;
         self.resolve = resolve;
@@ -382,43 +434,23 @@ impl TilePass {
         let Some(b) = self.buffers.as_ref() else {
             return false;
         };
-        // One job per item (`TileJob`): its first sprite and quads, the frame's sprites,
-        // the lists' stride; its index and the item count; every item's first sprite.
-        let mut firsts = Vec::with_capacity(order.len() + 1);
-        firsts.push(0u32);
-        for d in &order {
-            firsts.push(firsts[firsts.len() - 1] + d.width * d.members);
-        }
-        let mut jobs = vec![0u32; order.len() * JOB_STRIDE as usize / 4];
-        for (k, job) in jobs.chunks_mut(JOB_STRIDE as usize / 4).enumerate() {
-            let n = firsts[k + 1] - firsts[k];
-            job[..8].copy_from_slice(&[
-                firsts[k],
-                n,
-                total as u32,
-                b.capacity,
-                k as u32,
-                order.len() as u32,
-                0,
-                0,
-            ]);
-            job[8..8 + firsts.len()].copy_from_slice(&firsts);
-        }
-        ctx.queue
-            .write_buffer(&b.job_buffer, 0, bytemuck::cast_slice(&jobs));
-        // The resolve's draw: six vertices per shaded tile, counted by the shade.
-        ctx.queue
-            .write_buffer(&b.touched, 0, bytemuck::cast_slice(&[6u32, 0, 0, 0]));
-        enc.clear_buffer(&b.touched, TOUCHED_FLAGS * 4, None);
-        enc.clear_buffer(&b.accum, 0, None);
+        self.upload_jobs(ctx, &order, total as u32);
+        enc.clear_buffer(&b.touched, TOUCHED_FLAGS * 4, Some(grid_tiles(size) * 4));
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("TilePass::tiles"),
             timestamp_writes: None,
         });
-        let bins = grid(size, BIN_PX);
-        let tiles = grid(size, TILE_PX);
         // Project every item, bin once, then shade each item in draw order.
         for stage in 0..2 {
+            if stage == 1 {
+                pass.set_pipeline(&self.bin);
+                pass.set_bind_group(0, &frame.frame_group, &[0]);
+                pass.set_bind_group(1, &self.empty_group, &[]);
+                pass.set_bind_group(2, &self.empty_group, &[]);
+                pass.set_bind_group(3, &b.bin_group, &[0]);
+                let bins = grid(size, BIN_PX);
+                pass.dispatch_workgroups(bins.0, bins.1, 1);
+            }
             for (k, d) in order.iter().enumerate() {
                 let (Some(particles), Some(Some(pipes)), Some(sprite)) = (
                     frame.particle_group(d.key),
@@ -428,11 +460,8 @@ impl TilePass {
                     continue;
                 };
                 pass.set_pipeline(&pipes[stage]);
-                pass.set_bind_group(
-                    0,
-                    &frame.frame_group,
-                    &[FrameResources::look_offset(d.look_slot)],
-                );
+                let look = FrameResources::look_offset(d.look_slot);
+                pass.set_bind_group(0, &frame.frame_group, &[look]);
                 pass.set_bind_group(1, particles, &[]);
                 pass.set_bind_group(2, sprite, &[]);
                 pass.set_bind_group(3, &b.group, &[(k as u64 * JOB_STRIDE) as u32]);
@@ -440,18 +469,43 @@ impl TilePass {
                     let (x, y) = dispatch_size(d.width * d.members);
                     pass.dispatch_workgroups(x, y, 1);
                 } else {
-                    pass.dispatch_workgroups(tiles.0, tiles.1, 1);
+                    // Only the bins holding some of the item's sprites (the bin counts them).
+                    pass.dispatch_workgroups_indirect(&b.dispatch_args, k as u64 * 16);
                 }
-            }
-            if stage == 0 {
-                // Every group of the layout is bound by the projections above.
-                pass.set_pipeline(&self.bin);
-                pass.dispatch_workgroups(bins.0, bins.1, 1);
             }
         }
         drop(pass);
         self.drawn = true;
         true
+    }
+
+    /// Uploads one job per item (`TileJob`: its first sprite and quads, the frame's
+    /// sprites, the lists' stride; its index and the item count; every item's first
+    /// sprite), the resolve's draw arguments (six vertices per shaded tile, counted by the
+    /// shade) and the shades' dispatch arguments (bins counted by the bin, 64 tiles each).
+    fn upload_jobs(&self, ctx: &GpuContext, order: &[&DrawItem], total: u32) {
+        let Some(b) = self.buffers.as_ref() else {
+            return;
+        };
+        let mut firsts = Vec::with_capacity(order.len() + 1);
+        firsts.push(0u32);
+        for d in order {
+            firsts.push(firsts[firsts.len() - 1] + d.width * d.members);
+        }
+        let mut jobs = vec![0u32; order.len() * JOB_STRIDE as usize / 4];
+        let items = order.len() as u32;
+        for (k, job) in jobs.chunks_mut(JOB_STRIDE as usize / 4).enumerate() {
+            let n = firsts[k + 1] - firsts[k];
+            job[..8].copy_from_slice(&[firsts[k], n, total, b.capacity, k as u32, items, 0, 0]);
+            job[8..8 + firsts.len()].copy_from_slice(&firsts);
+        }
+        ctx.queue
+            .write_buffer(&b.job_buffer, 0, bytemuck::cast_slice(&jobs));
+        ctx.queue
+            .write_buffer(&b.touched, 0, bytemuck::cast_slice(&[6u32, 0, 0, 0]));
+        let args: Vec<u32> = order.iter().flat_map(|_| [0u32, 64, 1, 0]).collect();
+        ctx.queue
+            .write_buffer(&b.dispatch_args, 0, bytemuck::cast_slice(&args));
     }
 
     /// Creates the buffers for `size` and `sprites` quads (capacity in powers of two) and
@@ -475,98 +529,99 @@ impl TilePass {
         let capacity = sprites.next_power_of_two().max(256);
         let jobs = jobs.next_power_of_two().max(4);
         let (bx, by) = grid(size, BIN_PX);
-        let buffer = |label: &str, bytes: u64| {
+        let bins = u64::from(bx * by);
+        let buffer = |label: &str, bytes: u64, usage: wgpu::BufferUsages| {
             ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
                 size: bytes.max(16),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                usage: usage | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             })
         };
+        let none = wgpu::BufferUsages::empty();
+        let indirect = wgpu::BufferUsages::INDIRECT;
         let c = u64::from(capacity);
-        let tiles = {
-            let (tx, ty) = grid(size, TILE_PX);
-            u64::from(tx) * u64::from(ty)
+        // `touched`: the resolve's arguments, a flag per tile, the shaded tiles, and each
+        // item's bins.
+        let touched_words = TOUCHED_FLAGS + 2 * grid_tiles(size) + MAX_ITEMS as u64 * bins;
+        let lists = [
+            buffer("TilePass::sprites", c * SPRITE_BYTES, none),
+            buffer("TilePass::touched", touched_words * 4, indirect),
+            buffer("TilePass::bin_lists", bins * c * 4, none),
+            buffer(
+                "TilePass::bin_meta",
+                bins * (MAX_ITEMS as u64 + 1) * 4,
+                none,
+            ),
+            buffer(
+                "TilePass::accum",
+                u64::from(size.0) * u64::from(size.1) * 8,
+                none,
+            ),
+        ];
+        let job_buffer = buffer("TilePass::jobs", u64::from(jobs) * JOB_STRIDE, none);
+        let dispatch_args = buffer("TilePass::dispatch_args", MAX_ITEMS as u64 * 16, indirect);
+        let depth_view = depth.unwrap_or(&self.no_depth);
+        let group = |layout, args: Option<&wgpu::Buffer>| {
+            let mut entries: Vec<wgpu::BindGroupEntry<'_>> = lists
+                .iter()
+                .enumerate()
+                .map(|(i, b)| wgpu::BindGroupEntry {
+                    binding: [0, 1, 2, 3, 4][i],
+                    resource: b.as_entire_binding(),
+                })
+                .collect();
+            entries.push(wgpu::BindGroupEntry {
+                binding: 5,
+                resource: wgpu::BindingResource::TextureView(depth_view),
+            });
+            entries.push(wgpu::BindGroupEntry {
+                binding: 6,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &job_buffer,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(JOB_STRIDE),
+                }),
+            });
+            entries.extend(args.map(|a| wgpu::BindGroupEntry {
+                binding: 7,
+                resource: a.as_entire_binding(),
+            }));
+            ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("TilePass::group"),
+                layout,
+                entries: &entries,
+            })
         };
-        let sprites_buf = buffer("TilePass::sprites", c * SPRITE_BYTES);
-        let lists = buffer("TilePass::bin_lists", u64::from(bx * by) * c * 4);
-        let meta = buffer(
-            "TilePass::bin_meta",
-            u64::from(bx * by) * (MAX_ITEMS as u64 + 1) * 4,
-        );
-        let accum = buffer("TilePass::accum", u64::from(size.0) * u64::from(size.1) * 8);
-        let job_buffer = buffer("TilePass::jobs", u64::from(jobs) * JOB_STRIDE);
-        let touched = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("TilePass::touched"),
-            size: (TOUCHED_FLAGS + 2 * tiles) * 4,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::INDIRECT
-                | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("TilePass::group"),
-            layout: &self.tile_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: sprites_buf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: touched.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: lists.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: meta.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: accum.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: wgpu::BindingResource::TextureView(depth.unwrap_or(&self.no_depth)),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &job_buffer,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(JOB_STRIDE),
-                    }),
-                },
-            ],
-        });
+        let tile_group = group(&self.tile_layout, None);
+        let bin_group = group(&self.bin_group_layout, Some(&dispatch_args));
         let resolve_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("TilePass::resolve_group"),
             layout: &self.resolve_group_layout,
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
-                    resource: accum.as_entire_binding(),
+                    resource: lists[4].as_entire_binding(),
                 },
                 wgpu::BindGroupEntry {
                     binding: 1,
-                    resource: touched.as_entire_binding(),
+                    resource: lists[1].as_entire_binding(),
                 },
             ],
         });
+        let [sprites_buf, touched, bin_lists, meta, accum] = lists;
         self.buffers = Some(TileBuffers {
             size,
             capacity,
             jobs,
             job_buffer,
-            accum,
             touched,
-            group,
+            dispatch_args,
+            group: tile_group,
+            bin_group,
             resolve_group,
             depth: depth.cloned(),
-            _lists: [sprites_buf, lists, meta],
+            _lists: [sprites_buf, bin_lists, meta, accum],
         });
     }
 
