@@ -189,7 +189,10 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
         let gv = (ground_fade_arg(c2.world) - g0) / dv;
         s.ground = vec4<f32>(gu, gv, g0 - gu * c0.uv.x - gv * c0.uv.y, 0.0);
     }
-    s.grad = vec4<f32>(atlas_scale(), 0.0, 0.0);
+    // The flipbook's columns and rows, and the soft edges' 1 / distance: the shade reads
+    // nothing of the look (a private copy of it per invocation costs registers).
+    s.grad = vec4<f32>(atlas_scale(), f32(max(look.ids.w, 1u)), f32(max(look.ids.z, 1u)));
+    s.frames.w = look.soft.y;
     sprites[index] = s;
     // Pixel centres (x + 0.5) inside the quad's bounding box, clamped to the target.
     let p0 = to_pixels(c0.clip);
@@ -363,18 +366,18 @@ fn shade_sprite(i: u32, p: vec2<i32>, acc: vec4<f32>) -> vec4<f32> {
     if any(uv < uv_box.xy) || any(uv > uv_box.zw) || z < 0.0 || z > 1.0 || !visible(p, z) {
         return acc;
     }
-    let scale = sprites[i].grad.xy;
-    ddx *= scale;
-    ddy *= scale;
+    let grad = sprites[i].grad;
+    ddx *= grad.xy;
+    ddy *= grad.xy;
     let uv1 = vec3<f32>(uv, 1.0);
     let frames = sprites[i].frames;
     var t0 = vec2<f32>(uv.x * 0.5 + 0.5, 0.5 - uv.y * 0.5);
     if FLIPBOOK {
-        t0 = atlas_uv(frames.x, uv);
+        t0 = cell_uv(frames.x, uv, grad.zw);
     }
     var tex = textureSampleGrad(sprite_tex, sprite_sampler, t0, ddx, ddy);
     if FLIPBOOK && FLIP_BLEND {
-        let t1 = atlas_uv(frames.y, uv);
+        let t1 = cell_uv(frames.y, uv, grad.zw);
         tex = mix(tex, textureSampleGrad(sprite_tex, sprite_sampler, t1, ddx, ddy), frames.z);
     }
     let color = sprites[i].color;
@@ -387,7 +390,7 @@ fn shade_sprite(i: u32, p: vec2<i32>, acc: vec4<f32>) -> vec4<f32> {
     }
     if SOFT_DEPTH {
         let scene = textureLoad(scene_depth, p, 0);
-        let fade = clamp((view_distance(scene) - view_distance(z)) * look.soft.y, 0.0, 1.0);
+        let fade = clamp((view_distance(scene) - view_distance(z)) * frames.w, 0.0, 1.0);
         a *= fade;
         rgb *= fade;
     }
@@ -398,6 +401,15 @@ fn shade_sprite(i: u32, p: vec2<i32>, acc: vec4<f32>) -> vec4<f32> {
     // Rounded to f16 after every sprite, as the billboards' blending stores each one into
     // the f16 target: faint light on bright pixels is kept or lost as the billboards' is.
     return vec4<f32>(to_f16(out.rg), to_f16(out.ba));
+}
+
+// Atlas coordinates of flipbook frame `frame` at frame coordinates `uv` ∈ [-1, 1]² (y up),
+// `grid` = (columns, rows): look.wgsl's `atlas_uv` without the look.
+fn cell_uv(frame: f32, uv: vec2<f32>, grid: vec2<f32>) -> vec2<f32> {
+    let cols = u32(grid.x);
+    let f = u32(frame);
+    let cell = vec2<f32>(f32(f % cols), f32(f / cols));
+    return (cell + vec2<f32>(uv.x * 0.5 + 0.5, 0.5 - uv.y * 0.5)) / grid;
 }
 
 // Non-negative values rounded to f16 as the adapter's blending stores them: to nearest,
@@ -445,10 +457,6 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
     if run == 0u {
         return;
     }
-    // What the shade reads of the look: the flipbook's layout and the soft distance (not
-    // the whole 320-byte look per invocation).
-    look.ids = looks[0].look.ids;
-    look.soft = looks[0].look.soft;
     let origin = vec2<i32>(tile_xy * TILE);
     let p = origin + vec2<i32>(l.xy);
     let inside = all(vec2<f32>(p) < camera.viewport.xy);
