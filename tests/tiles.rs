@@ -273,7 +273,8 @@ fn tiles_are_deterministic_and_the_automatic_choice_follows_the_profile() {
         for _ in 0..30 {
             run.advance(1.0 / 60.0);
         }
-        run.render(SIZE).expect("render");
+        // Large enough that the flames' and smoke's fill passes TILES_MIN_FILL_PX.
+        run.render((960, 540)).expect("render");
         let items = run.player.draw_items();
         items
             .iter()
@@ -286,8 +287,8 @@ fn tiles_are_deterministic_and_the_automatic_choice_follows_the_profile() {
         chosen(AdapterProfile::GPU),
         "the choice changed"
     );
-    // On a GPU profile the large flames and smoke take the tiles; a software profile
-    // keeps billboards.
+    // On a GPU profile the large flames and smoke take the tiles (the embers are streaks);
+    // a software profile keeps billboards.
     let names: Vec<&str> = effect.emitters.iter().map(|e| e.name.as_str()).collect();
     for (i, tiles, _) in &gpu_choice {
         if ["flames", "smoke"].contains(&names[*i]) {

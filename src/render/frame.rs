@@ -10,6 +10,7 @@ use std::sync::Arc;
 use crate::effect::rows_key;
 use crate::effect::{
     BlendMode, DrawPath, Effect, FlipbookMode, Look, SPLAT_BELOW_PX, Streak, TILES_ABOVE_PX,
+    TILES_MIN_FILL_PX,
 };
 use crate::gpu::GpuContext;
 use crate::gpu::types::{CameraUniform, LookUniform, PARAMS_STRIDE, StateLayout};
@@ -780,7 +781,11 @@ impl FrameResources {
             && !splat
             && e.look.streak.is_none()
             && match e.look.draw_path {
-                DrawPath::Auto => self.auto_tiles && size_px >= TILES_ABOVE_PX,
+                DrawPath::Auto => {
+                    // Billboard fill at most (every quad at the largest size).
+                    let fill = (width * n) as f32 * size_px * size_px;
+                    self.auto_tiles && size_px >= TILES_ABOVE_PX && fill >= TILES_MIN_FILL_PX
+                }
                 DrawPath::Tiles => true,
                 DrawPath::Billboard | DrawPath::Splat => false,
             };
