@@ -213,6 +213,32 @@ var<workgroup> hits: array<u32, 256>;
 var<workgroup> shared_total: u32;
 var<workgroup> shared_run: vec2<u32>;
 var<workgroup> shared_flag: u32;
+// The sprite cache of the shade: the fields the pixels read of up to CACHE sprites.
+const CACHE: u32 = 64u;
+var<workgroup> cache_map: array<vec4<f32>, 64>;
+var<workgroup> cache_offset: array<vec4<f32>, 64>;
+var<workgroup> cache_box: array<vec4<f32>, 64>;
+var<workgroup> cache_color: array<vec4<f32>, 64>;
+var<workgroup> cache_frames: array<vec4<f32>, 64>;
+var<workgroup> cache_grad: array<vec4<f32>, 64>;
+var<workgroup> cache_ground: array<vec4<f32>, 64>;
+
+// Reads sprite `i`'s fields into slot `k` of the cache (the affine map as (inv0.xy,
+// inv1.xy) and (inv2.xy, affine flag, depth)).
+fn cache_sprite(k: u32, i: u32) {
+    let inv0 = sprites[i].inv0;
+    let inv1 = sprites[i].inv1;
+    let inv2 = sprites[i].inv2;
+    cache_map[k] = vec4<f32>(inv0.xy, inv1.xy);
+    cache_offset[k] = vec4<f32>(inv2.xy, inv0.w, inv2.w);
+    cache_box[k] = sprites[i].uv_box;
+    cache_color[k] = sprites[i].color;
+    cache_frames[k] = sprites[i].frames;
+    cache_grad[k] = sprites[i].grad;
+    if SOFT {
+        cache_ground[k] = sprites[i].ground;
+    }
+}
 var<workgroup> shared_bin: u32;
 var<workgroup> starts: array<u32, 64>;
 
@@ -334,24 +360,26 @@ fn view_distance(depth: f32) -> f32 {
     return -(k.x * depth + k.y) / (k.z * depth + k.w);
 }
 
-// Sprite `i` at pixel `p` blended into `acc` (rgb: premultiplied colour, a: coverage,
-// 1 − the transmittance). Fields are read as they are needed.
-fn shade_sprite(i: u32, p: vec2<i32>, acc: vec4<f32>) -> vec4<f32> {
+// Sprite `i` (cached in slot `k` of the workgroup's sprite cache) at pixel `p` blended into
+// `acc` (rgb: premultiplied colour, a: coverage, 1 − the transmittance).
+fn shade_sprite(i: u32, k: u32, p: vec2<i32>, acc: vec4<f32>) -> vec4<f32> {
     let pc = vec2<f32>(p) + 0.5;
-    let inv0 = sprites[i].inv0;
-    let inv1 = sprites[i].inv1;
-    let inv2 = sprites[i].inv2;
+    let ca = cache_map[k];
+    let cb = cache_offset[k];
     var uv: vec2<f32>;
     var ddx: vec2<f32>;
     var ddy: vec2<f32>;
     var z: f32;
-    if inv0.w != 0.0 {
+    if cb.z != 0.0 {
         // Affine (a camera-facing quad): derivatives and depth are the quad's.
-        uv = inv0.xy * pc.x + inv1.xy * pc.y + inv2.xy;
-        ddx = inv0.xy;
-        ddy = inv1.xy;
-        z = inv2.w;
+        uv = ca.xy * pc.x + ca.zw * pc.y + cb.xy;
+        ddx = ca.xy;
+        ddy = ca.zw;
+        z = cb.w;
     } else {
+        let inv0 = sprites[i].inv0;
+        let inv1 = sprites[i].inv1;
+        let inv2 = sprites[i].inv2;
         let h = inv0.xyz * pc.x + inv1.xyz * pc.y + inv2.xyz;
         uv = h.xy / h.z;
         // The derivatives exact at this pixel (the mip level the billboard's fragment
@@ -361,16 +389,16 @@ fn shade_sprite(i: u32, p: vec2<i32>, acc: vec4<f32>) -> vec4<f32> {
         let uv1 = vec3<f32>(uv, 1.0);
         z = dot(sprites[i].z_row.xyz, uv1) / dot(sprites[i].w_row.xyz, uv1);
     }
-    let uv_box = sprites[i].uv_box;
+    let uv_box = cache_box[k];
     // Clipped to the depth range as the rasteriser clips the billboard.
     if any(uv < uv_box.xy) || any(uv > uv_box.zw) || z < 0.0 || z > 1.0 || !visible(p, z) {
         return acc;
     }
-    let grad = sprites[i].grad;
+    let grad = cache_grad[k];
     ddx *= grad.xy;
     ddy *= grad.xy;
     let uv1 = vec3<f32>(uv, 1.0);
-    let frames = sprites[i].frames;
+    let frames = cache_frames[k];
     var t0 = vec2<f32>(uv.x * 0.5 + 0.5, 0.5 - uv.y * 0.5);
     if FLIPBOOK {
         t0 = cell_uv(frames.x, uv, grad.zw);
@@ -380,11 +408,11 @@ fn shade_sprite(i: u32, p: vec2<i32>, acc: vec4<f32>) -> vec4<f32> {
         let t1 = cell_uv(frames.y, uv, grad.zw);
         tex = mix(tex, textureSampleGrad(sprite_tex, sprite_sampler, t1, ddx, ddy), frames.z);
     }
-    let color = sprites[i].color;
+    let color = cache_color[k];
     var a = color.a * tex.a;
     var rgb = color.rgb * tex.rgb;
     if SOFT {
-        let fade = clamp(dot(sprites[i].ground.xyz, uv1), 0.0, 1.0);
+        let fade = clamp(dot(cache_ground[k].xyz, uv1), 0.0, 1.0);
         a *= fade;
         rgb *= fade;
     }
@@ -490,10 +518,20 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
         }
         let total = workgroupUniformLoad(&shared_total);
         shaded = shaded || total > 0u;
-        if inside {
-            for (var k = 0u; k < total; k++) {
-                acc = shade_sprite(hits[k], p, acc);
+        // The hits, 64 at a time: their records read once into workgroup memory (one
+        // invocation each), then every pixel reads them from there.
+        for (var sub = 0u; sub < total; sub += CACHE) {
+            if lid < CACHE && sub + lid < total {
+                cache_sprite(lid, hits[sub + lid]);
             }
+            workgroupBarrier();
+            let m = min(CACHE, total - sub);
+            if inside {
+                for (var k = 0u; k < m; k++) {
+                    acc = shade_sprite(hits[sub + k], k, p, acc);
+                }
+            }
+            workgroupBarrier();
         }
         workgroupBarrier();
     }
