@@ -711,8 +711,8 @@ pub const TILES_ABOVE_PX: f32 = 8.0;
 
 /// Auto draw path: an emitter takes the tile rasteriser only when its quads (all its
 /// instances' live windows) at their largest projected size would cover at least this
-/// many pixels: light fill costs the billboards little, and the tiles' shade a fixed
-/// ~0.3 ms on the H100 (`ignis bench presets`: the spark fountain's 26-sprite glow).
+/// many pixels: light fill costs the billboards little, and the tiles a fixed ~0.1 ms on
+/// the H100 (`ignis bench presets`: the spark fountain's 26-sprite glow).
 pub const TILES_MIN_FILL_PX: f32 = 1.0e6;
 
 /// A sprite texture: one of the procedural set generated at start, or a PNG with alpha.
