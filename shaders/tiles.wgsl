@@ -11,11 +11,11 @@
 // - group 2: the emitter's sprite and sampler (shade).
 // - group 3 (compute): 0 `sprites` (one TileSprite per quad of the frame's tile items),
 //   2 `bin_lists` (per bin, the sprites over it in draw order, `job.counts.w` entries
-//   each), 3 `bin_meta` (per bin, MAX_ITEMS + 1 entries: where each item's run of the list
-//   starts, then the list's length), 4 `accum` (per pixel: C.rg, C.b and the coverage
+//   each, a region of BLOCK per block of sprites), 3 `bin_meta` (per bin and block, the
+//   entries listed), 4 `accum` (per pixel: C.rg, C.b and the coverage
 //   1 − T as f16 pairs; valid in the tiles shaded this frame only), 1 `touched` (the
 //   resolve's draw arguments, a flag per tile, the list of tiles shaded this frame, each
-//   item's shade dispatch arguments and list of bins), 5 `scene_depth` (the host's depth, when
+//   item's list of bins and a flag per item and bin), 5 `scene_depth` (the host's depth, when
 //   its size is the viewport's), 6 `job` (this dispatch's item: dynamic offset).
 // - The resolve (a render pipeline): group 0 as above, group 1: 0 `accum_in`, 1
 //   `touched_in` (the same buffers, read-only).
@@ -65,10 +65,12 @@ const TOUCHED_FLAGS: u32 = 4u;
 // A bin list entry: the sprite (20 bits; src/render/tiles.rs keeps a frame below 2^20
 // sprites), then the first and last tile of the bin it covers (x0, y0, x1, y1, 3 bits each).
 const SPRITE_MASK: u32 = 0xFFFFFu;
+// Sprites a bin workgroup lists (keep in sync with src/render/tiles.rs).
+const BLOCK: u32 = 4096u;
 
 // One dispatch's work: x the item's first sprite, y its quads, z sprites this frame,
-// w the bin lists' stride (entries per bin); `firsts`: every item's first sprite, then
-// the frame's sprites (`items` + 1 entries; y of `counts2`: items).
+// w the bin lists' stride (entries per bin); `counts2`: the item's index, the items, the
+// blocks of BLOCK sprites; `firsts`: every item's first sprite, then the frame's sprites.
 struct TileJob {
     counts: vec4<u32>,
     counts2: vec4<u32>,
@@ -211,7 +213,7 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
 var<workgroup> bits: array<atomic<u32>, 8>;
 var<workgroup> hits: array<u32, 256>;
 var<workgroup> shared_total: u32;
-var<workgroup> shared_run: vec2<u32>;
+var<workgroup> shared_count: u32;
 var<workgroup> shared_flag: u32;
 // The sprite cache of the shade: the fields the pixels read of up to CACHE sprites.
 const CACHE: u32 = 64u;
@@ -240,7 +242,7 @@ fn cache_sprite(k: u32, i: u32) {
     }
 }
 var<workgroup> shared_bin: u32;
-var<workgroup> starts: array<u32, 64>;
+var<workgroup> item_hit: array<atomic<u32>, 64>;
 
 // An order-keeping compaction over the workgroup: how many invocations before `lid` have
 // `hit`; `shared_total` gets their number (read it with workgroupUniformLoad). Every
@@ -270,20 +272,26 @@ fn overlaps(a: vec4<i32>, b: vec4<i32>) -> bool {
     return all(a.xy <= b.zw) && all(b.xy <= a.zw);
 }
 
-// Lists, for one bin, the frame's sprites over it in draw order (an order-keeping
-// compaction: deterministic, whatever the scheduling), then where each item's run starts.
+// Lists, for one bin and one block of BLOCK sprites (workgroup z), the block's sprites over
+// the bin in draw order (an order-keeping compaction: deterministic, whatever the
+// scheduling); blocks run in parallel, so a frame of many sprites bins as fast as a few.
+// Each item with a sprite in the list joins the item's shade for this bin.
 @compute @workgroup_size(256)
 fn bin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     let b = wg.y * nwg.x + wg.x;
     let lo = vec2<i32>(wg.xy * BIN);
     let rect = vec4<i32>(lo, lo + i32(BIN) - 1);
-    let n = job.counts.z;
-    let stride = job.counts.w;
+    let start = wg.z * BLOCK;
+    let end = min(start + BLOCK, job.counts.z);
+    let region = b * job.counts.w + start;
+    if lid < 64u {
+        atomicStore(&item_hit[lid], 0u);
+    }
     var count = 0u;
-    for (var base = 0u; base < n; base += 256u) {
+    for (var base = start; base < end; base += 256u) {
         let i = base + lid;
         var r = vec4<i32>(1, 1, 0, 0);
-        if i < n {
+        if i < end {
             r = sprites[i].bounds;
         }
         let hit = overlaps(r, rect);
@@ -292,36 +300,51 @@ fn bin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<
             // The tiles of this bin it covers ride along: the shade tests them without
             // reading the sprite.
             let t = vec4<u32>(clamp((r - vec4<i32>(lo, lo)) / i32(TILE), vec4<i32>(0), vec4<i32>(i32(BIN_TILES) - 1)));
-            bin_lists[b * stride + count + at] = i | (t.x << 20u) | (t.y << 23u) | (t.z << 26u) | (t.w << 29u);
+            bin_lists[region + count + at] = i | (t.x << 20u) | (t.y << 23u) | (t.z << 26u) | (t.w << 29u);
+            atomicOr(&item_hit[item_of(i)], 1u);
         }
         count += workgroupUniformLoad(&shared_total);
     }
-    // The list's entries, written by the whole workgroup, are read below.
-    storageBarrier();
-    // Item k's run starts at the first entry at or after its first sprite.
-    let items = job.counts2.y;
-    if lid <= items {
-        var at = count;
-        if lid < items {
-            at = lower_bound(b, count, item_first(lid));
-        }
-        bin_meta[b * (MAX_ITEMS + 1u) + lid] = at;
-        starts[lid] = at;
+    if lid == 0u {
+        bin_meta[b * job.counts2.z + wg.z] = count;
     }
     workgroupBarrier();
-    // A bin with some of item k's sprites joins item k's shade (its indirect dispatch:
-    // one workgroup row per such bin, one workgroup per tile of it).
-    if lid < items && starts[lid] < starts[lid + 1u] {
+    // The first block to find some of item k's sprites over this bin adds the bin to item
+    // k's shade (its indirect dispatch: one workgroup row per bin, one workgroup per tile).
+    if lid < job.counts2.y && atomicLoad(&item_hit[lid]) != 0u && atomicExchange(&touched[item_flag(lid, b)], 1u) == 0u {
         let slot = atomicAdd(&dispatch_args[4u * lid], 1u);
         atomicStore(&touched[item_bins(lid) + slot], b);
     }
 }
 
+// The item sprite `i` belongs to (a search of the items' first sprites).
+fn item_of(i: u32) -> u32 {
+    var lo = 0u;
+    var hi = job.counts2.y;
+    while hi - lo > 1u {
+        let mid = (lo + hi) / 2u;
+        if item_first(mid) <= i {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
+// Bins across the target.
+fn bin_count() -> u32 {
+    return ((u32(camera.viewport.x) + BIN - 1u) / BIN) * ((u32(camera.viewport.y) + BIN - 1u) / BIN);
+}
+
 // Where item k's list of bins is in `touched`, after the resolve's arguments, the tile
-// flags and the tile list.
+// flags and the tile list; then a flag per item and bin.
 fn item_bins(k: u32) -> u32 {
-    let bins = ((u32(camera.viewport.x) + BIN - 1u) / BIN) * ((u32(camera.viewport.y) + BIN - 1u) / BIN);
-    return TOUCHED_FLAGS + 2u * tile_count() + k * bins;
+    return TOUCHED_FLAGS + 2u * tile_count() + k * bin_count();
+}
+
+fn item_flag(k: u32, b: u32) -> u32 {
+    return TOUCHED_FLAGS + 2u * tile_count() + (MAX_ITEMS + k) * bin_count() + b;
 }
 
 // Tiles across the target.
@@ -329,20 +352,6 @@ fn tile_count() -> u32 {
     return ((u32(camera.viewport.x) + TILE - 1u) / TILE) * ((u32(camera.viewport.y) + TILE - 1u) / TILE);
 }
 
-// The first entry of bin `b`'s list (`n` entries) at or after sprite `s`.
-fn lower_bound(b: u32, n: u32, s: u32) -> u32 {
-    var lo = 0u;
-    var hi = n;
-    while lo < hi {
-        let mid = (lo + hi) / 2u;
-        if (bin_lists[b * job.counts.w + mid] & SPRITE_MASK) < s {
-            lo = mid + 1u;
-        } else {
-            hi = mid;
-        }
-    }
-    return lo;
-}
 
 // Whether a sprite at NDC depth `z` is in front of the host's geometry at pixel `p`.
 fn visible(p: vec2<i32>, z: f32) -> bool {
@@ -474,15 +483,10 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
     if tile_xy.x >= tiles_x || tile_xy.y * TILE >= u32(camera.viewport.y) {
         return;
     }
-    // The item's sprites are a run of the bin's list.
-    if lid == 0u {
-        let at = b * (MAX_ITEMS + 1u) + job.counts2.x;
-        shared_run = vec2<u32>(bin_meta[at], bin_meta[at + 1u]);
-    }
-    let range = workgroupUniformLoad(&shared_run);
-    let first = range.x;
-    let run = range.y - range.x;
-    if run == 0u {
+    // The item's sprites, block by block of the bin's lists.
+    let first = job.counts.x;
+    let end = first + job.counts.y;
+    if end == first {
         return;
     }
     let origin = vec2<i32>(tile_xy * TILE);
@@ -502,37 +506,46 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
         acc = vec4<f32>(unpack2x16float(v.x), unpack2x16float(v.y));
     }
     var shaded = false;
-    for (var base = 0u; base < run; base += 256u) {
-        // The chunk's sprites over this tile, in order.
-        var hit = false;
-        var s = 0u;
-        if base + lid < run {
-            let e = bin_lists[b * job.counts.w + first + base + lid];
-            s = e & SPRITE_MASK;
-            let t = (vec4<u32>(e) >> vec4<u32>(20u, 23u, 26u, 29u)) & vec4<u32>(7u);
-            hit = all(local >= t.xy) && all(local <= t.zw);
+    for (var c = first / BLOCK; c <= (end - 1u) / BLOCK; c++) {
+        if lid == 0u {
+            shared_count = bin_meta[b * job.counts2.z + c];
         }
-        let at = compact(lid, hit);
-        if hit {
-            hits[at] = s;
-        }
-        let total = workgroupUniformLoad(&shared_total);
-        shaded = shaded || total > 0u;
-        // The hits, 64 at a time: their records read once into workgroup memory (one
-        // invocation each), then every pixel reads them from there.
-        for (var sub = 0u; sub < total; sub += CACHE) {
-            if lid < CACHE && sub + lid < total {
-                cache_sprite(lid, hits[sub + lid]);
+        let n = workgroupUniformLoad(&shared_count);
+        let region = b * job.counts.w + c * BLOCK;
+        for (var base = 0u; base < n; base += 256u) {
+            // The chunk's sprites of this item over this tile, in order.
+            var hit = false;
+            var s = 0u;
+            if base + lid < n {
+                let e = bin_lists[region + base + lid];
+                s = e & SPRITE_MASK;
+                let t = (vec4<u32>(e) >> vec4<u32>(20u, 23u, 26u, 29u)) & vec4<u32>(7u);
+                hit = s >= first && s < end && all(local >= t.xy) && all(local <= t.zw);
             }
-            workgroupBarrier();
-            let m = min(CACHE, total - sub);
-            if inside {
-                for (var k = 0u; k < m; k++) {
-                    acc = shade_sprite(hits[sub + k], k, p, acc);
+            let at = compact(lid, hit);
+            if hit {
+                hits[at] = s;
+            }
+            let total = workgroupUniformLoad(&shared_total);
+            shaded = shaded || total > 0u;
+            // The hits, 64 at a time: their records read once into workgroup memory (one
+            // invocation each), then every pixel reads them from there.
+            for (var sub = 0u; sub < total; sub += CACHE) {
+                if lid < CACHE && sub + lid < total {
+                    cache_sprite(lid, hits[sub + lid]);
                 }
+                workgroupBarrier();
+                let m = min(CACHE, total - sub);
+                if inside {
+                    for (var k = 0u; k < m; k++) {
+                        acc = shade_sprite(hits[sub + k], k, p, acc);
+                    }
+                }
+                workgroupBarrier();
             }
             workgroupBarrier();
         }
+        // No invocation reads this block's count once the next is written.
         workgroupBarrier();
     }
     if inside && shaded {

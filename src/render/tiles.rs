@@ -27,6 +27,9 @@ const SPRITE_BYTES: u64 = 176;
 pub const MAX_ITEMS: usize = 55;
 /// The `touched` buffer's header: the resolve's indirect draw arguments.
 const TOUCHED_FLAGS: u64 = 4;
+/// Sprites one bin workgroup lists (`BLOCK` in tiles.wgsl): the blocks of a frame's
+/// sprites are binned in parallel.
+const BLOCK: u32 = 4096;
 /// Stride of the per-dispatch jobs (the storage offset alignment).
 const JOB_STRIDE: u64 = 256;
 /// The bins' lists may take at most this many bytes: beyond it the frame's tile items
@@ -101,6 +104,12 @@ pub fn grid(size: (u32, u32), cell: u32) -> (u32, u32) {
 fn grid_tiles(size: (u32, u32)) -> u64 {
     let (tx, ty) = grid(size, TILE_PX);
     u64::from(tx) * u64::from(ty)
+}
+
+/// Bins across a target of `size` pixels.
+fn grid_bins(size: (u32, u32)) -> u64 {
+    let (bx, by) = grid(size, BIN_PX);
+    u64::from(bx) * u64::from(by)
 }
 
 /// Whether `sprites` quads fit the tile path's lists at `size`.
@@ -435,7 +444,15 @@ impl TilePass {
             return false;
         };
         self.upload_jobs(ctx, &order, total as u32);
-        enc.clear_buffer(&b.touched, TOUCHED_FLAGS * 4, Some(grid_tiles(size) * 4));
+        // The tile flags, and the item flags after the tile list and the items' bins.
+        let (tiles, bins) = (grid_tiles(size), grid_bins(size));
+        enc.clear_buffer(&b.touched, TOUCHED_FLAGS * 4, Some(tiles * 4));
+        let item_flags = TOUCHED_FLAGS + 2 * tiles + MAX_ITEMS as u64 * bins;
+        enc.clear_buffer(
+            &b.touched,
+            item_flags * 4,
+            Some(MAX_ITEMS as u64 * bins * 4),
+        );
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("TilePass::tiles"),
             timestamp_writes: None,
@@ -449,7 +466,7 @@ impl TilePass {
                 pass.set_bind_group(2, &self.empty_group, &[]);
                 pass.set_bind_group(3, &b.bin_group, &[0]);
                 let bins = grid(size, BIN_PX);
-                pass.dispatch_workgroups(bins.0, bins.1, 1);
+                pass.dispatch_workgroups(bins.0, bins.1, b.capacity.div_ceil(BLOCK));
             }
             for (k, d) in order.iter().enumerate() {
                 let (Some(particles), Some(Some(pipes)), Some(sprite)) = (
@@ -494,9 +511,11 @@ impl TilePass {
         }
         let mut jobs = vec![0u32; order.len() * JOB_STRIDE as usize / 4];
         let items = order.len() as u32;
+        let blocks = b.capacity.div_ceil(BLOCK);
         for (k, job) in jobs.chunks_mut(JOB_STRIDE as usize / 4).enumerate() {
             let n = firsts[k + 1] - firsts[k];
-            job[..8].copy_from_slice(&[firsts[k], n, total, b.capacity, k as u32, items, 0, 0]);
+            let head = [firsts[k], n, total, b.capacity, k as u32, items, blocks, 0];
+            job[..8].copy_from_slice(&head);
             job[8..8 + firsts.len()].copy_from_slice(&firsts);
         }
         ctx.queue
@@ -543,14 +562,14 @@ impl TilePass {
         let c = u64::from(capacity);
         // `touched`: the resolve's arguments, a flag per tile, the shaded tiles, and each
         // item's bins.
-        let touched_words = TOUCHED_FLAGS + 2 * grid_tiles(size) + MAX_ITEMS as u64 * bins;
+        let touched_words = TOUCHED_FLAGS + 2 * grid_tiles(size) + 2 * MAX_ITEMS as u64 * bins;
         let lists = [
             buffer("TilePass::sprites", c * SPRITE_BYTES, none),
             buffer("TilePass::touched", touched_words * 4, indirect),
             buffer("TilePass::bin_lists", bins * c * 4, none),
             buffer(
                 "TilePass::bin_meta",
-                bins * (MAX_ITEMS as u64 + 1) * 4,
+                bins * u64::from(capacity.div_ceil(BLOCK)) * 4,
                 none,
             ),
             buffer(
