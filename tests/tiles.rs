@@ -299,6 +299,33 @@ fn tiles_are_deterministic_and_the_automatic_choice_follows_the_profile() {
             );
         }
     }
+    // A runtime host's batches of instances keep billboards (a grid of torches measured
+    // slower with the tiles).
+    let ctx = base.clone().with_profile(Some(AdapterProfile::GPU));
+    let settings = ignis::PlayerSettings {
+        batch_instances: true,
+        ..ignis::render::Composite::player_settings()
+    };
+    let torch = ignis::preset::load("presets/torch.ron".as_ref()).expect("torch");
+    let mut run = Headless::with_settings(&ctx, torch, ShaderLibrary::embedded(), settings)
+        .expect("headless");
+    // A second torch beside the first: a batch of two.
+    let beside = glam::Mat4::from_translation(glam::vec3(0.5, 0.0, 0.0));
+    run.player.add_instance(beside, 2).expect("instance");
+    for _ in 0..30 {
+        run.advance(1.0 / 60.0);
+    }
+    run.render((960, 540)).expect("render");
+    let items: Vec<(bool, u32)> = run
+        .player
+        .draw_items()
+        .iter()
+        .map(|d| (d.tiles, d.members))
+        .collect();
+    assert!(
+        items.iter().all(|&(tiles, members)| !tiles && members > 1),
+        "batched instances took the tiles: {items:?}"
+    );
     assert!(
         chosen(AdapterProfile::SOFTWARE).iter().all(|(_, t, _)| !t),
         "a software profile took the tiles"

@@ -782,9 +782,14 @@ impl FrameResources {
             && e.look.streak.is_none()
             && match e.look.draw_path {
                 DrawPath::Auto => {
-                    // Billboard fill at most (every quad at the largest size).
+                    // Billboard fill at most (every quad at the largest size). A group of
+                    // several instances (a runtime host's batch) keeps billboards: a grid
+                    // of 100 torches measured 6.5 ms a frame with the tiles, 2.8 without.
                     let fill = (width * n) as f32 * size_px * size_px;
-                    self.auto_tiles && size_px >= TILES_ABOVE_PX && fill >= TILES_MIN_FILL_PX
+                    self.auto_tiles
+                        && n == 1
+                        && size_px >= TILES_ABOVE_PX
+                        && fill >= TILES_MIN_FILL_PX
                 }
                 DrawPath::Tiles => true,
                 DrawPath::Billboard | DrawPath::Splat => false,
