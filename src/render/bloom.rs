@@ -153,18 +153,8 @@ impl BloomPass {
             let make = |entry: &str, variant: usize| {
                 let b = |bit: usize| if variant & bit != 0 { 1.0 } else { 0.0 };
                 let constants = [("QUARTER", b(1)), ("GLOW", b(2))];
-                ctx.device
-                    .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                        label: Some(&format!("BloomPass::{entry}")),
-                        layout: Some(layout),
-                        module,
-                        entry_point: Some(entry),
-                        compilation_options: wgpu::PipelineCompilationOptions {
-                            constants: &constants,
-                            ..Default::default()
-                        },
-                        cache: None,
-                    })
+                let label = format!("BloomPass::{entry}");
+                crate::render::compute_pipeline(ctx, &label, layout, module, entry, &constants)
             };
             BloomPipelines {
                 prefilter: std::array::from_fn(|v| make("prefilter", v)),

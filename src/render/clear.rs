@@ -52,15 +52,7 @@ impl ClearPass {
     ) -> Result<wgpu::ComputePipeline, ShaderError> {
         let composed = lib.compose("clear.wgsl")?;
         create_checked(&ctx.device, &composed, lib, |module| {
-            ctx.device
-                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some("ClearPass::clear"),
-                    layout: Some(layout),
-                    module,
-                    entry_point: Some("clear"),
-                    compilation_options: Default::default(),
-                    cache: None,
-                })
+            crate::render::compute_pipeline(ctx, "ClearPass::clear", layout, module, "clear", &[])
         })
     }
 

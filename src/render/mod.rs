@@ -189,6 +189,29 @@ pub fn resolve_pipeline(
         })
 }
 
+/// A compute pipeline of `entry` in `module` with override `constants`.
+pub fn compute_pipeline(
+    ctx: &GpuContext,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+    constants: &[(&str, f64)],
+) -> wgpu::ComputePipeline {
+    ctx.device
+        .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
+            layout: Some(layout),
+            module,
+            entry_point: Some(entry),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants,
+                ..Default::default()
+            },
+            cache: None,
+        })
+}
+
 /// The compute paths' `DEPTH_TEST` constant for a target: 0 none, 1 a particle nearer
 /// than or level with the host's depth passes, 2 the reverse (reversed Z).
 pub fn depth_test(target: billboard::DrawTarget) -> f64 {

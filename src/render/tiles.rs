@@ -328,18 +328,8 @@ impl TilePass {
         entry: &str,
         constants: &[(&str, f64)],
     ) -> wgpu::ComputePipeline {
-        ctx.device
-            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(&format!("TilePass::{entry}")),
-                layout: Some(layout),
-                module,
-                entry_point: Some(entry),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants,
-                    ..Default::default()
-                },
-                cache: None,
-            })
+        let label = format!("TilePass::{entry}");
+        crate::render::compute_pipeline(ctx, &label, layout, module, entry, constants)
     }
 
     /// The project and shade pipelines of a look variant.

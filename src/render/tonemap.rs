@@ -107,20 +107,8 @@ impl TonemapPass {
                     ("LOW_ALPHA", b(low)),
                     ("GLOW", b(glow)),
                 ];
-                ctx.device
-                    .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                        label: Some(&format!(
-                            "TonemapPass bloom={bloom} low_alpha={low} glow={glow}"
-                        )),
-                        layout: Some(layout),
-                        module,
-                        entry_point: Some("tonemap"),
-                        compilation_options: wgpu::PipelineCompilationOptions {
-                            constants: &constants,
-                            ..Default::default()
-                        },
-                        cache: None,
-                    })
+                let label = format!("TonemapPass bloom={bloom} low_alpha={low} glow={glow}");
+                crate::render::compute_pipeline(ctx, &label, layout, module, "tonemap", &constants)
             };
             std::array::from_fn(make)
         })
