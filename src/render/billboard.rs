@@ -267,20 +267,9 @@ impl BillboardPass {
                 self.ensure_pipeline(ctx, d.variant.with_motion());
             }
             self.sprite_groups.entry(d.sprite.id).or_insert_with(|| {
-                ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("BillboardPass::sprite_group"),
-                    layout: &self.sprite_layout,
-                    entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: wgpu::BindingResource::TextureView(&d.sprite.view),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: wgpu::BindingResource::Sampler(sampler),
-                        },
-                    ],
-                })
+                let label = "BillboardPass::sprite_group";
+                d.sprite
+                    .bind_group(&ctx.device, label, &self.sprite_layout, sampler)
             });
         }
         // Drop bind groups of textures no longer drawn (e.g. a reloaded PNG).

@@ -47,6 +47,31 @@ pub struct SpriteTexture {
 pub const TRIM_THRESHOLD: f32 = 1.0 / 1024.0;
 
 impl SpriteTexture {
+    /// A bind group of this sprite and `sampler` at bindings 0 and 1 of `layout` (the draw
+    /// paths' sprite groups).
+    pub fn bind_group(
+        &self,
+        device: &wgpu::Device,
+        label: &str,
+        layout: &wgpu::BindGroupLayout,
+        sampler: &wgpu::Sampler,
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(label),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&self.view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::Sampler(sampler),
+                },
+            ],
+        })
+    }
+
     /// The part of every frame that holds something above `threshold`, as a `rows ×
     /// cols` flipbook (1 × 1 without one): `[u0, v0, u1, v1]` in frame-local texture
     /// coordinates (v down), the union over all frames, grown by one texel for bilinear

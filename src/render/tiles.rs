@@ -387,21 +387,15 @@ impl TilePass {
                 self.variants.insert(v, p);
             }
             self.sprite_groups.entry(d.sprite.id).or_insert_with(|| {
-                ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("TilePass::sprite_group"),
-                    layout: &self.sprite_layout,
-                    entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: wgpu::BindingResource::TextureView(&d.sprite.view),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: wgpu::BindingResource::Sampler(sampler),
-                        },
-                    ],
-                })
+                let label = "TilePass::sprite_group";
+                d.sprite
+                    .bind_group(&ctx.device, label, &self.sprite_layout, sampler)
             });
+        }
+        // Drop bind groups of textures no longer drawn (e.g. a reloaded PNG).
+        if self.sprite_groups.len() > 32 {
+            let live: std::collections::HashSet<u64> = items.iter().map(|d| d.sprite.id).collect();
+            self.sprite_groups.retain(|id, _| live.contains(id));
         }
     }
 
