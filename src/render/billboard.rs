@@ -73,10 +73,9 @@ pub struct BillboardPass {
     /// Two triangles over a quad's four vertices: 0 1 2, 2 1 3.
     quad_indices: wgpu::Buffer,
     pipeline_layout: wgpu::PipelineLayout,
-    sprite_layout: wgpu::BindGroupLayout,
     module: wgpu::ShaderModule,
     pipelines: HashMap<LookVariant, Option<wgpu::RenderPipeline>>,
-    sprite_groups: HashMap<u64, wgpu::BindGroup>,
+    sprites: crate::render::sprites::SpriteGroups,
 }
 
 impl BillboardPass {
@@ -135,10 +134,12 @@ impl BillboardPass {
             no_depth,
             quad_indices,
             pipeline_layout,
-            sprite_layout,
             module,
             pipelines,
-            sprite_groups: HashMap::new(),
+            sprites: crate::render::sprites::SpriteGroups::new(
+                "BillboardPass::sprite_group",
+                sprite_layout,
+            ),
         })
     }
 
@@ -266,17 +267,9 @@ impl BillboardPass {
             if motion {
                 self.ensure_pipeline(ctx, d.variant.with_motion());
             }
-            self.sprite_groups.entry(d.sprite.id).or_insert_with(|| {
-                let label = "BillboardPass::sprite_group";
-                d.sprite
-                    .bind_group(&ctx.device, label, &self.sprite_layout, sampler)
-            });
+            self.sprites.ensure(ctx, &d.sprite, sampler);
         }
-        // Drop bind groups of textures no longer drawn (e.g. a reloaded PNG).
-        if self.sprite_groups.len() > 32 {
-            let live: std::collections::HashSet<u64> = items.iter().map(|d| d.sprite.id).collect();
-            self.sprite_groups.retain(|id, _| live.contains(id));
-        }
+        self.sprites.keep_drawn(items.iter().map(|d| d.sprite.id));
     }
 
     /// Creates the pipeline of `variant` unless it exists (an invalid one is remembered
@@ -354,7 +347,7 @@ impl BillboardPass {
             let (Some(group), Some(Some(pipeline)), Some(sprite)) = (
                 frame.particle_group(d.key),
                 self.pipelines.get(&v),
-                self.sprite_groups.get(&d.sprite.id),
+                self.sprites.get(d.sprite.id),
             ) else {
                 continue;
             };

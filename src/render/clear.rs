@@ -10,6 +10,9 @@ pub struct ClearPass {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
     pipeline: wgpu::ComputePipeline,
+    /// The group over the last target cleared (the composite's target changes only with
+    /// its size).
+    group: Option<(wgpu::TextureView, wgpu::BindGroup)>,
 }
 
 impl ClearPass {
@@ -42,6 +45,7 @@ impl ClearPass {
             layout,
             pipeline_layout,
             pipeline,
+            group: None,
         })
     }
 
@@ -64,26 +68,32 @@ impl ClearPass {
 
     /// Zeroes `target` (an HDR texture with storage usage, `size` pixels).
     pub fn record(
-        &self,
+        &mut self,
         ctx: &GpuContext,
         enc: &mut wgpu::CommandEncoder,
         target: &wgpu::TextureView,
         size: (u32, u32),
     ) {
-        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("ClearPass::group"),
-            layout: &self.layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(target),
-            }],
-        });
+        if self.group.as_ref().is_none_or(|(view, _)| view != target) {
+            let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("ClearPass::group"),
+                layout: &self.layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(target),
+                }],
+            });
+            self.group = Some((target.clone(), group));
+        }
+        let Some((_, group)) = self.group.as_ref() else {
+            return;
+        };
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("ClearPass"),
             timestamp_writes: None,
         });
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &group, &[]);
+        pass.set_bind_group(0, group, &[]);
         pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
     }
 }

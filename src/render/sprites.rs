@@ -46,32 +46,60 @@ pub struct SpriteTexture {
 /// quads are trimmed to the texels above it (divided by the emitter's intensity).
 pub const TRIM_THRESHOLD: f32 = 1.0 / 1024.0;
 
-impl SpriteTexture {
-    /// A bind group of this sprite and `sampler` at bindings 0 and 1 of `layout` (the draw
-    /// paths' sprite groups).
-    pub fn bind_group(
-        &self,
-        device: &wgpu::Device,
-        label: &str,
-        layout: &wgpu::BindGroupLayout,
-        sampler: &wgpu::Sampler,
-    ) -> wgpu::BindGroup {
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some(label),
+/// A draw path's bind groups of sprites (texture at binding 0, sampler at 1 of its
+/// layout), cached by sprite id.
+pub struct SpriteGroups {
+    label: &'static str,
+    layout: wgpu::BindGroupLayout,
+    groups: std::collections::HashMap<u64, wgpu::BindGroup>,
+}
+
+impl SpriteGroups {
+    /// An empty cache of groups of `layout`.
+    pub fn new(label: &'static str, layout: wgpu::BindGroupLayout) -> Self {
+        Self {
+            label,
             layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&self.view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::Sampler(sampler),
-                },
-            ],
-        })
+            groups: std::collections::HashMap::new(),
+        }
     }
 
+    /// Creates `sprite`'s group with `sampler` unless it exists.
+    pub fn ensure(&mut self, ctx: &GpuContext, sprite: &SpriteTexture, sampler: &wgpu::Sampler) {
+        self.groups.entry(sprite.id).or_insert_with(|| {
+            ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(self.label),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(&sprite.view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::Sampler(sampler),
+                    },
+                ],
+            })
+        });
+    }
+
+    /// Drops the groups of sprites not in `drawn` once there are many (a reloaded PNG is
+    /// a new sprite).
+    pub fn keep_drawn(&mut self, drawn: impl Iterator<Item = u64>) {
+        if self.groups.len() > 32 {
+            let live: std::collections::HashSet<u64> = drawn.collect();
+            self.groups.retain(|id, _| live.contains(id));
+        }
+    }
+
+    /// The group of sprite `id`, if made.
+    pub fn get(&self, id: u64) -> Option<&wgpu::BindGroup> {
+        self.groups.get(&id)
+    }
+}
+
+impl SpriteTexture {
     /// The part of every frame that holds something above `threshold`, as a `rows ×
     /// cols` flipbook (1 × 1 without one): `[u0, v0, u1, v1]` in frame-local texture
     /// coordinates (v down), the union over all frames, grown by one texel for bilinear

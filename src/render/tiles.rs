@@ -55,7 +55,6 @@ pub struct TilePass {
     tile_layout: wgpu::BindGroupLayout,
     /// The resolve's read-only view of the accumulation and the shaded tiles.
     resolve_group_layout: wgpu::BindGroupLayout,
-    sprite_layout: wgpu::BindGroupLayout,
     no_depth: wgpu::TextureView,
     compute_layout: wgpu::PipelineLayout,
     /// The bin's group 3 (the tile group and the shades' dispatch arguments) and layout.
@@ -68,8 +67,7 @@ pub struct TilePass {
     variants: HashMap<LookVariant, Option<[wgpu::ComputePipeline; 2]>>,
     bin: wgpu::ComputePipeline,
     resolve: wgpu::RenderPipeline,
-    /// Compute-visible sprite bind groups by sprite id.
-    sprite_groups: HashMap<u64, wgpu::BindGroup>,
+    sprites: crate::render::sprites::SpriteGroups,
     buffers: Option<TileBuffers>,
     /// Whether the last record shaded anything (the resolve draws only then).
     drawn: bool,
@@ -235,7 +233,6 @@ impl TilePass {
             target,
             tile_layout,
             resolve_group_layout,
-            sprite_layout,
             no_depth: crate::gpu::placeholder_depth(d, "TilePass::no_depth"),
             compute_layout,
             bin_group_layout,
@@ -246,7 +243,10 @@ impl TilePass {
             variants,
             bin,
             resolve,
-            sprite_groups: HashMap::new(),
+            sprites: crate::render::sprites::SpriteGroups::new(
+                "TilePass::sprite_group",
+                sprite_layout,
+            ),
             buffers: None,
             drawn: false,
         })
@@ -386,17 +386,9 @@ impl TilePass {
                     });
                 self.variants.insert(v, p);
             }
-            self.sprite_groups.entry(d.sprite.id).or_insert_with(|| {
-                let label = "TilePass::sprite_group";
-                d.sprite
-                    .bind_group(&ctx.device, label, &self.sprite_layout, sampler)
-            });
+            self.sprites.ensure(ctx, &d.sprite, sampler);
         }
-        // Drop bind groups of textures no longer drawn (e.g. a reloaded PNG).
-        if self.sprite_groups.len() > 32 {
-            let live: std::collections::HashSet<u64> = items.iter().map(|d| d.sprite.id).collect();
-            self.sprite_groups.retain(|id, _| live.contains(id));
-        }
+        self.sprites.keep_drawn(items.iter().map(|d| d.sprite.id));
     }
 
     /// Projects, bins and shades every tile item of `items` (compute), testing against
@@ -418,7 +410,11 @@ impl TilePass {
             .map(|d| u64::from(d.width) * u64::from(d.members))
             .sum();
         self.drawn = false;
-        if total == 0 || !fits(size, total) || order.len() > MAX_ITEMS {
+        if total == 0 {
+            return false;
+        }
+        if !fits(size, total) || order.len() > MAX_ITEMS {
+            // The lists would be too large: their memory goes back.
             self.buffers = None;
             return false;
         }
@@ -456,7 +452,7 @@ impl TilePass {
                 let (Some(particles), Some(Some(pipes)), Some(sprite)) = (
                     frame.particle_group(d.key),
                     self.variants.get(&d.variant),
-                    self.sprite_groups.get(&d.sprite.id),
+                    self.sprites.get(d.sprite.id),
                 ) else {
                     continue;
                 };
