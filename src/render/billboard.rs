@@ -7,7 +7,6 @@ use std::collections::HashMap;
 
 use wgpu::util::DeviceExt;
 
-use crate::effect::BlendMode;
 use crate::gpu::GpuContext;
 use crate::render::frame::{DrawItem, FrameResources, LookVariant};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
@@ -332,13 +331,7 @@ impl BillboardPass {
             .iter()
             .filter(|d| !d.splat && !d.tiles && wanted(d))
             .collect();
-        // Alpha-blended layers in the given order (back to front), then the additive light
-        // grouped by emitter — each emitter's instances share a pipeline and a sprite, so
-        // consecutive draws skip setting them again (light adds up in any order).
-        sorted.sort_by_key(|d| match d.blend {
-            BlendMode::Alpha => (0, 0),
-            BlendMode::Additive => (1, d.index),
-        });
+        sorted.sort_by_key(|d| d.draw_key());
         pass.set_index_buffer(self.quad_indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.set_bind_group(3, &self.depth_group, &[]);
         let mut bound: Option<(LookVariant, u64)> = None;

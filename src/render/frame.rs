@@ -72,6 +72,16 @@ pub struct DrawItem {
 }
 
 impl DrawItem {
+    /// The order of a frame's draws: alpha-blended layers first, as given (back to
+    /// front), then the light by emitter (each emitter's instances share a pipeline and a
+    /// sprite; light adds up in any order).
+    pub fn draw_key(&self) -> (u8, usize) {
+        match self.blend {
+            BlendMode::Alpha => (0, 0),
+            BlendMode::Additive => (1, self.index),
+        }
+    }
+
     /// A large additive billboard that a draft render draws at half resolution
     /// (streaks stay sharp: they are thin however long).
     pub fn is_glow(&self) -> bool {

@@ -9,7 +9,6 @@
 
 use std::collections::HashMap;
 
-use crate::effect::BlendMode;
 use crate::gpu::GpuContext;
 use crate::render::billboard::DrawTarget;
 use crate::render::frame::{DrawItem, FrameResources, LookVariant};
@@ -94,7 +93,7 @@ struct TileBuffers {
 }
 
 /// Tiles and bins across a target of `size` pixels.
-pub fn grid(size: (u32, u32), cell: u32) -> (u32, u32) {
+fn grid(size: (u32, u32), cell: u32) -> (u32, u32) {
     (size.0.div_ceil(cell).max(1), size.1.div_ceil(cell).max(1))
 }
 
@@ -111,7 +110,7 @@ fn grid_bins(size: (u32, u32)) -> u64 {
 }
 
 /// Whether `sprites` quads fit the tile path's lists at `size`.
-pub fn fits(size: (u32, u32), sprites: u64) -> bool {
+fn fits(size: (u32, u32), sprites: u64) -> bool {
     let (bx, by) = grid(size, BIN_PX);
     // A bin list entry holds the sprite's index in 20 bits (`SPRITE_MASK` in tiles.wgsl).
     sprites < 1 << 20 && u64::from(bx * by) * sprites.next_power_of_two() * 4 <= MAX_LIST_BYTES
@@ -119,12 +118,9 @@ pub fn fits(size: (u32, u32), sprites: u64) -> bool {
 
 /// The frame's tile items in draw order: alpha-blended first (as given: back to front),
 /// then the light by emitter (as the billboards draw them).
-pub fn draw_order(items: &[DrawItem]) -> Vec<&DrawItem> {
+fn draw_order(items: &[DrawItem]) -> Vec<&DrawItem> {
     let mut order: Vec<&DrawItem> = items.iter().filter(|d| d.tiles).collect();
-    order.sort_by_key(|d| match d.blend {
-        BlendMode::Alpha => (0, 0),
-        BlendMode::Additive => (1, d.index),
-    });
+    order.sort_by_key(|d| d.draw_key());
     order
 }
 
