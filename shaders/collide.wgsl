@@ -14,6 +14,9 @@ struct Collided {
     pos: vec3<f32>,
     vel: vec3<f32>,
     killed: bool,
+    // An impact: the particle touched a collider moving into it faster than the rest
+    // speed, or was killed by it (a collision event fires).
+    hit: bool,
 }
 
 fn bounce(vel: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
@@ -38,6 +41,7 @@ fn bounce(vel: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 fn collide(old_pos: vec3<f32>, pos_in: vec3<f32>, vel_in: vec3<f32>) -> Collided {
     var pos = pos_in;
     var vel = vel_in;
+    var impact = false;
     let count = u32(params.collide_b.y);
     for (var i = 0u; i < min(count, 4u); i++) {
         let s = params.spheres[i];
@@ -62,22 +66,24 @@ fn collide(old_pos: vec3<f32>, pos_in: vec3<f32>, vel_in: vec3<f32>) -> Collided
         }
         if hit {
             if params.collide_b.z > 0.5 {
-                return Collided(pos, vel, true);
+                return Collided(pos, vel, true, true);
             }
             let contact = select(pos, old_pos + d * t_hit, c > 0.0);
             var n = contact - s.xyz;
             let len = length(n);
             n = select(vec3<f32>(0.0, 1.0, 0.0), n / len, len > 1e-6);
+            impact = impact || -dot(vel, n) > params.collide_b.x;
             pos = s.xyz + n * (s.w * 1.0001);
             vel = bounce(vel, n);
         }
     }
     if params.collide_b.w > 0.5 && pos.y < params.ground.x {
         if params.ground.w > 0.5 {
-            return Collided(pos, vel, true);
+            return Collided(pos, vel, true, true);
         }
+        impact = impact || -vel.y > params.collide_b.x;
         pos.y = params.ground.x;
         vel = bounce(vel, vec3<f32>(0.0, 1.0, 0.0));
     }
-    return Collided(pos, vel, false);
+    return Collided(pos, vel, false, impact);
 }

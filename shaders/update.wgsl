@@ -41,6 +41,9 @@
 #import "collide.wgsl"
 #import "alive_count.wgsl"
 #import "curves.wgsl"
+// The event hooks: events_off.wgsl (no code, no bindings) unless the emitter has events or
+// spawns from them, whose pipelines compose events_on.wgsl in its place.
+#import "events_off.wgsl"
 
 // Stateless mode: this pass only writes the spawn records of this step's window (one
 // invocation per spawn, no other slot is touched); the draw passes evaluate positions in
@@ -168,7 +171,19 @@ fn update_at(slot: u32) -> bool {
     if rel >= params.capacity {
         rel -= params.capacity;
     }
-    if rel < params.spawn_count {
+    let was_alive = is_alive(p);
+    let age_start = p.pos_age.w;
+    var born = false;
+    var hit = false;
+    var finite = true;
+    let from_event = event_birth(slot);
+    if from_event.born {
+        // A child of another emitter's event, born at the event's place this step.
+        p = from_event.p;
+        born = true;
+        alive = is_alive(p);
+    } else if rel < params.spawn_count {
+        born = true;
         // 64-bit spawn counter = base + rel.
         let lo = params.spawn_base_lo + rel;
         let hi = params.spawn_base_hi + select(0u, 1u, lo < rel);
@@ -209,6 +224,7 @@ fn update_at(slot: u32) -> bool {
         if MOD_COLLISIONS {
             let c = collide(p.pos_age.xyz, s.pos, s.vel);
             s = State(c.pos, c.vel);
+            hit = c.hit;
             if c.killed {
                 // Killed on contact: dead, and its age says so.
                 age = life;
@@ -222,8 +238,10 @@ fn update_at(slot: u32) -> bool {
             // Non-finite guard: kill and count, never let NaN reach the draw.
             p = Particle(vec4<f32>(0.0), vec4<f32>(0.0));
             atomicAdd(&counters[1], 1u);
+            finite = false;
         }
     }
+    emit_events(slot, p, born, was_alive && finite, alive, hit, age_start);
     store_state(slot, p);
     return alive;
 }

@@ -7,11 +7,13 @@
 use serde::{Deserialize, Serialize};
 
 mod curve;
+mod events;
 
 pub use curve::{
     CURVE_WIDTH, Curve, MAX_CURVE_KEYS, Param, ParamMode, SHAPES, bake_rows, lookup, lookup_blend,
     rows_key,
 };
+pub use events::{CountRange, Event, MAX_CHILDREN_PER_EVENT, MAX_EVENTS_PER_EMITTER, Trigger};
 
 /// The preset format version this build writes (and the newest it reads).
 pub const CURRENT_VERSION: u32 = 2;
@@ -185,6 +187,10 @@ pub struct Emitter {
     pub seed_offset: u32,
     /// How the particles are drawn.
     pub look: Look,
+    /// Particles of other emitters this emitter's particles spawn (on death, collision,
+    /// birth or over life; see [`Event`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub events: Vec<Event>,
 }
 
 /// A one-shot burst of particles.
@@ -910,6 +916,7 @@ impl Default for Emitter {
             collisions: Collisions::default(),
             seed_offset: 0,
             look: Look::default(),
+            events: Vec::new(),
         }
     }
 }
@@ -1518,6 +1525,7 @@ impl Effect {
                 }
             }
         }
+        self.check_events(&mut c);
         if c.errors.is_empty() {
             Ok(())
         } else {
@@ -1558,6 +1566,9 @@ impl Emitter {
         }
         if !f.speed_over_life.is_constant(1.0) {
             v.push("speed over life");
+        }
+        if !self.events.is_empty() {
+            v.push("events");
         }
         v
     }

@@ -23,6 +23,12 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ),
     ("collide.wgsl", include_str!("../shaders/collide.wgsl")),
     (
+        "events_off.wgsl",
+        include_str!("../shaders/events_off.wgsl"),
+    ),
+    ("events_on.wgsl", include_str!("../shaders/events_on.wgsl")),
+    ("events.wgsl", include_str!("../shaders/events.wgsl")),
+    (
         "alive_count.wgsl",
         include_str!("../shaders/alive_count.wgsl"),
     ),
@@ -68,14 +74,20 @@ pub const TINY_STATE_IO: (&str, &str) = ("state_full.wgsl", "state_tiny.wgsl");
 /// instance's pool a segment of shared buffers (see `params_instanced.wgsl`).
 pub const PARAMS_INSTANCED: (&str, &str) = ("params.wgsl", "params_instanced.wgsl");
 
+/// The update of an emitter with events or fed by them: events_on.wgsl (the hooks and
+/// their bindings) in place of events_off.wgsl (nothing).
+pub const EVENTS_IO: (&str, &str) = ("events_off.wgsl", "events_on.wgsl");
+
 /// Imports that some pipelines replace by another file (see
 /// [`ShaderLibrary::compose_with`]).
-pub const IMPORT_VARIANTS: &[(&str, &str)] = &[PACKED_STATE_IO, TINY_STATE_IO, PARAMS_INSTANCED];
+pub const IMPORT_VARIANTS: &[(&str, &str)] =
+    &[PACKED_STATE_IO, TINY_STATE_IO, PARAMS_INSTANCED, EVENTS_IO];
 
 /// The entry files, one per pipeline family; the others are imported by them.
 pub const ENTRY_FILES: &[&str] = &[
     "update.wgsl",
     "count.wgsl",
+    "events.wgsl",
     "billboard.wgsl",
     "splat.wgsl",
     "tiles.wgsl",

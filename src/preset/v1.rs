@@ -205,6 +205,7 @@ impl From<Emitter> for crate::effect::Emitter {
             collisions: e.collisions,
             seed_offset: e.seed_offset,
             look: e.look.into(),
+            events: Vec::new(),
         }
     }
 }

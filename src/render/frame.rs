@@ -647,7 +647,7 @@ impl FrameResources {
         u.clip_from_sim = view.camera.clip_from_sim(origin).to_cols_array_2d();
         let ground = e.collisions.ground.as_ref().map_or(0.0, |g| g.height_m);
         u.soft[0] = (f64::from(ground) - origin.y) as f32;
-        if Modules::of(e).contains(Modules::STATELESS) {
+        if Modules::in_effect(effect, i).contains(Modules::STATELESS) {
             // Closed-form evaluation at the render time (between the last two steps).
             let planner = sim.planner();
             let t = planner.time_secs - (1.0 - view.alpha as f64) * planner.last_dt_secs as f64;
@@ -808,7 +808,7 @@ impl FrameResources {
             &e.look,
             StateVariant {
                 layout: b.layout,
-                stateless: Modules::of(e).contains(Modules::STATELESS),
+                stateless: Modules::in_effect(first.effect, i).contains(Modules::STATELESS),
             },
         );
         variant.soft_depth = self.soft_depth;

@@ -261,6 +261,12 @@ fn batch_shape(effect: &Effect) -> Vec<(u32, StateLayout)> {
     effect
         .emitters
         .iter()
-        .map(|e| (e.capacity.max(1), StateLayout::of(Modules::of(e))))
+        .enumerate()
+        .map(|(i, e)| {
+            (
+                e.capacity.max(1),
+                StateLayout::of(Modules::in_effect(effect, i)),
+            )
+        })
         .collect()
 }

@@ -50,11 +50,12 @@ pub const BATCH_STATE_BYTES: u64 = 64 << 20;
 /// Steps one record may plan (the parameter blocks of a record live side by side).
 const MAX_STEPS: usize = 32;
 
-/// Whether `effect`'s emitters can be batched (full or packed state, not stateless).
+/// Whether `effect`'s emitters can be batched (full or packed state, not stateless, no
+/// events: a batch runs one dispatch per emitter and step, the events need a scan between).
 pub fn batchable(effect: &Effect) -> bool {
-    effect.emitters.iter().all(|e| {
-        let m = Modules::of(e);
-        !m.contains(Modules::TINY) && !m.contains(Modules::STATELESS)
+    (0..effect.emitters.len()).all(|i| {
+        let m = Modules::in_effect(effect, i);
+        !m.contains(Modules::TINY) && !m.contains(Modules::STATELESS) && !m.has_events()
     })
 }
 
@@ -397,7 +398,7 @@ impl InstanceBatch {
         let update = lock(&self.update);
         // One pipeline per emitter for the batch.
         let pipelines: Vec<Option<&wgpu::ComputePipeline>> = (0..n)
-            .map(|e| update.pipeline(&pipeline_key(effect.emitters.get(e)?)))
+            .map(|e| update.pipeline(&pipeline_key(effect, e)?))
             .collect();
         for (s, widths) in self.planned.chunks(n).enumerate() {
             for (e, pool) in self.pools.iter_mut().enumerate() {

@@ -11,8 +11,10 @@ use crate::gpu::types::{
 };
 use crate::gpu::{GpuContext, GpuError};
 use crate::shaders::{
-    PACKED_STATE_IO, PARAMS_INSTANCED, ShaderError, ShaderLibrary, TINY_STATE_IO, create_checked,
+    EVENTS_IO, PACKED_STATE_IO, PARAMS_INSTANCED, ShaderError, ShaderLibrary, TINY_STATE_IO,
+    create_checked,
 };
+use crate::sim::events::{EmitterEvents, EventHeader, EventPipes, ScanConfig};
 use crate::sim::modules::Modules;
 use crate::sim::planner::{EffectPlanner, LiveWindow};
 
@@ -36,9 +38,10 @@ pub enum SimError {
 /// What specialises an update pipeline: the integrator and the modules compiled in.
 pub type PipelineKey = (Integrator, Modules);
 
-/// The pipeline key an emitter needs.
-pub fn pipeline_key(e: &crate::effect::Emitter) -> PipelineKey {
-    (e.integrator, Modules::of(e))
+/// The pipeline key emitter `i` of `effect` needs.
+pub fn pipeline_key(effect: &Effect, i: usize) -> Option<PipelineKey> {
+    let e = effect.emitters.get(i)?;
+    Some((e.integrator, Modules::in_effect(effect, i)))
 }
 
 /// The update pipelines (one per integrator × module set, built on demand) and their layout.
@@ -57,6 +60,10 @@ pub struct UpdatePass {
     count_alive: bool,
     /// Batched instances (params_instanced.wgsl): parameters are an array in storage.
     batched: bool,
+    /// The event hooks' layout and the event scan.
+    pub(crate) events: EventPipes,
+    /// Groups 0 and 1: the update of an emitter with events.
+    events_pipeline_layout: wgpu::PipelineLayout,
 }
 
 /// How an update pass's pipelines are specialised.
@@ -75,28 +82,27 @@ impl UpdatePass {
     fn new(ctx: &GpuContext, mode: UpdateMode) -> Self {
         let batched = mode == UpdateMode::Batched;
         let storage = crate::gpu::compute_storage_entry;
+        let params_entry = wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                // See params.wgsl: an array of blocks for batched instances.
+                ty: if batched {
+                    wgpu::BufferBindingType::Storage { read_only: true }
+                } else {
+                    wgpu::BufferBindingType::Uniform
+                },
+                has_dynamic_offset: true,
+                min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<SimParams>() as u64),
+            },
+            count: None,
+        };
         let layout = ctx
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("UpdatePass::layout"),
                 entries: &[
-                    wgpu::BindGroupLayoutEntry {
-                        binding: 0,
-                        visibility: wgpu::ShaderStages::COMPUTE,
-                        ty: wgpu::BindingType::Buffer {
-                            // See params.wgsl: an array of blocks for batched instances.
-                            ty: if batched {
-                                wgpu::BufferBindingType::Storage { read_only: true }
-                            } else {
-                                wgpu::BufferBindingType::Uniform
-                            },
-                            has_dynamic_offset: true,
-                            min_binding_size: wgpu::BufferSize::new(
-                                std::mem::size_of::<SimParams>() as u64,
-                            ),
-                        },
-                        count: None,
-                    },
+                    params_entry,
                     storage(1, true),
                     storage(2, false),
                     storage(3, false),
@@ -113,6 +119,14 @@ impl UpdatePass {
                 bind_group_layouts: &[Some(&layout)],
                 immediate_size: 0,
             });
+        let events = EventPipes::new(ctx, params_entry);
+        let events_pipeline_layout =
+            ctx.device
+                .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("UpdatePass::events_pipeline_layout"),
+                    bind_group_layouts: &[Some(&layout), Some(&events.hooks_layout)],
+                    immediate_size: 0,
+                });
         let count_layout = ctx
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -136,6 +150,8 @@ impl UpdatePass {
             files: Vec::new(),
             count_alive: mode == UpdateMode::Counted,
             batched,
+            events,
+            events_pipeline_layout,
         }
     }
 
@@ -166,14 +182,18 @@ impl UpdatePass {
         let packed = compose(Some(PACKED_STATE_IO))?;
         // Tiny-state pipelines: state_tiny.wgsl as the state I/O.
         let tiny = compose(Some(TINY_STATE_IO))?;
+        // Emitters with events or fed by them: the event hooks (full state only).
+        let events = compose(Some(EVENTS_IO))?;
         let mut fresh = HashMap::new();
         for &(integrator, modules) in keys {
-            let composed = if modules.contains(Modules::TINY) {
-                &tiny
+            let (composed, layout) = if modules.has_events() {
+                (&events, &self.events_pipeline_layout)
+            } else if modules.contains(Modules::TINY) {
+                (&tiny, &self.pipeline_layout)
             } else if modules.contains(Modules::PACKED) {
-                &packed
+                (&packed, &self.pipeline_layout)
             } else {
-                &composed
+                (&composed, &self.pipeline_layout)
             };
             let mut constants = modules.constants();
             constants.push(("INTEGRATOR", integrator.index() as f64));
@@ -182,7 +202,7 @@ impl UpdatePass {
                 ctx.device
                     .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                         label: Some("UpdatePass::pipeline"),
-                        layout: Some(&self.pipeline_layout),
+                        layout: Some(layout),
                         module,
                         entry_point: Some("main"),
                         compilation_options: wgpu::PipelineCompilationOptions {
@@ -212,6 +232,7 @@ impl UpdatePass {
                     })
             })
         })?;
+        let scan_files = self.events.rebuild(ctx, lib)?;
         self.pipelines = fresh;
         self.count = Some(count);
         self.files = composed.files;
@@ -219,7 +240,9 @@ impl UpdatePass {
             .files
             .into_iter()
             .chain(tiny.files)
+            .chain(events.files)
             .chain(count_src.files)
+            .chain(scan_files)
         {
             if !self.files.contains(&f) {
                 self.files.push(f);
@@ -278,6 +301,8 @@ pub(super) struct EmitterState {
     /// The spawn counter after the last recorded step (equal to the planner's when the
     /// steps came from it; otherwise the live window is unknown).
     pub(super) spawned_end: u64,
+    /// Event records (a parent) and spawn list (a child).
+    pub(super) events: Option<EmitterEvents>,
 }
 
 /// A buffer for an emitter's baked over-life curves (rows A and B, [`CURVE_WIDTH`]
@@ -498,7 +523,7 @@ impl GpuSim {
         self.emitters.truncate(effect.emitters.len());
         for (i, e) in effect.emitters.iter().enumerate() {
             let capacity = e.capacity.max(1);
-            let layout = StateLayout::of(Modules::of(e));
+            let layout = StateLayout::of(Modules::in_effect(effect, i));
             match self.emitters.get(i) {
                 Some(s) if s.capacity == capacity && s.layout == layout => {}
                 // Switching the layout restarts the pool (nothing to convert in place), and
@@ -552,7 +577,11 @@ impl GpuSim {
             s.life_range = (e.lifetime_secs.min, e.lifetime_secs.max);
             s.seed = effect.seed;
             s.salt = crate::rng::emitter_salt(i as u32, e.seed_offset);
-            let modules = Modules::of(e);
+            let modules = Modules::in_effect(effect, i);
+            if modules.contains(Modules::EVENT_SPAWN) {
+                // The GPU fills this ring: the planner cannot know its live window.
+                s.whole_pool_until = f64::INFINITY;
+            }
             if modules.contains(Modules::CURVES) {
                 upload_over_life(&self.ctx.queue, &s.curves, &mut s.curves_key, e);
             }
@@ -572,7 +601,8 @@ impl GpuSim {
             self.ctx.queue.submit([enc.finish()]);
         }
         let slots = STEPS_PER_SUBMIT * effect.emitters.len().max(1);
-        if slots > self.params_slots {
+        let grown = slots > self.params_slots;
+        if grown {
             self.params_slots = slots;
             self.params_buffer = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("GpuSim::params"),
@@ -591,7 +621,42 @@ impl GpuSim {
         for key in used_keys(effect) {
             lock(&self.update).ensure(&self.ctx, &self.library, key)?;
         }
+        self.sync_events(effect, grown);
         Ok(())
+    }
+
+    /// Matches the event buffers to the effect's events (kept while they fit), and binds
+    /// each parent's scans to its children's lists.
+    fn sync_events(&mut self, effect: &Effect, rebind: bool) {
+        let update = Arc::clone(&self.update);
+        let update = lock(&update);
+        let mut changed = rebind;
+        for i in 0..self.emitters.len() {
+            let capacity = self.emitters[i].capacity;
+            let old = self.emitters[i].events.take();
+            let was = old.as_ref().map(|o| o.hooks.clone());
+            let fresh = EmitterEvents::sync(&self.ctx, &update.events, effect, i, capacity, old);
+            changed |= fresh.as_ref().map(|f| &f.hooks) != was.as_ref();
+            self.emitters[i].events = fresh;
+        }
+        if !changed {
+            return;
+        }
+        let lists: Vec<Option<wgpu::Buffer>> = self
+            .emitters
+            .iter()
+            .map(|s| s.events.as_ref().and_then(|ev| ev.list.clone()))
+            .collect();
+        for s in &mut self.emitters {
+            if let Some(ev) = &mut s.events {
+                ev.bind_scans(
+                    &self.ctx.device,
+                    &update.events,
+                    &self.params_buffer,
+                    &lists,
+                );
+            }
+        }
     }
 
     fn create_state(&mut self, capacity: u32, layout: StateLayout) -> EmitterState {
@@ -640,6 +705,7 @@ impl GpuSim {
             salt: 0,
             whole_pool_until: f64::NEG_INFINITY,
             spawned_end: 0,
+            events: None,
         }
     }
 
@@ -800,6 +866,8 @@ impl GpuSim {
             }
         }
         self.ctx.queue.write_buffer(&self.params_buffer, 0, &blocks);
+        self.write_scan_configs(effect);
+        let order = effect.update_order();
         // One compute pass for as many dispatches as possible (wgpu orders dependent
         // dispatches inside a pass): on lavapipe each pass costs about as much as a small
         // dispatch. GPUs end it where the alive counter must be cleared first.
@@ -818,13 +886,13 @@ impl GpuSim {
                     }
                 }
             }
-            for (e, params) in plan.iter().enumerate() {
-                let (Some(p), Some(em)) = (params, self.emitters.get_mut(e)) else {
+            for &e in &order {
+                let (Some(Some(p)), Some(em)) = (plan.get(e), self.emitters.get_mut(e)) else {
                     continue;
                 };
                 em.spawned_end = (u64::from(p.spawn_base_hi) << 32 | u64::from(p.spawn_base_lo))
                     + u64::from(p.spawn_count);
-                let Some(pipeline) = update.pipelines.get(&pipeline_key(&effect.emitters[e]))
+                let Some(pipeline) = pipeline_key(effect, e).and_then(|k| update.pipelines.get(&k))
                 else {
                     continue;
                 };
@@ -845,19 +913,86 @@ impl GpuSim {
                 if !em.stateless {
                     em.current = 1 - em.current;
                 }
-                if slots == 0 {
-                    // An empty window: nothing in the pool can be alive, both buffers hold
-                    // the same dead slots, so the swap above is all a step does (and the
-                    // cleared counter says zero).
-                    continue;
+                // An empty window: nothing in the pool can be alive, both buffers hold the
+                // same dead slots, so the swap above is all a step does (and the cleared
+                // counter says zero).
+                if slots > 0 {
+                    let pass = crate::gpu::compute_pass(pass, enc, "GpuSim::update");
+                    pass.set_pipeline(pipeline);
+                    pass.set_bind_group(0, group, &[offset]);
+                    if let Some(ev) = &em.events {
+                        pass.set_bind_group(1, &ev.hooks, &[]);
+                    }
+                    let (x, y) = dispatch_size(invocations);
+                    pass.dispatch_workgroups(x, y, 1);
                 }
-                let pass = crate::gpu::compute_pass(pass, enc, "GpuSim::update");
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, group, &[offset]);
-                let (x, y) = dispatch_size(invocations);
-                pass.dispatch_workgroups(x, y, 1);
+                // The parent's events become its children's spawn lists, the same step.
+                if let (Some(ev), Some(scan)) = (&em.events, &update.events.scan) {
+                    for group in ev.scans.iter().filter_map(|sc| sc.group.as_ref()) {
+                        let pass = crate::gpu::compute_pass(pass, enc, "GpuSim::update");
+                        pass.set_pipeline(scan);
+                        pass.set_bind_group(0, group, &[offset]);
+                        pass.dispatch_workgroups(1, 1, 1);
+                    }
+                }
             }
         }
+    }
+
+    /// Writes each scan's settings: the rule, the child's capacity and cap, the offset
+    /// between the parent's and the child's simulation spaces, the inherited velocity.
+    fn write_scan_configs(&self, effect: &Effect) {
+        for (i, s) in self.emitters.iter().enumerate() {
+            let Some(ev) = &s.events else {
+                continue;
+            };
+            let Some(e) = effect.emitters.get(i) else {
+                continue;
+            };
+            for (k, scan) in ev.scans.iter().enumerate() {
+                let origin = |j: usize| {
+                    self.planner
+                        .emitters
+                        .get(j)
+                        .map(|p| p.origin())
+                        .unwrap_or_default()
+                };
+                let delta = (origin(i) - origin(scan.child)).as_vec3();
+                let child_capacity = self.emitters.get(scan.child).map_or(1, |c| c.capacity);
+                let cfg = ScanConfig {
+                    rule_capacity_cap: [
+                        k as u32,
+                        child_capacity,
+                        crate::sim::events::step_cap(effect, i, k),
+                        0,
+                    ],
+                    delta_inherit: [
+                        delta.x,
+                        delta.y,
+                        delta.z,
+                        e.events.get(k).map_or(0.0, |x| x.inherit_velocity),
+                    ],
+                };
+                self.ctx
+                    .queue
+                    .write_buffer(&scan.config, 0, bytemuck::bytes_of(&cfg));
+            }
+        }
+    }
+
+    /// Emitter `index`'s spawn-list header (a child of an event): this step's children,
+    /// and those the events asked for and the cap dropped since the start.
+    pub fn read_event_header(&self, index: usize) -> Result<Option<EventHeader>, SimError> {
+        let Some(list) = self
+            .emitters
+            .get(index)
+            .and_then(|s| s.events.as_ref())
+            .and_then(|ev| ev.list.as_ref())
+        else {
+            return Ok(None);
+        };
+        let bytes = read_buffer(&self.ctx, list, size_of::<EventHeader>() as u64)?;
+        Ok(Some(bytemuck::pod_read_unaligned(&bytes)))
     }
 
     /// Writes the birth-table entries of the batches `plans` spawned for tiny emitter `e`
@@ -1162,6 +1297,9 @@ impl GpuSim {
                 enc.clear_buffer(b, 0, None);
             }
             enc.clear_buffer(&s.counters, 0, None);
+            if let Some(list) = s.events.as_ref().and_then(|ev| ev.list.as_ref()) {
+                enc.clear_buffer(list, 0, None);
+            }
             s.current = 0;
             s.whole_pool_until = f64::NEG_INFINITY;
             s.spawned_end = 0;
@@ -1185,7 +1323,9 @@ pub fn dispatch_size(slots: u32) -> (u32, u32) {
 
 /// Every pipeline key the effect uses (so only those pipelines are built).
 pub fn used_keys(effect: &Effect) -> Vec<PipelineKey> {
-    let mut v: Vec<PipelineKey> = effect.emitters.iter().map(pipeline_key).collect();
+    let mut v: Vec<PipelineKey> = (0..effect.emitters.len())
+        .filter_map(|i| pipeline_key(effect, i))
+        .collect();
     v.sort_by_key(|(i, m)| (i.index(), *m));
     v.dedup();
     if v.is_empty() {

@@ -3,6 +3,7 @@
 
 pub mod batch;
 pub mod cpu_reference;
+pub mod events;
 pub mod gpu_sim;
 pub mod modules;
 pub mod planner;

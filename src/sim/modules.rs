@@ -33,9 +33,13 @@ impl Modules {
     pub const TINY: Modules = Modules(1024);
     /// Over-life multipliers (speed, drag, turbulence, flame pull) read from baked curves.
     pub const CURVES: Modules = Modules(2048);
+    /// Events: the update writes each particle's events for the scan (events_on.wgsl).
+    pub const EVENTS: Modules = Modules(4096);
+    /// Spawning from another emitter's events instead of the emitter's own rate.
+    pub const EVENT_SPAWN: Modules = Modules(8192);
 
     /// Every module with its override-constant name.
-    pub const ALL: [(Modules, &'static str); 12] = [
+    pub const ALL: [(Modules, &'static str); 14] = [
         (Self::DRAG, "MOD_DRAG"),
         (Self::GUSTS, "MOD_GUSTS"),
         (Self::QUADRATIC_DRAG, "MOD_QUADRATIC_DRAG"),
@@ -48,6 +52,8 @@ impl Modules {
         (Self::PACKED, "MOD_PACKED"),
         (Self::TINY, "MOD_TINY"),
         (Self::CURVES, "MOD_CURVES"),
+        (Self::EVENTS, "MOD_EVENTS"),
+        (Self::EVENT_SPAWN, "MOD_EVENT_SPAWN"),
     ];
 
     /// The modules an emitter's settings need.
@@ -88,7 +94,10 @@ impl Modules {
         if over_life_params(e).iter().any(|p| !p.is_constant(1.0)) {
             m.0 |= Self::CURVES.0;
         }
-        if e.stateless && e.stateless_blockers().is_empty() {
+        if !e.events.is_empty() {
+            // A parent reads its particles' whole state every step: the full layout.
+            m.0 |= Self::EVENTS.0;
+        } else if e.stateless && e.stateless_blockers().is_empty() {
             m.0 |= Self::STATELESS.0;
         } else if e.tiny_state {
             m.0 |= Self::TINY.0;
@@ -96,6 +105,27 @@ impl Modules {
             m.0 |= Self::PACKED.0;
         }
         m
+    }
+
+    /// The modules emitter `i` of `effect` needs: [`Modules::of`], and for an emitter
+    /// fed by another's events the event spawn on the full state (its ring is filled by
+    /// the GPU, which packed, tiny and stateless pools cannot follow).
+    pub fn in_effect(effect: &crate::effect::Effect, i: usize) -> Modules {
+        let Some(e) = effect.emitters.get(i) else {
+            return Modules(0);
+        };
+        let m = Self::of(e);
+        if effect.event_fed(i) {
+            let layout = Self::STATELESS.0 | Self::PACKED.0 | Self::TINY.0;
+            Modules((m.0 & !layout) | Self::EVENT_SPAWN.0)
+        } else {
+            m
+        }
+    }
+
+    /// True when the update composes the event hooks (events_on.wgsl).
+    pub fn has_events(self) -> bool {
+        self.0 & (Self::EVENTS.0 | Self::EVENT_SPAWN.0) != 0
     }
 
     /// True when every module of `other` is in `self`.

@@ -157,7 +157,19 @@ impl EffectPlanner {
                 sink(i, None);
                 continue;
             }
-            p.plan_step_into(e, effect.seed, i as u32, t0, dt_secs, revision, &mut params);
+            let fed = effect.event_fed(i);
+            p.plan_step_into(
+                e,
+                effect.seed,
+                i as u32,
+                t0,
+                dt_secs,
+                revision,
+                fed,
+                &mut params,
+            );
+            // The step's number: the event scan stamps a child's list with it.
+            params.tiny_b[2] = self.step_index as u32;
             sink(i, Some(&params));
         }
         self.time_secs += dt_secs as f64;
@@ -182,12 +194,22 @@ impl EmitterPlanner {
         dt_secs: f32,
     ) -> SimParams {
         let mut params = SimParams::default();
-        self.plan_step_into(e, seed, emitter_index, t0_secs, dt_secs, None, &mut params);
+        self.plan_step_into(
+            e,
+            seed,
+            emitter_index,
+            t0_secs,
+            dt_secs,
+            None,
+            false,
+            &mut params,
+        );
         params
     }
 
     /// [`EmitterPlanner::plan_step`] into `out`, reusing the step-independent part of the
-    /// block while `revision` (of the emitter, its seed and place) stays the same.
+    /// block while `revision` (of the emitter, its seed and place) stays the same. `fed`:
+    /// the emitter spawns from another's events only (no rate, no bursts).
     #[allow(clippy::too_many_arguments)]
     fn plan_step_into(
         &mut self,
@@ -197,6 +219,7 @@ impl EmitterPlanner {
         t0_secs: f64,
         dt_secs: f32,
         revision: Option<u64>,
+        fed: bool,
         out: &mut SimParams,
     ) {
         let dt = dt_secs as f64;
@@ -204,7 +227,11 @@ impl EmitterPlanner {
         // The emitter's own clock (it stands still while the emitter is disabled).
         let c0 = self.clock_secs;
         // Spawns the continuous rate asks for over [c0, c0 + dt].
-        let expected = expected_spawns(&e.spawn_rate_per_sec, seed, salt, c0, dt);
+        let expected = if fed {
+            0.0
+        } else {
+            expected_spawns(&e.spawn_rate_per_sec, seed, salt, c0, dt)
+        };
         let acc_before = self.accumulator;
         self.accumulator += expected;
         let continuous = self.accumulator.floor();
@@ -219,6 +246,7 @@ impl EmitterPlanner {
         let burst: u64 = e
             .bursts
             .iter()
+            .filter(|_| !fed)
             .filter(|b| {
                 let t = b.time_secs as f64;
                 t >= t0_secs && t < t0_secs + dt

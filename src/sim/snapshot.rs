@@ -28,6 +28,9 @@ struct EmitterSnapshot {
     births_mirror: VecDeque<(u64, Birth)>,
     whole_pool_until: f64,
     spawned_end: u64,
+    /// A child's event-list header (its ring head, the last step's children and stamp,
+    /// the dropped count): the list's entries are rewritten every step before use.
+    event_header: Option<wgpu::Buffer>,
 }
 
 impl SimSnapshot {
@@ -62,7 +65,24 @@ impl GpuSim {
                     bytes += b.size();
                     copy
                 });
+                let event_header = s
+                    .events
+                    .as_ref()
+                    .and_then(|ev| ev.list.as_ref())
+                    .map(|list| {
+                        let size = size_of::<crate::sim::events::EventHeader>() as u64;
+                        let copy = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                            label: Some("SimSnapshot::event_header"),
+                            size,
+                            usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                            mapped_at_creation: false,
+                        });
+                        enc.copy_buffer_to_buffer(list, 0, &copy, 0, size);
+                        bytes += size;
+                        copy
+                    });
                 EmitterSnapshot {
+                    event_header,
                     generation: s.generation,
                     buffers,
                     current: s.current,
@@ -96,6 +116,12 @@ impl GpuSim {
                 enc.copy_buffer_to_buffer(copy, 0, b, 0, b.size());
             }
             enc.clear_buffer(&s.counters, 0, None);
+            let list = s.events.as_ref().and_then(|ev| ev.list.as_ref());
+            if let (Some(list), Some(header)) = (list, &k.event_header) {
+                enc.copy_buffer_to_buffer(header, 0, list, 0, header.size());
+            } else if let Some(list) = list {
+                enc.clear_buffer(list, 0, None);
+            }
             s.current = k.current;
             s.whole_pool_until = k.whole_pool_until;
             s.spawned_end = k.spawned_end;

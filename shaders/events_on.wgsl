@@ -1,0 +1,168 @@
+// events_on.wgsl — the update's event hooks (composed in place of events_off.wgsl for an
+// emitter with events, or one that spawns from them). Group 1: binding 0 this emitter's
+// event records (written), binding 1 the spawn list its parent's event feeds (read).
+//
+// Contract:
+// - MOD_EVENTS (a parent): every visited slot writes one record per rule — its position,
+//   velocity, how many children it spawns this step (0 when no event fired) and a key
+//   (seed, slot, the particle's spawn counter, rule, event ordinal) that the children's
+//   randomness comes from. Records of slots outside the window are stale: the scan
+//   (events.wgsl) reads the window only.
+// - MOD_EVENT_SPAWN (a child): the slots [head, head + count) of the ring (the list's
+//   header, written by the scan this step — `stamp` says which step) are born at the
+//   event's position plus the child's own shape offset, with the velocity of its own
+//   spawn settings plus the inherited part of the parent's.
+// Mirrored by `src/sim/events.rs` (the CPU reference of counts, keys and the scan).
+#import "common.wgsl"
+#import "rng.wgsl"
+
+override MOD_EVENTS: bool = false;
+override MOD_EVENT_SPAWN: bool = false;
+
+const TRIGGER_DEATH: u32 = 0u;
+const TRIGGER_COLLISION: u32 = 1u;
+const TRIGGER_BIRTH: u32 = 2u;
+const TRIGGER_OVER_LIFE: u32 = 3u;
+// A rule slot with no event.
+const TRIGGER_NONE: u32 = 0xFFFFFFFFu;
+// Keep in sync with MAX_CHILDREN_PER_EVENT (src/effect/events.rs).
+const MAX_CHILDREN: u32 = 64u;
+
+struct EventRule {
+    trigger: u32,
+    count_min: u32,
+    count_max: u32,
+    rate: f32,
+}
+
+struct EventRecord {
+    // xyz: position (the parent's simulation space), w: children (u32 bits).
+    pos_count: vec4<f32>,
+    // xyz: velocity, w: the event's key (u32 bits).
+    vel_key: vec4<f32>,
+}
+
+struct EventOut {
+    rules: array<EventRule, 2>,
+    records: array<EventRecord>,
+}
+
+struct EventSpawn {
+    // xyz: position in the child's simulation space, w: the event's key (u32 bits).
+    pos_key: vec4<f32>,
+    // xyz: the inherited velocity, w: the child's index within its event (u32 bits).
+    vel_j: vec4<f32>,
+}
+
+struct EventIn {
+    head: u32,
+    count: u32,
+    stamp: u32,
+    dropped: u32,
+    total: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+    list: array<EventSpawn>,
+}
+
+@group(1) @binding(0) var<storage, read_write> event_out: EventOut;
+@group(1) @binding(1) var<storage, read> event_in: EventIn;
+
+struct EventBirth {
+    born: bool,
+    p: Particle,
+}
+
+fn event_birth(slot: u32) -> EventBirth {
+    var out = EventBirth(false, Particle(vec4<f32>(0.0), vec4<f32>(0.0)));
+    if !MOD_EVENT_SPAWN || event_in.stamp != params.tiny_b.z {
+        return out;
+    }
+    var rel = slot + params.capacity - event_in.head;
+    if rel >= params.capacity {
+        rel -= params.capacity;
+    }
+    if rel >= event_in.count {
+        return out;
+    }
+    let s = event_in.list[rel];
+    let key = child_key(params.seed, params.emitter_salt, bitcast<u32>(s.pos_key.w), bitcast<u32>(s.vel_j.w));
+    let q = spawn_particle(slot, key);
+    // The child's own shape, centred on the event.
+    let offset = q.pos_age.xyz - params.world_from_emitter[3].xyz;
+    out.born = true;
+    out.p = Particle(
+        vec4<f32>(s.pos_key.xyz + offset, 0.0),
+        vec4<f32>(q.vel_life.xyz + s.vel_j.xyz, q.vel_life.w),
+    );
+    return out;
+}
+
+// The random stream of the j-th child of the event `event_key`.
+fn child_key(seed: u32, salt: u32, event_key: u32, j: u32) -> vec4<u32> {
+    return pcg4d(vec4<u32>(seed, salt ^ 0xE7E7E7E7u, event_key, j * 0x9E3779B9u));
+}
+
+// The key of rule `e`'s event of the particle with spawn counter `counter` in `slot`; the
+// ordinal tells apart several events of one life (collisions, over-life children).
+fn event_key(slot: u32, counter: vec2<u32>, e: u32, ordinal: u32) -> u32 {
+    let h = pcg4d(vec4<u32>(params.seed ^ (slot * 0x9E3779B9u), counter.x, counter.y ^ (e << 28u), ordinal));
+    return h.x ^ params.emitter_salt;
+}
+
+fn emit_events(slot: u32, p: Particle, born: bool, was_alive: bool, alive: bool, hit: bool, age_start: f32) {
+    if !MOD_EVENTS {
+        return;
+    }
+    // The particle's spawn counter: the ring has spawned base + count after this step.
+    let total_lo = params.spawn_base_lo + params.spawn_count;
+    let total_hi = params.spawn_base_hi + select(0u, 1u, total_lo < params.spawn_count);
+    var head = params.spawn_head + params.spawn_count;
+    if head >= params.capacity {
+        head -= params.capacity;
+    }
+    let counter = slot_counter(slot, head, total_lo, total_hi, params.capacity);
+    let lived = born || was_alive;
+    for (var e = 0u; e < 2u; e++) {
+        let rule = event_out.rules[e];
+        if rule.trigger == TRIGGER_NONE {
+            continue;
+        }
+        var fired = false;
+        var n = 0u;
+        var ordinal = 0u;
+        switch rule.trigger {
+            case TRIGGER_DEATH: {
+                fired = lived && !alive;
+            }
+            case TRIGGER_COLLISION: {
+                fired = lived && hit;
+                ordinal = bitcast<u32>(p.pos_age.w);
+            }
+            case TRIGGER_BIRTH: {
+                fired = born;
+            }
+            default: {
+                // Over life: the children due between the step's start and end ages.
+                if lived {
+                    let a0 = select(age_start, 0.0, born);
+                    let a1 = min(p.pos_age.w, p.vel_life.w);
+                    let k0 = floor(rule.rate * a0);
+                    n = u32(max(floor(rule.rate * a1) - k0, 0.0));
+                    ordinal = u32(k0);
+                }
+            }
+        }
+        let key = event_key(slot, counter, e, ordinal);
+        if fired {
+            let span = rule.count_max - rule.count_min + 1u;
+            n = rule.count_min + pcg4d(vec4<u32>(key, params.seed, e, 0xC0u)).y % span;
+        }
+        n = min(n, MAX_CHILDREN);
+        event_out.records[e * params.capacity + slot_base + slot] = EventRecord(
+            vec4<f32>(p.pos_age.xyz, bitcast<f32>(n)),
+            vec4<f32>(p.vel_life.xyz, bitcast<f32>(key)),
+        );
+    }
+}

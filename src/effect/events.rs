@@ -1,0 +1,224 @@
+//! Events: a parent emitter's particles spawn particles of another emitter of the same
+//! effect when they die, collide, are born, or at a rate while they live.
+//!
+//! The events are listed on the parent ([`crate::effect::Emitter::events`]); the emitter an
+//! event names (the child) then spawns only from events — its own rate and bursts are
+//! not used — and both run the full 32-byte state (stateless, packed and tiny state are
+//! off for them). A child is fed by one event at most; chains (a child that is itself a
+//! parent) are allowed, cycles are not.
+
+use serde::{Deserialize, Serialize};
+
+use super::{Checker, Effect};
+
+/// The most events one emitter can list.
+pub const MAX_EVENTS_PER_EMITTER: usize = 2;
+
+/// The most children one parent particle can spawn per event and step.
+pub const MAX_CHILDREN_PER_EVENT: u32 = 64;
+
+/// What makes a parent particle spawn children.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Trigger {
+    /// The step the particle dies (its age reaches its lifetime, or a collider kills it).
+    #[default]
+    Death,
+    /// Each step the particle hits the ground or a sphere faster than the rest speed.
+    Collision,
+    /// The step the particle is born.
+    Birth,
+    /// Continuously while the particle lives, `rate_per_sec` children per second each.
+    OverLife,
+}
+
+impl Trigger {
+    /// Every trigger, in the panel's order.
+    pub const ALL: [Trigger; 4] = [
+        Trigger::Death,
+        Trigger::Collision,
+        Trigger::Birth,
+        Trigger::OverLife,
+    ];
+
+    /// The shaders' trigger number (`TRIGGER_*` in `shaders/events_on.wgsl`).
+    pub fn index(self) -> u32 {
+        self as u32
+    }
+
+    /// A short name for the panel.
+    pub fn label(self) -> &'static str {
+        match self {
+            Trigger::Death => "on death",
+            Trigger::Collision => "on collision",
+            Trigger::Birth => "on birth",
+            Trigger::OverLife => "over life",
+        }
+    }
+}
+
+/// An inclusive range of whole numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CountRange {
+    /// Fewest.
+    pub min: u32,
+    /// Most.
+    pub max: u32,
+}
+
+/// One event of a parent emitter: when its particles spawn children, and how many.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Event {
+    /// When a parent particle spawns.
+    pub trigger: Trigger,
+    /// The child emitter's name (another emitter of the same effect).
+    pub emitter: String,
+    /// Children per event (death, collision, birth), each event drawing its own count.
+    pub count: CountRange,
+    /// Children per second per living parent (`OverLife` only).
+    pub rate_per_sec: f32,
+    /// The fraction of the parent's velocity a child starts with, added to the velocity
+    /// its own spawn settings give it.
+    pub inherit_velocity: f32,
+    /// At most this many children per step (whole effect); the rest are dropped and
+    /// counted in the child's statistics.
+    pub max_per_step: u32,
+}
+
+impl Default for Event {
+    fn default() -> Self {
+        Self {
+            trigger: Trigger::Death,
+            emitter: String::new(),
+            count: CountRange { min: 1, max: 1 },
+            rate_per_sec: 10.0,
+            inherit_velocity: 0.3,
+            max_per_step: 1024,
+        }
+    }
+}
+
+impl Effect {
+    /// The event feeding emitter `child`, as (parent index, event index), if any.
+    pub fn event_source(&self, child: usize) -> Option<(usize, usize)> {
+        let name = &self.emitters.get(child)?.name;
+        self.emitters.iter().enumerate().find_map(|(p, e)| {
+            e.events
+                .iter()
+                .position(|ev| &ev.emitter == name)
+                .map(|k| (p, k))
+        })
+    }
+
+    /// True when emitter `i` spawns from another emitter's events.
+    pub fn event_fed(&self, i: usize) -> bool {
+        self.event_source(i).is_some()
+    }
+
+    /// The index of the emitter an event names.
+    pub fn event_target(&self, event: &Event) -> Option<usize> {
+        self.emitters.iter().position(|e| e.name == event.emitter)
+    }
+
+    /// The emitters in update order: every parent before the children its events feed
+    /// (they read the parent's events the same step), otherwise in effect order.
+    pub fn update_order(&self) -> Vec<usize> {
+        let n = self.emitters.len();
+        let parent: Vec<Option<usize>> = (0..n)
+            .map(|i| self.event_source(i).map(|(p, _)| p))
+            .collect();
+        // Depth in the event chain (cycles are rejected by validation; capped anyway).
+        let depth = |mut i: usize| {
+            let mut d = 0;
+            while let Some(p) = parent[i] {
+                d += 1;
+                i = p;
+                if d > n {
+                    break;
+                }
+            }
+            d
+        };
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by_key(|&i| (depth(i), i));
+        order
+    }
+
+    /// The events' problems: unknown or self targets, a child fed twice, cycles, counts.
+    pub(super) fn check_events(&self, c: &mut Checker) {
+        let mut fed = std::collections::HashMap::new();
+        for (i, e) in self.emitters.iter().enumerate() {
+            if e.events.len() > MAX_EVENTS_PER_EMITTER {
+                c.push(
+                    format!("emitters[{i}].events"),
+                    e.events.len(),
+                    &format!("an emitter lists at most {MAX_EVENTS_PER_EMITTER} events"),
+                );
+            }
+            for (k, ev) in e.events.iter().enumerate() {
+                let p = |f: &str| format!("emitters[{i}].events[{k}].{f}");
+                match self.event_target(ev) {
+                    None => c.push(
+                        p("emitter"),
+                        format!("{:?}", ev.emitter),
+                        "names no emitter of this effect; use another emitter's name",
+                    ),
+                    Some(t) if t == i => c.push(
+                        p("emitter"),
+                        format!("{:?}", ev.emitter),
+                        "an emitter cannot feed itself; add a second emitter for the children",
+                    ),
+                    Some(t) => {
+                        if let Some(first) = fed.insert(t, (i, k)) {
+                            c.push(
+                                p("emitter"),
+                                format!("{:?}", ev.emitter),
+                                &format!(
+                                    "is already fed by emitters[{}].events[{}]; an emitter \
+                                     spawns from one event",
+                                    first.0, first.1
+                                ),
+                            );
+                        }
+                    }
+                }
+                if ev.count.min > ev.count.max || ev.count.max > MAX_CHILDREN_PER_EVENT {
+                    c.push(
+                        p("count"),
+                        format!("{}..={}", ev.count.min, ev.count.max),
+                        &format!("must be min ≤ max ≤ {MAX_CHILDREN_PER_EVENT}"),
+                    );
+                }
+                c.num(|| p("rate_per_sec"), ev.rate_per_sec, 0.0, 1000.0);
+                c.num(|| p("inherit_velocity"), ev.inherit_velocity, -10.0, 10.0);
+                if ev.max_per_step == 0 || ev.max_per_step > 1 << 20 {
+                    c.push(p("max_per_step"), ev.max_per_step, "must be in 1..=1048576");
+                }
+            }
+        }
+        self.check_event_cycles(c);
+    }
+
+    fn check_event_cycles(&self, c: &mut Checker) {
+        let n = self.emitters.len();
+        for start in 0..n {
+            let mut i = start;
+            for _ in 0..=n {
+                match self.event_source(i) {
+                    Some((p, k)) if p == start => {
+                        c.push(
+                            format!("emitters[{p}].events[{k}].emitter"),
+                            format!("{:?}", self.emitters[p].events[k].emitter),
+                            "closes a cycle of events (an emitter would feed itself through \
+                             others); remove one event of the cycle",
+                        );
+                        return;
+                    }
+                    Some((p, _)) => i = p,
+                    None => break,
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,464 @@
+//! Events on the GPU: a parent's update writes one record per slot and rule
+//! (`shaders/events_on.wgsl`), a scan turns a rule's records into its child's spawn list
+//! in slot order (`shaders/events.wgsl`), and the child's update spawns from the list the
+//! same step. Deterministic: nothing depends on the order threads run in.
+//!
+//! This file holds the buffers' layouts, the scan pipeline, each emitter's event buffers
+//! and the CPU mirror of the counts, keys and scan (the tests hold the GPU to it).
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::effect::{Effect, Emitter, MAX_CHILDREN_PER_EVENT, MAX_EVENTS_PER_EMITTER};
+use crate::gpu::types::{Particle, SimParams, slot_counter};
+use crate::gpu::{GpuContext, compute_storage_entry};
+use crate::rng::pcg4d;
+use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
+
+/// A rule slot with no event (`TRIGGER_NONE`).
+const TRIGGER_NONE: u32 = u32::MAX;
+
+/// One rule of a parent, as the update reads it (`EventRule` in the shaders).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct EventRule {
+    /// [`Trigger::index`], or `u32::MAX` for none.
+    pub trigger: u32,
+    /// Fewest children per event.
+    pub count_min: u32,
+    /// Most children per event.
+    pub count_max: u32,
+    /// Over life: children per second.
+    pub rate: f32,
+}
+
+/// One parent slot's record for one rule (`EventRecord`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct EventRecord {
+    /// Position, and the children (u32 bits).
+    pub pos_count: [f32; 4],
+    /// Velocity, and the event's key (u32 bits).
+    pub vel_key: [f32; 4],
+}
+
+/// One entry of a child's spawn list (`EventSpawn`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct EventSpawn {
+    /// Position in the child's simulation space, and the event's key (u32 bits).
+    pub pos_key: [f32; 4],
+    /// The inherited velocity, and the child's index in its event (u32 bits).
+    pub vel_j: [f32; 4],
+}
+
+/// The head of a child's spawn list (the first 32 bytes of `EventIn`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct EventHeader {
+    /// The ring slot of this step's first child.
+    pub head: u32,
+    /// Children this step.
+    pub count: u32,
+    /// The step number the scan last ran at.
+    pub stamp: u32,
+    /// Children dropped by the per-step cap, since the start.
+    pub dropped: u32,
+    /// Children the events asked for, since the start.
+    pub total: u32,
+    /// Padding.
+    pub pad: [u32; 3],
+}
+
+/// One rule's scan settings (`ScanConfig` in `shaders/events.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ScanConfig {
+    /// The rule's index, the child's capacity, the most children a step, unused.
+    pub rule_capacity_cap: [u32; 4],
+    /// The parent's simulation origin minus the child's, and the inherited fraction.
+    pub delta_inherit: [f32; 4],
+}
+
+/// Bytes before the records of a parent's buffer (the two rules).
+const RULES_BYTES: u64 = (MAX_EVENTS_PER_EMITTER * size_of::<EventRule>()) as u64;
+
+/// The update's rules of emitter `e` (unused slots say none).
+pub fn rules_of(e: &Emitter) -> [EventRule; MAX_EVENTS_PER_EMITTER] {
+    let mut rules = [EventRule {
+        trigger: TRIGGER_NONE,
+        ..Default::default()
+    }; MAX_EVENTS_PER_EMITTER];
+    for (r, ev) in rules.iter_mut().zip(&e.events) {
+        *r = EventRule {
+            trigger: ev.trigger.index(),
+            count_min: ev.count.min,
+            count_max: ev.count.max.max(ev.count.min),
+            rate: ev.rate_per_sec,
+        };
+    }
+    rules
+}
+
+/// The most children a step of event `k` of `parent` can spawn into `child`.
+pub fn step_cap(effect: &Effect, parent: usize, k: usize) -> u32 {
+    let ev = &effect.emitters[parent].events[k];
+    let child = effect
+        .event_target(ev)
+        .map_or(1, |c| effect.emitters[c].capacity);
+    ev.max_per_step.min(child).max(1)
+}
+
+/// The layouts and the scan pipeline (one per update pass).
+pub struct EventPipes {
+    /// Group 1 of an update with events: the records (written), the spawn list (read).
+    pub hooks_layout: wgpu::BindGroupLayout,
+    scan_layout: wgpu::BindGroupLayout,
+    scan_pipeline_layout: wgpu::PipelineLayout,
+    /// The scan, built from `events.wgsl`.
+    pub scan: Option<wgpu::ComputePipeline>,
+    /// Group 1 for updates with events but no parent or child role in it (placeholders).
+    placeholder: wgpu::Buffer,
+}
+
+impl EventPipes {
+    /// The layouts; the scan is built by [`EventPipes::rebuild`].
+    pub fn new(ctx: &GpuContext, params_entry: wgpu::BindGroupLayoutEntry) -> Self {
+        let device = &ctx.device;
+        let hooks_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("EventPipes::hooks_layout"),
+            entries: &[
+                compute_storage_entry(0, false),
+                compute_storage_entry(1, true),
+            ],
+        });
+        let scan_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("EventPipes::scan_layout"),
+            entries: &[
+                params_entry,
+                compute_storage_entry(1, true),
+                compute_storage_entry(2, false),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let scan_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("EventPipes::scan_pipeline_layout"),
+            bind_group_layouts: &[Some(&scan_layout)],
+            immediate_size: 0,
+        });
+        let placeholder = storage_buffer(device, "EventPipes::placeholder", 64);
+        Self {
+            hooks_layout,
+            scan_layout,
+            scan_pipeline_layout,
+            scan: None,
+            placeholder,
+        }
+    }
+
+    /// Builds the scan from `lib` (on error the old one stays); the files it read.
+    pub fn rebuild(
+        &mut self,
+        ctx: &GpuContext,
+        lib: &ShaderLibrary,
+    ) -> Result<Vec<String>, ShaderError> {
+        let src = lib.compose("events.wgsl")?;
+        let scan = create_checked(&ctx.device, &src, lib, |module| {
+            crate::render::compute_pipeline(
+                ctx,
+                "EventPipes::scan",
+                &self.scan_pipeline_layout,
+                module,
+                "main",
+                &[],
+            )
+        })?;
+        self.scan = Some(scan);
+        Ok(src.files)
+    }
+}
+
+/// A storage buffer of `size` bytes that can be cleared, written and read back.
+fn storage_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    })
+}
+
+/// One emitter's event buffers: its records (a parent) and its spawn list (a child).
+pub struct EmitterEvents {
+    /// Rules and records: `RULES_BYTES` then 2 × capacity records (a parent).
+    pub records: Option<wgpu::Buffer>,
+    /// Header and list (a child).
+    pub list: Option<wgpu::Buffer>,
+    /// The list's entries.
+    pub list_len: u32,
+    /// Group 1 of the update.
+    pub hooks: wgpu::BindGroup,
+    /// Per rule of this parent: the child, its config buffer and the scan's bind group.
+    pub scans: Vec<Scan>,
+    /// What the buffers were made for: (capacity, rules, list length).
+    key: (u32, [EventRule; MAX_EVENTS_PER_EMITTER], u32),
+}
+
+/// One rule's scan.
+pub struct Scan {
+    /// The child emitter.
+    pub child: usize,
+    /// The rule's `ScanConfig`.
+    pub config: wgpu::Buffer,
+    /// Group 0 of the scan (the parent's params at a dynamic offset).
+    pub group: Option<wgpu::BindGroup>,
+}
+
+impl EmitterEvents {
+    /// Buffers for emitter `i` of `effect` with `capacity` slots (reusing `old`'s when
+    /// they fit: same capacity, rules and list).
+    pub fn sync(
+        ctx: &GpuContext,
+        pipes: &EventPipes,
+        effect: &Effect,
+        i: usize,
+        capacity: u32,
+        old: Option<EmitterEvents>,
+    ) -> Option<EmitterEvents> {
+        let e = effect.emitters.get(i)?;
+        let list_len = effect
+            .event_source(i)
+            .map_or(0, |(p, k)| step_cap(effect, p, k));
+        if e.events.is_empty() && list_len == 0 {
+            return None;
+        }
+        let rules = rules_of(e);
+        let key = (capacity, rules, list_len);
+        if let Some(old) = old.filter(|o| o.key == key) {
+            return Some(old);
+        }
+        let device = &ctx.device;
+        let records = (!e.events.is_empty()).then(|| {
+            let size = RULES_BYTES
+                + (MAX_EVENTS_PER_EMITTER as u64)
+                    * u64::from(capacity)
+                    * size_of::<EventRecord>() as u64;
+            let b = storage_buffer(device, "EmitterEvents::records", size);
+            ctx.queue.write_buffer(&b, 0, bytemuck::cast_slice(&rules));
+            b
+        });
+        let list = (list_len > 0).then(|| {
+            let size = size_of::<EventHeader>() as u64
+                + u64::from(list_len) * size_of::<EventSpawn>() as u64;
+            // New buffers are zeroed: head 0, count 0, stamp 0.
+            storage_buffer(device, "EmitterEvents::list", size)
+        });
+        let hooks = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("EmitterEvents::hooks"),
+            layout: &pipes.hooks_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: records
+                        .as_ref()
+                        .unwrap_or(&pipes.placeholder)
+                        .as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: list
+                        .as_ref()
+                        .unwrap_or(&pipes.placeholder)
+                        .as_entire_binding(),
+                },
+            ],
+        });
+        let scans = e
+            .events
+            .iter()
+            .filter_map(|ev| effect.event_target(ev))
+            .map(|child| Scan {
+                child,
+                config: device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("EmitterEvents::scan_config"),
+                    size: size_of::<ScanConfig>() as u64,
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                }),
+                group: None,
+            })
+            .collect();
+        Some(EmitterEvents {
+            records,
+            list,
+            list_len,
+            hooks,
+            scans,
+            key,
+        })
+    }
+
+    /// Group 0 of each scan of this parent: `params` (the update's parameter blocks)
+    /// and the children's lists (`lists[child]`).
+    pub fn bind_scans(
+        &mut self,
+        device: &wgpu::Device,
+        pipes: &EventPipes,
+        params: &wgpu::Buffer,
+        lists: &[Option<wgpu::Buffer>],
+    ) {
+        let Some(records) = &self.records else {
+            return;
+        };
+        for scan in &mut self.scans {
+            let Some(Some(list)) = lists.get(scan.child) else {
+                scan.group = None;
+                continue;
+            };
+            scan.group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("EmitterEvents::scan"),
+                layout: &pipes.scan_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer: params,
+                            offset: 0,
+                            size: wgpu::BufferSize::new(size_of::<SimParams>() as u64),
+                        }),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: records.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: list.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: scan.config.as_entire_binding(),
+                    },
+                ],
+            }));
+        }
+    }
+}
+
+/// The children one parent slot's rule asks for this step and the event's key: the CPU
+/// mirror of `emit_events` (`shaders/events_on.wgsl`). `before`/`after`: the slot's state
+/// at the step's start and end; `born`: spawned this step; `hit`: a collider impact.
+#[allow(clippy::too_many_arguments)]
+pub fn event_of(
+    rule: &EventRule,
+    k: u32,
+    p: &SimParams,
+    slot: u32,
+    before: &Particle,
+    after: &Particle,
+    born: bool,
+    hit: bool,
+) -> (u32, u32) {
+    let cap = p.capacity;
+    let total =
+        (u64::from(p.spawn_base_hi) << 32 | u64::from(p.spawn_base_lo)) + u64::from(p.spawn_count);
+    let counter = slot_counter(slot, total, cap);
+    let lived = born || before.is_alive();
+    let alive = after.is_alive();
+    let (mut n, mut ordinal, mut fired) = (0u32, 0u32, false);
+    match rule.trigger {
+        0 => fired = lived && !alive,
+        1 => {
+            fired = lived && hit;
+            ordinal = after.pos_age[3].to_bits();
+        }
+        2 => fired = born,
+        3 => {
+            if lived {
+                let a0 = if born { 0.0 } else { before.pos_age[3] };
+                let a1 = after.pos_age[3].min(after.vel_life[3]);
+                let k0 = (rule.rate * a0).floor();
+                n = ((rule.rate * a1).floor() - k0).max(0.0) as u32;
+                ordinal = k0 as u32;
+            }
+        }
+        _ => return (0, 0),
+    }
+    let h = pcg4d([
+        p.seed ^ slot.wrapping_mul(0x9E37_79B9),
+        counter as u32,
+        ((counter >> 32) as u32) ^ (k << 28),
+        ordinal,
+    ]);
+    let key = h[0] ^ p.emitter_salt;
+    if fired {
+        let span = rule.count_max - rule.count_min + 1;
+        n = rule.count_min + pcg4d([key, p.seed, k, 0xC0])[1] % span;
+    }
+    (n.min(MAX_CHILDREN_PER_EVENT), key)
+}
+
+/// The spawn list a scan makes of one rule's records over the parent's window (the CPU
+/// mirror of `shaders/events.wgsl`): entries in slot order, at most `cap`; and the
+/// children asked for in all.
+pub fn scan_events(
+    window: (u32, u32),
+    capacity: u32,
+    records: &[(u32, EventRecord)],
+    cfg: &ScanConfig,
+) -> (Vec<EventSpawn>, u32) {
+    let by_slot: std::collections::HashMap<u32, &EventRecord> =
+        records.iter().map(|(s, r)| (*s, r)).collect();
+    let cap = cfg.rule_capacity_cap[2];
+    let d = cfg.delta_inherit;
+    let mut list = Vec::new();
+    let mut total = 0u32;
+    for i in 0..window.1 {
+        let slot = (window.0 + i) % capacity;
+        let Some(r) = by_slot.get(&slot) else {
+            continue;
+        };
+        let n = r.pos_count[3].to_bits();
+        for j in 0..n {
+            if total + j < cap {
+                list.push(EventSpawn {
+                    pos_key: [
+                        r.pos_count[0] + d[0],
+                        r.pos_count[1] + d[1],
+                        r.pos_count[2] + d[2],
+                        r.vel_key[3],
+                    ],
+                    vel_j: [
+                        r.vel_key[0] * d[3],
+                        r.vel_key[1] * d[3],
+                        r.vel_key[2] * d[3],
+                        f32::from_bits(j),
+                    ],
+                });
+            }
+        }
+        total += n;
+    }
+    (list, total)
+}
+
+/// The random stream of child `j` of the event `event_key` (`child_key` in
+/// `shaders/events_on.wgsl`).
+pub fn child_key(seed: u32, salt: u32, event_key: u32, j: u32) -> [u32; 4] {
+    pcg4d([
+        seed,
+        salt ^ 0xE7E7_E7E7,
+        event_key,
+        j.wrapping_mul(0x9E37_79B9),
+    ])
+}

@@ -1,0 +1,320 @@
+//! Events on a real adapter: children spawn exactly where and as many as the CPU mirror of
+//! the records and the scan says (the per-step cap and its dropped count included), every
+//! trigger fires when it should, a child never spawns twice from one step's list, and
+//! effects with events stay deterministic.
+
+mod common;
+
+use common::*;
+use ignis::effect::*;
+use ignis::gpu::types::{Particle, SimParams};
+use ignis::shaders::ShaderLibrary;
+use ignis::sim::GpuSim;
+use ignis::sim::events::{EventRecord, ScanConfig, child_key, event_of, rules_of, scan_events};
+
+const DT: f32 = 1.0 / 60.0;
+
+/// A parent spraying short-lived particles and a child fed by `event` (no own spawns).
+fn parent_and_child(event: Event, parent_rate: f32) -> Effect {
+    let parent = Emitter {
+        name: "parent".into(),
+        capacity: 1024,
+        spawn_rate_per_sec: Param::Constant(parent_rate),
+        lifetime_secs: Range::new(0.2, 0.6),
+        speed_m_per_s: Range::new(0.5, 1.5),
+        spread_deg: 40.0,
+        forces: Forces {
+            gravity_m_per_s2: [0.0, -2.0, 0.0],
+            ..plain_emitter().forces
+        },
+        events: vec![Event {
+            emitter: "child".into(),
+            ..event
+        }],
+        ..plain_emitter()
+    };
+    let child = Emitter {
+        name: "child".into(),
+        capacity: 4096,
+        // Ignored: a fed emitter spawns from its events only.
+        spawn_rate_per_sec: Param::Constant(500.0),
+        lifetime_secs: Range::new(50.0, 100.0),
+        transform: Transform {
+            position_m: [2.0, 0.5, 0.0],
+            ..Transform::default()
+        },
+        ..plain_emitter()
+    };
+    Effect {
+        emitters: vec![parent, child],
+        ..Effect::default()
+    }
+}
+
+/// The CPU mirror of one step: the parent's records for its window and the scan's list.
+fn expected_list(
+    effect: &Effect,
+    sim: &GpuSim,
+    p: &SimParams,
+    before: &[Particle],
+    after: &[Particle],
+) -> (Vec<ignis::sim::events::EventSpawn>, u32) {
+    let rule = rules_of(&effect.emitters[0])[0];
+    let mut records = Vec::new();
+    for i in 0..p.update_window[1] {
+        let slot = (p.update_window[0] + i) % p.capacity;
+        let rel = (slot + p.capacity - p.spawn_head) % p.capacity;
+        let born = rel < p.spawn_count;
+        let a = &after[slot as usize];
+        let (n, key) = event_of(&rule, 0, p, slot, &before[slot as usize], a, born, false);
+        records.push((
+            slot,
+            EventRecord {
+                pos_count: [a.pos_age[0], a.pos_age[1], a.pos_age[2], f32::from_bits(n)],
+                vel_key: [
+                    a.vel_life[0],
+                    a.vel_life[1],
+                    a.vel_life[2],
+                    f32::from_bits(key),
+                ],
+            },
+        ));
+    }
+    let delta = (sim.planner.emitters[0].origin() - sim.planner.emitters[1].origin()).as_vec3();
+    let ev = &effect.emitters[0].events[0];
+    let cfg = ScanConfig {
+        rule_capacity_cap: [0, effect.emitters[1].capacity, ev.max_per_step, 0],
+        delta_inherit: [delta.x, delta.y, delta.z, ev.inherit_velocity],
+    };
+    scan_events(
+        (p.update_window[0], p.update_window[1]),
+        p.capacity,
+        &records,
+        &cfg,
+    )
+}
+
+/// Step by step, the children born equal the CPU mirror's list: count (capped), slots,
+/// positions (in the child's simulation space), inherited velocities and lifetimes (from
+/// the keys); the dropped count is the excess.
+#[test]
+fn death_children_match_the_cpu_mirror_including_the_cap() {
+    let ctx = gpu();
+    let event = Event {
+        trigger: Trigger::Death,
+        count: CountRange { min: 1, max: 3 },
+        inherit_velocity: 0.5,
+        max_per_step: 12,
+        ..Event::default()
+    };
+    let effect = parent_and_child(event, 900.0);
+    effect.validate().expect("valid");
+    let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
+    let (mut head, mut last_count, mut dropped, mut capped_steps) = (0u32, 0u32, 0u32, 0);
+    let child_cap = effect.emitters[1].capacity;
+    for step in 0..60 {
+        sim.sync(&effect).expect("sync");
+        let before = sim.read_particles(0).expect("read");
+        let plans = sim.plan(&effect, DT, 1);
+        sim.record_and_submit(&effect, &plans);
+        let after = sim.read_particles(0).expect("read");
+        let child = sim.read_particles(1).expect("read");
+        let header = sim.read_event_header(1).expect("read").expect("a child");
+        let p = plans[0][0].expect("parent planned");
+        let (list, total) = expected_list(&effect, &sim, &p, &before, &after);
+        head = (head + last_count) % child_cap;
+        assert_eq!(header.head, head, "step {step}: head");
+        assert_eq!(header.count as usize, list.len(), "step {step}: count");
+        dropped += total - list.len() as u32;
+        capped_steps += usize::from(total > list.len() as u32);
+        assert_eq!(header.dropped, dropped, "step {step}: dropped");
+        let cp = plans[0][1].expect("child planned");
+        assert_eq!(cp.spawn_count, 0, "a fed emitter has no spawns of its own");
+        for (k, s) in list.iter().enumerate() {
+            let c = &child[((head + k as u32) % child_cap) as usize];
+            let want_pos = [s.pos_key[0], s.pos_key[1], s.pos_key[2]];
+            assert_eq!(
+                &c.pos_age[..3],
+                &want_pos,
+                "step {step} child {k}: position"
+            );
+            assert_eq!(c.pos_age[3], 0.0, "born this step");
+            assert_eq!(
+                &c.vel_life[..3],
+                &s.vel_j[..3],
+                "step {step} child {k}: velocity"
+            );
+            let key = child_key(
+                cp.seed,
+                cp.emitter_salt,
+                s.pos_key[3].to_bits(),
+                s.vel_j[3].to_bits(),
+            );
+            let want = ignis::sim::cpu_reference::spawn_particle(&cp, key);
+            assert_eq!(
+                c.vel_life[3], want.vel_life[3],
+                "step {step} child {k}: lifetime"
+            );
+        }
+        last_count = list.len() as u32;
+    }
+    assert!(
+        capped_steps > 5,
+        "the cap was reached in {capped_steps} steps"
+    );
+    let alive = alive_of(&sim.read_particles(1).expect("read"));
+    let header = sim.read_event_header(1).expect("read").expect("a child");
+    assert_eq!(
+        alive as u32,
+        header.total - header.dropped,
+        "children alive"
+    );
+}
+
+/// A burst of 100 parents of one fixed lifetime: once they are all dead there are exactly
+/// 100 × 3 children, born where the parents died.
+#[test]
+fn a_burst_that_dies_leaves_exactly_count_children() {
+    let ctx = gpu();
+    let event = Event {
+        count: CountRange { min: 3, max: 3 },
+        inherit_velocity: 0.0,
+        ..Event::default()
+    };
+    let mut effect = parent_and_child(event, 0.0);
+    effect.emitters[0].bursts = vec![Burst {
+        time_secs: 0.0,
+        count: 100,
+    }];
+    effect.emitters[0].lifetime_secs = Range::new(0.5, 0.5);
+    effect.emitters[0].forces.gravity_m_per_s2 = [0.0; 3];
+    let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
+    sim.step(&effect, DT, 25).expect("step");
+    assert_eq!(
+        alive_of(&sim.read_particles(1).expect("read")),
+        0,
+        "none dead yet"
+    );
+    sim.step(&effect, DT, 35).expect("step");
+    assert_eq!(alive_of(&sim.read_particles(0).expect("read")), 0);
+    let children = sim.read_particles(1).expect("read");
+    assert_eq!(alive_of(&children), 300);
+    // Parents flew straight at 0.5..1.5 m/s for 0.5 s from the origin: children sit on
+    // that shell (in the child's space, offset by its placement).
+    for c in children.iter().filter(|c| c.is_alive()) {
+        let world = c.position() + glam::Vec3::new(2.0, 0.5, 0.0);
+        let r = world.length();
+        assert!((0.24..0.76).contains(&r), "child at {world} (r = {r})");
+    }
+}
+
+/// Each trigger fires when it should: births (one child per parent born), over life
+/// (rate × life children per parent), collisions (an impact on the ground).
+#[test]
+fn birth_over_life_and_collision_triggers_count_exactly() {
+    let ctx = gpu();
+    let burst = |effect: &mut Effect| {
+        effect.emitters[0].bursts = vec![Burst {
+            time_secs: 0.0,
+            count: 50,
+        }];
+        effect.emitters[0].lifetime_secs = Range::new(1.0, 1.0);
+    };
+    // Birth: one child each.
+    let mut birth = parent_and_child(
+        Event {
+            trigger: Trigger::Birth,
+            count: CountRange { min: 2, max: 2 },
+            ..Event::default()
+        },
+        0.0,
+    );
+    burst(&mut birth);
+    let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &birth).expect("sim");
+    sim.step(&birth, DT, 10).expect("step");
+    assert_eq!(alive_of(&sim.read_particles(1).expect("read")), 100);
+    // Over life: 10 per second for a 1 s life = 10 each (the ages cross 1..=10 tenths;
+    // the last at age 1.0 when it dies).
+    let mut over = parent_and_child(
+        Event {
+            trigger: Trigger::OverLife,
+            rate_per_sec: 10.0,
+            ..Event::default()
+        },
+        0.0,
+    );
+    burst(&mut over);
+    let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &over).expect("sim");
+    sim.step(&over, DT, 90).expect("step");
+    let header = sim.read_event_header(1).expect("read").expect("child");
+    assert_eq!(header.dropped, 0);
+    assert_eq!(alive_of(&sim.read_particles(1).expect("read")), 50 * 10);
+    // Collision: parents fall onto the ground; each impact spawns one child; resting
+    // particles (below the rest speed) spawn nothing more.
+    let mut fall = parent_and_child(
+        Event {
+            trigger: Trigger::Collision,
+            ..Event::default()
+        },
+        0.0,
+    );
+    burst(&mut fall);
+    let p = &mut fall.emitters[0];
+    p.lifetime_secs = Range::new(3.0, 3.0);
+    p.speed_m_per_s = Range::new(0.0, 0.0);
+    p.transform.position_m = [0.0, 0.3, 0.0];
+    p.forces.gravity_m_per_s2 = [0.0, -9.81, 0.0];
+    p.collisions = Collisions {
+        ground: Some(GroundPlane {
+            height_m: 0.0,
+            kill_on_contact: false,
+        }),
+        elasticity: 0.0,
+        rest_speed_m_per_s: 0.5,
+        ..Collisions::default()
+    };
+    fall.validate().expect("valid");
+    let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &fall).expect("sim");
+    sim.step(&fall, DT, 120).expect("step");
+    assert_eq!(
+        alive_of(&sim.read_particles(1).expect("read")),
+        50,
+        "one impact each"
+    );
+}
+
+/// Validation names the field and the fix: unknown children, self-feeding, a child fed
+/// twice, cycles, impossible counts.
+#[test]
+fn bad_events_are_rejected_with_their_field() {
+    let mut effect = parent_and_child(Event::default(), 10.0);
+    effect.emitters[0].events[0].emitter = "nope".into();
+    let errs = effect.validate().expect_err("unknown child");
+    assert!(
+        errs.iter()
+            .any(|e| e.path == "emitters[0].events[0].emitter"),
+        "{errs:?}"
+    );
+    let mut effect = parent_and_child(Event::default(), 10.0);
+    effect.emitters[1].events = vec![Event {
+        emitter: "parent".into(),
+        ..Event::default()
+    }];
+    let errs = effect.validate().expect_err("a cycle");
+    assert!(errs.iter().any(|e| e.problem.contains("cycle")), "{errs:?}");
+    let mut effect = parent_and_child(Event::default(), 10.0);
+    effect.emitters[0].events[0].count = CountRange { min: 4, max: 2 };
+    let errs = effect.validate().expect_err("min > max");
+    assert!(
+        errs.iter().any(|e| e.path == "emitters[0].events[0].count"),
+        "{errs:?}"
+    );
+    let mut effect = parent_and_child(Event::default(), 10.0);
+    let twice = effect.emitters[0].events[0].clone();
+    effect.emitters[0].events.push(twice);
+    let errs = effect.validate().expect_err("fed twice");
+    assert!(
+        errs.iter().any(|e| e.problem.contains("already fed")),
+        "{errs:?}"
+    );
+}
