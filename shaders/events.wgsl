@@ -2,9 +2,11 @@
 // the parent's update this step, events_on.wgsl) into its child's spawn list, in slot
 // order over the parent's window: an exclusive prefix sum of the children per slot, so
 // the list is the same whatever the scheduling. At most `cap` children a step; the rest
-// are counted as dropped. Thread 0 then moves the child's ring head past the last step's
-// children and publishes this step's count, stamped with the step's number (a child
-// whose parent did not run this step sees a stale stamp and spawns nothing).
+// are counted as dropped. The first scan of a step into a child (its header's stamp is an
+// older step's) moves the child's ring head past the last step's children and starts an
+// empty list stamped with this step's number; each scan appends its children, so a child
+// fed by several events gets them in update order. A child none of whose parents ran this
+// step sees a stale stamp and spawns nothing.
 //
 // Group 0: binding 0 the parent's SimParams (dynamic offset), 1 its event records, 2 the
 // child's list (header + entries), 3 this rule's ScanConfig.
@@ -17,6 +19,10 @@ struct EventRule {
     count_min: u32,
     count_max: u32,
     rate: f32,
+    probability: f32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 struct EventRecord {
@@ -62,6 +68,8 @@ struct ScanConfig {
 const GROUP: u32 = 256u;
 var<workgroup> sums: array<u32, GROUP>;
 var<workgroup> running: u32;
+// Where this scan's children start in the list (after earlier scans' of this step).
+var<workgroup> start: u32;
 
 @compute @workgroup_size(256)
 fn main(@builtin(local_invocation_index) lid: u32) {
@@ -70,6 +78,16 @@ fn main(@builtin(local_invocation_index) lid: u32) {
     let capacity = params.capacity;
     let rule = cfg.rule_capacity_cap.x;
     let cap = cfg.rule_capacity_cap.z;
+    if lid == 0u {
+        if event_in.stamp != params.tiny_b.z {
+            event_in.head = (event_in.head + event_in.count) % cfg.rule_capacity_cap.y;
+            event_in.count = 0u;
+            event_in.stamp = params.tiny_b.z;
+        }
+        start = event_in.count;
+    }
+    workgroupBarrier();
+    let first_entry = workgroupUniformLoad(&start);
     for (var base = 0u; base < len; base += GROUP) {
         let i = base + lid;
         var n = 0u;
@@ -96,7 +114,7 @@ fn main(@builtin(local_invocation_index) lid: u32) {
         }
         let at = running + sums[lid] - n;
         for (var k = 0u; k < n && at + k < cap; k++) {
-            event_in.list[at + k] = EventSpawn(
+            event_in.list[first_entry + at + k] = EventSpawn(
                 vec4<f32>(rec.pos_count.xyz + cfg.delta_inherit.xyz, rec.vel_key.w),
                 vec4<f32>(rec.vel_key.xyz * cfg.delta_inherit.w, bitcast<f32>(k)),
             );
@@ -111,12 +129,8 @@ fn main(@builtin(local_invocation_index) lid: u32) {
     if lid == 0u {
         let total = running;
         let n = min(total, cap);
-        var head = event_in.head + event_in.count;
-        head = head % cfg.rule_capacity_cap.y;
-        event_in.head = head;
-        event_in.count = n;
+        event_in.count = first_entry + n;
         event_in.dropped += total - n;
         event_in.total += total;
-        event_in.stamp = params.tiny_b.z;
     }
 }

@@ -33,6 +33,10 @@ struct EventRule {
     count_min: u32,
     count_max: u32,
     rate: f32,
+    probability: f32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 struct EventRecord {
@@ -156,8 +160,9 @@ fn emit_events(slot: u32, p: Particle, born: bool, was_alive: bool, alive: bool,
         }
         let key = event_key(slot, counter, e, ordinal);
         if fired {
+            let h = pcg4d(vec4<u32>(key, params.seed, e, 0xC0u));
             let span = rule.count_max - rule.count_min + 1u;
-            n = rule.count_min + pcg4d(vec4<u32>(key, params.seed, e, 0xC0u)).y % span;
+            n = select(0u, rule.count_min + h.y % span, unorm4(h).z < rule.probability);
         }
         n = min(n, MAX_CHILDREN);
         event_out.records[e * params.capacity + slot_base + slot] = EventRecord(

@@ -14,6 +14,21 @@ use ignis::sim::events::{EventRecord, ScanConfig, child_key, event_of, rules_of,
 
 const DT: f32 = 1.0 / 60.0;
 
+/// The test's adapter, with any validation error a failure (the programs log them).
+fn strict_gpu() -> ignis::gpu::GpuContext {
+    let ctx = gpu();
+    ctx.device.on_uncaptured_error(std::sync::Arc::new(|e| {
+        let mut msg = e.to_string();
+        let mut source = std::error::Error::source(&e);
+        while let Some(s) = source {
+            msg += &format!(" / {s}");
+            source = s.source();
+        }
+        panic!("GPU validation error: {msg}")
+    }));
+    ctx
+}
+
 /// A parent spraying short-lived particles and a child fed by `event` (no own spawns).
 fn parent_and_child(event: Event, parent_rate: f32) -> Effect {
     let parent = Emitter {
@@ -99,10 +114,11 @@ fn expected_list(
 /// the keys); the dropped count is the excess.
 #[test]
 fn death_children_match_the_cpu_mirror_including_the_cap() {
-    let ctx = gpu();
+    let ctx = strict_gpu();
     let event = Event {
         trigger: Trigger::Death,
         count: CountRange { min: 1, max: 3 },
+        probability: 0.8,
         inherit_velocity: 0.5,
         max_per_step: 12,
         ..Event::default()
@@ -175,7 +191,7 @@ fn death_children_match_the_cpu_mirror_including_the_cap() {
 /// 100 × 3 children, born where the parents died.
 #[test]
 fn a_burst_that_dies_leaves_exactly_count_children() {
-    let ctx = gpu();
+    let ctx = strict_gpu();
     let event = Event {
         count: CountRange { min: 3, max: 3 },
         inherit_velocity: 0.0,
@@ -212,7 +228,7 @@ fn a_burst_that_dies_leaves_exactly_count_children() {
 /// (rate × life children per parent), collisions (an impact on the ground).
 #[test]
 fn birth_over_life_and_collision_triggers_count_exactly() {
-    let ctx = gpu();
+    let ctx = strict_gpu();
     let burst = |effect: &mut Effect| {
         effect.emitters[0].bursts = vec![Burst {
             time_secs: 0.0,
@@ -310,13 +326,47 @@ fn bad_events_are_rejected_with_their_field() {
         "{errs:?}"
     );
     let mut effect = parent_and_child(Event::default(), 10.0);
-    let twice = effect.emitters[0].events[0].clone();
-    effect.emitters[0].events.push(twice);
-    let errs = effect.validate().expect_err("fed twice");
+    effect.emitters[0].events[0].emitter = "parent".into();
+    let errs = effect.validate().expect_err("self");
     assert!(
-        errs.iter().any(|e| e.problem.contains("already fed")),
+        errs.iter()
+            .any(|e| e.problem.contains("cannot feed itself")),
         "{errs:?}"
     );
+}
+
+/// Two parents feeding one child: the list takes both parents' children in update order,
+/// one ring head; exactly 100 × 3 + 40 × 2 children once both bursts have died.
+#[test]
+fn two_parents_feed_one_child() {
+    let ctx = strict_gpu();
+    let mut effect = parent_and_child(
+        Event {
+            count: CountRange { min: 3, max: 3 },
+            ..Event::default()
+        },
+        0.0,
+    );
+    let p = &mut effect.emitters[0];
+    p.bursts = vec![Burst {
+        time_secs: 0.0,
+        count: 100,
+    }];
+    p.lifetime_secs = Range::new(0.3, 0.5);
+    let mut second = effect.emitters[0].clone();
+    second.name = "second parent".into();
+    second.seed_offset = 5;
+    second.bursts[0].count = 40;
+    second.events[0].count = CountRange { min: 2, max: 2 };
+    effect.emitters.push(second);
+    effect.validate().expect("valid");
+    assert_eq!(effect.event_sources(1), [(0, 0), (2, 0)]);
+    assert_eq!(effect.update_order(), [0, 2, 1], "parents first");
+    let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
+    sim.step(&effect, DT, 45).expect("step");
+    assert_eq!(alive_of(&sim.read_particles(1).expect("read")), 380);
+    let header = sim.read_event_header(1).expect("read").expect("child");
+    assert_eq!((header.total, header.dropped), (380, 0));
 }
 
 /// 2 s of frames at 30, 60, 144 and 240 fps, and jittered between 4 and 40 ms.
@@ -343,7 +393,7 @@ fn frame_sequences() -> Vec<(String, Vec<f64>)> {
 /// played state.
 #[test]
 fn events_are_frame_rate_independent_and_seekable() {
-    let ctx = gpu();
+    let ctx = strict_gpu();
     let mut effect = parent_and_child(
         Event {
             count: CountRange { min: 1, max: 4 },
@@ -386,14 +436,18 @@ fn events_are_frame_rate_independent_and_seekable() {
     };
     let mut reference = None;
     for (name, frames) in frame_sequences() {
-        let mut run = ignis::headless::Headless::new(&ctx, effect.clone(), ShaderLibrary::embedded())
-            .expect("headless");
+        let mut run =
+            ignis::headless::Headless::new(&ctx, effect.clone(), ShaderLibrary::embedded())
+                .expect("headless");
         for dt in &frames {
             run.advance(*dt);
         }
         let got = state(&run);
         let grandchildren = run.player.particles(run.instance, 2).expect("read");
-        assert!(alive_of(&grandchildren) > 20, "{name}: the chain reached the grandchild");
+        assert!(
+            alive_of(&grandchildren) > 20,
+            "{name}: the chain reached the grandchild"
+        );
         match &reference {
             None => reference = Some(got),
             Some(want) => assert!(*want == got, "{name}: differs from the first sequence"),
@@ -416,5 +470,8 @@ fn events_are_frame_rate_independent_and_seekable() {
         }
     }
     run.seek(1.0, 1.0 / 60.0);
-    assert!(state(&run) == at_one, "seeking back to 1 s gives the played state");
+    assert!(
+        state(&run) == at_one,
+        "seeking back to 1 s gives the played state"
+    );
 }

@@ -47,9 +47,16 @@ fn every_entry_validates() {
         .unwrap_or_else(|e| panic!("update with batched instances: {e}"));
     assert!(instanced.files.iter().any(|f| f == "params_instanced.wgsl"));
     assert!(!instanced.files.iter().any(|f| f == "params.wgsl"));
+    // An emitter with events: events_on.wgsl (hooks and bindings) for events_off.wgsl.
+    let events = project_shaders()
+        .compose_with("update.wgsl", &[ignis::shaders::EVENTS_IO])
+        .unwrap_or_else(|e| panic!("update with events: {e}"));
+    assert!(events.files.iter().any(|f| f == "events_on.wgsl"));
+    assert!(!events.files.iter().any(|f| f == "events_off.wgsl"));
     reached.extend(packed.files);
     reached.extend(tiny.files);
     reached.extend(instanced.files);
+    reached.extend(events.files);
     for f in std::fs::read_dir(dir).expect("shaders/") {
         let name = f.expect("entry").file_name().to_string_lossy().into_owned();
         if name.ends_with(".wgsl") {
@@ -72,7 +79,13 @@ fn rust_and_wgsl_struct_sizes_agree() {
     let update = lib.compose("update.wgsl").expect("update");
     let billboard = lib.compose("billboard.wgsl").expect("billboard");
     let tonemap = lib.compose("tonemap.wgsl").expect("tonemap");
+    let scan = lib.compose("events.wgsl").expect("events");
+    use ignis::sim::events::{EventRecord, EventRule, EventSpawn, ScanConfig};
     let cases = [
+        (&scan, "EventRule", size_of::<EventRule>()),
+        (&scan, "EventRecord", size_of::<EventRecord>()),
+        (&scan, "EventSpawn", size_of::<EventSpawn>()),
+        (&scan, "ScanConfig", size_of::<ScanConfig>()),
         (&update, "Particle", size_of::<Particle>()),
         (&update, "SimParams", size_of::<SimParams>()),
         (

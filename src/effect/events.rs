@@ -4,8 +4,8 @@
 //! The events are listed on the parent ([`crate::effect::Emitter::events`]); the emitter an
 //! event names (the child) then spawns only from events — its own rate and bursts are
 //! not used — and both run the full 32-byte state (stateless, packed and tiny state are
-//! off for them). A child is fed by one event at most; chains (a child that is itself a
-//! parent) are allowed, cycles are not.
+//! off for them). A child may be fed by several events (its list takes their children in
+//! update order); chains (a child that is itself a parent) are allowed, cycles are not.
 
 use serde::{Deserialize, Serialize};
 
@@ -76,6 +76,9 @@ pub struct Event {
     pub emitter: String,
     /// Children per event (death, collision, birth), each event drawing its own count.
     pub count: CountRange,
+    /// The chance that a death, collision or birth spawns children at all (1 = always):
+    /// a few smoke puffs from thousands of dying flames.
+    pub probability: f32,
     /// Children per second per living parent (`OverLife` only).
     pub rate_per_sec: f32,
     /// The fraction of the parent's velocity a child starts with, added to the velocity
@@ -92,6 +95,7 @@ impl Default for Event {
             trigger: Trigger::Death,
             emitter: String::new(),
             count: CountRange { min: 1, max: 1 },
+            probability: 1.0,
             rate_per_sec: 10.0,
             inherit_velocity: 0.3,
             max_per_step: 1024,
@@ -100,20 +104,31 @@ impl Default for Event {
 }
 
 impl Effect {
-    /// The event feeding emitter `child`, as (parent index, event index), if any.
-    pub fn event_source(&self, child: usize) -> Option<(usize, usize)> {
-        let name = &self.emitters.get(child)?.name;
-        self.emitters.iter().enumerate().find_map(|(p, e)| {
-            e.events
-                .iter()
-                .position(|ev| &ev.emitter == name)
-                .map(|k| (p, k))
-        })
+    /// The events feeding emitter `child`, as (parent index, event index), in update
+    /// order of the parents.
+    pub fn event_sources(&self, child: usize) -> Vec<(usize, usize)> {
+        let Some(c) = self.emitters.get(child) else {
+            return Vec::new();
+        };
+        let mut sources = Vec::new();
+        for (p, e) in self.emitters.iter().enumerate() {
+            for (k, ev) in e.events.iter().enumerate() {
+                if ev.emitter == c.name {
+                    sources.push((p, k));
+                }
+            }
+        }
+        sources
     }
 
-    /// True when emitter `i` spawns from another emitter's events.
+    /// True when emitter `i` spawns from other emitters' events.
     pub fn event_fed(&self, i: usize) -> bool {
-        self.event_source(i).is_some()
+        let Some(c) = self.emitters.get(i) else {
+            return false;
+        };
+        self.emitters
+            .iter()
+            .any(|e| e.events.iter().any(|ev| ev.emitter == c.name))
     }
 
     /// The index of the emitter an event names.
@@ -121,33 +136,43 @@ impl Effect {
         self.emitters.iter().position(|e| e.name == event.emitter)
     }
 
+    /// Each emitter's depth in the event graph: 0 without a parent, else one more than its
+    /// deepest parent's (at most the emitter count: cycles are rejected by validation).
+    fn event_depths(&self) -> Vec<usize> {
+        let n = self.emitters.len();
+        let mut depth = vec![0; n];
+        // Bellman–Ford style relaxation: n rounds settle any acyclic graph.
+        for _ in 0..n {
+            let mut changed = false;
+            for (p, e) in self.emitters.iter().enumerate() {
+                for ev in &e.events {
+                    if let Some(c) = self.event_target(ev) {
+                        let d = (depth[p] + 1).min(n + 1);
+                        if c != p && depth[c] < d {
+                            depth[c] = d;
+                            changed = true;
+                        }
+                    }
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        depth
+    }
+
     /// The emitters in update order: every parent before the children its events feed
     /// (they read the parent's events the same step), otherwise in effect order.
     pub fn update_order(&self) -> Vec<usize> {
-        let n = self.emitters.len();
-        let parent: Vec<Option<usize>> = (0..n)
-            .map(|i| self.event_source(i).map(|(p, _)| p))
-            .collect();
-        // Depth in the event chain (cycles are rejected by validation; capped anyway).
-        let depth = |mut i: usize| {
-            let mut d = 0;
-            while let Some(p) = parent[i] {
-                d += 1;
-                i = p;
-                if d > n {
-                    break;
-                }
-            }
-            d
-        };
-        let mut order: Vec<usize> = (0..n).collect();
-        order.sort_by_key(|&i| (depth(i), i));
+        let depth = self.event_depths();
+        let mut order: Vec<usize> = (0..self.emitters.len()).collect();
+        order.sort_by_key(|&i| (depth[i], i));
         order
     }
 
     /// The events' problems: unknown or self targets, a child fed twice, cycles, counts.
     pub(super) fn check_events(&self, c: &mut Checker) {
-        let mut fed = std::collections::HashMap::new();
         for (i, e) in self.emitters.iter().enumerate() {
             if e.events.len() > MAX_EVENTS_PER_EMITTER {
                 c.push(
@@ -169,19 +194,7 @@ impl Effect {
                         format!("{:?}", ev.emitter),
                         "an emitter cannot feed itself; add a second emitter for the children",
                     ),
-                    Some(t) => {
-                        if let Some(first) = fed.insert(t, (i, k)) {
-                            c.push(
-                                p("emitter"),
-                                format!("{:?}", ev.emitter),
-                                &format!(
-                                    "is already fed by emitters[{}].events[{}]; an emitter \
-                                     spawns from one event",
-                                    first.0, first.1
-                                ),
-                            );
-                        }
-                    }
+                    Some(_) => {}
                 }
                 if ev.count.min > ev.count.max || ev.count.max > MAX_CHILDREN_PER_EVENT {
                     c.push(
@@ -190,6 +203,7 @@ impl Effect {
                         &format!("must be min ≤ max ≤ {MAX_CHILDREN_PER_EVENT}"),
                     );
                 }
+                c.num(|| p("probability"), ev.probability, 0.0, 1.0);
                 c.num(|| p("rate_per_sec"), ev.rate_per_sec, 0.0, 1000.0);
                 c.num(|| p("inherit_velocity"), ev.inherit_velocity, -10.0, 10.0);
                 if ev.max_per_step == 0 || ev.max_per_step > 1 << 20 {
@@ -201,24 +215,25 @@ impl Effect {
     }
 
     fn check_event_cycles(&self, c: &mut Checker) {
+        // A depth that reaches the emitter count means a cycle (an acyclic chain is shorter).
         let n = self.emitters.len();
-        for start in 0..n {
-            let mut i = start;
-            for _ in 0..=n {
-                match self.event_source(i) {
-                    Some((p, k)) if p == start => {
-                        c.push(
-                            format!("emitters[{p}].events[{k}].emitter"),
-                            format!("{:?}", self.emitters[p].events[k].emitter),
-                            "closes a cycle of events (an emitter would feed itself through \
-                             others); remove one event of the cycle",
-                        );
-                        return;
-                    }
-                    Some((p, _)) => i = p,
-                    None => break,
-                }
-            }
+        let depth = self.event_depths();
+        if let Some((p, k)) = self.emitters.iter().enumerate().find_map(|(p, e)| {
+            (depth[p] >= n)
+                .then(|| {
+                    e.events
+                        .iter()
+                        .position(|ev| self.event_target(ev).is_some_and(|t| t != p))
+                })
+                .flatten()
+                .map(|k| (p, k))
+        }) {
+            c.push(
+                format!("emitters[{p}].events[{k}].emitter"),
+                format!("{:?}", self.emitters[p].events[k].emitter),
+                "closes a cycle of events (an emitter would feed itself through others); \
+                 remove one event of the cycle",
+            );
         }
     }
 }

@@ -29,6 +29,10 @@ pub struct EventRule {
     pub count_max: u32,
     /// Over life: children per second.
     pub rate: f32,
+    /// The chance an event (death, collision, birth) spawns at all.
+    pub probability: f32,
+    /// Padding.
+    pub pad: [u32; 3],
 }
 
 /// One parent slot's record for one rule (`EventRecord`).
@@ -94,6 +98,8 @@ pub fn rules_of(e: &Emitter) -> [EventRule; MAX_EVENTS_PER_EMITTER] {
             count_min: ev.count.min,
             count_max: ev.count.max.max(ev.count.min),
             rate: ev.rate_per_sec,
+            probability: ev.probability,
+            pad: [0; 3],
         };
     }
     rules
@@ -154,7 +160,8 @@ impl EventPipes {
             bind_group_layouts: &[Some(&scan_layout)],
             immediate_size: 0,
         });
-        let placeholder = storage_buffer(device, "EventPipes::placeholder", 64);
+        // Larger than either binding's fixed part (rules + one record; header + one entry).
+        let placeholder = storage_buffer(device, "EventPipes::placeholder", 256);
         Self {
             hooks_layout,
             scan_layout,
@@ -236,9 +243,11 @@ impl EmitterEvents {
         old: Option<EmitterEvents>,
     ) -> Option<EmitterEvents> {
         let e = effect.emitters.get(i)?;
-        let list_len = effect
-            .event_source(i)
-            .map_or(0, |(p, k)| step_cap(effect, p, k));
+        let list_len: u32 = effect
+            .event_sources(i)
+            .iter()
+            .map(|&(p, k)| step_cap(effect, p, k))
+            .sum();
         if e.events.is_empty() && list_len == 0 {
             return None;
         }
@@ -402,8 +411,14 @@ pub fn event_of(
     ]);
     let key = h[0] ^ p.emitter_salt;
     if fired {
+        let h = pcg4d([key, p.seed, k, 0xC0]);
         let span = rule.count_max - rule.count_min + 1;
-        n = rule.count_min + pcg4d([key, p.seed, k, 0xC0])[1] % span;
+        let chosen = crate::rng::unorm(h[2]) < rule.probability;
+        n = if chosen {
+            rule.count_min + h[1] % span
+        } else {
+            0
+        };
     }
     (n.min(MAX_CHILDREN_PER_EVENT), key)
 }
