@@ -16,6 +16,8 @@
 //   composites it "over". The look itself lives in look.wgsl (shared with splat.wgsl).
 #import "common.wgsl"
 #import "quad.wgsl"
+// The ribbon of an emitter with a trail (TRAIL: `segments` quads per particle).
+#import "trail.wgsl"
 
 @group(0) @binding(0) var<uniform> camera: CameraUniform;
 // Storage, not uniform: see params.wgsl (lavapipe's uniform inlining).
@@ -61,6 +63,9 @@ struct VsOut {
 @vertex
 fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u32) -> VsOut {
     var out: VsOut;
+    if TRAIL {
+        return trail_vertex(vertex, inst);
+    }
     // Quad q (one instance each), corner `vi` (two triangles: 0 1 2, 2 1 3) of four
     // shared vertices over the corners (-1,-1) (1,-1) (-1,1) (1,1): a third fewer vertex
     // invocations than two separate triangles.
@@ -105,6 +110,29 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u3
     return out;
 }
 
+// A ribbon's corner: quad q is segment q mod S of particle quad q / S (S segments each).
+fn trail_vertex(vertex: u32, inst: u32) -> VsOut {
+    var out: VsOut;
+    let segments = max(trail_ring.points, 2u) - 1u;
+    let q = (vertex >> 2u) + inst;
+    let qd = load_quad(q / segments);
+    if !qd.d.alive {
+        out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+        return out;
+    }
+    let c = trail_corner(qd, q % segments, segments, vertex & 3u);
+    out.clip = c.clip;
+    // Across the ribbon: the sprite's middle column.
+    out.uv0 = vec2<f32>(0.5, 0.5 - c.across * 0.5);
+    out.uv1 = out.uv0;
+    out.color = c.color;
+    out.blend_height = vec2<f32>(c.fade, ground_fade_arg(c.world));
+    if SOFT_DEPTH {
+        out.blend_height.y = look.soft.y;
+    }
+    return out;
+}
+
 @fragment
 fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     var tex = textureSample(sprite_tex, sprite_sampler, in.uv0);
@@ -119,6 +147,11 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
         a = in.color.a * select(max(max(tex.r, tex.g), tex.b), tex.a, SORTED);
     }
     var rgb = in.color.rgb * tex.rgb;
+    if TRAIL {
+        // The taper of opacity along the ribbon.
+        a *= in.blend_height.x;
+        rgb *= in.blend_height.x;
+    }
     if SOFT {
         // Soft particles: fade out towards the ground plane instead of a hard cut.
         let fade = clamp(in.blend_height.y, 0.0, 1.0);

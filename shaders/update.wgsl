@@ -44,6 +44,8 @@
 // The event hooks: events_off.wgsl (no code, no bindings) unless the emitter has events or
 // spawns from them, whose pipelines compose events_on.wgsl in its place.
 #import "events_off.wgsl"
+// The trail hook: trail_off.wgsl (nothing) unless the emitter has a trail (trail_on.wgsl).
+#import "trail_off.wgsl"
 
 // Stateless mode: this pass only writes the spawn records of this step's window (one
 // invocation per spawn, no other slot is touched); the draw passes evaluate positions in
@@ -242,6 +244,7 @@ fn update_at(slot: u32) -> bool {
         }
     }
     emit_events(slot, p, born, was_alive && finite, alive, hit, age_start);
+    record_trail(slot, p, born, alive);
     store_state(slot, p);
     return alive;
 }

@@ -8,12 +8,14 @@ use serde::{Deserialize, Serialize};
 
 mod curve;
 mod events;
+mod trail;
 
 pub use curve::{
     CURVE_WIDTH, Curve, MAX_CURVE_KEYS, Param, ParamMode, SHAPES, bake_rows, lookup, lookup_blend,
     rows_key,
 };
 pub use events::{CountRange, Event, MAX_CHILDREN_PER_EVENT, MAX_EVENTS_PER_EMITTER, Trigger};
+pub use trail::{MAX_TRAIL_POINTS, Trail};
 
 /// The preset format version this build writes (and the newest it reads).
 pub const CURRENT_VERSION: u32 = 2;
@@ -675,6 +677,9 @@ pub struct Look {
     pub spin_deg_per_s: Param,
     /// Stretch the billboard along the screen-space velocity (sparks).
     pub streak: Option<Streak>,
+    /// A ribbon through each particle's last positions (see [`Trail`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub trail: Option<Trail>,
     /// Fade the sprite where it meets the ground plane over this distance, metres (0 =
     /// off; the plane is the emitter's ground collider, or y = 0 without one).
     pub soft_ground_m: f32,
@@ -973,6 +978,7 @@ impl Default for Look {
             rotation_random_deg: 0.0,
             spin_deg_per_s: Param::Constant(0.0),
             streak: None,
+            trail: None,
             soft_ground_m: 0.0,
             color_over_life: vec![
                 ColorStop {
@@ -1501,6 +1507,9 @@ impl Effect {
                     FlipbookMode::OverLife => {}
                 }
             }
+            if let Some(t) = &l.trail {
+                t.check(&p("look.trail"), &mut c);
+            }
             if let Some(s) = &l.streak {
                 c.num(|| p("look.streak.length_secs"), s.length_secs, 0.0, 10.0);
                 c.num(|| p("look.streak.max_length_m"), s.max_length_m, 0.0, 1e3);
@@ -1569,6 +1578,9 @@ impl Emitter {
         }
         if !self.events.is_empty() {
             v.push("events");
+        }
+        if self.look.trail.is_some() {
+            v.push("trail");
         }
         v
     }

@@ -28,6 +28,9 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ),
     ("events_on.wgsl", include_str!("../shaders/events_on.wgsl")),
     ("events.wgsl", include_str!("../shaders/events.wgsl")),
+    ("trail_off.wgsl", include_str!("../shaders/trail_off.wgsl")),
+    ("trail_on.wgsl", include_str!("../shaders/trail_on.wgsl")),
+    ("trail.wgsl", include_str!("../shaders/trail.wgsl")),
     (
         "alive_count.wgsl",
         include_str!("../shaders/alive_count.wgsl"),
@@ -78,10 +81,19 @@ pub const PARAMS_INSTANCED: (&str, &str) = ("params.wgsl", "params_instanced.wgs
 /// their bindings) in place of events_off.wgsl (nothing).
 pub const EVENTS_IO: (&str, &str) = ("events_off.wgsl", "events_on.wgsl");
 
+/// The update of an emitter with a trail: trail_on.wgsl (the ring of positions) in
+/// place of trail_off.wgsl (nothing).
+pub const TRAIL_IO: (&str, &str) = ("trail_off.wgsl", "trail_on.wgsl");
+
 /// Imports that some pipelines replace by another file (see
 /// [`ShaderLibrary::compose_with`]).
-pub const IMPORT_VARIANTS: &[(&str, &str)] =
-    &[PACKED_STATE_IO, TINY_STATE_IO, PARAMS_INSTANCED, EVENTS_IO];
+pub const IMPORT_VARIANTS: &[(&str, &str)] = &[
+    PACKED_STATE_IO,
+    TINY_STATE_IO,
+    PARAMS_INSTANCED,
+    EVENTS_IO,
+    TRAIL_IO,
+];
 
 /// The entry files, one per pipeline family; the others are imported by them.
 pub const ENTRY_FILES: &[&str] = &[

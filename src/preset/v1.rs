@@ -268,6 +268,7 @@ impl From<Look> for crate::effect::Look {
                 }
             },
             streak: l.streak,
+            trail: None,
             soft_ground_m: l.soft_ground_m,
             color_over_life: l.color_over_life,
             intensity: l.intensity,

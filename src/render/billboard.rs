@@ -262,9 +262,14 @@ impl BillboardPass {
         motion: bool,
     ) {
         for d in items.iter().filter(|d| !d.splat && !d.tiles) {
-            self.ensure_pipeline(ctx, d.variant);
-            if motion {
-                self.ensure_pipeline(ctx, d.variant.with_motion());
+            if d.trail.is_none_or(|(_, sprite)| sprite) {
+                self.ensure_pipeline(ctx, d.variant);
+                if motion {
+                    self.ensure_pipeline(ctx, d.variant.with_motion());
+                }
+            }
+            if d.trail.is_some() {
+                self.ensure_pipeline(ctx, d.variant.with_trail());
             }
             self.sprites.ensure(ctx, &d.sprite, sampler);
         }
@@ -336,30 +341,40 @@ impl BillboardPass {
         pass.set_bind_group(3, &self.depth_group, &[]);
         let mut bound: Option<(LookVariant, u64)> = None;
         for d in sorted {
-            let v = variant(d.variant);
-            let (Some(group), Some(Some(pipeline)), Some(sprite)) = (
-                frame.particle_group(d.key),
-                self.pipelines.get(&v),
-                self.sprites.get(d.sprite.id),
-            ) else {
-                continue;
-            };
-            if bound.is_none_or(|(b, _)| b != v) {
-                pass.set_pipeline(pipeline);
+            // The ribbon first (behind its particles' sprites), then the sprites.
+            let ribbon = d.trail.filter(|_| !variant(d.variant).motion);
+            let draws = [
+                ribbon.map(|(segments, _)| (d.variant.with_trail(), segments)),
+                d.trail
+                    .is_none_or(|(_, sprite)| sprite)
+                    .then(|| (variant(d.variant), 1)),
+            ];
+            for (v, segments) in draws.into_iter().flatten() {
+                let (Some(group), Some(Some(pipeline)), Some(sprite)) = (
+                    frame.particle_group(d.key),
+                    self.pipelines.get(&v),
+                    self.sprites.get(d.sprite.id),
+                ) else {
+                    continue;
+                };
+                if bound.is_none_or(|(b, _)| b != v) {
+                    pass.set_pipeline(pipeline);
+                }
+                if bound.is_none_or(|(_, id)| id != d.sprite.id) {
+                    pass.set_bind_group(2, sprite, &[]);
+                }
+                bound = Some((v, d.sprite.id));
+                pass.set_bind_group(
+                    0,
+                    &frame.frame_group,
+                    &[FrameResources::look_offset(d.look_slot)],
+                );
+                pass.set_bind_group(1, group, &[]);
+                // One quad per slot of each instance's live window (`width` per
+                // instance), or sorted, through the sort's order; a ribbon has
+                // `segments` quads per particle.
+                pass.draw_indexed(0..6, 0, 0..d.width * d.members * segments);
             }
-            if bound.is_none_or(|(_, id)| id != d.sprite.id) {
-                pass.set_bind_group(2, sprite, &[]);
-            }
-            bound = Some((v, d.sprite.id));
-            pass.set_bind_group(
-                0,
-                &frame.frame_group,
-                &[FrameResources::look_offset(d.look_slot)],
-            );
-            pass.set_bind_group(1, group, &[]);
-            // One quad per slot of each instance's live window (`width` per instance), or
-            // sorted, through the sort's order.
-            pass.draw_indexed(0..6, 0, 0..d.width * d.members);
         }
     }
 }

@@ -69,6 +69,8 @@ pub struct DrawItem {
     pub sprite: Arc<SpriteTexture>,
     /// The particles' largest size on screen at the emitter's distance, pixels.
     pub size_px: f32,
+    /// The trail's ribbon: segments per particle, and whether the sprite is drawn too.
+    pub trail: Option<(u32, bool)>,
 }
 
 impl DrawItem {
@@ -131,6 +133,8 @@ pub struct FrameResources {
     particle_groups: HashMap<(u64, usize, bool), (wgpu::Buffer, wgpu::BindGroup)>,
     /// Bound as the draw order of emitters that are not sorted.
     no_order: wgpu::Buffer,
+    /// Bound as the trail ring of emitters without a trail.
+    no_trail: wgpu::Buffer,
     /// Cut billboards to the occupied part of their sprite (on by default; off draws the
     /// whole square, for comparisons).
     pub trim_sprites: bool,
@@ -188,7 +192,13 @@ pub fn look_uniform(look: &Look, ramp_row: u32, salt: u32, sprite_integral: f32)
         0.0
     };
     LookUniform {
-        size_intensity: [0.0, 0.0, look.intensity, 0.0],
+        // x, y: the trail's width and opacity at its tail (fractions; trail.wgsl).
+        size_intensity: [
+            look.trail.as_ref().map_or(1.0, |t| t.tail_width),
+            look.trail.as_ref().map_or(1.0, |t| t.tail_opacity),
+            look.intensity,
+            0.0,
+        ],
         ids: [ramp_row, blend, rows, cols],
         flags: [mode, random_start, salt, 0],
         extra: [
@@ -197,7 +207,13 @@ pub fn look_uniform(look: &Look, ramp_row: u32, salt: u32, sprite_integral: f32)
             look.rotation_random_deg.to_radians(),
             fps,
         ],
-        spin_streak: [0.0, 0.0, streak.length_secs, streak.max_length_m],
+        // x: the trail's width (× the particle's size; trail.wgsl).
+        spin_streak: [
+            look.trail.as_ref().map_or(0.0, |t| t.width),
+            0.0,
+            streak.length_secs,
+            streak.max_length_m,
+        ],
         soft: [0.0, inv_soft, 0.0, 0.0],
         trim: [0.0, 0.0, 1.0, 1.0],
         ..LookUniform::default()
@@ -222,6 +238,8 @@ pub struct LookVariant {
     pub soft_depth: bool,
     /// The motion pass: screen-space motion weighted by visibility, added up.
     pub motion: bool,
+    /// The trail's ribbon (segments between recorded positions) instead of the sprite.
+    pub trail: bool,
     /// How the shaders read the emitter's state (both draw paths).
     pub state: StateVariant,
 }
@@ -258,7 +276,20 @@ impl LookVariant {
             soft: look.soft_ground_m > 0.0,
             soft_depth: false,
             motion: false,
+            trail: false,
             state,
+        }
+    }
+
+    /// The ribbon variant of this look (no flipbook, no streak: a ribbon samples the
+    /// sprite's middle column across its width).
+    pub fn with_trail(self) -> Self {
+        Self {
+            trail: true,
+            flipbook: false,
+            flip_blend: false,
+            streak: false,
+            ..self
         }
     }
 
@@ -280,12 +311,13 @@ impl LookVariant {
             soft: false,
             soft_depth: false,
             motion: false,
+            trail: false,
             state: StateVariant::default(),
         }
     }
 
     /// The override constants of this variant's billboard pipeline.
-    pub fn constants(self) -> [(&'static str, f64); 9] {
+    pub fn constants(self) -> [(&'static str, f64); 10] {
         let b = |v: bool| if v { 1.0 } else { 0.0 };
         let [layout, stateless] = self.state.constants();
         [
@@ -296,6 +328,7 @@ impl LookVariant {
             ("SOFT", b(self.soft && !self.soft_depth)),
             ("SOFT_DEPTH", b(self.soft && self.soft_depth)),
             ("MOTION", b(self.motion)),
+            ("TRAIL", b(self.trail)),
             layout,
             stateless,
         ]
@@ -355,7 +388,8 @@ impl FrameResources {
         let particle_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("FrameResources::particle_layout"),
             // 3, 4: the same state buffers as 0, 1, seen as packed (or tiny) state; 5: the
-            // tiny state's birth table.
+            // tiny state's birth table; 6: the trail's ring (the billboards' ribbons; vertex
+            // only, so that it does not count toward the compute paths' storage buffers).
             entries: &[
                 storage(0),
                 storage(1),
@@ -363,6 +397,10 @@ impl FrameResources {
                 storage(3),
                 storage(4),
                 storage(5),
+                wgpu::BindGroupLayoutEntry {
+                    visibility: wgpu::ShaderStages::VERTEX,
+                    ..storage(6)
+                },
             ],
         });
         let camera = d.create_buffer(&wgpu::BufferDescriptor {
@@ -388,6 +426,12 @@ impl FrameResources {
             no_order: d.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("FrameResources::no_order"),
                 size: 16,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            }),
+            no_trail: d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("FrameResources::no_trail"),
+                size: 64,
                 usage: wgpu::BufferUsages::STORAGE,
                 mapped_at_creation: false,
             }),
@@ -673,6 +717,8 @@ impl FrameResources {
         // w: the live window's length (it ends at the ring's head, ring.x).
         u.ring_b = [b.seed_salt.0, b.seed_salt.1, b.capacity, b.window.len];
         [u.tiny, u.tiny_b, u.tiny_c] = b.tiny;
+        // The trail's newest entries are from before the last step (trail.wgsl).
+        u.tiny_c[1] = b.last_step;
         u.flags[3] = b.slot_base;
         // The window ends at the ring's head (u.ring[0]).
         let cap = b.capacity.max(1);
@@ -775,8 +821,17 @@ impl FrameResources {
         let size_m = e.look.size_m.bounds().1;
         let size_px = size_m * view.camera.pixels_per_unit() / distance.max(1e-3);
         let additive = e.look.blend == BlendMode::Additive;
+        // A trail's ribbon is drawn by the billboards (segments between its recorded
+        // points), and so is its particle's sprite.
+        let trail = e
+            .look
+            .trail
+            .as_ref()
+            .filter(|_| b.trail.is_some())
+            .map(|t| (t.segments(), t.draw_sprite));
         let splat = self.allow_splat
             && additive
+            && trail.is_none()
             && match e.look.draw_path {
                 // Streaks are long even when the particles are small.
                 DrawPath::Auto => size_px < SPLAT_BELOW_PX && e.look.streak.is_none(),
@@ -790,6 +845,7 @@ impl FrameResources {
             && self.allow_tiles
             && !splat
             && e.look.streak.is_none()
+            && trail.is_none()
             && match e.look.draw_path {
                 DrawPath::Auto => {
                     // Billboard fill at most (every quad at the largest size). A group of
@@ -826,6 +882,7 @@ impl FrameResources {
             variant,
             sprite,
             size_px,
+            trail,
         })
     }
 
@@ -873,6 +930,10 @@ impl FrameResources {
                 wgpu::BindGroupEntry {
                     binding: 5,
                     resource: b.births.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: b.trail.unwrap_or(&self.no_trail).as_entire_binding(),
                 },
             ],
         });

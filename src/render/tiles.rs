@@ -336,11 +336,11 @@ impl TilePass {
         v: LookVariant,
         target: DrawTarget,
     ) -> [wgpu::ComputePipeline; 2] {
-        // tiles.wgsl has no motion pass.
+        // tiles.wgsl has no motion pass and no ribbons (trails stay billboards).
         let mut constants: Vec<(&str, f64)> = v
             .constants()
             .into_iter()
-            .filter(|(name, _)| *name != "MOTION")
+            .filter(|(name, _)| *name != "MOTION" && *name != "TRAIL")
             .collect();
         constants.push(("DEPTH_TEST", crate::render::depth_test(target)));
         // Software blending (lavapipe) rounds f16 toward zero; the tiles round as it does.

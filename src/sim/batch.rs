@@ -51,11 +51,12 @@ pub const BATCH_STATE_BYTES: u64 = 64 << 20;
 const MAX_STEPS: usize = 32;
 
 /// Whether `effect`'s emitters can be batched (full or packed state, not stateless, no
-/// events: a batch runs one dispatch per emitter and step, the events need a scan between).
+/// events or trails: a batch runs one dispatch per emitter and step, the events need a scan
+/// between, and neither keeps per-instance hook buffers).
 pub fn batchable(effect: &Effect) -> bool {
     (0..effect.emitters.len()).all(|i| {
         let m = Modules::in_effect(effect, i);
-        !m.contains(Modules::TINY) && !m.contains(Modules::STATELESS) && !m.has_events()
+        !m.contains(Modules::TINY) && !m.contains(Modules::STATELESS) && !m.has_hooks()
     })
 }
 
@@ -497,6 +498,9 @@ impl SimState for BatchMember<'_> {
                 p.live_window(pool.capacity, pool.life_range.1)
             }),
             slot_base: self.slot * pool.capacity,
+            // Trails are not batched.
+            trail: None,
+            last_step: 0,
         })
     }
 

@@ -116,14 +116,16 @@ pub fn step_cap(effect: &Effect, parent: usize, k: usize) -> u32 {
 
 /// The layouts and the scan pipeline (one per update pass).
 pub struct EventPipes {
-    /// Group 1 of an update with events: the records (written), the spawn list (read).
+    /// Group 1 of an update with hooks: the event records (written), the spawn list
+    /// (read), the trail's ring (written).
     pub hooks_layout: wgpu::BindGroupLayout,
     scan_layout: wgpu::BindGroupLayout,
     scan_pipeline_layout: wgpu::PipelineLayout,
     /// The scan, built from `events.wgsl`.
     pub scan: Option<wgpu::ComputePipeline>,
-    /// Group 1 for updates with events but no parent or child role in it (placeholders).
-    placeholder: wgpu::Buffer,
+    /// Bound in group 1 for a role an emitter does not have (one per binding: a buffer
+    /// cannot be bound read-only and writable in one dispatch).
+    placeholders: [wgpu::Buffer; 3],
 }
 
 impl EventPipes {
@@ -135,6 +137,7 @@ impl EventPipes {
             entries: &[
                 compute_storage_entry(0, false),
                 compute_storage_entry(1, true),
+                compute_storage_entry(2, false),
             ],
         });
         let scan_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -161,13 +164,14 @@ impl EventPipes {
             immediate_size: 0,
         });
         // Larger than either binding's fixed part (rules + one record; header + one entry).
-        let placeholder = storage_buffer(device, "EventPipes::placeholder", 256);
+        let placeholders =
+            [0, 1, 2].map(|_| storage_buffer(device, "EventPipes::placeholder", 256));
         Self {
             hooks_layout,
             scan_layout,
             scan_pipeline_layout,
             scan: None,
-            placeholder,
+            placeholders,
         }
     }
 
@@ -205,7 +209,8 @@ fn storage_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer
     })
 }
 
-/// One emitter's event buffers: its records (a parent) and its spawn list (a child).
+/// One emitter's hook buffers: its event records (a parent), its spawn list (a child) and
+/// its trail's ring (see `crate::sim::trails`).
 pub struct EmitterEvents {
     /// Rules and records: `RULES_BYTES` then 2 × capacity records (a parent).
     pub records: Option<wgpu::Buffer>,
@@ -213,12 +218,20 @@ pub struct EmitterEvents {
     pub list: Option<wgpu::Buffer>,
     /// The list's entries.
     pub list_len: u32,
+    /// The trail's ring of positions (an emitter with a trail).
+    pub trail: Option<wgpu::Buffer>,
     /// Group 1 of the update.
     pub hooks: wgpu::BindGroup,
     /// Per rule of this parent: the child, its config buffer and the scan's bind group.
     pub scans: Vec<Scan>,
-    /// What the buffers were made for: (capacity, rules, list length).
-    key: (u32, [EventRule; MAX_EVENTS_PER_EMITTER], u32),
+    /// What the buffers were made for: (capacity, rules, list length, trail points and
+    /// steps between them).
+    key: (
+        u32,
+        [EventRule; MAX_EVENTS_PER_EMITTER],
+        u32,
+        Option<(u32, u32)>,
+    ),
 }
 
 /// One rule's scan.
@@ -248,11 +261,12 @@ impl EmitterEvents {
             .iter()
             .map(|&(p, k)| step_cap(effect, p, k))
             .sum();
-        if e.events.is_empty() && list_len == 0 {
+        let trail = e.look.trail.as_ref().map(|t| (t.points, t.every_steps));
+        if e.events.is_empty() && list_len == 0 && trail.is_none() {
             return None;
         }
         let rules = rules_of(e);
-        let key = (capacity, rules, list_len);
+        let key = (capacity, rules, list_len, trail);
         if let Some(old) = old.filter(|o| o.key == key) {
             return Some(old);
         }
@@ -272,6 +286,8 @@ impl EmitterEvents {
             // New buffers are zeroed: head 0, count 0, stamp 0.
             storage_buffer(device, "EmitterEvents::list", size)
         });
+        let trail = trail
+            .map(|(points, every)| crate::sim::trails::ring_buffer(ctx, capacity, points, every));
         let hooks = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("EmitterEvents::hooks"),
             layout: &pipes.hooks_layout,
@@ -280,14 +296,21 @@ impl EmitterEvents {
                     binding: 0,
                     resource: records
                         .as_ref()
-                        .unwrap_or(&pipes.placeholder)
+                        .unwrap_or(&pipes.placeholders[0])
                         .as_entire_binding(),
                 },
                 wgpu::BindGroupEntry {
                     binding: 1,
                     resource: list
                         .as_ref()
-                        .unwrap_or(&pipes.placeholder)
+                        .unwrap_or(&pipes.placeholders[1])
+                        .as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: trail
+                        .as_ref()
+                        .unwrap_or(&pipes.placeholders[2])
                         .as_entire_binding(),
                 },
             ],
@@ -311,6 +334,7 @@ impl EmitterEvents {
             records,
             list,
             list_len,
+            trail,
             hooks,
             scans,
             key,

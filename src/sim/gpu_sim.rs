@@ -12,7 +12,7 @@ use crate::gpu::types::{
 use crate::gpu::{GpuContext, GpuError};
 use crate::shaders::{
     EVENTS_IO, PACKED_STATE_IO, PARAMS_INSTANCED, ShaderError, ShaderLibrary, TINY_STATE_IO,
-    create_checked,
+    TRAIL_IO, create_checked,
 };
 use crate::sim::events::{EmitterEvents, EventHeader, EventPipes, ScanConfig};
 use crate::sim::modules::Modules;
@@ -182,12 +182,22 @@ impl UpdatePass {
         let packed = compose(Some(PACKED_STATE_IO))?;
         // Tiny-state pipelines: state_tiny.wgsl as the state I/O.
         let tiny = compose(Some(TINY_STATE_IO))?;
-        // Emitters with events or fed by them: the event hooks (full state only).
-        let events = compose(Some(EVENTS_IO))?;
+        // Emitters with events (or fed by them) or trails: their hooks, full state only.
+        let mut hooked = HashMap::new();
+        for &(_, modules) in keys.iter().filter(|(_, m)| m.has_hooks()) {
+            let key = (modules.has_events(), modules.contains(Modules::TRAIL));
+            if let std::collections::hash_map::Entry::Vacant(v) = hooked.entry(key) {
+                let hooks = [key.0.then_some(EVENTS_IO), key.1.then_some(TRAIL_IO)];
+                let aliases: Vec<(&str, &str)> =
+                    hooks.into_iter().flatten().chain(params).collect();
+                v.insert(lib.compose_with("update.wgsl", &aliases)?);
+            }
+        }
         let mut fresh = HashMap::new();
         for &(integrator, modules) in keys {
-            let (composed, layout) = if modules.has_events() {
-                (&events, &self.events_pipeline_layout)
+            let hooks = (modules.has_events(), modules.contains(Modules::TRAIL));
+            let (composed, layout) = if let Some(c) = hooked.get(&hooks) {
+                (c, &self.events_pipeline_layout)
             } else if modules.contains(Modules::TINY) {
                 (&tiny, &self.pipeline_layout)
             } else if modules.contains(Modules::PACKED) {
@@ -240,7 +250,7 @@ impl UpdatePass {
             .files
             .into_iter()
             .chain(tiny.files)
-            .chain(events.files)
+            .chain(hooked.into_values().flat_map(|c| c.files))
             .chain(count_src.files)
             .chain(scan_files)
         {
@@ -303,6 +313,9 @@ pub(super) struct EmitterState {
     pub(super) spawned_end: u64,
     /// Event records (a parent) and spawn list (a child).
     pub(super) events: Option<EmitterEvents>,
+    /// Spawns from other emitters' events: the GPU fills the ring, so the planner cannot
+    /// know its live window and every slot is visited.
+    pub(super) gpu_fed: bool,
 }
 
 /// A buffer for an emitter's baked over-life curves (rows A and B, [`CURVE_WIDTH`]
@@ -418,6 +431,10 @@ pub struct EmitterBuffers<'a> {
     pub window: LiveWindow,
     /// Where this pool's slots start in the buffers (a batched instance's segment; else 0).
     pub slot_base: u32,
+    /// The trail's ring of positions (an emitter with a trail).
+    pub trail: Option<&'a wgpu::Buffer>,
+    /// The number of the last step (the trail's newest entries are older).
+    pub last_step: u32,
 }
 
 /// What the draw passes read of a simulation: its pools and its planner (a
@@ -578,10 +595,7 @@ impl GpuSim {
             s.seed = effect.seed;
             s.salt = crate::rng::emitter_salt(i as u32, e.seed_offset);
             let modules = Modules::in_effect(effect, i);
-            if modules.contains(Modules::EVENT_SPAWN) {
-                // The GPU fills this ring: the planner cannot know its live window.
-                s.whole_pool_until = f64::INFINITY;
-            }
+            s.gpu_fed = modules.contains(Modules::EVENT_SPAWN);
             if modules.contains(Modules::CURVES) {
                 upload_over_life(&self.ctx.queue, &s.curves, &mut s.curves_key, e);
             }
@@ -706,6 +720,7 @@ impl GpuSim {
             whole_pool_until: f64::NEG_INFINITY,
             spawned_end: 0,
             events: None,
+            gpu_fed: false,
         }
     }
 
@@ -850,7 +865,8 @@ impl GpuSim {
                         .emitters
                         .get(e)
                         .map_or(f64::INFINITY, |pl| pl.clock_secs());
-                    if clock < em.whole_pool_until
+                    if em.gpu_fed
+                        || clock < em.whole_pool_until
                         || p.capacity != em.capacity
                         || p.update_window[1] > em.capacity
                     {
@@ -1122,7 +1138,8 @@ impl GpuSim {
             seed_salt: (s.seed, s.salt),
             window: match planner {
                 Some(p)
-                    if p.clock_secs() >= s.whole_pool_until
+                    if !s.gpu_fed
+                        && p.clock_secs() >= s.whole_pool_until
                         && p.spawned_total() == s.spawned_end =>
                 {
                     p.live_window(s.capacity, s.life_range.1)
@@ -1130,6 +1147,8 @@ impl GpuSim {
                 _ => LiveWindow::all(s.capacity),
             },
             slot_base: 0,
+            trail: s.events.as_ref().and_then(|ev| ev.trail.as_ref()),
+            last_step: self.planner.step_index.saturating_sub(1) as u32,
         })
     }
 

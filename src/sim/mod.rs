@@ -9,6 +9,7 @@ pub mod modules;
 pub mod planner;
 pub mod snapshot;
 pub mod stepper;
+pub mod trails;
 
 pub use cpu_reference::CpuSim;
 pub use gpu_sim::{GpuSim, SimError};

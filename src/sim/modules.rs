@@ -37,9 +37,11 @@ impl Modules {
     pub const EVENTS: Modules = Modules(4096);
     /// Spawning from another emitter's events instead of the emitter's own rate.
     pub const EVENT_SPAWN: Modules = Modules(8192);
+    /// Trails: the update records each particle's positions in a ring (trail_on.wgsl).
+    pub const TRAIL: Modules = Modules(16384);
 
     /// Every module with its override-constant name.
-    pub const ALL: [(Modules, &'static str); 14] = [
+    pub const ALL: [(Modules, &'static str); 15] = [
         (Self::DRAG, "MOD_DRAG"),
         (Self::GUSTS, "MOD_GUSTS"),
         (Self::QUADRATIC_DRAG, "MOD_QUADRATIC_DRAG"),
@@ -54,6 +56,7 @@ impl Modules {
         (Self::CURVES, "MOD_CURVES"),
         (Self::EVENTS, "MOD_EVENTS"),
         (Self::EVENT_SPAWN, "MOD_EVENT_SPAWN"),
+        (Self::TRAIL, "MOD_TRAIL"),
     ];
 
     /// The modules an emitter's settings need.
@@ -94,9 +97,15 @@ impl Modules {
         if over_life_params(e).iter().any(|p| !p.is_constant(1.0)) {
             m.0 |= Self::CURVES.0;
         }
+        if e.look.trail.is_some() {
+            m.0 |= Self::TRAIL.0;
+        }
         if !e.events.is_empty() {
-            // A parent reads its particles' whole state every step: the full layout.
             m.0 |= Self::EVENTS.0;
+        }
+        if m.has_hooks() {
+            // Events and trails read the particles' whole state every step: the full
+            // layout, stateful.
         } else if e.stateless && e.stateless_blockers().is_empty() {
             m.0 |= Self::STATELESS.0;
         } else if e.tiny_state {
@@ -126,6 +135,11 @@ impl Modules {
     /// True when the update composes the event hooks (events_on.wgsl).
     pub fn has_events(self) -> bool {
         self.0 & (Self::EVENTS.0 | Self::EVENT_SPAWN.0) != 0
+    }
+
+    /// True when the update has hooks in group 1 (events or the trail's ring).
+    pub fn has_hooks(self) -> bool {
+        self.has_events() || self.contains(Self::TRAIL)
     }
 
     /// True when every module of `other` is in `self`.

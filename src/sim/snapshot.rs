@@ -31,6 +31,8 @@ struct EmitterSnapshot {
     /// A child's event-list header (its ring head, the last step's children and stamp,
     /// the dropped count): the list's entries are rewritten every step before use.
     event_header: Option<wgpu::Buffer>,
+    /// The trail's ring (the positions the ribbon draws).
+    trail: Option<wgpu::Buffer>,
 }
 
 impl SimSnapshot {
@@ -81,7 +83,23 @@ impl GpuSim {
                         bytes += size;
                         copy
                     });
+                let trail = s
+                    .events
+                    .as_ref()
+                    .and_then(|ev| ev.trail.as_ref())
+                    .map(|ring| {
+                        let copy = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                            label: Some("SimSnapshot::trail"),
+                            size: ring.size(),
+                            usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                            mapped_at_creation: false,
+                        });
+                        enc.copy_buffer_to_buffer(ring, 0, &copy, 0, ring.size());
+                        bytes += ring.size();
+                        copy
+                    });
                 EmitterSnapshot {
+                    trail,
                     event_header,
                     generation: s.generation,
                     buffers,
@@ -121,6 +139,12 @@ impl GpuSim {
                 enc.copy_buffer_to_buffer(header, 0, list, 0, header.size());
             } else if let Some(list) = list {
                 enc.clear_buffer(list, 0, None);
+            }
+            let ring = s.events.as_ref().and_then(|ev| ev.trail.as_ref());
+            if let (Some(ring), Some(copy)) = (ring, &k.trail)
+                && ring.size() == copy.size()
+            {
+                enc.copy_buffer_to_buffer(copy, 0, ring, 0, ring.size());
             }
             s.current = k.current;
             s.whole_pool_until = k.whole_pool_until;

@@ -1,0 +1,88 @@
+// trail.wgsl — the ribbon of an emitter with a trail, as the billboards draw it
+// (`TRAIL`): segment s of a particle joins point s and point s + 1, where point 0 is the
+// particle as drawn (between the last two steps) and point j ≥ 1 the j-th newest entry
+// of its ring (trail_on.wgsl) recorded before the last step. A segment is a
+// camera-facing strip, its width and opacity tapering from the particle to the tail, its
+// colour the colour ramp at the age the particle had at the segment's near end.
+//
+// Contract: as quad.wgsl, plus group 1 binding 6 `trail_ring` (the emitter's ring; a
+// placeholder without a trail) and the look's trail fields: `look.tiny_c.y` the last
+// step's number, `look.spin_streak.x` the width (× the particle's size),
+// `look.size_intensity.x` the tail's width fraction, `size_intensity.y` its opacity.
+// Mirrored by `trail_points` in src/sim/trails.rs.
+#import "quad.wgsl"
+
+override TRAIL: bool = false;
+
+struct TrailRingRead {
+    points: u32,
+    every: u32,
+    pad0: u32,
+    pad1: u32,
+    history: array<vec4<f32>>,
+}
+
+@group(1) @binding(6) var<storage, read> trail_ring: TrailRingRead;
+
+// Point j ≥ 1 of the trail of `slot` (xyz position, w age).
+fn trail_point(slot: u32, j: u32) -> vec4<f32> {
+    let n = max(trail_ring.points, 1u);
+    let every = max(trail_ring.every, 1u);
+    // The newest recording step before the last step (a particle born in the last step
+    // filled its whole ring, so any entry is its birth point).
+    let before = look.tiny_c.y - 1u;
+    let k = before - before % every;
+    let r = (k / every + n - (j - 1u) % n) % n;
+    return trail_ring.history[(look.flags.w + slot) * n + r];
+}
+
+struct TrailCorner {
+    clip: vec4<f32>,
+    // Premultiplied colour of the segment (flat).
+    color: vec4<f32>,
+    // The opacity taper at this corner (interpolated along the segment).
+    fade: f32,
+    // Across the ribbon: -1 .. 1.
+    across: f32,
+    world: vec3<f32>,
+}
+
+// Corner `vi` of segment `seg` (of `segments`) of the particle `qd`.
+fn trail_corner(qd: Quad, seg: u32, segments: u32, vi: u32) -> TrailCorner {
+    var out: TrailCorner;
+    let d = qd.d;
+    let head = select(trail_point(qd.slot, seg), vec4<f32>(d.pos, d.age), seg == 0u);
+    let tail = trail_point(qd.slot, seg + 1u);
+    let far = (vi & 1u) == 0u;
+    let end = select(head, tail, far);
+    let u = (f32(seg) + select(0.0, 1.0, far)) / f32(segments);
+    let taper = mix(1.0, look.size_intensity.x, u);
+    out.fade = mix(1.0, look.size_intensity.y, u);
+    let head_clip = look.clip_from_sim * vec4<f32>(head.xyz, 1.0);
+    var tail_clip = look.clip_from_sim * vec4<f32>(tail.xyz, 1.0);
+    if tail_clip.w <= 1e-4 || head_clip.w <= 1e-4 {
+        tail_clip = head_clip;
+    }
+    let half_vp = 0.5 * camera.viewport.xy;
+    let dir_px = (head_clip.xy / head_clip.w - tail_clip.xy / tail_clip.w) * half_vp;
+    let l = length(dir_px);
+    let dir = select(vec2<f32>(1.0, 0.0), dir_px / l, l > 1e-3);
+    let perp = vec2<f32>(-dir.y, dir.x);
+    let c = select(head_clip, tail_clip, far);
+    out.across = f32(vi >> 1u) * 2.0 - 1.0;
+    // The half-width in pixels is 0.5·width·viewport.z / w; in clip units the w cancels.
+    let width = qd.lc.x * look.spin_streak.x * taper;
+    let off_px = perp * out.across * (0.5 * width * camera.viewport.z);
+    out.clip = vec4<f32>(c.xy + off_px / half_vp, c.z, c.w);
+    out.world = end.xyz;
+    // The colour at the age of the segment's near end.
+    let t = age_fraction(head.w, d.life);
+    let col = particle_color(t);
+    let alpha = col.a * qd.lc.y;
+    var gain = alpha;
+    if !SORTED {
+        gain *= look.size_intensity.z;
+    }
+    out.color = vec4<f32>(col.rgb * gain, alpha);
+    return out;
+}
