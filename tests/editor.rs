@@ -58,7 +58,9 @@ fn a_widget_edits_the_effect_and_the_running_copy() {
     let before = harness.state().effect.emitters[0]
         .spawn_rate_per_sec
         .clone();
-    assert_eq!(before, ignis::effect::Param::Constant(90.0));
+    // The smoke spawns from the flames' death events; its own rate (unused while it is
+    // fed) is still a field the panel edits.
+    assert_eq!(before, ignis::effect::Param::Constant(0.0));
 
     harness
         .get_by_label("Spawn rate")
@@ -464,7 +466,12 @@ fn a_smaller_capacity_keeps_the_particles_that_fit() {
 #[test]
 fn reordering_emitters_moves_their_particles_along() {
     let ctx = GpuContext::headless().expect("a GPU adapter (lavapipe is fine)");
-    let state = campfire_state();
+    let mut state = campfire_state();
+    // A rate of its own for the smoke: unused while the flames' events feed it, the rate
+    // its copy (which no event names) spawns at.
+    for effect in [&mut state.effect, &mut state.running] {
+        effect.emitters[0].spawn_rate_per_sec = ignis::effect::Param::Constant(90.0);
+    }
     // The editor's player: one instance with a simulation of its own.
     let settings = PlayerSettings {
         batch_instances: false,
@@ -1497,4 +1504,57 @@ fn the_curve_editor_drags_adds_and_deletes_keys() {
     }
     assert_eq!(size(&harness).rows()[0].keys.len(), 2);
     assert!(harness.state().validation_errors.is_empty());
+}
+
+/// The Events section: an event added to the embers (its first choice of child is the
+/// smoke), its chance edited live, undone with the keyboard; an event that would close a
+/// cycle (smoke → flames, whose deaths feed the smoke) is refused by validation while the
+/// last valid effect keeps running.
+#[test]
+fn events_are_added_edited_validated_and_undone_in_the_panel() {
+    let mut state = campfire_state();
+    let embers = emitter_index(&state.effect, "embers");
+    state.selected = embers;
+    state.open_sections = Some(vec!["events".to_owned()]);
+    let mut harness = panel_harness(state);
+    harness.run();
+    harness.get_by_label("Add event").click_accesskit();
+    harness.run();
+    let events = &harness.state().effect.emitters[embers].events;
+    assert_eq!(events.len(), 1);
+    assert_eq!(events[0].emitter, "smoke");
+    assert_eq!(events[0].trigger, ignis::effect::Trigger::Death);
+    harness.get_by_label("Chance").set_value_accesskit(0.25);
+    harness.run();
+    let s = harness.state();
+    assert_eq!(s.effect.emitters[embers].events[0].probability, 0.25);
+    assert_eq!(s.running.emitters[embers].events[0].probability, 0.25);
+    assert!(s.validation_errors.is_empty(), "{:?}", s.validation_errors);
+    assert_eq!(s.running.event_sources(0), [(1, 0), (embers, 0)]);
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    harness.run();
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    harness.run();
+    assert!(harness.state().effect.emitters[embers].events.is_empty());
+
+    let mut state = campfire_state();
+    state.selected = emitter_index(&state.effect, "smoke");
+    state.open_sections = Some(vec!["events".to_owned()]);
+    let mut harness = panel_harness(state);
+    harness.run();
+    harness.get_by_label("Add event").click_accesskit();
+    harness.run();
+    let s = harness.state();
+    assert_eq!(s.effect.emitters[0].events[0].emitter, "flames");
+    assert!(
+        s.validation_errors
+            .iter()
+            .any(|e| e.problem.contains("cycle")),
+        "{:?}",
+        s.validation_errors
+    );
+    assert!(
+        s.running.emitters[0].events.is_empty(),
+        "the last valid effect runs"
+    );
 }

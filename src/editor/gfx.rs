@@ -541,6 +541,7 @@ impl Gfx {
                 for (s, c) in stats.emitters.iter_mut().zip(counts) {
                     s.alive = c.alive;
                     s.nonfinite = c.nonfinite;
+                    s.events = c.events;
                 }
                 stats.counters_age_frames = 0;
             }

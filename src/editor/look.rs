@@ -4,7 +4,7 @@ use egui::{Color32, DragValue, Rgba, RichText, Sense, Ui};
 
 use crate::effect::{
     BlendMode, Bloom, ColorStop, DrawPath, Effect, Flipbook, FlipbookMode, Look, MAX_COLOR_STOPS,
-    Param, Post, SPLAT_BELOW_PX, Sprite, Streak, TILES_ABOVE_PX,
+    MAX_TRAIL_POINTS, Param, Post, SPLAT_BELOW_PX, Sprite, Streak, TILES_ABOVE_PX, Trail,
 };
 pub use crate::render::look::sample_gradient;
 
@@ -215,6 +215,7 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
                 }
             });
             ui.end_row();
+            trail_rows_ui(ui, look);
             let label = ui
                 .label("Soft ground")
                 .on_hover_text("Fade sprites over this distance above the ground plane (the emitter's ground collider, else y = 0) instead of cutting them: soft particles. 0 = off");
@@ -239,6 +240,67 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
     );
     gradient_editor_ui(ui, &mut look.color_over_life);
     color_stops_ui(ui, &mut look.color_over_life);
+}
+
+/// The trail: on/off, points and spacing; width, tapers and the sprite when on (rows of an
+/// open grid).
+fn trail_rows_ui(ui: &mut Ui, look: &mut Look) {
+    let label = ui.label("Trail").on_hover_text(
+        "A ribbon through each particle's last positions, recorded every few steps (drawn by the billboards); the velocity streak is the cheaper option",
+    );
+    ui.horizontal(|ui| {
+        let mut on = look.trail.is_some();
+        if ui.checkbox(&mut on, "ribbon").changed() {
+            look.trail = on.then(Trail::default);
+        }
+        if let Some(t) = &mut look.trail {
+            ui.add(
+                DragValue::new(&mut t.points)
+                    .range(2..=MAX_TRAIL_POINTS)
+                    .prefix("points "),
+            )
+            .labelled_by(label.id);
+            ui.add(
+                DragValue::new(&mut t.every_steps)
+                    .range(1..=120)
+                    .prefix("every ")
+                    .suffix(" steps"),
+            )
+            .labelled_by(label.id);
+        }
+    });
+    ui.end_row();
+    let Some(t) = &mut look.trail else {
+        return;
+    };
+    let label = ui.label("Trail width").on_hover_text(
+        "Width at the particle (× its size), then the width and opacity at the tail as fractions of it; sprite: draw the particle's sprite too",
+    );
+    ui.horizontal(|ui| {
+        ui.add(
+            DragValue::new(&mut t.width)
+                .range(0.0..=100.0)
+                .speed(0.01)
+                .suffix("×"),
+        )
+        .labelled_by(label.id);
+        ui.add(
+            DragValue::new(&mut t.tail_width)
+                .range(0.0..=1.0)
+                .speed(0.01)
+                .prefix("tail "),
+        )
+        .labelled_by(label.id);
+        ui.add(
+            DragValue::new(&mut t.tail_opacity)
+                .range(0.0..=1.0)
+                .speed(0.01)
+                .prefix("fade "),
+        )
+        .labelled_by(label.id);
+        ui.checkbox(&mut t.draw_sprite, "sprite");
+    });
+    ui.end_row();
 }
 
 /// The sprite picker, the PNG path and the flipbook (rows of an open grid).

@@ -7,6 +7,7 @@
 pub mod app;
 pub mod curve_editor;
 pub mod emitter_cost;
+pub mod events_ui;
 pub mod export_ui;
 mod gfx;
 pub mod inspect;

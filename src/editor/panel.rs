@@ -71,6 +71,16 @@ pub fn panel_ui(ui: &mut Ui, state: &mut EditorState) {
                     forces_ui(ui, &mut state.effect, state.selected);
                 },
             );
+            section_ui(
+                ui,
+                "events",
+                "Events",
+                &name,
+                (false, open("events")),
+                |ui| {
+                    super::events_ui::events_ui(ui, &mut state.effect, state.selected);
+                },
+            );
             section_ui(ui, "time", "Time", "", (true, open("time")), |ui| {
                 time_ui(ui, &mut state.effect, &mut state.playback, state.selected);
             });
@@ -467,10 +477,18 @@ pub fn unique_name(effect: &Effect, base: &str) -> String {
 pub fn emitter_ui(ui: &mut Ui, effect: &mut Effect, selected: &mut usize) {
     emitter_list_ui(ui, effect, selected);
     ui.separator();
-    let Some(e) = effect.emitters.get_mut(*selected) else {
+    let Some(old_name) = effect.emitters.get(*selected).map(|e| e.name.clone()) else {
         ui.label("No emitter: add one.");
         return;
     };
+    emitter_fields_ui(ui, &mut effect.emitters[*selected]);
+    // Events name their children: a renamed emitter keeps its parents' events.
+    let new_name = effect.emitters[*selected].name.clone();
+    super::events_ui::rename_references(effect, &old_name, &new_name);
+}
+
+/// The selected emitter's own fields (name, shape, placement, spawning, bursts).
+fn emitter_fields_ui(ui: &mut Ui, e: &mut Emitter) {
     grid("emitter_grid").show(ui, |ui| {
         row_ui(
 ui, "Name", "Unique name of this layer", |ui| {

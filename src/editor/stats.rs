@@ -23,6 +23,8 @@ pub struct EmitterStats {
     pub window: u32,
     /// Spawn accounting from the CPU planner.
     pub spawn: SpawnStats,
+    /// Fed by events: children asked for and dropped by the per-step caps (GPU counters).
+    pub events: Option<crate::runtime::EventCount>,
 }
 
 /// The last shader hot reload.
@@ -243,6 +245,21 @@ pub fn stats_ui(ui: &mut egui::Ui, stats: &Stats, effect: &Effect) {
                 s.nonfinite
             ));
         });
+        if let Some(ev) = s.events {
+            ui.horizontal(|ui| {
+                ui.add_space(84.0);
+                let text = format!("events: {} asked, {} dropped", ev.asked, ev.dropped);
+                if ev.dropped > 0 {
+                    ui.colored_label(ui.visuals().warn_fg_color, text)
+                        .on_hover_text(
+                            "Dropped: a step's events asked for more children than their cap \
+                         per step — raise the parent's event cap (Events section).",
+                        );
+                } else {
+                    ui.weak(text);
+                }
+            });
+        }
         let dropped = s.spawn.dropped_by_cap + s.spawn.dropped_over_capacity;
         if dropped > 0 || s.spawn.recycled_alive > 0 || s.nonfinite > 0 {
             ui.horizontal(|ui| {

@@ -23,6 +23,7 @@ use crate::sim::{GpuSim, SimError};
 pub const PLAYER_SHADERS: &[&str] = &[
     "update.wgsl",
     "count.wgsl",
+    "events.wgsl",
     "billboard.wgsl",
     "splat.wgsl",
     "tiles.wgsl",
@@ -166,7 +167,7 @@ impl Player {
     pub fn reload_shader(&mut self, dir: &Path, entry: &str) -> Result<(), ShaderError> {
         let lib = ShaderLibrary::from_dir(dir);
         match entry {
-            "update.wgsl" | "count.wgsl" => {
+            "update.wgsl" | "count.wgsl" | "events.wgsl" => {
                 lock(&self.update).rebuild(&self.ctx, &lib, &used_keys(&self.effect))?;
                 // The state snapshots were simulated by the old update.
                 self.snapshots.clear();

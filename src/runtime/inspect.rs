@@ -44,6 +44,18 @@ pub struct ParticleCount {
     /// Killed since the start for a non-finite position or velocity (an unstable
     /// integrator or an extreme force; 0 for batched instances, which do not count).
     pub nonfinite: u32,
+    /// An emitter fed by events: the children its parents' events asked for since the
+    /// start, and those the per-step caps dropped.
+    pub events: Option<EventCount>,
+}
+
+/// The children an emitter's events asked for and dropped (see [`ParticleCount`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct EventCount {
+    /// Children asked for since the start.
+    pub asked: u32,
+    /// Children dropped by the per-step caps since the start.
+    pub dropped: u32,
 }
 
 impl Player {
@@ -106,7 +118,15 @@ impl Player {
                 _ if !e.enabled => ParticleCount::default(),
                 Backing::Own(sim) => {
                     let [alive, nonfinite] = sim.read_counters(i)?;
-                    ParticleCount { alive, nonfinite }
+                    let events = sim.read_event_header(i)?.map(|h| EventCount {
+                        asked: h.total,
+                        dropped: h.dropped,
+                    });
+                    ParticleCount {
+                        alive,
+                        nonfinite,
+                        events,
+                    }
                 }
                 Backing::Batched { .. } => ParticleCount {
                     alive: self
@@ -115,6 +135,7 @@ impl Player {
                         .filter(|p| p.is_alive())
                         .count() as u32,
                     nonfinite: 0,
+                    events: None,
                 },
             };
             counts.push(count);

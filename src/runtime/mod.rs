@@ -13,7 +13,7 @@ mod seeking;
 
 pub use crate::render::Camera;
 pub use editing::PLAYER_SHADERS;
-pub use inspect::{ClockStats, EmitterStats, ParticleCount};
+pub use inspect::{ClockStats, EmitterStats, EventCount, ParticleCount};
 pub use instances::InstanceId;
 pub use layers::Layers;
 pub use particle_info::ParticleInfo;
