@@ -178,13 +178,16 @@ fn update_at(slot: u32) -> bool {
     var born = false;
     var hit = false;
     var finite = true;
+    // module-begin
     let from_event = event_birth(slot);
     if from_event.born {
         // A child of another emitter's event, born at the event's place this step.
         p = from_event.p;
         born = true;
         alive = is_alive(p);
-    } else if rel < params.spawn_count {
+    } else
+    // module-end
+    if rel < params.spawn_count {
         born = true;
         // 64-bit spawn counter = base + rel.
         let lo = params.spawn_base_lo + rel;
@@ -243,8 +246,10 @@ fn update_at(slot: u32) -> bool {
             finite = false;
         }
     }
+    // module-begin
     emit_events(slot, p, born, was_alive && finite, alive, hit, age_start);
     record_trail(slot, p, born, alive);
+    // module-end
     store_state(slot, p);
     return alive;
 }

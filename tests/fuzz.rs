@@ -109,14 +109,14 @@ fn text_at(text: &str, line: usize, column: usize) -> &str {
 #[test]
 fn loader_regressions_locate_values_exactly_or_fail_cleanly() {
     let campfire = PRESETS[0];
-    let rate = "spawn_rate_per_sec: Constant(90.0)";
-    assert!(campfire.contains(rate), "the campfire's smoke rate");
+    let rate = "spawn_rate_per_sec: Constant(2000.0)";
+    assert!(campfire.contains(rate), "the campfire's flame rate");
     let negative = campfire.replacen(rate, "spawn_rate_per_sec: Constant(-5)", 1);
     let variants = [
         negative.clone(),
         negative.replace('\n', "\r\n"),
         negative.replacen("(\n", "( // ünïcödé ✓ 🔥\n", 1),
-        negative.replacen("-5", "/* was 90 */ -5", 1),
+        negative.replacen("-5", "/* was 2000 */ -5", 1),
         negative.replacen("-5", "-5e0", 1),
         campfire.replacen(rate, "spawn_rate_per_sec: Constant(1e39)", 1),
     ];

@@ -301,6 +301,7 @@ fn only_dependent_pipelines_rebuild() {
         vec![
             "billboard.wgsl",
             "count.wgsl",
+            "events.wgsl",
             "sort.wgsl",
             "splat.wgsl",
             "tiles.wgsl",

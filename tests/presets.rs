@@ -1564,6 +1564,7 @@ fn documented_examples_and_defaults_match_the_code() {
     e.collisions.spheres = vec![SphereCollider::default()];
     e.look.flipbook = Some(Flipbook::default());
     e.look.streak = Some(Streak::default());
+    e.look.trail = Some(ignis::effect::Trail::default());
     expected.post.bloom = Some(Bloom::default());
     assert_eq!(documented, expected);
 }

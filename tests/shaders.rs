@@ -53,6 +53,13 @@ fn every_entry_validates() {
         .unwrap_or_else(|e| panic!("update with events: {e}"));
     assert!(events.files.iter().any(|f| f == "events_on.wgsl"));
     assert!(!events.files.iter().any(|f| f == "events_off.wgsl"));
+    // An emitter with a trail: trail_on.wgsl (the ring of positions) for trail_off.wgsl.
+    let trail = project_shaders()
+        .compose_with("update.wgsl", &[ignis::shaders::TRAIL_IO])
+        .unwrap_or_else(|e| panic!("update with a trail: {e}"));
+    assert!(trail.files.iter().any(|f| f == "trail_on.wgsl"));
+    assert!(!trail.files.iter().any(|f| f == "trail_off.wgsl"));
+    reached.extend(trail.files);
     reached.extend(packed.files);
     reached.extend(tiny.files);
     reached.extend(instanced.files);

@@ -203,8 +203,9 @@ fn shipped_presets_survive_one_second_steps() {
                 assert_eq!(
                     sim.read_counters(i).expect("counters")[1],
                     0,
-                    "{}: non-finite kills",
-                    path.display()
+                    "{}: {}: non-finite kills",
+                    path.display(),
+                    effect.emitters[i].name
                 );
                 assert!(
                     sim.read_particles(i)

@@ -451,6 +451,10 @@ fn module_costs(ctx: &GpuContext, opts: &PerfOptions) -> Result<Vec<(String, f64
                 e.collisions.spheres = vec![Default::default()];
             }),
         ),
+        (
+            "trail on (12 points, every 2 steps)",
+            Box::new(|e: &mut Emitter| e.look.trail = Some(Default::default())),
+        ),
     ];
     for (name, apply) in on {
         let mut effect = plain.clone();
@@ -464,6 +468,28 @@ fn module_costs(ctx: &GpuContext, opts: &PerfOptions) -> Result<Vec<(String, f64
             ShaderLibrary::embedded(),
         ));
     }
+    // Events: the pool's particles spawn one child each on death into a small emitter (the
+    // records of every slot written each step, the scan, the child's update).
+    let mut events = plain.clone();
+    let mut child = events.emitters[0].clone();
+    child.name = "event child".into();
+    child.capacity = 4096;
+    child.spawn_rate_per_sec = crate::effect::Param::Constant(0.0);
+    events.emitters[0].events = vec![crate::effect::Event {
+        emitter: child.name.clone(),
+        max_per_step: 4096,
+        ..Default::default()
+    }];
+    events.emitters.push(child);
+    let mods = Modules::in_effect(&events, 0);
+    variants.push((
+        format!(
+            "events on (death → a 4096-slot child) [{}]",
+            mods.names().join(", ")
+        ),
+        events,
+        ShaderLibrary::embedded(),
+    ));
     // Every variant on one pool, filled like the throughput rows' (66 steps: every slot
     // alive), and no other large pool alive: on the H100 the same one-step update of a
     // 16.8M pool measured 0.41 ms with one such pool allocated, 0.74 ms with two and

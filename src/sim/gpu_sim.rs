@@ -62,8 +62,8 @@ pub struct UpdatePass {
     batched: bool,
     /// The event hooks' layout and the event scan.
     pub(crate) events: EventPipes,
-    /// Groups 0 and 1: the update of an emitter with events.
-    events_pipeline_layout: wgpu::PipelineLayout,
+    /// Groups 0 and 1: the update of an emitter with hooks (none when batched).
+    events_pipeline_layout: Option<wgpu::PipelineLayout>,
 }
 
 /// How an update pass's pipelines are specialised.
@@ -120,13 +120,16 @@ impl UpdatePass {
                 immediate_size: 0,
             });
         let events = EventPipes::new(ctx, params_entry);
-        let events_pipeline_layout =
+        // Batched updates have no hooks (effects with events or trails are not batched),
+        // and their parameters in storage would take them past 8 storage buffers.
+        let events_pipeline_layout = (!batched).then(|| {
             ctx.device
                 .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                     label: Some("UpdatePass::events_pipeline_layout"),
                     bind_group_layouts: &[Some(&layout), Some(&events.hooks_layout)],
                     immediate_size: 0,
-                });
+                })
+        });
         let count_layout = ctx
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -196,8 +199,9 @@ impl UpdatePass {
         let mut fresh = HashMap::new();
         for &(integrator, modules) in keys {
             let hooks = (modules.has_events(), modules.contains(Modules::TRAIL));
-            let (composed, layout) = if let Some(c) = hooked.get(&hooks) {
-                (c, &self.events_pipeline_layout)
+            let with_hooks = hooked.get(&hooks).zip(self.events_pipeline_layout.as_ref());
+            let (composed, layout) = if let Some((c, l)) = with_hooks {
+                (c, l)
             } else if modules.contains(Modules::TINY) {
                 (&tiny, &self.pipeline_layout)
             } else if modules.contains(Modules::PACKED) {
@@ -242,7 +246,12 @@ impl UpdatePass {
                     })
             })
         })?;
-        let scan_files = self.events.rebuild(ctx, lib)?;
+        // The event scan (batched updates have no events: none).
+        let scan_files = if self.batched {
+            Vec::new()
+        } else {
+            self.events.rebuild(ctx, lib)?
+        };
         self.pipelines = fresh;
         self.count = Some(count);
         self.files = composed.files;
@@ -373,6 +382,17 @@ static NEXT_GENERATION: AtomicU64 = AtomicU64::new(1);
 /// A generation no pool has had.
 pub(crate) fn next_generation() -> u64 {
     NEXT_GENERATION.fetch_add(1, Ordering::Relaxed)
+}
+
+/// A trail's ring read back ([`GpuSim::read_trail`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TrailRing {
+    /// Entries per slot.
+    pub points: u32,
+    /// Steps between recorded points.
+    pub every_steps: u32,
+    /// `points` entries per slot, slot after slot: position (simulation space) and age.
+    pub entries: Vec<[f32; 4]>,
 }
 
 /// The update pipelines, shared by the simulations of one effect's instances.
@@ -994,6 +1014,26 @@ impl GpuSim {
                     .write_buffer(&scan.config, 0, bytemuck::bytes_of(&cfg));
             }
         }
+    }
+
+    /// Emitter `index`'s trail ring (a blocking readback): points per slot, steps between
+    /// them, and the entries (`points` per slot: position, and the age then).
+    pub fn read_trail(&self, index: usize) -> Result<Option<TrailRing>, SimError> {
+        let Some(ring) = self
+            .emitters
+            .get(index)
+            .and_then(|s| s.events.as_ref())
+            .and_then(|ev| ev.trail.as_ref())
+        else {
+            return Ok(None);
+        };
+        let bytes = read_buffer(&self.ctx, ring, ring.size())?;
+        let header: [u32; 4] = bytemuck::pod_read_unaligned(&bytes[..16]);
+        Ok(Some(TrailRing {
+            points: header[0],
+            every_steps: header[1],
+            entries: bytemuck::pod_collect_to_vec(&bytes[16..]),
+        }))
     }
 
     /// Emitter `index`'s spawn-list header (a child of an event): this step's children,
