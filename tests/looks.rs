@@ -900,6 +900,7 @@ fn alpha_layers_at_half_resolution_match_full_resolution() {
     no_smoke
         .emitters
         .retain(|e| e.look.blend != BlendMode::Alpha);
+    no_smoke.drop_dangling_events();
     let frame = |effect: Effect| {
         let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
         for _ in 0..150 {

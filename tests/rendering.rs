@@ -219,6 +219,7 @@ fn billboard_and_splat_paths_agree() {
     let render = |path: DrawPath| {
         let mut effect = Effect::default_campfire();
         effect.emitters.retain(|e| e.name == "flames");
+        effect.drop_dangling_events();
         let e = &mut effect.emitters[0];
         e.look.size_m = ignis::effect::Param::Curve {
             keys: vec![(0.0, 0.03), (1.0, 0.02)],
@@ -277,6 +278,7 @@ fn stateless_emitter_renders_like_the_stateful_one() {
     let render = |stateless: bool| {
         let mut effect = Effect::default_campfire();
         effect.emitters.retain(|e| e.name == "flames");
+        effect.drop_dangling_events();
         let e = &mut effect.emitters[0];
         e.integrator = ignis::effect::Integrator::Exponential;
         // Closed form: constant acceleration and linear drag only.
@@ -365,6 +367,12 @@ fn live_window_draws_what_the_whole_pool_draws() {
     let ctx = gpu();
     let mut effect = Effect::default_campfire();
     effect.post.bloom = None;
+    // Live windows are the planner's: the smoke at a rate of its own (fed by the flames'
+    // events, the GPU fills its ring and every slot is visited).
+    for e in &mut effect.emitters {
+        e.events.clear();
+    }
+    effect.emitters[0].spawn_rate_per_sec = ignis::effect::Param::Constant(90.0);
     let bounds: Vec<f32> = effect
         .emitters
         .iter()
@@ -513,6 +521,7 @@ fn billboards_beyond_one_draw_carry_all_their_light() {
         let mut effect = Effect::default_campfire();
         effect.post.bloom = None;
         effect.emitters.retain(|e| e.name == "flames");
+        effect.drop_dangling_events();
         let e = &mut effect.emitters[0];
         e.capacity = 150_000;
         e.spawn_rate_per_sec = ignis::effect::Param::Constant(120_000.0);

@@ -637,6 +637,8 @@ fn emitter_list_ui(ui: &mut Ui, effect: &mut Effect, selected: &mut usize) {
             && *selected < n
         {
             effect.emitters.remove(*selected);
+            // Events that fed the removed emitter go with it.
+            effect.drop_dangling_events();
             *selected = selected.saturating_sub(1).min(n - 2);
         }
         if ui

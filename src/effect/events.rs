@@ -136,6 +136,16 @@ impl Effect {
         self.emitters.iter().position(|e| e.name == event.emitter)
     }
 
+    /// Removes the events whose child is no longer an emitter of the effect (after
+    /// emitters were removed).
+    pub fn drop_dangling_events(&mut self) {
+        let names: std::collections::HashSet<String> =
+            self.emitters.iter().map(|e| e.name.clone()).collect();
+        for e in &mut self.emitters {
+            e.events.retain(|ev| names.contains(&ev.emitter));
+        }
+    }
+
     /// Each emitter's depth in the event graph: 0 without a parent, else one more than its
     /// deepest parent's (at most the emitter count: cycles are rejected by validation).
     fn event_depths(&self) -> Vec<usize> {
