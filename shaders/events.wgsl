@@ -13,44 +13,7 @@
 // Mirrored by `scan_events` in src/sim/events.rs.
 #import "common.wgsl"
 #import "params.wgsl"
-
-struct EventRule {
-    trigger: u32,
-    count_min: u32,
-    count_max: u32,
-    rate: f32,
-    probability: f32,
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
-}
-
-struct EventRecord {
-    pos_count: vec4<f32>,
-    vel_key: vec4<f32>,
-}
-
-struct EventOut {
-    rules: array<EventRule, 2>,
-    records: array<EventRecord>,
-}
-
-struct EventSpawn {
-    pos_key: vec4<f32>,
-    vel_j: vec4<f32>,
-}
-
-struct EventIn {
-    head: u32,
-    count: u32,
-    stamp: u32,
-    dropped: u32,
-    total: u32,
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
-    list: array<EventSpawn>,
-}
+#import "event_types.wgsl"
 
 struct ScanConfig {
     // The rule's index in the parent's records, the child's capacity, the most children

@@ -15,6 +15,7 @@
 // Mirrored by `src/sim/events.rs` (the CPU reference of counts, keys and the scan).
 #import "common.wgsl"
 #import "rng.wgsl"
+#import "event_types.wgsl"
 
 override MOD_EVENTS: bool = false;
 override MOD_EVENT_SPAWN: bool = false;
@@ -27,48 +28,6 @@ const TRIGGER_OVER_LIFE: u32 = 3u;
 const TRIGGER_NONE: u32 = 0xFFFFFFFFu;
 // Keep in sync with MAX_CHILDREN_PER_EVENT (src/effect/events.rs).
 const MAX_CHILDREN: u32 = 64u;
-
-struct EventRule {
-    trigger: u32,
-    count_min: u32,
-    count_max: u32,
-    rate: f32,
-    probability: f32,
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
-}
-
-struct EventRecord {
-    // xyz: position (the parent's simulation space), w: children (u32 bits).
-    pos_count: vec4<f32>,
-    // xyz: velocity, w: the event's key (u32 bits).
-    vel_key: vec4<f32>,
-}
-
-struct EventOut {
-    rules: array<EventRule, 2>,
-    records: array<EventRecord>,
-}
-
-struct EventSpawn {
-    // xyz: position in the child's simulation space, w: the event's key (u32 bits).
-    pos_key: vec4<f32>,
-    // xyz: the inherited velocity, w: the child's index within its event (u32 bits).
-    vel_j: vec4<f32>,
-}
-
-struct EventIn {
-    head: u32,
-    count: u32,
-    stamp: u32,
-    dropped: u32,
-    total: u32,
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
-    list: array<EventSpawn>,
-}
 
 @group(1) @binding(0) var<storage, read_write> event_out: EventOut;
 @group(1) @binding(1) var<storage, read> event_in: EventIn;

@@ -122,17 +122,11 @@ fn quad_corner(qd: Quad, vi: u32) -> Corner {
         if len > look.spin_streak.w {
             tail *= look.spin_streak.w / len;
         }
-        let head_clip = look.clip_from_sim * vec4<f32>(d.pos, 1.0);
-        var tail_clip = look.clip_from_sim * vec4<f32>(d.pos - tail, 1.0);
-        if tail_clip.w <= 1e-4 || head_clip.w <= 1e-4 {
-            tail_clip = head_clip;
-        }
-        let half_vp = 0.5 * camera.viewport.xy;
-        let dir_px = (head_clip.xy / head_clip.w - tail_clip.xy / tail_clip.w) * half_vp;
-        let l = length(dir_px);
-        let dir = select(vec2<f32>(1.0, 0.0), dir_px / l, l > 1e-3);
+        let s = strip_between(d.pos, d.pos - tail);
+        let dir = s.dir;
         let perp = vec2<f32>(-dir.y, dir.x);
-        let end = select(tail_clip, head_clip, corner.x > 0.0);
+        let half_vp = 0.5 * camera.viewport.xy;
+        let end = select(s.tail, s.head, corner.x > 0.0);
         // The half-width in pixels is 0.5·size·viewport.z / w; in clip units the w cancels.
         let off_px = (dir * corner.x + perp * corner.y) * (0.5 * size * camera.viewport.z);
         out.clip = vec4<f32>(end.xy + off_px / half_vp, end.z, end.w);
@@ -146,6 +140,27 @@ fn quad_corner(qd: Quad, vi: u32) -> Corner {
         out.clip = look.clip_from_sim * vec4<f32>(out.world, 1.0);
     }
     return out;
+}
+
+// A screen-space strip from `tail` to `head` (simulation space): both ends in clip space
+// (the tail on the head when either end is behind the camera) and the unit direction in
+// pixels from tail to head (x when they coincide on screen). Streaks and trails use it.
+struct Strip {
+    head: vec4<f32>,
+    tail: vec4<f32>,
+    dir: vec2<f32>,
+}
+
+fn strip_between(head: vec3<f32>, tail: vec3<f32>) -> Strip {
+    let head_clip = look.clip_from_sim * vec4<f32>(head, 1.0);
+    var tail_clip = look.clip_from_sim * vec4<f32>(tail, 1.0);
+    if tail_clip.w <= 1e-4 || head_clip.w <= 1e-4 {
+        tail_clip = head_clip;
+    }
+    let half_vp = 0.5 * camera.viewport.xy;
+    let dir_px = (head_clip.xy / head_clip.w - tail_clip.xy / tail_clip.w) * half_vp;
+    let l = length(dir_px);
+    return Strip(head_clip, tail_clip, select(vec2<f32>(1.0, 0.0), dir_px / l, l > 1e-3));
 }
 
 // The flipbook frames of a quad: x = frame, y = next frame, z = weight of y.

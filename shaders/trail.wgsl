@@ -11,18 +11,11 @@
 // `look.size_intensity.x` the tail's width fraction, `size_intensity.y` its opacity.
 // Mirrored by `trail_points` in src/sim/trails.rs.
 #import "quad.wgsl"
+#import "trail_ring.wgsl"
 
 override TRAIL: bool = false;
 
-struct TrailRingRead {
-    points: u32,
-    every: u32,
-    pad0: u32,
-    pad1: u32,
-    history: array<vec4<f32>>,
-}
-
-@group(1) @binding(6) var<storage, read> trail_ring: TrailRingRead;
+@group(1) @binding(6) var<storage, read> trail_ring: TrailRing;
 
 // Point j ≥ 1 of the trail of `slot` (xyz position, w age).
 fn trail_point(slot: u32, j: u32) -> vec4<f32> {
@@ -58,17 +51,10 @@ fn trail_corner(qd: Quad, seg: u32, segments: u32, vi: u32) -> TrailCorner {
     let u = (f32(seg) + select(0.0, 1.0, far)) / f32(segments);
     let taper = mix(1.0, look.size_intensity.x, u);
     out.fade = mix(1.0, look.size_intensity.y, u);
-    let head_clip = look.clip_from_sim * vec4<f32>(head.xyz, 1.0);
-    var tail_clip = look.clip_from_sim * vec4<f32>(tail.xyz, 1.0);
-    if tail_clip.w <= 1e-4 || head_clip.w <= 1e-4 {
-        tail_clip = head_clip;
-    }
+    let s = strip_between(head.xyz, tail.xyz);
+    let perp = vec2<f32>(-s.dir.y, s.dir.x);
     let half_vp = 0.5 * camera.viewport.xy;
-    let dir_px = (head_clip.xy / head_clip.w - tail_clip.xy / tail_clip.w) * half_vp;
-    let l = length(dir_px);
-    let dir = select(vec2<f32>(1.0, 0.0), dir_px / l, l > 1e-3);
-    let perp = vec2<f32>(-dir.y, dir.x);
-    let c = select(head_clip, tail_clip, far);
+    let c = select(s.head, s.tail, far);
     out.across = f32(vi >> 1u) * 2.0 - 1.0;
     // The half-width in pixels is 0.5·width·viewport.z / w; in clip units the w cancels.
     let width = qd.lc.x * look.spin_streak.x * taper;

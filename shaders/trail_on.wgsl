@@ -8,16 +8,9 @@
 // - Every `every` steps (the step number `params.tiny_b.z` a multiple of it), entry
 //   (step / every) mod points takes the particle's position after the step.
 #import "common.wgsl"
+#import "trail_ring.wgsl"
 
 override MOD_TRAIL: bool = false;
-
-struct TrailRing {
-    points: u32,
-    every: u32,
-    pad0: u32,
-    pad1: u32,
-    history: array<vec4<f32>>,
-}
 
 @group(1) @binding(2) var<storage, read_write> trail: TrailRing;
 

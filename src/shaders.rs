@@ -28,6 +28,14 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ),
     ("events_on.wgsl", include_str!("../shaders/events_on.wgsl")),
     ("events.wgsl", include_str!("../shaders/events.wgsl")),
+    (
+        "event_types.wgsl",
+        include_str!("../shaders/event_types.wgsl"),
+    ),
+    (
+        "trail_ring.wgsl",
+        include_str!("../shaders/trail_ring.wgsl"),
+    ),
     ("trail_off.wgsl", include_str!("../shaders/trail_off.wgsl")),
     ("trail_on.wgsl", include_str!("../shaders/trail_on.wgsl")),
     ("trail.wgsl", include_str!("../shaders/trail.wgsl")),
