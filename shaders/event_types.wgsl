@@ -12,16 +12,22 @@ struct EventRule {
     pad2: u32,
 }
 
-struct EventRecord {
-    // xyz: position (the parent's simulation space), w: children (u32 bits).
-    pos_count: vec4<f32>,
-    // xyz: velocity, w: the event's key (u32 bits).
-    vel_key: vec4<f32>,
-}
-
+// A parent's event buffer: its two rules, then u32 words — first the children each slot
+// asks for per rule (`words[rule · capacity + slot]`, written for every slot the update
+// visits), then a record per rule and slot, written only when it asks for children
+// (`RECORD_WORDS` words from `2 · capacity + (rule · capacity + slot) · RECORD_WORDS`:
+// position xyz (the parent's simulation space), the event's key, velocity xyz, unused).
+// The scan reads every count but only the records of slots with children.
 struct EventOut {
     rules: array<EventRule, 2>,
-    records: array<EventRecord>,
+    words: array<u32>,
+}
+
+const RECORD_WORDS: u32 = 8u;
+
+// The first word of rule `rule`'s record of `slot` in a pool of `capacity` slots.
+fn record_at(rule: u32, slot: u32, capacity: u32) -> u32 {
+    return 2u * capacity + (rule * capacity + slot) * RECORD_WORDS;
 }
 
 struct EventSpawn {

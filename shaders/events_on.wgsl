@@ -3,11 +3,11 @@
 // event records (written), binding 1 the spawn list its parent's event feeds (read).
 //
 // Contract:
-// - MOD_EVENTS (a parent): every visited slot writes one record per rule — its position,
-//   velocity, how many children it spawns this step (0 when no event fired) and a key
-//   (seed, slot, the particle's spawn counter, rule, event ordinal) that the children's
-//   randomness comes from. Records of slots outside the window are stale: the scan
-//   (events.wgsl) reads the window only.
+// - MOD_EVENTS (a parent): every visited slot writes per rule how many children it spawns
+//   this step (0 when no event fired), and, when some, a record — its position, velocity
+//   and a key (seed, slot, the particle's spawn counter, rule, event ordinal) that the
+//   children's randomness comes from (event_types.wgsl). Counts of slots outside the
+//   window are stale: the scan (events.wgsl) reads the window only.
 // - MOD_EVENT_SPAWN (a child): the slots [head, head + count) of the ring (the list's
 //   header, written by the scan this step — `stamp` says which step) are born at the
 //   event's position plus the child's own shape offset, with the velocity of its own
@@ -124,9 +124,19 @@ fn emit_events(slot: u32, p: Particle, born: bool, was_alive: bool, alive: bool,
             n = select(0u, rule.count_min + h.y % span, unorm4(h).z < rule.probability);
         }
         n = min(n, MAX_CHILDREN);
-        event_out.records[e * params.capacity + slot_base + slot] = EventRecord(
-            vec4<f32>(p.pos_age.xyz, bitcast<f32>(n)),
-            vec4<f32>(p.vel_life.xyz, bitcast<f32>(key)),
-        );
+        let s = slot_base + slot;
+        event_out.words[e * params.capacity + s] = n;
+        if n > 0u {
+            let at = record_at(e, s, params.capacity);
+            let pos = bitcast<vec3<u32>>(p.pos_age.xyz);
+            let vel = bitcast<vec3<u32>>(p.vel_life.xyz);
+            event_out.words[at] = pos.x;
+            event_out.words[at + 1u] = pos.y;
+            event_out.words[at + 2u] = pos.z;
+            event_out.words[at + 3u] = key;
+            event_out.words[at + 4u] = vel.x;
+            event_out.words[at + 5u] = vel.y;
+            event_out.words[at + 6u] = vel.z;
+        }
     }
 }

@@ -94,7 +94,7 @@ fn undo_and_redo_restore_the_effect_with_the_keyboard() {
 
     harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     harness.run();
-    assert_eq!(harness.state().effect.emitters[0].capacity, 2048);
+    assert_eq!(harness.state().effect.emitters[0].capacity, 512);
     assert_eq!(
         harness.state().effect.emitters[0].spawn_rate_per_sec,
         ignis::effect::Param::Constant(500.0)
@@ -114,7 +114,7 @@ fn undo_and_redo_restore_the_effect_with_the_keyboard() {
         harness.state().effect.emitters[0].spawn_rate_per_sec,
         ignis::effect::Param::Constant(500.0)
     );
-    assert_eq!(harness.state().effect.emitters[0].capacity, 2048);
+    assert_eq!(harness.state().effect.emitters[0].capacity, 512);
     assert_eq!(harness.state().history.redo_len(), 1);
 }
 

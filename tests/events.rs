@@ -114,16 +114,24 @@ fn expected_list(
 /// the keys); the dropped count is the excess.
 #[test]
 fn death_children_match_the_cpu_mirror_including_the_cap() {
+    // One block of the scan; then a parent window of several blocks wrapping its ring.
+    check_against_the_mirror(1024, 900.0, 12);
+    check_against_the_mirror(4096, 9_000.0, 100);
+}
+
+fn check_against_the_mirror(parent_capacity: u32, parent_rate: f32, max_per_step: u32) {
     let ctx = strict_gpu();
     let event = Event {
         trigger: Trigger::Death,
         count: CountRange { min: 1, max: 3 },
         probability: 0.8,
         inherit_velocity: 0.5,
-        max_per_step: 12,
+        max_per_step,
         ..Event::default()
     };
-    let effect = parent_and_child(event, 900.0);
+    let mut effect = parent_and_child(event, parent_rate);
+    effect.emitters[0].capacity = parent_capacity;
+    effect.emitters[1].capacity = 16384;
     effect.validate().expect("valid");
     let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
     let (mut head, mut last_count, mut dropped, mut capped_steps) = (0u32, 0u32, 0u32, 0);

@@ -87,10 +87,9 @@ fn rust_and_wgsl_struct_sizes_agree() {
     let billboard = lib.compose("billboard.wgsl").expect("billboard");
     let tonemap = lib.compose("tonemap.wgsl").expect("tonemap");
     let scan = lib.compose("events.wgsl").expect("events");
-    use ignis::sim::events::{EventRecord, EventRule, EventSpawn, ScanConfig};
+    use ignis::sim::events::{EventRule, EventSpawn, ScanConfig};
     let cases = [
         (&scan, "EventRule", size_of::<EventRule>()),
-        (&scan, "EventRecord", size_of::<EventRecord>()),
         (&scan, "EventSpawn", size_of::<EventSpawn>()),
         (&scan, "ScanConfig", size_of::<ScanConfig>()),
         (&update, "Particle", size_of::<Particle>()),

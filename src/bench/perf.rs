@@ -68,6 +68,9 @@ pub fn scaled_campfire(n: u64, max_pool: u64) -> Effect {
             };
             e.max_spawn_per_step = 0;
             e.look.size_m = e.look.size_m.scaled(scale.min(1.0));
+            // The flames alone: no smoke from their deaths (the events' cost has a row of
+            // its own in the module table).
+            e.events.clear();
             e
         })
         .collect();

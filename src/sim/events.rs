@@ -35,7 +35,8 @@ pub struct EventRule {
     pub pad: [u32; 3],
 }
 
-/// One parent slot's record for one rule (`EventRecord`).
+/// One parent slot's record for one rule, as the CPU mirror takes it (the GPU keeps the
+/// count apart from the rest: `EventOut` in `shaders/event_types.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct EventRecord {
@@ -83,8 +84,14 @@ pub struct ScanConfig {
     pub delta_inherit: [f32; 4],
 }
 
-/// Bytes before the records of a parent's buffer (the two rules).
+/// Bytes before the counts of a parent's buffer (the two rules).
 const RULES_BYTES: u64 = (MAX_EVENTS_PER_EMITTER * size_of::<EventRule>()) as u64;
+
+/// Words of one record (`RECORD_WORDS` in `shaders/event_types.wgsl`).
+const RECORD_WORDS: u64 = 8;
+
+/// Slots per workgroup of the scan's passes (`BLOCK` in `shaders/events.wgsl`).
+pub const EVENT_SCAN_BLOCK: u32 = 1024;
 
 /// The update's rules of emitter `e` (unused slots say none).
 pub fn rules_of(e: &Emitter) -> [EventRule; MAX_EVENTS_PER_EMITTER] {
@@ -121,8 +128,9 @@ pub struct EventPipes {
     pub hooks_layout: wgpu::BindGroupLayout,
     scan_layout: wgpu::BindGroupLayout,
     scan_pipeline_layout: wgpu::PipelineLayout,
-    /// The scan, built from `events.wgsl`.
-    pub scan: Option<wgpu::ComputePipeline>,
+    /// The scan's three passes (count the blocks, scan their sums, write the list),
+    /// built from `events.wgsl`.
+    pub scan: Option<[wgpu::ComputePipeline; 3]>,
     /// Bound in group 1 for a role an emitter does not have (one per binding: a buffer
     /// cannot be bound read-only and writable in one dispatch).
     placeholders: [wgpu::Buffer; 3],
@@ -146,6 +154,7 @@ impl EventPipes {
                 params_entry,
                 compute_storage_entry(1, true),
                 compute_storage_entry(2, false),
+                compute_storage_entry(4, false),
                 wgpu::BindGroupLayoutEntry {
                     binding: 3,
                     visibility: wgpu::ShaderStages::COMPUTE,
@@ -183,14 +192,16 @@ impl EventPipes {
     ) -> Result<Vec<String>, ShaderError> {
         let src = lib.compose("events.wgsl")?;
         let scan = create_checked(&ctx.device, &src, lib, |module| {
-            crate::render::compute_pipeline(
-                ctx,
-                "EventPipes::scan",
-                &self.scan_pipeline_layout,
-                module,
-                "main",
-                &[],
-            )
+            ["count_blocks", "scan_blocks", "write_list"].map(|entry| {
+                crate::render::compute_pipeline(
+                    ctx,
+                    "EventPipes::scan",
+                    &self.scan_pipeline_layout,
+                    module,
+                    entry,
+                    &[],
+                )
+            })
         })?;
         self.scan = Some(scan);
         Ok(src.files)
@@ -212,7 +223,7 @@ fn storage_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer
 /// One emitter's hook buffers: its event records (a parent), its spawn list (a child) and
 /// its trail's ring (see `crate::sim::trails`).
 pub struct EmitterEvents {
-    /// Rules and records: `RULES_BYTES` then 2 × capacity records (a parent).
+    /// Rules, counts and records (a parent; `EventOut` in `shaders/event_types.wgsl`).
     pub records: Option<wgpu::Buffer>,
     /// Header and list (a child).
     pub list: Option<wgpu::Buffer>,
@@ -240,6 +251,9 @@ pub struct Scan {
     pub child: usize,
     /// The rule's `ScanConfig`.
     pub config: wgpu::Buffer,
+    /// The scan's scratch: where its children start in the list, then one sum (then
+    /// offset) per block of the parent's window.
+    pub blocks: wgpu::Buffer,
     /// Group 0 of the scan (the parent's params at a dynamic offset).
     pub group: Option<wgpu::BindGroup>,
 }
@@ -272,10 +286,9 @@ impl EmitterEvents {
         }
         let device = &ctx.device;
         let records = (!e.events.is_empty()).then(|| {
-            let size = RULES_BYTES
-                + (MAX_EVENTS_PER_EMITTER as u64)
-                    * u64::from(capacity)
-                    * size_of::<EventRecord>() as u64;
+            // A count (one word) and a record (RECORD_WORDS words) per rule and slot.
+            let words = (1 + RECORD_WORDS) * MAX_EVENTS_PER_EMITTER as u64 * u64::from(capacity);
+            let size = RULES_BYTES + 4 * words;
             let b = storage_buffer(device, "EmitterEvents::records", size);
             ctx.queue.write_buffer(&b, 0, bytemuck::cast_slice(&rules));
             b
@@ -327,6 +340,11 @@ impl EmitterEvents {
                     usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                     mapped_at_creation: false,
                 }),
+                blocks: storage_buffer(
+                    device,
+                    "EmitterEvents::scan_blocks",
+                    4 * (1 + u64::from(capacity.div_ceil(EVENT_SCAN_BLOCK))),
+                ),
                 group: None,
             })
             .collect();
@@ -381,6 +399,10 @@ impl EmitterEvents {
                     wgpu::BindGroupEntry {
                         binding: 3,
                         resource: scan.config.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 4,
+                        resource: scan.blocks.as_entire_binding(),
                     },
                 ],
             }));

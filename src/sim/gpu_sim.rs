@@ -964,11 +964,17 @@ impl GpuSim {
                 }
                 // The parent's events become its children's spawn lists, the same step.
                 if let (Some(ev), Some(scan)) = (&em.events, &update.events.scan) {
+                    let blocks = slots.div_ceil(crate::sim::events::EVENT_SCAN_BLOCK);
                     for group in ev.scans.iter().filter_map(|sc| sc.group.as_ref()) {
-                        let pass = crate::gpu::compute_pass(pass, enc, "GpuSim::update");
-                        pass.set_pipeline(scan);
+                        let pass = crate::gpu::compute_pass(pass, enc, "GpuSim::events");
                         pass.set_bind_group(0, group, &[offset]);
-                        pass.dispatch_workgroups(1, 1, 1);
+                        for (pipeline, groups) in scan.iter().zip([blocks, 1, blocks]) {
+                            if groups > 0 {
+                                pass.set_pipeline(pipeline);
+                                let (x, y) = dispatch_groups(groups);
+                                pass.dispatch_workgroups(x, y, 1);
+                            }
+                        }
                     }
                 }
             }
@@ -1375,7 +1381,13 @@ pub const SLOTS_PER_INVOCATION: u32 = 2;
 
 /// Workgroups for `slots` slots of 256, as a 2-D grid (x ≤ 65535).
 pub fn dispatch_size(slots: u32) -> (u32, u32) {
-    let groups = slots.div_ceil(256).max(1);
+    dispatch_groups(slots.div_ceil(256))
+}
+
+/// `groups` workgroups (at least one) as a 2-D grid (x ≤ 65535); the grid may hold a few
+/// more, which find no work.
+pub fn dispatch_groups(groups: u32) -> (u32, u32) {
+    let groups = groups.max(1);
     let x = groups.min(65_535);
     (x, groups.div_ceil(x))
 }
