@@ -172,3 +172,29 @@ fn the_ribbon_lights_the_pixels_between_the_particle_and_its_tail() {
     );
     assert_eq!(lit.len() as u32, last - first + 1, "one unbroken ribbon");
 }
+
+/// A trail whose ring cannot fit one storage binding is refused with a message that names
+/// the emitter and the fix (and nothing is half-built: the simulation is not created).
+#[test]
+fn a_trail_too_large_for_the_device_is_a_clear_error() {
+    let ctx = gpu();
+    let limit = ctx.device.limits().max_storage_buffer_binding_size;
+    let mut e = plain_emitter();
+    e.name = "long tails".into();
+    // The state fits; 64 points of 16 bytes per slot do not.
+    e.capacity = (limit / 1024 + 1024).min(u64::from(u32::MAX)) as u32;
+    e.spawn_rate_per_sec = Param::Constant(0.0);
+    e.look.trail = Some(Trail {
+        points: 64,
+        ..Trail::default()
+    });
+    let effect = bare_effect(e);
+    let err = match GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect) {
+        Ok(_) => panic!("a ring over the binding limit was accepted"),
+        Err(err) => err.to_string(),
+    };
+    assert!(
+        err.contains("long tails") && err.contains("fewer trail points"),
+        "{err}"
+    );
+}

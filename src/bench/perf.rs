@@ -455,8 +455,13 @@ fn module_costs(ctx: &GpuContext, opts: &PerfOptions) -> Result<Vec<(String, f64
             }),
         ),
         (
-            "trail on (12 points, every 2 steps)",
-            Box::new(|e: &mut Emitter| e.look.trail = Some(Default::default())),
+            "trail on (4 points, every 2 steps)",
+            Box::new(|e: &mut Emitter| {
+                e.look.trail = Some(crate::effect::Trail {
+                    points: 4,
+                    ..Default::default()
+                })
+            }),
         ),
     ];
     for (name, apply) in on {

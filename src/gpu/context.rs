@@ -31,6 +31,22 @@ pub enum GpuError {
         /// Largest capacity that fits.
         max_capacity: u64,
     },
+    /// A trail's ring of positions needs more than one storage binding holds.
+    #[error(
+        "emitter \"{emitter}\": a trail of {points} points over {capacity} slots needs {needed_bytes} bytes, but this adapter's max_storage_buffer_binding_size is {limit_bytes} bytes; use fewer trail points or a smaller capacity"
+    )]
+    TrailTooLarge {
+        /// Emitter name.
+        emitter: String,
+        /// Trail points.
+        points: u32,
+        /// Slots.
+        capacity: u32,
+        /// Bytes it needs.
+        needed_bytes: u64,
+        /// The limit's value.
+        limit_bytes: u64,
+    },
 }
 
 /// An adapter, device and queue, shared by the simulation and the renderers.
@@ -169,6 +185,24 @@ impl GpuContext {
     }
 
     /// Checks that `capacity` slots fit in one storage binding, naming the limit if not.
+    /// Fails with a clear message when emitter `emitter`'s trail ring does not fit one
+    /// storage binding.
+    pub fn check_trail(&self, emitter: &str, capacity: u32, points: u32) -> Result<(), GpuError> {
+        let limit_bytes = self.device.limits().max_storage_buffer_binding_size;
+        let needed_bytes = crate::sim::trails::ring_bytes(capacity, points);
+        if needed_bytes > limit_bytes {
+            return Err(GpuError::TrailTooLarge {
+                emitter: emitter.to_owned(),
+                points,
+                capacity,
+                needed_bytes,
+                limit_bytes,
+            });
+        }
+        Ok(())
+    }
+
+    /// Fails with a clear message when `capacity` slots do not fit a storage binding.
     pub fn check_capacity(&self, emitter: &str, capacity: u32) -> Result<(), GpuError> {
         let limits = self.device.limits();
         let per = std::mem::size_of::<crate::gpu::types::Particle>() as u64;

@@ -556,6 +556,9 @@ impl GpuSim {
     pub fn sync(&mut self, effect: &Effect) -> Result<(), SimError> {
         for e in &effect.emitters {
             self.ctx.check_capacity(&e.name, e.capacity)?;
+            if let Some(t) = &e.look.trail {
+                self.ctx.check_trail(&e.name, e.capacity.max(1), t.points)?;
+            }
         }
         self.emitters.truncate(effect.emitters.len());
         for (i, e) in effect.emitters.iter().enumerate() {

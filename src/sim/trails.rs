@@ -7,9 +7,14 @@ use crate::gpu::GpuContext;
 /// Bytes before the ring's entries: points, steps between points, padding.
 const HEADER_BYTES: u64 = 16;
 
+/// Bytes of a ring of `points` entries per slot for `capacity` slots.
+pub fn ring_bytes(capacity: u32, points: u32) -> u64 {
+    HEADER_BYTES + u64::from(capacity) * u64::from(points) * 16
+}
+
 /// A ring of `points` entries per slot for `capacity` slots, its header written.
 pub fn ring_buffer(ctx: &GpuContext, capacity: u32, points: u32, every: u32) -> wgpu::Buffer {
-    let size = HEADER_BYTES + u64::from(capacity) * u64::from(points) * 16;
+    let size = ring_bytes(capacity, points);
     let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("trail_ring"),
         size,
