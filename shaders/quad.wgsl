@@ -74,16 +74,21 @@ fn load_quad(q: u32) -> Quad {
     let t = age_fraction(out.d.age, out.d.life);
     out.rnd = particle_random(slot, out.d.life);
     out.lc = look_curves(t, curve_random(slot, out.d.life, out.rnd));
-    // Premultiplied once per particle, and scaled by the intensity when additive: the
-    // per-pixel work reads nothing from the look.
+    // Premultiplied once per particle: the per-pixel work reads nothing from the look.
+    out.color = premultiplied_color(t, out.lc.y);
+    return out;
+}
+
+// The colour at normalised age `t` times `opacity`, premultiplied, and scaled by the
+// intensity when additive.
+fn premultiplied_color(t: f32, opacity: f32) -> vec4<f32> {
     let c = particle_color(t);
-    let alpha = c.a * out.lc.y;
+    let alpha = c.a * opacity;
     var gain = alpha;
     if !SORTED {
         gain *= look.size_intensity.z;
     }
-    out.color = vec4<f32>(c.rgb * gain, alpha);
-    return out;
+    return vec4<f32>(c.rgb * gain, alpha);
 }
 
 // One corner of a quad: where it lands, its coordinates in the sprite's frame ([-1, 1]²,

@@ -62,13 +62,6 @@ fn trail_corner(qd: Quad, seg: u32, segments: u32, vi: u32) -> TrailCorner {
     out.clip = vec4<f32>(c.xy + off_px / half_vp, c.z, c.w);
     out.world = end.xyz;
     // The colour at the age of the segment's near end.
-    let t = age_fraction(head.w, d.life);
-    let col = particle_color(t);
-    let alpha = col.a * qd.lc.y;
-    var gain = alpha;
-    if !SORTED {
-        gain *= look.size_intensity.z;
-    }
-    out.color = vec4<f32>(col.rgb * gain, alpha);
+    out.color = premultiplied_color(age_fraction(head.w, d.life), qd.lc.y);
     return out;
 }

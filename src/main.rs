@@ -77,7 +77,7 @@ enum Command {
         #[arg(long)]
         profile: bool,
         /// Open exactly these panel sections at start, comma-separated (emitter,
-        /// randomness, forces, time, look, view, stats) — for screenshots.
+        /// randomness, forces, events, time, look, view, stats) — for screenshots.
         #[arg(long, value_delimiter = ',')]
         sections: Option<Vec<String>>,
         /// Select this emitter (by name) at start.

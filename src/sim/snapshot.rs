@@ -52,52 +52,31 @@ impl GpuSim {
     /// the planning: the simulation after its last recorded step.
     pub fn snapshot(&self, enc: &mut wgpu::CommandEncoder) -> SimSnapshot {
         let mut bytes = 0;
+        // A copy of the first `size` bytes of `b`, recorded into `enc`.
+        let mut copy_of = |enc: &mut wgpu::CommandEncoder, b: &wgpu::Buffer, size: u64| {
+            let copy = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("SimSnapshot::copy"),
+                size,
+                usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            enc.copy_buffer_to_buffer(b, 0, &copy, 0, size);
+            bytes += size;
+            copy
+        };
         let emitters = self
             .emitters
             .iter()
             .map(|s| {
-                let buffers = s.buffers.each_ref().map(|b| {
-                    let copy = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("SimSnapshot::state"),
-                        size: b.size(),
-                        usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-                        mapped_at_creation: false,
-                    });
-                    enc.copy_buffer_to_buffer(b, 0, &copy, 0, b.size());
-                    bytes += b.size();
-                    copy
-                });
-                let event_header = s
-                    .events
-                    .as_ref()
+                let buffers = s.buffers.each_ref().map(|b| copy_of(enc, b, b.size()));
+                let hooks = s.events.as_ref();
+                let header = size_of::<crate::sim::events::EventHeader>() as u64;
+                let event_header = hooks
                     .and_then(|ev| ev.list.as_ref())
-                    .map(|list| {
-                        let size = size_of::<crate::sim::events::EventHeader>() as u64;
-                        let copy = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                            label: Some("SimSnapshot::event_header"),
-                            size,
-                            usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-                            mapped_at_creation: false,
-                        });
-                        enc.copy_buffer_to_buffer(list, 0, &copy, 0, size);
-                        bytes += size;
-                        copy
-                    });
-                let trail = s
-                    .events
-                    .as_ref()
+                    .map(|list| copy_of(enc, list, header));
+                let trail = hooks
                     .and_then(|ev| ev.trail.as_ref())
-                    .map(|ring| {
-                        let copy = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                            label: Some("SimSnapshot::trail"),
-                            size: ring.size(),
-                            usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-                            mapped_at_creation: false,
-                        });
-                        enc.copy_buffer_to_buffer(ring, 0, &copy, 0, ring.size());
-                        bytes += ring.size();
-                        copy
-                    });
+                    .map(|ring| copy_of(enc, ring, ring.size()));
                 EmitterSnapshot {
                     trail,
                     event_header,
