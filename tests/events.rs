@@ -518,3 +518,80 @@ fn the_campfire_smoke_comes_from_its_flames() {
     assert_eq!(header.dropped, 0);
     assert!((150..=400).contains(&alive), "smoke alive: {alive}");
 }
+
+/// A runtime player's live edit that adds events to a batched effect moves its instances
+/// onto simulations of their own (events are not batched) and the children spawn; removing
+/// the events batches them again, and the instances keep playing.
+#[test]
+fn adding_and_removing_events_live_moves_instances_between_batches_and_own_sims() {
+    let ctx = strict_gpu();
+    let torch = ignis::preset::load(std::path::Path::new("presets/torch.ron")).expect("load");
+    assert!(ignis::sim::batch::batchable(&torch));
+    let settings = ignis::PlayerSettings {
+        batch_instances: true,
+        ..ignis::render::Composite::player_settings()
+    };
+    let mut run =
+        ignis::headless::Headless::with_settings(&ctx, torch, ShaderLibrary::embedded(), settings)
+            .expect("headless");
+    let second = run
+        .player
+        .add_instance(glam::Mat4::from_translation(glam::vec3(1.0, 0.0, 0.0)), 9)
+        .expect("instance");
+    for _ in 0..30 {
+        run.advance(1.0 / 60.0);
+    }
+    let smoke = run
+        .effect()
+        .emitters
+        .iter()
+        .position(|e| e.name == "smoke")
+        .expect("smoke");
+    let sparks = run
+        .effect()
+        .emitters
+        .iter()
+        .position(|e| e.name == "sparks")
+        .expect("sparks");
+    run.edit(|fx| {
+        let flame = fx
+            .emitters
+            .iter()
+            .position(|e| e.name == "flame")
+            .expect("flame");
+        fx.emitters[flame].events = vec![Event {
+            emitter: "sparks".into(),
+            count: CountRange { min: 1, max: 2 },
+            probability: 0.2,
+            ..Event::default()
+        }];
+    })
+    .expect("the edit");
+    for _ in 0..60 {
+        run.advance(1.0 / 60.0);
+    }
+    for id in [run.instance, second] {
+        let counts = run.player.count_particles(id).expect("counts");
+        let events = counts[sparks].events.expect("the sparks are fed");
+        assert!(events.asked > 20, "{events:?}");
+        assert!(counts[sparks].alive > 0 && counts[smoke].alive > 0);
+    }
+    run.edit(|fx| {
+        for e in &mut fx.emitters {
+            e.events.clear();
+        }
+    })
+    .expect("the edit back");
+    for _ in 0..30 {
+        run.advance(1.0 / 60.0);
+    }
+    let alive = |id| {
+        run.player
+            .count_particles(id)
+            .expect("counts")
+            .iter()
+            .map(|c| c.alive)
+            .sum::<u32>()
+    };
+    assert!(alive(run.instance) > 0 && alive(second) > 0);
+}
