@@ -967,18 +967,13 @@ impl GpuSim {
                 }
                 // The parent's events become its children's spawn lists, the same step.
                 if let (Some(ev), Some(scan)) = (&em.events, &update.events.scan) {
-                    let blocks = slots.div_ceil(crate::sim::events::EVENT_SCAN_BLOCK);
-                    for group in ev.scans.iter().filter_map(|sc| sc.group.as_ref()) {
-                        let pass = crate::gpu::compute_pass(pass, enc, "GpuSim::events");
-                        pass.set_bind_group(0, group, &[offset]);
-                        for (pipeline, groups) in scan.iter().zip([blocks, 1, blocks]) {
-                            if groups > 0 {
-                                pass.set_pipeline(pipeline);
-                                let (x, y) = dispatch_groups(groups);
-                                pass.dispatch_workgroups(x, y, 1);
-                            }
-                        }
-                    }
+                    record_scans(
+                        crate::gpu::compute_pass(pass, enc, "GpuSim::events"),
+                        ev,
+                        scan,
+                        offset,
+                        slots,
+                    );
                 }
             }
         }
@@ -1376,6 +1371,29 @@ impl GpuSim {
         }
         self.ctx.queue.submit([enc.finish()]);
         self.planner.reset();
+    }
+}
+
+/// Records the scans of a parent's events (`ev`) after its update: per event the three
+/// passes of `events.wgsl` over the blocks of the parent's window of `slots` slots, with
+/// the step's parameter block at `offset`.
+fn record_scans(
+    pass: &mut wgpu::ComputePass<'static>,
+    ev: &EmitterEvents,
+    scan: &[wgpu::ComputePipeline; 3],
+    offset: u32,
+    slots: u32,
+) {
+    let blocks = slots.div_ceil(crate::sim::events::EVENT_SCAN_BLOCK);
+    for group in ev.scans.iter().filter_map(|sc| sc.group.as_ref()) {
+        pass.set_bind_group(0, group, &[offset]);
+        for (pipeline, groups) in scan.iter().zip([blocks, 1, blocks]) {
+            if groups > 0 {
+                pass.set_pipeline(pipeline);
+                let (x, y) = dispatch_groups(groups);
+                pass.dispatch_workgroups(x, y, 1);
+            }
+        }
     }
 }
 
