@@ -16,7 +16,8 @@ struct EventRule {
 // asks for per rule (`words[rule · capacity + slot]`, written for every slot the update
 // visits), then a record per rule and slot, written only when it asks for children
 // (`RECORD_WORDS` words from `2 · capacity + (rule · capacity + slot) · RECORD_WORDS`:
-// position xyz (the parent's simulation space), the event's key, velocity xyz, unused).
+// position xyz (the parent's simulation space), the event's key, velocity xyz, the
+// parent's normalised age (f32 bits)).
 // The scan reads every count but only the records of slots with children.
 struct EventOut {
     rules: array<EventRule, 2>,
@@ -33,7 +34,8 @@ fn record_at(rule: u32, slot: u32, capacity: u32) -> u32 {
 struct EventSpawn {
     // xyz: position in the child's simulation space, w: the event's key (u32 bits).
     pos_key: vec4<f32>,
-    // xyz: the inherited velocity, w: the child's index within its event (u32 bits).
+    // xyz: the inherited velocity, w (u32 bits): the child's index within its event (low
+    // 16 bits), the parent's normalised age × 255 (bits 16–23), inherit the colour (bit 24).
     vel_j: vec4<f32>,
 }
 

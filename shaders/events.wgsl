@@ -20,7 +20,8 @@
 #import "event_types.wgsl"
 
 struct ScanConfig {
-    // The rule's index, the child's capacity, the most children a step, unused.
+    // The rule's index, the child's capacity, the most children a step, 1 when the
+    // children inherit the parent's colour.
     rule_capacity_cap: vec4<u32>,
     // xyz: the parent's simulation origin minus the child's, w: the inherited fraction
     // of the parent's velocity.
@@ -158,10 +159,13 @@ fn write_list(
         let pos = bitcast<vec3<f32>>(vec3<u32>(event_out.words[r], event_out.words[r + 1u], event_out.words[r + 2u]));
         let vel = bitcast<vec3<f32>>(vec3<u32>(event_out.words[r + 4u], event_out.words[r + 5u], event_out.words[r + 6u]));
         let key = event_out.words[r + 3u];
+        // The parent's normalised age to 1/255, and whether the child inherits its colour.
+        let t = u32(bitcast<f32>(event_out.words[r + 7u]) * 255.0 + 0.5);
+        let color = (t << 16u) | (cfg.rule_capacity_cap.w << 24u);
         for (var j = 0u; j < c && at + j < cap; j++) {
             event_in.list[start + at + j] = EventSpawn(
                 vec4<f32>(pos + cfg.delta_inherit.xyz, bitcast<f32>(key)),
-                vec4<f32>(vel * cfg.delta_inherit.w, bitcast<f32>(j)),
+                vec4<f32>(vel * cfg.delta_inherit.w, bitcast<f32>(color | j)),
             );
         }
         at += c;

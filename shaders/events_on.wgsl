@@ -50,14 +50,23 @@ fn event_birth(slot: u32) -> EventBirth {
         return out;
     }
     let s = event_in.list[rel];
-    let key = child_key(params.seed, params.emitter_salt, bitcast<u32>(s.pos_key.w), bitcast<u32>(s.vel_j.w));
+    // w: the child's index in its event (low 16 bits), the parent's normalised age to
+    // 1/255 (bits 16–23) and whether the child inherits its colour (bit 24).
+    let bits = bitcast<u32>(s.vel_j.w);
+    let key = child_key(params.seed, params.emitter_salt, bitcast<u32>(s.pos_key.w), bits & 0xFFFFu);
     let q = spawn_particle(slot, key);
     // The child's own shape, centred on the event.
     let offset = q.pos_age.xyz - params.world_from_emitter[3].xyz;
+    var life = q.vel_life.w;
+    if (bits & 0x1000000u) != 0u {
+        // The parent's colour travels in the lifetime's lowest 8 bits (a relative change
+        // below 3e-5; look.wgsl's inherited_rgb reads it back).
+        life = bitcast<f32>((bitcast<u32>(life) & 0xFFFFFF00u) | ((bits >> 16u) & 0xFFu));
+    }
     out.born = true;
     out.p = Particle(
         vec4<f32>(s.pos_key.xyz + offset, 0.0),
-        vec4<f32>(q.vel_life.xyz + s.vel_j.xyz, q.vel_life.w),
+        vec4<f32>(q.vel_life.xyz + s.vel_j.xyz, life),
     );
     return out;
 }
@@ -137,6 +146,8 @@ fn emit_events(slot: u32, p: Particle, born: bool, was_alive: bool, alive: bool,
             event_out.words[at + 4u] = vel.x;
             event_out.words[at + 5u] = vel.y;
             event_out.words[at + 6u] = vel.z;
+            // The parent's normalised age (its colour, for children that inherit it).
+            event_out.words[at + 7u] = bitcast<u32>(clamp(p.pos_age.w / p.vel_life.w, 0.0, 1.0));
         }
     }
 }

@@ -94,13 +94,29 @@ const RAMP_WIDTH: u32 = 1024u;
 // Colour and alpha at normalised age t: the emitter's gradient baked into a ramp row
 // (exact at the texel centres, t = i / (RAMP_WIDTH - 1); linear in between).
 fn particle_color(t: f32) -> vec4<f32> {
+    return ramp_at(look.ids.x, t);
+}
+
+// Colour ramp row `row` at normalised age t.
+fn ramp_at(row: u32, t: f32) -> vec4<f32> {
     let x = clamp(t, 0.0, 1.0) * f32(RAMP_WIDTH - 1u);
     let i = min(u32(x), RAMP_WIDTH - 1u);
     let j = min(i + 1u, RAMP_WIDTH - 1u);
-    let row = i32(look.ids.x);
-    let c0 = textureLoad(ramps, vec2<i32>(i32(i), row), 0);
-    let c1 = textureLoad(ramps, vec2<i32>(i32(j), row), 0);
+    let c0 = textureLoad(ramps, vec2<i32>(i32(i), i32(row)), 0);
+    let c1 = textureLoad(ramps, vec2<i32>(i32(j), i32(row)), 0);
     return mix(c0, c1, x - f32(i));
+}
+
+// What multiplies the colour of a particle with lifetime `life`: for an emitter that
+// inherits its parent's colour (look.tiny_c.z = the parent's ramp row + 1), the parent's
+// ramp at the age the child carries in its lifetime's lowest 8 bits (events_on.wgsl);
+// white otherwise.
+fn inherited_rgb(life: f32) -> vec3<f32> {
+    if look.tiny_c.z == 0u {
+        return vec3<f32>(1.0);
+    }
+    let t = f32(bitcast<u32>(life) & 0xFFu) / 255.0;
+    return ramp_at(look.tiny_c.z - 1u, t).rgb;
 }
 
 // Four random numbers in [0, 1) fixed for one particle's life: a hash of the slot and

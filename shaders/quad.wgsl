@@ -76,6 +76,7 @@ fn load_quad(q: u32) -> Quad {
     out.lc = look_curves(t, curve_random(slot, out.d.life, out.rnd));
     // Premultiplied once per particle: the per-pixel work reads nothing from the look.
     out.color = premultiplied_color(t, out.lc.y);
+    out.color = vec4<f32>(out.color.rgb * inherited_rgb(out.d.life), out.color.a);
     return out;
 }
 

@@ -94,7 +94,7 @@ fn splat(
         return;
     }
     let t = age_fraction(d.age, d.life);
-    let color = particle_color(t);
+    let color = particle_color(t) * vec4<f32>(inherited_rgb(d.life), 1.0);
     let rnd = particle_random(slot, d.life);
     let lc = look_curves(t, curve_random(slot, d.life, rnd));
     let size_px = lc.x * camera.viewport.z / clip.w;

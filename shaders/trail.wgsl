@@ -62,6 +62,7 @@ fn trail_corner(qd: Quad, seg: u32, segments: u32, vi: u32) -> TrailCorner {
     out.clip = vec4<f32>(c.xy + off_px / half_vp, c.z, c.w);
     out.world = end.xyz;
     // The colour at the age of the segment's near end.
-    out.color = premultiplied_color(age_fraction(head.w, d.life), qd.lc.y);
+    let color = premultiplied_color(age_fraction(head.w, d.life), qd.lc.y);
+    out.color = vec4<f32>(color.rgb * inherited_rgb(d.life), color.a);
     return out;
 }

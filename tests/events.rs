@@ -92,13 +92,19 @@ fn expected_list(
                     a.vel_life[2],
                     f32::from_bits(key),
                 ],
+                parent_t: (a.pos_age[3] / a.vel_life[3]).clamp(0.0, 1.0),
             },
         ));
     }
     let delta = (sim.planner.emitters[0].origin() - sim.planner.emitters[1].origin()).as_vec3();
     let ev = &effect.emitters[0].events[0];
     let cfg = ScanConfig {
-        rule_capacity_cap: [0, effect.emitters[1].capacity, ev.max_per_step, 0],
+        rule_capacity_cap: [
+            0,
+            effect.emitters[1].capacity,
+            ev.max_per_step,
+            u32::from(ev.inherit_color),
+        ],
         delta_inherit: [delta.x, delta.y, delta.z, ev.inherit_velocity],
     };
     scan_events(
@@ -115,17 +121,24 @@ fn expected_list(
 #[test]
 fn death_children_match_the_cpu_mirror_including_the_cap() {
     // One block of the scan; then a parent window of several blocks wrapping its ring.
-    check_against_the_mirror(1024, 900.0, 12);
-    check_against_the_mirror(4096, 9_000.0, 100);
+    check_against_the_mirror(1024, 900.0, 12, false);
+    // Children that inherit the parent's colour carry its age at the event.
+    check_against_the_mirror(4096, 9_000.0, 100, true);
 }
 
-fn check_against_the_mirror(parent_capacity: u32, parent_rate: f32, max_per_step: u32) {
+fn check_against_the_mirror(
+    parent_capacity: u32,
+    parent_rate: f32,
+    max_per_step: u32,
+    inherit_color: bool,
+) {
     let ctx = strict_gpu();
     let event = Event {
         trigger: Trigger::Death,
         count: CountRange { min: 1, max: 3 },
         probability: 0.8,
         inherit_velocity: 0.5,
+        inherit_color,
         max_per_step,
         ..Event::default()
     };
@@ -168,15 +181,23 @@ fn check_against_the_mirror(parent_capacity: u32, parent_rate: f32, max_per_step
                 &s.vel_j[..3],
                 "step {step} child {k}: velocity"
             );
+            let bits = s.vel_j[3].to_bits();
             let key = child_key(
                 cp.seed,
                 cp.emitter_salt,
                 s.pos_key[3].to_bits(),
-                s.vel_j[3].to_bits(),
+                bits & 0xFFFF,
             );
-            let want = ignis::sim::cpu_reference::spawn_particle(&cp, key);
+            let want = ignis::sim::cpu_reference::spawn_particle(&cp, key).vel_life[3];
+            // Inheriting the colour, the lifetime's lowest 8 bits carry the parent's age.
+            let want = if inherit_color {
+                f32::from_bits((want.to_bits() & !0xFF) | ((bits >> 16) & 0xFF))
+            } else {
+                want
+            };
             assert_eq!(
-                c.vel_life[3], want.vel_life[3],
+                c.vel_life[3].to_bits(),
+                want.to_bits(),
                 "step {step} child {k}: lifetime"
             );
         }
@@ -594,4 +615,78 @@ fn adding_and_removing_events_live_moves_instances_between_batches_and_own_sims(
             .sum::<u32>()
     };
     assert!(alive(run.instance) > 0 && alive(second) > 0);
+}
+
+/// A child that inherits its parent's colour is drawn in it: an invisible parent with a
+/// pure red ramp, whose births spawn white children; with `inherit_color` the children's
+/// light is red, without it white (billboards, tiles and the splat read it alike).
+#[test]
+fn inherited_colour_tints_the_children() {
+    let ctx = strict_gpu();
+    let white = vec![
+        ColorStop {
+            t: 0.0,
+            rgba: [1.0, 1.0, 1.0, 1.0],
+        },
+        ColorStop {
+            t: 1.0,
+            rgba: [1.0, 1.0, 1.0, 1.0],
+        },
+    ];
+    let light = |inherit_color: bool, path: DrawPath| {
+        let mut effect = parent_and_child(
+            Event {
+                trigger: Trigger::Birth,
+                inherit_color,
+                inherit_velocity: 0.0,
+                ..Event::default()
+            },
+            400.0,
+        );
+        effect.camera.target_m = [0.0, 0.5, 0.0];
+        effect.post.bloom = None;
+        let parent = &mut effect.emitters[0];
+        parent.look.intensity = 0.0;
+        parent.look.color_over_life = vec![
+            ColorStop {
+                t: 0.0,
+                rgba: [1.0, 0.0, 0.0, 1.0],
+            },
+            ColorStop {
+                t: 1.0,
+                rgba: [1.0, 0.0, 0.0, 1.0],
+            },
+        ];
+        let child = &mut effect.emitters[1];
+        child.transform.position_m = [0.0, 0.0, 0.0];
+        child.look.color_over_life = white.clone();
+        child.look.intensity = 0.5;
+        child.look.draw_path = path;
+        effect.validate().expect("valid");
+        let mut run = ignis::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
+            .expect("headless");
+        for _ in 0..30 {
+            run.advance(1.0 / 60.0);
+        }
+        let image = run.render((160, 120)).expect("render");
+        let mut sum = [0.0f64; 3];
+        for p in image.pixels() {
+            for c in 0..3 {
+                sum[c] += f64::from(p[c]);
+            }
+        }
+        sum
+    };
+    for path in [DrawPath::Billboard, DrawPath::Splat, DrawPath::Tiles] {
+        let [r, g, b] = light(true, path);
+        assert!(
+            r > 1000.0 && g < r * 0.05 && b < r * 0.05,
+            "{path:?} inherited: {r} {g} {b}"
+        );
+        let [r, g, b] = light(false, path);
+        assert!(
+            g > r * 0.5 && b > r * 0.5,
+            "{path:?} own colour: {r} {g} {b}"
+        );
+    }
 }

@@ -110,6 +110,9 @@ fn event_grid_ui(ui: &mut Ui, ev: &mut Event, others: &[String]) {
             ui.add(DragValue::new(&mut ev.inherit_velocity).range(-10.0..=10.0).speed(0.01))
                 .labelled_by(label.id);
             ui.end_row();
+            ui.label("Inherit colour").on_hover_text("Multiply the child's colour by the parent's colour at the event (a white child gradient takes the parent's colour)");
+            ui.checkbox(&mut ev.inherit_color, "parent's colour");
+            ui.end_row();
             let label = ui.label("Cap / step").on_hover_text("At most this many children a step; the rest are dropped and counted in Stats");
             ui.add(DragValue::new(&mut ev.max_per_step).range(1..=1 << 20).speed(1.0))
                 .labelled_by(label.id);

@@ -84,6 +84,9 @@ pub struct Event {
     /// The fraction of the parent's velocity a child starts with, added to the velocity
     /// its own spawn settings give it.
     pub inherit_velocity: f32,
+    /// The child's colour is multiplied by the parent's colour at the event (its colour
+    /// ramp at its age then, to 1/255): a white child ramp takes the parent's colour.
+    pub inherit_color: bool,
     /// At most this many children per step (whole effect); the rest are dropped and
     /// counted in the child's statistics.
     pub max_per_step: u32,
@@ -98,6 +101,7 @@ impl Default for Event {
             probability: 1.0,
             rate_per_sec: 10.0,
             inherit_velocity: 0.3,
+            inherit_color: false,
             max_per_step: 1024,
         }
     }
@@ -129,6 +133,15 @@ impl Effect {
         self.emitters
             .iter()
             .any(|e| e.events.iter().any(|ev| ev.emitter == c.name))
+    }
+
+    /// The emitter whose colour emitter `child` inherits: the first parent whose event
+    /// feeding it has `inherit_color`.
+    pub fn color_parent(&self, child: usize) -> Option<usize> {
+        self.event_sources(child)
+            .into_iter()
+            .find(|&(p, k)| self.emitters[p].events[k].inherit_color)
+            .map(|(p, _)| p)
     }
 
     /// The index of the emitter an event names.

@@ -719,6 +719,10 @@ impl FrameResources {
         [u.tiny, u.tiny_b, u.tiny_c] = b.tiny;
         // The trail's newest entries are from before the last step (trail.wgsl).
         u.tiny_c[1] = b.last_step;
+        // An emitter that inherits its parent's colour: the parent's ramp row + 1.
+        u.tiny_c[2] = effect
+            .color_parent(i)
+            .map_or(0, |p| ROWS_PER_EMITTER * p as u32 + 1);
         u.flags[3] = b.slot_base;
         // The window ends at the ring's head (u.ring[0]).
         let cap = b.capacity.max(1);

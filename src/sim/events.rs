@@ -44,6 +44,8 @@ pub struct EventRecord {
     pub pos_count: [f32; 4],
     /// Velocity, and the event's key (u32 bits).
     pub vel_key: [f32; 4],
+    /// The parent's normalised age.
+    pub parent_t: f32,
 }
 
 /// One entry of a child's spawn list (`EventSpawn`).
@@ -78,7 +80,8 @@ pub struct EventHeader {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ScanConfig {
-    /// The rule's index, the child's capacity, the most children a step, unused.
+    /// The rule's index, the child's capacity, the most children a step, 1 when the
+    /// children inherit the parent's colour.
     pub rule_capacity_cap: [u32; 4],
     /// The parent's simulation origin minus the child's, and the inherited fraction.
     pub delta_inherit: [f32; 4],
@@ -490,6 +493,8 @@ pub fn scan_events(
             continue;
         };
         let n = r.pos_count[3].to_bits();
+        let t = (r.parent_t * 255.0 + 0.5) as u32;
+        let color = (t << 16) | (cfg.rule_capacity_cap[3] << 24);
         for j in 0..n {
             if total + j < cap {
                 list.push(EventSpawn {
@@ -503,7 +508,7 @@ pub fn scan_events(
                         r.vel_key[0] * d[3],
                         r.vel_key[1] * d[3],
                         r.vel_key[2] * d[3],
-                        f32::from_bits(j),
+                        f32::from_bits(color | j),
                     ],
                 });
             }

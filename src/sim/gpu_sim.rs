@@ -999,12 +999,13 @@ impl GpuSim {
                 };
                 let delta = (origin(i) - origin(scan.child)).as_vec3();
                 let child_capacity = self.emitters.get(scan.child).map_or(1, |c| c.capacity);
+                let inherit_color = e.events.get(k).is_some_and(|x| x.inherit_color);
                 let cfg = ScanConfig {
                     rule_capacity_cap: [
                         k as u32,
                         child_capacity,
                         crate::sim::events::step_cap(effect, i, k),
-                        0,
+                        u32::from(inherit_color),
                     ],
                     delta_inherit: [
                         delta.x,
