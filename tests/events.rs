@@ -623,16 +623,7 @@ fn adding_and_removing_events_live_moves_instances_between_batches_and_own_sims(
 #[test]
 fn inherited_colour_tints_the_children() {
     let ctx = strict_gpu();
-    let white = vec![
-        ColorStop {
-            t: 0.0,
-            rgba: [1.0, 1.0, 1.0, 1.0],
-        },
-        ColorStop {
-            t: 1.0,
-            rgba: [1.0, 1.0, 1.0, 1.0],
-        },
-    ];
+    let white = flat_color([1.0, 1.0, 1.0, 1.0]);
     let light = |inherit_color: bool, path: DrawPath| {
         let mut effect = parent_and_child(
             Event {
@@ -647,16 +638,7 @@ fn inherited_colour_tints_the_children() {
         effect.post.bloom = None;
         let parent = &mut effect.emitters[0];
         parent.look.intensity = 0.0;
-        parent.look.color_over_life = vec![
-            ColorStop {
-                t: 0.0,
-                rgba: [1.0, 0.0, 0.0, 1.0],
-            },
-            ColorStop {
-                t: 1.0,
-                rgba: [1.0, 0.0, 0.0, 1.0],
-            },
-        ];
+        parent.look.color_over_life = flat_color([1.0, 0.0, 0.0, 1.0]);
         let child = &mut effect.emitters[1];
         child.transform.position_m = [0.0, 0.0, 0.0];
         child.look.color_over_life = white.clone();

@@ -117,16 +117,7 @@ fn the_ribbon_lights_the_pixels_between_the_particle_and_its_tail() {
         tail_opacity: 1.0,
         draw_sprite: false,
     });
-    e.look.color_over_life = vec![
-        ColorStop {
-            t: 0.0,
-            rgba: [1.0, 1.0, 1.0, 1.0],
-        },
-        ColorStop {
-            t: 1.0,
-            rgba: [1.0, 1.0, 1.0, 1.0],
-        },
-    ];
+    e.look.color_over_life = flat_color([1.0, 1.0, 1.0, 1.0]);
     e.look.intensity = 4.0;
     let mut effect = bare_effect(e);
     effect.time.mode = TimeMode::FixedStep;

@@ -2,7 +2,7 @@
 //! (lavapipe in CI); no adapter is a failure, never a skip.
 #![allow(dead_code)]
 
-use ignis::effect::{Effect, Emitter, Forces, Range, Shape, SpawnNoise};
+use ignis::effect::{ColorStop, Effect, Emitter, Forces, Range, Shape, SpawnNoise};
 use ignis::gpu::GpuContext;
 use ignis::gpu::types::{Particle, SimParams};
 use ignis::shaders::ShaderLibrary;
@@ -116,4 +116,9 @@ pub fn play_steps(ctx: &GpuContext, player: &mut ignis::Player, steps: u32) {
         player.simulate(&mut enc);
         ctx.queue.submit([enc.finish()]);
     }
+}
+
+/// A colour gradient of one colour over the whole life.
+pub fn flat_color(rgba: [f32; 4]) -> Vec<ColorStop> {
+    vec![ColorStop { t: 0.0, rgba }, ColorStop { t: 1.0, rgba }]
 }
