@@ -49,6 +49,15 @@ fn count_of(i: u32) -> u32 {
     return event_out.words[cfg.rule_capacity_cap.x * params.capacity + window_slot(i)];
 }
 
+// The children of one thread's PER_THREAD slots of the window, from the i-th.
+fn thread_children(first: u32) -> u32 {
+    var n = 0u;
+    for (var k = 0u; k < PER_THREAD; k++) {
+        n += count_of(first + k);
+    }
+    return n;
+}
+
 fn window_slot(i: u32) -> u32 {
     var slot = params.update_window.x + i;
     if slot >= params.capacity {
@@ -88,11 +97,7 @@ fn count_blocks(
         // A spare workgroup of the 2-D grid.
         return;
     }
-    var n = 0u;
-    for (var k = 0u; k < PER_THREAD; k++) {
-        n += count_of(b * BLOCK + lid * PER_THREAD + k);
-    }
-    let total = workgroup_inclusive(lid, n);
+    let total = workgroup_inclusive(lid, thread_children(b * BLOCK + lid * PER_THREAD));
     if lid == GROUP - 1u {
         blocks[1u + b] = total;
     }
@@ -140,10 +145,7 @@ fn write_list(
         return;
     }
     let first = b * BLOCK + lid * PER_THREAD;
-    var n = 0u;
-    for (var k = 0u; k < PER_THREAD; k++) {
-        n += count_of(first + k);
-    }
+    let n = thread_children(first);
     let incl = workgroup_inclusive(lid, n);
     // This thread's first child's place among this scan's children.
     var at = blocks[1u + b] + incl - n;

@@ -14,7 +14,8 @@ use crate::shaders::{
     EVENTS_IO, PACKED_STATE_IO, PARAMS_INSTANCED, ShaderError, ShaderLibrary, TINY_STATE_IO,
     TRAIL_IO, create_checked,
 };
-use crate::sim::events::{EmitterEvents, EventHeader, EventPipes, ScanConfig};
+use crate::sim::events::{EventHeader, ScanConfig};
+use crate::sim::hooks::{EmitterHooks, HookPipes};
 use crate::sim::modules::Modules;
 use crate::sim::planner::{EffectPlanner, LiveWindow};
 
@@ -61,9 +62,9 @@ pub struct UpdatePass {
     /// Batched instances (params_instanced.wgsl): parameters are an array in storage.
     batched: bool,
     /// The event hooks' layout and the event scan.
-    pub(crate) events: EventPipes,
+    pub(crate) hooks: HookPipes,
     /// Groups 0 and 1: the update of an emitter with hooks (none when batched).
-    events_pipeline_layout: Option<wgpu::PipelineLayout>,
+    hooks_pipeline_layout: Option<wgpu::PipelineLayout>,
 }
 
 /// How an update pass's pipelines are specialised.
@@ -119,14 +120,14 @@ impl UpdatePass {
                 bind_group_layouts: &[Some(&layout)],
                 immediate_size: 0,
             });
-        let events = EventPipes::new(ctx, params_entry);
+        let hooks = HookPipes::new(ctx, params_entry);
         // Batched updates have no hooks (effects with events or trails are not batched),
         // and their parameters in storage would take them past 8 storage buffers.
-        let events_pipeline_layout = (!batched).then(|| {
+        let hooks_pipeline_layout = (!batched).then(|| {
             ctx.device
                 .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some("UpdatePass::events_pipeline_layout"),
-                    bind_group_layouts: &[Some(&layout), Some(&events.hooks_layout)],
+                    label: Some("UpdatePass::hooks_pipeline_layout"),
+                    bind_group_layouts: &[Some(&layout), Some(&hooks.hooks_layout)],
                     immediate_size: 0,
                 })
         });
@@ -153,8 +154,8 @@ impl UpdatePass {
             files: Vec::new(),
             count_alive: mode == UpdateMode::Counted,
             batched,
-            events,
-            events_pipeline_layout,
+            hooks,
+            hooks_pipeline_layout,
         }
     }
 
@@ -199,7 +200,7 @@ impl UpdatePass {
         let mut fresh = HashMap::new();
         for &(integrator, modules) in keys {
             let hooks = (modules.has_events(), modules.contains(Modules::TRAIL));
-            let with_hooks = hooked.get(&hooks).zip(self.events_pipeline_layout.as_ref());
+            let with_hooks = hooked.get(&hooks).zip(self.hooks_pipeline_layout.as_ref());
             let (composed, layout) = if let Some((c, l)) = with_hooks {
                 (c, l)
             } else if modules.contains(Modules::TINY) {
@@ -250,7 +251,7 @@ impl UpdatePass {
         let scan_files = if self.batched {
             Vec::new()
         } else {
-            self.events.rebuild(ctx, lib)?
+            self.hooks.rebuild(ctx, lib)?
         };
         self.pipelines = fresh;
         self.count = Some(count);
@@ -321,7 +322,7 @@ pub(super) struct EmitterState {
     /// steps came from it; otherwise the live window is unknown).
     pub(super) spawned_end: u64,
     /// Event records (a parent) and spawn list (a child).
-    pub(super) events: Option<EmitterEvents>,
+    pub(super) hooks: Option<EmitterHooks>,
     /// Spawns from other emitters' events: the GPU fills the ring, so the planner cannot
     /// know its live window and every slot is visited.
     pub(super) gpu_fed: bool,
@@ -670,11 +671,11 @@ impl GpuSim {
         let mut changed = rebind;
         for i in 0..self.emitters.len() {
             let capacity = self.emitters[i].capacity;
-            let old = self.emitters[i].events.take();
+            let old = self.emitters[i].hooks.take();
             let was = old.as_ref().map(|o| o.hooks.clone());
-            let fresh = EmitterEvents::sync(&self.ctx, &update.events, effect, i, capacity, old);
+            let fresh = EmitterHooks::sync(&self.ctx, &update.hooks, effect, i, capacity, old);
             changed |= fresh.as_ref().map(|f| &f.hooks) != was.as_ref();
-            self.emitters[i].events = fresh;
+            self.emitters[i].hooks = fresh;
         }
         if !changed {
             return;
@@ -682,16 +683,11 @@ impl GpuSim {
         let lists: Vec<Option<wgpu::Buffer>> = self
             .emitters
             .iter()
-            .map(|s| s.events.as_ref().and_then(|ev| ev.list.clone()))
+            .map(|s| s.hooks.as_ref().and_then(|ev| ev.list.clone()))
             .collect();
         for s in &mut self.emitters {
-            if let Some(ev) = &mut s.events {
-                ev.bind_scans(
-                    &self.ctx.device,
-                    &update.events,
-                    &self.params_buffer,
-                    &lists,
-                );
+            if let Some(ev) = &mut s.hooks {
+                ev.bind_scans(&self.ctx.device, &update.hooks, &self.params_buffer, &lists);
             }
         }
     }
@@ -742,7 +738,7 @@ impl GpuSim {
             salt: 0,
             whole_pool_until: f64::NEG_INFINITY,
             spawned_end: 0,
-            events: None,
+            hooks: None,
             gpu_fed: false,
         }
     }
@@ -959,14 +955,14 @@ impl GpuSim {
                     let pass = crate::gpu::compute_pass(pass, enc, "GpuSim::update");
                     pass.set_pipeline(pipeline);
                     pass.set_bind_group(0, group, &[offset]);
-                    if let Some(ev) = &em.events {
+                    if let Some(ev) = &em.hooks {
                         pass.set_bind_group(1, &ev.hooks, &[]);
                     }
                     let (x, y) = dispatch_size(invocations);
                     pass.dispatch_workgroups(x, y, 1);
                 }
                 // The parent's events become its children's spawn lists, the same step.
-                if let (Some(ev), Some(scan)) = (&em.events, &update.events.scan) {
+                if let (Some(ev), Some(scan)) = (&em.hooks, &update.hooks.scan) {
                     record_scans(
                         crate::gpu::compute_pass(pass, enc, "GpuSim::events"),
                         ev,
@@ -981,55 +977,60 @@ impl GpuSim {
 
     /// Writes each scan's settings: the rule, the child's capacity and cap, the offset
     /// between the parent's and the child's simulation spaces, the inherited velocity.
-    fn write_scan_configs(&self, effect: &Effect) {
-        for (i, s) in self.emitters.iter().enumerate() {
-            let Some(ev) = &s.events else {
+    fn write_scan_configs(&mut self, effect: &Effect) {
+        let origin = |j: usize| {
+            self.planner
+                .emitters
+                .get(j)
+                .map(|p| p.origin())
+                .unwrap_or_default()
+        };
+        let mut configs = Vec::new();
+        for (i, (s, e)) in self.emitters.iter().zip(&effect.emitters).enumerate() {
+            let Some(hooks) = &s.hooks else {
                 continue;
             };
-            let Some(e) = effect.emitters.get(i) else {
-                continue;
-            };
-            for (k, scan) in ev.scans.iter().enumerate() {
-                let origin = |j: usize| {
-                    self.planner
-                        .emitters
-                        .get(j)
-                        .map(|p| p.origin())
-                        .unwrap_or_default()
-                };
+            for (k, (scan, ev)) in hooks.scans.iter().zip(&e.events).enumerate() {
                 let delta = (origin(i) - origin(scan.child)).as_vec3();
                 let child_capacity = self.emitters.get(scan.child).map_or(1, |c| c.capacity);
-                let inherit_color = e.events.get(k).is_some_and(|x| x.inherit_color);
                 let cfg = ScanConfig {
                     rule_capacity_cap: [
                         k as u32,
                         child_capacity,
                         crate::sim::events::step_cap(effect, i, k),
-                        u32::from(inherit_color),
+                        u32::from(ev.inherit_color),
                     ],
-                    delta_inherit: [
-                        delta.x,
-                        delta.y,
-                        delta.z,
-                        e.events.get(k).map_or(0.0, |x| x.inherit_velocity),
-                    ],
+                    delta_inherit: [delta.x, delta.y, delta.z, ev.inherit_velocity],
                 };
+                configs.push((i, k, cfg));
+            }
+        }
+        for (i, k, cfg) in configs {
+            let Some(scan) = self.emitters[i]
+                .hooks
+                .as_mut()
+                .and_then(|h| h.scans.get_mut(k))
+            else {
+                continue;
+            };
+            if scan.written != Some(cfg) {
                 self.ctx
                     .queue
                     .write_buffer(&scan.config, 0, bytemuck::bytes_of(&cfg));
+                scan.written = Some(cfg);
             }
         }
+    }
+
+    /// Emitter `index`'s hook buffers (events, trail), if it has any.
+    fn hooks(&self, index: usize) -> Option<&EmitterHooks> {
+        self.emitters.get(index).and_then(|s| s.hooks.as_ref())
     }
 
     /// Emitter `index`'s trail ring (a blocking readback): points per slot, steps between
     /// them, and the entries (`points` per slot: position, and the age then).
     pub fn read_trail(&self, index: usize) -> Result<Option<TrailRing>, SimError> {
-        let Some(ring) = self
-            .emitters
-            .get(index)
-            .and_then(|s| s.events.as_ref())
-            .and_then(|ev| ev.trail.as_ref())
-        else {
+        let Some(ring) = self.hooks(index).and_then(|h| h.trail.as_ref()) else {
             return Ok(None);
         };
         let bytes = read_buffer(&self.ctx, ring, ring.size())?;
@@ -1044,12 +1045,7 @@ impl GpuSim {
     /// Emitter `index`'s spawn-list header (a child of an event): this step's children,
     /// and those the events asked for and the cap dropped since the start.
     pub fn read_event_header(&self, index: usize) -> Result<Option<EventHeader>, SimError> {
-        let Some(list) = self
-            .emitters
-            .get(index)
-            .and_then(|s| s.events.as_ref())
-            .and_then(|ev| ev.list.as_ref())
-        else {
+        let Some(list) = self.hooks(index).and_then(|h| h.list.as_ref()) else {
             return Ok(None);
         };
         let bytes = read_buffer(&self.ctx, list, size_of::<EventHeader>() as u64)?;
@@ -1192,7 +1188,7 @@ impl GpuSim {
                 _ => LiveWindow::all(s.capacity),
             },
             slot_base: 0,
-            trail: s.events.as_ref().and_then(|ev| ev.trail.as_ref()),
+            trail: s.hooks.as_ref().and_then(|ev| ev.trail.as_ref()),
             last_step: self.planner.step_index.saturating_sub(1) as u32,
         })
     }
@@ -1361,7 +1357,7 @@ impl GpuSim {
                 enc.clear_buffer(b, 0, None);
             }
             enc.clear_buffer(&s.counters, 0, None);
-            if let Some(list) = s.events.as_ref().and_then(|ev| ev.list.as_ref()) {
+            if let Some(list) = s.hooks.as_ref().and_then(|ev| ev.list.as_ref()) {
                 enc.clear_buffer(list, 0, None);
             }
             s.current = 0;
@@ -1380,7 +1376,7 @@ impl GpuSim {
 /// the step's parameter block at `offset`.
 fn record_scans(
     pass: &mut wgpu::ComputePass<'static>,
-    ev: &EmitterEvents,
+    ev: &EmitterHooks,
     scan: &[wgpu::ComputePipeline; 3],
     offset: u32,
     slots: u32,

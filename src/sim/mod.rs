@@ -5,6 +5,7 @@ pub mod batch;
 pub mod cpu_reference;
 pub mod events;
 pub mod gpu_sim;
+pub mod hooks;
 pub mod modules;
 pub mod planner;
 pub mod snapshot;

@@ -69,7 +69,7 @@ impl GpuSim {
             .iter()
             .map(|s| {
                 let buffers = s.buffers.each_ref().map(|b| copy_of(enc, b, b.size()));
-                let hooks = s.events.as_ref();
+                let hooks = s.hooks.as_ref();
                 let header = size_of::<crate::sim::events::EventHeader>() as u64;
                 let event_header = hooks
                     .and_then(|ev| ev.list.as_ref())
@@ -113,13 +113,13 @@ impl GpuSim {
                 enc.copy_buffer_to_buffer(copy, 0, b, 0, b.size());
             }
             enc.clear_buffer(&s.counters, 0, None);
-            let list = s.events.as_ref().and_then(|ev| ev.list.as_ref());
+            let list = s.hooks.as_ref().and_then(|ev| ev.list.as_ref());
             if let (Some(list), Some(header)) = (list, &k.event_header) {
                 enc.copy_buffer_to_buffer(header, 0, list, 0, header.size());
             } else if let Some(list) = list {
                 enc.clear_buffer(list, 0, None);
             }
-            let ring = s.events.as_ref().and_then(|ev| ev.trail.as_ref());
+            let ring = s.hooks.as_ref().and_then(|ev| ev.trail.as_ref());
             if let (Some(ring), Some(copy)) = (ring, &k.trail)
                 && ring.size() == copy.size()
             {
