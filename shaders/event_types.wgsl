@@ -14,7 +14,7 @@ struct EventRule {
 
 // A parent's event buffer: its two rules, then u32 words — first the children each slot
 // asks for per rule (`words[rule · capacity + slot]`, written for every slot the update
-// visits), then a record per rule and slot, written only when it asks for children
+// visits; BORN_BIT set when the particle was born this step), then a record per rule and slot, written only when it asks for children
 // (`RECORD_WORDS` words from `2 · capacity + (rule · capacity + slot) · RECORD_WORDS`:
 // position xyz (the parent's simulation space), the event's key, velocity xyz, the
 // parent's normalised age (f32 bits)).
@@ -25,6 +25,8 @@ struct EventOut {
 }
 
 const RECORD_WORDS: u32 = 8u;
+// Set in a slot's count word when the particle was born this step.
+const BORN_BIT: u32 = 0x80000000u;
 
 // The first word of rule `rule`'s record of `slot` in a pool of `capacity` slots.
 fn record_at(rule: u32, slot: u32, capacity: u32) -> u32 {

@@ -11,17 +11,30 @@
 // gets them in update order. A child none of whose parents ran this step sees a stale
 // stamp and spawns nothing.
 //
+//
+// A child drawn as a ribbon per parent (ScanConfig flag RIBBON) is linked as the list is
+// written: each child's entry of the child's trail ring gets (the slot and birth stamp of
+// the child its parent spawned before it, or none; its own birth stamp), stamps being the
+// step's number + 1. The parent's last child is kept per parent slot after the block sums
+// and forgotten when the parent slot is born again (BORN_BIT), so a ribbon never joins two
+// parents' lives; the draw (trail.wgsl) also checks that the linked slot still holds the
+// child it names.
+//
 // Group 0: binding 0 the parent's SimParams (dynamic offset), 1 its event buffer, 2 the
-// child's list (header + entries), 3 this rule's ScanConfig, 4 the block sums (scratch:
-// word 0 the list position this scan starts at, then one word per block).
-// Mirrored by `scan_events` in src/sim/events.rs.
+// child's list (header + entries), 3 this rule's ScanConfig, 4 the scan's scratch (word 0
+// the list position this scan starts at, one word per block, then two words per parent
+// slot: its last child's slot and stamp), 5 the child's trail ring (a placeholder unless
+// RIBBON).
+// Mirrored by `scan_events` in src/sim/events.rs (the links are read by `Link` in
+// src/sim/trails.rs).
 #import "common.wgsl"
 #import "params.wgsl"
 #import "event_types.wgsl"
+#import "trail_ring.wgsl"
 
 struct ScanConfig {
-    // The rule's index, the child's capacity, the most children a step, 1 when the
-    // children inherit the parent's colour.
+    // The rule's index, the child's capacity, the most children a step, flags
+    // (INHERIT_COLOR, RIBBON).
     rule_capacity_cap: vec4<u32>,
     // xyz: the parent's simulation origin minus the child's, w: the inherited fraction
     // of the parent's velocity.
@@ -32,6 +45,13 @@ struct ScanConfig {
 @group(0) @binding(2) var<storage, read_write> event_in: EventIn;
 @group(0) @binding(3) var<uniform> cfg: ScanConfig;
 @group(0) @binding(4) var<storage, read_write> blocks: array<u32>;
+@group(0) @binding(5) var<storage, read_write> ribbon: TrailRing;
+
+// ScanConfig flags (keep in sync with src/sim/events.rs).
+const INHERIT_COLOR: u32 = 1u;
+const RIBBON: u32 = 2u;
+// No previous child.
+const NO_LINK: u32 = 0xFFFFFFFFu;
 
 const GROUP: u32 = 256u;
 // Slots per thread and per workgroup (keep in sync with EVENT_SCAN_BLOCK in
@@ -46,7 +66,17 @@ fn count_of(i: u32) -> u32 {
     if i >= params.update_window.y {
         return 0u;
     }
-    return event_out.words[cfg.rule_capacity_cap.x * params.capacity + window_slot(i)];
+    return event_out.words[cfg.rule_capacity_cap.x * params.capacity + window_slot(i)] & ~BORN_BIT;
+}
+
+// Whether the particle in the i-th slot of the parent's window was born this step.
+fn born_at(i: u32) -> bool {
+    return (event_out.words[cfg.rule_capacity_cap.x * params.capacity + window_slot(i)] & BORN_BIT) != 0u;
+}
+
+// Where parent `slot`'s last child (slot, stamp) is kept in the scratch.
+fn last_child_at(slot: u32) -> u32 {
+    return 1u + (params.capacity + BLOCK - 1u) / BLOCK + 2u * slot;
 }
 
 // The children of one thread's PER_THREAD slots of the window, from the i-th.
@@ -152,24 +182,49 @@ fn write_list(
     let start = blocks[0];
     let cap = cfg.rule_capacity_cap.z;
     let capacity = params.capacity;
+    let flags = cfg.rule_capacity_cap.w;
     for (var k = 0u; k < PER_THREAD; k++) {
+        let slot = window_slot(first + k);
+        if (flags & RIBBON) != 0u && first + k < params.update_window.y && born_at(first + k) {
+            blocks[last_child_at(slot)] = NO_LINK;
+        }
         let c = count_of(first + k);
         if c == 0u {
             continue;
         }
-        let r = record_at(cfg.rule_capacity_cap.x, window_slot(first + k), capacity);
+        let r = record_at(cfg.rule_capacity_cap.x, slot, capacity);
         let pos = bitcast<vec3<f32>>(vec3<u32>(event_out.words[r], event_out.words[r + 1u], event_out.words[r + 2u]));
         let vel = bitcast<vec3<f32>>(vec3<u32>(event_out.words[r + 4u], event_out.words[r + 5u], event_out.words[r + 6u]));
         let key = event_out.words[r + 3u];
         // The parent's normalised age to 1/255, and whether the child inherits its colour.
         let t = u32(bitcast<f32>(event_out.words[r + 7u]) * 255.0 + 0.5);
-        let color = (t << 16u) | (cfg.rule_capacity_cap.w << 24u);
+        let color = (t << 16u) | ((flags & INHERIT_COLOR) << 24u);
         for (var j = 0u; j < c && at + j < cap; j++) {
             event_in.list[start + at + j] = EventSpawn(
                 vec4<f32>(pos + cfg.delta_inherit.xyz, bitcast<f32>(key)),
                 vec4<f32>(vel * cfg.delta_inherit.w, bitcast<f32>(color | j)),
             );
         }
+        if (flags & RIBBON) != 0u && at < cap {
+            link_children(slot, start + at, min(c, cap - at));
+        }
         at += c;
     }
+}
+
+// Links the `n` children parent `slot` spawns this step, from list entry `entry` on: each
+// to the one before it (the first to the parent's last child), and keeps the last.
+fn link_children(slot: u32, entry: u32, n: u32) {
+    let child_capacity = cfg.rule_capacity_cap.y;
+    let stamp = params.tiny_b.z + 1u;
+    let kept = last_child_at(slot);
+    var prev = vec2<u32>(blocks[kept], blocks[kept + 1u]);
+    var child = 0u;
+    for (var j = 0u; j < n; j++) {
+        child = (event_in.head + entry + j) % child_capacity;
+        ribbon.history[child] = bitcast<vec4<f32>>(vec4<u32>(prev, stamp, 0u));
+        prev = vec2<u32>(child, stamp);
+    }
+    blocks[kept] = child;
+    blocks[kept + 1u] = stamp;
 }

@@ -134,7 +134,8 @@ fn emit_events(slot: u32, p: Particle, born: bool, was_alive: bool, alive: bool,
         }
         n = min(n, MAX_CHILDREN);
         let s = slot_base + slot;
-        event_out.words[e * params.capacity + s] = n;
+        // Bit 31: born this step (a ribbon per parent starts afresh, events.wgsl).
+        event_out.words[e * params.capacity + s] = n | select(0u, BORN_BIT, born);
         if n > 0u {
             let at = record_at(e, s, params.capacity);
             let pos = bitcast<vec3<u32>>(p.pos_age.xyz);

@@ -1,12 +1,18 @@
-// trail_ring.wgsl — a trail's ring of positions, as the update writes it (trail_on.wgsl)
-// and the billboards read it (trail.wgsl): `points` entries per slot, one recorded every
-// `every` steps (xyz: position in simulation space, w: the particle's age then).
+// trail_ring.wgsl — a trail's ring, as the update (trail_on.wgsl) or the event scan
+// (events.wgsl) writes it and the billboards read it (trail.wgsl). `mode` TRAIL_HISTORY:
+// `points` entries per slot, one recorded every `every` steps (xyz: position in simulation
+// space, w: the particle's age then). TRAIL_PER_PARENT: one entry per slot, its u32 bits
+// (the previous child of the same parent: slot or 0xFFFFFFFF, birth stamp; this
+// particle's birth stamp; 0), a stamp being the step's number + 1.
 // Keep in sync with src/sim/trails.rs.
+
+const TRAIL_HISTORY: u32 = 0u;
+const TRAIL_PER_PARENT: u32 = 1u;
 
 struct TrailRing {
     points: u32,
     every: u32,
+    mode: u32,
     pad0: u32,
-    pad1: u32,
     history: array<vec4<f32>>,
 }

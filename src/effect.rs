@@ -15,7 +15,7 @@ pub use curve::{
     rows_key,
 };
 pub use events::{CountRange, Event, MAX_CHILDREN_PER_EVENT, MAX_EVENTS_PER_EMITTER, Trigger};
-pub use trail::{MAX_TRAIL_POINTS, Trail};
+pub use trail::{MAX_TRAIL_POINTS, Trail, TrailMode};
 
 /// The preset format version this build writes (and the newest it reads).
 pub const CURRENT_VERSION: u32 = 2;

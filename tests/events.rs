@@ -329,7 +329,7 @@ fn birth_over_life_and_collision_triggers_count_exactly() {
 }
 
 /// Validation names the field and the fix: unknown children, self-feeding, a child fed
-/// twice, cycles, impossible counts.
+/// twice, cycles, impossible counts, a ribbon per parent with no parent.
 #[test]
 fn bad_events_are_rejected_with_their_field() {
     let mut effect = parent_and_child(Event::default(), 10.0);
@@ -360,6 +360,18 @@ fn bad_events_are_rejected_with_their_field() {
     assert!(
         errs.iter()
             .any(|e| e.problem.contains("cannot feed itself")),
+        "{errs:?}"
+    );
+    // A ribbon per parent on an emitter no event feeds.
+    let mut effect = parent_and_child(Event::default(), 10.0);
+    effect.emitters[0].look.trail = Some(Trail {
+        mode: TrailMode::PerParent,
+        ..Trail::default()
+    });
+    let errs = effect.validate().expect_err("an unfed ribbon per parent");
+    assert!(
+        errs.iter()
+            .any(|e| e.path == "emitters[0].look.trail.mode" && e.problem.contains("History")),
         "{errs:?}"
     );
 }
@@ -417,7 +429,7 @@ fn frame_sequences() -> Vec<(String, Vec<f64>)> {
 }
 
 /// A fixed-step effect with a chain of events (death → child, whose collisions feed a
-/// grandchild) played through a player at 30, 60, 144 and 240 fps and under jitter ends
+/// grandchild drawn as a ribbon per parent) played through a player at 30, 60, 144 and 240 fps and under jitter ends
 /// bit-identical, and seeking back to 1 s (from snapshots and from the start) gives the
 /// played state.
 #[test]
@@ -446,21 +458,33 @@ fn events_are_frame_rate_independent_and_seekable() {
         count: CountRange { min: 2, max: 3 },
         ..Event::default()
     }];
-    effect.emitters.push(Emitter {
+    let mut grandchild = Emitter {
         name: "grandchild".into(),
         capacity: 2048,
         lifetime_secs: Range::new(0.3, 0.6),
         speed_m_per_s: Range::new(1.0, 2.0),
         spread_deg: 80.0,
         ..plain_emitter()
+    };
+    // The grandchildren of one impact joined by a ribbon per parent: its links too.
+    grandchild.look.trail = Some(Trail {
+        mode: TrailMode::PerParent,
+        ..Trail::default()
     });
+    effect.emitters.push(grandchild);
     effect.validate().expect("valid");
     let state = |run: &ignis::headless::Headless| -> Vec<u8> {
+        let links = run
+            .player
+            .trail(run.instance, 2)
+            .expect("read")
+            .expect("a ring");
         (0..3)
             .flat_map(|e| {
                 let p = run.player.particles(run.instance, e).expect("read");
                 bytemuck::cast_slice::<_, u8>(&p).to_vec()
             })
+            .chain(bytemuck::cast_slice::<_, u8>(&links.entries).to_vec())
             .collect()
     };
     let mut reference = None;

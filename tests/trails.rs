@@ -1,7 +1,9 @@
 //! Trails on a real adapter: the points a ribbon is drawn through are the particle's own
 //! positions after the steps that recorded them (the ring read back, its entries chosen as
 //! the vertex shader chooses them), a reused slot's ribbon holds only its new particle's
-//! points, and the drawn ribbon lights the pixels between the particle and its tail.
+//! points, and the drawn ribbon lights the pixels between the particle and its tail. A
+//! ribbon per parent joins each parent's children in the order it spawned them, never two
+//! parents' lives, and lights the pixels between them.
 
 mod common;
 
@@ -9,7 +11,7 @@ use common::*;
 use ignis::effect::*;
 use ignis::shaders::ShaderLibrary;
 use ignis::sim::GpuSim;
-use ignis::sim::trails::trail_indices;
+use ignis::sim::trails::{Link, trail_indices};
 
 const DT: f32 = 1.0 / 60.0;
 
@@ -116,6 +118,7 @@ fn the_ribbon_lights_the_pixels_between_the_particle_and_its_tail() {
         tail_width: 1.0,
         tail_opacity: 1.0,
         draw_sprite: false,
+        ..Trail::default()
     });
     e.look.color_over_life = flat_color([1.0, 1.0, 1.0, 1.0]);
     e.look.intensity = 4.0;
@@ -188,4 +191,190 @@ fn a_trail_too_large_for_the_device_is_a_clear_error() {
         err.contains("long tails") && err.contains("fewer trail points"),
         "{err}"
     );
+}
+
+/// Parents flying straight out of the origin (each on a ray of its own) that leave still
+/// children over their lives, drawn as a ribbon per parent.
+fn ribbon_effect() -> Effect {
+    let parent = Emitter {
+        name: "parent".into(),
+        capacity: 6,
+        spawn_rate_per_sec: Param::Constant(8.0),
+        lifetime_secs: Range::new(0.5, 0.5),
+        speed_m_per_s: Range::new(2.0, 2.0),
+        spread_deg: 90.0,
+        events: vec![Event {
+            trigger: Trigger::OverLife,
+            emitter: "ribbon".into(),
+            rate_per_sec: 30.0,
+            inherit_velocity: 0.0,
+            ..Event::default()
+        }],
+        ..plain_emitter()
+    };
+    let mut ribbon = Emitter {
+        name: "ribbon".into(),
+        capacity: 128,
+        lifetime_secs: Range::new(0.7, 0.7),
+        ..plain_emitter()
+    };
+    ribbon.look.trail = Some(Trail {
+        mode: TrailMode::PerParent,
+        ..Trail::default()
+    });
+    let mut effect = bare_effect(parent);
+    effect.emitters.push(ribbon);
+    effect.validate().expect("valid");
+    effect
+}
+
+/// The segments a ribbon per parent draws (read back: links, and the children's states)
+/// join, on every step, two children of one parent life spawned one after the other —
+/// children lie on their parent's ray, ordered by their distance from the origin — and
+/// each parent's living children form one unbroken chain, while parent and child slots
+/// are reused many times.
+#[test]
+fn a_ribbon_per_parent_joins_each_parents_children_in_order() {
+    let ctx = gpu();
+    let effect = ribbon_effect();
+    let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
+    let (mut segments, mut rays_seen, mut births) = (0usize, 0usize, 0usize);
+    let mut stamps = vec![0u32; 128];
+    for step in 0..180 {
+        sim.step(&effect, DT, 1).expect("step");
+        let children = sim.read_particles(1).expect("read");
+        let ring = sim.read_trail(1).expect("read").expect("a ring");
+        assert_eq!(ring.points, 1);
+        let links: Vec<Link> = ring.entries.iter().map(|e| Link::from_entry(*e)).collect();
+        let alive: Vec<usize> = (0..children.len())
+            .filter(|&s| children[s].is_alive())
+            .collect();
+        for &s in &alive {
+            births += usize::from(links[s].stamp != stamps[s]);
+            stamps[s] = links[s].stamp;
+        }
+        // Children by ray (their parent's direction), nearest the origin (oldest) first.
+        let dir = |s: usize| glam::Vec3::from_slice(&children[s].pos_age[..3]).normalize();
+        let mut rays: Vec<Vec<usize>> = Vec::new();
+        for &s in &alive {
+            match rays.iter_mut().find(|r| dir(r[0]).dot(dir(s)) > 0.99999) {
+                Some(r) => r.push(s),
+                None => rays.push(vec![s]),
+            }
+        }
+        for ray in &mut rays {
+            ray.sort_by(|&a, &b| {
+                children[a].pos_age[3]
+                    .total_cmp(&children[b].pos_age[3])
+                    .reverse()
+            });
+            // Each child but the oldest is joined to the one before it on its ray.
+            for pair in ray.windows(2) {
+                let got = links[pair[1]].drawn_prev(&links);
+                assert_eq!(
+                    got,
+                    Some(pair[0] as u32),
+                    "step {step}: {pair:?} not joined"
+                );
+            }
+            // The oldest living child of a life has no drawn segment: its predecessor is
+            // dead (or none), never another life's child.
+            let first = links[ray[0]].drawn_prev(&links);
+            assert!(
+                first.is_none_or(|p| !children[p as usize].is_alive()),
+                "step {step}: the oldest child of a ray joined to a living {first:?}"
+            );
+            segments += ray.len() - 1;
+        }
+        rays_seen += rays.len();
+    }
+    assert!(
+        rays_seen > 500 && segments > 5000,
+        "{rays_seen} rays, {segments} segments"
+    );
+    // 180 steps of about 120 children a second in 128 slots: every slot used a few times.
+    assert!(births > 300, "{births} children born");
+}
+
+/// Two children of one parent, still and side by side across the view: the ribbon per
+/// parent lights the row between them and nothing beyond (no sprites drawn).
+#[test]
+fn a_ribbon_per_parent_lights_the_pixels_between_the_children() {
+    let ctx = gpu();
+    let mut effect = ribbon_effect();
+    let parent = &mut effect.emitters[0];
+    parent.capacity = 1;
+    parent.spawn_rate_per_sec = Param::Constant(0.0);
+    parent.bursts = vec![Burst {
+        time_secs: 0.0,
+        count: 1,
+    }];
+    parent.lifetime_secs = Range::new(0.45, 0.45);
+    parent.transform.position_m = [-1.0, 1.0, 0.0];
+    parent.direction = [1.0, 0.0, 0.0];
+    parent.spread_deg = 0.0;
+    parent.speed_m_per_s = Range::new(4.0, 4.0);
+    parent.events[0].rate_per_sec = 5.0;
+    let ribbon = &mut effect.emitters[1];
+    ribbon.transform.position_m = [-1.0, 1.0, 0.0];
+    ribbon.lifetime_secs = Range::new(5.0, 5.0);
+    ribbon.look.size_m = Param::Constant(0.05);
+    ribbon.look.color_over_life = flat_color([1.0, 1.0, 1.0, 1.0]);
+    ribbon.look.intensity = 4.0;
+    ribbon.look.trail = Some(Trail {
+        mode: TrailMode::PerParent,
+        tail_width: 1.0,
+        tail_opacity: 1.0,
+        draw_sprite: false,
+        ..Trail::default()
+    });
+    effect.time.mode = TimeMode::FixedStep;
+    effect.time.step_secs = DT;
+    effect.camera = CameraHint {
+        target_m: [0.0, 1.0, 0.0],
+        distance_m: 3.0,
+        yaw_deg: 0.0,
+        pitch_deg: 0.0,
+        fov_y_deg: 45.0,
+    };
+    effect.post.bloom = None;
+    effect.validate().expect("valid");
+    let mut run =
+        ignis::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    for _ in 0..60 {
+        run.advance(f64::from(DT));
+    }
+    // Two children (5 a second over the parent's 0.45 s), where the parent was at ages
+    // 0.2 and 0.4 (the end of the steps that crossed them): x ≈ −0.2 and 0.6.
+    let mut xs: Vec<f32> = run
+        .player
+        .particle_motion(run.instance)
+        .expect("read")
+        .iter()
+        .map(|(p, _)| p.x)
+        .collect();
+    xs.sort_by(f32::total_cmp);
+    assert!(
+        xs.len() == 2 && (xs[0] + 0.2).abs() < 0.1 && (xs[1] - 0.6).abs() < 0.1,
+        "two children near x = −0.2 and 0.6: {xs:?}"
+    );
+    let (w, h) = (320u32, 240u32);
+    let image = run.render((w, h)).expect("render");
+    let px_per_m = (h as f32 / 2.0) / (3.0 * (22.5f32).to_radians().tan());
+    let to_px = |x: f32| w as f32 / 2.0 + x * px_per_m;
+    let (a, b) = (to_px(xs[0]), to_px(xs[1]));
+    let row = h / 2;
+    let lit: Vec<u32> = (0..w)
+        .filter(|&x| image.get_pixel(x, row)[0] > 40)
+        .collect();
+    let (first, last) = (*lit.first().expect("lit pixels"), *lit.last().expect("lit"));
+    assert!(
+        (first as f32 - a).abs() <= 2.0 && (last as f32 - b).abs() <= 2.0,
+        "lit {first}..={last}, children at {a:.1} and {b:.1}"
+    );
+    assert_eq!(lit.len() as u32, last - first + 1, "one unbroken ribbon");
+    let lit_rows = (0..h)
+        .filter(|&y| image.get_pixel(((a + b) / 2.0) as u32, y)[0] > 40)
+        .count();
+    assert!(lit_rows <= 4, "a thin ribbon: {lit_rows} rows lit");
 }

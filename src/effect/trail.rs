@@ -1,8 +1,13 @@
-//! Trails: each particle drawn as a ribbon through its last positions, which the update
-//! records in a small ring per particle (`shaders/trail_on.wgsl`); the billboards draw
-//! one camera-facing segment per pair of neighbouring points (`shaders/billboard.wgsl`,
-//! `TRAIL`). The velocity streak (`Look::streak`) stays the cheap option: one quad
-//! stretched along the velocity.
+//! Trails: ribbons drawn by the billboards (`shaders/billboard.wgsl`, `TRAIL`), one
+//! camera-facing segment per pair of neighbouring points, in one of two modes:
+//! - [`TrailMode::History`]: each particle through its last positions, which the update
+//!   records in a small ring per particle (`shaders/trail_on.wgsl`);
+//! - [`TrailMode::PerParent`]: an emitter fed by events, one ribbon per parent through the
+//!   particles it spawned, in order — each particle joined to the one its parent spawned
+//!   before it (the event scan keeps the links, `shaders/events.wgsl`).
+//!
+//! The velocity streak (`Look::streak`) stays the cheap option: one quad stretched along
+//! the velocity.
 
 use serde::{Deserialize, Serialize};
 
@@ -11,10 +16,38 @@ use super::Checker;
 /// The most points a trail keeps per particle.
 pub const MAX_TRAIL_POINTS: u32 = 64;
 
+/// What a ribbon passes through.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum TrailMode {
+    /// Each particle's own last positions (`points`, one every `every_steps` steps).
+    #[default]
+    History,
+    /// The particles each parent's events spawned, in order: every particle joined to its
+    /// parent's previous child while both live (an emitter fed by events only; `points`
+    /// and `every_steps` are not used). Smoke lines behind debris, lightning-like chains.
+    PerParent,
+}
+
+impl TrailMode {
+    /// Every mode, in the order the panel lists them.
+    pub const ALL: [TrailMode; 2] = [TrailMode::History, TrailMode::PerParent];
+
+    /// What the panel calls it.
+    pub fn label(self) -> &'static str {
+        match self {
+            TrailMode::History => "its own last positions",
+            TrailMode::PerParent => "a ribbon per parent",
+        }
+    }
+}
+
 /// A ribbon behind each particle.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Trail {
+    /// What the ribbon passes through.
+    #[serde(skip_serializing_if = "is_history")]
+    pub mode: TrailMode,
     /// Positions kept per particle (the ribbon has one segment fewer, plus the one to the
     /// particle itself): 2..=64.
     pub points: u32,
@@ -23,17 +56,24 @@ pub struct Trail {
     pub every_steps: u32,
     /// The ribbon's width at the particle as a multiple of the particle's size.
     pub width: f32,
-    /// The width at the tail as a fraction of the width at the particle.
+    /// The width at the tail as a fraction of the width at the particle (per parent: at
+    /// the end of a particle's life, the width following its age).
     pub tail_width: f32,
-    /// The opacity at the tail as a fraction of the particle's.
+    /// The opacity at the tail as a fraction of the particle's (per parent: at the end of
+    /// a particle's life).
     pub tail_opacity: f32,
     /// Also draw the particle's own sprite (off: the ribbon alone).
     pub draw_sprite: bool,
 }
 
+fn is_history(mode: &TrailMode) -> bool {
+    *mode == TrailMode::History
+}
+
 impl Default for Trail {
     fn default() -> Self {
         Self {
+            mode: TrailMode::History,
             points: 12,
             every_steps: 2,
             width: 1.0,
@@ -72,8 +112,21 @@ impl Trail {
     }
 
     /// Segments drawn per particle: one per recorded point but the newest (the segment
-    /// from the particle to the newest point older than its current step replaces it).
+    /// from the particle to the newest point older than its current step replaces it);
+    /// per parent, one (to the parent's previous child).
     pub fn segments(&self) -> u32 {
-        self.points.saturating_sub(1).max(1)
+        match self.mode {
+            TrailMode::History => self.points.saturating_sub(1).max(1),
+            TrailMode::PerParent => 1,
+        }
+    }
+
+    /// Ring entries per slot: the recorded points, or per parent one link (the previous
+    /// child's slot and birth stamp, this particle's birth stamp).
+    pub fn ring_points(&self) -> u32 {
+        match self.mode {
+            TrailMode::History => self.points,
+            TrailMode::PerParent => 1,
+        }
     }
 }

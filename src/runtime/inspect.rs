@@ -190,6 +190,21 @@ impl Player {
         Ok(read?)
     }
 
+    /// Emitter `emitter`'s trail ring in instance `id` (a blocking readback; none without
+    /// a trail — an emitter with one runs a simulation of its own).
+    #[doc(hidden)]
+    pub fn trail(
+        &self,
+        id: InstanceId,
+        emitter: usize,
+    ) -> Result<Option<crate::sim::gpu_sim::TrailRing>, PlayerError> {
+        let instance = self.instances.get(id).ok_or(PlayerError::NoInstance)?;
+        match &instance.state {
+            Backing::Own(sim) => Ok(sim.read_trail(emitter)?),
+            Backing::Batched { .. } => Ok(None),
+        }
+    }
+
     /// The effect instance `id` runs: the player's, with the instance's seed and its
     /// emitters placed in the world (tests compare it with a simulation of its own).
     #[doc(hidden)]

@@ -79,11 +79,17 @@ pub struct EventHeader {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ScanConfig {
-    /// The rule's index, the child's capacity, the most children a step, 1 when the
-    /// children inherit the parent's colour.
+    /// The rule's index, the child's capacity, the most children a step, flags
+    /// ([`scan_flags`]).
     pub rule_capacity_cap: [u32; 4],
     /// The parent's simulation origin minus the child's, and the inherited fraction.
     pub delta_inherit: [f32; 4],
+}
+
+/// A scan's flags: its children inherit the parent's colour (bit 0), they are linked
+/// into a ribbon per parent (bit 1).
+pub fn scan_flags(inherit_color: bool, ribbon: bool) -> u32 {
+    u32::from(inherit_color) | u32::from(ribbon) << 1
 }
 
 /// Bytes before the counts of a parent's buffer (the two rules).
@@ -204,7 +210,7 @@ pub fn scan_events(
         };
         let n = r.pos_count[3].to_bits();
         let t = (r.parent_t * 255.0 + 0.5) as u32;
-        let color = (t << 16) | (cfg.rule_capacity_cap[3] << 24);
+        let color = (t << 16) | ((cfg.rule_capacity_cap[3] & 1) << 24);
         for j in 0..n {
             if total + j < cap {
                 list.push(EventSpawn {

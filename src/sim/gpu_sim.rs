@@ -4,7 +4,7 @@ use std::collections::{HashMap, VecDeque};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
-use crate::effect::{CURVE_WIDTH, Effect, Integrator, rows_key};
+use crate::effect::{CURVE_WIDTH, Effect, Integrator, TrailMode, rows_key};
 use crate::gpu::types::{
     Birth, PARAMS_STRIDE, PackedParticle, Particle, SimParams, StateLayout, double_single,
     slot_counter, tiny_decode,
@@ -14,7 +14,7 @@ use crate::shaders::{
     EVENTS_IO, PACKED_STATE_IO, PARAMS_INSTANCED, ShaderError, ShaderLibrary, TINY_STATE_IO,
     TRAIL_IO, create_checked,
 };
-use crate::sim::events::{EventHeader, ScanConfig};
+use crate::sim::events::{EventHeader, ScanConfig, scan_flags};
 use crate::sim::hooks::{EmitterHooks, HookPipes};
 use crate::sim::modules::Modules;
 use crate::sim::planner::{EffectPlanner, LiveWindow};
@@ -558,7 +558,8 @@ impl GpuSim {
         for e in &effect.emitters {
             self.ctx.check_capacity(&e.name, e.capacity)?;
             if let Some(t) = &e.look.trail {
-                self.ctx.check_trail(&e.name, e.capacity.max(1), t.points)?;
+                self.ctx
+                    .check_trail(&e.name, e.capacity.max(1), t.ring_points())?;
             }
         }
         self.emitters.truncate(effect.emitters.len());
@@ -685,9 +686,28 @@ impl GpuSim {
             .iter()
             .map(|s| s.hooks.as_ref().and_then(|ev| ev.list.clone()))
             .collect();
+        let ribbons: Vec<Option<wgpu::Buffer>> = effect
+            .emitters
+            .iter()
+            .zip(&self.emitters)
+            .map(|(e, s)| {
+                let per_parent =
+                    e.look.trail.as_ref().map(|t| t.mode) == Some(TrailMode::PerParent);
+                s.hooks
+                    .as_ref()
+                    .and_then(|ev| ev.trail.clone())
+                    .filter(|_| per_parent)
+            })
+            .collect();
         for s in &mut self.emitters {
             if let Some(ev) = &mut s.hooks {
-                ev.bind_scans(&self.ctx.device, &update.hooks, &self.params_buffer, &lists);
+                ev.bind_scans(
+                    &self.ctx.device,
+                    &update.hooks,
+                    &self.params_buffer,
+                    &lists,
+                    &ribbons,
+                );
             }
         }
     }
@@ -993,12 +1013,17 @@ impl GpuSim {
             for (k, (scan, ev)) in hooks.scans.iter().zip(&e.events).enumerate() {
                 let delta = (origin(i) - origin(scan.child)).as_vec3();
                 let child_capacity = self.emitters.get(scan.child).map_or(1, |c| c.capacity);
+                let ribbon = effect
+                    .emitters
+                    .get(scan.child)
+                    .and_then(|c| c.look.trail.as_ref())
+                    .is_some_and(|t| t.mode == TrailMode::PerParent);
                 let cfg = ScanConfig {
                     rule_capacity_cap: [
                         k as u32,
                         child_capacity,
                         crate::sim::events::step_cap(effect, i, k),
-                        u32::from(ev.inherit_color),
+                        scan_flags(ev.inherit_color, ribbon),
                     ],
                     delta_inherit: [delta.x, delta.y, delta.z, ev.inherit_velocity],
                 };

@@ -4,7 +4,7 @@
 //! layouts and pipelines of the event scan that runs between a parent's update and its
 //! children's. What the buffers hold: `crate::sim::events` and `crate::sim::trails`.
 
-use crate::effect::{Effect, MAX_EVENTS_PER_EMITTER};
+use crate::effect::{Effect, MAX_EVENTS_PER_EMITTER, TrailMode};
 use crate::gpu::types::SimParams;
 use crate::gpu::{GpuContext, compute_storage_entry};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
@@ -47,6 +47,7 @@ impl HookPipes {
                 compute_storage_entry(1, true),
                 compute_storage_entry(2, false),
                 compute_storage_entry(4, false),
+                compute_storage_entry(5, false),
                 wgpu::BindGroupLayoutEntry {
                     binding: 3,
                     visibility: wgpu::ShaderStages::COMPUTE,
@@ -126,13 +127,13 @@ pub struct EmitterHooks {
     pub hooks: wgpu::BindGroup,
     /// Per rule of this parent: the child, its config buffer and the scan's bind group.
     pub scans: Vec<Scan>,
-    /// What the buffers were made for: (capacity, rules, list length, trail points and
-    /// steps between them).
+    /// What the buffers were made for: (capacity, rules, list length, trail points, steps
+    /// between them and mode).
     key: (
         u32,
         [EventRule; MAX_EVENTS_PER_EMITTER],
         u32,
-        Option<(u32, u32)>,
+        Option<(u32, u32, TrailMode)>,
     ),
 }
 
@@ -169,7 +170,11 @@ impl EmitterHooks {
             .iter()
             .map(|&(p, k)| step_cap(effect, p, k))
             .sum();
-        let trail = e.look.trail.as_ref().map(|t| (t.points, t.every_steps));
+        let trail = e
+            .look
+            .trail
+            .as_ref()
+            .map(|t| (t.ring_points(), t.every_steps, t.mode));
         if e.events.is_empty() && list_len == 0 && trail.is_none() {
             return None;
         }
@@ -193,8 +198,9 @@ impl EmitterHooks {
             // New buffers are zeroed: head 0, count 0, stamp 0.
             storage_buffer(device, "EmitterHooks::list", size)
         });
-        let trail = trail
-            .map(|(points, every)| crate::sim::trails::ring_buffer(ctx, capacity, points, every));
+        let trail = trail.map(|(points, every, mode)| {
+            crate::sim::trails::ring_buffer(ctx, capacity, points, every, mode)
+        });
         let hooks = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("EmitterHooks::hooks"),
             layout: &pipes.hooks_layout,
@@ -234,10 +240,13 @@ impl EmitterHooks {
                     usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                     mapped_at_creation: false,
                 }),
+                // Where the list starts, a sum per block, each parent slot's last child.
                 blocks: storage_buffer(
                     device,
                     "EmitterHooks::scan_blocks",
-                    4 * (1 + u64::from(capacity.div_ceil(EVENT_SCAN_BLOCK))),
+                    4 * (1
+                        + u64::from(capacity.div_ceil(EVENT_SCAN_BLOCK))
+                        + 2 * u64::from(capacity)),
                 ),
                 group: None,
                 written: None,
@@ -254,14 +263,16 @@ impl EmitterHooks {
         })
     }
 
-    /// Group 0 of each scan of this parent: `params` (the update's parameter blocks)
-    /// and the children's lists (`lists[child]`).
+    /// Group 0 of each scan of this parent: `params` (the update's parameter blocks),
+    /// the children's lists (`lists[child]`) and their ribbons' rings (`ribbons[child]`,
+    /// an emitter drawn as a ribbon per parent).
     pub fn bind_scans(
         &mut self,
         device: &wgpu::Device,
         pipes: &HookPipes,
         params: &wgpu::Buffer,
         lists: &[Option<wgpu::Buffer>],
+        ribbons: &[Option<wgpu::Buffer>],
     ) {
         let Some(records) = &self.records else {
             return;
@@ -271,36 +282,46 @@ impl EmitterHooks {
                 scan.group = None;
                 continue;
             };
-            scan.group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("EmitterHooks::scan"),
-                layout: &pipes.scan_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                            buffer: params,
-                            offset: 0,
-                            size: wgpu::BufferSize::new(size_of::<SimParams>() as u64),
-                        }),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: records.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: list.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: scan.config.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 4,
-                        resource: scan.blocks.as_entire_binding(),
-                    },
-                ],
-            }));
+            scan.group = Some(
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("EmitterHooks::scan"),
+                    layout: &pipes.scan_layout,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                                buffer: params,
+                                offset: 0,
+                                size: wgpu::BufferSize::new(size_of::<SimParams>() as u64),
+                            }),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: records.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 2,
+                            resource: list.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 3,
+                            resource: scan.config.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 4,
+                            resource: scan.blocks.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 5,
+                            resource: ribbons
+                                .get(scan.child)
+                                .and_then(Option::as_ref)
+                                .unwrap_or(&pipes.placeholders[2])
+                                .as_entire_binding(),
+                        },
+                    ],
+                }),
+            );
         }
     }
 }

@@ -97,7 +97,13 @@ impl Modules {
         if over_life_params(e).iter().any(|p| !p.is_constant(1.0)) {
             m.0 |= Self::CURVES.0;
         }
-        if e.look.trail.is_some() {
+        // A ribbon per parent records nothing in the update (the event scan links the
+        // children).
+        if e.look
+            .trail
+            .as_ref()
+            .is_some_and(|t| t.mode == crate::effect::TrailMode::History)
+        {
             m.0 |= Self::TRAIL.0;
         }
         if !e.events.is_empty() {

@@ -31,8 +31,11 @@ struct EmitterSnapshot {
     /// A child's event-list header (its ring head, the last step's children and stamp,
     /// the dropped count): the list's entries are rewritten every step before use.
     event_header: Option<wgpu::Buffer>,
-    /// The trail's ring (the positions the ribbon draws).
+    /// The trail's ring (the positions the ribbon draws, or a ribbon per parent's links).
     trail: Option<wgpu::Buffer>,
+    /// Each scan's scratch of a parent (the last child of each parent slot, which a ribbon
+    /// per parent links its next child to).
+    scans: Vec<wgpu::Buffer>,
 }
 
 impl SimSnapshot {
@@ -77,8 +80,17 @@ impl GpuSim {
                 let trail = hooks
                     .and_then(|ev| ev.trail.as_ref())
                     .map(|ring| copy_of(enc, ring, ring.size()));
+                let scans = hooks
+                    .map(|ev| {
+                        ev.scans
+                            .iter()
+                            .map(|s| copy_of(enc, &s.blocks, s.blocks.size()))
+                            .collect()
+                    })
+                    .unwrap_or_default();
                 EmitterSnapshot {
                     trail,
+                    scans,
                     event_header,
                     generation: s.generation,
                     buffers,
@@ -124,6 +136,12 @@ impl GpuSim {
                 && ring.size() == copy.size()
             {
                 enc.copy_buffer_to_buffer(copy, 0, ring, 0, ring.size());
+            }
+            let scans = s.hooks.as_ref().map_or(&[][..], |ev| &ev.scans[..]);
+            for (scan, copy) in scans.iter().zip(&k.scans) {
+                if scan.blocks.size() == copy.size() {
+                    enc.copy_buffer_to_buffer(copy, 0, &scan.blocks, 0, copy.size());
+                }
             }
             s.current = k.current;
             s.whole_pool_until = k.whole_pool_until;
