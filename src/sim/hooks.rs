@@ -112,6 +112,15 @@ fn storage_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer
     })
 }
 
+/// What an emitter's hook buffers were made for: capacity, rules, list length, and the
+/// trail's ring (points, steps between them, mode).
+type HooksKey = (
+    u32,
+    [EventRule; MAX_EVENTS_PER_EMITTER],
+    u32,
+    Option<(u32, u32, TrailMode)>,
+);
+
 /// One emitter's hook buffers: its event records (a parent), its spawn list (a child) and
 /// its trail's ring (see `crate::sim::trails`).
 pub struct EmitterHooks {
@@ -127,14 +136,8 @@ pub struct EmitterHooks {
     pub hooks: wgpu::BindGroup,
     /// Per rule of this parent: the child, its config buffer and the scan's bind group.
     pub scans: Vec<Scan>,
-    /// What the buffers were made for: (capacity, rules, list length, trail points, steps
-    /// between them and mode).
-    key: (
-        u32,
-        [EventRule; MAX_EVENTS_PER_EMITTER],
-        u32,
-        Option<(u32, u32, TrailMode)>,
-    ),
+    /// What the buffers were made for.
+    key: HooksKey,
 }
 
 /// One rule's scan.
