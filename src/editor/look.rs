@@ -5,6 +5,7 @@ use egui::{Color32, DragValue, Rgba, RichText, Sense, Ui};
 use crate::effect::{
     BlendMode, Bloom, ColorStop, DrawPath, Effect, Flipbook, FlipbookMode, Look, MAX_COLOR_STOPS,
     MAX_TRAIL_POINTS, Param, Post, SPLAT_BELOW_PX, Sprite, Streak, TILES_ABOVE_PX, Trail,
+    TrailMode,
 };
 pub use crate::render::look::sample_gradient;
 
@@ -246,7 +247,7 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
 /// open grid).
 fn trail_rows_ui(ui: &mut Ui, look: &mut Look) {
     let label = ui.label("Trail").on_hover_text(
-        "A ribbon through each particle's last positions, recorded every few steps (drawn by the billboards); the velocity streak is the cheaper option",
+        "A ribbon (drawn by the billboards) through each particle's last positions, recorded every few steps, or — an emitter fed by events — one per parent through the particles it spawned, in order; the velocity streak is the cheaper option",
     );
     ui.horizontal(|ui| {
         let mut on = look.trail.is_some();
@@ -254,22 +255,49 @@ fn trail_rows_ui(ui: &mut Ui, look: &mut Look) {
             look.trail = on.then(Trail::default);
         }
         if let Some(t) = &mut look.trail {
-            ui.add(
-                DragValue::new(&mut t.points)
-                    .range(2..=MAX_TRAIL_POINTS)
-                    .prefix("points "),
-            )
-            .labelled_by(label.id);
-            ui.add(
-                DragValue::new(&mut t.every_steps)
-                    .range(1..=120)
-                    .prefix("every ")
-                    .suffix(" steps"),
-            )
-            .labelled_by(label.id);
+            egui::ComboBox::from_id_salt("trail_mode")
+                .selected_text(format!("through {}", t.mode.label()))
+                .show_ui(ui, |ui| {
+                    for m in TrailMode::ALL {
+                        ui.selectable_value(&mut t.mode, m, m.label());
+                    }
+                })
+                .response
+                .labelled_by(label.id);
         }
     });
     ui.end_row();
+    if let Some(t) = look.trail.as_mut().filter(|t| t.mode == TrailMode::History) {
+        trail_points_row_ui(ui, t);
+    }
+    trail_width_rows_ui(ui, look);
+}
+
+/// The points a trail through a particle's last positions keeps (a row of an open grid).
+fn trail_points_row_ui(ui: &mut Ui, t: &mut Trail) {
+    let label = ui.label("Trail points").on_hover_text(
+        "Positions kept per particle, and how many simulation steps apart they are recorded",
+    );
+    ui.horizontal(|ui| {
+        ui.add(
+            DragValue::new(&mut t.points)
+                .range(2..=MAX_TRAIL_POINTS)
+                .prefix("points "),
+        )
+        .labelled_by(label.id);
+        ui.add(
+            DragValue::new(&mut t.every_steps)
+                .range(1..=120)
+                .prefix("every ")
+                .suffix(" steps"),
+        )
+        .labelled_by(label.id);
+    });
+    ui.end_row();
+}
+
+/// The trail's width, tapers and sprite (rows of an open grid; none without a trail).
+fn trail_width_rows_ui(ui: &mut Ui, look: &mut Look) {
     let Some(t) = &mut look.trail else {
         return;
     };
