@@ -1558,3 +1558,37 @@ fn events_are_added_edited_validated_and_undone_in_the_panel() {
         "the last valid effect runs"
     );
 }
+
+/// The trail's mode in the panel: a ribbon turned on for the campfire's smoke (fed by the
+/// flames' deaths) is switched to a ribbon per parent, which runs live; its points row goes
+/// away; undo restores the ribbon through its own positions.
+#[test]
+fn the_trail_mode_is_chosen_in_the_panel() {
+    use ignis::effect::TrailMode;
+    let mut state = campfire_state();
+    let smoke = emitter_index(&state.effect, "smoke");
+    state.selected = smoke;
+    state.open_sections = Some(vec!["look".to_owned()]);
+    let mut harness = panel_harness(state);
+    harness.run();
+    harness.get_by_label("ribbon").click_accesskit();
+    harness.run();
+    let trail = harness.state().effect.emitters[smoke].look.trail.clone();
+    assert_eq!(trail.map(|t| t.mode), Some(TrailMode::History));
+    assert!(harness.query_all_by_label("Trail points").next().is_some());
+    harness.get_by_label("Trail mode").click_accesskit();
+    harness.run();
+    harness
+        .get_by_label("a ribbon per parent")
+        .click_accesskit();
+    harness.run();
+    let s = harness.state();
+    let mode = |e: &ignis::Effect| e.emitters[smoke].look.trail.as_ref().map(|t| t.mode);
+    assert_eq!(mode(&s.effect), Some(TrailMode::PerParent));
+    assert_eq!(mode(&s.running), Some(TrailMode::PerParent), "runs live");
+    assert!(s.validation_errors.is_empty(), "{:?}", s.validation_errors);
+    assert!(harness.query_all_by_label("Trail points").next().is_none());
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    harness.run();
+    assert_eq!(mode(&harness.state().effect), Some(TrailMode::History));
+}

@@ -255,15 +255,16 @@ fn trail_rows_ui(ui: &mut Ui, look: &mut Look) {
             look.trail = on.then(Trail::default);
         }
         if let Some(t) = &mut look.trail {
-            egui::ComboBox::from_id_salt("trail_mode")
+            let menu = egui::ComboBox::from_id_salt("trail_mode")
                 .selected_text(format!("through {}", t.mode.label()))
                 .show_ui(ui, |ui| {
                     for m in TrailMode::ALL {
                         ui.selectable_value(&mut t.mode, m, m.label());
                     }
-                })
-                .response
-                .labelled_by(label.id);
+                });
+            menu.response.labelled_by(label.id).widget_info(|| {
+                egui::WidgetInfo::labeled(egui::Role::ComboBox, true, "Trail mode")
+            });
         }
     });
     ui.end_row();
