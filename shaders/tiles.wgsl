@@ -1,6 +1,9 @@
 // tiles.wgsl — pass 2, large sprites on the compute units: a tile rasteriser. The quads
 // the billboards would draw (quad.wgsl builds both) are projected once, binned into
-// 128-pixel bins in draw order, and each 16×16-pixel tile is shaded by one workgroup:
+// 128-pixel bins in draw order — counted per block of sprites, scanned into each list's
+// place, then written (`bin_count_blocks`, `bin_scan`, `bin_starts`, `bin`: memory and
+// work in proportion to the sprites' footprints, no atomics on the order) — and each
+// 16×16-pixel tile is shaded by one workgroup:
 // the sprites over it, in order, blended in registers — premultiplied "over" for
 // alpha-blended layers (back to front, the sort's order), added for light — and the
 // tile's colour and coverage written once per emitter. A full-screen draw in the
@@ -10,9 +13,8 @@
 // - group 0, 1: as billboard.wgsl (camera, looks, ramps; the state and the sort's order).
 // - group 2: the emitter's sprite and sampler (shade).
 // - group 3 (compute): 0 `sprites` (one TileSprite per quad of the frame's tile items),
-//   2 `bin_lists` (per bin, the sprites over it in draw order, `job.counts.w` entries
-//   each, a region of BLOCK per block of sprites), 3 `bin_meta` (per bin and block, the
-//   entries listed), 4 `accum` (per pixel: C.rg, C.b and the coverage
+//   2 `bin_lists` (per bin, the sprites over it in draw order, one list after another,
+//   `job.counts.w` entries in all), 3 `bin_meta` (the counts and scans, `meta_*`), 4 `accum` (per pixel: C.rg, C.b and the coverage
 //   1 − T as f16 pairs; valid in the tiles shaded this frame only), 1 `touched` (the
 //   resolve's draw arguments, a flag per tile, the list of tiles shaded this frame, each
 //   item's list of bins and a flag per item and bin), 5 `scene_depth` (the host's depth, when
@@ -62,15 +64,19 @@ const BIN: u32 = 128u;
 const MAX_ITEMS: u32 = 55u;
 // `touched`: the draw arguments (4), then a flag per tile, then the shaded tiles' list.
 const TOUCHED_FLAGS: u32 = 4u;
-// A bin list entry: the sprite (20 bits; src/render/tiles.rs keeps a frame below 2^20
-// sprites), then the first and last tile of the bin it covers (x0, y0, x1, y1, 3 bits each).
-const SPRITE_MASK: u32 = 0xFFFFFu;
-// Sprites a bin workgroup lists (keep in sync with src/render/tiles.rs).
-const BLOCK: u32 = 4096u;
+// A bin list entry: the sprite within its block (10 bits), then the first and last tile
+// of the bin it covers (x0, y0, x1, y1, 3 bits each).
+const SPRITE_MASK: u32 = 0x3FFu;
+// Sprites a bin workgroup lists (keep in sync with src/render/tiles.rs); each item's
+// sprites start at a multiple of it, so that a block holds one item's.
+const BLOCK: u32 = 1024u;
+// Bins a target holds at most (keep in sync with src/render/tiles.rs).
+const MAX_BINS: u32 = 2048u;
 
-// One dispatch's work: x the item's first sprite, y its quads, z sprites this frame,
-// w the bin lists' stride (entries per bin); `counts2`: the item's index, the items, the
-// blocks of BLOCK sprites; `firsts`: every item's first sprite, then the frame's sprites.
+// One dispatch's work: x the item's first sprite, y its quads, z sprites this frame
+// (each item's rounded up to whole blocks), w the capacity of the bin lists (entries);
+// `counts2`: the item's index, the items, the blocks of BLOCK sprites; `firsts`: every
+// item's first sprite, then the frame's sprites.
 struct TileJob {
     counts: vec4<u32>,
     counts2: vec4<u32>,
@@ -126,6 +132,10 @@ fn atlas_scale() -> vec2<f32> {
 fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     let q = (wg.y * nwg.x + wg.x) * 256u + lid;
     if q >= job.counts.y {
+        // The rest of the item's last block: no sprite.
+        if q < (job.counts.y + BLOCK - 1u) / BLOCK * BLOCK {
+            sprites[job.counts.x + q].bounds = vec4<i32>(1, 1, 0, 0);
+        }
         return;
     }
     let index = job.counts.x + q;
@@ -267,26 +277,163 @@ fn compact(lid: u32, hit: bool) -> u32 {
     return before;
 }
 
-// Whether pixel rectangles `a` and `b` (x0, y0, x1, y1, inclusive) overlap.
+// Whether pixel rectangle `a` (x0, y0, x1, y1, inclusive; empty when x0 > x1 or y0 > y1)
+// overlaps the non-empty `b`.
 fn overlaps(a: vec4<i32>, b: vec4<i32>) -> bool {
-    return all(a.xy <= b.zw) && all(b.xy <= a.zw);
+    return all(a.xy <= a.zw) && all(a.xy <= b.zw) && all(b.xy <= a.zw);
 }
 
-// Lists, for one bin and one block of BLOCK sprites (workgroup z), the block's sprites over
-// the bin in draw order (an order-keeping compaction: deterministic, whatever the
-// scheduling); blocks run in parallel, so a frame of many sprites bins as fast as a few.
-// Each item with a sprite in the list joins the item's shade for this bin.
+// `bin_meta`, per frame: the entries of each bin and block (bin-major), then their place
+// in the bin's list, then each bin's entries, then where each bin's list starts in
+// `bin_lists` (and, after the last bin, every list's end).
+fn meta_count(b: u32, c: u32) -> u32 {
+    return b * job.counts2.z + c;
+}
+
+fn meta_local(b: u32, c: u32) -> u32 {
+    return (bin_count() + b) * job.counts2.z + c;
+}
+
+fn meta_total(b: u32) -> u32 {
+    return 2u * bin_count() * job.counts2.z + b;
+}
+
+fn meta_start(b: u32) -> u32 {
+    return 2u * bin_count() * job.counts2.z + bin_count() + b;
+}
+
+// The bins a sprite's pixel rectangle covers (x0, y0, x1, y1; empty when x0 > x1).
+fn bins_of(r: vec4<i32>) -> vec4<u32> {
+    if r.x > r.z || r.y > r.w {
+        return vec4<u32>(1u, 1u, 0u, 0u);
+    }
+    return vec4<u32>(r) / BIN;
+}
+
+var<workgroup> hist: array<atomic<u32>, MAX_BINS>;
+var<workgroup> sums: array<u32, 256>;
+
+// Counts, for one block of BLOCK sprites (workgroup x), the block's sprites over each bin.
 @compute @workgroup_size(256)
-fn bin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
-    let b = wg.y * nwg.x + wg.x;
-    let lo = vec2<i32>(wg.xy * BIN);
-    let rect = vec4<i32>(lo, lo + i32(BIN) - 1);
-    let start = wg.z * BLOCK;
-    let end = min(start + BLOCK, job.counts.z);
-    let region = b * job.counts.w + start;
+fn bin_count_blocks(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    let c = wg.x;
+    let bins = bin_count();
+    let bins_x = (u32(camera.viewport.x) + BIN - 1u) / BIN;
+    for (var b = lid; b < bins; b += 256u) {
+        atomicStore(&hist[b], 0u);
+    }
+    workgroupBarrier();
+    let end = min((c + 1u) * BLOCK, job.counts.z);
+    for (var i = c * BLOCK + lid; i < end; i += 256u) {
+        let r = bins_of(sprites[i].bounds);
+        for (var y = r.y; y <= r.w; y++) {
+            for (var x = r.x; x <= r.z; x++) {
+                atomicAdd(&hist[y * bins_x + x], 1u);
+            }
+        }
+    }
+    workgroupBarrier();
+    for (var b = lid; b < bins; b += 256u) {
+        bin_meta[meta_count(b, c)] = atomicLoad(&hist[b]);
+    }
+}
+
+// An inclusive Hillis–Steele scan of `v` over the workgroup; `sums[255]` is the total.
+fn workgroup_inclusive(lid: u32, v: u32) -> u32 {
+    sums[lid] = v;
+    workgroupBarrier();
+    for (var d = 1u; d < 256u; d *= 2u) {
+        var x = sums[lid];
+        if lid >= d {
+            x += sums[lid - d];
+        }
+        workgroupBarrier();
+        sums[lid] = x;
+        workgroupBarrier();
+    }
+    return sums[lid];
+}
+
+// One bin (workgroup x): each block's place in the bin's list (an exclusive scan of the
+// counts in block order) and the bin's entries; each item with sprites over the bin adds
+// the bin to its shade (its indirect dispatch: one workgroup row per bin, one workgroup
+// per tile).
+@compute @workgroup_size(256)
+fn bin_scan(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    let b = wg.x;
+    let blocks = job.counts2.z;
     if lid < 64u {
         atomicStore(&item_hit[lid], 0u);
     }
+    var running = 0u;
+    for (var base = 0u; base < blocks; base += 256u) {
+        let c = base + lid;
+        var v = 0u;
+        if c < blocks {
+            v = bin_meta[meta_count(b, c)];
+        }
+        let incl = workgroup_inclusive(lid, v);
+        if c < blocks {
+            bin_meta[meta_local(b, c)] = running + incl - v;
+            if v > 0u {
+                atomicOr(&item_hit[item_of(c * BLOCK)], 1u);
+            }
+        }
+        running += sums[255];
+        workgroupBarrier();
+    }
+    if lid == 0u {
+        bin_meta[meta_total(b)] = running;
+    }
+    if lid < job.counts2.y && atomicLoad(&item_hit[lid]) != 0u {
+        let slot = atomicAdd(&dispatch_args[4u * lid], 1u);
+        atomicStore(&touched[item_bins(lid) + slot], b);
+    }
+}
+
+// Where each bin's list starts: an exclusive scan of the bins' entries (one workgroup).
+@compute @workgroup_size(256)
+fn bin_starts(@builtin(local_invocation_index) lid: u32) {
+    let bins = bin_count();
+    var running = 0u;
+    for (var base = 0u; base < bins; base += 256u) {
+        let b = base + lid;
+        var v = 0u;
+        if b < bins {
+            v = bin_meta[meta_total(b)];
+        }
+        let incl = workgroup_inclusive(lid, v);
+        if b < bins {
+            bin_meta[meta_start(b)] = running + incl - v;
+        }
+        running += sums[255];
+        workgroupBarrier();
+    }
+    if lid == 0u {
+        bin_meta[meta_start(bins)] = running;
+    }
+}
+
+// Lists, for one bin and one block of BLOCK sprites (workgroup z) with some over the bin,
+// the block's sprites over the bin in draw order (an order-keeping compaction:
+// deterministic, whatever the scheduling) at the place the scans gave the block. A list
+// past the lists' capacity is not written: the shade then reads the bin's sprites
+// directly.
+@compute @workgroup_size(256)
+fn bin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    let b = wg.y * nwg.x + wg.x;
+    let c = wg.z;
+    if lid == 0u {
+        shared_count = bin_meta[meta_count(b, c)];
+    }
+    if workgroupUniformLoad(&shared_count) == 0u {
+        return;
+    }
+    let lo = vec2<i32>(wg.xy * BIN);
+    let rect = vec4<i32>(lo, lo + i32(BIN) - 1);
+    let start = c * BLOCK;
+    let end = min(start + BLOCK, job.counts.z);
+    let region = bin_meta[meta_start(b)] + bin_meta[meta_local(b, c)];
     var count = 0u;
     for (var base = start; base < end; base += 256u) {
         let i = base + lid;
@@ -296,24 +443,13 @@ fn bin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<
         }
         let hit = overlaps(r, rect);
         let at = compact(lid, hit);
-        if hit {
+        if hit && region + count + at < job.counts.w {
             // The tiles of this bin it covers ride along: the shade tests them without
             // reading the sprite.
             let t = vec4<u32>(clamp((r - vec4<i32>(lo, lo)) / i32(TILE), vec4<i32>(0), vec4<i32>(i32(BIN_TILES) - 1)));
-            bin_lists[region + count + at] = i | (t.x << 20u) | (t.y << 23u) | (t.z << 26u) | (t.w << 29u);
-            atomicOr(&item_hit[item_of(i)], 1u);
+            bin_lists[region + count + at] = (i - start) | (t.x << 10u) | (t.y << 13u) | (t.z << 16u) | (t.w << 19u);
         }
         count += workgroupUniformLoad(&shared_total);
-    }
-    if lid == 0u {
-        bin_meta[b * job.counts2.z + wg.z] = count;
-    }
-    workgroupBarrier();
-    // The first block to find some of item k's sprites over this bin adds the bin to item
-    // k's shade (its indirect dispatch: one workgroup row per bin, one workgroup per tile).
-    if lid < job.counts2.y && atomicLoad(&item_hit[lid]) != 0u && atomicExchange(&touched[item_flag(lid, b)], 1u) == 0u {
-        let slot = atomicAdd(&dispatch_args[4u * lid], 1u);
-        atomicStore(&touched[item_bins(lid) + slot], b);
     }
 }
 
@@ -338,13 +474,9 @@ fn bin_count() -> u32 {
 }
 
 // Where item k's list of bins is in `touched`, after the resolve's arguments, the tile
-// flags and the tile list; then a flag per item and bin.
+// flags and the tile list.
 fn item_bins(k: u32) -> u32 {
     return TOUCHED_FLAGS + 2u * tile_count() + k * bin_count();
-}
-
-fn item_flag(k: u32, b: u32) -> u32 {
-    return TOUCHED_FLAGS + 2u * tile_count() + (MAX_ITEMS + k) * bin_count() + b;
 }
 
 // Tiles across the target.
@@ -506,20 +638,30 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
         acc = vec4<f32>(unpack2x16float(v.x), unpack2x16float(v.y));
     }
     var shaded = false;
+    // A bin whose list did not fit the lists' capacity: its blocks' sprites are read
+    // directly (slower, never a sprite lost).
+    let overflow = bin_meta[meta_start(b + 1u)] > job.counts.w;
+    let tile_rect = vec4<i32>(origin, origin + i32(TILE) - 1);
     for (var c = first / BLOCK; c <= (end - 1u) / BLOCK; c++) {
         if lid == 0u {
-            shared_count = bin_meta[b * job.counts2.z + c];
+            shared_count = bin_meta[meta_count(b, c)];
         }
-        let n = workgroupUniformLoad(&shared_count);
-        let region = b * job.counts.w + c * BLOCK;
+        var n = workgroupUniformLoad(&shared_count);
+        if overflow && n > 0u {
+            n = min(BLOCK, job.counts.z - c * BLOCK);
+        }
+        let region = bin_meta[meta_start(b)] + bin_meta[meta_local(b, c)];
         for (var base = 0u; base < n; base += 256u) {
             // The chunk's sprites of this item over this tile, in order.
             var hit = false;
             var s = 0u;
-            if base + lid < n {
+            if base + lid < n && overflow {
+                s = c * BLOCK + base + lid;
+                hit = s >= first && s < end && overlaps(sprites[s].bounds, tile_rect);
+            } else if base + lid < n {
                 let e = bin_lists[region + base + lid];
-                s = e & SPRITE_MASK;
-                let t = (vec4<u32>(e) >> vec4<u32>(20u, 23u, 26u, 29u)) & vec4<u32>(7u);
+                s = c * BLOCK + (e & SPRITE_MASK);
+                let t = (vec4<u32>(e) >> vec4<u32>(10u, 13u, 16u, 19u)) & vec4<u32>(7u);
                 hit = s >= first && s < end && all(local >= t.xy) && all(local <= t.zw);
             }
             let at = compact(lid, hit);

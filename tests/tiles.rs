@@ -1,8 +1,9 @@
 //! The tile rasteriser (`tiles.wgsl`) draws what the billboards draw: every shipped
 //! preset and each look module with both paths forced agree within 1/255 mean and 12/255
 //! max (measured on lavapipe: at most 0.003/255 mean; above 5/255 only at one pixel, a
-//! sub-pixel sprite); sprites crossing tile borders, larger than the screen, behind the camera and
-//! piled hundreds deep on one tile keep all their light; binning is deterministic; the
+//! sub-pixel sprite); sprites crossing tile borders, larger than the screen, behind the camera,
+//! piled hundreds deep on one tile, or thousands over several bins whose lists overflow keep
+//! all their light; binning is deterministic; the
 //! automatic choice follows the adapter profile. All on the real adapter (lavapipe in CI).
 
 mod common;
@@ -331,4 +332,35 @@ fn tiles_are_deterministic_and_the_automatic_choice_follows_the_profile() {
         chosen(AdapterProfile::SOFTWARE).iter().all(|(_, t, _)| !t),
         "a software profile took the tiles"
     );
+}
+
+/// 3000 sprites thrown out of one point across a bin border: three blocks of sprites over
+/// two bins, listed block after block. Their light agrees with the billboards', and it
+/// stays the very same image when the bins' lists are given too little room (bins shaded
+/// from the sprites directly, none lost).
+#[test]
+fn many_sprites_over_several_bins_and_blocks_keep_their_light_when_lists_overflow() {
+    let ctx = gpu();
+    let mut effect = pile(3000.0, 0.5, [0.55, 0.0, 0.0]);
+    effect.emitters[0].spread_deg = 180.0;
+    effect.emitters[0].speed_m_per_s = Range::new(0.5, 1.0);
+    light_agrees(&ctx, "3000 over two bins", &effect);
+    effect.emitters[0].look.draw_path = DrawPath::Tiles;
+    let image = |list_capacity: Option<u32>| {
+        let mut run =
+            Headless::new(&ctx, effect.clone(), ShaderLibrary::embedded()).expect("headless");
+        run.player
+            .tile_pass()
+            .expect("the tiles")
+            .set_list_capacity(list_capacity);
+        for _ in 0..6 {
+            run.advance(1.0 / 60.0);
+        }
+        run.render(SIZE).expect("render")
+    };
+    // Each bin lists all 3000: room for 4000 fits the first bin, not the second.
+    let fitted = image(None);
+    assert!(total_light(&fitted) > 1e3);
+    assert!(image(Some(4000)) == fitted, "one bin overflowing");
+    assert!(image(Some(1)) == fitted, "every bin overflowing");
 }

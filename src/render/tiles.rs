@@ -1,7 +1,9 @@
 //! The tile draw path for large sprites: a compute rasteriser. Each frame's tile items
 //! (emitters whose quads are drawn on the compute units) are projected once
 //! (`tiles.wgsl` `project`, the quads of `quad.wgsl` that the billboards draw), listed per
-//! 128-pixel bin in draw order (`bin`), and shaded per 16×16 tile and emitter (`shade`):
+//! 128-pixel bin in draw order (counted per block of sprites, scanned, then written:
+//! `bin_count_blocks`, `bin_scan`, `bin_starts`, `bin`), and shaded per 16×16 tile and
+//! emitter (`shade`):
 //! alpha-blended layers back to front, light added, the tile's pixels read and written
 //! once per emitter. A full-screen draw composites the result into the host's pass.
 //! GPUs that keep only a sliver of their chip for rasterisation (the H100) fill large
@@ -27,22 +29,28 @@ pub const MAX_ITEMS: usize = 55;
 /// The `touched` buffer's header: the resolve's indirect draw arguments.
 const TOUCHED_FLAGS: u64 = 4;
 /// Sprites one bin workgroup lists (`BLOCK` in tiles.wgsl): the blocks of a frame's
-/// sprites are binned in parallel.
-const BLOCK: u32 = 4096;
+/// sprites are binned in parallel; each item's sprites start at a multiple of it.
+const BLOCK: u32 = 1024;
+/// Bins a target may hold (`MAX_BINS` in tiles.wgsl): 7680×4320 at most, beyond it the
+/// frame's tile items are billboards.
+const MAX_BINS: u64 = 2048;
 /// Stride of the per-dispatch jobs (the storage offset alignment).
 const JOB_STRIDE: u64 = 256;
-/// The bins' lists may take at most this many bytes: beyond it the frame's tile items
-/// are drawn as billboards.
+/// The bins' lists take at most this many bytes: a frame whose lists need more shades its
+/// overflowing bins from the sprites directly.
 const MAX_LIST_BYTES: u64 = 128 << 20;
 
 /// The module, the basic variant's pipelines (built to validate the module), the bin
-/// pipeline and the resolve.
+/// pipelines and the resolve.
 type Built = (
     wgpu::ShaderModule,
     HashMap<LookVariant, Option<[wgpu::ComputePipeline; 2]>>,
-    wgpu::ComputePipeline,
+    BinPipes,
     wgpu::RenderPipeline,
 );
+
+/// The binning's four passes: count per block, scan per bin, the bins' starts, the lists.
+type BinPipes = [wgpu::ComputePipeline; 4];
 
 /// Storage buffers per shader stage the tile passes bind (the looks, the six state
 /// views, the tiles' six): a device created with fewer draws every quad as a billboard.
@@ -64,19 +72,23 @@ pub struct TilePass {
     module: wgpu::ShaderModule,
     /// (project, shade) per look variant, built on first use (`None`: failed, logged).
     variants: HashMap<LookVariant, Option<[wgpu::ComputePipeline; 2]>>,
-    bin: wgpu::ComputePipeline,
+    bin: BinPipes,
     resolve: wgpu::RenderPipeline,
     sprites: crate::render::sprites::SpriteGroups,
     buffers: Option<TileBuffers>,
     /// Whether the last record shaded anything (the resolve draws only then).
     drawn: bool,
+    /// The bins' lists' capacity in entries, when set (tests force an overflow with it).
+    list_capacity: Option<u32>,
 }
 
 /// The frame's buffers for one target size and sprite capacity.
 struct TileBuffers {
     size: (u32, u32),
-    /// Sprites the buffers hold (and entries per bin list).
+    /// Sprites the buffers hold (whole blocks).
     capacity: u32,
+    /// Entries the bins' lists hold in all.
+    list_capacity: u32,
     /// Jobs the job buffer holds.
     jobs: u32,
     job_buffer: wgpu::Buffer,
@@ -109,11 +121,43 @@ fn grid_bins(size: (u32, u32)) -> u64 {
     u64::from(bx) * u64::from(by)
 }
 
-/// Whether `sprites` quads fit the tile path's lists at `size`.
-fn fits(size: (u32, u32), sprites: u64) -> bool {
-    let (bx, by) = grid(size, BIN_PX);
-    // A bin list entry holds the sprite's index in 20 bits (`SPRITE_MASK` in tiles.wgsl).
-    sprites < 1 << 20 && u64::from(bx * by) * sprites.next_power_of_two() * 4 <= MAX_LIST_BYTES
+/// Whether `sprites` quads (whole blocks) fit the tile path's buffers at `size` on a
+/// device whose storage bindings take `limit` bytes.
+fn fits(size: (u32, u32), sprites: u64, limit: u64) -> bool {
+    grid_bins(size) <= MAX_BINS && sprites.next_power_of_two() * SPRITE_BYTES <= limit
+}
+
+/// The sprites of the frame's items in whole blocks: each item's first sprite (then the
+/// frame's), its quads rounded up to blocks.
+fn item_firsts(order: &[&DrawItem]) -> Vec<u32> {
+    let mut firsts = Vec::with_capacity(order.len() + 1);
+    firsts.push(0u32);
+    for d in order {
+        let n = (d.width * d.members).next_multiple_of(BLOCK);
+        firsts.push(firsts[firsts.len() - 1] + n);
+    }
+    firsts
+}
+
+/// Entries for the bins' lists of `order`'s sprites (`sprites`, whole blocks) at `size`:
+/// every bin for each when that is small, else about twice what their projected sizes
+/// cover (a bin whose list does not fit is shaded from the sprites directly).
+fn list_entries(order: &[&DrawItem], size: (u32, u32), sprites: u32, limit: u64) -> u32 {
+    let every = grid_bins(size) * u64::from(sprites);
+    let covered: f64 = order
+        .iter()
+        .map(|d| {
+            let side = (f64::from(d.size_px) * 1.5 / f64::from(BIN_PX)).ceil() + 1.0;
+            f64::from(d.width * d.members) * side * side
+        })
+        .sum();
+    let estimate = (2.0 * covered) as u64;
+    let cap = (limit.min(MAX_LIST_BYTES) / 4).min(u64::from(u32::MAX));
+    // In powers of two: room to grow before the buffer is made again.
+    every
+        .min(estimate.max(1 << 20).next_power_of_two())
+        .min(cap)
+        .max(1) as u32
 }
 
 /// The frame's tile items in draw order: alpha-blended first (as given: back to front),
@@ -245,6 +289,7 @@ impl TilePass {
             ),
             buffers: None,
             drawn: false,
+            list_capacity: None,
         })
     }
 
@@ -299,7 +344,8 @@ impl TilePass {
     ) -> Result<Built, ShaderError> {
         let composed = lib.compose("tiles.wgsl")?;
         create_checked(&ctx.device, &composed, lib, |module| {
-            let bin = Self::compute(ctx, bin_layout, module, "bin", &[]);
+            let bin = ["bin_count_blocks", "bin_scan", "bin_starts", "bin"]
+                .map(|entry| Self::compute(ctx, bin_layout, module, entry, &[]));
             let basic = LookVariant::basic(false);
             let variants = HashMap::from([(
                 basic,
@@ -401,34 +447,28 @@ impl TilePass {
         depth: Option<&wgpu::TextureView>,
     ) -> bool {
         let order = draw_order(items);
-        let total: u64 = order
-            .iter()
-            .map(|d| u64::from(d.width) * u64::from(d.members))
-            .sum();
+        let firsts = item_firsts(&order);
+        let total = u64::from(firsts[firsts.len() - 1]);
         self.drawn = false;
         if total == 0 {
             return false;
         }
-        if !fits(size, total) || order.len() > MAX_ITEMS {
-            // The lists would be too large: their memory goes back.
+        let limit = ctx.device.limits().max_storage_buffer_binding_size;
+        if !fits(size, total, limit) || order.len() > MAX_ITEMS {
+            // The buffers would be too large: their memory goes back.
             self.buffers = None;
             return false;
         }
+        let lists = self
+            .list_capacity
+            .unwrap_or_else(|| list_entries(&order, size, total as u32, limit));
         self.prepare(ctx, &order, &frame.sprites.sampler);
-        self.ensure_buffers(ctx, size, total as u32, order.len() as u32, depth);
+        self.ensure_buffers(ctx, size, (total as u32, lists), order.len() as u32, depth);
         let Some(b) = self.buffers.as_ref() else {
             return false;
         };
-        self.upload_jobs(ctx, &order, total as u32);
-        // The tile flags, and the item flags after the tile list and the items' bins.
-        let (tiles, bins) = (grid_tiles(size), grid_bins(size));
-        enc.clear_buffer(&b.touched, TOUCHED_FLAGS * 4, Some(tiles * 4));
-        let item_flags = TOUCHED_FLAGS + 2 * tiles + MAX_ITEMS as u64 * bins;
-        enc.clear_buffer(
-            &b.touched,
-            item_flags * 4,
-            Some(MAX_ITEMS as u64 * bins * 4),
-        );
+        self.upload_jobs(ctx, &order, &firsts);
+        enc.clear_buffer(&b.touched, TOUCHED_FLAGS * 4, Some(grid_tiles(size) * 4));
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("TilePass::tiles"),
             timestamp_writes: None,
@@ -436,13 +476,7 @@ impl TilePass {
         // Project every item, bin once, then shade each item in draw order.
         for stage in 0..2 {
             if stage == 1 {
-                pass.set_pipeline(&self.bin);
-                pass.set_bind_group(0, &frame.frame_group, &[0]);
-                pass.set_bind_group(1, &self.empty_group, &[]);
-                pass.set_bind_group(2, &self.empty_group, &[]);
-                pass.set_bind_group(3, &b.bin_group, &[0]);
-                let bins = grid(size, BIN_PX);
-                pass.dispatch_workgroups(bins.0, bins.1, b.capacity.div_ceil(BLOCK));
+                self.record_bins(&mut pass, frame, size, total as u32 / BLOCK);
             }
             for (k, d) in order.iter().enumerate() {
                 let (Some(particles), Some(Some(pipes)), Some(sprite)) = (
@@ -459,7 +493,8 @@ impl TilePass {
                 pass.set_bind_group(2, sprite, &[]);
                 pass.set_bind_group(3, &b.group, &[(k as u64 * JOB_STRIDE) as u32]);
                 if stage == 0 {
-                    let (x, y) = dispatch_size(d.width * d.members);
+                    // The item's last block is filled up with empty sprites.
+                    let (x, y) = dispatch_size((d.width * d.members).next_multiple_of(BLOCK));
                     pass.dispatch_workgroups(x, y, 1);
                 } else {
                     // Only the bins holding some of the item's sprites (the bin counts them).
@@ -472,27 +507,72 @@ impl TilePass {
         true
     }
 
-    /// Uploads one job per item (`TileJob`: its first sprite and quads, the frame's
-    /// sprites, the lists' stride; its index and the item count; every item's first
-    /// sprite), the resolve's draw arguments (six vertices per shaded tile, counted by the
-    /// shade) and the shades' dispatch arguments (bins counted by the bin, 64 tiles each).
-    fn upload_jobs(&self, ctx: &GpuContext, order: &[&DrawItem], total: u32) {
+    /// The binning's passes over the frame's `blocks` blocks of sprites: count per block,
+    /// scan per bin, the bins' starts, the lists.
+    fn record_bins(
+        &self,
+        pass: &mut wgpu::ComputePass<'_>,
+        frame: &FrameResources,
+        size: (u32, u32),
+        blocks: u32,
+    ) {
         let Some(b) = self.buffers.as_ref() else {
             return;
         };
-        let mut firsts = Vec::with_capacity(order.len() + 1);
-        firsts.push(0u32);
-        for d in order {
-            firsts.push(firsts[firsts.len() - 1] + d.width * d.members);
-        }
+        pass.set_bind_group(0, &frame.frame_group, &[0]);
+        pass.set_bind_group(1, &self.empty_group, &[]);
+        pass.set_bind_group(2, &self.empty_group, &[]);
+        pass.set_bind_group(3, &b.bin_group, &[0]);
+        let bins = grid(size, BIN_PX);
+        let [count, scan, starts, list] = &self.bin;
+        pass.set_pipeline(count);
+        pass.dispatch_workgroups(blocks, 1, 1);
+        pass.set_pipeline(scan);
+        pass.dispatch_workgroups(bins.0 * bins.1, 1, 1);
+        pass.set_pipeline(starts);
+        pass.dispatch_workgroups(1, 1, 1);
+        pass.set_pipeline(list);
+        pass.dispatch_workgroups(bins.0, bins.1, blocks);
+    }
+
+    /// Sets the bins' lists' capacity in entries (`None`: from the sprites' projected
+    /// sizes). Tests make it small to force overflowing bins.
+    #[doc(hidden)]
+    pub fn set_list_capacity(&mut self, entries: Option<u32>) {
+        self.list_capacity = entries;
+    }
+
+    /// Uploads one job per item (`TileJob`: its first sprite and quads, the frame's
+    /// sprites, the lists' capacity; its index, the item count and the blocks; every item's
+    /// first sprite), the resolve's draw arguments (six vertices per shaded tile, counted
+    /// by the shade) and the shades' dispatch arguments (bins counted by the bin scan, 64
+    /// tiles each).
+    fn upload_jobs(&self, ctx: &GpuContext, order: &[&DrawItem], firsts: &[u32]) {
+        let Some(b) = self.buffers.as_ref() else {
+            return;
+        };
         let mut jobs = vec![0u32; order.len() * JOB_STRIDE as usize / 4];
         let items = order.len() as u32;
-        let blocks = b.capacity.div_ceil(BLOCK);
-        for (k, job) in jobs.chunks_mut(JOB_STRIDE as usize / 4).enumerate() {
-            let n = firsts[k + 1] - firsts[k];
-            let head = [firsts[k], n, total, b.capacity, k as u32, items, blocks, 0];
+        let total = firsts[firsts.len() - 1];
+        let blocks = total / BLOCK;
+        for (k, (job, d)) in jobs
+            .chunks_mut(JOB_STRIDE as usize / 4)
+            .zip(order)
+            .enumerate()
+        {
+            let n = d.width * d.members;
+            let head = [
+                firsts[k],
+                n,
+                total,
+                b.list_capacity,
+                k as u32,
+                items,
+                blocks,
+                0,
+            ];
             job[..8].copy_from_slice(&head);
-            job[8..8 + firsts.len()].copy_from_slice(&firsts);
+            job[8..8 + firsts.len()].copy_from_slice(firsts);
         }
         ctx.queue
             .write_buffer(&b.job_buffer, 0, bytemuck::cast_slice(&jobs));
@@ -503,25 +583,28 @@ impl TilePass {
             .write_buffer(&b.dispatch_args, 0, bytemuck::cast_slice(&args));
     }
 
-    /// Creates the buffers for `size` and `sprites` quads (capacity in powers of two) and
-    /// `jobs` dispatches unless the current ones hold them; rebinds a new depth view.
+    /// Creates the buffers for `size`, `sprites` quads (capacity in powers of two),
+    /// `lists` list entries and `jobs` dispatches unless the current ones hold them;
+    /// rebinds a new depth view.
     fn ensure_buffers(
         &mut self,
         ctx: &GpuContext,
         size: (u32, u32),
-        sprites: u32,
+        (sprites, list_capacity): (u32, u32),
         jobs: u32,
         depth: Option<&wgpu::TextureView>,
     ) {
         if let Some(b) = &self.buffers
             && b.size == size
             && b.capacity >= sprites
+            && b.list_capacity >= list_capacity
+            && (self.list_capacity.is_none() || b.list_capacity == list_capacity)
             && b.jobs >= jobs
             && b.depth.as_ref() == depth
         {
             return;
         }
-        let capacity = sprites.next_power_of_two().max(256);
+        let capacity = sprites.next_power_of_two().max(BLOCK);
         let jobs = jobs.next_power_of_two().max(4);
         let (bx, by) = grid(size, BIN_PX);
         let bins = u64::from(bx * by);
@@ -538,16 +621,14 @@ impl TilePass {
         let c = u64::from(capacity);
         // `touched`: the resolve's arguments, a flag per tile, the shaded tiles, and each
         // item's bins.
-        let touched_words = TOUCHED_FLAGS + 2 * grid_tiles(size) + 2 * MAX_ITEMS as u64 * bins;
+        let touched_words = TOUCHED_FLAGS + 2 * grid_tiles(size) + MAX_ITEMS as u64 * bins;
+        // `bin_meta`: counts and places per bin and block, each bin's total and start.
+        let meta_words = 2 * bins * (c / u64::from(BLOCK)) + 2 * bins + 1;
         let lists = [
             buffer("TilePass::sprites", c * SPRITE_BYTES, none),
             buffer("TilePass::touched", touched_words * 4, indirect),
-            buffer("TilePass::bin_lists", bins * c * 4, none),
-            buffer(
-                "TilePass::bin_meta",
-                bins * u64::from(capacity.div_ceil(BLOCK)) * 4,
-                none,
-            ),
+            buffer("TilePass::bin_lists", u64::from(list_capacity) * 4, none),
+            buffer("TilePass::bin_meta", meta_words * 4, none),
             buffer(
                 "TilePass::accum",
                 u64::from(size.0) * u64::from(size.1) * 8,
@@ -608,6 +689,7 @@ impl TilePass {
         self.buffers = Some(TileBuffers {
             size,
             capacity,
+            list_capacity,
             jobs,
             job_buffer,
             touched,

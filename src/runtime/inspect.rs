@@ -212,6 +212,12 @@ impl Player {
         self.instances.get(id).map(|i| i.effect())
     }
 
+    /// The tile rasteriser, when the device has one (tests force its lists to overflow).
+    #[doc(hidden)]
+    pub fn tile_pass(&mut self) -> Option<&mut crate::render::TilePass> {
+        self.tiles.as_mut()
+    }
+
     /// The draws prepared by the last record (tests look at the paths and layers chosen).
     #[doc(hidden)]
     pub fn draw_items(&self) -> &[DrawItem] {
