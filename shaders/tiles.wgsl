@@ -234,6 +234,7 @@ var<workgroup> cache_color: array<vec4<f32>, 64>;
 var<workgroup> cache_frames: array<vec4<f32>, 64>;
 var<workgroup> cache_grad: array<vec4<f32>, 64>;
 var<workgroup> cache_ground: array<vec4<f32>, 64>;
+var<workgroup> cache_bounds: array<vec4<i32>, 64>;
 
 // Reads sprite `i`'s fields into slot `k` of the cache (the affine map as (inv0.xy,
 // inv1.xy) and (inv2.xy, affine flag, depth)).
@@ -250,6 +251,7 @@ fn cache_sprite(k: u32, i: u32) {
     if SOFT {
         cache_ground[k] = sprites[i].ground;
     }
+    cache_bounds[k] = sprites[i].bounds;
 }
 var<workgroup> shared_bin: u32;
 var<workgroup> item_hit: array<atomic<u32>, 64>;
@@ -504,6 +506,12 @@ fn view_distance(depth: f32) -> f32 {
 // Sprite `i` (cached in slot `k` of the workgroup's sprite cache) at pixel `p` blended into
 // `acc` (rgb: premultiplied colour, a: coverage, 1 − the transmittance).
 fn shade_sprite(i: u32, k: u32, p: vec2<i32>, acc: vec4<f32>) -> vec4<f32> {
+    // Outside the pixel rectangle the quad's centres lie in: nothing (most of a tile, for
+    // small sprites; whole warps skip the rest).
+    let r = cache_bounds[k];
+    if any(p < r.xy) || any(p > r.zw) {
+        return acc;
+    }
     let pc = vec2<f32>(p) + 0.5;
     let ca = cache_map[k];
     let cb = cache_offset[k];

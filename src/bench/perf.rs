@@ -11,7 +11,9 @@ use crate::gpu::timer::{GpuTimer, median};
 use crate::gpu::types::StateLayout;
 use crate::render::billboard::{BillboardPass, DrawTarget};
 use crate::render::sort::SortPass;
+use crate::render::tiles::TileStages;
 use crate::render::{
+    TilePass,
     DrawItem, FrameResources, OrbitCamera, SplatPass, TonemapPass, begin_hdr_pass,
 };
 use crate::shaders::ShaderLibrary;
@@ -110,6 +112,12 @@ pub struct PerfRow {
     pub billboard_ms: Option<f64>,
     /// Splat draw (clear + splat + resolve), ms.
     pub splat_ms: f64,
+    /// Tile draw (project, bin, shade and the resolve), ms (None when the quads do not
+    /// fit the device's tile buffers, or the device has no tile rasteriser).
+    pub tiles_ms: Option<f64>,
+    /// The tile draw's project alone and project + bin, ms (the shade and resolve are the
+    /// rest of `tiles_ms`).
+    pub tiles_stages_ms: Option<[f64; 2]>,
     /// Tonemap composite, ms.
     pub composite_ms: f64,
     /// The path Auto picks for this scene.
@@ -314,9 +322,16 @@ fn measure_row(
 
     let lib = ShaderLibrary::embedded();
     let mut frame = FrameResources::new(ctx);
+    // The automatic choice as a player on this adapter makes it.
+    frame.auto_tiles = ctx.profile.tile_raster;
+    frame.allow_tiles = TilePass::supported(&ctx.device);
     let mut sort = SortPass::new(ctx, &lib)?;
     let mut billboard = BillboardPass::new(ctx, &lib, &frame, DrawTarget::hdr())?;
     let mut splat = SplatPass::new(ctx, &lib, &frame, DrawTarget::hdr())?;
+    let mut tiles = frame
+        .allow_tiles
+        .then(|| TilePass::new(ctx, &lib, &frame, DrawTarget::hdr()))
+        .transpose()?;
     let tonemap = TonemapPass::new(ctx, &lib)?;
     let camera = OrbitCamera::from_hint(&effect.camera);
     let size = opts.size;
@@ -331,14 +346,25 @@ fn measure_row(
     frame.upload_looks(&mut uploads, &mut enc);
     uploads.finish(&enc);
     ctx.queue.submit([enc.finish()]);
-    let auto_splat = items.iter().all(|d| d.splat);
-    let with_path = |splat: bool| -> Vec<DrawItem> {
+    let auto_path = if items.iter().all(|d| d.splat) {
+        "splat"
+    } else if items.iter().all(|d| d.tiles) {
+        "tiles"
+    } else {
+        "billboard"
+    };
+    let with_path = |splat: bool, tiles: bool| -> Vec<DrawItem> {
         items
             .iter()
-            .map(|d| DrawItem { splat, ..d.clone() })
+            .map(|d| DrawItem {
+                splat,
+                tiles,
+                ..d.clone()
+            })
             .collect()
     };
-    let (all_billboard, all_splat) = (with_path(false), with_path(true));
+    let (all_billboard, all_splat) = (with_path(false, false), with_path(true, false));
+    let all_tiles = with_path(false, true);
     billboard.prepare(ctx, &all_billboard, &frame.sprites.sampler, false);
     let billboard_ms = (n <= opts.billboard_limit).then(|| {
         time_median(&timer, ctx, opts.repeats.min(3), |enc| {
@@ -357,6 +383,24 @@ fn measure_row(
         }
         median(&mut samples)
     };
+    // Tiles: project, bin, shade and the resolve into the HDR target.
+    let mut tiles_stages_ms = None;
+    let tiles_ms = tiles.as_mut().and_then(|t| {
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        let fits = t.record(ctx, &mut enc, &frame, &all_tiles, size, None);
+        ctx.queue.submit([enc.finish()]);
+        let time = |t: &mut TilePass, stages| {
+            t.set_stages(stages);
+            time_median(&timer, ctx, opts.repeats, |enc| {
+                t.record(ctx, enc, &frame, &all_tiles, size, None);
+                t.resolve(&mut begin_hdr_pass(enc, &targets.hdr_view), &frame);
+            })
+        };
+        fits.then(|| {
+            tiles_stages_ms = Some([TileStages::Project, TileStages::Bin].map(|s| time(t, s)));
+            time(t, TileStages::All)
+        })
+    });
     // Composite: the tonemap.
     let composite_ms = time_median(&timer, ctx, opts.repeats, |enc| {
         tonemap.record(
@@ -370,10 +414,10 @@ fn measure_row(
             1.0,
         );
     });
-    let draw = if auto_splat {
-        splat_ms
-    } else {
-        billboard_ms.unwrap_or(f64::NAN)
+    let draw = match auto_path {
+        "splat" => splat_ms,
+        "tiles" => tiles_ms.unwrap_or(f64::NAN),
+        _ => billboard_ms.unwrap_or(f64::NAN),
     };
     Ok(PerfRow {
         particles: n,
@@ -383,8 +427,10 @@ fn measure_row(
         copy_ms,
         billboard_ms,
         splat_ms,
+        tiles_ms,
+        tiles_stages_ms,
         composite_ms,
-        auto_path: if auto_splat { "splat" } else { "billboard" },
+        auto_path,
         frame_ms: update_ms + draw + composite_ms,
     })
 }
@@ -659,6 +705,7 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
     let mut compact_rows = [Vec::new(), Vec::new()];
     let mut rows = Vec::new();
     let mut table = Vec::new();
+    let mut tile_table = Vec::new();
     let limit = ctx.max_capacity() * 8;
     for &side in &opts.sides {
         let n = side as u64 * side as u64;
@@ -683,6 +730,15 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
                 continue;
             }
         };
+        if let (Some(all), Some([project, bin])) = (row.tiles_ms, row.tiles_stages_ms) {
+            tile_table.push(vec![
+                format!("{side}² = {n}"),
+                format!("{project:.3}"),
+                format!("{:.3}", bin - project),
+                format!("{:.3}", all - bin),
+                format!("{all:.3}"),
+            ]);
+        }
         let gbps = n as f64 * 64.0 / (row.lean_update_ms * 1e-3) / 1e9;
         let copy_gbps = n as f64 * 64.0 / (row.copy_ms * 1e-3) / 1e9;
         let thesis = THESIS_FPS.iter().find(|(s, _)| *s == side).map(|(_, f)| *f);
@@ -699,6 +755,7 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
             row.billboard_ms
                 .map_or("skipped".into(), |m| format!("{m:.3}")),
             format!("{:.3}", row.splat_ms),
+            row.tiles_ms.map_or("—".into(), |m| format!("{m:.3}")),
             format!("{:.3}", row.composite_ms),
             format!("{:.3} ({})", row.frame_ms, row.auto_path),
             format!("{fps:.0}"),
@@ -752,6 +809,7 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
             "update bandwidth, without them (vs copy)",
             "billboard draw ms",
             "splat draw ms (clear + splat)",
+            "tile draw ms (project, bin, shade, resolve)",
             "composite ms (tonemap + splat resolve)",
             "frame ms (auto path)",
             "fps",
@@ -759,6 +817,15 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
             "particles/s",
         ],
         &table,
+    );
+    report.heading("Tile path stages");
+    report.para(
+        "The tile draw of each row timed stage by stage (records that stop after a stage, same run): \
+         project every quad, bin (count per block, scan, list), then shade and resolve (the rest).",
+    );
+    report.table(
+        &["particles", "project ms", "bin ms", "shade + resolve ms", "tile draw ms"],
+        &tile_table,
     );
     let [packed_table, tiny_table] = compact_tables;
     let [packed_rows, tiny_rows] = compact_rows;

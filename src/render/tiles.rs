@@ -80,6 +80,21 @@ pub struct TilePass {
     drawn: bool,
     /// The bins' lists' capacity in entries, when set (tests force an overflow with it).
     list_capacity: Option<u32>,
+    /// The stages a record runs (the bench times them apart).
+    stages: TileStages,
+}
+
+/// How far a record goes: the bench times the stages by recording the first ones alone.
+#[doc(hidden)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TileStages {
+    /// Project only.
+    Project,
+    /// Project and bin.
+    Bin,
+    /// Everything: project, bin and shade.
+    #[default]
+    All,
 }
 
 /// The frame's buffers for one target size and sprite capacity.
@@ -290,6 +305,7 @@ impl TilePass {
             buffers: None,
             drawn: false,
             list_capacity: None,
+            stages: TileStages::All,
         })
     }
 
@@ -476,7 +492,13 @@ impl TilePass {
         // Project every item, bin once, then shade each item in draw order.
         for stage in 0..2 {
             if stage == 1 {
+                if self.stages == TileStages::Project {
+                    return false;
+                }
                 self.record_bins(&mut pass, frame, size, total as u32 / BLOCK);
+                if self.stages == TileStages::Bin {
+                    return false;
+                }
             }
             for (k, d) in order.iter().enumerate() {
                 let (Some(particles), Some(Some(pipes)), Some(sprite)) = (
@@ -533,6 +555,13 @@ impl TilePass {
         pass.dispatch_workgroups(1, 1, 1);
         pass.set_pipeline(list);
         pass.dispatch_workgroups(bins.0, bins.1, blocks);
+    }
+
+    /// Sets how far the next records go (the bench times the stages apart; a record that
+    /// stops before the shade draws nothing).
+    #[doc(hidden)]
+    pub fn set_stages(&mut self, stages: TileStages) {
+        self.stages = stages;
     }
 
     /// Sets the bins' lists' capacity in entries (`None`: from the sprites' projected
