@@ -1,9 +1,8 @@
 // tiles.wgsl — pass 2, large sprites on the compute units: a tile rasteriser. The quads
 // the billboards would draw (quad.wgsl builds both) are projected once, binned into
-// bins of 2×2 to 8×8 tiles in draw order — counted per block of sprites, scanned into
-// each list's place, then written (`bin_count_blocks`, `bin_scan`, `bin_starts`, `bin`:
-// memory and work in proportion to the sprites' footprints, the order from counts, not
-// from atomics) — and each
+// 128-pixel bins in draw order — counted per block of sprites, scanned into each list's
+// place, then written (`bin_count_blocks`, `bin_scan`, `bin_starts`, `bin`: memory and
+// work in proportion to the sprites' footprints, no atomics on the order) — and each
 // 16×16-pixel tile is shaded by one workgroup:
 // the sprites over it, in order, blended in registers — premultiplied "over" for
 // alpha-blended layers (back to front, the sort's order), added for light — and the
@@ -59,8 +58,8 @@ override F16_ROUND_DOWN: bool = false;
 // Pixels per tile side (one workgroup each) and tiles per bin side (keep in sync with
 // src/render/tiles.rs).
 const TILE: u32 = 16u;
-// A bin is 2, 4 or 8 tiles a side (`job.counts2.w` pixels): the smallest that keeps a
-// target's bins within MAX_BINS.
+const BIN_TILES: u32 = 8u;
+const BIN: u32 = 128u;
 // Tile items a frame holds at most (keep in sync with src/render/tiles.rs).
 const MAX_ITEMS: u32 = 55u;
 // `touched`: the draw arguments (4), then a flag per tile, then the shaded tiles' list.
@@ -76,8 +75,8 @@ const MAX_BINS: u32 = 2048u;
 
 // One dispatch's work: x the item's first sprite, y its quads, z sprites this frame
 // (each item's rounded up to whole blocks), w the capacity of the bin lists (entries);
-// `counts2`: the item's index, the items, the blocks of BLOCK sprites, the bins' side in
-// pixels; `firsts`: every item's first sprite, then the frame's sprites.
+// `counts2`: the item's index, the items, the blocks of BLOCK sprites; `firsts`: every
+// item's first sprite, then the frame's sprites.
 struct TileJob {
     counts: vec4<u32>,
     counts2: vec4<u32>,
@@ -310,31 +309,18 @@ fn bins_of(r: vec4<i32>) -> vec4<u32> {
     if r.x > r.z || r.y > r.w {
         return vec4<u32>(1u, 1u, 0u, 0u);
     }
-    return vec4<u32>(r) / bin_px();
+    return vec4<u32>(r) / BIN;
 }
 
 var<workgroup> hist: array<atomic<u32>, MAX_BINS>;
 var<workgroup> sums: array<u32, 256>;
-
-// Pixels per bin side, and tiles.
-fn bin_px() -> u32 {
-    return job.counts2.w;
-}
-
-fn bin_tiles() -> u32 {
-    return job.counts2.w / TILE;
-}
-
-fn bins_x() -> u32 {
-    return (u32(camera.viewport.x) + bin_px() - 1u) / bin_px();
-}
 
 // Counts, for one block of BLOCK sprites (workgroup x), the block's sprites over each bin.
 @compute @workgroup_size(256)
 fn bin_count_blocks(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     let c = wg.x;
     let bins = bin_count();
-    let bins_x = bins_x();
+    let bins_x = (u32(camera.viewport.x) + BIN - 1u) / BIN;
     for (var b = lid; b < bins; b += 256u) {
         atomicStore(&hist[b], 0u);
     }
@@ -430,60 +416,42 @@ fn bin_starts(@builtin(local_invocation_index) lid: u32) {
     }
 }
 
-var<workgroup> rects: array<vec4<u32>, 256>;
-
-// Lists one block of BLOCK sprites (workgroup x) into the bins they cover, in draw order,
-// at the places the scans gave the block: a sprite's place in a bin's list is the block's
-// start there, plus the block's earlier sprites over the bin — those of earlier chunks
-// (counted in workgroup memory) and those of earlier invocations of its chunk (counted
-// from the chunk's bin rectangles): deterministic, whatever the scheduling. A list past the
-// lists' capacity is not written: the shade then reads the bin's sprites directly.
+// Lists, for one bin and one block of BLOCK sprites (workgroup z) with some over the bin,
+// the block's sprites over the bin in draw order (an order-keeping compaction:
+// deterministic, whatever the scheduling) at the place the scans gave the block. A list
+// past the lists' capacity is not written: the shade then reads the bin's sprites
+// directly.
 @compute @workgroup_size(256)
-fn bin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
-    let c = wg.x;
-    let bins = bin_count();
-    let bins_x = bins_x();
-    let size = i32(bin_px());
-    let top = i32(bin_tiles()) - 1;
-    for (var b = lid; b < bins; b += 256u) {
-        atomicStore(&hist[b], 0u);
+fn bin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    let b = wg.y * nwg.x + wg.x;
+    let c = wg.z;
+    if lid == 0u {
+        shared_count = bin_meta[meta_count(b, c)];
     }
+    if workgroupUniformLoad(&shared_count) == 0u {
+        return;
+    }
+    let lo = vec2<i32>(wg.xy * BIN);
+    let rect = vec4<i32>(lo, lo + i32(BIN) - 1);
     let start = c * BLOCK;
     let end = min(start + BLOCK, job.counts.z);
+    let region = bin_meta[meta_start(b)] + bin_meta[meta_local(b, c)];
+    var count = 0u;
     for (var base = start; base < end; base += 256u) {
         let i = base + lid;
         var r = vec4<i32>(1, 1, 0, 0);
         if i < end {
             r = sprites[i].bounds;
         }
-        let bb = bins_of(r);
-        rects[lid] = bb;
-        workgroupBarrier();
-        for (var y = bb.y; y <= bb.w; y++) {
-            for (var x = bb.x; x <= bb.z; x++) {
-                let b = y * bins_x + x;
-                var rank = 0u;
-                for (var t = 0u; t < lid; t++) {
-                    let o = rects[t];
-                    rank += u32(x >= o.x && x <= o.z && y >= o.y && y <= o.w);
-                }
-                let at = bin_meta[meta_start(b)] + bin_meta[meta_local(b, c)] + atomicLoad(&hist[b]) + rank;
-                if at < job.counts.w {
-                    // The tiles of this bin it covers ride along: the shade tests them
-                    // without reading the sprite.
-                    let lo = vec2<i32>(i32(x), i32(y)) * size;
-                    let t = vec4<u32>(clamp((r - vec4<i32>(lo, lo)) / i32(TILE), vec4<i32>(0), vec4<i32>(top)));
-                    bin_lists[at] = (i - start) | (t.x << 10u) | (t.y << 13u) | (t.z << 16u) | (t.w << 19u);
-                }
-            }
+        let hit = overlaps(r, rect);
+        let at = compact(lid, hit);
+        if hit && region + count + at < job.counts.w {
+            // The tiles of this bin it covers ride along: the shade tests them without
+            // reading the sprite.
+            let t = vec4<u32>(clamp((r - vec4<i32>(lo, lo)) / i32(TILE), vec4<i32>(0), vec4<i32>(i32(BIN_TILES) - 1)));
+            bin_lists[region + count + at] = (i - start) | (t.x << 10u) | (t.y << 13u) | (t.z << 16u) | (t.w << 19u);
         }
-        workgroupBarrier();
-        for (var y = bb.y; y <= bb.w; y++) {
-            for (var x = bb.x; x <= bb.z; x++) {
-                atomicAdd(&hist[y * bins_x + x], 1u);
-            }
-        }
-        workgroupBarrier();
+        count += workgroupUniformLoad(&shared_total);
     }
 }
 
@@ -504,7 +472,7 @@ fn item_of(i: u32) -> u32 {
 
 // Bins across the target.
 fn bin_count() -> u32 {
-    return bins_x() * ((u32(camera.viewport.y) + bin_px() - 1u) / bin_px());
+    return ((u32(camera.viewport.x) + BIN - 1u) / BIN) * ((u32(camera.viewport.y) + BIN - 1u) / BIN);
 }
 
 // Where item k's list of bins is in `touched`, after the resolve's arguments, the tile
@@ -643,14 +611,14 @@ fn to_f16(v: vec2<f32>) -> vec2<f32> {
 @compute @workgroup_size(16, 16)
 fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     // Workgroup (x, y): tile y of the x-th bin holding some of this item's sprites.
-    let bins_x = bins_x();
+    let bins_x = (u32(camera.viewport.x) + BIN - 1u) / BIN;
     if lid == 0u {
         shared_bin = atomicLoad(&touched[item_bins(job.counts2.x) + wg.x]);
     }
     let b = workgroupUniformLoad(&shared_bin);
     // This tile within its bin, and across the target.
-    let local = vec2<u32>(wg.y % bin_tiles(), wg.y / bin_tiles());
-    let tile_xy = vec2<u32>(b % bins_x, b / bins_x) * bin_tiles() + local;
+    let local = vec2<u32>(wg.y % BIN_TILES, wg.y / BIN_TILES);
+    let tile_xy = vec2<u32>(b % bins_x, b / bins_x) * BIN_TILES + local;
     let tiles_x = (u32(camera.viewport.x) + TILE - 1u) / TILE;
     if tile_xy.x >= tiles_x || tile_xy.y * TILE >= u32(camera.viewport.y) {
         return;

@@ -334,8 +334,8 @@ fn tiles_are_deterministic_and_the_automatic_choice_follows_the_profile() {
     );
 }
 
-/// 3000 sprites thrown out of one point across bin borders: three blocks of sprites over
-/// several bins, listed block after block. Their light agrees with the billboards', and it
+/// 3000 sprites thrown out of one point across a bin border: three blocks of sprites over
+/// two bins, listed block after block. Their light agrees with the billboards', and it
 /// stays the very same image when the bins' lists are given too little room (bins shaded
 /// from the sprites directly, none lost).
 #[test]
@@ -358,8 +358,7 @@ fn many_sprites_over_several_bins_and_blocks_keep_their_light_when_lists_overflo
         }
         run.render(SIZE).expect("render")
     };
-    // The sprites cover several bins each (over 3000 entries in all): room for 4000 fits
-    // the first bins' lists, not the later ones.
+    // Each bin lists all 3000: room for 4000 fits the first bin, not the second.
     let fitted = image(None);
     assert!(total_light(&fitted) > 1e3);
     assert!(image(Some(4000)) == fitted, "one bin overflowing");

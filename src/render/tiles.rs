@@ -19,8 +19,7 @@ use crate::sim::gpu_sim::dispatch_size;
 
 /// Pixels per tile side (one workgroup each; keep in sync with `TILE` in tiles.wgsl).
 pub const TILE_PX: u32 = 16;
-/// Pixels per bin side at most (a bin is 2×2 to 8×8 tiles: the smallest whose count
-/// stays within `MAX_BINS`, `bin_px`).
+/// Pixels per bin side (keep in sync with `BIN` in tiles.wgsl).
 pub const BIN_PX: u32 = 128;
 /// Bytes of one projected sprite (`TileSprite` in tiles.wgsl).
 const SPRITE_BYTES: u64 = 176;
@@ -131,21 +130,9 @@ fn grid_tiles(size: (u32, u32)) -> u64 {
     u64::from(tx) * u64::from(ty)
 }
 
-/// Pixels per bin side at `size`: the smallest of 32, 64 and 128 whose bins fit
-/// `MAX_BINS` (smaller bins: shorter lists for each tile to read).
-fn bin_px(size: (u32, u32)) -> u32 {
-    [32, 64, BIN_PX]
-        .into_iter()
-        .find(|&px| {
-            let (bx, by) = grid(size, px);
-            u64::from(bx) * u64::from(by) <= MAX_BINS
-        })
-        .unwrap_or(BIN_PX)
-}
-
 /// Bins across a target of `size` pixels.
 fn grid_bins(size: (u32, u32)) -> u64 {
-    let (bx, by) = grid(size, bin_px(size));
+    let (bx, by) = grid(size, BIN_PX);
     u64::from(bx) * u64::from(by)
 }
 
@@ -175,7 +162,7 @@ fn list_entries(order: &[&DrawItem], size: (u32, u32), sprites: u32, limit: u64)
     let covered: f64 = order
         .iter()
         .map(|d| {
-            let side = (f64::from(d.size_px) * 1.5 / f64::from(bin_px(size))).ceil() + 1.0;
+            let side = (f64::from(d.size_px) * 1.5 / f64::from(BIN_PX)).ceil() + 1.0;
             f64::from(d.width * d.members) * side * side
         })
         .sum();
@@ -558,15 +545,16 @@ impl TilePass {
         pass.set_bind_group(1, &self.empty_group, &[]);
         pass.set_bind_group(2, &self.empty_group, &[]);
         pass.set_bind_group(3, &b.bin_group, &[0]);
+        let bins = grid(size, BIN_PX);
         let [count, scan, starts, list] = &self.bin;
         pass.set_pipeline(count);
         pass.dispatch_workgroups(blocks, 1, 1);
         pass.set_pipeline(scan);
-        pass.dispatch_workgroups(grid_bins(size) as u32, 1, 1);
+        pass.dispatch_workgroups(bins.0 * bins.1, 1, 1);
         pass.set_pipeline(starts);
         pass.dispatch_workgroups(1, 1, 1);
         pass.set_pipeline(list);
-        pass.dispatch_workgroups(blocks, 1, 1);
+        pass.dispatch_workgroups(bins.0, bins.1, blocks);
     }
 
     /// Sets how far the next records go (the bench times the stages apart; a record that
@@ -596,7 +584,6 @@ impl TilePass {
         let items = order.len() as u32;
         let total = firsts[firsts.len() - 1];
         let blocks = total / BLOCK;
-        let bin = bin_px(b.size);
         for (k, (job, d)) in jobs
             .chunks_mut(JOB_STRIDE as usize / 4)
             .zip(order)
@@ -611,7 +598,7 @@ impl TilePass {
                 k as u32,
                 items,
                 blocks,
-                bin,
+                0,
             ];
             job[..8].copy_from_slice(&head);
             job[8..8 + firsts.len()].copy_from_slice(firsts);
@@ -620,9 +607,7 @@ impl TilePass {
             .write_buffer(&b.job_buffer, 0, bytemuck::cast_slice(&jobs));
         ctx.queue
             .write_buffer(&b.touched, 0, bytemuck::cast_slice(&[6u32, 0, 0, 0]));
-        // One workgroup row per bin (counted by the bin scan), one workgroup per tile.
-        let tiles = (bin / TILE_PX).pow(2);
-        let args: Vec<u32> = order.iter().flat_map(|_| [0u32, tiles, 1, 0]).collect();
+        let args: Vec<u32> = order.iter().flat_map(|_| [0u32, 64, 1, 0]).collect();
         ctx.queue
             .write_buffer(&b.dispatch_args, 0, bytemuck::cast_slice(&args));
     }
@@ -650,7 +635,8 @@ impl TilePass {
         }
         let capacity = sprites.next_power_of_two().max(BLOCK);
         let jobs = jobs.next_power_of_two().max(4);
-        let bins = grid_bins(size);
+        let (bx, by) = grid(size, BIN_PX);
+        let bins = u64::from(bx * by);
         let buffer = |label: &str, bytes: u64, usage: wgpu::BufferUsages| {
             ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
