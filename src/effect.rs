@@ -717,8 +717,10 @@ pub enum DrawPath {
 pub const SPLAT_BELOW_PX: f32 = 4.0;
 
 /// Auto draw path on adapters whose profile allows the tile rasteriser: particles that
-/// project at least this large (pixels) take it; billboards between the two sizes.
-pub const TILES_ABOVE_PX: f32 = 8.0;
+/// project at least this large (pixels) take it — where the splat stops: on the H100 the
+/// tiles beat the billboards from there (`ignis bench perf`: 4M flames of about 6 px,
+/// 22.5 ms against 31.4).
+pub const TILES_ABOVE_PX: f32 = 4.0;
 
 /// Auto draw path: an emitter takes the tile rasteriser only when its quads (all its
 /// instances' live windows) at their largest projected size would cover at least this

@@ -13,8 +13,7 @@ use crate::render::billboard::{BillboardPass, DrawTarget};
 use crate::render::sort::SortPass;
 use crate::render::tiles::TileStages;
 use crate::render::{
-    TilePass,
-    DrawItem, FrameResources, OrbitCamera, SplatPass, TonemapPass, begin_hdr_pass,
+    DrawItem, FrameResources, OrbitCamera, SplatPass, TilePass, TonemapPass, begin_hdr_pass,
 };
 use crate::shaders::ShaderLibrary;
 use crate::sim::{GpuSim, Modules, SimError};
@@ -824,7 +823,13 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
          project every quad, bin (count per block, scan, list), then shade and resolve (the rest).",
     );
     report.table(
-        &["particles", "project ms", "bin ms", "shade + resolve ms", "tile draw ms"],
+        &[
+            "particles",
+            "project ms",
+            "bin ms",
+            "shade + resolve ms",
+            "tile draw ms",
+        ],
         &tile_table,
     );
     let [packed_table, tiny_table] = compact_tables;
