@@ -13,7 +13,7 @@ use crate::render::billboard::{BillboardPass, DrawTarget};
 use crate::render::sort::SortPass;
 use crate::render::tiles::TileStages;
 use crate::render::{
-    DrawItem, FrameResources, OrbitCamera, SplatPass, TilePass, TonemapPass, begin_hdr_pass,
+    DrawItem, FrameResources, OrbitCamera, SplatPass, TilePass, TonemapPass, load_hdr_pass,
 };
 use crate::shaders::ShaderLibrary;
 use crate::sim::{GpuSim, Modules, SimError};
@@ -367,7 +367,7 @@ fn measure_row(
     billboard.prepare(ctx, &all_billboard, &frame.sprites.sampler, false);
     let billboard_ms = (n <= opts.billboard_limit).then(|| {
         time_median(&timer, ctx, opts.repeats.min(3), |enc| {
-            let mut pass = begin_hdr_pass(enc, &targets.hdr_view);
+            let mut pass = load_hdr_pass(enc, &targets.hdr_view);
             billboard.draw(&mut pass, &frame, &all_billboard, |_| true);
         })
     });
@@ -377,7 +377,7 @@ fn measure_row(
         for _ in 0..opts.repeats {
             samples.push(timer.time(ctx, |enc| {
                 splat.splat(ctx, enc, &frame, &all_splat, size, None);
-                splat.resolve(&mut begin_hdr_pass(enc, &targets.hdr_view), &frame);
+                splat.resolve(&mut load_hdr_pass(enc, &targets.hdr_view), &frame);
             }));
         }
         median(&mut samples)
@@ -392,7 +392,7 @@ fn measure_row(
             t.set_stages(stages);
             time_median(&timer, ctx, opts.repeats, |enc| {
                 t.record(ctx, enc, &frame, &all_tiles, size, None);
-                t.resolve(&mut begin_hdr_pass(enc, &targets.hdr_view), &frame);
+                t.resolve(&mut load_hdr_pass(enc, &targets.hdr_view), &frame);
             })
         };
         fits.then(|| {

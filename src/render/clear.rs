@@ -1,18 +1,21 @@
-//! A compute clear of the HDR target (`shaders/clear.wgsl`): the particles' pass then
-//! loads it instead of clearing, which the H100's small raster slice does slowly.
+//! A compute clear of HDR targets (`shaders/clear.wgsl`): the particles' passes then
+//! load them instead of clearing, which the H100's small raster slice does slowly.
 
 use crate::gpu::GpuContext;
 use crate::render::HDR_FORMAT;
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
+
+/// Targets whose bind groups a clear keeps.
+const MAX_GROUPS: usize = 4;
 
 /// The clear's pipeline.
 pub struct ClearPass {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
     pipeline: wgpu::ComputePipeline,
-    /// The group over the last target cleared (the composite's target changes only with
-    /// its size).
-    group: Option<(wgpu::TextureView, wgpu::BindGroup)>,
+    /// The groups over the last targets cleared, newest last (the composite's targets — the
+    /// image and its reduced layers — change only with its size).
+    groups: Vec<(wgpu::TextureView, wgpu::BindGroup)>,
 }
 
 impl ClearPass {
@@ -45,7 +48,7 @@ impl ClearPass {
             layout,
             pipeline_layout,
             pipeline,
-            group: None,
+            groups: Vec::new(),
         })
     }
 
@@ -74,18 +77,25 @@ impl ClearPass {
         target: &wgpu::TextureView,
         size: (u32, u32),
     ) {
-        if self.group.as_ref().is_none_or(|(view, _)| view != target) {
-            let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("ClearPass::group"),
-                layout: &self.layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(target),
-                }],
-            });
-            self.group = Some((target.clone(), group));
+        let group = match self.groups.iter().position(|(view, _)| view == target) {
+            Some(k) => self.groups.remove(k),
+            None => {
+                let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("ClearPass::group"),
+                    layout: &self.layout,
+                    entries: &[wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(target),
+                    }],
+                });
+                (target.clone(), group)
+            }
+        };
+        if self.groups.len() >= MAX_GROUPS {
+            self.groups.remove(0);
         }
-        let Some((_, group)) = self.group.as_ref() else {
+        self.groups.push(group);
+        let Some((_, group)) = self.groups.last() else {
             return;
         };
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {

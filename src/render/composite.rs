@@ -7,7 +7,7 @@
 use crate::gpu::{GpuContext, TextureReadback};
 use crate::render::bloom::BloomPass;
 use crate::render::{
-    Camera, HDR_FORMAT, Targets, TonemapPass, begin_hdr_pass, ensure_layer, reduced,
+    Camera, HDR_FORMAT, Targets, TonemapPass, ensure_layer, load_hdr_pass, reduced,
 };
 use crate::runtime::{Layers, Player, PlayerSettings};
 use crate::shaders::{ShaderError, ShaderLibrary};
@@ -133,7 +133,8 @@ impl Composite {
             let low = reduced(size, downscale);
             ensure_layer(ctx, &mut self.alpha_layer, "Composite::alpha_layer", low);
             if let Some((_, view)) = &self.alpha_layer {
-                player.draw_layers(&mut begin_hdr_pass(enc, view), Layers::BLENDED);
+                self.clear.record(ctx, enc, view, low);
+                player.draw_layers(&mut load_hdr_pass(enc, view), Layers::BLENDED);
                 layered |= Layers::BLENDED;
             }
         }
@@ -141,14 +142,15 @@ impl Composite {
             let half = reduced(size, 2);
             ensure_layer(ctx, &mut self.glow_layer, "Composite::glow_layer", half);
             if let Some((_, view)) = &self.glow_layer {
-                player.draw_layers(&mut begin_hdr_pass(enc, view), Layers::GLOW);
+                self.clear.record(ctx, enc, view, half);
+                player.draw_layers(&mut load_hdr_pass(enc, view), Layers::GLOW);
                 layered |= Layers::GLOW;
             }
         }
         if let Some(targets) = self.targets.as_ref() {
             self.clear.record(ctx, enc, &targets.hdr_view, targets.size);
             player.draw_layers(
-                &mut crate::render::load_hdr_pass(enc, &targets.hdr_view),
+                &mut load_hdr_pass(enc, &targets.hdr_view),
                 Layers::ALL.without(layered),
             );
         }
