@@ -709,7 +709,8 @@ pub enum DrawPath {
     /// Always the compute tile rasteriser: the billboards' quads, binned into screen
     /// tiles and blended per tile on the compute units (the look of the billboards; in a
     /// host's pass only with its depth view). Alpha-blended emitters take it together or
-    /// not at all; streaks stay billboards.
+    /// not at all (ribbons aside: they stay billboards, drawn behind the tiles' blended
+    /// layers); streaks stay billboards.
     Tiles,
 }
 

@@ -364,3 +364,36 @@ fn many_sprites_over_several_bins_and_blocks_keep_their_light_when_lists_overflo
     assert!(image(Some(4000)) == fitted, "one bin overflowing");
     assert!(image(Some(1)) == fitted, "every bin overflowing");
 }
+
+/// The fireball's debris leaves alpha-blended smoke lines (ribbons, which only the
+/// billboards draw): they stay billboards, drawn behind the tiles' blended layers, and the
+/// smoke puffs keep the tiles.
+#[test]
+fn alpha_blended_ribbons_leave_the_other_blended_layers_their_tiles() {
+    let ctx = gpu();
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("presets/fireball.ron");
+    let mut effect = ignis::preset::load(&path).expect("the fireball");
+    for e in &mut effect.emitters {
+        e.look.draw_path = DrawPath::Tiles;
+    }
+    let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    for _ in 0..60 {
+        run.advance(1.0 / 60.0);
+    }
+    run.render(SIZE).expect("render");
+    let item = |name: &str| {
+        let i = run
+            .effect()
+            .emitters
+            .iter()
+            .position(|e| e.name == name)
+            .expect("emitter");
+        run.player
+            .draw_items()
+            .iter()
+            .find(|d| d.index == i)
+            .map(|d| (d.blend, d.tiles, d.trail.is_some()))
+    };
+    assert_eq!(item("smoke"), Some((BlendMode::Alpha, true, false)));
+    assert_eq!(item("debris smoke"), Some((BlendMode::Alpha, false, true)));
+}
