@@ -31,6 +31,7 @@
 #import "params.wgsl"
 #import "event_types.wgsl"
 #import "trail_ring.wgsl"
+#import "workgroup_scan.wgsl"
 
 struct ScanConfig {
     // The rule's index, the child's capacity, the most children a step, flags
@@ -59,7 +60,6 @@ const GROUP: u32 = 256u;
 const PER_THREAD: u32 = 4u;
 const BLOCK: u32 = 1024u;
 
-var<workgroup> sums: array<u32, GROUP>;
 
 // The children of the i-th slot of the parent's window.
 fn count_of(i: u32) -> u32 {
@@ -96,21 +96,6 @@ fn window_slot(i: u32) -> u32 {
     return slot;
 }
 
-// An inclusive Hillis–Steele scan of `v` over the workgroup; every thread gets its own.
-fn workgroup_inclusive(lid: u32, v: u32) -> u32 {
-    sums[lid] = v;
-    workgroupBarrier();
-    for (var d = 1u; d < GROUP; d *= 2u) {
-        var x = sums[lid];
-        if lid >= d {
-            x += sums[lid - d];
-        }
-        workgroupBarrier();
-        sums[lid] = x;
-        workgroupBarrier();
-    }
-    return sums[lid];
-}
 
 fn block_index(wg: vec3<u32>, nwg: vec3<u32>) -> u32 {
     return wg.y * nwg.x + wg.x;

@@ -24,6 +24,7 @@
 // - DEPTH_TEST: as splat.wgsl (0 none, 1 nearer or level passes, 2 reversed Z).
 #import "common.wgsl"
 #import "quad.wgsl"
+#import "workgroup_scan.wgsl"
 
 @group(0) @binding(0) var<uniform> camera: CameraUniform;
 @group(0) @binding(1) var<storage, read> looks: array<LookSlot>;
@@ -313,7 +314,6 @@ fn bins_of(r: vec4<i32>) -> vec4<u32> {
 }
 
 var<workgroup> hist: array<atomic<u32>, MAX_BINS>;
-var<workgroup> sums: array<u32, 256>;
 
 // Counts, for one block of BLOCK sprites (workgroup x), the block's sprites over each bin.
 @compute @workgroup_size(256)
@@ -340,21 +340,6 @@ fn bin_count_blocks(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocat
     }
 }
 
-// An inclusive Hillis–Steele scan of `v` over the workgroup; `sums[255]` is the total.
-fn workgroup_inclusive(lid: u32, v: u32) -> u32 {
-    sums[lid] = v;
-    workgroupBarrier();
-    for (var d = 1u; d < 256u; d *= 2u) {
-        var x = sums[lid];
-        if lid >= d {
-            x += sums[lid - d];
-        }
-        workgroupBarrier();
-        sums[lid] = x;
-        workgroupBarrier();
-    }
-    return sums[lid];
-}
 
 // One bin (workgroup x): each block's place in the bin's list (an exclusive scan of the
 // counts in block order) and the bin's entries; each item with sprites over the bin adds

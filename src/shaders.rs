@@ -72,6 +72,10 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ("tonemap.wgsl", include_str!("../shaders/tonemap.wgsl")),
     ("bloom.wgsl", include_str!("../shaders/bloom.wgsl")),
     ("clear.wgsl", include_str!("../shaders/clear.wgsl")),
+    (
+        "workgroup_scan.wgsl",
+        include_str!("../shaders/workgroup_scan.wgsl"),
+    ),
 ];
 
 /// The packed-state update: update.wgsl with state_packed.wgsl composed in place of

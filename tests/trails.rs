@@ -25,6 +25,34 @@ fn point_steps(points: u32, every: u32, steps: u64) -> Vec<i64> {
         .collect()
 }
 
+/// The pixel tests' view of `effect`: fixed 1/60 s steps, seen side on from 3 m at 1 m
+/// up (the x axis along the middle row), without bloom.
+fn side_view(effect: &mut Effect) {
+    effect.time.mode = TimeMode::FixedStep;
+    effect.time.step_secs = DT;
+    effect.camera = CameraHint {
+        target_m: [0.0, 1.0, 0.0],
+        distance_m: 3.0,
+        yaw_deg: 0.0,
+        pitch_deg: 0.0,
+        fov_y_deg: 45.0,
+    };
+    effect.post.bloom = None;
+}
+
+/// The column of world x (at 1 m up, z = 0) in a `size` image of [`side_view`].
+fn side_view_px(x: f32, (w, h): (u32, u32)) -> f32 {
+    let px_per_m = (h as f32 / 2.0) / (3.0 * (22.5f32).to_radians().tan());
+    w as f32 / 2.0 + x * px_per_m
+}
+
+/// The columns of `row` lit by the ribbon.
+fn lit_pixels(image: &image::RgbaImage, row: u32) -> Vec<u32> {
+    (0..image.width())
+        .filter(|&x| image.get_pixel(x, row)[0] > 40)
+        .collect()
+}
+
 #[test]
 fn ribbon_points_are_the_recorded_positions_of_one_life() {
     let ctx = gpu();
@@ -123,16 +151,7 @@ fn the_ribbon_lights_the_pixels_between_the_particle_and_its_tail() {
     e.look.color_over_life = flat_color([1.0, 1.0, 1.0, 1.0]);
     e.look.intensity = 4.0;
     let mut effect = bare_effect(e);
-    effect.time.mode = TimeMode::FixedStep;
-    effect.time.step_secs = DT;
-    effect.camera = CameraHint {
-        target_m: [0.0, 1.0, 0.0],
-        distance_m: 3.0,
-        yaw_deg: 0.0,
-        pitch_deg: 0.0,
-        fov_y_deg: 45.0,
-    };
-    effect.post.bloom = None;
+    side_view(&mut effect);
     let mut run =
         ignis::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
     let frames = 60u32;
@@ -144,8 +163,7 @@ fn the_ribbon_lights_the_pixels_between_the_particle_and_its_tail() {
     // Born half way through the first step at x = −1, at 1.2 m/s: after step k it is at
     // −1 + 1.2 (k + ½) dt. The particle is drawn between its states after the last two
     // steps; the oldest point is the state after the oldest recording step shown.
-    let px_per_m = (h as f32 / 2.0) / (3.0 * (22.5f32).to_radians().tan());
-    let to_px = |x: f32| w as f32 / 2.0 + x * px_per_m;
+    let to_px = |x: f32| side_view_px(x, (w, h));
     let after = |k: i64| -1.0 + 1.2 * (k as f32 + 0.5) * DT;
     let last_step = i64::from(frames) - 1;
     let (head_lo, head_hi) = (to_px(after(last_step - 1)), to_px(after(last_step)));
@@ -155,9 +173,7 @@ fn the_ribbon_lights_the_pixels_between_the_particle_and_its_tail() {
         .expect("points");
     let tail = to_px(after(oldest_step));
     let row = h / 2;
-    let lit: Vec<u32> = (0..w)
-        .filter(|&x| image.get_pixel(x, row)[0] > 40)
-        .collect();
+    let lit = lit_pixels(&image, row);
     let (first, last) = (*lit.first().expect("lit pixels"), *lit.last().expect("lit"));
     assert!(
         (first as f32 - tail).abs() <= 2.0
@@ -328,16 +344,7 @@ fn a_ribbon_per_parent_lights_the_pixels_between_the_children() {
         draw_sprite: false,
         ..Trail::default()
     });
-    effect.time.mode = TimeMode::FixedStep;
-    effect.time.step_secs = DT;
-    effect.camera = CameraHint {
-        target_m: [0.0, 1.0, 0.0],
-        distance_m: 3.0,
-        yaw_deg: 0.0,
-        pitch_deg: 0.0,
-        fov_y_deg: 45.0,
-    };
-    effect.post.bloom = None;
+    side_view(&mut effect);
     effect.validate().expect("valid");
     let mut run =
         ignis::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
@@ -360,13 +367,10 @@ fn a_ribbon_per_parent_lights_the_pixels_between_the_children() {
     );
     let (w, h) = (320u32, 240u32);
     let image = run.render((w, h)).expect("render");
-    let px_per_m = (h as f32 / 2.0) / (3.0 * (22.5f32).to_radians().tan());
-    let to_px = |x: f32| w as f32 / 2.0 + x * px_per_m;
+    let to_px = |x: f32| side_view_px(x, (w, h));
     let (a, b) = (to_px(xs[0]), to_px(xs[1]));
     let row = h / 2;
-    let lit: Vec<u32> = (0..w)
-        .filter(|&x| image.get_pixel(x, row)[0] > 40)
-        .collect();
+    let lit = lit_pixels(&image, row);
     let (first, last) = (*lit.first().expect("lit pixels"), *lit.last().expect("lit"));
     assert!(
         (first as f32 - a).abs() <= 2.0 && (last as f32 - b).abs() <= 2.0,

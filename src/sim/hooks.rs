@@ -112,13 +112,15 @@ fn storage_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer
     })
 }
 
-/// What an emitter's hook buffers were made for: capacity, rules, list length, and the
-/// trail's ring (points, steps between them, mode).
+/// What an emitter's hook buffers were made for: capacity, rules, list length, the
+/// trail's ring (points, steps between them, mode), and which rules' children are linked
+/// into ribbons per parent.
 type HooksKey = (
     u32,
     [EventRule; MAX_EVENTS_PER_EMITTER],
     u32,
     Option<(u32, u32, TrailMode)>,
+    [bool; MAX_EVENTS_PER_EMITTER],
 );
 
 /// One emitter's hook buffers: its event records (a parent), its spawn list (a child) and
@@ -182,7 +184,20 @@ impl EmitterHooks {
             return None;
         }
         let rules = rules_of(e);
-        let key = (capacity, rules, list_len, trail);
+        let children: Vec<usize> = e
+            .events
+            .iter()
+            .filter_map(|ev| effect.event_target(ev))
+            .collect();
+        let mut linked = [false; MAX_EVENTS_PER_EMITTER];
+        for (l, &child) in linked.iter_mut().zip(&children) {
+            *l = effect.emitters[child]
+                .look
+                .trail
+                .as_ref()
+                .is_some_and(|t| t.mode == TrailMode::PerParent);
+        }
+        let key = (capacity, rules, list_len, trail, linked);
         if let Some(old) = old.filter(|o| o.key == key) {
             return Some(old);
         }
@@ -231,11 +246,10 @@ impl EmitterHooks {
                 },
             ],
         });
-        let scans = e
-            .events
-            .iter()
-            .filter_map(|ev| effect.event_target(ev))
-            .map(|child| Scan {
+        let scans = children
+            .into_iter()
+            .zip(linked)
+            .map(|(child, linked)| Scan {
                 child,
                 config: device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("EmitterHooks::scan_config"),
@@ -243,13 +257,14 @@ impl EmitterHooks {
                     usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                     mapped_at_creation: false,
                 }),
-                // Where the list starts, a sum per block, each parent slot's last child.
+                // Where the list starts, a sum per block, and for a ribbon per parent each
+                // parent slot's last child.
                 blocks: storage_buffer(
                     device,
                     "EmitterHooks::scan_blocks",
                     4 * (1
                         + u64::from(capacity.div_ceil(EVENT_SCAN_BLOCK))
-                        + 2 * u64::from(capacity)),
+                        + if linked { 2 * u64::from(capacity) } else { 0 }),
                 ),
                 group: None,
                 written: None,

@@ -1,0 +1,22 @@
+// workgroup_scan.wgsl — an inclusive prefix sum over a workgroup of 256 invocations
+// (Hillis–Steele in workgroup memory), shared by the event scan (events.wgsl) and the
+// tiles' binning (tiles.wgsl).
+
+var<workgroup> sums: array<u32, 256>;
+
+// The inclusive sum of `v` over invocations 0..=lid; every invocation of the workgroup
+// must call it. `sums[255]` then holds the total (read it before the next call).
+fn workgroup_inclusive(lid: u32, v: u32) -> u32 {
+    sums[lid] = v;
+    workgroupBarrier();
+    for (var d = 1u; d < 256u; d *= 2u) {
+        var x = sums[lid];
+        if lid >= d {
+            x += sums[lid - d];
+        }
+        workgroupBarrier();
+        sums[lid] = x;
+        workgroupBarrier();
+    }
+    return sums[lid];
+}
