@@ -644,15 +644,23 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
             n = min(BLOCK, job.counts.z - c * BLOCK);
         }
         let region = bin_meta[meta_start(b)] + bin_meta[meta_local(b, c)];
+        // The next chunk's entry is read while this one is shaded (its latency hidden).
+        var next = 0u;
+        if !overflow && lid < n {
+            next = bin_lists[region + lid];
+        }
         for (var base = 0u; base < n; base += 256u) {
             // The chunk's sprites of this item over this tile, in order.
             var hit = false;
             var s = 0u;
+            let e = next;
+            if !overflow && base + 256u + lid < n {
+                next = bin_lists[region + base + 256u + lid];
+            }
             if base + lid < n && overflow {
                 s = c * BLOCK + base + lid;
                 hit = s >= first && s < end && overlaps(sprites[s].bounds, tile_rect);
             } else if base + lid < n {
-                let e = bin_lists[region + base + lid];
                 s = c * BLOCK + (e & SPRITE_MASK);
                 let t = (vec4<u32>(e) >> vec4<u32>(10u, 13u, 16u, 19u)) & vec4<u32>(7u);
                 hit = s >= first && s < end && all(local >= t.xy) && all(local <= t.zw);
