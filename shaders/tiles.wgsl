@@ -222,7 +222,8 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
 }
 
 var<workgroup> bits: array<atomic<u32>, 8>;
-var<workgroup> hits: array<u32, 256>;
+// The shade's hits waiting for a batch: fewer than CACHE carried over plus a chunk's.
+var<workgroup> hits: array<u32, 320>;
 var<workgroup> shared_total: u32;
 var<workgroup> shared_count: u32;
 var<workgroup> shared_flag: u32;
@@ -631,6 +632,8 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
         acc = vec4<f32>(unpack2x16float(v.x), unpack2x16float(v.y));
     }
     var shaded = false;
+    // Hits waiting in `hits` (the same in every invocation).
+    var pending = 0u;
     // A bin whose list did not fit the lists' capacity: its blocks' sprites are read
     // directly (slower, never a sprite lost).
     let overflow = bin_meta[meta_start(b + 1u)] > job.counts.w;
@@ -667,29 +670,55 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
             }
             let at = compact(lid, hit);
             if hit {
-                hits[at] = s;
+                hits[pending + at] = s;
             }
-            let total = workgroupUniformLoad(&shared_total);
-            shaded = shaded || total > 0u;
-            // The hits, 64 at a time: their records read once into workgroup memory (one
-            // invocation each), then every pixel reads them from there.
-            for (var sub = 0u; sub < total; sub += CACHE) {
-                if lid < CACHE && sub + lid < total {
-                    cache_sprite(lid, hits[sub + lid]);
+            pending += workgroupUniformLoad(&shared_total);
+            shaded = shaded || pending > 0u;
+            // Whole batches of CACHE hits: their records read once into workgroup memory
+            // (one invocation each), then every pixel reads them from there. Fewer wait
+            // for the next chunk's.
+            var done = 0u;
+            while pending - done >= CACHE {
+                if lid < CACHE {
+                    cache_sprite(lid, hits[done + lid]);
                 }
                 workgroupBarrier();
-                let m = min(CACHE, total - sub);
                 if inside {
-                    for (var k = 0u; k < m; k++) {
-                        acc = shade_sprite(hits[sub + k], k, p, acc);
+                    for (var k = 0u; k < CACHE; k++) {
+                        acc = shade_sprite(hits[done + k], k, p, acc);
                     }
                 }
                 workgroupBarrier();
+                done += CACHE;
+            }
+            if done > 0u {
+                // The rest (fewer than CACHE) to the front.
+                var v = 0u;
+                if lid < pending - done {
+                    v = hits[done + lid];
+                }
+                workgroupBarrier();
+                if lid < pending - done {
+                    hits[lid] = v;
+                }
+                pending -= done;
             }
             workgroupBarrier();
         }
         // No invocation reads this block's count once the next is written.
         workgroupBarrier();
+    }
+    // The last hits.
+    if pending > 0u {
+        if lid < pending {
+            cache_sprite(lid, hits[lid]);
+        }
+        workgroupBarrier();
+        if inside {
+            for (var k = 0u; k < pending; k++) {
+                acc = shade_sprite(hits[k], k, p, acc);
+            }
+        }
     }
     if inside && shaded {
         accum[pixel] = vec2<u32>(pack2x16float(acc.rg), pack2x16float(acc.ba));
