@@ -61,17 +61,18 @@ const PER_THREAD: u32 = 4u;
 const BLOCK: u32 = 1024u;
 
 
-// The children of the i-th slot of the parent's window.
-fn count_of(i: u32) -> u32 {
+// The count word of the i-th slot of the parent's window (its children, BORN_BIT when
+// born this step); 0 past the window.
+fn slot_word(i: u32) -> u32 {
     if i >= params.update_window.y {
         return 0u;
     }
-    return event_out.words[cfg.rule_capacity_cap.x * params.capacity + window_slot(i)] & ~BORN_BIT;
+    return event_out.words[cfg.rule_capacity_cap.x * params.capacity + window_slot(i)];
 }
 
-// Whether the particle in the i-th slot of the parent's window was born this step.
-fn born_at(i: u32) -> bool {
-    return (event_out.words[cfg.rule_capacity_cap.x * params.capacity + window_slot(i)] & BORN_BIT) != 0u;
+// The children of the i-th slot of the parent's window.
+fn count_of(i: u32) -> u32 {
+    return slot_word(i) & ~BORN_BIT;
 }
 
 // Where parent `slot`'s last child (slot, stamp) is kept in the scratch.
@@ -128,12 +129,10 @@ fn scan_blocks(@builtin(local_invocation_index) lid: u32) {
         if i < n_blocks {
             v = blocks[1u + i];
         }
-        let incl = workgroup_inclusive(lid, v);
+        let at = running_exclusive(lid, v, &running);
         if i < n_blocks {
-            blocks[1u + i] = running + incl - v;
+            blocks[1u + i] = at;
         }
-        running += sums[GROUP - 1u];
-        workgroupBarrier();
     }
     if lid == 0u {
         if event_in.stamp != params.tiny_b.z {
@@ -170,10 +169,11 @@ fn write_list(
     let flags = cfg.rule_capacity_cap.w;
     for (var k = 0u; k < PER_THREAD; k++) {
         let slot = window_slot(first + k);
-        if (flags & RIBBON) != 0u && first + k < params.update_window.y && born_at(first + k) {
+        let word = slot_word(first + k);
+        if (flags & RIBBON) != 0u && (word & BORN_BIT) != 0u {
             blocks[last_child_at(slot)] = NO_LINK;
         }
-        let c = count_of(first + k);
+        let c = word & ~BORN_BIT;
         if c == 0u {
             continue;
         }

@@ -360,15 +360,13 @@ fn bin_scan(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_inde
         if c < blocks {
             v = bin_meta[meta_count(b, c)];
         }
-        let incl = workgroup_inclusive(lid, v);
+        let at = running_exclusive(lid, v, &running);
         if c < blocks {
-            bin_meta[meta_local(b, c)] = running + incl - v;
+            bin_meta[meta_local(b, c)] = at;
             if v > 0u {
                 atomicOr(&item_hit[item_of(c * BLOCK)], 1u);
             }
         }
-        running += sums[255];
-        workgroupBarrier();
     }
     if lid == 0u {
         bin_meta[meta_total(b)] = running;
@@ -390,12 +388,10 @@ fn bin_starts(@builtin(local_invocation_index) lid: u32) {
         if b < bins {
             v = bin_meta[meta_total(b)];
         }
-        let incl = workgroup_inclusive(lid, v);
+        let at = running_exclusive(lid, v, &running);
         if b < bins {
-            bin_meta[meta_start(b)] = running + incl - v;
+            bin_meta[meta_start(b)] = at;
         }
-        running += sums[255];
-        workgroupBarrier();
     }
     if lid == 0u {
         bin_meta[meta_start(bins)] = running;

@@ -1,5 +1,5 @@
-// workgroup_scan.wgsl — an inclusive prefix sum over a workgroup of 256 invocations
-// (Hillis–Steele in workgroup memory), shared by the event scan (events.wgsl) and the
+// workgroup_scan.wgsl — prefix sums over a workgroup of 256 invocations (Hillis–Steele
+// in workgroup memory), shared by the event scan (events.wgsl) and the
 // tiles' binning (tiles.wgsl).
 
 var<workgroup> sums: array<u32, 256>;
@@ -19,4 +19,14 @@ fn workgroup_inclusive(lid: u32, v: u32) -> u32 {
         workgroupBarrier();
     }
     return sums[lid];
+}
+
+// One chunk of a running exclusive scan over many chunks of 256: the place of `v` after
+// `*running` and the earlier invocations' values; `*running` grows by the chunk's total.
+// Every invocation calls it with the same `*running`.
+fn running_exclusive(lid: u32, v: u32, running: ptr<function, u32>) -> u32 {
+    let at = *running + workgroup_inclusive(lid, v) - v;
+    *running += sums[255];
+    workgroupBarrier();
+    return at;
 }

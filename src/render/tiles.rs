@@ -495,7 +495,7 @@ impl TilePass {
                 if self.stages == TileStages::Project {
                     return false;
                 }
-                self.record_bins(&mut pass, frame, size, total as u32 / BLOCK);
+                self.record_bins(&mut pass, frame, b, size, total as u32 / BLOCK);
                 if self.stages == TileStages::Bin {
                     return false;
                 }
@@ -519,7 +519,8 @@ impl TilePass {
                     let (x, y) = dispatch_size((d.width * d.members).next_multiple_of(BLOCK));
                     pass.dispatch_workgroups(x, y, 1);
                 } else {
-                    // Only the bins holding some of the item's sprites (the bin counts them).
+                    // Only the bins holding some of the item's sprites (the bin scan lists
+                    // them).
                     pass.dispatch_workgroups_indirect(&b.dispatch_args, k as u64 * 16);
                 }
             }
@@ -535,12 +536,10 @@ impl TilePass {
         &self,
         pass: &mut wgpu::ComputePass<'_>,
         frame: &FrameResources,
+        b: &TileBuffers,
         size: (u32, u32),
         blocks: u32,
     ) {
-        let Some(b) = self.buffers.as_ref() else {
-            return;
-        };
         pass.set_bind_group(0, &frame.frame_group, &[0]);
         pass.set_bind_group(1, &self.empty_group, &[]);
         pass.set_bind_group(2, &self.empty_group, &[]);
