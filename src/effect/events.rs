@@ -233,12 +233,7 @@ impl Effect {
                     c.push(p("max_per_step"), ev.max_per_step, "must be in 1..=1048576");
                 }
             }
-            let per_parent = e
-                .look
-                .trail
-                .as_ref()
-                .is_some_and(|t| t.mode == super::TrailMode::PerParent);
-            if per_parent && !self.event_fed(i) {
+            if e.look.ribbon_per_parent() && !self.event_fed(i) {
                 c.push(
                     format!("emitters[{i}].look.trail.mode"),
                     "PerParent",

@@ -130,3 +130,13 @@ impl Trail {
         }
     }
 }
+
+impl super::Look {
+    /// Whether the look draws a ribbon per parent (its particles linked by the events that
+    /// spawn them).
+    pub fn ribbon_per_parent(&self) -> bool {
+        self.trail
+            .as_ref()
+            .is_some_and(|t| t.mode == TrailMode::PerParent)
+    }
+}

@@ -4,7 +4,7 @@ use std::collections::{HashMap, VecDeque};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
-use crate::effect::{CURVE_WIDTH, Effect, Integrator, TrailMode, rows_key};
+use crate::effect::{CURVE_WIDTH, Effect, Integrator, rows_key};
 use crate::gpu::types::{
     Birth, PARAMS_STRIDE, PackedParticle, Particle, SimParams, StateLayout, double_single,
     slot_counter, tiny_decode,
@@ -691,12 +691,10 @@ impl GpuSim {
             .iter()
             .zip(&self.emitters)
             .map(|(e, s)| {
-                let per_parent =
-                    e.look.trail.as_ref().map(|t| t.mode) == Some(TrailMode::PerParent);
                 s.hooks
                     .as_ref()
                     .and_then(|ev| ev.trail.clone())
-                    .filter(|_| per_parent)
+                    .filter(|_| e.look.ribbon_per_parent())
             })
             .collect();
         for s in &mut self.emitters {
@@ -1013,17 +1011,12 @@ impl GpuSim {
             for (k, (scan, ev)) in hooks.scans.iter().zip(&e.events).enumerate() {
                 let delta = (origin(i) - origin(scan.child)).as_vec3();
                 let child_capacity = self.emitters.get(scan.child).map_or(1, |c| c.capacity);
-                let ribbon = effect
-                    .emitters
-                    .get(scan.child)
-                    .and_then(|c| c.look.trail.as_ref())
-                    .is_some_and(|t| t.mode == TrailMode::PerParent);
                 let cfg = ScanConfig {
                     rule_capacity_cap: [
                         k as u32,
                         child_capacity,
                         crate::sim::events::step_cap(effect, i, k),
-                        scan_flags(ev.inherit_color, ribbon),
+                        scan_flags(ev.inherit_color, scan.linked),
                     ],
                     delta_inherit: [delta.x, delta.y, delta.z, ev.inherit_velocity],
                 };

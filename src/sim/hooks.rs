@@ -153,6 +153,9 @@ pub struct Scan {
     pub blocks: wgpu::Buffer,
     /// Group 0 of the scan (the parent's params at a dynamic offset).
     pub group: Option<wgpu::BindGroup>,
+    /// Whether the scan links the children into ribbons per parent (its scratch keeps
+    /// each parent slot's last child).
+    pub linked: bool,
     /// What `config` holds (written again only when it changes: the simulation spaces'
     /// origins move only at a restart).
     pub written: Option<ScanConfig>,
@@ -191,11 +194,7 @@ impl EmitterHooks {
             .collect();
         let mut linked = [false; MAX_EVENTS_PER_EMITTER];
         for (l, &child) in linked.iter_mut().zip(&children) {
-            *l = effect.emitters[child]
-                .look
-                .trail
-                .as_ref()
-                .is_some_and(|t| t.mode == TrailMode::PerParent);
+            *l = effect.emitters[child].look.ribbon_per_parent();
         }
         let key = (capacity, rules, list_len, trail, linked);
         if let Some(old) = old.filter(|o| o.key == key) {
@@ -267,6 +266,7 @@ impl EmitterHooks {
                         + if linked { 2 * u64::from(capacity) } else { 0 }),
                 ),
                 group: None,
+                linked,
                 written: None,
             })
             .collect();

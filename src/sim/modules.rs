@@ -99,11 +99,7 @@ impl Modules {
         }
         // A ribbon per parent records nothing in the update (the event scan links the
         // children).
-        if e.look
-            .trail
-            .as_ref()
-            .is_some_and(|t| t.mode == crate::effect::TrailMode::History)
-        {
+        if e.look.trail.is_some() && !e.look.ribbon_per_parent() {
             m.0 |= Self::TRAIL.0;
         }
         if !e.events.is_empty() {
