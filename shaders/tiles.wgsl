@@ -40,7 +40,7 @@ var<private> look: LookUniform;
 @group(2) @binding(1) var sprite_sampler: sampler;
 @group(3) @binding(0) var<storage, read_write> sprites: array<TileSprite>;
 @group(3) @binding(1) var<storage, read_write> touched: array<atomic<u32>>;
-@group(3) @binding(2) var<storage, read_write> bin_lists: array<u32>;
+@group(3) @binding(2) var<storage, read_write> bin_lists: array<vec2<u32>>;
 @group(3) @binding(3) var<storage, read_write> bin_meta: array<u32>;
 @group(3) @binding(4) var<storage, read_write> accum: array<vec2<u32>>;
 @group(3) @binding(5) var scene_depth: texture_depth_2d;
@@ -65,9 +65,8 @@ const BIN: u32 = 128u;
 const MAX_ITEMS: u32 = 55u;
 // `touched`: the draw arguments (4), then a flag per tile, then the shaded tiles' list.
 const TOUCHED_FLAGS: u32 = 4u;
-// A bin list entry: the sprite within its block (10 bits), then the first and last tile
-// of the bin it covers (x0, y0, x1, y1, 3 bits each).
-const SPRITE_MASK: u32 = 0x3FFu;
+// A bin list entry: x the sprite, y the first and last tile of the bin it covers (x0, y0,
+// x1, y1, 3 bits each).
 // Sprites a bin workgroup lists (keep in sync with src/render/tiles.rs); each item's
 // sprites start at a multiple of it, so that a block holds one item's.
 const BLOCK: u32 = 1024u;
@@ -431,7 +430,7 @@ fn bin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<
             // The tiles of this bin it covers ride along: the shade tests them without
             // reading the sprite.
             let t = vec4<u32>(clamp((r - vec4<i32>(lo, lo)) / i32(TILE), vec4<i32>(0), vec4<i32>(i32(BIN_TILES) - 1)));
-            bin_lists[region + count + at] = (i - start) | (t.x << 10u) | (t.y << 13u) | (t.z << 16u) | (t.w << 19u);
+            bin_lists[region + count + at] = vec2<u32>(i, t.x | (t.y << 3u) | (t.z << 6u) | (t.w << 9u));
         }
         count += workgroupUniformLoad(&shared_total);
     }
@@ -485,14 +484,14 @@ fn view_distance(depth: f32) -> f32 {
     return -(k.x * depth + k.y) / (k.z * depth + k.w);
 }
 
-// Sprite `i` (cached in slot `k` of the workgroup's sprite cache) at pixel `p` blended into
-// `acc` (rgb: premultiplied colour, a: coverage, 1 − the transmittance).
-fn shade_sprite(i: u32, k: u32, p: vec2<i32>, acc: vec4<f32>) -> vec4<f32> {
+// Sprite `i` (cached in slot `k` of the workgroup's sprite cache) at pixel `p`: its
+// premultiplied colour and coverage (zero where it draws nothing).
+fn sprite_light(i: u32, k: u32, p: vec2<i32>) -> vec4<f32> {
     // Outside the pixel rectangle the quad's centres lie in: nothing (most of a tile, for
     // small sprites; whole warps skip the rest).
     let r = cache_bounds[k];
     if any(p < r.xy) || any(p > r.zw) {
-        return acc;
+        return vec4<f32>(0.0);
     }
     let pc = vec2<f32>(p) + 0.5;
     let ca = cache_map[k];
@@ -523,7 +522,7 @@ fn shade_sprite(i: u32, k: u32, p: vec2<i32>, acc: vec4<f32>) -> vec4<f32> {
     let uv_box = cache_box[k];
     // Clipped to the depth range as the rasteriser clips the billboard.
     if any(uv < uv_box.xy) || any(uv > uv_box.zw) || z < 0.0 || z > 1.0 || !visible(p, z) {
-        return acc;
+        return vec4<f32>(0.0);
     }
     let grad = cache_grad[k];
     ddx *= grad.xy;
@@ -553,13 +552,38 @@ fn shade_sprite(i: u32, k: u32, p: vec2<i32>, acc: vec4<f32>) -> vec4<f32> {
         a *= fade;
         rgb *= fade;
     }
-    var out = vec4<f32>(acc.rgb + rgb, acc.a);
+    return vec4<f32>(rgb, a);
+}
+
+// Light `c` (premultiplied colour, coverage) blended into `acc` (rgb: premultiplied colour,
+// a: coverage, 1 − the transmittance); no light leaves `acc` as it is.
+fn blend(acc: vec4<f32>, c: vec4<f32>) -> vec4<f32> {
+    var out = vec4<f32>(acc.rgb + c.rgb, acc.a);
     if SORTED {
-        out = vec4<f32>(acc.rgb * (1.0 - a) + rgb, acc.a + a * (1.0 - acc.a));
+        out = vec4<f32>(acc.rgb * (1.0 - c.a) + c.rgb, acc.a + c.a * (1.0 - acc.a));
     }
     // Rounded to f16 after every sprite, as the billboards' blending stores each one into
     // the f16 target: faint light on bright pixels is kept or lost as the billboards' is.
     return vec4<f32>(to_f16(out.rg), to_f16(out.ba));
+}
+
+// Cached sprites 0..`to` (hits `at`..) blended into `acc` at pixel `p`,
+// four at a time: their texels are fetched together (latency overlapped), then blended
+// in order.
+fn shade_cached(to: u32, at: u32, p: vec2<i32>, acc_in: vec4<f32>) -> vec4<f32> {
+    var acc = acc_in;
+    var k = 0u;
+    for (; k + 4u <= to; k += 4u) {
+        let c0 = sprite_light(hits[at + k], k, p);
+        let c1 = sprite_light(hits[at + k + 1u], k + 1u, p);
+        let c2 = sprite_light(hits[at + k + 2u], k + 2u, p);
+        let c3 = sprite_light(hits[at + k + 3u], k + 3u, p);
+        acc = blend(blend(blend(blend(acc, c0), c1), c2), c3);
+    }
+    for (; k < to; k++) {
+        acc = blend(acc, sprite_light(hits[at + k], k, p));
+    }
+    return acc;
 }
 
 // Atlas coordinates of flipbook frame `frame` at frame coordinates `uv` ∈ [-1, 1]² (y up),
@@ -605,7 +629,7 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
     if tile_xy.x >= tiles_x || tile_xy.y * TILE >= u32(camera.viewport.y) {
         return;
     }
-    // The item's sprites, block by block of the bin's lists.
+    // The item's sprites.
     let first = job.counts.x;
     let end = first + job.counts.y;
     if end == first {
@@ -630,78 +654,75 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
     var shaded = false;
     // Hits waiting in `hits` (the same in every invocation).
     var pending = 0u;
-    // A bin whose list did not fit the lists' capacity: its blocks' sprites are read
-    // directly (slower, never a sprite lost).
+    // The item's entries in the bin's list: its blocks', one after another. A bin whose
+    // list did not fit the lists' capacity is shaded from the item's sprites directly
+    // (slower, never a sprite lost).
+    let c0 = first / BLOCK;
+    let c1 = (end - 1u) / BLOCK;
     let overflow = bin_meta[meta_start(b + 1u)] > job.counts.w;
+    if lid == 0u {
+        let before = bin_meta[meta_local(b, c0)];
+        shared_bin = bin_meta[meta_start(b)] + before;
+        shared_count = select(bin_meta[meta_local(b, c1)] + bin_meta[meta_count(b, c1)] - before, end - first, overflow);
+    }
+    let region = workgroupUniformLoad(&shared_bin);
+    let n = workgroupUniformLoad(&shared_count);
     let tile_rect = vec4<i32>(origin, origin + i32(TILE) - 1);
-    for (var c = first / BLOCK; c <= (end - 1u) / BLOCK; c++) {
-        if lid == 0u {
-            shared_count = bin_meta[meta_count(b, c)];
+    // The next chunk's entry is read while this one is shaded (its latency hidden).
+    var next = vec2<u32>(0u);
+    if !overflow && lid < n {
+        next = bin_lists[region + lid];
+    }
+    for (var base = 0u; base < n; base += 256u) {
+        // The chunk's sprites of this item over this tile, in order.
+        let i = base + lid;
+        let e = next;
+        if !overflow && i + 256u < n {
+            next = bin_lists[region + i + 256u];
         }
-        var n = workgroupUniformLoad(&shared_count);
-        if overflow && n > 0u {
-            n = min(BLOCK, job.counts.z - c * BLOCK);
+        var hit = false;
+        var s = 0u;
+        if i < n && overflow {
+            s = first + i;
+            hit = overlaps(sprites[s].bounds, tile_rect);
+        } else if i < n {
+            s = e.x;
+            let t = (vec4<u32>(e.y) >> vec4<u32>(0u, 3u, 6u, 9u)) & vec4<u32>(7u);
+            hit = all(local >= t.xy) && all(local <= t.zw);
         }
-        let region = bin_meta[meta_start(b)] + bin_meta[meta_local(b, c)];
-        // The next chunk's entry is read while this one is shaded (its latency hidden).
-        var next = 0u;
-        if !overflow && lid < n {
-            next = bin_lists[region + lid];
+        let at = compact(lid, hit);
+        if hit {
+            hits[pending + at] = s;
         }
-        for (var base = 0u; base < n; base += 256u) {
-            // The chunk's sprites of this item over this tile, in order.
-            var hit = false;
-            var s = 0u;
-            let e = next;
-            if !overflow && base + 256u + lid < n {
-                next = bin_lists[region + base + 256u + lid];
-            }
-            if base + lid < n && overflow {
-                s = c * BLOCK + base + lid;
-                hit = s >= first && s < end && overlaps(sprites[s].bounds, tile_rect);
-            } else if base + lid < n {
-                s = c * BLOCK + (e & SPRITE_MASK);
-                let t = (vec4<u32>(e) >> vec4<u32>(10u, 13u, 16u, 19u)) & vec4<u32>(7u);
-                hit = s >= first && s < end && all(local >= t.xy) && all(local <= t.zw);
-            }
-            let at = compact(lid, hit);
-            if hit {
-                hits[pending + at] = s;
-            }
-            pending += workgroupUniformLoad(&shared_total);
-            shaded = shaded || pending > 0u;
-            // Whole batches of CACHE hits: their records read once into workgroup memory
-            // (one invocation each), then every pixel reads them from there. Fewer wait
-            // for the next chunk's.
-            var done = 0u;
-            while pending - done >= CACHE {
-                if lid < CACHE {
-                    cache_sprite(lid, hits[done + lid]);
-                }
-                workgroupBarrier();
-                if inside {
-                    for (var k = 0u; k < CACHE; k++) {
-                        acc = shade_sprite(hits[done + k], k, p, acc);
-                    }
-                }
-                workgroupBarrier();
-                done += CACHE;
-            }
-            if done > 0u {
-                // The rest (fewer than CACHE) to the front.
-                var v = 0u;
-                if lid < pending - done {
-                    v = hits[done + lid];
-                }
-                workgroupBarrier();
-                if lid < pending - done {
-                    hits[lid] = v;
-                }
-                pending -= done;
+        pending += workgroupUniformLoad(&shared_total);
+        shaded = shaded || pending > 0u;
+        // Whole batches of CACHE hits: their records read once into workgroup memory
+        // (one invocation each), then every pixel reads them from there. Fewer wait for
+        // the next chunk's.
+        var done = 0u;
+        while pending - done >= CACHE {
+            if lid < CACHE {
+                cache_sprite(lid, hits[done + lid]);
             }
             workgroupBarrier();
+            if inside {
+                acc = shade_cached(CACHE, done, p, acc);
+            }
+            workgroupBarrier();
+            done += CACHE;
         }
-        // No invocation reads this block's count once the next is written.
+        if done > 0u {
+            // The rest (fewer than CACHE) to the front.
+            var v = 0u;
+            if lid < pending - done {
+                v = hits[done + lid];
+            }
+            workgroupBarrier();
+            if lid < pending - done {
+                hits[lid] = v;
+            }
+            pending -= done;
+        }
         workgroupBarrier();
     }
     // The last hits.
@@ -711,9 +732,7 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
         }
         workgroupBarrier();
         if inside {
-            for (var k = 0u; k < pending; k++) {
-                acc = shade_sprite(hits[k], k, p, acc);
-            }
+            acc = shade_cached(pending, 0u, p, acc);
         }
     }
     if inside && shaded {

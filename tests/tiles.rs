@@ -242,11 +242,12 @@ fn sprites_across_tile_borders_and_larger_than_the_screen_keep_their_light() {
 #[test]
 fn a_tile_with_more_sprites_than_a_workgroup_keeps_every_sprite() {
     let ctx = gpu();
-    // 1000 sprites on the same tiles: four chunks of the shade's 256-wide loop.
-    let effect = pile(1000.0, 0.5, [0.0; 3]);
-    // The billboards draw every sprite: a dropped chunk of 256 would take a quarter of
-    // the light.
-    light_agrees(&ctx, "1000 deep", &effect);
+    // 3000 sprites on the same tiles: twelve chunks of the shade's 256 list entries, 46
+    // batches of its sprite cache, hits carried from chunk to chunk.
+    let effect = pile(3000.0, 0.5, [0.0; 3]);
+    // The billboards draw every sprite: a dropped chunk of 256 would take a twelfth of the
+    // light, a dropped batch of 64 two percent.
+    light_agrees(&ctx, "3000 deep", &effect);
 }
 
 #[test]

@@ -39,6 +39,8 @@ const JOB_STRIDE: u64 = 256;
 /// The bins' lists take at most this many bytes: a frame whose lists need more shades its
 /// overflowing bins from the sprites directly.
 const MAX_LIST_BYTES: u64 = 128 << 20;
+/// Bytes per list entry: the sprite and the bin's tiles it covers.
+const LIST_ENTRY_BYTES: u64 = 8;
 
 /// The module, the basic variant's pipelines (built to validate the module), the bin
 /// pipelines and the resolve.
@@ -167,7 +169,7 @@ fn list_entries(order: &[&DrawItem], size: (u32, u32), sprites: u32, limit: u64)
         })
         .sum();
     let estimate = (2.0 * covered) as u64;
-    let cap = (limit.min(MAX_LIST_BYTES) / 4).min(u64::from(u32::MAX));
+    let cap = (limit.min(MAX_LIST_BYTES) / LIST_ENTRY_BYTES).min(u64::from(u32::MAX));
     // In powers of two: room to grow before the buffer is made again.
     every
         .min(estimate.max(1 << 20).next_power_of_two())
@@ -655,7 +657,11 @@ impl TilePass {
         let lists = [
             buffer("TilePass::sprites", c * SPRITE_BYTES, none),
             buffer("TilePass::touched", touched_words * 4, indirect),
-            buffer("TilePass::bin_lists", u64::from(list_capacity) * 4, none),
+            buffer(
+                "TilePass::bin_lists",
+                u64::from(list_capacity) * LIST_ENTRY_BYTES,
+                none,
+            ),
             buffer("TilePass::bin_meta", meta_words * 4, none),
             buffer(
                 "TilePass::accum",
