@@ -104,11 +104,13 @@ struct TileSprite {
     uv_box: vec4<f32>,
     // Premultiplied colour (× intensity when additive).
     color: vec4<f32>,
-    // x, y: the flipbook frames, z: the next frame's weight.
+    // The atlas coordinates at frame coordinates (0, 0) of the flipbook frame (xy) and of
+    // the next one it blends into (zw).
     frames: vec4<f32>,
     // The ground fade's argument as an affine function of (uv, 1).
     ground: vec4<f32>,
-    // xy: atlas coordinates per unit of frame coordinates (the derivatives' scale).
+    // xy: atlas coordinates per unit of frame coordinates (the derivatives' scale), z: the
+    // next frame's weight, w: the soft edges' 1 / distance.
     grad: vec4<f32>,
 }
 
@@ -192,19 +194,24 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
     }
     s.uv_box = vec4<f32>(min(c0.uv, c3.uv), max(c0.uv, c3.uv));
     s.color = qd.color;
+    // The flipbook's cells, found here once: the shade maps frame coordinates to the
+    // atlas with one multiply-add (the look's `atlas_uv`, rearranged).
+    var frames = vec3<f32>(0.0);
+    var grid = vec2<u32>(1u);
     if FLIPBOOK {
-        s.frames = vec4<f32>(quad_frames(qd), 0.0);
+        frames = quad_frames(qd);
+        grid = vec2<u32>(max(look.ids.w, 1u), max(look.ids.z, 1u));
     }
+    s.frames = vec4<f32>(cell_centre(frames.x, grid), cell_centre(frames.y, grid));
     if SOFT {
         let g0 = ground_fade_arg(c0.world);
         let gu = (ground_fade_arg(c1.world) - g0) / du;
         let gv = (ground_fade_arg(c2.world) - g0) / dv;
         s.ground = vec4<f32>(gu, gv, g0 - gu * c0.uv.x - gv * c0.uv.y, 0.0);
     }
-    // The flipbook's columns and rows, and the soft edges' 1 / distance: the shade reads
-    // nothing of the look (a private copy of it per invocation costs registers).
-    s.grad = vec4<f32>(atlas_scale(), f32(max(look.ids.w, 1u)), f32(max(look.ids.z, 1u)));
-    s.frames.w = look.soft.y;
+    // The shade reads nothing of the look (a private copy of it per invocation costs
+    // registers).
+    s.grad = vec4<f32>(atlas_scale(), frames.z, look.soft.y);
     sprites[index] = s;
     // Pixel centres (x + 0.5) inside the quad's bounding box, clamped to the target.
     let p0 = to_pixels(c0.clip);
@@ -529,14 +536,10 @@ fn sprite_light(i: u32, k: u32, p: vec2<i32>) -> vec4<f32> {
     ddy *= grad.xy;
     let uv1 = vec3<f32>(uv, 1.0);
     let frames = cache_frames[k];
-    var t0 = vec2<f32>(uv.x * 0.5 + 0.5, 0.5 - uv.y * 0.5);
-    if FLIPBOOK {
-        t0 = cell_uv(frames.x, uv, grad.zw);
-    }
-    var tex = textureSampleGrad(sprite_tex, sprite_sampler, t0, ddx, ddy);
+    var tex = textureSampleGrad(sprite_tex, sprite_sampler, uv * grad.xy + frames.xy, ddx, ddy);
     if FLIPBOOK && FLIP_BLEND {
-        let t1 = cell_uv(frames.y, uv, grad.zw);
-        tex = mix(tex, textureSampleGrad(sprite_tex, sprite_sampler, t1, ddx, ddy), frames.z);
+        let next = textureSampleGrad(sprite_tex, sprite_sampler, uv * grad.xy + frames.zw, ddx, ddy);
+        tex = mix(tex, next, grad.z);
     }
     let color = cache_color[k];
     var a = color.a * tex.a;
@@ -548,7 +551,7 @@ fn sprite_light(i: u32, k: u32, p: vec2<i32>) -> vec4<f32> {
     }
     if SOFT_DEPTH {
         let scene = textureLoad(scene_depth, p, 0);
-        let fade = clamp((view_distance(scene) - view_distance(z)) * frames.w, 0.0, 1.0);
+        let fade = clamp((view_distance(scene) - view_distance(z)) * grad.w, 0.0, 1.0);
         a *= fade;
         rgb *= fade;
     }
@@ -567,32 +570,76 @@ fn blend(acc: vec4<f32>, c: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(to_f16(out.rg), to_f16(out.ba));
 }
 
-// Cached sprites 0..`to` (hits `at`..) blended into `acc` at pixel `p`,
-// four at a time: their texels are fetched together (latency overlapped), then blended
-// in order.
-fn shade_cached(to: u32, at: u32, p: vec2<i32>, acc_in: vec4<f32>) -> vec4<f32> {
-    var acc = acc_in;
-    var k = 0u;
-    for (; k + 4u <= to; k += 4u) {
-        let c0 = sprite_light(hits[at + k], k, p);
-        let c1 = sprite_light(hits[at + k + 1u], k + 1u, p);
-        let c2 = sprite_light(hits[at + k + 2u], k + 2u, p);
-        let c3 = sprite_light(hits[at + k + 3u], k + 3u, p);
-        acc = blend(blend(blend(blend(acc, c0), c1), c2), c3);
+// Lane groups of the shade: 32 invocations (a warp on most GPUs), 8×4 pixels of the tile.
+const GROUP: u32 = 32u;
+
+// The top-left pixel of lane group `g` of the tile at `origin` (two groups across, eight
+// down).
+fn group_corner(origin: vec2<i32>, g: u32) -> vec2<i32> {
+    return origin + vec2<i32>(i32(g % 2u) * 8, i32(g / 2u) * 4);
+}
+// Per lane group, the cached sprites over its pixels (CACHE bits).
+var<workgroup> group_masks: array<atomic<u32>, 16>;
+
+// Shades a batch: hits `at`..`at + count` (count ≤ CACHE) read into the sprite cache, each
+// lane group listing the sprites over its pixels, then blended into `acc` at pixel `p` of
+// the tile at `origin`, in order. Every invocation calls it; its last reads of the cache
+// need a barrier before the cache is written again.
+fn shade_batch(lid: u32, count: u32, at: u32, origin: vec2<i32>, p: vec2<i32>, inside: bool, acc: vec4<f32>) -> vec4<f32> {
+    if lid < count {
+        cache_sprite(lid, hits[at + lid]);
     }
-    for (; k < to; k++) {
-        acc = blend(acc, sprite_light(hits[at + k], k, p));
+    if lid < 16u {
+        atomicStore(&group_masks[lid], 0u);
+    }
+    workgroupBarrier();
+    // Lane l of group g tests sprites l and l + 32 against the group's pixels.
+    let g = lid / GROUP;
+    let corner = group_corner(origin, g);
+    let block = vec4<i32>(corner, corner + vec2<i32>(7, 3));
+    for (var k = lid % GROUP; k < count; k += GROUP) {
+        if overlaps(cache_bounds[k], block) {
+            atomicOr(&group_masks[2u * g + k / 32u], 1u << (k % 32u));
+        }
+    }
+    workgroupBarrier();
+    if !inside {
+        return acc;
+    }
+    let low = shade_listed(atomicLoad(&group_masks[2u * g]), 0u, at, p, acc);
+    return shade_listed(atomicLoad(&group_masks[2u * g + 1u]), 32u, at, p, low);
+}
+
+// The cached sprites of `mask` (bit k: cache slot `first + k`, hit `at + first + k`)
+// blended into `acc` at pixel `p` in order, four at a time: their texels are fetched
+// together (the latencies overlap), then blended.
+fn shade_listed(mask: u32, first: u32, at: u32, p: vec2<i32>, acc_in: vec4<f32>) -> vec4<f32> {
+    var acc = acc_in;
+    var m = mask;
+    while m != 0u {
+        let c0 = next_light(&m, first, at, p);
+        let c1 = next_light(&m, first, at, p);
+        let c2 = next_light(&m, first, at, p);
+        let c3 = next_light(&m, first, at, p);
+        acc = blend(blend(blend(blend(acc, c0), c1), c2), c3);
     }
     return acc;
 }
 
-// Atlas coordinates of flipbook frame `frame` at frame coordinates `uv` ∈ [-1, 1]² (y up),
-// `grid` = (columns, rows): look.wgsl's `atlas_uv` without the look.
-fn cell_uv(frame: f32, uv: vec2<f32>, grid: vec2<f32>) -> vec2<f32> {
-    let cols = u32(grid.x);
+// The light at `p` of the first sprite of `*m` (none when `*m` is empty), taken off `*m`.
+fn next_light(m: ptr<function, u32>, first: u32, at: u32, p: vec2<i32>) -> vec4<f32> {
+    if *m == 0u {
+        return vec4<f32>(0.0);
+    }
+    let k = first + firstTrailingBit(*m);
+    *m &= *m - 1u;
+    return sprite_light(hits[at + k], k, p);
+}
+// The atlas coordinates of flipbook frame `frame`'s centre (frame coordinates (0, 0)) in
+// an atlas of `grid` = (columns, rows) cells: look.wgsl's `atlas_uv` at the centre.
+fn cell_centre(frame: f32, grid: vec2<u32>) -> vec2<f32> {
     let f = u32(frame);
-    let cell = vec2<f32>(f32(f % cols), f32(f / cols));
-    return (cell + vec2<f32>(uv.x * 0.5 + 0.5, 0.5 - uv.y * 0.5)) / grid;
+    return (vec2<f32>(f32(f % grid.x), f32(f / grid.x)) + 0.5) / vec2<f32>(grid);
 }
 
 // Non-negative values rounded to f16 as the adapter's blending stores them: to nearest,
@@ -615,7 +662,7 @@ fn to_f16(v: vec2<f32>) -> vec2<f32> {
 // Shades one tile with the job's item: its sprites over the tile, in draw order, into the
 // tile's pixels of `accum`.
 @compute @workgroup_size(16, 16)
-fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     // Workgroup (x, y): tile y of the x-th bin holding some of this item's sprites.
     let bins_x = (u32(camera.viewport.x) + BIN - 1u) / BIN;
     if lid == 0u {
@@ -636,7 +683,7 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
         return;
     }
     let origin = vec2<i32>(tile_xy * TILE);
-    let p = origin + vec2<i32>(l.xy);
+    let p = group_corner(origin, lid / GROUP) + vec2<i32>(i32(lid % 8u), i32(lid / 8u % 4u));
     let inside = all(vec2<f32>(p) < camera.viewport.xy);
     let pixel = u32(p.y) * u32(camera.viewport.x) + u32(p.x);
     // A tile no earlier item shaded starts empty: `accum` is not cleared between frames,
@@ -701,13 +748,7 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
         // the next chunk's.
         var done = 0u;
         while pending - done >= CACHE {
-            if lid < CACHE {
-                cache_sprite(lid, hits[done + lid]);
-            }
-            workgroupBarrier();
-            if inside {
-                acc = shade_cached(CACHE, done, p, acc);
-            }
+            acc = shade_batch(lid, CACHE, done, origin, p, inside, acc);
             workgroupBarrier();
             done += CACHE;
         }
@@ -727,13 +768,7 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l: 
     }
     // The last hits.
     if pending > 0u {
-        if lid < pending {
-            cache_sprite(lid, hits[lid]);
-        }
-        workgroupBarrier();
-        if inside {
-            acc = shade_cached(pending, 0u, p, acc);
-        }
+        acc = shade_batch(lid, pending, 0u, origin, p, inside, acc);
     }
     if inside && shaded {
         accum[pixel] = vec2<u32>(pack2x16float(acc.rg), pack2x16float(acc.ba));
