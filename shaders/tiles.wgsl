@@ -89,17 +89,17 @@ fn item_first(k: u32) -> u32 {
 }
 
 // A projected quad. Its coordinates in the sprite's frame at a pixel p (pixel units, the
-// origin at the target's top-left corner): h = inv0·p.x + inv1·p.y + inv2, uv = h.xy / h.z
-// (a projective map: the perspective-correct interpolation of the billboard's corners).
+// origin at the target's top-left corner): h = (map.xy·p.x + map.zw·p.y + offset.xy,
+// map_z·(p, 1)), uv = h.xy / h.z (a projective map: the perspective-correct interpolation
+// of the billboard's corners). A camera-facing quad's map is affine (offset.z = 1): uv =
+// h.xy; the fields after `ground` are then never written or read. The shade reads the
+// first eight fields of every sprite it meets: they fill four whole 32-byte sectors.
 struct TileSprite {
     // Pixel rectangle (x0, y0, x1, y1, inclusive; empty when x0 > x1).
     bounds: vec4<i32>,
-    inv0: vec4<f32>,
-    inv1: vec4<f32>,
-    inv2: vec4<f32>,
-    // Clip z and w as affine functions of (uv, 1).
-    z_row: vec4<f32>,
-    w_row: vec4<f32>,
+    map: vec4<f32>,
+    // xy: the map's constant terms, z: 1 when the map is affine, w: the depth then.
+    offset: vec4<f32>,
     // The quad: uv0.xy to uv1.xy (the sprite's occupied part).
     uv_box: vec4<f32>,
     // Premultiplied colour (× intensity when additive).
@@ -107,11 +107,17 @@ struct TileSprite {
     // The atlas coordinates at frame coordinates (0, 0) of the flipbook frame (xy) and of
     // the next one it blends into (zw).
     frames: vec4<f32>,
-    // The ground fade's argument as an affine function of (uv, 1).
-    ground: vec4<f32>,
     // xy: atlas coordinates per unit of frame coordinates (the derivatives' scale), z: the
     // next frame's weight, w: the soft edges' 1 / distance.
     grad: vec4<f32>,
+    // The ground fade's argument as an affine function of (uv, 1).
+    ground: vec4<f32>,
+    // A projective map's h.z row, and clip z and w as affine functions of (uv, 1).
+    map_z: vec4<f32>,
+    z_row: vec4<f32>,
+    w_row: vec4<f32>,
+    // To 192 bytes: every sprite starts on a sector.
+    pad: vec4<f32>,
 }
 
 // Pixel coordinates of a clip position.
@@ -128,23 +134,48 @@ fn atlas_scale() -> vec2<f32> {
     return vec2<f32>(0.5, -0.5);
 }
 
-// Projects quad `q` of the job's item into sprite `job.counts.x + q`: its inverse map,
-// colour, frames and pixel bounds (empty when it draws nothing).
+// Projects quad `q` of the job's item into sprite `job.counts.x + q`: its map, colour,
+// frames and pixel bounds (empty when it draws nothing). Written once, the projective
+// fields only for a projective map.
 @compute @workgroup_size(256)
 fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     let q = (wg.y * nwg.x + wg.x) * 256u + lid;
+    let index = job.counts.x + q;
     if q >= job.counts.y {
         // The rest of the item's last block: no sprite.
         if q < (job.counts.y + BLOCK - 1u) / BLOCK * BLOCK {
-            sprites[job.counts.x + q].bounds = vec4<i32>(1, 1, 0, 0);
+            sprites[index].bounds = vec4<i32>(1, 1, 0, 0);
         }
         return;
     }
-    let index = job.counts.x + q;
-    sprites[index].bounds = vec4<i32>(1, 1, 0, 0);
+    let s = project_quad(q);
+    sprites[index].bounds = s.bounds;
+    if s.bounds.x > s.bounds.z {
+        return;
+    }
+    sprites[index].map = s.map;
+    sprites[index].offset = s.offset;
+    sprites[index].uv_box = s.uv_box;
+    sprites[index].color = s.color;
+    sprites[index].frames = s.frames;
+    sprites[index].grad = s.grad;
+    if SOFT {
+        sprites[index].ground = s.ground;
+    }
+    if s.offset.z == 0.0 {
+        sprites[index].map_z = s.map_z;
+        sprites[index].z_row = s.z_row;
+        sprites[index].w_row = s.w_row;
+    }
+}
+
+// Quad `q` of the job's item projected (empty bounds when it draws nothing).
+fn project_quad(q: u32) -> TileSprite {
+    var s: TileSprite;
+    s.bounds = vec4<i32>(1, 1, 0, 0);
     let qd = load_quad(q);
     if !qd.d.alive {
-        return;
+        return s;
     }
     // Corners 0 (uv0.x, uv0.y), 1 (uv1.x, uv0.y), 2 (uv0.x, uv1.y), 3: the clip position is
     // affine in the frame coordinates (both for rotated squares and streaks).
@@ -153,12 +184,12 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
     let c2 = quad_corner(qd, 2u);
     let c3 = quad_corner(qd, 3u);
     if min(min(c0.clip.w, c1.clip.w), min(c2.clip.w, c3.clip.w)) <= 1e-4 {
-        return;
+        return s;
     }
     let du = c1.uv.x - c0.uv.x;
     let dv = c2.uv.y - c0.uv.y;
     if abs(du) < 1e-12 || abs(dv) < 1e-12 {
-        return;
+        return s;
     }
     let col_u = (c1.clip - c0.clip) / du;
     let col_v = (c2.clip - c0.clip) / dv;
@@ -172,25 +203,22 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
     );
     // The adjugate: (uv, 1) ∝ adj(m) · (p, 1) (a scale, sign included, cancels in h.xy / h.z).
     let adj = transpose(mat3x3<f32>(cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1])));
-    var s: TileSprite;
-    s.bounds = vec4<i32>(1, 1, 0, 0);
-    s.inv0 = vec4<f32>(adj[0], 0.0);
-    s.inv1 = vec4<f32>(adj[1], 0.0);
-    s.inv2 = vec4<f32>(adj[2], 0.0);
+    s.map = vec4<f32>(adj[0].xy, adj[1].xy);
+    s.offset = vec4<f32>(adj[2].xy, 0.0, 0.0);
+    s.map_z = vec4<f32>(adj[0].z, adj[1].z, adj[2].z, 0.0);
     s.z_row = vec4<f32>(col_u.z, col_v.z, col_1.z, 0.0);
     s.w_row = vec4<f32>(col_u.w, col_v.w, col_1.w, 0.0);
     if abs(col_u.w) + abs(col_v.w) <= 1e-6 * abs(col_1.w) {
         // A quad parallel to the image plane (a camera-facing billboard): one depth, and
-        // the map is affine — uv = inv0.xy · p.x + inv1.xy · p.y + inv2.xy, flagged by
-        // inv0.w = 1, the depth in inv2.w (culled here when outside the depth range).
+        // the map is affine — uv = map.xy · p.x + map.zw · p.y + offset.xy, flagged by
+        // offset.z = 1, the depth in offset.w (culled here when outside the depth range).
         let z = col_1.z / col_1.w;
         if z < 0.0 || z > 1.0 {
-            return;
+            return s;
         }
         let k = 1.0 / adj[2].z;
-        s.inv0 = vec4<f32>(adj[0].xy * k, 0.0, 1.0);
-        s.inv1 = vec4<f32>(adj[1].xy * k, 0.0, 0.0);
-        s.inv2 = vec4<f32>(adj[2].xy * k, 1.0, z);
+        s.map = vec4<f32>(adj[0].xy, adj[1].xy) * k;
+        s.offset = vec4<f32>(adj[2].xy * k, 1.0, z);
     }
     s.uv_box = vec4<f32>(min(c0.uv, c3.uv), max(c0.uv, c3.uv));
     s.color = qd.color;
@@ -212,7 +240,6 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
     // The shade reads nothing of the look (a private copy of it per invocation costs
     // registers).
     s.grad = vec4<f32>(atlas_scale(), frames.z, look.soft.y);
-    sprites[index] = s;
     // Pixel centres (x + 0.5) inside the quad's bounding box, clamped to the target.
     let p0 = to_pixels(c0.clip);
     let p1 = to_pixels(c1.clip);
@@ -222,10 +249,12 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
     let hi = ceil(max(max(p0, p1), max(p2, p3)) - 0.5);
     let size = vec2<f32>(camera.viewport.xy) - 1.0;
     if any(hi < vec2<f32>(0.0)) || any(lo > size) {
-        return;
+        return s;
     }
-    sprites[index].bounds = vec4<i32>(vec2<i32>(max(lo, vec2<f32>(0.0))), vec2<i32>(min(hi, size)));
+    s.bounds = vec4<i32>(vec2<i32>(max(lo, vec2<f32>(0.0))), vec2<i32>(min(hi, size)));
+    return s;
 }
+
 
 var<workgroup> bits: array<atomic<u32>, 8>;
 // The shade's hits waiting for a batch: fewer than CACHE carried over plus a chunk's.
@@ -244,14 +273,10 @@ var<workgroup> cache_grad: array<vec4<f32>, 64>;
 var<workgroup> cache_ground: array<vec4<f32>, 64>;
 var<workgroup> cache_bounds: array<vec4<i32>, 64>;
 
-// Reads sprite `i`'s fields into slot `k` of the cache (the affine map as (inv0.xy,
-// inv1.xy) and (inv2.xy, affine flag, depth)).
+// Reads sprite `i`'s fields into slot `k` of the cache.
 fn cache_sprite(k: u32, i: u32) {
-    let inv0 = sprites[i].inv0;
-    let inv1 = sprites[i].inv1;
-    let inv2 = sprites[i].inv2;
-    cache_map[k] = vec4<f32>(inv0.xy, inv1.xy);
-    cache_offset[k] = vec4<f32>(inv2.xy, inv0.w, inv2.w);
+    cache_map[k] = sprites[i].map;
+    cache_offset[k] = sprites[i].offset;
     cache_box[k] = sprites[i].uv_box;
     cache_color[k] = sprites[i].color;
     cache_frames[k] = sprites[i].frames;
@@ -514,15 +539,13 @@ fn sprite_light(i: u32, k: u32, p: vec2<i32>) -> vec4<f32> {
         ddy = ca.zw;
         z = cb.w;
     } else {
-        let inv0 = sprites[i].inv0;
-        let inv1 = sprites[i].inv1;
-        let inv2 = sprites[i].inv2;
-        let h = inv0.xyz * pc.x + inv1.xyz * pc.y + inv2.xyz;
+        let mz = sprites[i].map_z;
+        let h = vec3<f32>(ca.xy * pc.x + ca.zw * pc.y + cb.xy, dot(mz.xyz, vec3<f32>(pc, 1.0)));
         uv = h.xy / h.z;
         // The derivatives exact at this pixel (the mip level the billboard's fragment
         // would pick).
-        ddx = (inv0.xy * h.z - h.xy * inv0.z) / (h.z * h.z);
-        ddy = (inv1.xy * h.z - h.xy * inv1.z) / (h.z * h.z);
+        ddx = (ca.xy * h.z - h.xy * mz.x) / (h.z * h.z);
+        ddy = (ca.zw * h.z - h.xy * mz.y) / (h.z * h.z);
         let uv1 = vec3<f32>(uv, 1.0);
         z = dot(sprites[i].z_row.xyz, uv1) / dot(sprites[i].w_row.xyz, uv1);
     }

@@ -22,7 +22,7 @@ pub const TILE_PX: u32 = 16;
 /// Pixels per bin side (keep in sync with `BIN` in tiles.wgsl).
 pub const BIN_PX: u32 = 128;
 /// Bytes of one projected sprite (`TileSprite` in tiles.wgsl).
-const SPRITE_BYTES: u64 = 176;
+const SPRITE_BYTES: u64 = 192;
 /// Tile items (emitters of a group of instances) a frame draws with the tiles at most
 /// (`MAX_ITEMS` in tiles.wgsl); beyond, the frame's tile items are billboards.
 pub const MAX_ITEMS: usize = 55;
