@@ -25,6 +25,7 @@
 #import "common.wgsl"
 #import "quad.wgsl"
 #import "workgroup_scan.wgsl"
+#import "tile_lists.wgsl"
 
 @group(0) @binding(0) var<uniform> camera: CameraUniform;
 @group(0) @binding(1) var<storage, read> looks: array<LookSlot>;
@@ -63,8 +64,9 @@ const BIN_TILES: u32 = 8u;
 const BIN: u32 = 128u;
 // Tile items a frame holds at most (keep in sync with src/render/tiles.rs).
 const MAX_ITEMS: u32 = 55u;
-// `touched`: the draw arguments (4), then a flag per tile, then the shaded tiles' list.
-const TOUCHED_FLAGS: u32 = 4u;
+// `touched`: the draw arguments (4), the tile lists' allocator, then a flag per tile, then
+// the shaded tiles' list.
+const TOUCHED_FLAGS: u32 = 8u;
 // A bin list entry: x the sprite, y the first and last tile of the bin it covers (x0, y0,
 // x1, y1, 3 bits each).
 // Sprites a bin workgroup lists (keep in sync with src/render/tiles.rs); each item's
@@ -408,7 +410,8 @@ fn bin_scan(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_inde
     }
 }
 
-// Where each bin's list starts: an exclusive scan of the bins' entries (one workgroup).
+// Where each bin's list starts: an exclusive scan of the bins' entries (one workgroup);
+// then the chunks of the tile lists' passes.
 @compute @workgroup_size(256)
 fn bin_starts(@builtin(local_invocation_index) lid: u32) {
     let bins = bin_count();
@@ -427,6 +430,7 @@ fn bin_starts(@builtin(local_invocation_index) lid: u32) {
     if lid == 0u {
         bin_meta[meta_start(bins)] = running;
     }
+    count_chunks(lid);
 }
 
 // Lists, for one bin and one block of BLOCK sprites (workgroup z) with some over the bin,
@@ -734,9 +738,25 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) 
         let before = bin_meta[meta_local(b, c0)];
         shared_bin = bin_meta[meta_start(b)] + before;
         shared_count = select(bin_meta[meta_local(b, c1)] + bin_meta[meta_count(b, c1)] - before, end - first, overflow);
+        // Where the bin's tile lists were written: the tile's own list.
+        shared_flag = u32(!overflow && tile_lists_fit(b));
+        if shared_flag != 0u {
+            let run = tl_item_run(b, wg.y);
+            shared_bin = run.x;
+            shared_count = run.y;
+        }
     }
+    let listed = workgroupUniformLoad(&shared_flag) != 0u;
     let region = workgroupUniformLoad(&shared_bin);
     let n = workgroupUniformLoad(&shared_count);
+    if listed {
+        acc = shade_tile_run(lid, region, n, origin, p, inside, acc);
+        if inside && n > 0u {
+            accum[pixel] = vec2<u32>(pack2x16float(acc.rg), pack2x16float(acc.ba));
+        }
+        list_shaded_tile(lid, n > 0u, t);
+        return;
+    }
     let tile_rect = vec4<i32>(origin, origin + i32(TILE) - 1);
     // The next chunk's entry is read while this one is shaded (its latency hidden).
     var next = vec2<u32>(0u);
@@ -796,11 +816,37 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) 
     if inside && shaded {
         accum[pixel] = vec2<u32>(pack2x16float(acc.rg), pack2x16float(acc.ba));
     }
-    // The first item to shade this tile lists it for the resolve.
+    list_shaded_tile(lid, shaded, t);
+}
+
+// The first item to shade tile `t` lists it for the resolve.
+fn list_shaded_tile(lid: u32, shaded: bool, t: u32) {
     if lid == 0u && shaded && atomicExchange(&touched[TOUCHED_FLAGS + t], 1u) == 0u {
         let k = atomicAdd(&touched[1], 1u);
         atomicStore(&touched[TOUCHED_FLAGS + tile_count() + k], t);
     }
+}
+
+// The job's item's `n` sprites over this tile from tile list entry `start` (the tile's
+// own list) blended into `acc`, batch by batch (the next batch's sprites read ahead).
+fn shade_tile_run(lid: u32, start: u32, n: u32, origin: vec2<i32>, p: vec2<i32>, inside: bool, acc_in: vec4<f32>) -> vec4<f32> {
+    var acc = acc_in;
+    var next = 0u;
+    if lid < min(n, CACHE) {
+        next = bin_meta[tl_entry(start + lid)];
+    }
+    for (var base = 0u; base < n; base += CACHE) {
+        let count = min(CACHE, n - base);
+        if lid < count {
+            hits[lid] = next;
+        }
+        if lid < CACHE && base + CACHE + lid < n {
+            next = bin_meta[tl_entry(start + base + CACHE + lid)];
+        }
+        acc = shade_batch(lid, count, 0u, origin, p, inside, acc);
+        workgroupBarrier();
+    }
+    return acc;
 }
 
 // The resolve: the shaded tiles (one instance each, two triangles) composited over the

@@ -67,6 +67,10 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ("quad.wgsl", include_str!("../shaders/quad.wgsl")),
     ("billboard.wgsl", include_str!("../shaders/billboard.wgsl")),
     ("tiles.wgsl", include_str!("../shaders/tiles.wgsl")),
+    (
+        "tile_lists.wgsl",
+        include_str!("../shaders/tile_lists.wgsl"),
+    ),
     ("splat.wgsl", include_str!("../shaders/splat.wgsl")),
     ("sort.wgsl", include_str!("../shaders/sort.wgsl")),
     ("tonemap.wgsl", include_str!("../shaders/tonemap.wgsl")),

@@ -26,8 +26,11 @@ const SPRITE_BYTES: u64 = 192;
 /// Tile items (emitters of a group of instances) a frame draws with the tiles at most
 /// (`MAX_ITEMS` in tiles.wgsl); beyond, the frame's tile items are billboards.
 pub const MAX_ITEMS: usize = 55;
-/// The `touched` buffer's header: the resolve's indirect draw arguments.
-const TOUCHED_FLAGS: u64 = 4;
+/// The `touched` buffer's header: the resolve's indirect draw arguments, the tile lists'
+/// allocator.
+const TOUCHED_FLAGS: u64 = 8;
+/// Entries per chunk of the tile lists' passes (`CHUNK` in tile_lists.wgsl).
+const CHUNK: u64 = 256;
 /// Sprites one bin workgroup lists (`BLOCK` in tiles.wgsl): the blocks of a frame's
 /// sprites are binned in parallel; each item's sprites start at a multiple of it.
 const BLOCK: u32 = 1024;
@@ -51,8 +54,9 @@ type Built = (
     wgpu::RenderPipeline,
 );
 
-/// The binning's four passes: count per block, scan per bin, the bins' starts, the lists.
-type BinPipes = [wgpu::ComputePipeline; 4];
+/// The binning's passes: count per block, scan per bin, the bins' starts, the lists; then
+/// the tiles' lists: count per chunk, scan per bin, scatter.
+type BinPipes = [wgpu::ComputePipeline; 7];
 
 /// Storage buffers per shader stage the tile passes bind (the looks, the six state
 /// views, the tiles' six): a device created with fewer draws every quad as a billboard.
@@ -69,6 +73,8 @@ pub struct TilePass {
     /// The bin's group 3 (the tile group and the shades' dispatch arguments) and layout.
     bin_group_layout: wgpu::BindGroupLayout,
     bin_layout: wgpu::PipelineLayout,
+    /// The tiles' lists' passes: the tile group (as the shade's) in group 3.
+    list_layout: wgpu::PipelineLayout,
     empty_group: wgpu::BindGroup,
     resolve_layout: wgpu::PipelineLayout,
     module: wgpu::ShaderModule,
@@ -82,6 +88,8 @@ pub struct TilePass {
     drawn: bool,
     /// The bins' lists' capacity in entries, when set (tests force an overflow with it).
     list_capacity: Option<u32>,
+    /// The tiles' lists' capacity in entries, when set (tests force an overflow with it).
+    tile_list_capacity: Option<u32>,
     /// The stages a record runs (the bench times them apart).
     stages: TileStages,
 }
@@ -175,6 +183,32 @@ fn list_entries(order: &[&DrawItem], size: (u32, u32), sprites: u32, limit: u64)
         .min(estimate.max(1 << 20).next_power_of_two())
         .min(cap)
         .max(1) as u32
+}
+
+/// Chunks the tile lists' passes read at most: every bin's list in chunks of `CHUNK`
+/// (`job.counts2.w`).
+fn chunk_capacity(list_capacity: u32, size: (u32, u32)) -> u32 {
+    (u64::from(list_capacity).div_ceil(CHUNK) + grid_bins(size)) as u32
+}
+
+/// `bin_meta` words for the tiles' lists (tile_lists.wgsl `tl_*`): the chunks and places
+/// per bin, tile and chunk, then the lists' entries — twice the bins' lists' (a sprite
+/// over several tiles is listed on each), within the storage binding's limit. Lists that
+/// do not fit are shaded from the bins' lists. `bin_words`: the bins' words before them;
+/// `limit`: the storage binding's limit in bytes.
+/// `entries`: the lists' entries when set (tests), else twice the bins'.
+fn tile_list_words(
+    (list_capacity, entries): (u32, Option<u32>),
+    size: (u32, u32),
+    bin_words: u64,
+    limit: u64,
+) -> u64 {
+    let bins = grid_bins(size);
+    let chunks = u64::from(chunk_capacity(list_capacity, size));
+    let places = 130 * bins + 1 + 128 * chunks;
+    let room = (limit / 4).saturating_sub(bin_words + places);
+    let entries = entries.map_or(2 * u64::from(list_capacity), u64::from);
+    places + entries.min(room)
 }
 
 /// The frame's tile items in draw order: alpha-blended first (as given: back to front),
@@ -275,6 +309,18 @@ impl TilePass {
             ],
             immediate_size: 0,
         });
+        // The tiles' lists' passes: the tile group only (the chunk passes' arguments are
+        // read as indirect arguments, so they may not be bound for writing).
+        let list_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("TilePass::list_layout"),
+            bind_group_layouts: &[
+                Some(&frame.frame_layout),
+                Some(&empty_layout),
+                Some(&empty_layout),
+                Some(&tile_layout),
+            ],
+            immediate_size: 0,
+        });
         let resolve_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("TilePass::resolve_layout"),
             bind_group_layouts: &[Some(&frame.frame_layout), Some(&resolve_group_layout)],
@@ -283,7 +329,7 @@ impl TilePass {
         let (module, variants, bin, resolve) = Self::build(
             ctx,
             lib,
-            [&compute_layout, &bin_layout, &resolve_layout],
+            [&compute_layout, &bin_layout, &list_layout, &resolve_layout],
             target,
         )?;
         Ok(Self {
@@ -294,6 +340,7 @@ impl TilePass {
             compute_layout,
             bin_group_layout,
             bin_layout,
+            list_layout,
             empty_group,
             resolve_layout,
             module,
@@ -307,6 +354,7 @@ impl TilePass {
             buffers: None,
             drawn: false,
             list_capacity: None,
+            tile_list_capacity: None,
             stages: TileStages::All,
         })
     }
@@ -357,13 +405,21 @@ impl TilePass {
     fn build(
         ctx: &GpuContext,
         lib: &ShaderLibrary,
-        [layout, bin_layout, resolve_layout]: [&wgpu::PipelineLayout; 3],
+        [layout, bin_layout, list_layout, resolve_layout]: [&wgpu::PipelineLayout; 4],
         target: DrawTarget,
     ) -> Result<Built, ShaderError> {
         let composed = lib.compose("tiles.wgsl")?;
         create_checked(&ctx.device, &composed, lib, |module| {
-            let bin = ["bin_count_blocks", "bin_scan", "bin_starts", "bin"]
-                .map(|entry| Self::compute(ctx, bin_layout, module, entry, &[]));
+            let bin = [
+                ("bin_count_blocks", bin_layout),
+                ("bin_scan", bin_layout),
+                ("bin_starts", bin_layout),
+                ("bin", bin_layout),
+                ("tiles_count", list_layout),
+                ("tiles_scan", list_layout),
+                ("tiles_scatter", list_layout),
+            ]
+            .map(|(entry, layout)| Self::compute(ctx, layout, module, entry, &[]));
             let basic = LookVariant::basic(false);
             let variants = HashMap::from([(
                 basic,
@@ -419,7 +475,12 @@ impl TilePass {
     /// Rebuilds the pipelines; keeps the old ones on error. Variants are rebuilt on
     /// first use.
     pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
-        let layouts = [&self.compute_layout, &self.bin_layout, &self.resolve_layout];
+        let layouts = [
+            &self.compute_layout,
+            &self.bin_layout,
+            &self.list_layout,
+            &self.resolve_layout,
+        ];
         let (module, variants, bin, resolve) = Self::build(ctx, lib, layouts, self.target)?;
         self.module = module;
         self.bin = bin;
@@ -533,7 +594,7 @@ impl TilePass {
     }
 
     /// The binning's passes over the frame's `blocks` blocks of sprites: count per block,
-    /// scan per bin, the bins' starts, the lists.
+    /// scan per bin, the bins' starts, the lists; then the tiles' lists.
     fn record_bins(
         &self,
         pass: &mut wgpu::ComputePass<'_>,
@@ -547,7 +608,15 @@ impl TilePass {
         pass.set_bind_group(2, &self.empty_group, &[]);
         pass.set_bind_group(3, &b.bin_group, &[0]);
         let bins = grid(size, BIN_PX);
-        let [count, scan, starts, list] = &self.bin;
+        let [
+            count,
+            scan,
+            starts,
+            list,
+            tile_count,
+            tile_scan,
+            tile_scatter,
+        ] = &self.bin;
         pass.set_pipeline(count);
         pass.dispatch_workgroups(blocks, 1, 1);
         pass.set_pipeline(scan);
@@ -556,6 +625,15 @@ impl TilePass {
         pass.dispatch_workgroups(1, 1, 1);
         pass.set_pipeline(list);
         pass.dispatch_workgroups(bins.0, bins.1, blocks);
+        // The tiles' lists: over the chunks of the bins' lists (counted by `bin_starts`).
+        let chunks = MAX_ITEMS as u64 * 16;
+        pass.set_bind_group(3, &b.group, &[0]);
+        pass.set_pipeline(tile_count);
+        pass.dispatch_workgroups_indirect(&b.dispatch_args, chunks);
+        pass.set_pipeline(tile_scan);
+        pass.dispatch_workgroups(bins.0 * bins.1, 1, 1);
+        pass.set_pipeline(tile_scatter);
+        pass.dispatch_workgroups_indirect(&b.dispatch_args, chunks);
     }
 
     /// Sets how far the next records go (the bench times the stages apart; a record that
@@ -570,6 +648,14 @@ impl TilePass {
     #[doc(hidden)]
     pub fn set_list_capacity(&mut self, entries: Option<u32>) {
         self.list_capacity = entries;
+    }
+
+    /// Sets the tiles' lists' capacity in entries (`None`: twice the bins' lists'). Tests
+    /// make it small to shade bins from their bin lists.
+    #[doc(hidden)]
+    pub fn set_tile_list_capacity(&mut self, entries: Option<u32>) {
+        self.tile_list_capacity = entries;
+        self.buffers = None;
     }
 
     /// Uploads one job per item (`TileJob`: its first sprite and quads, the frame's
@@ -599,15 +685,18 @@ impl TilePass {
                 k as u32,
                 items,
                 blocks,
-                0,
+                chunk_capacity(b.list_capacity, b.size),
             ];
             job[..8].copy_from_slice(&head);
             job[8..8 + firsts.len()].copy_from_slice(firsts);
         }
         ctx.queue
             .write_buffer(&b.job_buffer, 0, bytemuck::cast_slice(&jobs));
-        ctx.queue
-            .write_buffer(&b.touched, 0, bytemuck::cast_slice(&[6u32, 0, 0, 0]));
+        ctx.queue.write_buffer(
+            &b.touched,
+            0,
+            bytemuck::cast_slice(&[6u32, 0, 0, 0, 0, 0, 0, 0]),
+        );
         let args: Vec<u32> = order.iter().flat_map(|_| [0u32, 64, 1, 0]).collect();
         ctx.queue
             .write_buffer(&b.dispatch_args, 0, bytemuck::cast_slice(&args));
@@ -652,8 +741,17 @@ impl TilePass {
         // `touched`: the resolve's arguments, a flag per tile, the shaded tiles, and each
         // item's bins.
         let touched_words = TOUCHED_FLAGS + 2 * grid_tiles(size) + MAX_ITEMS as u64 * bins;
-        // `bin_meta`: counts and places per bin and block, each bin's total and start.
-        let meta_words = 2 * bins * (c / u64::from(BLOCK)) + 2 * bins + 1;
+        // `bin_meta`: counts and places per bin and block, each bin's total and start; then
+        // the tiles' lists (tile_lists.wgsl).
+        let bin_words = 2 * bins * (c / u64::from(BLOCK)) + 2 * bins + 1;
+        let limit = ctx.device.limits().max_storage_buffer_binding_size;
+        let tile_words = tile_list_words(
+            (list_capacity, self.tile_list_capacity),
+            size,
+            bin_words,
+            limit,
+        );
+        let meta_words = bin_words + tile_words;
         let lists = [
             buffer("TilePass::sprites", c * SPRITE_BYTES, none),
             buffer("TilePass::touched", touched_words * 4, indirect),
@@ -670,7 +768,12 @@ impl TilePass {
             ),
         ];
         let job_buffer = buffer("TilePass::jobs", u64::from(jobs) * JOB_STRIDE, none);
-        let dispatch_args = buffer("TilePass::dispatch_args", MAX_ITEMS as u64 * 16, indirect);
+        // Each item's shade, then the tile lists' chunk passes.
+        let dispatch_args = buffer(
+            "TilePass::dispatch_args",
+            (MAX_ITEMS as u64 + 1) * 16,
+            indirect,
+        );
         let depth_view = depth.unwrap_or(&self.no_depth);
         let group = |layout, args: Option<&wgpu::Buffer>| {
             let mut entries: Vec<wgpu::BindGroupEntry<'_>> = lists
