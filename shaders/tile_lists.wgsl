@@ -5,7 +5,8 @@
 // of the bins' lists: count per chunk and tile (`tiles_count`), place every tile's list and
 // each chunk's part of it (`tiles_scan`), write (`tiles_scatter`). The order within a chunk
 // comes from bit masks (an entry's place is the bits before its own): deterministic, no
-// atomics on the order. A bin whose tile lists do not fit is shaded from its bin list.
+// atomics on the order. A bin with a short list, or whose tile lists do not fit, is shaded
+// from its bin list.
 //
 // Contract: the bindings and `meta_*` of tiles.wgsl. `bin_meta` holds, after the bins'
 // starts, the words the `tl_*` functions place; `job.counts2.w` is the chunks' capacity;
@@ -16,6 +17,11 @@
 const CHUNK: u32 = 256u;
 // The tile lists' allocator in `touched` (in its header).
 const TL_ALLOC: u32 = 4u;
+// Bins with shorter lists are shaded from them (each tile filters a few chunks): their
+// tile lists would cost more than they save.
+const TL_MIN_ENTRIES: u32 = 4096u;
+// `tl_bin_start` of a bin without tile lists.
+const TL_NONE: u32 = 0xFFFFFFFFu;
 
 fn tl_base() -> u32 {
     return meta_start(bin_count()) + 1u;
@@ -61,22 +67,27 @@ fn tl_capacity() -> u32 {
     return arrayLength(&bin_meta) - tl_entry(0u);
 }
 
-// Whether bin b's tile lists were all written (its bin list was).
+// Whether bin b has tile lists, all written.
 fn tile_lists_fit(b: u32) -> bool {
-    let room = bin_meta[tl_bin_start(b)] + bin_meta[tl_tile_local(b, 63u)] + bin_meta[tl_tile_total(b, 63u)];
-    return bin_meta[meta_start(b + 1u)] <= job.counts.w && room <= tl_capacity();
+    let start = bin_meta[tl_bin_start(b)];
+    let entries = bin_meta[tl_tile_local(b, 63u)] + bin_meta[tl_tile_total(b, 63u)];
+    return start != TL_NONE && entries <= tl_capacity() && start <= tl_capacity() - entries;
 }
 
-// The chunks of each complete bin list (after `bin_starts` placed the lists) and the
-// chunk passes' dispatch arguments. Every invocation of the workgroup calls it.
+// The chunks of each complete bin list of TL_MIN_ENTRIES or more (after `bin_starts`
+// placed the lists) and the chunk passes' dispatch arguments. Every invocation of the
+// workgroup calls it.
 fn count_chunks(lid: u32) {
     let bins = bin_count();
     var chunks = 0u;
     for (var base = 0u; base < bins; base += 256u) {
         let b = base + lid;
         var v = 0u;
-        if b < bins && bin_meta[meta_start(b)] + bin_meta[meta_total(b)] <= job.counts.w {
-            v = (bin_meta[meta_total(b)] + CHUNK - 1u) / CHUNK;
+        if b < bins {
+            let n = bin_meta[meta_total(b)];
+            if n >= TL_MIN_ENTRIES && bin_meta[meta_start(b)] + n <= job.counts.w {
+                v = (n + CHUNK - 1u) / CHUNK;
+            }
         }
         let at = running_exclusive(lid, v, &chunks);
         if b < bins {
@@ -178,7 +189,17 @@ fn tiles_scan(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
     let t = lid % 64u;
     let r = lid / 64u;
     let first = bin_meta[tl_chunk_first(b)];
-    let n = bin_meta[tl_chunk_first(b + 1u)] - first;
+    if lid == 0u {
+        shared_count = bin_meta[tl_chunk_first(b + 1u)] - first;
+    }
+    let n = workgroupUniformLoad(&shared_count);
+    if n == 0u {
+        // No tile lists: the bin's tiles filter its list.
+        if lid == 0u {
+            bin_meta[tl_bin_start(b)] = TL_NONE;
+        }
+        return;
+    }
     let lo = first + n * r / 4u;
     let hi = first + n * (r + 1u) / 4u;
     var sum = 0u;

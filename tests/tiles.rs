@@ -335,18 +335,19 @@ fn tiles_are_deterministic_and_the_automatic_choice_follows_the_profile() {
     );
 }
 
-/// 3000 sprites thrown out of one point across a bin border: three blocks of sprites over
-/// two bins, listed block after block. Their light agrees with the billboards', and it
+/// 5000 sprites thrown out of one point across a bin border: five blocks of sprites over
+/// two bins, listed block after block (long enough lists for tile lists). Their light agrees with the billboards', and it
 /// stays the very same image when the bins' lists are given too little room (bins shaded
 /// from the sprites directly, none lost) and when the tiles' own lists are (tiles shaded
 /// from their bins' lists).
 #[test]
 fn many_sprites_over_several_bins_and_blocks_keep_their_light_when_lists_overflow() {
     let ctx = gpu();
-    let mut effect = pile(3000.0, 0.5, [0.55, 0.0, 0.0]);
+    let mut effect = pile(5000.0, 0.5, [0.55, 0.0, 0.0]);
+    effect.emitters[0].capacity = 8192;
     effect.emitters[0].spread_deg = 180.0;
     effect.emitters[0].speed_m_per_s = Range::new(0.5, 1.0);
-    light_agrees(&ctx, "3000 over two bins", &effect);
+    light_agrees(&ctx, "5000 over two bins", &effect);
     effect.emitters[0].look.draw_path = DrawPath::Tiles;
     let image = |list_capacity: Option<u32>, tile_list_capacity: Option<u32>| {
         let mut run =
@@ -359,15 +360,15 @@ fn many_sprites_over_several_bins_and_blocks_keep_their_light_when_lists_overflo
         }
         run.render(SIZE).expect("render")
     };
-    // Each bin lists all 3000: room for 4000 fits the first bin, not the second.
+    // Each bin lists all 5000: room for 6000 fits the first bin, not the second.
     let fitted = image(None, None);
     assert!(total_light(&fitted) > 1e3);
-    assert!(image(Some(4000), None) == fitted, "one bin overflowing");
+    assert!(image(Some(6000), None) == fitted, "one bin overflowing");
     assert!(image(Some(1), None) == fitted, "every bin overflowing");
     // The tiles' own lists: without them every tile filters its bin's list; with room for
-    // one bin's, the other bin's tiles do.
+    // fewer than both bins', some tiles do.
     assert!(image(None, Some(0)) == fitted, "no tile lists");
-    assert!(image(None, Some(4000)) == fitted, "one bin's tile lists");
+    assert!(image(None, Some(8000)) == fitted, "some bins' tile lists");
 }
 
 /// The fireball's debris leaves alpha-blended smoke lines (ribbons, which only the
