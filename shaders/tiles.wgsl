@@ -3,7 +3,8 @@
 // 128-pixel bins in draw order — counted per block of sprites, scanned into each list's
 // place, then written (`bin_count_blocks`, `bin_scan`, `bin_starts`, `bin`: memory and
 // work in proportion to the sprites' footprints, no atomics on the order) — and each
-// 16×16-pixel tile is shaded by one workgroup:
+// 16×16-pixel tile is shaded by one workgroup (a dense bin's list split first into a list
+// per tile, tile_lists.wgsl):
 // the sprites over it, in order, blended in registers — premultiplied "over" for
 // alpha-blended layers (back to front, the sort's order), added for light — and the
 // tile's colour and coverage written once per emitter. A full-screen draw in the
@@ -14,9 +15,10 @@
 // - group 2: the emitter's sprite and sampler (shade).
 // - group 3 (compute): 0 `sprites` (one TileSprite per quad of the frame's tile items),
 //   2 `bin_lists` (per bin, the sprites over it in draw order, one list after another,
-//   `job.counts.w` entries in all), 3 `bin_meta` (the counts and scans, `meta_*`), 4 `accum` (per pixel: C.rg, C.b and the coverage
+//   `job.counts.w` entries in all), 3 `bin_meta` (the counts and scans, `meta_*`, then the
+//   tiles' lists, `tl_*`), 4 `accum` (per pixel: C.rg, C.b and the coverage
 //   1 − T as f16 pairs; valid in the tiles shaded this frame only), 1 `touched` (the
-//   resolve's draw arguments, a flag per tile, the list of tiles shaded this frame, each
+//   resolve's draw arguments, the tile lists' allocator, a flag per tile, the list of tiles shaded this frame, each
 //   item's list of bins and a flag per item and bin), 5 `scene_depth` (the host's depth, when
 //   its size is the viewport's), 6 `job` (this dispatch's item: dynamic offset).
 // - The resolve (a render pipeline): group 0 as above, group 1: 0 `accum_in`, 1

@@ -820,7 +820,7 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
     report.heading("Tile path stages");
     report.para(
         "The tile draw of each row timed stage by stage (records that stop after a stage, same run): \
-         project every quad, bin (count per block, scan, list), then shade and resolve (the rest).",
+         project every quad, bin (count per block, scan, list; then the dense bins' lists per tile), then shade and resolve (the rest).",
     );
     report.table(
         &[
