@@ -104,6 +104,32 @@ fn the_editor_window_shows_the_panel_and_the_fire() {
     let (report, image) = run_editor(60, &[]);
     println!("{report}");
     assert_panel_and_fire(&image, 3000);
+    assert_viewport_only_repaints(&report, 20);
+}
+
+/// With the retained window image (the software adapter profile, as under lavapipe), a
+/// playing effect repaints only the viewport and the timeline under it: the rest of the
+/// window is repainted when it changes (the first frames, new glyphs in egui's font atlas),
+/// not every frame — a label outside those that changed every frame would make every
+/// frame a full repaint.
+fn assert_viewport_only_repaints(report: &str, at_least: u32) {
+    let Some(line) = report.lines().find(|l| l.starts_with("retained UI:")) else {
+        assert!(
+            !report.contains("llvmpipe"),
+            "no retained-UI line on a software adapter: {report}"
+        );
+        return;
+    };
+    let live: u32 = line
+        .split(", ")
+        .nth(1)
+        .and_then(|part| part.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("unreadable retained-UI line: {line}"));
+    assert!(
+        live >= at_least,
+        "only {live} frames repainted over the viewport alone: {line}"
+    );
 }
 
 #[test]

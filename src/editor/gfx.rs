@@ -79,8 +79,8 @@ pub(super) struct Gfx {
     /// The frame clock and the run's timings.
     pub(super) log: FrameLog,
     pub(super) viewport_px: (u32, u32),
-    /// Where the viewport is in the window (points).
-    pub(super) viewport_rect: egui::Rect,
+    /// What changes every frame (points): the viewport and the timeline under it.
+    pub(super) live_rect: egui::Rect,
     /// The retained window image (the adapter profile's choice, and a surface that can be
     /// copied to): the panel is repainted only when it changed.
     pub(super) retained: Option<super::retained::RetainedUi>,
@@ -251,7 +251,7 @@ impl Gfx {
             viewport_image: None,
             log: FrameLog::default(),
             viewport_px: (1, 1),
-            viewport_rect: egui::Rect::NOTHING,
+            live_rect: egui::Rect::NOTHING,
             retained,
             pass_timer,
             profiler: StageProfiler::new(options.profile),
@@ -285,15 +285,19 @@ impl Gfx {
         let texture = self.viewport_texture;
         let state_textures = &mut self.state_textures;
         let mut viewport = ViewportOutput::default();
+        let mut timeline = egui::Rect::NOTHING;
         let mut output = self.egui_ctx.run_ui(raw_input, |ui| {
             egui::Panel::right("inspector")
                 .resizable(true)
                 .default_size(PANEL_WIDTH)
                 .size_range(300.0..=640.0)
                 .show(ui, |ui| panel_ui(ui, state));
-            egui::Panel::bottom("timeline").show(ui, |ui| {
-                super::timeline::timeline_ui(ui, state);
-            });
+            timeline = egui::Panel::bottom("timeline")
+                .show(ui, |ui| {
+                    super::timeline::timeline_ui(ui, state);
+                })
+                .response
+                .rect;
             egui::CentralPanel::no_frame().show(ui, |ui| {
                 viewport = viewport_ui(ui, camera, state, texture);
             });
@@ -304,7 +308,9 @@ impl Gfx {
         self.egui_state
             .handle_platform_output(&self.window, platform);
         self.viewport_px = viewport.size_px;
-        self.viewport_rect = viewport.rect;
+        // The timeline under the viewport moves every frame too: the retained image repaints
+        // both (one rectangle: the timeline spans the viewport's width).
+        self.live_rect = viewport.rect.union(timeline);
         self.profiler.end_stage(&self.ctx);
         output
     }

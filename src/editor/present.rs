@@ -69,7 +69,7 @@ impl Gfx {
                 let image = r.image(&self.ctx.device, size, self.config.format).clone();
                 let repaint = r.plan(
                     &all_jobs,
-                    self.viewport_rect,
+                    self.live_rect,
                     screen.size_in_pixels,
                     textures_changed,
                     VIEWPORT_BACKGROUND,
