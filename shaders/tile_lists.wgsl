@@ -3,20 +3,18 @@
 // into one list per 16×16 tile, in the same order, so that a tile's shade reads exactly
 // its own sprites instead of filtering the bin's. Three passes over chunks of 256 entries
 // of the bins' lists: count per chunk and tile (`tiles_count`), place every tile's list and
-// each chunk's part of it (`tiles_scan`), write (`tiles_scatter`). The order within a chunk
+// each chunk's part of it within its bin's lists (`tiles_scan`), place the bins' lists one
+// after another (`tiles_starts`), write (`tiles_scatter`). The order within a chunk
 // comes from bit masks (an entry's place is the bits before its own): deterministic, no
 // atomics on the order. A bin with a short list, or whose tile lists do not fit, is shaded
 // from its bin list.
 //
 // Contract: the bindings and `meta_*` of tiles.wgsl. `bin_meta` holds, after the bins'
 // starts, the words the `tl_*` functions place; `job.counts2.w` is the chunks' capacity;
-// `touched[TL_ALLOC]` hands out the tile lists' room (zero at the frame's start);
 // `dispatch_args` slot MAX_ITEMS holds the chunk passes' arguments (`bin_starts`).
 
 // Entries per chunk (one per invocation).
 const CHUNK: u32 = 256u;
-// The tile lists' allocator in `touched` (in its header).
-const TL_ALLOC: u32 = 4u;
 // Bins with shorter lists are shaded from them (each tile filters a few chunks): their
 // tile lists would cost more than they save.
 const TL_MIN_ENTRIES: u32 = 4096u;
@@ -228,7 +226,29 @@ fn tiles_scan(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
             bin_meta[tl_tile_total(b, k)] = tile_part[k];
             at += tile_part[k];
         }
-        bin_meta[tl_bin_start(b)] = atomicAdd(&touched[TL_ALLOC], at);
+        // Listed: `tiles_starts` places it.
+        bin_meta[tl_bin_start(b)] = 0u;
+    }
+}
+
+// Places the bins' tile lists one after another, in bin order (one workgroup): bins past
+// the lists' capacity keep their places and are shaded from their bin lists
+// (`tile_lists_fit`), the same bins whatever the scheduling.
+@compute @workgroup_size(256)
+fn tiles_starts(@builtin(local_invocation_index) lid: u32) {
+    let bins = bin_count();
+    var running = 0u;
+    for (var base = 0u; base < bins; base += 256u) {
+        let b = base + lid;
+        var v = 0u;
+        let listed = b < bins && bin_meta[tl_bin_start(b)] != TL_NONE;
+        if listed {
+            v = bin_meta[tl_tile_local(b, 63u)] + bin_meta[tl_tile_total(b, 63u)];
+        }
+        let at = running_exclusive(lid, v, &running);
+        if listed {
+            bin_meta[tl_bin_start(b)] = at;
+        }
     }
 }
 

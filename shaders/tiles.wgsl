@@ -18,8 +18,8 @@
 //   `job.counts.w` entries in all), 3 `bin_meta` (the counts and scans, `meta_*`, then the
 //   tiles' lists, `tl_*`), 4 `accum` (per pixel: C.rg, C.b and the coverage
 //   1 − T as f16 pairs; valid in the tiles shaded this frame only), 1 `touched` (the
-//   resolve's draw arguments, the tile lists' allocator, a flag per tile, the list of tiles shaded this frame, each
-//   item's list of bins and a flag per item and bin), 5 `scene_depth` (the host's depth, when
+//   resolve's draw arguments, a flag per tile, the list of tiles shaded this frame, each
+//   item's list of bins), 5 `scene_depth` (the host's depth, when
 //   its size is the viewport's), 6 `job` (this dispatch's item: dynamic offset).
 // - The resolve (a render pipeline): group 0 as above, group 1: 0 `accum_in`, 1
 //   `touched_in` (the same buffers, read-only).
@@ -43,13 +43,16 @@ var<private> look: LookUniform;
 @group(2) @binding(1) var sprite_sampler: sampler;
 @group(3) @binding(0) var<storage, read_write> sprites: array<TileSprite>;
 @group(3) @binding(1) var<storage, read_write> touched: array<atomic<u32>>;
+// A bin list entry: x the sprite, y the first and last tile of the bin it covers (x0, y0,
+// x1, y1, 3 bits each).
 @group(3) @binding(2) var<storage, read_write> bin_lists: array<vec2<u32>>;
 @group(3) @binding(3) var<storage, read_write> bin_meta: array<u32>;
 @group(3) @binding(4) var<storage, read_write> accum: array<vec2<u32>>;
 @group(3) @binding(5) var scene_depth: texture_depth_2d;
 @group(3) @binding(6) var<storage, read> job: TileJob;
-// `bin` only: each item's shade dispatch arguments (x: its bins, y: 64 tiles each, z: 1),
-// the indirect arguments of the shade.
+// The bin passes only: each item's shade dispatch arguments (x: its bins, y: 64 tiles
+// each, z: 1), the indirect arguments of the shade; then (slot MAX_ITEMS) the tile lists'
+// chunk passes' (`count_chunks`).
 @group(3) @binding(7) var<storage, read_write> dispatch_args: array<atomic<u32>>;
 // The resolve's view of `accum` and `touched`.
 @group(1) @binding(0) var<storage, read> accum_in: array<vec2<u32>>;
@@ -66,11 +69,8 @@ const BIN_TILES: u32 = 8u;
 const BIN: u32 = 128u;
 // Tile items a frame holds at most (keep in sync with src/render/tiles.rs).
 const MAX_ITEMS: u32 = 55u;
-// `touched`: the draw arguments (4), the tile lists' allocator, then a flag per tile, then
-// the shaded tiles' list.
-const TOUCHED_FLAGS: u32 = 8u;
-// A bin list entry: x the sprite, y the first and last tile of the bin it covers (x0, y0,
-// x1, y1, 3 bits each).
+// `touched`: the draw arguments (4), then a flag per tile, then the shaded tiles' list.
+const TOUCHED_FLAGS: u32 = 4u;
 // Sprites a bin workgroup lists (keep in sync with src/render/tiles.rs); each item's
 // sprites start at a multiple of it, so that a block holds one item's.
 const BLOCK: u32 = 1024u;
@@ -79,8 +79,9 @@ const MAX_BINS: u32 = 2048u;
 
 // One dispatch's work: x the item's first sprite, y its quads, z sprites this frame
 // (each item's rounded up to whole blocks), w the capacity of the bin lists (entries);
-// `counts2`: the item's index, the items, the blocks of BLOCK sprites; `firsts`: every
-// item's first sprite, then the frame's sprites.
+// `counts2`: the item's index, the items, the blocks of BLOCK sprites, the chunks the tile
+// lists' passes read at most; `firsts`: every item's first sprite, then the frame's
+// sprites.
 struct TileJob {
     counts: vec4<u32>,
     counts2: vec4<u32>,
@@ -602,7 +603,7 @@ fn blend(acc: vec4<f32>, c: vec4<f32>) -> vec4<f32> {
 // Lane groups of the shade: 32 invocations (a warp on most GPUs), 8×4 pixels of the tile.
 const GROUP: u32 = 32u;
 
-// The top-left pixel of lane group `g` of the tile at `origin` (two groups across, eight
+// The top-left pixel of lane group `g` of the tile at `origin` (two groups across, four
 // down).
 fn group_corner(origin: vec2<i32>, g: u32) -> vec2<i32> {
     return origin + vec2<i32>(i32(g % 2u) * 8, i32(g / 2u) * 4);

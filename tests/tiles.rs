@@ -242,8 +242,8 @@ fn sprites_across_tile_borders_and_larger_than_the_screen_keep_their_light() {
 #[test]
 fn a_tile_with_more_sprites_than_a_workgroup_keeps_every_sprite() {
     let ctx = gpu();
-    // 3000 sprites on the same tiles: twelve chunks of the shade's 256 list entries, 46
-    // batches of its sprite cache, hits carried from chunk to chunk.
+    // 3000 sprites on the same tiles: twelve chunks of the shade's 256 list entries, 47
+    // batches of its sprite cache (the last one partial), hits carried from chunk to chunk.
     let effect = pile(3000.0, 0.5, [0.0; 3]);
     // The billboards draw every sprite: a dropped chunk of 256 would take a twelfth of the
     // light, a dropped batch of 64 two percent.
@@ -366,9 +366,12 @@ fn many_sprites_over_several_bins_and_blocks_keep_their_light_when_lists_overflo
     assert!(image(Some(6000), None) == fitted, "one bin overflowing");
     assert!(image(Some(1), None) == fitted, "every bin overflowing");
     // The tiles' own lists: without them every tile filters its bin's list; with room for
-    // fewer than both bins', some tiles do.
+    // fewer entries than both bins' tile lists take, the bins past it do.
     assert!(image(None, Some(0)) == fitted, "no tile lists");
-    assert!(image(None, Some(8000)) == fitted, "some bins' tile lists");
+    assert!(
+        image(None, Some(8000)) == fitted,
+        "tile lists short of room"
+    );
 }
 
 /// The fireball's debris leaves alpha-blended smoke lines (ribbons, which only the

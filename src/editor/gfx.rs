@@ -309,7 +309,8 @@ impl Gfx {
             .handle_platform_output(&self.window, platform);
         self.viewport_px = viewport.size_px;
         // The timeline under the viewport moves every frame too: the retained image repaints
-        // both (one rectangle: the timeline spans the viewport's width).
+        // both (one rectangle, as the timeline spans the viewport's width: the inspector
+        // panel is laid out first).
         self.live_rect = viewport.rect.union(timeline);
         self.profiler.end_stage(&self.ctx);
         output

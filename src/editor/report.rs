@@ -108,7 +108,7 @@ impl std::fmt::Display for RunReport {
         if let Some((full, live)) = self.ui_repaints {
             write!(
                 f,
-                "\nretained UI: {full} frames painted in full, {live} only over the viewport"
+                "\nretained UI: {full} frames painted in full, {live} only over the viewport and timeline"
             )?;
         }
         if self.devices_recreated > 0 {

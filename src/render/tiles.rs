@@ -26,9 +26,8 @@ const SPRITE_BYTES: u64 = 192;
 /// Tile items (emitters of a group of instances) a frame draws with the tiles at most
 /// (`MAX_ITEMS` in tiles.wgsl); beyond, the frame's tile items are billboards.
 pub const MAX_ITEMS: usize = 55;
-/// The `touched` buffer's header: the resolve's indirect draw arguments, the tile lists'
-/// allocator.
-const TOUCHED_FLAGS: u64 = 8;
+/// The `touched` buffer's header: the resolve's indirect draw arguments.
+const TOUCHED_FLAGS: u64 = 4;
 /// Entries per chunk of the tile lists' passes (`CHUNK` in tile_lists.wgsl).
 const CHUNK: u64 = 256;
 /// Sprites one bin workgroup lists (`BLOCK` in tiles.wgsl): the blocks of a frame's
@@ -55,8 +54,8 @@ type Built = (
 );
 
 /// The binning's passes: count per block, scan per bin, the bins' starts, the lists; then
-/// the tiles' lists: count per chunk, scan per bin, scatter.
-type BinPipes = [wgpu::ComputePipeline; 7];
+/// the tiles' lists: count per chunk, scan per bin, the bins' starts, scatter.
+type BinPipes = [wgpu::ComputePipeline; 8];
 
 /// Storage buffers per shader stage the tile passes bind (the looks, the six state
 /// views, the tiles' six): a device created with fewer draws every quad as a billboard.
@@ -417,6 +416,7 @@ impl TilePass {
                 ("bin", bin_layout),
                 ("tiles_count", list_layout),
                 ("tiles_scan", list_layout),
+                ("tiles_starts", list_layout),
                 ("tiles_scatter", list_layout),
             ]
             .map(|(entry, layout)| Self::compute(ctx, layout, module, entry, &[]));
@@ -615,6 +615,7 @@ impl TilePass {
             list,
             tile_count,
             tile_scan,
+            tile_starts,
             tile_scatter,
         ] = &self.bin;
         pass.set_pipeline(count);
@@ -626,14 +627,16 @@ impl TilePass {
         pass.set_pipeline(list);
         pass.dispatch_workgroups(bins.0, bins.1, blocks);
         // The tiles' lists: over the chunks of the bins' lists (counted by `bin_starts`).
-        let chunks = MAX_ITEMS as u64 * 16;
+        let chunk_args = MAX_ITEMS as u64 * 16;
         pass.set_bind_group(3, &b.group, &[0]);
         pass.set_pipeline(tile_count);
-        pass.dispatch_workgroups_indirect(&b.dispatch_args, chunks);
+        pass.dispatch_workgroups_indirect(&b.dispatch_args, chunk_args);
         pass.set_pipeline(tile_scan);
         pass.dispatch_workgroups(bins.0 * bins.1, 1, 1);
+        pass.set_pipeline(tile_starts);
+        pass.dispatch_workgroups(1, 1, 1);
         pass.set_pipeline(tile_scatter);
-        pass.dispatch_workgroups_indirect(&b.dispatch_args, chunks);
+        pass.dispatch_workgroups_indirect(&b.dispatch_args, chunk_args);
     }
 
     /// Sets how far the next records go (the bench times the stages apart; a record that
@@ -659,8 +662,8 @@ impl TilePass {
     }
 
     /// Uploads one job per item (`TileJob`: its first sprite and quads, the frame's
-    /// sprites, the lists' capacity; its index, the item count and the blocks; every item's
-    /// first sprite), the resolve's draw arguments (six vertices per shaded tile, counted
+    /// sprites, the lists' capacity; its index, the item count, the blocks and the chunks'
+    /// capacity; every item's first sprite), the resolve's draw arguments (six vertices per shaded tile, counted
     /// by the shade) and the shades' dispatch arguments (bins counted by the bin scan, 64
     /// tiles each).
     fn upload_jobs(&self, ctx: &GpuContext, order: &[&DrawItem], firsts: &[u32]) {
@@ -692,11 +695,8 @@ impl TilePass {
         }
         ctx.queue
             .write_buffer(&b.job_buffer, 0, bytemuck::cast_slice(&jobs));
-        ctx.queue.write_buffer(
-            &b.touched,
-            0,
-            bytemuck::cast_slice(&[6u32, 0, 0, 0, 0, 0, 0, 0]),
-        );
+        ctx.queue
+            .write_buffer(&b.touched, 0, bytemuck::cast_slice(&[6u32, 0, 0, 0]));
         let args: Vec<u32> = order.iter().flat_map(|_| [0u32, 64, 1, 0]).collect();
         ctx.queue
             .write_buffer(&b.dispatch_args, 0, bytemuck::cast_slice(&args));
