@@ -65,10 +65,15 @@ fn tl_capacity() -> u32 {
     return arrayLength(&bin_meta) - tl_entry(0u);
 }
 
+// Bin b's tile list entries in all (its last tile's list ends there).
+fn tl_bin_entries(b: u32) -> u32 {
+    return bin_meta[tl_tile_local(b, 63u)] + bin_meta[tl_tile_total(b, 63u)];
+}
+
 // Whether bin b has tile lists, all written.
 fn tile_lists_fit(b: u32) -> bool {
     let start = bin_meta[tl_bin_start(b)];
-    let entries = bin_meta[tl_tile_local(b, 63u)] + bin_meta[tl_tile_total(b, 63u)];
+    let entries = tl_bin_entries(b);
     return start != TL_NONE && entries <= tl_capacity() && start <= tl_capacity() - entries;
 }
 
@@ -76,24 +81,9 @@ fn tile_lists_fit(b: u32) -> bool {
 // placed the lists) and the chunk passes' dispatch arguments. Every invocation of the
 // workgroup calls it.
 fn count_chunks(lid: u32) {
-    let bins = bin_count();
-    var chunks = 0u;
-    for (var base = 0u; base < bins; base += 256u) {
-        let b = base + lid;
-        var v = 0u;
-        if b < bins {
-            let n = bin_meta[meta_total(b)];
-            if n >= TL_MIN_ENTRIES && bin_meta[meta_start(b)] + n <= job.counts.w {
-                v = (n + CHUNK - 1u) / CHUNK;
-            }
-        }
-        let at = running_exclusive(lid, v, &chunks);
-        if b < bins {
-            bin_meta[tl_chunk_first(b)] = at;
-        }
-    }
+    let chunks = scan_bins(lid, SCAN_CHUNKS);
     if lid == 0u {
-        bin_meta[tl_chunk_first(bins)] = chunks;
+        bin_meta[tl_chunk_first(bin_count())] = chunks;
         atomicStore(&dispatch_args[4u * MAX_ITEMS], min(chunks, 256u));
         atomicStore(&dispatch_args[4u * MAX_ITEMS + 1u], (chunks + 255u) / 256u);
         atomicStore(&dispatch_args[4u * MAX_ITEMS + 2u], 1u);
@@ -236,20 +226,7 @@ fn tiles_scan(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
 // (`tile_lists_fit`), the same bins whatever the scheduling.
 @compute @workgroup_size(256)
 fn tiles_starts(@builtin(local_invocation_index) lid: u32) {
-    let bins = bin_count();
-    var running = 0u;
-    for (var base = 0u; base < bins; base += 256u) {
-        let b = base + lid;
-        var v = 0u;
-        let listed = b < bins && bin_meta[tl_bin_start(b)] != TL_NONE;
-        if listed {
-            v = bin_meta[tl_tile_local(b, 63u)] + bin_meta[tl_tile_total(b, 63u)];
-        }
-        let at = running_exclusive(lid, v, &running);
-        if listed {
-            bin_meta[tl_bin_start(b)] = at;
-        }
-    }
+    scan_bins(lid, SCAN_TILE_LISTS);
 }
 
 // Writes one chunk's (workgroup) entries into the lists of the tiles they cover, each at

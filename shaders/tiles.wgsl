@@ -417,23 +417,66 @@ fn bin_scan(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_inde
 // then the chunks of the tile lists' passes.
 @compute @workgroup_size(256)
 fn bin_starts(@builtin(local_invocation_index) lid: u32) {
+    let entries = scan_bins(lid, SCAN_LISTS);
+    if lid == 0u {
+        bin_meta[meta_start(bin_count())] = entries;
+    }
+    count_chunks(lid);
+}
+
+// What `scan_bins` scans: the bins' list entries (into `meta_start`), the chunks of the
+// tile lists' passes (into `tl_chunk_first`), the bins' tile list entries (into
+// `tl_bin_start`, listed bins only).
+const SCAN_LISTS: u32 = 0u;
+const SCAN_CHUNKS: u32 = 1u;
+const SCAN_TILE_LISTS: u32 = 2u;
+
+// Bin b's value for the scan `what`, and whether its place is written.
+fn scan_value(what: u32, b: u32) -> vec2<u32> {
+    switch what {
+        case SCAN_LISTS: {
+            return vec2<u32>(bin_meta[meta_total(b)], 1u);
+        }
+        case SCAN_CHUNKS: {
+            // Complete lists of TL_MIN_ENTRIES or more only.
+            let n = bin_meta[meta_total(b)];
+            let listed = n >= TL_MIN_ENTRIES && bin_meta[meta_start(b)] + n <= job.counts.w;
+            return vec2<u32>(select(0u, (n + CHUNK - 1u) / CHUNK, listed), 1u);
+        }
+        default: {
+            let listed = bin_meta[tl_bin_start(b)] != TL_NONE;
+            return vec2<u32>(select(0u, tl_bin_entries(b), listed), u32(listed));
+        }
+    }
+}
+
+// An exclusive scan over the bins of `scan_value(what, ·)` (one workgroup; every
+// invocation calls it): each bin's place written where `what` says; returns the total.
+fn scan_bins(lid: u32, what: u32) -> u32 {
     let bins = bin_count();
     var running = 0u;
     for (var base = 0u; base < bins; base += 256u) {
         let b = base + lid;
-        var v = 0u;
+        var v = vec2<u32>(0u);
         if b < bins {
-            v = bin_meta[meta_total(b)];
+            v = scan_value(what, b);
         }
-        let at = running_exclusive(lid, v, &running);
-        if b < bins {
-            bin_meta[meta_start(b)] = at;
+        let at = running_exclusive(lid, v.x, &running);
+        if v.y != 0u {
+            switch what {
+                case SCAN_LISTS: {
+                    bin_meta[meta_start(b)] = at;
+                }
+                case SCAN_CHUNKS: {
+                    bin_meta[tl_chunk_first(b)] = at;
+                }
+                default: {
+                    bin_meta[tl_bin_start(b)] = at;
+                }
+            }
         }
     }
-    if lid == 0u {
-        bin_meta[meta_start(bins)] = running;
-    }
-    count_chunks(lid);
+    return running;
 }
 
 // Lists, for one bin and one block of BLOCK sprites (workgroup z) with some over the bin,

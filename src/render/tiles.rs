@@ -298,28 +298,23 @@ impl TilePass {
             layout: &empty_layout,
             entries: &[],
         });
-        let bin_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("TilePass::bin_layout"),
-            bind_group_layouts: &[
-                Some(&frame.frame_layout),
-                Some(&empty_layout),
-                Some(&empty_layout),
-                Some(&bin_group_layout),
-            ],
-            immediate_size: 0,
-        });
-        // The tiles' lists' passes: the tile group only (the chunk passes' arguments are
-        // read as indirect arguments, so they may not be bound for writing).
-        let list_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("TilePass::list_layout"),
-            bind_group_layouts: &[
-                Some(&frame.frame_layout),
-                Some(&empty_layout),
-                Some(&empty_layout),
-                Some(&tile_layout),
-            ],
-            immediate_size: 0,
-        });
+        // The bin passes and the tiles' lists' passes: the frame and one group of their own.
+        let group3_layout = |label, group: &wgpu::BindGroupLayout| {
+            d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(label),
+                bind_group_layouts: &[
+                    Some(&frame.frame_layout),
+                    Some(&empty_layout),
+                    Some(&empty_layout),
+                    Some(group),
+                ],
+                immediate_size: 0,
+            })
+        };
+        let bin_layout = group3_layout("TilePass::bin_layout", &bin_group_layout);
+        // The tiles' lists' passes: the tile group (the chunk passes' arguments are read as
+        // indirect arguments, so they may not be bound for writing).
+        let list_layout = group3_layout("TilePass::list_layout", &tile_layout);
         let resolve_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("TilePass::resolve_layout"),
             bind_group_layouts: &[Some(&frame.frame_layout), Some(&resolve_group_layout)],
