@@ -771,9 +771,6 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) 
         let v = accum[pixel];
         acc = vec4<f32>(unpack2x16float(v.x), unpack2x16float(v.y));
     }
-    var shaded = false;
-    // Hits waiting in `hits` (the same in every invocation).
-    var pending = 0u;
     // The item's entries in the bin's list: its blocks', one after another. A bin whose
     // list did not fit the lists' capacity is shaded from the item's sprites directly
     // (slower, never a sprite lost).
@@ -795,36 +792,66 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) 
     let listed = workgroupUniformLoad(&shared_flag) != 0u;
     let region = workgroupUniformLoad(&shared_bin);
     let n = workgroupUniformLoad(&shared_count);
+    var shaded: Shaded;
     if listed {
-        acc = shade_tile_run(lid, region, n, origin, p, inside, acc);
-        if inside && n > 0u {
-            accum[pixel] = vec2<u32>(pack2x16float(acc.rg), pack2x16float(acc.ba));
-        }
-        list_shaded_tile(lid, n > 0u, t);
-        return;
+        shaded = Shaded(shade_tile_run(lid, region, n, origin, p, inside, acc), n > 0u);
+    } else {
+        let run = BinRun(region, overflow, first, local);
+        shaded = shade_bin_run(lid, n, run, origin, p, inside, acc);
     }
+    if inside && shaded.any {
+        accum[pixel] = vec2<u32>(pack2x16float(shaded.acc.rg), pack2x16float(shaded.acc.ba));
+    }
+    list_shaded_tile(lid, shaded.any, t);
+}
+
+// A tile's pixel after the item's sprites, and whether any sprite was over the tile.
+struct Shaded {
+    acc: vec4<f32>,
+    any: bool,
+}
+
+// The item's run of a bin's list as a tile filters it: entries from `region` of
+// `bin_lists`, or (`overflow`: the list did not fit) the item's sprites from `first`;
+// `local`: the tile within the bin.
+struct BinRun {
+    region: u32,
+    overflow: bool,
+    first: u32,
+    local: vec2<u32>,
+}
+
+// The item's sprites over the tile at `origin` blended into `acc` at pixel `p`, found by
+// filtering the `n` entries (or sprites) of the bin's run chunk by chunk (an
+// order-keeping compaction) and shaded batch by batch. Every invocation of the workgroup
+// calls it with the same `n`.
+fn shade_bin_run(lid: u32, n: u32, run: BinRun, origin: vec2<i32>, p: vec2<i32>, inside: bool, acc_in: vec4<f32>) -> Shaded {
+    var acc = acc_in;
+    var shaded = false;
+    // Hits waiting in `hits` (the same in every invocation).
+    var pending = 0u;
     let tile_rect = vec4<i32>(origin, origin + i32(TILE) - 1);
     // The next chunk's entry is read while this one is shaded (its latency hidden).
     var next = vec2<u32>(0u);
-    if !overflow && lid < n {
-        next = bin_lists[region + lid];
+    if !run.overflow && lid < n {
+        next = bin_lists[run.region + lid];
     }
     for (var base = 0u; base < n; base += 256u) {
         // The chunk's sprites of this item over this tile, in order.
         let i = base + lid;
         let e = next;
-        if !overflow && i + 256u < n {
-            next = bin_lists[region + i + 256u];
+        if !run.overflow && i + 256u < n {
+            next = bin_lists[run.region + i + 256u];
         }
         var hit = false;
         var s = 0u;
-        if i < n && overflow {
-            s = first + i;
+        if i < n && run.overflow {
+            s = run.first + i;
             hit = overlaps(sprites[s].bounds, tile_rect);
         } else if i < n {
             s = e.x;
             let t = (vec4<u32>(e.y) >> vec4<u32>(0u, 3u, 6u, 9u)) & vec4<u32>(7u);
-            hit = all(local >= t.xy) && all(local <= t.zw);
+            hit = all(run.local >= t.xy) && all(run.local <= t.zw);
         }
         let at = compact(lid, hit);
         if hit {
@@ -859,10 +886,7 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) 
     if pending > 0u {
         acc = shade_batch(lid, pending, 0u, origin, p, inside, acc);
     }
-    if inside && shaded {
-        accum[pixel] = vec2<u32>(pack2x16float(acc.rg), pack2x16float(acc.ba));
-    }
-    list_shaded_tile(lid, shaded, t);
+    return Shaded(acc, shaded);
 }
 
 // The first item to shade tile `t` lists it for the resolve.
