@@ -22,7 +22,8 @@
 //   item's list of bins), 5 `scene_depth` (the host's depth, when
 //   its size is the viewport's), 6 `job` (this dispatch's item: dynamic offset).
 // - The resolve (a render pipeline): group 0 as above, group 1: 0 `accum_in`, 1
-//   `touched_in` (the same buffers, read-only).
+//   `touched_in` (the same buffers, read-only). The compute resolve (`resolve_over`, where
+//   the adapter can): the same, and group 2 binding 2 `resolve_image`, the target.
 // - DEPTH_TEST: as splat.wgsl (0 none, 1 nearer or level passes, 2 reversed Z).
 #import "common.wgsl"
 #import "quad.wgsl"
@@ -57,6 +58,8 @@ var<private> look: LookUniform;
 // The resolve's view of `accum` and `touched`.
 @group(1) @binding(0) var<storage, read> accum_in: array<vec2<u32>>;
 @group(1) @binding(1) var<storage, read> touched_in: array<u32>;
+// The compute resolve's target (the HDR image, read and written in place).
+@group(2) @binding(2) var resolve_image: texture_storage_2d<rgba16float, read_write>;
 
 override DEPTH_TEST: u32 = 0u;
 // The adapter's blending rounds f16 toward zero (lavapipe), not to nearest.
@@ -939,4 +942,21 @@ fn vs_resolve(@builtin(vertex_index) vi: u32, @builtin(instance_index) inst: u32
 fn fs_resolve(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let v = accum_in[u32(frag.y) * u32(camera.viewport.x) + u32(frag.x)];
     return vec4<f32>(unpack2x16float(v.x), unpack2x16float(v.y));
+}
+
+// The compute resolve: the same composite by every compute unit instead of the raster (the
+// H100 keeps only a sliver of its chip for that), one workgroup per tile; untouched tiles
+// return at once.
+@compute @workgroup_size(16, 16)
+fn resolve_over(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {
+    let size = vec2<u32>(camera.viewport.xy);
+    let tiles_x = (size.x + TILE - 1u) / TILE;
+    let px = wg.xy * TILE + lid.xy;
+    if touched_in[TOUCHED_FLAGS + wg.y * tiles_x + wg.x] == 0u || any(px >= size) {
+        return;
+    }
+    let v = accum_in[px.y * size.x + px.x];
+    let src = vec4<f32>(unpack2x16float(v.x), unpack2x16float(v.y));
+    let dst = textureLoad(resolve_image, vec2<i32>(px));
+    textureStore(resolve_image, vec2<i32>(px), dst * (1.0 - src.a) + src);
 }

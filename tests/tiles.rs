@@ -406,3 +406,46 @@ fn alpha_blended_ribbons_leave_the_other_blended_layers_their_tiles() {
     assert_eq!(item("smoke"), Some((BlendMode::Alpha, true, false)));
     assert_eq!(item("debris smoke"), Some((BlendMode::Alpha, false, true)));
 }
+
+/// The editor's and renders' own HDR image takes the tiles by compute (`resolve_over`)
+/// where the adapter can read and write it in place: the image is the one the resolve's
+/// draw gives, over alpha-blended billboards (the fireball's smoke lines stay billboards,
+/// drawn under the tiles) and on their own (the torch).
+#[test]
+fn the_compute_resolve_composites_what_the_resolve_draw_does() {
+    let ctx = gpu();
+    for name in ["fireball", "torch"] {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("presets/{name}.ron"));
+        let mut effect = ignis::preset::load(&path).expect("the preset");
+        for e in &mut effect.emitters {
+            e.look.draw_path = DrawPath::Tiles;
+        }
+        let image = |compute: bool| {
+            let mut run =
+                Headless::new(&ctx, effect.clone(), ShaderLibrary::embedded()).expect("headless");
+            let tiles = run.player.tile_pass().expect("the tiles");
+            tiles.set_compute_resolve(compute);
+            for _ in 0..60 {
+                run.advance(1.0 / 60.0);
+            }
+            let image = run.render(SIZE).expect("render");
+            let tiles = run.player.tile_pass().expect("the tiles");
+            assert_eq!(
+                tiles.can_resolve_into(SIZE),
+                compute,
+                "{name}: the compute resolve was {}used",
+                if compute { "not " } else { "" }
+            );
+            image
+        };
+        let (drawn, computed) = (image(false), image(true));
+        assert!(total_light(&drawn) > 1e3, "{name}: almost nothing drawn");
+        let (mean, max) = image_diff(&drawn, &computed);
+        eprintln!("{name}: compute resolve vs draw: mean {mean:.4}/255, max {max}/255");
+        assert!(
+            mean <= 0.01 && max <= 1,
+            "{name}: the compute resolve differs by {mean:.4}/255 mean, {max}/255 max"
+        );
+    }
+}

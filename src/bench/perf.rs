@@ -117,6 +117,9 @@ pub struct PerfRow {
     /// The tile draw's project alone and project + bin, ms (the shade and resolve are the
     /// rest of `tiles_ms`).
     pub tiles_stages_ms: Option<[f64; 2]>,
+    /// The tiles' resolve alone, ms: by compute (None where the adapter cannot; the tile
+    /// draw uses it where it can, as the editor does) and by a draw.
+    pub tiles_resolve_ms: Option<(Option<f64>, f64)>,
     /// Tonemap composite, ms.
     pub composite_ms: f64,
     /// The path Auto picks for this scene.
@@ -382,22 +385,38 @@ fn measure_row(
         }
         median(&mut samples)
     };
-    // Tiles: project, bin, shade and the resolve into the HDR target.
-    let mut tiles_stages_ms = None;
+    // Tiles: project, bin, shade and the resolve into the HDR target (by compute where
+    // the adapter can, as the composite does).
+    let (mut tiles_stages_ms, mut tiles_resolve_ms) = (None, None);
+    let hdr = &targets.hdr_view;
     let tiles_ms = tiles.as_mut().and_then(|t| {
         let mut enc = ctx.device.create_command_encoder(&Default::default());
         let fits = t.record(ctx, &mut enc, &frame, &all_tiles, size, None);
         ctx.queue.submit([enc.finish()]);
+        let resolve = |t: &mut TilePass, enc: &mut wgpu::CommandEncoder| {
+            if !t.resolve_into(ctx, enc, &frame, hdr, size) {
+                t.resolve(&mut load_hdr_pass(enc, hdr), &frame);
+            }
+        };
         let time = |t: &mut TilePass, stages| {
             t.set_stages(stages);
             time_median(&timer, ctx, opts.repeats, |enc| {
                 t.record(ctx, enc, &frame, &all_tiles, size, None);
-                t.resolve(&mut load_hdr_pass(enc, &targets.hdr_view), &frame);
+                resolve(t, enc);
             })
         };
         fits.then(|| {
             tiles_stages_ms = Some([TileStages::Project, TileStages::Bin].map(|s| time(t, s)));
-            time(t, TileStages::All)
+            let all = time(t, TileStages::All);
+            // The last record stays shaded: each resolve timed alone.
+            let by_compute = t
+                .can_resolve_into(size)
+                .then(|| time_median(&timer, ctx, opts.repeats, |enc| resolve(t, enc)));
+            let by_draw = time_median(&timer, ctx, opts.repeats, |enc| {
+                t.resolve(&mut load_hdr_pass(enc, hdr), &frame);
+            });
+            tiles_resolve_ms = Some((by_compute, by_draw));
+            all
         })
     });
     // Composite: the tonemap.
@@ -428,6 +447,7 @@ fn measure_row(
         splat_ms,
         tiles_ms,
         tiles_stages_ms,
+        tiles_resolve_ms,
         composite_ms,
         auto_path,
         frame_ms: update_ms + draw + composite_ms,
@@ -729,13 +749,17 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
                 continue;
             }
         };
-        if let (Some(all), Some([project, bin])) = (row.tiles_ms, row.tiles_stages_ms) {
+        if let (Some(all), Some([project, bin]), Some((by_compute, by_draw))) =
+            (row.tiles_ms, row.tiles_stages_ms, row.tiles_resolve_ms)
+        {
             tile_table.push(vec![
                 format!("{side}² = {n}"),
                 format!("{project:.3}"),
                 format!("{:.3}", bin - project),
                 format!("{:.3}", all - bin),
                 format!("{all:.3}"),
+                by_compute.map_or_else(|| "—".into(), |ms| format!("{ms:.3}")),
+                format!("{by_draw:.3}"),
             ]);
         }
         let gbps = n as f64 * 64.0 / (row.lean_update_ms * 1e-3) / 1e9;
@@ -820,7 +844,10 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
     report.heading("Tile path stages");
     report.para(
         "The tile draw of each row timed stage by stage (records that stop after a stage, same run): \
-         project every quad, bin (count per block, scan, list; then the dense bins' lists per tile), then shade and resolve (the rest).",
+         project every quad, bin (count per block, scan, list; then the dense bins' lists per tile), then shade and resolve (the rest). \
+         The last two columns time the resolve of the shaded tiles into the HDR image alone: by compute \
+         (the tile draw's, as in the editor, where the adapter reads and writes the image in place) and by a draw \
+         (what a host's render pass gets).",
     );
     report.table(
         &[
@@ -829,6 +856,8 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
             "bin ms",
             "shade + resolve ms",
             "tile draw ms",
+            "resolve ms (compute)",
+            "resolve ms (draw)",
         ],
         &tile_table,
     );

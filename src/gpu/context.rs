@@ -95,9 +95,13 @@ impl GpuContext {
             .max(limits.max_storage_buffers_per_shader_stage)
             .min(crate::render::tiles::STORAGE_BUFFERS_NEEDED);
         // Blending into 32-bit float targets where the adapter can (the export's
-        // accumulation of bright additive light; f16 rounds it by a few percent).
+        // accumulation of bright additive light; f16 rounds it by a few percent); the
+        // adapter's own format features (the tiles' compute resolve reads and writes the
+        // HDR image in place).
         let features = crate::gpu::timer::timing_features(&adapter)
-            | (adapter.features() & wgpu::Features::FLOAT32_BLENDABLE);
+            | (adapter.features()
+                & (wgpu::Features::FLOAT32_BLENDABLE
+                    | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES));
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("ignis device"),
             required_features: features,

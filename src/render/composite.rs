@@ -148,11 +148,20 @@ impl Composite {
             }
         }
         if let Some(targets) = self.targets.as_ref() {
-            self.clear.record(ctx, enc, &targets.hdr_view, targets.size);
-            player.draw_layers(
-                &mut load_hdr_pass(enc, &targets.hdr_view),
-                Layers::ALL.without(layered),
-            );
+            let (view, size) = (&targets.hdr_view, targets.size);
+            self.clear.record(ctx, enc, view, size);
+            // The tiles are resolved by compute where the adapter can (between the
+            // blended billboards under them and the light over them), else drawn.
+            let main = Layers::ALL.without(layered);
+            if main.contains(Layers::LIGHT) && player.tiles_resolvable_into(size) {
+                if player.draws_under_tiles(main) {
+                    player.draw_under_tiles(&mut load_hdr_pass(enc, view), main);
+                }
+                let resolved = player.resolve_tiles_into(enc, view, size);
+                player.draw_over_tiles(&mut load_hdr_pass(enc, view), main, !resolved);
+            } else {
+                player.draw_layers(&mut load_hdr_pass(enc, view), main);
+            }
         }
         layered
     }

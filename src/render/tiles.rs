@@ -44,14 +44,22 @@ const MAX_LIST_BYTES: u64 = 128 << 20;
 /// Bytes per list entry: the sprite and the bin's tiles it covers.
 const LIST_ENTRY_BYTES: u64 = 8;
 
-/// The module, the basic variant's pipelines (built to validate the module), the bin
-/// pipelines and the resolve.
-type Built = (
-    wgpu::ShaderModule,
-    HashMap<LookVariant, Option<[wgpu::ComputePipeline; 2]>>,
-    BinPipes,
-    wgpu::RenderPipeline,
-);
+/// What a build of `tiles.wgsl` makes.
+struct Built {
+    module: wgpu::ShaderModule,
+    /// The basic variant's pipelines (built to validate the module).
+    variants: HashMap<LookVariant, Option<[wgpu::ComputePipeline; 2]>>,
+    bin: BinPipes,
+    resolve: wgpu::RenderPipeline,
+    /// The compute resolve, where the adapter can read and write the target in place.
+    resolve_over: Option<wgpu::ComputePipeline>,
+}
+
+/// The compute resolve's target layout and pipeline layout.
+struct ComputeResolve {
+    image_layout: wgpu::BindGroupLayout,
+    layout: wgpu::PipelineLayout,
+}
 
 /// The binning's passes: count per block, scan per bin, the bins' starts, the lists; then
 /// the tiles' lists: count per chunk, scan per bin, the bins' starts, scatter.
@@ -81,6 +89,14 @@ pub struct TilePass {
     variants: HashMap<LookVariant, Option<[wgpu::ComputePipeline; 2]>>,
     bin: BinPipes,
     resolve: wgpu::RenderPipeline,
+    /// The compute resolve's layouts, pipeline and groups over the targets it wrote last
+    /// (`None`: the adapter cannot, or the host's target is not an HDR image).
+    compute_resolve: Option<ComputeResolve>,
+    resolve_over: Option<wgpu::ComputePipeline>,
+    image_groups: Vec<(wgpu::TextureView, wgpu::BindGroup)>,
+    /// Whether [`TilePass::resolve_into`] may resolve by compute (tests compare it with
+    /// the draw).
+    compute_resolve_on: bool,
     sprites: crate::render::sprites::SpriteGroups,
     buffers: Option<TileBuffers>,
     /// Whether the last record shaded anything (the resolve draws only then).
@@ -271,8 +287,11 @@ impl TilePass {
         let resolve_group_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("TilePass::resolve_group_layout"),
             entries: &[
-                read(0, wgpu::ShaderStages::FRAGMENT),
-                read(1, wgpu::ShaderStages::VERTEX),
+                read(
+                    0,
+                    wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+                ),
+                read(1, wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE),
             ],
         });
         let compute_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -320,10 +339,13 @@ impl TilePass {
             bind_group_layouts: &[Some(&frame.frame_layout), Some(&resolve_group_layout)],
             immediate_size: 0,
         });
-        let (module, variants, bin, resolve) = Self::build(
+        let compute_resolve =
+            ComputeResolve::new(ctx, target, &frame.frame_layout, &resolve_group_layout);
+        let built = Self::build(
             ctx,
             lib,
             [&compute_layout, &bin_layout, &list_layout, &resolve_layout],
+            compute_resolve.as_ref().map(|c| &c.layout),
             target,
         )?;
         Ok(Self {
@@ -337,10 +359,14 @@ impl TilePass {
             list_layout,
             empty_group,
             resolve_layout,
-            module,
-            variants,
-            bin,
-            resolve,
+            module: built.module,
+            variants: built.variants,
+            bin: built.bin,
+            resolve: built.resolve,
+            compute_resolve,
+            resolve_over: built.resolve_over,
+            image_groups: Vec::new(),
+            compute_resolve_on: true,
             sprites: crate::render::sprites::SpriteGroups::new(
                 "TilePass::sprite_group",
                 sprite_layout,
@@ -395,11 +421,12 @@ impl TilePass {
     }
 
     /// The module (validated with the full-state pipelines), the bin pipeline and the
-    /// resolve.
+    /// resolves.
     fn build(
         ctx: &GpuContext,
         lib: &ShaderLibrary,
         [layout, bin_layout, list_layout, resolve_layout]: [&wgpu::PipelineLayout; 4],
+        over_layout: Option<&wgpu::PipelineLayout>,
         target: DrawTarget,
     ) -> Result<Built, ShaderError> {
         let composed = lib.compose("tiles.wgsl")?;
@@ -428,7 +455,15 @@ impl TilePass {
                 target,
                 wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING,
             );
-            (module.clone(), variants, bin, resolve)
+            let resolve_over =
+                over_layout.map(|l| Self::compute(ctx, l, module, "resolve_over", &[]));
+            Built {
+                module: module.clone(),
+                variants,
+                bin,
+                resolve,
+                resolve_over,
+            }
         })
     }
 
@@ -476,11 +511,13 @@ impl TilePass {
             &self.list_layout,
             &self.resolve_layout,
         ];
-        let (module, variants, bin, resolve) = Self::build(ctx, lib, layouts, self.target)?;
-        self.module = module;
-        self.bin = bin;
-        self.resolve = resolve;
-        self.variants = variants;
+        let over = self.compute_resolve.as_ref().map(|c| &c.layout);
+        let built = Self::build(ctx, lib, layouts, over, self.target)?;
+        self.module = built.module;
+        self.bin = built.bin;
+        self.resolve = built.resolve;
+        self.resolve_over = built.resolve_over;
+        self.variants = built.variants;
         Ok(())
     }
 
@@ -846,8 +883,142 @@ impl TilePass {
         pass.draw_indirect(&b.touched, 0);
     }
 
+    /// Composites the last record's tiles over `target` (the HDR image of `size` pixels
+    /// the resolve would draw into, with storage usage) by compute instead of a draw: the
+    /// same `dst · T + C` per shaded pixel, on every compute unit rather than the raster
+    /// (the H100 keeps only a sliver of its chip for that). Returns false, recording
+    /// nothing, where the adapter cannot (then [`TilePass::resolve`] draws it).
+    pub fn resolve_into(
+        &mut self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        frame: &FrameResources,
+        target: &wgpu::TextureView,
+        size: (u32, u32),
+    ) -> bool {
+        if !self.can_resolve_into(size) {
+            return false;
+        }
+        let (Some(c), Some(pipeline), Some(b)) = (
+            self.compute_resolve.as_ref(),
+            self.resolve_over.as_ref(),
+            self.buffers.as_ref(),
+        ) else {
+            return false;
+        };
+        let group = match self.image_groups.iter().position(|(v, _)| v == target) {
+            Some(i) => &self.image_groups[i].1,
+            None => {
+                let group = c.image_group(ctx, target);
+                if self.image_groups.len() >= MAX_IMAGE_GROUPS {
+                    self.image_groups.remove(0);
+                }
+                self.image_groups.push((target.clone(), group));
+                &self.image_groups[self.image_groups.len() - 1].1
+            }
+        };
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("TilePass::resolve_over"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &frame.frame_group, &[0]);
+        pass.set_bind_group(1, &b.resolve_group, &[]);
+        pass.set_bind_group(2, group, &[]);
+        let (tx, ty) = grid(size, TILE_PX);
+        pass.dispatch_workgroups(tx, ty, 1);
+        true
+    }
+
+    /// Whether [`TilePass::resolve_into`] resolves the last record into a target of
+    /// `size` pixels.
+    pub fn can_resolve_into(&self, size: (u32, u32)) -> bool {
+        self.drawn
+            && self.compute_resolve_on
+            && self.resolve_over.is_some()
+            && self.buffers.as_ref().is_some_and(|b| b.size == size)
+    }
+
+    /// Lets [`TilePass::resolve_into`] resolve by compute (the default) or not (tests
+    /// compare the two).
+    #[doc(hidden)]
+    pub fn set_compute_resolve(&mut self, on: bool) {
+        self.compute_resolve_on = on;
+    }
+
     /// Whether the last record drew anything.
     pub fn drawn(&self) -> bool {
         self.drawn
+    }
+}
+
+/// Targets whose bind groups the compute resolve keeps (the composite's image changes
+/// only with its size).
+const MAX_IMAGE_GROUPS: usize = 2;
+
+impl ComputeResolve {
+    /// Group 2 binding 2, the target (read and written in place), after the frame and
+    /// the resolve's groups; `None` where `target` is not a single-sample HDR image or the
+    /// device cannot read and write one in place (Vulkan adapters can, asked for their own
+    /// format features: the layout is tried in an error scope, which works on a host's
+    /// device too).
+    fn new(
+        ctx: &GpuContext,
+        target: DrawTarget,
+        frame_layout: &wgpu::BindGroupLayout,
+        resolve_layout: &wgpu::BindGroupLayout,
+    ) -> Option<Self> {
+        let d = &ctx.device;
+        let adapter_formats = d
+            .features()
+            .contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES);
+        if !adapter_formats
+            || target.color_format != crate::render::HDR_FORMAT
+            || target.sample_count > 1
+        {
+            return None;
+        }
+        let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
+        let image_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("TilePass::image_layout"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::ReadWrite,
+                    format: crate::render::HDR_FORMAT,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                },
+                count: None,
+            }],
+        });
+        if let Some(err) = pollster::block_on(scope.pop()) {
+            log::info!("the tiles are resolved by draws: {err}");
+            return None;
+        }
+        let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("TilePass::resolve_over_layout"),
+            bind_group_layouts: &[
+                Some(frame_layout),
+                Some(resolve_layout),
+                Some(&image_layout),
+            ],
+            immediate_size: 0,
+        });
+        Some(Self {
+            image_layout,
+            layout,
+        })
+    }
+
+    fn image_group(&self, ctx: &GpuContext, target: &wgpu::TextureView) -> wgpu::BindGroup {
+        ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("TilePass::image_group"),
+            layout: &self.image_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::TextureView(target),
+            }],
+        })
     }
 }

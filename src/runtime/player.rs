@@ -549,23 +549,68 @@ impl Player {
     pub fn draw_layers(&self, pass: &mut wgpu::RenderPass<'_>, layers: Layers) {
         // Alpha-blended billboards, then the tiles (alpha-blended layers are drawn by
         // one path or the other, never both), then the light.
-        let wanted = |d: &DrawItem| layers.contains(Layers::of(d));
+        self.draw_under_tiles(pass, layers);
+        self.draw_over_tiles(pass, layers, true);
+    }
+
+    /// What [`Player::draw_layers`] draws before the tiles: the alpha-blended billboards
+    /// of `layers`.
+    pub(crate) fn draw_under_tiles(&self, pass: &mut wgpu::RenderPass<'_>, layers: Layers) {
         self.billboard.draw(pass, &self.frame, &self.items, |d| {
-            d.blend == BlendMode::Alpha && wanted(d)
+            d.blend == BlendMode::Alpha && layers.contains(Layers::of(d))
         });
-        if let Some(tiles) = self
+    }
+
+    /// Whether [`Player::draw_under_tiles`] draws anything for `layers`.
+    pub(crate) fn draws_under_tiles(&self, layers: Layers) -> bool {
+        self.items.iter().any(|d| {
+            !d.splat && !d.tiles && d.blend == BlendMode::Alpha && layers.contains(Layers::of(d))
+        })
+    }
+
+    /// The rest of [`Player::draw_layers`]: the tiles (unless `tiles` is false: resolved
+    /// by compute already), the additive billboards and the splat's light.
+    pub(crate) fn draw_over_tiles(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        layers: Layers,
+        tiles: bool,
+    ) {
+        if let Some(t) = self
             .tiles
             .as_ref()
-            .filter(|_| layers.contains(Layers::LIGHT))
+            .filter(|_| tiles && layers.contains(Layers::LIGHT))
         {
-            tiles.resolve(pass, &self.frame);
+            t.resolve(pass, &self.frame);
         }
         self.billboard.draw(pass, &self.frame, &self.items, |d| {
-            d.blend == BlendMode::Additive && wanted(d)
+            d.blend == BlendMode::Additive && layers.contains(Layers::of(d))
         });
         if self.splatted && layers.contains(Layers::LIGHT) {
             self.splat.resolve(pass, &self.frame);
         }
+    }
+
+    /// Whether [`Player::resolve_tiles_into`] resolves into a target of `size` pixels.
+    pub(crate) fn tiles_resolvable_into(&self, size: (u32, u32)) -> bool {
+        self.tiles
+            .as_ref()
+            .is_some_and(|t| t.can_resolve_into(size))
+    }
+
+    /// Resolves the last record's tiles into `target` (an HDR image of `size` pixels with
+    /// storage usage) by compute, between [`Player::draw_under_tiles`] and
+    /// [`Player::draw_over_tiles`]; false where it cannot (nothing recorded).
+    pub(crate) fn resolve_tiles_into(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        size: (u32, u32),
+    ) -> bool {
+        let Some(tiles) = self.tiles.as_mut() else {
+            return false;
+        };
+        tiles.resolve_into(&self.ctx, enc, &self.frame, target, size)
     }
 
     /// Prepares the motion pass from the next [`Player::record`] on (the export's
