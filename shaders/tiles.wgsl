@@ -134,6 +134,12 @@ fn to_pixels(c: vec4<f32>) -> vec2<f32> {
     return vec2<f32>((n.x * 0.5 + 0.5) * camera.viewport.x, (0.5 - n.y * 0.5) * camera.viewport.y);
 }
 
+// A pixel position on the rasteriser's sub-pixel grid (8 bits: Vulkan's usual
+// subPixelPrecisionBits, lavapipe's and NVIDIA's).
+fn snap(p: vec2<f32>) -> vec2<f32> {
+    return round(p * 256.0) / 256.0;
+}
+
 // The atlas coordinates' scale per unit of frame coordinates.
 fn atlas_scale() -> vec2<f32> {
     if FLIPBOOK {
@@ -224,9 +230,7 @@ fn project_quad(q: u32) -> TileSprite {
         if z < 0.0 || z > 1.0 {
             return s;
         }
-        let k = 1.0 / adj[2].z;
-        s.map = vec4<f32>(adj[0].xy, adj[1].xy) * k;
-        s.offset = vec4<f32>(adj[2].xy * k, 1.0, z);
+        s.offset = vec4<f32>(0.0, 0.0, 1.0, z);
     }
     s.uv_box = vec4<f32>(min(c0.uv, c3.uv), max(c0.uv, c3.uv));
     s.color = qd.color;
@@ -248,11 +252,25 @@ fn project_quad(q: u32) -> TileSprite {
     // The shade reads nothing of the look (a private copy of it per invocation costs
     // registers).
     s.grad = vec4<f32>(atlas_scale(), frames.z, look.soft.y);
+    // The corners where the rasteriser puts them: snapped to its sub-pixel grid.
+    let p0 = snap(to_pixels(c0.clip));
+    let p1 = snap(to_pixels(c1.clip));
+    let p2 = snap(to_pixels(c2.clip));
+    let p3 = snap(to_pixels(c3.clip));
+    if s.offset.z == 1.0 {
+        // The affine map from the snapped corners (p = p0 + J · (uv − uv0)), so that the
+        // pixels a sprite smaller than a pixel covers are the billboard's.
+        let j = mat2x2<f32>((p1 - p0) / du, (p2 - p0) / dv);
+        let det = determinant(j);
+        if abs(det) < 1e-30 {
+            // No area on the grid: the rasteriser draws nothing either.
+            return s;
+        }
+        let inv = mat2x2<f32>(vec2<f32>(j[1].y, -j[0].y), vec2<f32>(-j[1].x, j[0].x)) * (1.0 / det);
+        s.map = vec4<f32>(inv[0], inv[1]);
+        s.offset = vec4<f32>(c0.uv - inv * p0, s.offset.zw);
+    }
     // Pixel centres (x + 0.5) inside the quad's bounding box, clamped to the target.
-    let p0 = to_pixels(c0.clip);
-    let p1 = to_pixels(c1.clip);
-    let p2 = to_pixels(c2.clip);
-    let p3 = to_pixels(c3.clip);
     let lo = floor(min(min(p0, p1), min(p2, p3)) - 0.5);
     let hi = ceil(max(max(p0, p1), max(p2, p3)) - 0.5);
     let size = vec2<f32>(camera.viewport.xy) - 1.0;

@@ -566,7 +566,7 @@ fn module_costs(ctx: &GpuContext, opts: &PerfOptions) -> Result<Vec<(String, f64
     // Every variant on one pool, filled like the throughput rows' (66 steps: every slot
     // alive), and no other large pool alive: on the H100 the same one-step update of a
     // 16.8M pool measured 0.41 ms with one such pool allocated, 0.74 ms with two and
-    // 1.04 ms with ten (a device-memory effect, not the code — session 3's diagnostic);
+    // 1.04 ms with ten (a device-memory effect, not the code);
     // earlier versions of this table, holding two or more pools, reported the slowed
     // figures, and pools allocated and freed in turn land erratically. Switching variants
     // swaps the pipelines (the bare one is built from another library), never the pool.
@@ -717,7 +717,17 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
     // Modules first: measured on a fresh device, before the large pools of the throughput
     // rows have been allocated and freed.
     eprintln!("bench perf: module costs");
+    let fresh_ms = small_frame_ms(ctx, opts)?;
     let costs = module_costs(ctx, opts)?;
+    let state = ProcessState {
+        fresh_ms,
+        after_large_ms: small_frame_ms(ctx, opts)?,
+        new_device_ms: small_frame_ms(
+            &GpuContext::headless()?.with_profile(Some(ctx.profile)),
+            opts,
+        )?,
+        pool: u64::from(opts.module_capacity).min(ctx.max_capacity()),
+    };
     // Per compact layout: its table and JSON rows.
     let compact = [(StateLayout::Packed, "packed"), (StateLayout::Tiny, "tiny")];
     let mut compact_tables = [Vec::new(), Vec::new()];
@@ -904,8 +914,7 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
         "Update pass at {mcap} particles, ms per step: the median and the best of {} one-step submissions in 3 rounds \
          over the variants, all on one full pool (several large pools alive at once slow every one of them on the \
          H100), each after 100 ms of untimed steps; stateless mode, which clears the pool, last. The comparison uses \
-         the best: on the H100 a share of samples runs in a slow state (0.42 → 0.75 ms for the same step, bimodal, \
-         session 3's diagnostic), which moves medians by tens of percent while the best repeats to 1 %. \
+         the best: on the H100 a share of samples runs in a slow state (0.42 → 0.75 ms for the same step, bimodal), which moves medians by tens of percent while the best repeats to 1 %. \
          The first two rows are the \"off costs nothing\" check: the pipeline with every module compiled out \
          by its override constant against one built from source with the module code deleted.",
         opts.repeats.max(1) * 3
@@ -963,8 +972,69 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
             .map(|(n, ms, best)| serde_json::json!({"variant": n, "ms": ms, "best_ms": best}))
             .collect::<Vec<_>>(),
     )?;
+    state.report(&mut report);
     report.json["resolution"] = serde_json::json!([opts.size.0, opts.size.1]);
     report.json["timing"] = serde_json::Value::String(timer.source.label().into());
     let _ = DrawPath::Auto;
     Ok(report)
+}
+
+/// A small frame (the 64² flames) in three states of the process: on a fresh device; on
+/// the same device after the module table's pools were allocated and freed; on a new
+/// device of the same process (what each throughput row, and the editor after a large
+/// pool, move to).
+struct ProcessState {
+    fresh_ms: f64,
+    after_large_ms: f64,
+    new_device_ms: f64,
+    /// Particles in the module table's pool.
+    pool: u64,
+}
+
+/// The 64² row's frame on `ctx`, ms.
+fn small_frame_ms(ctx: &GpuContext, opts: &PerfOptions) -> Result<f64, SimError> {
+    let copy = copy_pipeline(ctx, COPY_WGSL);
+    measure_row(ctx, opts, 64 * 64, &copy).map(|r| r.frame_ms)
+}
+
+impl ProcessState {
+    /// The section and its JSON (`process_state`).
+    fn report(&self, report: &mut Report) {
+        report.heading("Process state");
+        report.para(&format!(
+            "The 64² row's frame (update, auto draw, composite) on the first device before the module table, on the \
+             same device after the table's {}-particle pools were allocated and freed, and on a new device of the \
+             same process. The check: no state of the process leaves small work 2× slower than a fresh process — \
+             the throughput rows run on new devices, and the editor moves to one when a large pool is freed.",
+            self.pool
+        ));
+        let ratio = |ms: f64| format!("{:.2}×", ms / self.fresh_ms);
+        report.table(
+            &["device", "frame ms", "vs fresh"],
+            &[
+                vec![
+                    "fresh".into(),
+                    format!("{:.3}", self.fresh_ms),
+                    ratio(self.fresh_ms),
+                ],
+                vec![
+                    "same device, after the large pools".into(),
+                    format!("{:.3}", self.after_large_ms),
+                    ratio(self.after_large_ms),
+                ],
+                vec![
+                    "new device, same process".into(),
+                    format!("{:.3}", self.new_device_ms),
+                    ratio(self.new_device_ms),
+                ],
+            ],
+        );
+        report.json["process_state"] = serde_json::json!({
+            "pool": self.pool,
+            "fresh_ms": self.fresh_ms,
+            "after_large_ms": self.after_large_ms,
+            "new_device_ms": self.new_device_ms,
+            "new_device_within_2x": self.new_device_ms <= 2.0 * self.fresh_ms,
+        });
+    }
 }
