@@ -159,6 +159,13 @@ enum BenchKind {
         /// Timed frames per row (medians are reported).
         #[arg(long, default_value_t = 15)]
         frames: usize,
+        /// Passes over every row (each row reports its fastest pass).
+        #[arg(long, default_value_t = 3)]
+        passes: usize,
+        /// Save a close-up of where a path's image differs from the billboards' by more
+        /// than 8/255 into this folder.
+        #[arg(long)]
+        diff_crops: Option<PathBuf>,
         /// Output folder.
         #[arg(long, default_value = "bench/results")]
         out: PathBuf,
@@ -528,6 +535,8 @@ fn bench(kind: BenchKind, profile: &ProfileRequest) -> anyhow::Result<()> {
             paths,
             sizes,
             frames,
+            passes,
+            diff_crops,
             out,
             name,
         } => {
@@ -550,6 +559,8 @@ fn bench(kind: BenchKind, profile: &ProfileRequest) -> anyhow::Result<()> {
                 presets,
                 sizes,
                 frames: frames.max(1),
+                passes: passes.max(1),
+                diff_crops,
             };
             let report = ignis::bench::presets::run(&ctx, &opts)?;
             save_report(&report, &out, name, "presets", &ctx)?;
