@@ -100,16 +100,19 @@ fn item_first(k: u32) -> u32 {
 // origin at the target's top-left corner): h = (map.xy·p.x + map.zw·p.y + offset.xy,
 // map_z·(p, 1)), uv = h.xy / h.z (a projective map: the perspective-correct interpolation
 // of the billboard's corners). A camera-facing quad's map is affine (offset.z = 1): uv =
-// h.xy; the fields after `ground` are then never written or read. The shade reads the
-// first eight fields of every sprite it meets: they fill four whole 32-byte sectors.
+// h.xy; the projective fields are then never written or read. The pixels a quad covers are
+// the rasteriser's: its two triangles (corners 0 1 2 and 2 1 3) on the rasteriser's
+// sub-pixel grid, edges by the top-left rule. The shade reads the first eight fields of
+// every sprite it meets: they fill four whole 32-byte sectors.
 struct TileSprite {
     // Pixel rectangle (x0, y0, x1, y1, inclusive; empty when x0 > x1).
     bounds: vec4<i32>,
     map: vec4<f32>,
     // xy: the map's constant terms, z: 1 when the map is affine, w: the depth then.
     offset: vec4<f32>,
-    // The quad: uv0.xy to uv1.xy (the sprite's occupied part).
-    uv_box: vec4<f32>,
+    // The corners on the rasteriser's grid, pixels: 0 and 1, then 2 and 3.
+    corners01: vec4<f32>,
+    corners23: vec4<f32>,
     // Premultiplied colour (× intensity when additive).
     color: vec4<f32>,
     // The atlas coordinates at frame coordinates (0, 0) of the flipbook frame (xy) and of
@@ -118,14 +121,12 @@ struct TileSprite {
     // xy: atlas coordinates per unit of frame coordinates (the derivatives' scale), z: the
     // next frame's weight, w: the soft edges' 1 / distance.
     grad: vec4<f32>,
-    // The ground fade's argument as an affine function of (uv, 1).
+    // The ground fade's argument as an affine function of (uv, 1) (soft looks only).
     ground: vec4<f32>,
     // A projective map's h.z row, and clip z and w as affine functions of (uv, 1).
     map_z: vec4<f32>,
     z_row: vec4<f32>,
     w_row: vec4<f32>,
-    // To 192 bytes: every sprite starts on a sector.
-    pad: vec4<f32>,
 }
 
 // Pixel coordinates of a clip position.
@@ -169,7 +170,8 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
     }
     sprites[index].map = s.map;
     sprites[index].offset = s.offset;
-    sprites[index].uv_box = s.uv_box;
+    sprites[index].corners01 = s.corners01;
+    sprites[index].corners23 = s.corners23;
     sprites[index].color = s.color;
     sprites[index].frames = s.frames;
     sprites[index].grad = s.grad;
@@ -232,7 +234,6 @@ fn project_quad(q: u32) -> TileSprite {
         }
         s.offset = vec4<f32>(0.0, 0.0, 1.0, z);
     }
-    s.uv_box = vec4<f32>(min(c0.uv, c3.uv), max(c0.uv, c3.uv));
     s.color = qd.color;
     // The flipbook's cells, found here once: the shade maps frame coordinates to the
     // atlas with one multiply-add (the look's `atlas_uv`, rearranged).
@@ -257,9 +258,11 @@ fn project_quad(q: u32) -> TileSprite {
     let p1 = snap(to_pixels(c1.clip));
     let p2 = snap(to_pixels(c2.clip));
     let p3 = snap(to_pixels(c3.clip));
+    s.corners01 = vec4<f32>(p0, p1);
+    s.corners23 = vec4<f32>(p2, p3);
     if s.offset.z == 1.0 {
-        // The affine map from the snapped corners (p = p0 + J · (uv − uv0)), so that the
-        // pixels a sprite smaller than a pixel covers are the billboard's.
+        // The affine map from the snapped corners (p = p0 + J · (uv − uv0)), as the
+        // rasteriser interpolates.
         let j = mat2x2<f32>((p1 - p0) / du, (p2 - p0) / dv);
         let det = determinant(j);
         if abs(det) < 1e-30 {
@@ -292,18 +295,60 @@ var<workgroup> shared_flag: u32;
 const CACHE: u32 = 64u;
 var<workgroup> cache_map: array<vec4<f32>, 64>;
 var<workgroup> cache_offset: array<vec4<f32>, 64>;
-var<workgroup> cache_box: array<vec4<f32>, 64>;
+var<workgroup> cache_corners01: array<vec4<f32>, 64>;
+var<workgroup> cache_corners23: array<vec4<f32>, 64>;
+// The orientation of the quad's two triangles (±1, 0 when one has no area).
+var<workgroup> cache_sides: array<vec2<f32>, 64>;
 var<workgroup> cache_color: array<vec4<f32>, 64>;
 var<workgroup> cache_frames: array<vec4<f32>, 64>;
 var<workgroup> cache_grad: array<vec4<f32>, 64>;
 var<workgroup> cache_ground: array<vec4<f32>, 64>;
 var<workgroup> cache_bounds: array<vec4<i32>, 64>;
 
+// The z of the cross product of a and b.
+fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
+    return a.x * b.y - a.y * b.x;
+}
+
+// Whether a pixel centre `d` from an edge's start lies inside the edge `e` (oriented with
+// the inside to its left: f > 0), or on it and the edge is a top or left one — the
+// rasteriser's tie rule. Exact for sprites of a few pixels (their corners' and centres'
+// coordinates are multiples of 1/256 with few bits), which is where ties show.
+fn inside_edge(e: vec2<f32>, d: vec2<f32>) -> bool {
+    let f = cross2(e, d);
+    return f > 0.0 || (f == 0.0 && (e.y < 0.0 || (e.y == 0.0 && e.x > 0.0)));
+}
+
+// Whether the rasteriser covers pixel centre `pc` with cached sprite k's quad: either
+// triangle, corners 0 1 2 or 2 1 3. Their shared diagonal is evaluated once, so that a
+// centre on it belongs to exactly one of them.
+fn covers(k: u32, pc: vec2<f32>) -> bool {
+    let c01 = cache_corners01[k];
+    let c23 = cache_corners23[k];
+    let side = cache_sides[k];
+    let d1 = pc - c01.zw;
+    let diagonal = c23.xy - c01.zw;
+    let in_a = inside_edge(side.x * (c01.zw - c01.xy), pc - c01.xy)
+        && inside_edge(side.x * diagonal, d1)
+        && inside_edge(side.x * (c01.xy - c23.xy), pc - c23.xy);
+    let in_b = inside_edge(-side.y * diagonal, d1)
+        && inside_edge(side.y * (c23.zw - c01.zw), d1)
+        && inside_edge(side.y * (c23.xy - c23.zw), pc - c23.zw);
+    return in_a || in_b;
+}
+
 // Reads sprite `i`'s fields into slot `k` of the cache.
 fn cache_sprite(k: u32, i: u32) {
     cache_map[k] = sprites[i].map;
     cache_offset[k] = sprites[i].offset;
-    cache_box[k] = sprites[i].uv_box;
+    let c01 = sprites[i].corners01;
+    let c23 = sprites[i].corners23;
+    cache_corners01[k] = c01;
+    cache_corners23[k] = c23;
+    cache_sides[k] = vec2<f32>(
+        sign(cross2(c01.zw - c01.xy, c23.xy - c01.xy)),
+        sign(cross2(c01.zw - c23.xy, c23.zw - c23.xy)),
+    );
     cache_color[k] = sprites[i].color;
     cache_frames[k] = sprites[i].frames;
     cache_grad[k] = sprites[i].grad;
@@ -597,6 +642,9 @@ fn sprite_light(i: u32, k: u32, p: vec2<i32>) -> vec4<f32> {
         return vec4<f32>(0.0);
     }
     let pc = vec2<f32>(p) + 0.5;
+    if !covers(k, pc) {
+        return vec4<f32>(0.0);
+    }
     let ca = cache_map[k];
     let cb = cache_offset[k];
     var uv: vec2<f32>;
@@ -620,9 +668,8 @@ fn sprite_light(i: u32, k: u32, p: vec2<i32>) -> vec4<f32> {
         let uv1 = vec3<f32>(uv, 1.0);
         z = dot(sprites[i].z_row.xyz, uv1) / dot(sprites[i].w_row.xyz, uv1);
     }
-    let uv_box = cache_box[k];
     // Clipped to the depth range as the rasteriser clips the billboard.
-    if any(uv < uv_box.xy) || any(uv > uv_box.zw) || z < 0.0 || z > 1.0 || !visible(p, z) {
+    if z < 0.0 || z > 1.0 || !visible(p, z) {
         return vec4<f32>(0.0);
     }
     let grad = cache_grad[k];
