@@ -100,17 +100,21 @@ fn item_first(k: u32) -> u32 {
 // origin at the target's top-left corner): h = (map.xy·p.x + map.zw·p.y + offset.xy,
 // map_z·(p, 1)), uv = h.xy / h.z (a projective map: the perspective-correct interpolation
 // of the billboard's corners). A camera-facing quad's map is affine (offset.z = 1): uv =
-// h.xy; the projective fields are then never written or read. The pixels a quad covers are
-// the rasteriser's: its two triangles (corners 0 1 2 and 2 1 3) on the rasteriser's
-// sub-pixel grid, edges by the top-left rule. The shade reads the first eight fields of
-// every sprite it meets: they fill four whole 32-byte sectors.
+// h.xy; the projective fields are then never written or read. A small quad (`is_small`)
+// covers the rasteriser's pixels exactly: its two triangles (corners 0 1 2 and 2 1 3) on
+// the rasteriser's sub-pixel grid, edges by the top-left rule; a larger one the pixels
+// whose uv lies in its box (the map is built from the snapped corners: the same pixels but
+// for centres within about 1/256 pixel of an edge, where a sprite's light is faint). The
+// shade reads the first eight fields of every sprite it meets: they fill four whole
+// 32-byte sectors.
 struct TileSprite {
     // Pixel rectangle (x0, y0, x1, y1, inclusive; empty when x0 > x1).
     bounds: vec4<i32>,
     map: vec4<f32>,
     // xy: the map's constant terms, z: 1 when the map is affine, w: the depth then.
     offset: vec4<f32>,
-    // The corners on the rasteriser's grid, pixels: 0 and 1, then 2 and 3.
+    // A small quad: its corners on the rasteriser's grid, pixels, 0 and 1, then 2 and 3. A
+    // larger one: its uv box (uv0.xy, uv1.xy: the sprite's occupied part), then nothing.
     corners01: vec4<f32>,
     corners23: vec4<f32>,
     // Premultiplied colour (× intensity when additive).
@@ -258,8 +262,6 @@ fn project_quad(q: u32) -> TileSprite {
     let p1 = snap(to_pixels(c1.clip));
     let p2 = snap(to_pixels(c2.clip));
     let p3 = snap(to_pixels(c3.clip));
-    s.corners01 = vec4<f32>(p0, p1);
-    s.corners23 = vec4<f32>(p2, p3);
     if s.offset.z == 1.0 {
         // The affine map from the snapped corners (p = p0 + J · (uv − uv0)), as the
         // rasteriser interpolates.
@@ -281,7 +283,20 @@ fn project_quad(q: u32) -> TileSprite {
         return s;
     }
     s.bounds = vec4<i32>(vec2<i32>(max(lo, vec2<f32>(0.0))), vec2<i32>(min(hi, size)));
+    if is_small(s.bounds) {
+        s.corners01 = vec4<f32>(p0, p1);
+        s.corners23 = vec4<f32>(p2, p3);
+    } else {
+        s.corners01 = vec4<f32>(min(c0.uv, c3.uv), max(c0.uv, c3.uv));
+    }
     return s;
+}
+
+// Whether a quad whose pixel centres lie in `bounds` is small: its coverage is tested
+// exactly, edge by edge (a pixel holds much of a small sprite's light; the test costs the
+// shade too much to run for every sprite).
+fn is_small(bounds: vec4<i32>) -> bool {
+    return all(bounds.zw - bounds.xy < vec2<i32>(4));
 }
 
 
@@ -339,23 +354,26 @@ fn covers(k: u32, pc: vec2<f32>) -> bool {
 
 // Reads sprite `i`'s fields into slot `k` of the cache.
 fn cache_sprite(k: u32, i: u32) {
+    let bounds = sprites[i].bounds;
+    cache_bounds[k] = bounds;
     cache_map[k] = sprites[i].map;
     cache_offset[k] = sprites[i].offset;
     let c01 = sprites[i].corners01;
-    let c23 = sprites[i].corners23;
     cache_corners01[k] = c01;
-    cache_corners23[k] = c23;
-    cache_sides[k] = vec2<f32>(
-        sign(cross2(c01.zw - c01.xy, c23.xy - c01.xy)),
-        sign(cross2(c01.zw - c23.xy, c23.zw - c23.xy)),
-    );
+    if is_small(bounds) {
+        let c23 = sprites[i].corners23;
+        cache_corners23[k] = c23;
+        cache_sides[k] = vec2<f32>(
+            sign(cross2(c01.zw - c01.xy, c23.xy - c01.xy)),
+            sign(cross2(c01.zw - c23.xy, c23.zw - c23.xy)),
+        );
+    }
     cache_color[k] = sprites[i].color;
     cache_frames[k] = sprites[i].frames;
     cache_grad[k] = sprites[i].grad;
     if SOFT {
         cache_ground[k] = sprites[i].ground;
     }
-    cache_bounds[k] = sprites[i].bounds;
 }
 var<workgroup> shared_bin: u32;
 var<workgroup> item_hit: array<atomic<u32>, 64>;
@@ -642,7 +660,9 @@ fn sprite_light(i: u32, k: u32, p: vec2<i32>) -> vec4<f32> {
         return vec4<f32>(0.0);
     }
     let pc = vec2<f32>(p) + 0.5;
-    if !covers(k, pc) {
+    // The same for every lane: the sprite is the workgroup's.
+    let small = is_small(r);
+    if small && !covers(k, pc) {
         return vec4<f32>(0.0);
     }
     let ca = cache_map[k];
@@ -668,8 +688,10 @@ fn sprite_light(i: u32, k: u32, p: vec2<i32>) -> vec4<f32> {
         let uv1 = vec3<f32>(uv, 1.0);
         z = dot(sprites[i].z_row.xyz, uv1) / dot(sprites[i].w_row.xyz, uv1);
     }
+    let uv_box = cache_corners01[k];
+    let outside = any(uv < uv_box.xy) || any(uv > uv_box.zw);
     // Clipped to the depth range as the rasteriser clips the billboard.
-    if z < 0.0 || z > 1.0 || !visible(p, z) {
+    if (!small && outside) || z < 0.0 || z > 1.0 || !visible(p, z) {
         return vec4<f32>(0.0);
     }
     let grad = cache_grad[k];

@@ -134,7 +134,7 @@ fn report_difference(
     row: &Row,
     opts: &PresetsOptions,
 ) {
-    let (mut at, mut worst) = ((0, 0), 0u8);
+    let (mut at, mut worst, mut over) = ((0, 0), 0u8, 0usize);
     for (x, y, p) in image.enumerate_pixels() {
         let q = reference.get_pixel(x, y);
         let d =
@@ -143,12 +143,13 @@ fn report_difference(
                 .map(|(a, b)| a.abs_diff(b))
                 .max()
                 .unwrap_or(0);
+        over += usize::from(d > 8);
         if d > worst {
             (at, worst) = ((x, y), d);
         }
     }
     println!(
-        "  {} {} {}: largest difference {worst}/255 at {at:?}: {:?} (billboards {:?})",
+        "  {} {} {}: {over} pixels over 8/255, the largest {worst}/255 at {at:?}: {:?} (billboards {:?})",
         row.preset,
         row.size,
         row.path,
