@@ -64,6 +64,9 @@ var<private> look: LookUniform;
 override DEPTH_TEST: u32 = 0u;
 // The adapter's blending rounds f16 toward zero (lavapipe), not to nearest.
 override F16_ROUND_DOWN: bool = false;
+// Small quads cover exactly the rasteriser's pixels (an item of small sprites: the test
+// costs the shade of large ones a fifth of its time even where it is not taken).
+override EXACT: bool = false;
 
 // Pixels per tile side (one workgroup each) and tiles per bin side (keep in sync with
 // src/render/tiles.rs).
@@ -100,23 +103,22 @@ fn item_first(k: u32) -> u32 {
 // origin at the target's top-left corner): h = (map.xy·p.x + map.zw·p.y + offset.xy,
 // map_z·(p, 1)), uv = h.xy / h.z (a projective map: the perspective-correct interpolation
 // of the billboard's corners). A camera-facing quad's map is affine (offset.z = 1): uv =
-// h.xy; the projective fields are then never written or read. A small quad (`is_small`)
-// covers the rasteriser's pixels exactly: its two triangles (corners 0 1 2 and 2 1 3) on
-// the rasteriser's sub-pixel grid, edges by the top-left rule; a larger one the pixels
-// whose uv lies in its box (the map is built from the snapped corners: the same pixels but
-// for centres within about 1/256 pixel of an edge, where a sprite's light is faint). The
-// shade reads the first eight fields of every sprite it meets: they fill four whole
-// 32-byte sectors.
+// h.xy; the fields after `ground` are then never written or read. The shade reads the
+// first eight fields of every sprite it meets: they fill four whole 32-byte sectors.
+// A quad covers the pixels whose uv lies in its box (the map is built from the corners on
+// the rasteriser's sub-pixel grid: the rasteriser's pixels but for centres within about
+// 1/256 pixel of an edge, where a large sprite's light is faint). With EXACT (items of
+// small sprites) a small quad (`is_small`) covers exactly the rasteriser's pixels: its
+// two triangles (corners 0 1 2 and 2 1 3) on that grid, edges by the top-left rule.
 struct TileSprite {
     // Pixel rectangle (x0, y0, x1, y1, inclusive; empty when x0 > x1).
     bounds: vec4<i32>,
     map: vec4<f32>,
     // xy: the map's constant terms, z: 1 when the map is affine, w: the depth then.
     offset: vec4<f32>,
-    // A small quad: its corners on the rasteriser's grid, pixels, 0 and 1, then 2 and 3. A
-    // larger one: its uv box (uv0.xy, uv1.xy: the sprite's occupied part), then nothing.
-    corners01: vec4<f32>,
-    corners23: vec4<f32>,
+    // The quad: uv0.xy to uv1.xy (the sprite's occupied part); with EXACT, a small quad's
+    // corners 0 and 1 on the rasteriser's grid, pixels, instead.
+    uv_box: vec4<f32>,
     // Premultiplied colour (× intensity when additive).
     color: vec4<f32>,
     // The atlas coordinates at frame coordinates (0, 0) of the flipbook frame (xy) and of
@@ -125,12 +127,15 @@ struct TileSprite {
     // xy: atlas coordinates per unit of frame coordinates (the derivatives' scale), z: the
     // next frame's weight, w: the soft edges' 1 / distance.
     grad: vec4<f32>,
-    // The ground fade's argument as an affine function of (uv, 1) (soft looks only).
+    // The ground fade's argument as an affine function of (uv, 1).
     ground: vec4<f32>,
     // A projective map's h.z row, and clip z and w as affine functions of (uv, 1).
     map_z: vec4<f32>,
     z_row: vec4<f32>,
     w_row: vec4<f32>,
+    // With EXACT, a small quad's corners 2 and 3 (and to 192 bytes: every sprite starts on
+    // a sector).
+    corners23: vec4<f32>,
 }
 
 // Pixel coordinates of a clip position.
@@ -174,8 +179,10 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
     }
     sprites[index].map = s.map;
     sprites[index].offset = s.offset;
-    sprites[index].corners01 = s.corners01;
-    sprites[index].corners23 = s.corners23;
+    sprites[index].uv_box = s.uv_box;
+    if EXACT && is_small(s.bounds) {
+        sprites[index].corners23 = s.corners23;
+    }
     sprites[index].color = s.color;
     sprites[index].frames = s.frames;
     sprites[index].grad = s.grad;
@@ -238,6 +245,7 @@ fn project_quad(q: u32) -> TileSprite {
         }
         s.offset = vec4<f32>(0.0, 0.0, 1.0, z);
     }
+    s.uv_box = vec4<f32>(min(c0.uv, c3.uv), max(c0.uv, c3.uv));
     s.color = qd.color;
     // The flipbook's cells, found here once: the shade maps frame coordinates to the
     // atlas with one multiply-add (the look's `atlas_uv`, rearranged).
@@ -263,8 +271,8 @@ fn project_quad(q: u32) -> TileSprite {
     let p2 = snap(to_pixels(c2.clip));
     let p3 = snap(to_pixels(c3.clip));
     if s.offset.z == 1.0 {
-        // The affine map from the snapped corners (p = p0 + J · (uv − uv0)), as the
-        // rasteriser interpolates.
+        // The affine map from the snapped corners (p = p0 + J · (uv − uv0)), so that the
+        // pixels a sprite smaller than a pixel covers are the billboard's.
         let j = mat2x2<f32>((p1 - p0) / du, (p2 - p0) / dv);
         let det = determinant(j);
         if abs(det) < 1e-30 {
@@ -283,18 +291,15 @@ fn project_quad(q: u32) -> TileSprite {
         return s;
     }
     s.bounds = vec4<i32>(vec2<i32>(max(lo, vec2<f32>(0.0))), vec2<i32>(min(hi, size)));
-    if is_small(s.bounds) {
-        s.corners01 = vec4<f32>(p0, p1);
+    if EXACT && is_small(s.bounds) {
+        s.uv_box = vec4<f32>(p0, p1);
         s.corners23 = vec4<f32>(p2, p3);
-    } else {
-        s.corners01 = vec4<f32>(min(c0.uv, c3.uv), max(c0.uv, c3.uv));
     }
     return s;
 }
 
-// Whether a quad whose pixel centres lie in `bounds` is small: its coverage is tested
-// exactly, edge by edge (a pixel holds much of a small sprite's light; the test costs the
-// shade too much to run for every sprite).
+// Whether a quad whose pixel centres lie in `bounds` is small: with EXACT its coverage is
+// tested edge by edge (a pixel holds much of a small sprite's light).
 fn is_small(bounds: vec4<i32>) -> bool {
     return all(bounds.zw - bounds.xy < vec2<i32>(4));
 }
@@ -310,9 +315,10 @@ var<workgroup> shared_flag: u32;
 const CACHE: u32 = 64u;
 var<workgroup> cache_map: array<vec4<f32>, 64>;
 var<workgroup> cache_offset: array<vec4<f32>, 64>;
-var<workgroup> cache_corners01: array<vec4<f32>, 64>;
+var<workgroup> cache_box: array<vec4<f32>, 64>;
+// With EXACT, a small quad's corners 2 and 3 and its two triangles' orientations (±1, 0
+// when one has no area); its corners 0 and 1 are in `cache_box`.
 var<workgroup> cache_corners23: array<vec4<f32>, 64>;
-// The orientation of the quad's two triangles (±1, 0 when one has no area).
 var<workgroup> cache_sides: array<vec2<f32>, 64>;
 var<workgroup> cache_color: array<vec4<f32>, 64>;
 var<workgroup> cache_frames: array<vec4<f32>, 64>;
@@ -338,7 +344,7 @@ fn inside_edge(e: vec2<f32>, d: vec2<f32>) -> bool {
 // triangle, corners 0 1 2 or 2 1 3. Their shared diagonal is evaluated once, so that a
 // centre on it belongs to exactly one of them.
 fn covers(k: u32, pc: vec2<f32>) -> bool {
-    let c01 = cache_corners01[k];
+    let c01 = cache_box[k];
     let c23 = cache_corners23[k];
     let side = cache_sides[k];
     let d1 = pc - c01.zw;
@@ -354,18 +360,16 @@ fn covers(k: u32, pc: vec2<f32>) -> bool {
 
 // Reads sprite `i`'s fields into slot `k` of the cache.
 fn cache_sprite(k: u32, i: u32) {
-    let bounds = sprites[i].bounds;
-    cache_bounds[k] = bounds;
     cache_map[k] = sprites[i].map;
     cache_offset[k] = sprites[i].offset;
-    let c01 = sprites[i].corners01;
-    cache_corners01[k] = c01;
-    if is_small(bounds) {
+    let box = sprites[i].uv_box;
+    cache_box[k] = box;
+    if EXACT && is_small(sprites[i].bounds) {
         let c23 = sprites[i].corners23;
         cache_corners23[k] = c23;
         cache_sides[k] = vec2<f32>(
-            sign(cross2(c01.zw - c01.xy, c23.xy - c01.xy)),
-            sign(cross2(c01.zw - c23.xy, c23.zw - c23.xy)),
+            sign(cross2(box.zw - box.xy, c23.xy - box.xy)),
+            sign(cross2(box.zw - c23.xy, c23.zw - c23.xy)),
         );
     }
     cache_color[k] = sprites[i].color;
@@ -374,6 +378,7 @@ fn cache_sprite(k: u32, i: u32) {
     if SOFT {
         cache_ground[k] = sprites[i].ground;
     }
+    cache_bounds[k] = sprites[i].bounds;
 }
 var<workgroup> shared_bin: u32;
 var<workgroup> item_hit: array<atomic<u32>, 64>;
@@ -661,8 +666,8 @@ fn sprite_light(i: u32, k: u32, p: vec2<i32>) -> vec4<f32> {
     }
     let pc = vec2<f32>(p) + 0.5;
     // The same for every lane: the sprite is the workgroup's.
-    let small = is_small(r);
-    if small && !covers(k, pc) {
+    let exact = EXACT && is_small(r);
+    if exact && !covers(k, pc) {
         return vec4<f32>(0.0);
     }
     let ca = cache_map[k];
@@ -688,10 +693,10 @@ fn sprite_light(i: u32, k: u32, p: vec2<i32>) -> vec4<f32> {
         let uv1 = vec3<f32>(uv, 1.0);
         z = dot(sprites[i].z_row.xyz, uv1) / dot(sprites[i].w_row.xyz, uv1);
     }
-    let uv_box = cache_corners01[k];
-    let outside = any(uv < uv_box.xy) || any(uv > uv_box.zw);
+    let uv_box = cache_box[k];
+    let outside = !exact && (any(uv < uv_box.xy) || any(uv > uv_box.zw));
     // Clipped to the depth range as the rasteriser clips the billboard.
-    if (!small && outside) || z < 0.0 || z > 1.0 || !visible(p, z) {
+    if outside || z < 0.0 || z > 1.0 || !visible(p, z) {
         return vec4<f32>(0.0);
     }
     let grad = cache_grad[k];

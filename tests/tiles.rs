@@ -460,10 +460,11 @@ fn the_compute_resolve_composites_what_the_resolve_draw_does() {
     }
 }
 
-/// Sprites smaller than a pixel — the thesis preset's hard-edged points at 320×180 —
+/// Sprites of a pixel or a few — the thesis preset's hard-edged points at 320×180 —
 /// light the pixels the rasteriser lights: the tiles snap the quads' corners to its
-/// 1/256-pixel grid and give a centre on an edge to the triangle whose top or left edge
-/// it is. With the quad's exact corners and inclusive edges instead, single pixels
+/// 1/256-pixel grid and, for an emitter of small sprites, test a small quad's two
+/// triangles edge by edge, a centre on an edge going to the triangle whose top or left
+/// edge it is. With the quad's exact corners and inclusive edges instead, single pixels
 /// differed by up to 66/255 here (69/255 with snapped corners and inclusive edges).
 #[test]
 fn sprites_smaller_than_a_pixel_cover_the_rasterisers_pixels() {
