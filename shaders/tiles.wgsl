@@ -64,9 +64,6 @@ var<private> look: LookUniform;
 override DEPTH_TEST: u32 = 0u;
 // The adapter's blending rounds f16 toward zero (lavapipe), not to nearest.
 override F16_ROUND_DOWN: bool = false;
-// Small quads cover exactly the rasteriser's pixels (an item of small sprites: the test
-// costs the shade of large ones a fifth of its time even where it is not taken).
-override EXACT: bool = false;
 
 // Pixels per tile side (one workgroup each) and tiles per bin side (keep in sync with
 // src/render/tiles.rs).
@@ -105,19 +102,19 @@ fn item_first(k: u32) -> u32 {
 // of the billboard's corners). A camera-facing quad's map is affine (offset.z = 1): uv =
 // h.xy; the fields after `ground` are then never written or read. The shade reads the
 // first eight fields of every sprite it meets: they fill four whole 32-byte sectors.
-// A quad covers the pixels whose uv lies in its box (the map is built from the corners on
-// the rasteriser's sub-pixel grid: the rasteriser's pixels but for centres within about
-// 1/256 pixel of an edge, where a large sprite's light is faint). With EXACT (items of
-// small sprites) a small quad (`is_small`) covers exactly the rasteriser's pixels: its
-// two triangles (corners 0 1 2 and 2 1 3) on that grid, edges by the top-left rule.
+// The corners are placed on the rasteriser's sub-pixel grid. An upright rectangle there
+// (an unrotated camera-facing sprite) covers exactly the rasteriser's pixels: the centres
+// in its half-open pixel box (the top-left rule). Another quad covers the pixels whose uv
+// lies in its box: the rasteriser's but for centres within about 1/256 pixel of an edge.
 struct TileSprite {
     // Pixel rectangle (x0, y0, x1, y1, inclusive; empty when x0 > x1).
     bounds: vec4<i32>,
     map: vec4<f32>,
-    // xy: the map's constant terms, z: 1 when the map is affine, w: the depth then.
+    // xy: the map's constant terms, z: 1 when the map is affine (2: and the quad an
+    // upright rectangle), w: the depth then.
     offset: vec4<f32>,
-    // The quad: uv0.xy to uv1.xy (the sprite's occupied part); with EXACT, a small quad's
-    // corners 0 and 1 on the rasteriser's grid, pixels, instead.
+    // The quad: uv0.xy to uv1.xy (the sprite's occupied part); an upright rectangle's
+    // pixels (x0, y0, x1, y1: the centres in [x0, x1) × [y0, y1)) instead.
     uv_box: vec4<f32>,
     // Premultiplied colour (× intensity when additive).
     color: vec4<f32>,
@@ -133,9 +130,8 @@ struct TileSprite {
     map_z: vec4<f32>,
     z_row: vec4<f32>,
     w_row: vec4<f32>,
-    // With EXACT, a small quad's corners 2 and 3 (and to 192 bytes: every sprite starts on
-    // a sector).
-    corners23: vec4<f32>,
+    // To 192 bytes: every sprite starts on a sector.
+    pad: vec4<f32>,
 }
 
 // Pixel coordinates of a clip position.
@@ -180,9 +176,6 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
     sprites[index].map = s.map;
     sprites[index].offset = s.offset;
     sprites[index].uv_box = s.uv_box;
-    if EXACT && is_small(s.bounds) {
-        sprites[index].corners23 = s.corners23;
-    }
     sprites[index].color = s.color;
     sprites[index].frames = s.frames;
     sprites[index].grad = s.grad;
@@ -282,6 +275,13 @@ fn project_quad(q: u32) -> TileSprite {
         let inv = mat2x2<f32>(vec2<f32>(j[1].y, -j[0].y), vec2<f32>(-j[1].x, j[0].x)) * (1.0 / det);
         s.map = vec4<f32>(inv[0], inv[1]);
         s.offset = vec4<f32>(c0.uv - inv * p0, s.offset.zw);
+        if p0.x == p2.x && p1.x == p3.x && p0.y == p1.y && p2.y == p3.y {
+            // An upright rectangle on the grid (an unrotated camera-facing sprite): the
+            // rasteriser's pixels are exactly the centres in [x0, x1) × [y0, y1) (the
+            // top-left rule), tested in pixels (offset.z = 2) against this box.
+            s.offset.z = 2.0;
+            s.uv_box = vec4<f32>(min(p0, p3), max(p0, p3));
+        }
     }
     // Pixel centres (x + 0.5) inside the quad's bounding box, clamped to the target.
     let lo = floor(min(min(p0, p1), min(p2, p3)) - 0.5);
@@ -291,17 +291,7 @@ fn project_quad(q: u32) -> TileSprite {
         return s;
     }
     s.bounds = vec4<i32>(vec2<i32>(max(lo, vec2<f32>(0.0))), vec2<i32>(min(hi, size)));
-    if EXACT && is_small(s.bounds) {
-        s.uv_box = vec4<f32>(p0, p1);
-        s.corners23 = vec4<f32>(p2, p3);
-    }
     return s;
-}
-
-// Whether a quad whose pixel centres lie in `bounds` is small: with EXACT its coverage is
-// tested edge by edge (a pixel holds much of a small sprite's light).
-fn is_small(bounds: vec4<i32>) -> bool {
-    return all(bounds.zw - bounds.xy < vec2<i32>(4));
 }
 
 
@@ -316,62 +306,17 @@ const CACHE: u32 = 64u;
 var<workgroup> cache_map: array<vec4<f32>, 64>;
 var<workgroup> cache_offset: array<vec4<f32>, 64>;
 var<workgroup> cache_box: array<vec4<f32>, 64>;
-// With EXACT, a small quad's corners 2 and 3 and its two triangles' orientations (±1, 0
-// when one has no area); its corners 0 and 1 are in `cache_box`.
-var<workgroup> cache_corners23: array<vec4<f32>, 64>;
-var<workgroup> cache_sides: array<vec2<f32>, 64>;
 var<workgroup> cache_color: array<vec4<f32>, 64>;
 var<workgroup> cache_frames: array<vec4<f32>, 64>;
 var<workgroup> cache_grad: array<vec4<f32>, 64>;
 var<workgroup> cache_ground: array<vec4<f32>, 64>;
 var<workgroup> cache_bounds: array<vec4<i32>, 64>;
 
-// The z of the cross product of a and b.
-fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
-    return a.x * b.y - a.y * b.x;
-}
-
-// Whether a pixel centre `d` from an edge's start lies inside the edge `e` (oriented with
-// the inside to its left: f > 0), or on it and the edge is a top or left one — the
-// rasteriser's tie rule. Exact for sprites of a few pixels (their corners' and centres'
-// coordinates are multiples of 1/256 with few bits), which is where ties show.
-fn inside_edge(e: vec2<f32>, d: vec2<f32>) -> bool {
-    let f = cross2(e, d);
-    return f > 0.0 || (f == 0.0 && (e.y < 0.0 || (e.y == 0.0 && e.x > 0.0)));
-}
-
-// Whether the rasteriser covers pixel centre `pc` with cached sprite k's quad: either
-// triangle, corners 0 1 2 or 2 1 3. Their shared diagonal is evaluated once, so that a
-// centre on it belongs to exactly one of them.
-fn covers(k: u32, pc: vec2<f32>) -> bool {
-    let c01 = cache_box[k];
-    let c23 = cache_corners23[k];
-    let side = cache_sides[k];
-    let d1 = pc - c01.zw;
-    let diagonal = c23.xy - c01.zw;
-    let in_a = inside_edge(side.x * (c01.zw - c01.xy), pc - c01.xy)
-        && inside_edge(side.x * diagonal, d1)
-        && inside_edge(side.x * (c01.xy - c23.xy), pc - c23.xy);
-    let in_b = inside_edge(-side.y * diagonal, d1)
-        && inside_edge(side.y * (c23.zw - c01.zw), d1)
-        && inside_edge(side.y * (c23.xy - c23.zw), pc - c23.zw);
-    return in_a || in_b;
-}
-
 // Reads sprite `i`'s fields into slot `k` of the cache.
 fn cache_sprite(k: u32, i: u32) {
     cache_map[k] = sprites[i].map;
     cache_offset[k] = sprites[i].offset;
-    let box = sprites[i].uv_box;
-    cache_box[k] = box;
-    if EXACT && is_small(sprites[i].bounds) {
-        let c23 = sprites[i].corners23;
-        cache_corners23[k] = c23;
-        cache_sides[k] = vec2<f32>(
-            sign(cross2(box.zw - box.xy, c23.xy - box.xy)),
-            sign(cross2(box.zw - c23.xy, c23.zw - c23.xy)),
-        );
-    }
+    cache_box[k] = sprites[i].uv_box;
     cache_color[k] = sprites[i].color;
     cache_frames[k] = sprites[i].frames;
     cache_grad[k] = sprites[i].grad;
@@ -665,11 +610,6 @@ fn sprite_light(i: u32, k: u32, p: vec2<i32>) -> vec4<f32> {
         return vec4<f32>(0.0);
     }
     let pc = vec2<f32>(p) + 0.5;
-    // The same for every lane: the sprite is the workgroup's.
-    let exact = EXACT && is_small(r);
-    if exact && !covers(k, pc) {
-        return vec4<f32>(0.0);
-    }
     let ca = cache_map[k];
     let cb = cache_offset[k];
     var uv: vec2<f32>;
@@ -694,7 +634,10 @@ fn sprite_light(i: u32, k: u32, p: vec2<i32>) -> vec4<f32> {
         z = dot(sprites[i].z_row.xyz, uv1) / dot(sprites[i].w_row.xyz, uv1);
     }
     let uv_box = cache_box[k];
-    let outside = !exact && (any(uv < uv_box.xy) || any(uv > uv_box.zw));
+    // The box: pixels, half-open (an upright rectangle), or uv (else).
+    let upright = cb.z == 2.0;
+    let q = select(uv, pc, upright);
+    let outside = any(q < uv_box.xy) || any(q > uv_box.zw) || (upright && any(q == uv_box.zw));
     // Clipped to the depth range as the rasteriser clips the billboard.
     if outside || z < 0.0 || z > 1.0 || !visible(p, z) {
         return vec4<f32>(0.0);

@@ -1,6 +1,6 @@
 //! The tile rasteriser (`tiles.wgsl`) draws what the billboards draw: every shipped
 //! preset and each look module with both paths forced agree within 1/255 mean and 8/255
-//! max (measured on lavapipe: at most 0.005/255 mean, 2/255 max); sprites smaller than a
+//! max (measured on lavapipe: at most 0.005/255 mean, 6/255 max); sprites smaller than a
 //! pixel cover the rasteriser's pixels; sprites crossing tile borders, larger than the screen, behind the camera,
 //! piled hundreds deep on one tile, or thousands over several bins whose lists overflow keep
 //! all their light; binning is deterministic; the
@@ -461,11 +461,10 @@ fn the_compute_resolve_composites_what_the_resolve_draw_does() {
 }
 
 /// Sprites of a pixel or a few — the thesis preset's hard-edged points at 320×180 —
-/// light the pixels the rasteriser lights: the tiles snap the quads' corners to its
-/// 1/256-pixel grid and, for an emitter of small sprites, test a small quad's two
-/// triangles edge by edge, a centre on an edge going to the triangle whose top or left
-/// edge it is. With the quad's exact corners and inclusive edges instead, single pixels
-/// differed by up to 66/255 here (69/255 with snapped corners and inclusive edges).
+/// light the pixels the rasteriser lights: the tiles place the quads' corners on its
+/// 1/256-pixel grid, and an upright quad covers the centres in its half-open pixel box
+/// (the top-left rule). Testing the uv box of the exact corners instead, single pixels
+/// differed by up to 66/255 here (69/255 with the corners snapped).
 #[test]
 fn sprites_smaller_than_a_pixel_cover_the_rasterisers_pixels() {
     let ctx = gpu();

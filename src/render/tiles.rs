@@ -48,7 +48,7 @@ const LIST_ENTRY_BYTES: u64 = 8;
 struct Built {
     module: wgpu::ShaderModule,
     /// The basic variant's pipelines (built to validate the module).
-    variants: HashMap<TileVariant, Option<[wgpu::ComputePipeline; 2]>>,
+    variants: HashMap<LookVariant, Option<[wgpu::ComputePipeline; 2]>>,
     bin: BinPipes,
     resolve: wgpu::RenderPipeline,
     /// The compute resolve, where the adapter can read and write the target in place.
@@ -64,21 +64,6 @@ struct ComputeResolve {
 /// The binning's passes: count per block, scan per bin, the bins' starts, the lists; then
 /// the tiles' lists: count per chunk, scan per bin, the bins' starts, scatter.
 type BinPipes = [wgpu::ComputePipeline; 8];
-
-/// Items whose sprites are at most this large on screen (pixels, at the emitter's
-/// distance) cover exactly the rasteriser's pixels with their small quads (`EXACT` in
-/// tiles.wgsl): a pixel holds much of a small sprite's light. Larger sprites skip the
-/// test (it costs their shade a fifth even where it is not taken: the fireball at 4K,
-/// 2.17 → 2.59 ms on the H100).
-const EXACT_BELOW_PX: f32 = 8.0;
-
-/// A look variant and whether its small quads' coverage is exact.
-type TileVariant = (LookVariant, bool);
-
-/// The tile pipelines' variant of `d`.
-fn tile_variant(d: &DrawItem) -> TileVariant {
-    (d.variant, d.size_px <= EXACT_BELOW_PX)
-}
 
 /// Storage buffers per shader stage the tile passes bind (the looks, the six state
 /// views, the tiles' six): a device created with fewer draws every quad as a billboard.
@@ -101,7 +86,7 @@ pub struct TilePass {
     resolve_layout: wgpu::PipelineLayout,
     module: wgpu::ShaderModule,
     /// (project, shade) per look variant, built on first use (`None`: failed, logged).
-    variants: HashMap<TileVariant, Option<[wgpu::ComputePipeline; 2]>>,
+    variants: HashMap<LookVariant, Option<[wgpu::ComputePipeline; 2]>>,
     bin: BinPipes,
     resolve: wgpu::RenderPipeline,
     /// The compute resolve's layouts, pipeline and groups over the targets it wrote last
@@ -457,7 +442,7 @@ impl TilePass {
                 ("tiles_scatter", list_layout),
             ]
             .map(|(entry, layout)| Self::compute(ctx, layout, module, entry, &[]));
-            let basic = (LookVariant::basic(false), false);
+            let basic = LookVariant::basic(false);
             let variants = HashMap::from([(
                 basic,
                 Some(Self::variant_pipelines(ctx, layout, module, basic, target)),
@@ -498,7 +483,7 @@ impl TilePass {
         ctx: &GpuContext,
         layout: &wgpu::PipelineLayout,
         module: &wgpu::ShaderModule,
-        (v, exact): TileVariant,
+        v: LookVariant,
         target: DrawTarget,
     ) -> [wgpu::ComputePipeline; 2] {
         // tiles.wgsl has no motion pass and no ribbons (trails stay billboards).
@@ -511,7 +496,6 @@ impl TilePass {
         // Software blending (lavapipe) rounds f16 toward zero; the tiles round as it does.
         let round_down = ctx.profile.is_software();
         constants.push(("F16_ROUND_DOWN", if round_down { 1.0 } else { 0.0 }));
-        constants.push(("EXACT", if exact { 1.0 } else { 0.0 }));
         [
             Self::compute(ctx, layout, module, "project", &constants),
             Self::compute(ctx, layout, module, "shade", &constants),
@@ -541,7 +525,7 @@ impl TilePass {
     /// bind groups.
     fn prepare(&mut self, ctx: &GpuContext, items: &[&DrawItem], sampler: &wgpu::Sampler) {
         for d in items {
-            let v = tile_variant(d);
+            let v = d.variant;
             if !self.variants.contains_key(&v) {
                 let p =
                     crate::render::scoped_variant(ctx, format_args!("tile variant {v:?}"), || {
@@ -614,7 +598,7 @@ impl TilePass {
             for (k, d) in order.iter().enumerate() {
                 let (Some(particles), Some(Some(pipes)), Some(sprite)) = (
                     frame.particle_group(d.key),
-                    self.variants.get(&tile_variant(d)),
+                    self.variants.get(&d.variant),
                     self.sprites.get(d.sprite.id),
                 ) else {
                     continue;
