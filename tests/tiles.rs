@@ -56,6 +56,12 @@ fn render_at(
     img
 }
 
+/// The shipped preset `presets/<name>.ron`.
+fn shipped(name: &str) -> Effect {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("presets/{name}.ron"));
+    ignis::preset::load(&path).expect("a shipped preset")
+}
+
 /// Both paths of `effect` agree within 1/255 mean and 8/255 max; returns (mean, max).
 /// The blended layer at full resolution in both (the tiles always draw it so; the
 /// billboards at `post.alpha_downscale`).
@@ -390,8 +396,7 @@ fn many_sprites_over_several_bins_and_blocks_keep_their_light_when_lists_overflo
 #[test]
 fn alpha_blended_ribbons_leave_the_other_blended_layers_their_tiles() {
     let ctx = gpu();
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("presets/fireball.ron");
-    let mut effect = ignis::preset::load(&path).expect("the fireball");
+    let mut effect = shipped("fireball");
     for e in &mut effect.emitters {
         e.look.draw_path = DrawPath::Tiles;
     }
@@ -425,9 +430,7 @@ fn alpha_blended_ribbons_leave_the_other_blended_layers_their_tiles() {
 fn the_compute_resolve_composites_what_the_resolve_draw_does() {
     let ctx = gpu();
     for name in ["fireball", "torch"] {
-        let path =
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("presets/{name}.ron"));
-        let mut effect = ignis::preset::load(&path).expect("the preset");
+        let mut effect = shipped(name);
         for e in &mut effect.emitters {
             e.look.draw_path = DrawPath::Tiles;
         }
@@ -468,8 +471,7 @@ fn the_compute_resolve_composites_what_the_resolve_draw_does() {
 #[test]
 fn sprites_smaller_than_a_pixel_cover_the_rasterisers_pixels() {
     let ctx = gpu();
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("presets/thesis_2006.ron");
-    let mut effect = ignis::preset::load(&path).expect("the thesis preset");
+    let mut effect = shipped("thesis_2006");
     effect.post.alpha_downscale = 1;
     let size = (320, 180);
     let a = render_at(&ctx, &effect, DrawPath::Billboard, 90, size);
