@@ -2,53 +2,39 @@
 //! load them instead of clearing, which the H100's small raster slice does slowly.
 
 use crate::gpu::GpuContext;
-use crate::render::HDR_FORMAT;
+use crate::render::image_groups::ImageGroups;
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
-
-/// Targets whose bind groups a clear keeps.
-const MAX_GROUPS: usize = 4;
 
 /// The clear's pipeline.
 pub struct ClearPass {
-    layout: wgpu::BindGroupLayout,
+    /// The target's layout and groups (the composite's targets — the image and its reduced
+    /// layers — change only with its size).
+    images: ImageGroups,
     pipeline_layout: wgpu::PipelineLayout,
     pipeline: wgpu::ComputePipeline,
-    /// The groups over the last targets cleared, newest last (the composite's targets — the
-    /// image and its reduced layers — change only with its size).
-    groups: Vec<(wgpu::TextureView, wgpu::BindGroup)>,
 }
 
 impl ClearPass {
     /// Builds the pipeline from `lib`.
     pub fn new(ctx: &GpuContext, lib: &ShaderLibrary) -> Result<Self, ShaderError> {
-        let layout = ctx
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("ClearPass::layout"),
-                entries: &[wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format: HDR_FORMAT,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                    },
-                    count: None,
-                }],
-            });
+        let images = ImageGroups::new(
+            ctx,
+            "ClearPass::image",
+            0,
+            wgpu::StorageTextureAccess::WriteOnly,
+        );
         let pipeline_layout = ctx
             .device
             .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("ClearPass::pipeline_layout"),
-                bind_group_layouts: &[Some(&layout)],
+                bind_group_layouts: &[Some(images.layout())],
                 immediate_size: 0,
             });
         let pipeline = Self::build(ctx, lib, &pipeline_layout)?;
         Ok(Self {
-            layout,
+            images,
             pipeline_layout,
             pipeline,
-            groups: Vec::new(),
         })
     }
 
@@ -77,27 +63,7 @@ impl ClearPass {
         target: &wgpu::TextureView,
         size: (u32, u32),
     ) {
-        let group = match self.groups.iter().position(|(view, _)| view == target) {
-            Some(k) => self.groups.remove(k),
-            None => {
-                let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("ClearPass::group"),
-                    layout: &self.layout,
-                    entries: &[wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::TextureView(target),
-                    }],
-                });
-                (target.clone(), group)
-            }
-        };
-        if self.groups.len() >= MAX_GROUPS {
-            self.groups.remove(0);
-        }
-        self.groups.push(group);
-        let Some((_, group)) = self.groups.last() else {
-            return;
-        };
+        let group = self.images.group(ctx, target);
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("ClearPass"),
             timestamp_writes: None,

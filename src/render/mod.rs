@@ -6,6 +6,7 @@ pub mod camera;
 pub mod clear;
 pub mod composite;
 pub mod frame;
+pub(crate) mod image_groups;
 pub mod look;
 pub mod sort;
 pub mod splat;

@@ -14,6 +14,7 @@ use std::collections::HashMap;
 use crate::gpu::GpuContext;
 use crate::render::billboard::DrawTarget;
 use crate::render::frame::{DrawItem, FrameResources, LookVariant};
+use crate::render::image_groups::ImageGroups;
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 use crate::sim::gpu_sim::dispatch_size;
 
@@ -57,7 +58,8 @@ struct Built {
 
 /// The compute resolve's target layout and pipeline layout.
 struct ComputeResolve {
-    image_layout: wgpu::BindGroupLayout,
+    /// The target's layout (group 2) and groups.
+    images: ImageGroups,
     layout: wgpu::PipelineLayout,
 }
 
@@ -93,7 +95,6 @@ pub struct TilePass {
     /// (`None`: the adapter cannot, or the host's target is not an HDR image).
     compute_resolve: Option<ComputeResolve>,
     resolve_over: Option<wgpu::ComputePipeline>,
-    image_groups: Vec<(wgpu::TextureView, wgpu::BindGroup)>,
     /// Whether [`TilePass::resolve_into`] may resolve by compute (tests compare it with
     /// the draw).
     compute_resolve_on: bool,
@@ -365,7 +366,6 @@ impl TilePass {
             resolve: built.resolve,
             compute_resolve,
             resolve_over: built.resolve_over,
-            image_groups: Vec::new(),
             compute_resolve_on: true,
             sprites: crate::render::sprites::SpriteGroups::new(
                 "TilePass::sprite_group",
@@ -900,23 +900,13 @@ impl TilePass {
             return false;
         }
         let (Some(c), Some(pipeline), Some(b)) = (
-            self.compute_resolve.as_ref(),
+            self.compute_resolve.as_mut(),
             self.resolve_over.as_ref(),
             self.buffers.as_ref(),
         ) else {
             return false;
         };
-        let group = match self.image_groups.iter().position(|(v, _)| v == target) {
-            Some(i) => &self.image_groups[i].1,
-            None => {
-                let group = c.image_group(ctx, target);
-                if self.image_groups.len() >= MAX_IMAGE_GROUPS {
-                    self.image_groups.remove(0);
-                }
-                self.image_groups.push((target.clone(), group));
-                &self.image_groups[self.image_groups.len() - 1].1
-            }
-        };
+        let group = c.images.group(ctx, target);
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("TilePass::resolve_over"),
             timestamp_writes: None,
@@ -952,10 +942,6 @@ impl TilePass {
     }
 }
 
-/// Targets whose bind groups the compute resolve keeps (the composite's image changes
-/// only with its size).
-const MAX_IMAGE_GROUPS: usize = 2;
-
 impl ComputeResolve {
     /// Group 2 binding 2, the target (read and written in place), after the frame and
     /// the resolve's groups; `None` where `target` is not a single-sample HDR image or the
@@ -979,19 +965,12 @@ impl ComputeResolve {
             return None;
         }
         let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
-        let image_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("TilePass::image_layout"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 2,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::StorageTexture {
-                    access: wgpu::StorageTextureAccess::ReadWrite,
-                    format: crate::render::HDR_FORMAT,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                },
-                count: None,
-            }],
-        });
+        let images = ImageGroups::new(
+            ctx,
+            "TilePass::image",
+            2,
+            wgpu::StorageTextureAccess::ReadWrite,
+        );
         if let Some(err) = pollster::block_on(scope.pop()) {
             log::info!("the tiles are resolved by draws: {err}");
             return None;
@@ -1001,24 +980,10 @@ impl ComputeResolve {
             bind_group_layouts: &[
                 Some(frame_layout),
                 Some(resolve_layout),
-                Some(&image_layout),
+                Some(images.layout()),
             ],
             immediate_size: 0,
         });
-        Some(Self {
-            image_layout,
-            layout,
-        })
-    }
-
-    fn image_group(&self, ctx: &GpuContext, target: &wgpu::TextureView) -> wgpu::BindGroup {
-        ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("TilePass::image_group"),
-            layout: &self.image_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 2,
-                resource: wgpu::BindingResource::TextureView(target),
-            }],
-        })
+        Some(Self { images, layout })
     }
 }

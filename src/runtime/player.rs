@@ -556,16 +556,15 @@ impl Player {
     /// What [`Player::draw_layers`] draws before the tiles: the alpha-blended billboards
     /// of `layers`.
     pub(crate) fn draw_under_tiles(&self, pass: &mut wgpu::RenderPass<'_>, layers: Layers) {
-        self.billboard.draw(pass, &self.frame, &self.items, |d| {
-            d.blend == BlendMode::Alpha && layers.contains(Layers::of(d))
-        });
+        self.billboard
+            .draw(pass, &self.frame, &self.items, |d| under_tiles(d, layers));
     }
 
     /// Whether [`Player::draw_under_tiles`] draws anything for `layers`.
     pub(crate) fn draws_under_tiles(&self, layers: Layers) -> bool {
-        self.items.iter().any(|d| {
-            !d.splat && !d.tiles && d.blend == BlendMode::Alpha && layers.contains(Layers::of(d))
-        })
+        self.items
+            .iter()
+            .any(|d| !d.splat && !d.tiles && under_tiles(d, layers))
     }
 
     /// The rest of [`Player::draw_layers`]: the tiles (unless `tiles` is false: resolved
@@ -652,6 +651,12 @@ pub(super) fn update_mode(batched: bool) -> UpdateMode {
     } else {
         UpdateMode::Uncounted
     }
+}
+
+/// Whether `d`, when a billboard, is drawn before the tiles in `layers`: the
+/// alpha-blended layers (the tiles' blended layers go over them).
+fn under_tiles(d: &DrawItem, layers: Layers) -> bool {
+    d.blend == BlendMode::Alpha && layers.contains(Layers::of(d))
 }
 
 #[cfg(test)]
