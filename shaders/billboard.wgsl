@@ -76,6 +76,15 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u3
     }
     let corner = quad_corner(qd, vertex & 3u);
     out.clip = corner.clip;
+    if !STREAK {
+        // A camera-facing quad (one w): its corner on the sub-pixel grid, where the tile
+        // rasteriser puts it (quad.wgsl `grid_pixels`).
+        if corner.clip.w <= 1e-4 {
+            out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+            return out;
+        }
+        out.clip = grid_clip(grid_pixels(corner.clip), corner.clip.z / corner.clip.w);
+    }
     if FLIPBOOK {
         let f = quad_frames(qd);
         out.uv0 = atlas_uv(f.x, corner.uv);

@@ -148,6 +148,29 @@ fn quad_corner(qd: Quad, vi: u32) -> Corner {
     return out;
 }
 
+// A clip position in pixels (the origin at the target's top-left corner) on the
+// rasteriser's sub-pixel grid (8 bits: Vulkan's usual subPixelPrecisionBits, lavapipe's
+// and NVIDIA's). Both quad draw paths put a camera-facing quad's corners here, so they
+// light the same pixels where an edge meets a pixel centre. Left to the rasteriser's own
+// snapping, a position computed a little differently (another division, another fused
+// multiply-add) lands one step away from the tile path's now and then: on an H100 a few of
+// the thesis preset's 16384 sparks a frame lit a column of pixels in one path only.
+fn grid_pixels(c: vec4<f32>) -> vec2<f32> {
+    let n = c.xy / c.w;
+    let p = vec2<f32>((n.x * 0.5 + 0.5) * camera.viewport.x, (0.5 - n.y * 0.5) * camera.viewport.y);
+    return round(p * 256.0) / 256.0;
+}
+
+// The clip position of `p`, a position on the sub-pixel grid (`grid_pixels`), at
+// normalised depth `z`, with w = 1: the rasteriser's snapping finds `p` again (its
+// arithmetic lands within a rounding error of the grid point, far from the halfway points
+// between them). Only for a quad whose corners share one w (camera-facing), so that its
+// interpolation stays exact.
+fn grid_clip(p: vec2<f32>, z: f32) -> vec4<f32> {
+    let n = p / camera.viewport.xy * 2.0 - 1.0;
+    return vec4<f32>(n.x, -n.y, z, 1.0);
+}
+
 // A screen-space strip from `tail` to `head` (simulation space): both ends in clip space
 // (the tail on the head when either end is behind the camera) and the unit direction in
 // pixels from tail to head (x when they coincide on screen). Streaks and trails use it.

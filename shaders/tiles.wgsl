@@ -134,18 +134,6 @@ struct TileSprite {
     pad: vec4<f32>,
 }
 
-// Pixel coordinates of a clip position.
-fn to_pixels(c: vec4<f32>) -> vec2<f32> {
-    let n = c.xy / c.w;
-    return vec2<f32>((n.x * 0.5 + 0.5) * camera.viewport.x, (0.5 - n.y * 0.5) * camera.viewport.y);
-}
-
-// A pixel position on the rasteriser's sub-pixel grid (8 bits: Vulkan's usual
-// subPixelPrecisionBits, lavapipe's and NVIDIA's).
-fn snap(p: vec2<f32>) -> vec2<f32> {
-    return round(p * 256.0) / 256.0;
-}
-
 // The atlas coordinates' scale per unit of frame coordinates.
 fn atlas_scale() -> vec2<f32> {
     if FLIPBOOK {
@@ -258,11 +246,12 @@ fn project_quad(q: u32) -> TileSprite {
     // The shade reads nothing of the look (a private copy of it per invocation costs
     // registers).
     s.grad = vec4<f32>(atlas_scale(), frames.z, look.soft.y);
-    // The corners where the rasteriser puts them: snapped to its sub-pixel grid.
-    let p0 = snap(to_pixels(c0.clip));
-    let p1 = snap(to_pixels(c1.clip));
-    let p2 = snap(to_pixels(c2.clip));
-    let p3 = snap(to_pixels(c3.clip));
+    // The corners where the rasteriser puts them: on its sub-pixel grid, where the
+    // billboards' vertex shader puts them too.
+    let p0 = grid_pixels(c0.clip);
+    let p1 = grid_pixels(c1.clip);
+    let p2 = grid_pixels(c2.clip);
+    let p3 = grid_pixels(c3.clip);
     if s.offset.z == 1.0 {
         // The affine map from the snapped corners (p = p0 + J · (uv − uv0)), so that the
         // pixels a sprite smaller than a pixel covers are the billboard's.
