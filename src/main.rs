@@ -18,12 +18,13 @@ struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
     /// The choices that differ between GPUs and software adapters (render scale, draft
-    /// glow, UI painter, retained window, timestamps, tile rasteriser): gpu or software (default:
-    /// from the adapter's type).
+    /// glow, UI painter, retained window, timestamps, tile rasteriser, splat density): gpu or
+    /// software (default: from the adapter's type).
     #[arg(long, global = true)]
     adapter_profile: Option<ProfileArg>,
     /// Set single fields of the adapter profile, comma-separated FIELD=VALUE (fields:
-    /// timestamps, render_scale, draft, lean_painter, retained_window, tile_raster).
+    /// timestamps, render_scale, draft, lean_painter, retained_window, tile_raster,
+    /// splat_dense_only).
     #[arg(long, global = true, value_delimiter = ',')]
     adapt: Vec<ProfileSetting>,
 }

@@ -326,6 +326,7 @@ fn measure_row(
     let mut frame = FrameResources::new(ctx);
     // The automatic choice as a player on this adapter makes it.
     frame.auto_tiles = ctx.profile.tile_raster;
+    frame.splat_dense_only = ctx.profile.splat_dense_only;
     frame.allow_tiles = TilePass::supported(&ctx.device);
     let mut sort = SortPass::new(ctx, &lib)?;
     let mut billboard = BillboardPass::new(ctx, &lib, &frame, DrawTarget::hdr())?;

@@ -9,8 +9,8 @@ use std::sync::Arc;
 
 use crate::effect::rows_key;
 use crate::effect::{
-    BlendMode, DrawPath, Effect, FlipbookMode, Look, SPLAT_BELOW_PX, Streak, TILES_ABOVE_PX,
-    TILES_MIN_FILL_PX,
+    BlendMode, DrawPath, Effect, FlipbookMode, Look, SPLAT_BELOW_PX, SPLAT_PX_PER_QUAD, Streak,
+    TILES_ABOVE_PX, TILES_MIN_FILL_PX,
 };
 use crate::gpu::GpuContext;
 use crate::gpu::types::{CameraUniform, LookUniform, PARAMS_STRIDE, StateLayout};
@@ -153,6 +153,9 @@ pub struct FrameResources {
     pub auto_tiles: bool,
     /// The tile rasteriser exists (the device's limits allow it).
     pub allow_tiles: bool,
+    /// The automatic path splats only dense emitters (the adapter profile's
+    /// `splat_dense_only`).
+    pub splat_dense_only: bool,
     /// This frame's look blocks on their way to `looks`.
     look_bytes: Vec<u8>,
 }
@@ -441,6 +444,7 @@ impl FrameResources {
             allow_splat: true,
             soft_depth: false,
             auto_tiles: false,
+            splat_dense_only: false,
             allow_tiles: false,
             look_bytes: Vec::new(),
         }
@@ -834,12 +838,16 @@ impl FrameResources {
             .as_ref()
             .filter(|_| b.trail.is_some())
             .map(|t| (t.segments(), t.draw_sprite));
+        // Dense enough for the splat's whole-target clear and resolve to pay.
+        let (tw, th) = view.camera.size_px();
+        let dense = !self.splat_dense_only
+            || (width * n) as f32 * SPLAT_PX_PER_QUAD >= tw as f32 * th as f32;
         let splat = self.allow_splat
             && additive
             && trail.is_none()
             && match e.look.draw_path {
                 // Streaks are long even when the particles are small.
-                DrawPath::Auto => size_px < SPLAT_BELOW_PX && e.look.streak.is_none(),
+                DrawPath::Auto => size_px < SPLAT_BELOW_PX && e.look.streak.is_none() && dense,
                 DrawPath::Billboard | DrawPath::Tiles => false,
                 DrawPath::Splat => true,
             };

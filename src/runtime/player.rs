@@ -372,6 +372,7 @@ impl Player {
         // the pass's depth attachment) draw every particle.
         self.frame.allow_splat = depth.is_some() || self.settings.depth_format.is_none();
         self.frame.auto_tiles = self.ctx.profile.tile_raster;
+        self.frame.splat_dense_only = self.ctx.profile.splat_dense_only;
         self.frame.allow_tiles = self.tiles.is_some();
         let members: Vec<Vec<Option<BatchMember<'_>>>> = self
             .batches
