@@ -160,6 +160,40 @@ pub struct FrameResources {
     look_bytes: Vec<u8>,
 }
 
+/// Emitter `i` across a group's instances (`FrameResources::group_looks`).
+struct GroupLooks<'s> {
+    looks: Vec<Option<LookUniform>>,
+    members: Vec<SortMember>,
+    pool: Option<crate::sim::gpu_sim::EmitterBuffers<'s>>,
+    distance: f32,
+}
+
+/// What the automatic draw path looks at: the particles' largest projected size (pixels),
+/// the quads of the draw (every instance's live window), the instances, whether a trail's
+/// ribbon is drawn, and the target's size.
+struct PathScene {
+    size_px: f32,
+    quads: u32,
+    instances: u32,
+    trail: bool,
+    target_px: (u32, u32),
+}
+
+/// Writes the draw's looks into `block` (one per instance, at `PARAMS_STRIDE`), each with
+/// the draw's widest window `width`; a missing instance gets an empty segment of its pool
+/// of `capacity` slots (no window, nothing drawn).
+fn write_looks(block: &mut [u8], looks: &[Option<LookUniform>], width: u32, capacity: u32) {
+    for (k, u) in looks.iter().enumerate() {
+        let mut u = u.unwrap_or(LookUniform {
+            ring_b: [0, 0, capacity, 0],
+            ..LookUniform::default()
+        });
+        u.ring[3] = width;
+        block[k * PARAMS_STRIDE as usize..][..size_of::<LookUniform>()]
+            .copy_from_slice(bytemuck::bytes_of(&u));
+    }
+}
+
 /// The look uniform of an emitter (everything but the matrices, the ground height and
 /// stateless motion, which depend on the frame). `ramp_row` is the emitter's colour ramp
 /// row (its curve rows follow it), `salt` its per-particle random salt, `sprite_integral` the sprite's ∫ brightness.
@@ -768,28 +802,12 @@ impl FrameResources {
             self.upload_ramp(ctx, i, &e.look);
         }
         let base = self.base_look(first.effect, i, &sprite);
-        let mut looks = Vec::with_capacity(view.group.len());
-        let mut pool = None;
-        let mut members = Vec::new();
-        // The nearest instance's distance decides the projected size (and the path).
-        let mut distance = f32::INFINITY;
-        for scene in view.group {
-            let Some(scene) = scene else {
-                looks.push(None);
-                members.push(SortMember::default());
-                continue;
-            };
-            let Some((u, b, sort)) = self.member_look(view, scene, i, &base) else {
-                looks.push(None);
-                members.push(SortMember::default());
-                continue;
-            };
-            let placed = glam::Vec3::from(scene.effect.emitters[i].transform.position_m);
-            distance = distance.min((view.camera.eye() - placed).length());
-            members.push(sort);
-            looks.push(Some(u));
-            pool.get_or_insert(b);
-        }
+        let GroupLooks {
+            looks,
+            members,
+            pool,
+            distance,
+        } = self.group_looks(view, i, &base);
         let b = pool?;
         let width = looks
             .iter()
@@ -797,39 +815,14 @@ impl FrameResources {
             .map(|u| u.ring_b[3])
             .max()
             .unwrap_or(0);
-        for (k, u) in looks.iter().enumerate() {
-            let mut u = u.unwrap_or(LookUniform {
-                // An empty segment: no window, nothing drawn.
-                ring_b: [0, 0, b.capacity, 0],
-                ..LookUniform::default()
-            });
-            u.ring[3] = width;
-            block[k * PARAMS_STRIDE as usize..][..size_of::<LookUniform>()]
-                .copy_from_slice(bytemuck::bytes_of(&u));
-        }
+        write_looks(block, &looks, width, b.capacity);
         if !e.enabled {
             return None;
         }
-        // Alpha-blended emitters are drawn back to front through the sort's order: one
-        // sort over the group's slots.
-        let sorted = e.look.blend == BlendMode::Alpha;
         let n = view.group.len() as u32;
-        let job = sorted.then(|| SortJob {
-            key: b.generation,
-            state: b.current.clone(),
-            layout: b.layout,
-            capacity: b.capacity,
-            width,
-            members: std::mem::take(&mut members),
-        });
-        let order_buffer = job
-            .as_ref()
-            .map(|j| sort.buffers(ctx, j.key, b.capacity * n).values.clone());
-        let key = (b.generation, b.parity, sorted);
-        self.ensure_particle_group(ctx, key, &b, order_buffer);
+        let (job, key) = self.bind_particles(ctx, sort, &b, e.look.blend, (width, n), members);
         let size_m = e.look.size_m.bounds().1;
         let size_px = size_m * view.camera.pixels_per_unit() / distance.max(1e-3);
-        let additive = e.look.blend == BlendMode::Additive;
         // A trail's ribbon is drawn by the billboards (segments between its recorded
         // points), and so is its particle's sprite.
         let trail = e
@@ -838,41 +831,16 @@ impl FrameResources {
             .as_ref()
             .filter(|_| b.trail.is_some())
             .map(|t| (t.segments(), t.draw_sprite));
-        // Dense enough for the splat's whole-target clear and resolve to pay.
-        let (tw, th) = view.camera.size_px();
-        let dense = !self.splat_dense_only
-            || (width * n) as f32 * SPLAT_PX_PER_QUAD >= tw as f32 * th as f32;
-        let splat = self.allow_splat
-            && additive
-            && trail.is_none()
-            && match e.look.draw_path {
-                // Streaks are long even when the particles are small.
-                DrawPath::Auto => size_px < SPLAT_BELOW_PX && e.look.streak.is_none() && dense,
-                DrawPath::Billboard | DrawPath::Tiles => false,
-                DrawPath::Splat => true,
-            };
-        // The compute paths test the host's depth themselves: they need its view.
-        // Streaks stay billboards: slivers a pixel or two wide, whose coverage and mip
-        // level the rasteriser decides per 2×2 pixels.
-        let tiles = self.allow_splat
-            && self.allow_tiles
-            && !splat
-            && e.look.streak.is_none()
-            && trail.is_none()
-            && match e.look.draw_path {
-                DrawPath::Auto => {
-                    // Billboard fill at most (every quad at the largest size). A group of
-                    // several instances (a runtime host's batch) keeps billboards: a grid
-                    // of 100 torches measured 6.5 ms a frame with the tiles, 2.8 without.
-                    let fill = (width * n) as f32 * size_px * size_px;
-                    self.auto_tiles
-                        && n == 1
-                        && size_px >= TILES_ABOVE_PX
-                        && fill >= TILES_MIN_FILL_PX
-                }
-                DrawPath::Tiles => true,
-                DrawPath::Billboard | DrawPath::Splat => false,
-            };
+        let (splat, tiles) = self.choose_path(
+            &e.look,
+            PathScene {
+                size_px,
+                quads: width * n,
+                instances: n,
+                trail: trail.is_some(),
+                target_px: view.camera.size_px(),
+            },
+        );
         let mut variant = LookVariant::of(
             &e.look,
             StateVariant {
@@ -897,6 +865,117 @@ impl FrameResources {
             size_px,
             trail,
         })
+    }
+
+    /// Emitter `i`'s look in every instance of the group (from `base`), each instance's
+    /// sort member, the pool the instances share and the nearest instance's distance from
+    /// the camera (it decides the projected size, and so the path).
+    fn group_looks<'s>(
+        &self,
+        view: &GroupView<'_, 's>,
+        i: usize,
+        base: &LookUniform,
+    ) -> GroupLooks<'s> {
+        let mut out = GroupLooks {
+            looks: Vec::with_capacity(view.group.len()),
+            members: Vec::new(),
+            pool: None,
+            distance: f32::INFINITY,
+        };
+        for scene in view.group {
+            let Some((scene, (u, b, sort))) = scene
+                .as_ref()
+                .and_then(|s| Some((s, self.member_look(view, s, i, base)?)))
+            else {
+                out.looks.push(None);
+                out.members.push(SortMember::default());
+                continue;
+            };
+            let placed = glam::Vec3::from(scene.effect.emitters[i].transform.position_m);
+            out.distance = out.distance.min((view.camera.eye() - placed).length());
+            out.members.push(sort);
+            out.looks.push(Some(u));
+            out.pool.get_or_insert(b);
+        }
+        out
+    }
+
+    /// The sort job of an alpha-blended emitter (drawn back to front through the sort's
+    /// order: one sort over the group's slots, `shape` = (widest window, instances)) and
+    /// the key of the particle bind group over pool `b`, made here unless it exists.
+    fn bind_particles(
+        &mut self,
+        ctx: &GpuContext,
+        sort: &mut crate::render::sort::SortPass,
+        b: &crate::sim::gpu_sim::EmitterBuffers<'_>,
+        blend: BlendMode,
+        shape: (u32, u32),
+        members: Vec<SortMember>,
+    ) -> (Option<SortJob>, (u64, usize, bool)) {
+        let (width, n) = shape;
+        let sorted = blend == BlendMode::Alpha;
+        let job = sorted.then(|| SortJob {
+            key: b.generation,
+            state: b.current.clone(),
+            layout: b.layout,
+            capacity: b.capacity,
+            width,
+            members,
+        });
+        let order_buffer = job
+            .as_ref()
+            .map(|j| sort.buffers(ctx, j.key, b.capacity * n).values.clone());
+        let key = (b.generation, b.parity, sorted);
+        self.ensure_particle_group(ctx, key, b, order_buffer);
+        (job, key)
+    }
+
+    /// The draw path of an emitter with look `look` in `scene`: (splat, tiles); neither is
+    /// the billboards. The look's `draw_path` forces one (where the emitter can take it);
+    /// `Auto` chooses from the projected size, the count and the adapter profile.
+    fn choose_path(&self, look: &Look, scene: PathScene) -> (bool, bool) {
+        let PathScene {
+            size_px,
+            quads,
+            instances,
+            trail,
+            target_px: (tw, th),
+        } = scene;
+        // Dense enough for the splat's whole-target clear and resolve to pay.
+        let dense =
+            !self.splat_dense_only || quads as f32 * SPLAT_PX_PER_QUAD >= tw as f32 * th as f32;
+        let splat = self.allow_splat
+            && look.blend == BlendMode::Additive
+            && !trail
+            && match look.draw_path {
+                // Streaks are long even when the particles are small.
+                DrawPath::Auto => size_px < SPLAT_BELOW_PX && look.streak.is_none() && dense,
+                DrawPath::Billboard | DrawPath::Tiles => false,
+                DrawPath::Splat => true,
+            };
+        // The compute paths test the host's depth themselves: they need its view.
+        // Streaks stay billboards: slivers a pixel or two wide, whose coverage and mip
+        // level the rasteriser decides per 2×2 pixels.
+        let tiles = self.allow_splat
+            && self.allow_tiles
+            && !splat
+            && look.streak.is_none()
+            && !trail
+            && match look.draw_path {
+                DrawPath::Auto => {
+                    // Billboard fill at most (every quad at the largest size). A group of
+                    // several instances (a runtime host's batch) keeps billboards: a grid
+                    // of 100 torches measured 6.5 ms a frame with the tiles, 2.8 without.
+                    let fill = quads as f32 * size_px * size_px;
+                    self.auto_tiles
+                        && instances == 1
+                        && size_px >= TILES_ABOVE_PX
+                        && fill >= TILES_MIN_FILL_PX
+                }
+                DrawPath::Tiles => true,
+                DrawPath::Billboard | DrawPath::Splat => false,
+            };
+        (splat, tiles)
     }
 
     /// Creates the particle bind group `key` names unless it exists: `b`'s state, and
