@@ -37,6 +37,7 @@ use crate::effect::{CURRENT_VERSION, Effect};
 
 mod atomic;
 mod errors;
+mod explain;
 mod layout;
 mod locate;
 mod tokens;
@@ -44,7 +45,8 @@ mod v1;
 
 pub use atomic::{write_atomic, write_atomic_with};
 pub use errors::PresetError;
-use errors::{clean_path, explain};
+use errors::clean_path;
+use explain::explain;
 pub use layout::to_ron;
 use tokens::{Token, parse_integer, tokenize};
 
