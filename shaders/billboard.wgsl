@@ -10,8 +10,9 @@
 //   `order` (sorted: buffer indices of the batch's slots, farthest first).
 // - Unsorted, quad q is slot q mod W of instance q / W's live window (W: the widest
 //   window of the draw's instances); sorted, quad q is `order[q]`.
-// - Dead slots emit a degenerate quad outside the clip volume: no fragments, unlike the
-//   2006 thesis whose dead particles piled up at the origin.
+// - Dead slots (and flat quads at or behind the camera) emit a degenerate quad outside the
+//   clip volume: no fragments, unlike the 2006 thesis whose dead particles piled up at the
+//   origin.
 // - The fragment output is premultiplied: additive blending adds it, alpha blending
 //   composites it "over". The look itself lives in look.wgsl (shared with splat.wgsl).
 #import "common.wgsl"
@@ -76,10 +77,12 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u3
     }
     let corner = quad_corner(qd, vertex & 3u);
     out.clip = corner.clip;
-    if !STREAK {
-        // A camera-facing quad (one w): its corner on the sub-pixel grid, where the tile
-        // rasteriser puts it (quad.wgsl `grid_pixels`).
-        if corner.clip.w <= 1e-4 {
+    let flat_w = quad_flat_w(qd);
+    if flat_w >= 0.0 {
+        // A flat quad (one w: camera-facing): its corner on the sub-pixel grid, where the
+        // tile rasteriser puts it (quad.wgsl `grid_pixels`); at or behind the camera, the
+        // whole quad is culled.
+        if flat_w <= 1e-4 {
             out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
             return out;
         }

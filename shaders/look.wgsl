@@ -17,7 +17,7 @@ struct CameraUniform {
     clip_from_world: mat4x4<f32>,
     // xyz: camera right (world), w: interpolation alpha between prev and cur.
     right_alpha: vec4<f32>,
-    // xyz: camera up (world), w: unused.
+    // xyz: camera up (world), w: the motion pass's interval (s; billboard.wgsl MOTION).
     up: vec4<f32>,
     // xy: target size in pixels, z: pixels per unit of (size / clip w), w: unused.
     viewport: vec4<f32>,

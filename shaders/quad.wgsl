@@ -148,9 +148,24 @@ fn quad_corner(qd: Quad, vi: u32) -> Corner {
     return out;
 }
 
-// A clip position in pixels (the origin at the target's top-left corner) on the
-// rasteriser's sub-pixel grid (8 bits: Vulkan's usual subPixelPrecisionBits, lavapipe's
-// and NVIDIA's). Both quad draw paths put a camera-facing quad's corners here, so they
+// The clip w that every corner of quad `qd` shares, or a negative number where its
+// corners' w differ (a streak, or a view with shear, where the quad is not parallel to
+// the image plane): a flat quad's interpolation is affine on screen. Both quad draw paths
+// decide with it (the tiles' affine map, the billboards' grid corners).
+fn quad_flat_w(qd: Quad) -> f32 {
+    if STREAK {
+        return -1.0;
+    }
+    let row = transpose(look.clip_from_sim)[3];
+    let w = dot(row, vec4<f32>(qd.d.pos, 1.0));
+    // The change of w across the quad's half-size along the camera's right and up.
+    let dw = 0.5 * qd.lc.x * (abs(dot(row.xyz, camera.right_alpha.xyz)) + abs(dot(row.xyz, camera.up.xyz)));
+    return select(-1.0, w, dw <= 1e-6 * abs(w));
+}
+
+// A clip position in pixels of `camera.viewport` (the origin at the top-left corner) on
+// the rasteriser's sub-pixel grid (8 bits: Vulkan's usual subPixelPrecisionBits, lavapipe's
+// and NVIDIA's). Both quad draw paths put a flat quad's corners here, so they
 // light the same pixels where an edge meets a pixel centre. Left to the rasteriser's own
 // snapping, a position computed a little differently (another division, another fused
 // multiply-add) lands one step away from the tile path's now and then: on an H100 a few of
@@ -164,8 +179,9 @@ fn grid_pixels(c: vec4<f32>) -> vec2<f32> {
 // The clip position of `p`, a position on the sub-pixel grid (`grid_pixels`), at
 // normalised depth `z`, with w = 1: the rasteriser's snapping finds `p` again (its
 // arithmetic lands within a rounding error of the grid point, far from the halfway points
-// between them). Only for a quad whose corners share one w (camera-facing), so that its
-// interpolation stays exact.
+// between them). Only for a flat quad (`quad_flat_w`), so that its interpolation stays
+// exact. On a target smaller than `camera.viewport` (a reduced layer) the point is still
+// where it belongs; only the grid is finer than that target's.
 fn grid_clip(p: vec2<f32>, z: f32) -> vec4<f32> {
     let n = p / camera.viewport.xy * 2.0 - 1.0;
     return vec4<f32>(n.x, -n.y, z, 1.0);

@@ -216,7 +216,7 @@ fn project_quad(q: u32) -> TileSprite {
     s.map_z = vec4<f32>(adj[0].z, adj[1].z, adj[2].z, 0.0);
     s.z_row = vec4<f32>(col_u.z, col_v.z, col_1.z, 0.0);
     s.w_row = vec4<f32>(col_u.w, col_v.w, col_1.w, 0.0);
-    if abs(col_u.w) + abs(col_v.w) <= 1e-6 * abs(col_1.w) {
+    if quad_flat_w(qd) >= 0.0 {
         // A quad parallel to the image plane (a camera-facing billboard): one depth, and
         // the map is affine — uv = map.xy · p.x + map.zw · p.y + offset.xy, flagged by
         // offset.z = 1, the depth in offset.w (culled here when outside the depth range).

@@ -232,8 +232,8 @@ impl App {
         {
             log::warn!("destroying the GPU device (--lose-device-at)");
             gfx.ctx.device.destroy();
-            // A destroyed device is lost (its callback called) only once its queue is
-            // empty: wait for that, as a driver's loss is reported at once, so that the
+            // `destroy` reports the loss (calls the lost callback) only once the queue
+            // drains, where a driver's loss is reported at once: wait for it, so that the
             // next frame never records onto the dead device.
             if let Err(err) = gfx.ctx.device.poll(wgpu::PollType::wait_indefinitely()) {
                 log::warn!("waiting for the destroyed device's work: {err}");

@@ -26,6 +26,7 @@ pub(super) struct Checker {
 }
 
 impl Checker {
+    /// Records a problem: the field's path, its value and what it must be.
     pub(super) fn push(&mut self, path: String, value: impl std::fmt::Display, problem: &str) {
         self.errors.push(ValidationError {
             path,
@@ -45,12 +46,14 @@ impl Checker {
         }
     }
 
+    /// Three finite numbers within `[-limit, limit]`.
     pub(super) fn vec3(&mut self, path: impl Fn() -> String, v: [f32; 3], limit: f32) {
         for (i, c) in v.iter().enumerate() {
             self.num(|| format!("{}[{i}]", path()), *c, -limit, limit);
         }
     }
 
+    /// A direction: finite and not the zero vector.
     pub(super) fn nonzero_vec3(&mut self, path: impl Fn() -> String, v: [f32; 3]) {
         self.vec3(&path, v, 1e6);
         if glam::Vec3::from(v).length_squared() < 1e-12 {
@@ -85,6 +88,8 @@ impl Checker {
         }
     }
 
+    /// A curve's keys: 1..=MAX_CURVE_KEYS of them, finite, times in `[0, t_max]` strictly
+    /// increasing, values in `values`.
     pub(super) fn keys(
         &mut self,
         path: impl Fn() -> String,
@@ -120,6 +125,7 @@ impl Checker {
         }
     }
 
+    /// A range whose ends lie in `[lo, hi]`, min ≤ max.
     pub(super) fn range(&mut self, path: impl Fn() -> String, r: Range, lo: f32, hi: f32) {
         self.num(|| format!("{}.min", path()), r.min, lo, hi);
         self.num(|| format!("{}.max", path()), r.max, lo, hi);
@@ -249,6 +255,7 @@ impl Emitter {
         c.num(|| p("spread_deg"), self.spread_deg, 0.0, 180.0);
         c.range(|| p("speed_m_per_s"), self.speed_m_per_s, 0.0, 1e5);
         self.forces.check(p, c);
+        self.check_state(p, c);
         self.collisions.check(p, c);
         let n = &self.spawn_noise;
         c.num(
@@ -275,7 +282,6 @@ impl Emitter {
             -1e3,
             1e3,
         );
-        self.check_state(p, c);
         self.look.check(p, c);
     }
 

@@ -259,7 +259,7 @@ pub struct CameraUniform {
     pub clip_from_world: [[f32; 4]; 4],
     /// xyz: camera right, w: interpolation alpha.
     pub right_alpha: [f32; 4],
-    /// xyz: camera up.
+    /// xyz: camera up, w: the motion pass's interval (s; the export's motion vectors).
     pub up: [f32; 4],
     /// xy: target size in pixels, z: pixels per unit of size / clip w.
     pub viewport: [f32; 4],

@@ -162,15 +162,19 @@ pub struct FrameResources {
 
 /// Emitter `i` across a group's instances (`FrameResources::group_looks`).
 struct GroupLooks<'s> {
+    /// Each instance's look (`None`: the instance has no such emitter or nothing alive).
     looks: Vec<Option<LookUniform>>,
+    /// Each instance's part of the sort (alpha-blended emitters).
     members: Vec<SortMember>,
+    /// The pool the instances' segments are in.
     pool: Option<crate::sim::gpu_sim::EmitterBuffers<'s>>,
+    /// The nearest instance's distance from the camera (m).
     distance: f32,
 }
 
 /// What the automatic draw path looks at: the particles' largest projected size (pixels),
-/// the quads of the draw (every instance's live window), the instances, whether a trail's
-/// ribbon is drawn, and the target's size.
+/// the quads of the draw (the widest live window × the instances: at least the live
+/// particles), the instances, whether a trail's ribbon is drawn, and the target's size.
 struct PathScene {
     size_px: f32,
     quads: u32,
