@@ -3,7 +3,7 @@
 
 use std::collections::VecDeque;
 
-use crate::effect::{Effect, Emitter, Param, Shape};
+use crate::effect::{Collisions, Effect, Emitter, Forces, Param, Shape};
 use crate::gpu::types::{SimParams, double_single};
 use crate::rng;
 
@@ -19,6 +19,14 @@ pub struct SpawnStats {
     /// Particles cut short because the ring wrapped onto them while still alive:
     /// the capacity is too small for rate × lifetime.
     pub recycled_alive: u64,
+}
+
+/// A step's spawns: how many, and the first's birth fraction within the step and the
+/// fraction between consecutive births.
+struct Spawns {
+    count: u64,
+    frac0: f64,
+    frac_step: f64,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -226,89 +234,15 @@ impl EmitterPlanner {
         let salt = rng::emitter_salt(emitter_index, e.seed_offset);
         // The emitter's own clock (it stands still while the emitter is disabled).
         let c0 = self.clock_secs;
-        // Spawns the continuous rate asks for over [c0, c0 + dt].
-        let expected = if fed {
-            0.0
-        } else {
-            expected_spawns(&e.spawn_rate_per_sec, seed, salt, c0, dt)
-        };
-        let acc_before = self.accumulator;
-        self.accumulator += expected;
-        let continuous = self.accumulator.floor();
-        self.accumulator -= continuous;
-        let mut continuous = continuous as u64;
-        let cap = e.effective_spawn_cap() as u64;
-        let capped = continuous > cap;
-        if capped {
-            self.stats.dropped_by_cap += continuous - cap;
-            continuous = cap;
-        }
-        let burst: u64 = e
-            .bursts
-            .iter()
-            .filter(|_| !fed)
-            .filter(|b| {
-                let t = b.time_secs as f64;
-                t >= t0_secs && t < t0_secs + dt
-            })
-            .map(|b| b.count as u64)
-            .sum();
-        let mut count = continuous + burst;
+        let Spawns {
+            count,
+            frac0,
+            frac_step,
+        } = self.count_spawns(e, (seed, salt), t0_secs, dt, fed);
         let capacity = e.capacity.max(1) as u64;
-        if count > capacity {
-            self.stats.dropped_over_capacity += count - capacity;
-            count = capacity;
-        }
-
-        // Birth fractions within the step: the k-th integer crossing of the accumulator.
-        let (frac0, frac_step) = if burst == 0 && !capped && expected > 0.0 {
-            let per = 1.0 / expected;
-            ((1.0 - acc_before) * per, per)
-        } else if count > 0 {
-            (0.5 / count as f64, 1.0 / count as f64)
-        } else {
-            (0.0, 0.0)
-        };
-
-        self.clock_secs += dt;
-        self.min_dt_secs = if self.min_dt_secs > 0.0 {
-            self.min_dt_secs.min(dt)
-        } else {
-            dt
-        };
-        self.last_dt_secs = dt;
-        let max_life_now = e.lifetime_secs.max as f64;
-        // A raised range stretches the lives of packed particles already born. Every
-        // batch holds at least the last step's maximum: only a raise changes any.
-        if self
-            .history
-            .back()
-            .is_some_and(|b| b.max_life_secs < max_life_now)
-        {
-            for b in &mut self.history {
-                b.max_life_secs = b.max_life_secs.max(max_life_now);
-            }
-        }
-        // The older of the two state buffers holds the state at the last step's start:
-        // a batch dead by then is dead (and identical) in both, and need not be visited.
-        let t_dead = self.last_t0_secs.map_or(c0, |t| t.min(c0));
-        self.last_t0_secs = Some(c0);
-        self.account_overwrites(e, seed, salt, count, c0, t_dead);
+        let max_life_now = self.advance_clock(e, dt);
+        let update_window = self.update_window(e, (seed, salt), count, c0, max_life_now);
         let base = self.spawned_total;
-        let min_dt = self.min_dt_secs;
-        let first_live = self
-            .history
-            .iter()
-            .find(|b| !b.surely_dead(t_dead, max_life_now, min_dt))
-            .map_or(base, |b| b.first_index);
-        let end = base + count;
-        let first_live = first_live.max(end.saturating_sub(capacity));
-        let update_window = [
-            (first_live % capacity) as u32,
-            (end - first_live) as u32,
-            0,
-            0,
-        ];
         if count > 0 {
             self.history.push_back(Batch {
                 first_index: base,
@@ -346,6 +280,127 @@ impl EmitterPlanner {
         out.update_window = update_window;
         out.tiny = [t0_hi.to_bits(), t0_lo.to_bits(), first_seq as u32, entries];
         out.tiny_b = [oldest, span, 0, 0];
+    }
+
+    /// The particles this step spawns (the continuous rate's integer crossings over
+    /// [clock, clock + dt], capped, plus the bursts that fall in [t0, t0 + dt]; none when
+    /// `fed`: the step's births come from events) and their birth fractions within the
+    /// step. `keys` = (effect seed, emitter salt).
+    fn count_spawns(
+        &mut self,
+        e: &Emitter,
+        keys: (u32, u32),
+        t0_secs: f64,
+        dt: f64,
+        fed: bool,
+    ) -> Spawns {
+        let (seed, salt) = keys;
+        let expected = if fed {
+            0.0
+        } else {
+            expected_spawns(&e.spawn_rate_per_sec, seed, salt, self.clock_secs, dt)
+        };
+        let acc_before = self.accumulator;
+        self.accumulator += expected;
+        let continuous = self.accumulator.floor();
+        self.accumulator -= continuous;
+        let mut continuous = continuous as u64;
+        let cap = e.effective_spawn_cap() as u64;
+        let capped = continuous > cap;
+        if capped {
+            self.stats.dropped_by_cap += continuous - cap;
+            continuous = cap;
+        }
+        let burst: u64 = e
+            .bursts
+            .iter()
+            .filter(|_| !fed)
+            .filter(|b| {
+                let t = b.time_secs as f64;
+                t >= t0_secs && t < t0_secs + dt
+            })
+            .map(|b| b.count as u64)
+            .sum();
+        let mut count = continuous + burst;
+        let capacity = e.capacity.max(1) as u64;
+        if count > capacity {
+            self.stats.dropped_over_capacity += count - capacity;
+            count = capacity;
+        }
+        // Birth fractions within the step: the k-th integer crossing of the accumulator.
+        let (frac0, frac_step) = if burst == 0 && !capped && expected > 0.0 {
+            let per = 1.0 / expected;
+            ((1.0 - acc_before) * per, per)
+        } else if count > 0 {
+            (0.5 / count as f64, 1.0 / count as f64)
+        } else {
+            (0.0, 0.0)
+        };
+        Spawns {
+            count,
+            frac0,
+            frac_step,
+        }
+    }
+
+    /// Moves the emitter's clock on by `dt` (and the smallest and last steps); returns the
+    /// lifetime range's maximum now, raising the batches' where it grew.
+    fn advance_clock(&mut self, e: &Emitter, dt: f64) -> f64 {
+        self.clock_secs += dt;
+        self.min_dt_secs = if self.min_dt_secs > 0.0 {
+            self.min_dt_secs.min(dt)
+        } else {
+            dt
+        };
+        self.last_dt_secs = dt;
+        let max_life_now = e.lifetime_secs.max as f64;
+        // A raised range stretches the lives of packed particles already born. Every
+        // batch holds at least the last step's maximum: only a raise changes any.
+        if self
+            .history
+            .back()
+            .is_some_and(|b| b.max_life_secs < max_life_now)
+        {
+            for b in &mut self.history {
+                b.max_life_secs = b.max_life_secs.max(max_life_now);
+            }
+        }
+        max_life_now
+    }
+
+    /// The update's window for a step from `c0` that spawns `count`: from the first slot
+    /// that may hold a living particle to the newest spawn (slot, length). Accounts the
+    /// particles the spawns overwrite.
+    fn update_window(
+        &mut self,
+        e: &Emitter,
+        keys: (u32, u32),
+        count: u64,
+        c0: f64,
+        max_life_now: f64,
+    ) -> [u32; 4] {
+        let (seed, salt) = keys;
+        let capacity = e.capacity.max(1) as u64;
+        // The older of the two state buffers holds the state at the last step's start:
+        // a batch dead by then is dead (and identical) in both, and need not be visited.
+        let t_dead = self.last_t0_secs.map_or(c0, |t| t.min(c0));
+        self.last_t0_secs = Some(c0);
+        self.account_overwrites(e, seed, salt, count, c0, t_dead);
+        let base = self.spawned_total;
+        let min_dt = self.min_dt_secs;
+        let first_live = self
+            .history
+            .iter()
+            .find(|b| !b.surely_dead(t_dead, max_life_now, min_dt))
+            .map_or(base, |b| b.first_index);
+        let end = base + count;
+        let first_live = first_live.max(end.saturating_sub(capacity));
+        [
+            (first_live % capacity) as u32,
+            (end - first_live) as u32,
+            0,
+            0,
+        ]
     }
 
     /// The birth table's oldest entry's first spawn counter (low 32 bits) and the counters
@@ -602,87 +657,17 @@ fn static_params(
     salt: u32,
     capacity: u32,
 ) -> SimParams {
-    let (shape_a, shape_b) = match &e.shape {
-        Shape::Point => ([0.0; 4], [0.0; 4]),
-        Shape::Sphere {
-            radius_m,
-            surface_only,
-        } => (
-            [*radius_m, if *surface_only { 1.0 } else { 0.0 }, 0.0, 0.0],
-            [0.0; 4],
-        ),
-        Shape::Disc { radius_m, normal } => {
-            let n = glam::Vec3::from(*normal).normalize_or(glam::Vec3::Y);
-            ([*radius_m, 0.0, 0.0, 0.0], [n.x, n.y, n.z, 0.0])
-        }
-        Shape::Box { half_extents_m: h } => ([h[0], h[1], h[2], 0.0], [0.0; 4]),
-        Shape::Cone {
-            angle_deg,
-            radius_m,
-        } => ([angle_deg.to_radians(), *radius_m, 0.0, 0.0], [0.0; 4]),
-        Shape::Line { a_m, b_m } => ([a_m[0], a_m[1], a_m[2], 0.0], [b_m[0], b_m[1], b_m[2], 0.0]),
-    };
+    let (shape_a, shape_b) = shape_params(&e.shape);
     let dir = glam::Vec3::from(e.direction).normalize_or(glam::Vec3::Y);
     // Translation relative to the simulation origin, computed in f64.
     let mut world = e.transform.world_from_emitter();
     let rel = (glam::Vec3::from(e.transform.position_m).as_dvec3() - origin).as_vec3();
     world.w_axis = rel.extend(1.0);
-    let local = |p: [f32; 3]| (glam::Vec3::from(p).as_dvec3() - origin).as_vec3();
-    let axis_origin = rel;
     let world_dir = world.transform_vector3(dir).normalize_or(glam::Vec3::Y);
-    let f = &e.forces;
-    let turbulence = f.turbulence.as_ref().map_or([0.0; 4], |t| {
-        [
-            t.strength_m_per_s2,
-            t.frequency_per_m,
-            t.octaves.clamp(1, 4) as f32,
-            t.scroll_m_per_s,
-        ]
-    });
-    let (gust_strength, gust_hz) = f
-        .gusts
-        .as_ref()
-        .map_or((0.0, 0.0), |g| (g.strength, g.frequency_hz));
-    let (pull, pull_exp) = f
-        .flame_pull
-        .as_ref()
-        .map_or((0.0, 1.0), |p| (p.strength_per_s2, p.exponent));
-    let (vortex_center, vortex_axis) =
-        f.vortex
-            .as_ref()
-            .map_or(([0.0; 4], [0.0, 1.0, 0.0, 0.0]), |v| {
-                let a = glam::Vec3::from(v.axis).normalize_or(glam::Vec3::Y);
-                (
-                    [v.center_m[0], v.center_m[1], v.center_m[2], v.radius_m],
-                    [a.x, a.y, a.z, v.swirl_m_per_s2],
-                )
-            });
-    let (attractor, attractor_mode, attractor_radius) =
-        f.attractor.as_ref().map_or(([0.0; 4], 0.0, 1.0), |a| {
-            (
-                [
-                    a.position_m[0],
-                    a.position_m[1],
-                    a.position_m[2],
-                    a.strength,
-                ],
-                match a.falloff {
-                    crate::effect::Falloff::InverseSquare => 0.0,
-                    crate::effect::Falloff::ConstantWithinRadius => 1.0,
-                },
-                a.radius_m,
-            )
-        });
-    let col = &e.collisions;
-    let mut spheres = [[0.0f32; 4]; 4];
-    for (slot, s) in spheres.iter_mut().zip(&col.spheres) {
-        *slot = local(s.center_m).extend(s.radius_m).to_array();
-    }
-    let ground = col.ground.as_ref();
     let accel = e.forces.constant_acceleration();
     let wind = e.forces.wind_m_per_s;
     let n = &e.spawn_noise;
-    SimParams {
+    let mut p = SimParams {
         world_from_emitter: world.to_cols_array_2d(),
         shape_a,
         shape_b,
@@ -701,46 +686,106 @@ fn static_params(
             n.direction_amplitude,
             n.scroll_per_sec,
         ],
-        dt_secs: 0.0,
         seed,
         emitter_salt: salt,
         shape_kind: e.shape.kind_index(),
         capacity,
-        spawn_head: 0,
-        spawn_count: 0,
-        spawn_base_lo: 0,
-        spawn_base_hi: 0,
-        flags: 0,
-        spawn_frac0: 0.0,
-        spawn_frac_step: 0.0,
-        turbulence,
-        gusts_qdrag_pull: [gust_strength, gust_hz, f.quadratic_drag_per_m, pull],
-        vortex_center,
-        vortex_axis,
-        attractor,
-        attractor_b: [attractor_radius, attractor_mode, pull_exp, 0.0],
-        axis_origin: axis_origin.extend(0.0).to_array(),
+        axis_origin: rel.extend(0.0).to_array(),
         axis_dir: [world_dir.x, world_dir.y, world_dir.z, 0.0],
-        ground: [
-            ground.map_or(0.0, |g| (g.height_m as f64 - origin.y) as f32),
-            col.elasticity,
-            col.friction,
-            if ground.is_some_and(|g| g.kill_on_contact) {
-                1.0
-            } else {
-                0.0
-            },
-        ],
-        collide_b: [
-            col.rest_speed_m_per_s,
-            col.spheres.len().min(4) as f32,
-            if col.kill_on_sphere_contact { 1.0 } else { 0.0 },
-            if ground.is_some() { 1.0 } else { 0.0 },
-        ],
-        spheres,
-        collide_c: [if col.stick_on_contact { 1.0 } else { 0.0 }, 0.0, 0.0, 0.0],
         update_window: [0, capacity, 0, 0],
-        tiny: [0; 4],
-        tiny_b: [0; 4],
+        ..SimParams::default()
+    };
+    set_force_fields(&mut p, &e.forces);
+    set_collisions(&mut p, &e.collisions, origin);
+    p
+}
+
+/// The emitter shape's two parameter rows (`shape_a`, `shape_b`; see spawn.wgsl).
+fn shape_params(shape: &Shape) -> ([f32; 4], [f32; 4]) {
+    match shape {
+        Shape::Point => ([0.0; 4], [0.0; 4]),
+        Shape::Sphere {
+            radius_m,
+            surface_only,
+        } => (
+            [*radius_m, if *surface_only { 1.0 } else { 0.0 }, 0.0, 0.0],
+            [0.0; 4],
+        ),
+        Shape::Disc { radius_m, normal } => {
+            let n = glam::Vec3::from(*normal).normalize_or(glam::Vec3::Y);
+            ([*radius_m, 0.0, 0.0, 0.0], [n.x, n.y, n.z, 0.0])
+        }
+        Shape::Box { half_extents_m: h } => ([h[0], h[1], h[2], 0.0], [0.0; 4]),
+        Shape::Cone {
+            angle_deg,
+            radius_m,
+        } => ([angle_deg.to_radians(), *radius_m, 0.0, 0.0], [0.0; 4]),
+        Shape::Line { a_m, b_m } => ([a_m[0], a_m[1], a_m[2], 0.0], [b_m[0], b_m[1], b_m[2], 0.0]),
     }
+}
+
+/// The optional forces' parameters: turbulence, gusts, quadratic drag, flame pull, vortex
+/// and attractor (an absent one's parameters leave it without effect).
+fn set_force_fields(p: &mut SimParams, f: &Forces) {
+    p.turbulence = f.turbulence.as_ref().map_or([0.0; 4], |t| {
+        [
+            t.strength_m_per_s2,
+            t.frequency_per_m,
+            t.octaves.clamp(1, 4) as f32,
+            t.scroll_m_per_s,
+        ]
+    });
+    let (gust_strength, gust_hz) = f
+        .gusts
+        .as_ref()
+        .map_or((0.0, 0.0), |g| (g.strength, g.frequency_hz));
+    let (pull, pull_exp) = f
+        .flame_pull
+        .as_ref()
+        .map_or((0.0, 1.0), |fp| (fp.strength_per_s2, fp.exponent));
+    p.gusts_qdrag_pull = [gust_strength, gust_hz, f.quadratic_drag_per_m, pull];
+    (p.vortex_center, p.vortex_axis) =
+        f.vortex
+            .as_ref()
+            .map_or(([0.0; 4], [0.0, 1.0, 0.0, 0.0]), |v| {
+                let a = glam::Vec3::from(v.axis).normalize_or(glam::Vec3::Y);
+                (
+                    [v.center_m[0], v.center_m[1], v.center_m[2], v.radius_m],
+                    [a.x, a.y, a.z, v.swirl_m_per_s2],
+                )
+            });
+    let (attractor, mode, radius) = f.attractor.as_ref().map_or(([0.0; 4], 0.0, 1.0), |a| {
+        let at = a.position_m;
+        let mode = match a.falloff {
+            crate::effect::Falloff::InverseSquare => 0.0,
+            crate::effect::Falloff::ConstantWithinRadius => 1.0,
+        };
+        ([at[0], at[1], at[2], a.strength], mode, a.radius_m)
+    });
+    p.attractor = attractor;
+    p.attractor_b = [radius, mode, pull_exp, 0.0];
+}
+
+/// The collision parameters: the ground (its height relative to the simulation `origin`),
+/// the response and up to four spheres.
+fn set_collisions(p: &mut SimParams, col: &Collisions, origin: glam::DVec3) {
+    let flag = |on: bool| if on { 1.0 } else { 0.0 };
+    for (slot, s) in p.spheres.iter_mut().zip(&col.spheres) {
+        let center = (glam::Vec3::from(s.center_m).as_dvec3() - origin).as_vec3();
+        *slot = center.extend(s.radius_m).to_array();
+    }
+    let ground = col.ground.as_ref();
+    p.ground = [
+        ground.map_or(0.0, |g| (g.height_m as f64 - origin.y) as f32),
+        col.elasticity,
+        col.friction,
+        flag(ground.is_some_and(|g| g.kill_on_contact)),
+    ];
+    p.collide_b = [
+        col.rest_speed_m_per_s,
+        col.spheres.len().min(4) as f32,
+        flag(col.kill_on_sphere_contact),
+        flag(ground.is_some()),
+    ];
+    p.collide_c = [flag(col.stick_on_contact), 0.0, 0.0, 0.0];
 }
