@@ -63,8 +63,8 @@ pub(crate) mod runtime;
 pub use effect::Effect;
 pub use gpu::{AdapterProfile, ProfileKind, ProfileRequest, ProfileSetting};
 pub use runtime::{
-    Camera, ClockStats, EmitterStats, InstanceId, Layers, PLAYER_SHADERS, ParticleCount,
-    ParticleInfo, Player, PlayerError, PlayerSettings,
+    Camera, ClockStats, EmitterStats, EventCount, InstanceId, Layers, PLAYER_SHADERS,
+    ParticleCount, ParticleInfo, Player, PlayerError, PlayerSettings,
 };
 pub use shaders::ShaderError;
 pub use sim::planner::SpawnStats;
