@@ -695,6 +695,131 @@ fn sort_costs(
     Ok(rows)
 }
 
+/// The compact state layouts the bench measures beside the full state, and their names.
+const COMPACT: [(StateLayout, &str); 2] =
+    [(StateLayout::Packed, "packed"), (StateLayout::Tiny, "tiny")];
+
+/// The throughput rows as they are measured: the main table, the tile path's stages, the
+/// JSON rows and, per compact layout ([`COMPACT`]), its table and JSON rows.
+#[derive(Default)]
+struct Tables {
+    table: Vec<Vec<String>>,
+    tile_table: Vec<Vec<String>>,
+    rows: Vec<serde_json::Value>,
+    compact_tables: [Vec<Vec<String>>; 2],
+    compact_rows: [Vec<serde_json::Value>; 2],
+}
+
+impl Tables {
+    /// Measures row `side`² on a device of its own, as a fresh process has: after a large
+    /// pool is freed, small work on the same device runs 2–5× slower on the H100 (not
+    /// memory we keep: its allocator holds nothing then; a new device is fast again). The
+    /// compact states are measured from 1M particles up (below, launch overheads dominate).
+    fn measure_side(
+        &mut self,
+        ctx: &GpuContext,
+        opts: &PerfOptions,
+        side: u32,
+        report: &mut Report,
+    ) -> anyhow::Result<()> {
+        let n = side as u64 * side as u64;
+        eprintln!("bench perf: {side}² = {n} particles");
+        let row_ctx = GpuContext::headless()?.with_profile(Some(ctx.profile));
+        let ctx = &row_ctx;
+        let copy = copy_pipeline(ctx, COPY_WGSL);
+        let copy20 = copy_pipeline(ctx, COPY20_WGSL);
+        let row = measure_row(ctx, opts, n, &copy)?;
+        self.push_row(side, n, &row);
+        for (k, (layout, name)) in COMPACT.iter().enumerate() {
+            if n < 1 << 20 {
+                break;
+            }
+            eprintln!("bench perf: {side}² {name}");
+            match measure_compact(ctx, opts, n, *layout, &copy20) {
+                Ok(p) => self.push_compact(k, side, n, 2.0 * layout.slot_bytes() as f64, &p, &row),
+                Err(e) => report.para(&format!("{side}² {name}: {e}")),
+            }
+        }
+        Ok(())
+    }
+
+    /// Row `side`² = `n` of the throughput and tile-stage tables and the JSON.
+    fn push_row(&mut self, side: u32, n: u64, row: &PerfRow) {
+        if let (Some(all), Some([project, bin]), Some((by_compute, by_draw))) =
+            (row.tiles_ms, row.tiles_stages_ms, row.tiles_resolve_ms)
+        {
+            self.tile_table.push(vec![
+                format!("{side}² = {n}"),
+                format!("{project:.3}"),
+                format!("{:.3}", bin - project),
+                format!("{:.3}", all - bin),
+                format!("{all:.3}"),
+                by_compute.map_or_else(|| "—".into(), |ms| format!("{ms:.3}")),
+                format!("{by_draw:.3}"),
+            ]);
+        }
+        let gbps = n as f64 * 64.0 / (row.lean_update_ms * 1e-3) / 1e9;
+        let copy_gbps = n as f64 * 64.0 / (row.copy_ms * 1e-3) / 1e9;
+        let thesis = THESIS_FPS.iter().find(|(s, _)| *s == side).map(|(_, f)| *f);
+        let fps = 1000.0 / row.frame_ms;
+        self.table.push(vec![
+            format!("{side}² = {n}"),
+            format!("{:.3}", row.update_ms),
+            format!("{:.3}", row.lean_update_ms),
+            format!("{:.3}", row.copy_ms),
+            format!(
+                "{gbps:.3} GB/s ({:.0} % of the copy's {copy_gbps:.3})",
+                100.0 * row.copy_ms / row.lean_update_ms
+            ),
+            row.billboard_ms
+                .map_or("skipped".into(), |m| format!("{m:.3}")),
+            format!("{:.3}", row.splat_ms),
+            row.tiles_ms.map_or("—".into(), |m| format!("{m:.3}")),
+            format!("{:.3}", row.composite_ms),
+            format!("{:.3} ({})", row.frame_ms, row.auto_path),
+            format!("{fps:.0}"),
+            thesis.map_or("—".into(), |t| format!("{t:.0} (ours: {:.2}×)", fps / t)),
+            sci(n as f64 * fps),
+        ]);
+        self.rows.push(serde_json::json!({
+            "side": side, "row": row, "update_gb_per_s": gbps, "copy_gb_per_s": copy_gbps,
+            "update_vs_copy": row.copy_ms / row.lean_update_ms, "fps": fps, "thesis_fps": thesis,
+        }));
+    }
+
+    /// Compact layout `k`'s row `side`² = `n` (`moved` bytes per particle-step), against
+    /// the full state's `row`.
+    fn push_compact(
+        &mut self,
+        k: usize,
+        side: u32,
+        n: u64,
+        moved: f64,
+        p: &PackedRow,
+        row: &PerfRow,
+    ) {
+        let pgbps = n as f64 * moved / (p.update_ms * 1e-3) / 1e9;
+        let pcopy = n as f64 * moved / (p.copy_ms * 1e-3) / 1e9;
+        self.compact_tables[k].push(vec![
+            format!("{side}² = {n}"),
+            format!("{:.3}", p.update_ms),
+            format!("{:.3}", row.lean_update_ms),
+            format!("{:.2}×", row.lean_update_ms / p.update_ms),
+            format!("{:.3}", p.copy_ms),
+            format!(
+                "{pgbps:.3} GB/s ({:.0} % of the copy's {pcopy:.3})",
+                100.0 * p.copy_ms / p.update_ms
+            ),
+        ]);
+        self.compact_rows[k].push(serde_json::json!({
+            "side": side, "row": p, "full_update_ms": row.lean_update_ms,
+            "bytes_moved_per_particle_step": moved,
+            "update_gb_per_s": pgbps, "copy_gb_per_s": pcopy,
+            "update_vs_copy": p.copy_ms / p.update_ms,
+        }));
+    }
+}
+
 /// Runs the perf bench.
 pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
     let mut report = Report::new("ignis bench perf", ctx);
@@ -729,13 +854,7 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
         )?,
         pool: u64::from(opts.module_capacity).min(ctx.max_capacity()),
     };
-    // Per compact layout: its table and JSON rows.
-    let compact = [(StateLayout::Packed, "packed"), (StateLayout::Tiny, "tiny")];
-    let mut compact_tables = [Vec::new(), Vec::new()];
-    let mut compact_rows = [Vec::new(), Vec::new()];
-    let mut rows = Vec::new();
-    let mut table = Vec::new();
-    let mut tile_table = Vec::new();
+    let mut tables = Tables::default();
     let limit = ctx.max_capacity() * 8;
     for &side in &opts.sides {
         let n = side as u64 * side as u64;
@@ -745,94 +864,17 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
             ));
             continue;
         }
-        eprintln!("bench perf: {side}² = {n} particles");
-        // Each row on a device of its own, as a fresh process has: after a large pool is
-        // freed, small work on the same device runs 2–5× slower on the H100 (not memory
-        // we keep: its allocator holds nothing then; a new device is fast again).
-        let row_ctx = GpuContext::headless()?.with_profile(Some(ctx.profile));
-        let ctx = &row_ctx;
-        let copy = copy_pipeline(ctx, COPY_WGSL);
-        let copy20 = copy_pipeline(ctx, COPY20_WGSL);
-        let row = match measure_row(ctx, opts, n, &copy) {
-            Ok(r) => r,
-            Err(e) => {
-                report.para(&format!("{side}² = {n}: {e}"));
-                continue;
-            }
-        };
-        if let (Some(all), Some([project, bin]), Some((by_compute, by_draw))) =
-            (row.tiles_ms, row.tiles_stages_ms, row.tiles_resolve_ms)
-        {
-            tile_table.push(vec![
-                format!("{side}² = {n}"),
-                format!("{project:.3}"),
-                format!("{:.3}", bin - project),
-                format!("{:.3}", all - bin),
-                format!("{all:.3}"),
-                by_compute.map_or_else(|| "—".into(), |ms| format!("{ms:.3}")),
-                format!("{by_draw:.3}"),
-            ]);
-        }
-        let gbps = n as f64 * 64.0 / (row.lean_update_ms * 1e-3) / 1e9;
-        let copy_gbps = n as f64 * 64.0 / (row.copy_ms * 1e-3) / 1e9;
-        let thesis = THESIS_FPS.iter().find(|(s, _)| *s == side).map(|(_, f)| *f);
-        let fps = 1000.0 / row.frame_ms;
-        table.push(vec![
-            format!("{side}² = {n}"),
-            format!("{:.3}", row.update_ms),
-            format!("{:.3}", row.lean_update_ms),
-            format!("{:.3}", row.copy_ms),
-            format!(
-                "{gbps:.3} GB/s ({:.0} % of the copy's {copy_gbps:.3})",
-                100.0 * row.copy_ms / row.lean_update_ms
-            ),
-            row.billboard_ms
-                .map_or("skipped".into(), |m| format!("{m:.3}")),
-            format!("{:.3}", row.splat_ms),
-            row.tiles_ms.map_or("—".into(), |m| format!("{m:.3}")),
-            format!("{:.3}", row.composite_ms),
-            format!("{:.3} ({})", row.frame_ms, row.auto_path),
-            format!("{fps:.0}"),
-            thesis.map_or("—".into(), |t| format!("{t:.0} (ours: {:.2}×)", fps / t)),
-            sci(n as f64 * fps),
-        ]);
-        rows.push(serde_json::json!({
-            "side": side, "row": row, "update_gb_per_s": gbps, "copy_gb_per_s": copy_gbps,
-            "update_vs_copy": row.copy_ms / row.lean_update_ms, "fps": fps, "thesis_fps": thesis,
-        }));
-        // The compact states, from 1M particles up (below, launch overheads dominate).
-        for (k, (layout, name)) in compact.iter().enumerate() {
-            if n < 1 << 20 {
-                break;
-            }
-            eprintln!("bench perf: {side}² {name}");
-            let moved = 2.0 * layout.slot_bytes() as f64;
-            match measure_compact(ctx, opts, n, *layout, &copy20) {
-                Ok(p) => {
-                    let pgbps = n as f64 * moved / (p.update_ms * 1e-3) / 1e9;
-                    let pcopy = n as f64 * moved / (p.copy_ms * 1e-3) / 1e9;
-                    compact_tables[k].push(vec![
-                        format!("{side}² = {n}"),
-                        format!("{:.3}", p.update_ms),
-                        format!("{:.3}", row.lean_update_ms),
-                        format!("{:.2}×", row.lean_update_ms / p.update_ms),
-                        format!("{:.3}", p.copy_ms),
-                        format!(
-                            "{pgbps:.3} GB/s ({:.0} % of the copy's {pcopy:.3})",
-                            100.0 * p.copy_ms / p.update_ms
-                        ),
-                    ]);
-                    compact_rows[k].push(serde_json::json!({
-                        "side": side, "row": p, "full_update_ms": row.lean_update_ms,
-                        "bytes_moved_per_particle_step": moved,
-                        "update_gb_per_s": pgbps, "copy_gb_per_s": pcopy,
-                        "update_vs_copy": p.copy_ms / p.update_ms,
-                    }));
-                }
-                Err(e) => report.para(&format!("{side}² {name}: {e}")),
-            }
+        if let Err(e) = tables.measure_side(ctx, opts, side, &mut report) {
+            report.para(&format!("{side}² = {n}: {e}"));
         }
     }
+    let Tables {
+        table,
+        tile_table,
+        rows,
+        compact_tables,
+        compact_rows,
+    } = tables;
     report.heading("Throughput");
     report.table(
         &[
