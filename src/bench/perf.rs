@@ -818,6 +818,170 @@ impl Tables {
             "update_vs_copy": p.copy_ms / p.update_ms,
         }));
     }
+
+    /// Writes the throughput, tile-stage and compact-state sections and their JSON.
+    fn report(self, report: &mut Report) {
+        let Tables {
+            table,
+            tile_table,
+            rows,
+            compact_tables,
+            compact_rows,
+        } = self;
+        report.heading("Throughput");
+        report.table(
+            &[
+                "particles",
+                "update ms (campfire flames: turbulence + flame pull)",
+                "update ms (without them)",
+                "copy ms",
+                "update bandwidth, without them (vs copy)",
+                "billboard draw ms",
+                "splat draw ms (clear + splat)",
+                "tile draw ms (project, bin, shade, resolve)",
+                "composite ms (tonemap + splat resolve)",
+                "frame ms (auto path)",
+                "fps",
+                "2006 thesis fps (ours ×)",
+                "particles/s",
+            ],
+            &table,
+        );
+        report.heading("Tile path stages");
+        report.para(
+            "The tile draw of each row timed stage by stage (records that stop after a stage, same run): \
+             project every quad, bin (count per block, scan, list; then the dense bins' lists per tile), then shade and resolve (the rest). \
+             The last two columns time the resolve of the shaded tiles into the HDR image alone: by compute \
+             (the tile draw's, as in the editor, where the adapter reads and writes the image in place) and by a draw \
+             (what a host's render pass gets).",
+        );
+        report.table(
+            &[
+                "particles",
+                "project ms",
+                "bin ms",
+                "shade + resolve ms",
+                "tile draw ms",
+                "resolve ms (compute)",
+                "resolve ms (draw)",
+            ],
+            &tile_table,
+        );
+        let [packed_table, tiny_table] = compact_tables;
+        let [packed_rows, tiny_rows] = compact_rows;
+        let compact_header = |what: &str| {
+            [
+                "particles".to_string(),
+                format!("{what} update ms"),
+                "full update ms (above, without turbulence)".into(),
+                "speed-up".into(),
+                "copy ms (20 B elements)".into(),
+                format!("{what} bandwidth (vs copy)"),
+            ]
+        };
+        report.heading("Packed state (20 B per particle)");
+        report.para(
+            "The `packed_state` option: f32 position, f16 velocity, 16-bit life fraction, lifetime re-derived \
+             from the spawn hash — 40 B moved per particle-step (20 read + 20 written) instead of 64. The copy \
+             moves the same 20-byte elements in the same run. Accuracy cost: `ignis bench accuracy` (\"+ packed\" rows).",
+        );
+        report.table(
+            &compact_header("packed").each_ref().map(String::as_str),
+            &packed_table,
+        );
+        report.json["packed"] = serde_json::Value::Array(packed_rows);
+        report.heading("Tiny state (10 B per particle)");
+        report.para(
+            "The `tiny_state` option: f16 position, shared-exponent velocity (8 significant bits of the largest \
+             component), no age (each step's births are in a table the update reads, so ages are exact) and no \
+             lifetime (re-derived) — 20 B moved per particle-step (10 read + 10 written). One invocation updates a \
+             pair of slots (they share a word); the copy moves the same bytes as 20-byte pairs in the same run. \
+             Accuracy cost: `ignis bench accuracy` (\"+ tiny\" rows).",
+        );
+        report.table(
+            &compact_header("tiny").each_ref().map(String::as_str),
+            &tiny_table,
+        );
+        report.json["tiny"] = serde_json::Value::Array(tiny_rows);
+        report.json["rows"] = serde_json::Value::Array(rows);
+    }
+}
+
+/// Writes the optional modules' section (`costs`: variant, median ms, best ms).
+fn report_modules(
+    report: &mut Report,
+    ctx: &GpuContext,
+    opts: &PerfOptions,
+    costs: &[(String, f64, f64)],
+) -> anyhow::Result<()> {
+    report.heading("Optional modules");
+    let bare = costs.first().map_or(f64::NAN, |c| c.2);
+    let mcap = opts.module_capacity.min(ctx.max_capacity() as u32);
+    report.para(&format!(
+        "Update pass at {mcap} particles, ms per step: the median and the best of {} one-step submissions in 3 rounds \
+         over the variants, all on one full pool (several large pools alive at once slow every one of them on the \
+         H100), each after 100 ms of untimed steps; stateless mode, which clears the pool, last. The comparison uses \
+         the best: on the H100 a share of samples runs in a slow state (0.42 → 0.75 ms for the same step, bimodal), which moves medians by tens of percent while the best repeats to 1 %. \
+         The first two rows are the \"off costs nothing\" check: the pipeline with every module compiled out \
+         by its override constant against one built from source with the module code deleted.",
+        opts.repeats.max(1) * 3
+    ));
+    let mrows: Vec<Vec<String>> = costs
+        .iter()
+        .map(|(name, ms, best)| {
+            vec![
+                name.clone(),
+                format!("{ms:.4}"),
+                format!("{best:.4}"),
+                format!("{:+.1} %", 100.0 * (best / bare - 1.0)),
+            ]
+        })
+        .collect();
+    report.table(
+        &["variant", "update ms/step (median)", "best", "best vs bare"],
+        &mrows,
+    );
+    report.json["modules"] = serde_json::to_value(
+        costs
+            .iter()
+            .map(|(n, ms, best)| serde_json::json!({"variant": n, "ms": ms, "best_ms": best}))
+            .collect::<Vec<_>>(),
+    )?;
+    Ok(())
+}
+
+/// Writes the sorting section and its JSON.
+fn report_sorts(report: &mut Report, sorts: &[SortRow]) -> anyhow::Result<()> {
+    report.heading("Sorting (alpha-blended emitters)");
+    report.para(
+        "Back-to-front order of (depth key, slot) pairs: the bitonic network split so that every run of stages \
+         with a compare distance below 512 is one dispatch in workgroup memory, against the plain network (one \
+         global dispatch per stage), same keys, same run. In a frame only the emitter's live window is sorted.",
+    );
+    let srows: Vec<Vec<String>> = sorts
+        .iter()
+        .map(|r| {
+            vec![
+                r.keys.to_string(),
+                format!("{} / {}", r.split_dispatches, r.plain_dispatches),
+                format!("{:.3}", r.split_ms),
+                format!("{:.3}", r.plain_ms),
+                format!("{:.2}×", r.plain_ms / r.split_ms),
+            ]
+        })
+        .collect();
+    report.table(
+        &[
+            "keys",
+            "dispatches (split / plain)",
+            "split ms",
+            "plain ms",
+            "speed-up",
+        ],
+        &srows,
+    );
+    report.json["sort"] = serde_json::to_value(sorts)?;
+    Ok(())
 }
 
 /// Runs the perf bench.
@@ -868,153 +1032,11 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
             report.para(&format!("{side}² = {n}: {e}"));
         }
     }
-    let Tables {
-        table,
-        tile_table,
-        rows,
-        compact_tables,
-        compact_rows,
-    } = tables;
-    report.heading("Throughput");
-    report.table(
-        &[
-            "particles",
-            "update ms (campfire flames: turbulence + flame pull)",
-            "update ms (without them)",
-            "copy ms",
-            "update bandwidth, without them (vs copy)",
-            "billboard draw ms",
-            "splat draw ms (clear + splat)",
-            "tile draw ms (project, bin, shade, resolve)",
-            "composite ms (tonemap + splat resolve)",
-            "frame ms (auto path)",
-            "fps",
-            "2006 thesis fps (ours ×)",
-            "particles/s",
-        ],
-        &table,
-    );
-    report.heading("Tile path stages");
-    report.para(
-        "The tile draw of each row timed stage by stage (records that stop after a stage, same run): \
-         project every quad, bin (count per block, scan, list; then the dense bins' lists per tile), then shade and resolve (the rest). \
-         The last two columns time the resolve of the shaded tiles into the HDR image alone: by compute \
-         (the tile draw's, as in the editor, where the adapter reads and writes the image in place) and by a draw \
-         (what a host's render pass gets).",
-    );
-    report.table(
-        &[
-            "particles",
-            "project ms",
-            "bin ms",
-            "shade + resolve ms",
-            "tile draw ms",
-            "resolve ms (compute)",
-            "resolve ms (draw)",
-        ],
-        &tile_table,
-    );
-    let [packed_table, tiny_table] = compact_tables;
-    let [packed_rows, tiny_rows] = compact_rows;
-    let compact_header = |what: &str| {
-        [
-            "particles".to_string(),
-            format!("{what} update ms"),
-            "full update ms (above, without turbulence)".into(),
-            "speed-up".into(),
-            "copy ms (20 B elements)".into(),
-            format!("{what} bandwidth (vs copy)"),
-        ]
-    };
-    report.heading("Packed state (20 B per particle)");
-    report.para(
-        "The `packed_state` option: f32 position, f16 velocity, 16-bit life fraction, lifetime re-derived \
-         from the spawn hash — 40 B moved per particle-step (20 read + 20 written) instead of 64. The copy \
-         moves the same 20-byte elements in the same run. Accuracy cost: `ignis bench accuracy` (\"+ packed\" rows).",
-    );
-    report.table(
-        &compact_header("packed").each_ref().map(String::as_str),
-        &packed_table,
-    );
-    report.json["packed"] = serde_json::Value::Array(packed_rows);
-    report.heading("Tiny state (10 B per particle)");
-    report.para(
-        "The `tiny_state` option: f16 position, shared-exponent velocity (8 significant bits of the largest \
-         component), no age (each step's births are in a table the update reads, so ages are exact) and no \
-         lifetime (re-derived) — 20 B moved per particle-step (10 read + 10 written). One invocation updates a \
-         pair of slots (they share a word); the copy moves the same bytes as 20-byte pairs in the same run. \
-         Accuracy cost: `ignis bench accuracy` (\"+ tiny\" rows).",
-    );
-    report.table(
-        &compact_header("tiny").each_ref().map(String::as_str),
-        &tiny_table,
-    );
-    report.json["tiny"] = serde_json::Value::Array(tiny_rows);
-    report.heading("Optional modules");
-    let bare = costs.first().map_or(f64::NAN, |c| c.2);
-    let mcap = opts.module_capacity.min(ctx.max_capacity() as u32);
-    report.para(&format!(
-        "Update pass at {mcap} particles, ms per step: the median and the best of {} one-step submissions in 3 rounds \
-         over the variants, all on one full pool (several large pools alive at once slow every one of them on the \
-         H100), each after 100 ms of untimed steps; stateless mode, which clears the pool, last. The comparison uses \
-         the best: on the H100 a share of samples runs in a slow state (0.42 → 0.75 ms for the same step, bimodal), which moves medians by tens of percent while the best repeats to 1 %. \
-         The first two rows are the \"off costs nothing\" check: the pipeline with every module compiled out \
-         by its override constant against one built from source with the module code deleted.",
-        opts.repeats.max(1) * 3
-    ));
-    let mrows: Vec<Vec<String>> = costs
-        .iter()
-        .map(|(name, ms, best)| {
-            vec![
-                name.clone(),
-                format!("{ms:.4}"),
-                format!("{best:.4}"),
-                format!("{:+.1} %", 100.0 * (best / bare - 1.0)),
-            ]
-        })
-        .collect();
-    report.table(
-        &["variant", "update ms/step (median)", "best", "best vs bare"],
-        &mrows,
-    );
+    tables.report(&mut report);
+    report_modules(&mut report, ctx, opts, &costs)?;
     eprintln!("bench perf: sorting");
     let sorts = sort_costs(ctx, opts, &timer)?;
-    report.heading("Sorting (alpha-blended emitters)");
-    report.para(
-        "Back-to-front order of (depth key, slot) pairs: the bitonic network split so that every run of stages \
-         with a compare distance below 512 is one dispatch in workgroup memory, against the plain network (one \
-         global dispatch per stage), same keys, same run. In a frame only the emitter's live window is sorted.",
-    );
-    let srows: Vec<Vec<String>> = sorts
-        .iter()
-        .map(|r| {
-            vec![
-                r.keys.to_string(),
-                format!("{} / {}", r.split_dispatches, r.plain_dispatches),
-                format!("{:.3}", r.split_ms),
-                format!("{:.3}", r.plain_ms),
-                format!("{:.2}×", r.plain_ms / r.split_ms),
-            ]
-        })
-        .collect();
-    report.table(
-        &[
-            "keys",
-            "dispatches (split / plain)",
-            "split ms",
-            "plain ms",
-            "speed-up",
-        ],
-        &srows,
-    );
-    report.json["sort"] = serde_json::to_value(&sorts)?;
-    report.json["rows"] = serde_json::Value::Array(rows);
-    report.json["modules"] = serde_json::to_value(
-        costs
-            .iter()
-            .map(|(n, ms, best)| serde_json::json!({"variant": n, "ms": ms, "best_ms": best}))
-            .collect::<Vec<_>>(),
-    )?;
+    report_sorts(&mut report, &sorts)?;
     state.report(&mut report);
     report.json["resolution"] = serde_json::json!([opts.size.0, opts.size.1]);
     report.json["timing"] = serde_json::Value::String(timer.source.label().into());
