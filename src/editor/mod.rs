@@ -7,8 +7,10 @@
 pub mod app;
 pub mod curve_editor;
 pub mod emitter_cost;
+mod emitter_ui;
 pub mod events_ui;
 pub mod export_ui;
+mod forces_ui;
 mod gfx;
 pub mod inspect;
 pub mod look;
@@ -21,6 +23,7 @@ pub mod retained;
 pub mod screenshot;
 pub mod state;
 pub mod stats;
+mod time_ui;
 pub mod timeline;
 pub mod ui_painter;
 pub mod undo;

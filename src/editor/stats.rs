@@ -144,6 +144,16 @@ pub fn percentile(values: &[f32], q: f32) -> f32 {
 
 /// The Stats section: timings, counters per emitter and a frame-time plot.
 pub fn stats_ui(ui: &mut egui::Ui, stats: &Stats, effect: &Effect) {
+    timings_ui(ui, stats);
+    ui.add_space(4.0);
+    emitters_ui(ui, stats, effect);
+    ui.add_space(4.0);
+    frame_plot_ui(ui, stats);
+}
+
+/// The timings and the frame's facts: frame rate, CPU and GPU times, steps, the viewport,
+/// the adapter, the UI painter and the last shader reload.
+fn timings_ui(ui: &mut egui::Ui, stats: &Stats) {
     egui::Grid::new("stats_grid")
         .num_columns(2)
         .spacing([12.0, 4.0])
@@ -215,7 +225,10 @@ pub fn stats_ui(ui: &mut egui::Ui, stats: &Stats, effect: &Effect) {
                 ui.end_row();
             }
         });
-    ui.add_space(4.0);
+}
+
+/// Each emitter's live particles against its capacity, its events and what it dropped.
+fn emitters_ui(ui: &mut egui::Ui, stats: &Stats, effect: &Effect) {
     for (i, e) in effect.emitters.iter().enumerate() {
         let Some(s) = stats.emitters.get(i) else {
             continue;
@@ -279,7 +292,10 @@ pub fn stats_ui(ui: &mut egui::Ui, stats: &Stats, effect: &Effect) {
             });
         }
     }
-    ui.add_space(4.0);
+}
+
+/// The frame-time and CPU-time plot over the last frames.
+fn frame_plot_ui(ui: &mut egui::Ui, stats: &Stats) {
     // Spikes (start-up, a resize) are clipped so they do not flatten the rest.
     let frames: Vec<f32> = stats.frame_secs.iter().map(|s| s * 1e3).collect();
     let y_max = (percentile(&frames, 0.95) * 1.5).max(34.0) as f64;

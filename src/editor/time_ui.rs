@@ -1,0 +1,215 @@
+//! The panel's Time section: the step mode, the integrator, the measured accuracy and the
+//! stability hints.
+
+use egui::{Color32, DragValue, Ui};
+
+use crate::effect::{Effect, Emitter, Integrator, TimeMode};
+
+use super::panel::{drag, grid, row_ui};
+use super::state::Playback;
+
+/// Time stepping, playback and the integrator of each emitter with its stability hint.
+pub fn time_ui(ui: &mut Ui, effect: &mut Effect, playback: &mut Playback, selected: usize) {
+    ui.horizontal(|ui| {
+        super::timeline::playback_buttons_ui(ui, playback);
+        if playback.is_paused {
+            ui.colored_label(Color32::from_rgb(240, 200, 90), "paused");
+        }
+    });
+    let t = &mut effect.time;
+    grid("time_grid").show(ui, |ui| {
+        ui.label("Mode").on_hover_text(
+            "Fixed step: an accumulator runs whole steps, so the result does not depend on the frame rate. Frame delta: one step per frame of the frame's duration (the 2006 thesis's mode)",
+        );
+        ui.horizontal(|ui| {
+            ui.radio_value(&mut t.mode, TimeMode::FixedStep, "Fixed step");
+            ui.radio_value(&mut t.mode, TimeMode::FrameDelta, "Frame delta");
+        });
+        ui.end_row();
+        let is_fixed = t.mode == TimeMode::FixedStep;
+        let label = ui
+            .label("Step size")
+            .on_hover_text("Fixed step size, seconds");
+        ui.horizontal(|ui| {
+            ui.add_enabled(
+                is_fixed,
+                drag(&mut t.step_secs, 0.0001..=0.1, 0.0002, " s").min_decimals(4),
+            )
+            .labelled_by(label.id);
+            if t.step_secs > 0.0 {
+                ui.weak(format!("{:.0} Hz", 1.0 / t.step_secs));
+            }
+        });
+        ui.end_row();
+        row_ui(
+ui,
+            "Max substeps",
+            "At most this many fixed steps per frame; the rest of the time is dropped and counted (Stats)",
+            |ui| ui.add_enabled(is_fixed, DragValue::new(&mut t.max_substeps).range(1..=256).speed(0.1)),
+        );
+        row_ui(
+ui,
+            "Max frame dt",
+            "Frame-delta mode: a longer frame is clamped to this step, seconds",
+            |ui| {
+                ui.add_enabled(
+                    !is_fixed,
+                    drag(&mut t.max_frame_dt_secs, 0.001..=0.5, 0.001, " s").min_decimals(3),
+                )
+            },
+        );
+        row_ui(
+ui,
+            "Sim speed",
+            "Simulation speed multiplier (1 = real time)",
+            |ui| ui.add(drag(&mut t.speed, 0.0..=10.0, 0.01, "×").min_decimals(2)),
+        );
+        if let Some(e) = effect.emitters.get_mut(selected) {
+            let label = ui
+                .label("Integrator")
+                .on_hover_text("Integration method of the selected emitter");
+            egui::ComboBox::from_id_salt("integrator")
+                .selected_text(e.integrator.label())
+                .width(150.0)
+                .show_ui(ui, |ui| {
+                    for i in Integrator::ALL {
+                        ui.selectable_value(&mut e.integrator, i, i.label());
+                    }
+                })
+                .response
+                .labelled_by(label.id);
+            ui.end_row();
+            row_ui(
+                ui,
+                "Stateless",
+                "Closed form instead of steps: each particle's position is evaluated from its spawn record and age (exact, cheaper). Only for constant acceleration and linear drag",
+                |ui| {
+                    let r = ui.checkbox(&mut e.stateless, "closed form");
+                    if r.changed() && e.stateless {
+                        e.packed_state = false;
+                        e.tiny_state = false;
+                    }
+                    r
+                },
+            );
+            // Three radio buttons, each named by its own text (not by the row's label).
+            let tip = "Bytes stored per particle. 32 B: f32 position, velocity, age, lifetime. 20 B packed: f16 velocity, 16-bit life fraction, lifetime re-derived from the spawn hash. 10 B tiny: f16 position, shared-exponent velocity, age from a table of each step's births. Smaller moves less memory for huge pools, at the accuracy cost `ignis bench accuracy` reports (\"+ packed\", \"+ tiny\" rows). Switching restarts this emitter's particles";
+            ui.label("State size").on_hover_text(tip);
+            ui.horizontal(|ui| {
+                let before = (e.packed_state, e.tiny_state);
+                let mut size = if e.tiny_state {
+                    10
+                } else if e.packed_state {
+                    20
+                } else {
+                    32
+                };
+                for (bytes, text) in [(32, "32 B"), (20, "20 B packed"), (10, "10 B tiny")] {
+                    ui.radio_value(&mut size, bytes, text).on_hover_text(tip);
+                }
+                e.packed_state = size == 20;
+                e.tiny_state = size == 10;
+                if (e.packed_state, e.tiny_state) != before && size != 32 {
+                    e.stateless = false;
+                }
+            });
+            ui.end_row();
+            let blockers = e.stateless_blockers();
+            if e.stateless && !blockers.is_empty() {
+                ui.label("");
+                ui.colored_label(
+                    ui.visuals().warn_fg_color,
+                    format!("turn off: {}", blockers.join(", ")),
+                );
+                ui.end_row();
+            }
+        }
+    });
+    if let Some(e) = effect.emitters.get(selected) {
+        measured_ui(ui, e.integrator, step_secs(effect));
+    }
+    stability_ui(ui, effect);
+}
+
+/// The step the integrators see: the fixed step, or the largest frame-delta step.
+pub fn step_secs(effect: &Effect) -> f32 {
+    match effect.time.mode {
+        TimeMode::FixedStep => effect.time.step_secs,
+        TimeMode::FrameDelta => effect.time.max_frame_dt_secs,
+    }
+}
+
+/// What the accuracy bench measured for `integrator` near `dt_secs` (the committed H100
+/// results embedded in the binary), cached because the figures are parsed from JSON.
+fn measured_ui(ui: &mut Ui, integrator: Integrator, dt_secs: f32) {
+    type Cache = Option<((Integrator, u32), Vec<super::measured::Measured>)>;
+    static CACHE: std::sync::Mutex<Cache> = std::sync::Mutex::new(None);
+    let key = (integrator, dt_secs.to_bits());
+    let figures = match CACHE.lock() {
+        Ok(mut cache) => {
+            if cache.as_ref().is_none_or(|(k, _)| *k != key) {
+                let figures = super::measured::measured_for(integrator, dt_secs as f64);
+                *cache = Some((key, figures));
+            }
+            cache.as_ref().map(|(_, f)| f.clone()).unwrap_or_default()
+        }
+        Err(_) => Vec::new(),
+    };
+    if figures.is_empty() {
+        return;
+    }
+    ui.weak(format!(
+        "{} as measured (H100, T = 2 s):",
+        integrator.label()
+    ))
+    .on_hover_text(
+        "From the committed accuracy bench (bench/results/accuracy-nvidia-h100-80gb.json): \
+             RMS position error relative to the reference solution after 2 s, and the update \
+             cost per particle and step, at the measured step nearest to this one",
+    );
+    for m in figures {
+        ui.weak(format!(
+            "  {}: error {:.1e} at dt {:.4} s, {:.2} ns/particle-step",
+            m.scene, m.rms_rel_error, m.dt_secs, m.cost_ns
+        ));
+    }
+}
+
+/// k·dt of the step the integrator sees (the worst case in frame-delta mode).
+pub fn drag_times_dt(effect: &Effect, emitter: &Emitter) -> f32 {
+    emitter.forces.drag_per_sec * step_secs(effect)
+}
+
+/// The drag stability hint for every emitter: k·dt against the integrator's limit.
+fn stability_ui(ui: &mut Ui, effect: &Effect) {
+    egui::Grid::new("stability_grid")
+        .num_columns(3)
+        .spacing([10.0, 2.0])
+        .show(ui, |ui| {
+            ui.weak("emitter");
+            ui.weak("integrator");
+            ui.weak("drag·dt / limit")
+                .on_hover_text("Linear drag v' = −k·v is stable for k·dt below the method's limit; above it the velocity oscillates and grows");
+            ui.end_row();
+            for e in &effect.emitters {
+                let kdt = drag_times_dt(effect, e);
+                ui.label(&e.name);
+                ui.label(e.integrator.label());
+                match e.integrator.drag_stability_limit() {
+                    Some(limit) if kdt > limit => {
+                        ui.colored_label(
+                            ui.visuals().error_fg_color,
+                            format!("{kdt:.3} > {limit:.3}: unstable"),
+                        );
+                    }
+                    Some(limit) => {
+                        ui.label(format!("{kdt:.3} / {limit:.3}"));
+                    }
+                    None => {
+                        ui.label(format!("{kdt:.3} / ∞"));
+                    }
+                }
+                ui.end_row();
+            }
+        });
+}
