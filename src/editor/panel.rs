@@ -142,8 +142,26 @@ fn section_ui(
         .show(ui, add);
 }
 
-/// Title, undo/redo and the validation message.
+/// Title, undo/redo, the preset file and the messages: what failed, and what keeps running.
 pub fn header_ui(ui: &mut Ui, state: &mut EditorState) {
+    title_ui(ui, state);
+    undo_ui(ui, state);
+    preset_file_ui(ui, state);
+    preset_library_ui(ui, state);
+    match &state.preset_message {
+        Some(Ok(msg)) => {
+            ui.colored_label(Color32::from_rgb(130, 200, 130), msg);
+        }
+        Some(Err(msg)) => {
+            ui.colored_label(ui.visuals().error_fg_color, msg);
+        }
+        None => {}
+    }
+    problems_ui(ui, state);
+}
+
+/// The title: the effect's name, its file and whether it has unsaved edits.
+fn title_ui(ui: &mut Ui, state: &EditorState) {
     ui.horizontal(|ui| {
         ui.heading(
             RichText::new("ignis")
@@ -157,6 +175,10 @@ pub fn header_ui(ui: &mut Ui, state: &mut EditorState) {
                 .on_hover_text("The effect differs from the last loaded or saved preset");
         }
     });
+}
+
+/// Undo and redo, and how many steps each has.
+fn undo_ui(ui: &mut Ui, state: &mut EditorState) {
     ui.horizontal(|ui| {
         let undo = ui
             .add_enabled(state.history.undo_len() > 0, egui::Button::new("Undo"))
@@ -176,6 +198,11 @@ pub fn header_ui(ui: &mut Ui, state: &mut EditorState) {
             state.history.redo_len()
         ));
     });
+}
+
+/// The preset path with Save, Load and Revert, and the question a pending load or an
+/// outside change asks before unsaved edits are discarded.
+fn preset_file_ui(ui: &mut Ui, state: &mut EditorState) {
     ui.horizontal(|ui| {
         let label = ui.label("Preset");
         ui.add(
@@ -233,16 +260,11 @@ pub fn header_ui(ui: &mut Ui, state: &mut EditorState) {
             });
         });
     }
-    preset_library_ui(ui, state);
-    match &state.preset_message {
-        Some(Ok(msg)) => {
-            ui.colored_label(Color32::from_rgb(130, 200, 130), msg);
-        }
-        Some(Err(msg)) => {
-            ui.colored_label(ui.visuals().error_fg_color, msg);
-        }
-        None => {}
-    }
+}
+
+/// What keeps the edit from running: invalid fields, a shader error, a stopped
+/// simulation, a lost device, an effect the GPU refused.
+fn problems_ui(ui: &mut Ui, state: &mut EditorState) {
     if !state.validation_errors.is_empty() {
         error_box_ui(ui, |ui| {
             ui.label(RichText::new("Not applied: the last valid effect keeps running.").strong());
