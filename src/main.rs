@@ -541,23 +541,8 @@ fn bench(kind: BenchKind, profile: &ProfileRequest) -> anyhow::Result<()> {
             out,
             name,
         } => {
-            let paths = if paths.is_empty() {
-                vec![PathBuf::from("presets")]
-            } else {
-                paths
-            };
-            let presets = paths
-                .iter()
-                .flat_map(|p| {
-                    if p.is_dir() {
-                        ignis::preset::list(p)
-                    } else {
-                        vec![p.clone()]
-                    }
-                })
-                .collect();
             let opts = ignis::bench::presets::PresetsOptions {
-                presets,
+                presets: preset_files(paths),
                 sizes,
                 frames: frames.max(1),
                 passes: passes.max(1),
@@ -636,34 +621,65 @@ fn bench(kind: BenchKind, profile: &ProfileRequest) -> anyhow::Result<()> {
             out,
             name,
         } => {
-            let cpu = ctx.profile.is_software();
-            let sides = if sides.is_empty() {
-                let mut s = vec![64, 128, 256, 512, 1024, 2048];
-                if !cpu {
-                    s.extend([4096, 8192, 11586]);
-                }
-                s
-            } else {
-                sides
-            };
-            let opts = ignis::bench::perf::PerfOptions {
-                sides,
-                size,
-                repeats: repeats.max(1),
-                billboard_limit: if cpu { 1 << 20 } else { 1 << 26 },
-                module_capacity: if module_capacity > 0 {
-                    module_capacity
-                } else if cpu {
-                    1 << 20
-                } else {
-                    1 << 24
-                },
-            };
+            let opts = perf_options(&ctx, sides, size, repeats, module_capacity);
             let report = ignis::bench::perf::run(&ctx, &opts)?;
             save_report(&report, &out, name, "perf", &ctx)?;
         }
     }
     Ok(())
+}
+
+/// The preset files of `paths` (folders listed; `presets/` when none are given).
+fn preset_files(paths: Vec<PathBuf>) -> Vec<PathBuf> {
+    let paths = if paths.is_empty() {
+        vec![PathBuf::from("presets")]
+    } else {
+        paths
+    };
+    paths
+        .iter()
+        .flat_map(|p| {
+            if p.is_dir() {
+                ignis::preset::list(p)
+            } else {
+                vec![p.clone()]
+            }
+        })
+        .collect()
+}
+
+/// `bench perf`'s options: on a software adapter smaller defaults (sides up to 2048², 1M
+/// billboards, a 1M-particle module pool); 0 or none given means the default.
+fn perf_options(
+    ctx: &GpuContext,
+    sides: Vec<u32>,
+    size: (u32, u32),
+    repeats: usize,
+    module_capacity: u32,
+) -> ignis::bench::perf::PerfOptions {
+    let cpu = ctx.profile.is_software();
+    let sides = if sides.is_empty() {
+        let mut s = vec![64, 128, 256, 512, 1024, 2048];
+        if !cpu {
+            s.extend([4096, 8192, 11586]);
+        }
+        s
+    } else {
+        sides
+    };
+    ignis::bench::perf::PerfOptions {
+        sides,
+        size,
+        repeats: repeats.max(1),
+        billboard_limit: if cpu { 1 << 20 } else { 1 << 26 },
+        module_capacity: if module_capacity > 0 {
+            module_capacity
+        } else if cpu {
+            1 << 20
+        } else {
+            1 << 24
+        },
+    }
 }
 
 fn check(paths: &[PathBuf]) -> anyhow::Result<()> {
