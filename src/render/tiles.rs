@@ -807,6 +807,35 @@ impl TilePass {
             indirect,
         );
         let depth_view = depth.unwrap_or(&self.no_depth);
+        let [tile_group, bin_group, resolve_group] =
+            self.bind_groups(ctx, &lists, (&job_buffer, &dispatch_args), depth_view);
+        let [sprites_buf, touched, bin_lists, meta, accum] = lists;
+        self.buffers = Some(TileBuffers {
+            size,
+            capacity,
+            list_capacity,
+            jobs,
+            job_buffer,
+            touched,
+            dispatch_args,
+            group: tile_group,
+            bin_group,
+            resolve_group,
+            depth: depth.cloned(),
+            _lists: [sprites_buf, bin_lists, meta, accum],
+        });
+    }
+
+    /// The tile group (`lists`: sprites, touched, bin lists, bin meta, accumulation; the
+    /// host's depth view; the jobs), the bin passes' group (the same and the dispatch
+    /// arguments) and the resolve's group (accumulation and touched), over new buffers.
+    fn bind_groups(
+        &self,
+        ctx: &GpuContext,
+        lists: &[wgpu::Buffer; 5],
+        (job_buffer, dispatch_args): (&wgpu::Buffer, &wgpu::Buffer),
+        depth_view: &wgpu::TextureView,
+    ) -> [wgpu::BindGroup; 3] {
         let group = |layout, args: Option<&wgpu::Buffer>| {
             let mut entries: Vec<wgpu::BindGroupEntry<'_>> = lists
                 .iter()
@@ -823,7 +852,7 @@ impl TilePass {
             entries.push(wgpu::BindGroupEntry {
                 binding: 6,
                 resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &job_buffer,
+                    buffer: job_buffer,
                     offset: 0,
                     size: wgpu::BufferSize::new(JOB_STRIDE),
                 }),
@@ -839,7 +868,7 @@ impl TilePass {
             })
         };
         let tile_group = group(&self.tile_layout, None);
-        let bin_group = group(&self.bin_group_layout, Some(&dispatch_args));
+        let bin_group = group(&self.bin_group_layout, Some(dispatch_args));
         let resolve_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("TilePass::resolve_group"),
             layout: &self.resolve_group_layout,
@@ -854,21 +883,7 @@ impl TilePass {
                 },
             ],
         });
-        let [sprites_buf, touched, bin_lists, meta, accum] = lists;
-        self.buffers = Some(TileBuffers {
-            size,
-            capacity,
-            list_capacity,
-            jobs,
-            job_buffer,
-            touched,
-            dispatch_args,
-            group: tile_group,
-            bin_group,
-            resolve_group,
-            depth: depth.cloned(),
-            _lists: [sprites_buf, bin_lists, meta, accum],
-        });
+        [tile_group, bin_group, resolve_group]
     }
 
     /// Composites the last record's tiles into an open render pass of the target's
