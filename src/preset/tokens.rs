@@ -46,150 +46,180 @@ pub(super) fn is_word_char(c: char) -> bool {
 /// Splits RON text into tokens. Never fails: an unterminated string or comment ends the
 /// token list (the deserialiser reports it).
 pub(super) fn tokenize(text: &str) -> Vec<Token> {
-    let mut tokens = Vec::new();
-    let chars: Vec<(usize, char)> = text.char_indices().collect();
-    let mut i = 0;
-    let mut line = 1;
-    let mut col = 1;
-    // Advances over chars[i..j], updating the position.
-    let advance = |i: &mut usize, j: usize, line: &mut usize, col: &mut usize| {
-        for &(_, c) in &chars[*i..j.min(chars.len())] {
-            if c == '\n' {
-                *line += 1;
-                *col = 1;
-            } else {
-                *col += 1;
-            }
-        }
-        *i = j.min(chars.len());
+    let lex = Lexer {
+        text,
+        chars: text.char_indices().collect(),
     };
-    let byte = |k: usize| chars.get(k).map_or(text.len(), |&(b, _)| b);
-    let at = |k: usize| chars.get(k).map(|&(_, c)| c);
-    while i < chars.len() {
-        let c = chars[i].1;
-        let start_pos = TextPos { line, column: col };
-        let mut j = i + 1;
-        let kind = match c {
-            c if c.is_whitespace() => {
-                advance(&mut i, j, &mut line, &mut col);
-                continue;
-            }
-            '/' if at(i + 1) == Some('/') => {
-                while j < chars.len() && chars[j].1 != '\n' {
-                    j += 1;
-                }
-                advance(&mut i, j, &mut line, &mut col);
-                continue;
-            }
-            '/' if at(i + 1) == Some('*') => {
-                let mut depth = 1;
-                j = i + 2;
-                while j < chars.len() && depth > 0 {
-                    if chars[j].1 == '/' && at(j + 1) == Some('*') {
-                        depth += 1;
-                        j += 2;
-                    } else if chars[j].1 == '*' && at(j + 1) == Some('/') {
-                        depth -= 1;
-                        j += 2;
-                    } else {
-                        j += 1;
-                    }
-                }
-                if depth > 0 {
-                    break;
-                }
-                advance(&mut i, j, &mut line, &mut col);
-                continue;
-            }
-            '(' | '[' | '{' => Tok::Open(c as u8),
-            ')' | ']' | '}' => Tok::Close(c as u8),
-            ',' => Tok::Comma,
-            ':' => Tok::Colon,
-            '"' => {
-                let mut closed = false;
-                while j < chars.len() {
-                    match chars[j].1 {
-                        '\\' => j += 2,
-                        '"' => {
-                            j += 1;
-                            closed = true;
-                            break;
-                        }
-                        _ => j += 1,
-                    }
-                }
-                if !closed {
-                    break;
-                }
-                Tok::Str
-            }
-            '\'' => {
-                j = if at(i + 1) == Some('\\') {
-                    i + 4
-                } else {
-                    i + 3
-                };
-                while j <= chars.len() && at(j - 1) != Some('\'') && j < i + 12 {
-                    j += 1;
-                }
-                Tok::Str
-            }
-            c if is_word_char(c) => {
-                while j < chars.len() && is_word_char(chars[j].1) {
-                    j += 1;
-                }
-                let word = &text[byte(i)..byte(j)];
-                // Raw strings r"…", r#"…"#, br"…" and raw identifiers r#name.
-                if matches!(word, "r" | "br" | "b") && matches!(at(j), Some('#' | '"')) {
-                    let mut hashes = 0;
-                    while at(j + hashes) == Some('#') {
-                        hashes += 1;
-                    }
-                    if at(j + hashes) == Some('"') && (word != "b" || hashes == 0) {
-                        let mut k = j + hashes + 1;
-                        let mut closed = false;
-                        while k < chars.len() {
-                            if word == "b" && chars[k].1 == '\\' {
-                                k += 2;
-                                continue;
-                            }
-                            if chars[k].1 == '"' && (0..hashes).all(|h| at(k + 1 + h) == Some('#'))
-                            {
-                                k += 1 + hashes;
-                                closed = true;
-                                break;
-                            }
-                            k += 1;
-                        }
-                        if !closed {
-                            break;
-                        }
-                        j = k;
-                        Tok::Str
-                    } else {
-                        j += hashes;
-                        while j < chars.len() && is_word_char(chars[j].1) {
-                            j += 1;
-                        }
-                        Tok::Word
-                    }
-                } else {
-                    Tok::Word
-                }
-            }
-            _ => Tok::Other,
+    let mut tokens = Vec::new();
+    let (mut i, mut pos) = (0, TextPos { line: 1, column: 1 });
+    while i < lex.chars.len() {
+        let c = lex.chars[i].1;
+        let (kind, j) = match c {
+            c if c.is_whitespace() => (None, i + 1),
+            '/' if lex.at(i + 1) == Some('/') => (None, lex.line_comment_end(i)),
+            '/' if lex.at(i + 1) == Some('*') => match lex.block_comment_end(i) {
+                Some(j) => (None, j),
+                None => break,
+            },
+            '(' | '[' | '{' => (Some(Tok::Open(c as u8)), i + 1),
+            ')' | ']' | '}' => (Some(Tok::Close(c as u8)), i + 1),
+            ',' => (Some(Tok::Comma), i + 1),
+            ':' => (Some(Tok::Colon), i + 1),
+            '"' => match lex.string_end(i) {
+                Some(j) => (Some(Tok::Str), j),
+                None => break,
+            },
+            '\'' => (Some(Tok::Str), lex.char_end(i)),
+            c if is_word_char(c) => match lex.word_end(i) {
+                Some((kind, j)) => (Some(kind), j),
+                None => break,
+            },
+            _ => (Some(Tok::Other), i + 1),
         };
-        let start = byte(i);
-        advance(&mut i, j, &mut line, &mut col);
-        tokens.push(Token {
-            kind,
-            start,
-            end: byte(i),
-            pos: start_pos,
-            end_pos: TextPos { line, column: col },
-        });
+        let (start, start_pos) = (lex.byte(i), pos);
+        i = lex.advance(i, j, &mut pos);
+        if let Some(kind) = kind {
+            tokens.push(Token {
+                kind,
+                start,
+                end: lex.byte(i),
+                pos: start_pos,
+                end_pos: pos,
+            });
+        }
     }
     tokens
+}
+
+/// The text being split into tokens, as characters with their byte offsets.
+struct Lexer<'a> {
+    text: &'a str,
+    chars: Vec<(usize, char)>,
+}
+
+impl Lexer<'_> {
+    /// The byte offset of character `k` (the text's length past the end).
+    fn byte(&self, k: usize) -> usize {
+        self.chars.get(k).map_or(self.text.len(), |&(b, _)| b)
+    }
+
+    /// Character `k`, if there is one.
+    fn at(&self, k: usize) -> Option<char> {
+        self.chars.get(k).map(|&(_, c)| c)
+    }
+
+    /// Moves `pos` over characters `i..j`; returns where it stopped (`j`, or the end).
+    fn advance(&self, i: usize, j: usize, pos: &mut TextPos) -> usize {
+        let j = j.min(self.chars.len());
+        for &(_, c) in &self.chars[i..j] {
+            if c == '\n' {
+                pos.line += 1;
+                pos.column = 1;
+            } else {
+                pos.column += 1;
+            }
+        }
+        j
+    }
+
+    /// The end of the `//` comment at `i` (its line's end).
+    fn line_comment_end(&self, i: usize) -> usize {
+        let mut j = i + 1;
+        while j < self.chars.len() && self.chars[j].1 != '\n' {
+            j += 1;
+        }
+        j
+    }
+
+    /// The end of the `/* */` comment at `i` (nested ones included); `None` when it is
+    /// never closed.
+    fn block_comment_end(&self, i: usize) -> Option<usize> {
+        let mut depth = 1;
+        let mut j = i + 2;
+        while j < self.chars.len() && depth > 0 {
+            if self.chars[j].1 == '/' && self.at(j + 1) == Some('*') {
+                depth += 1;
+                j += 2;
+            } else if self.chars[j].1 == '*' && self.at(j + 1) == Some('/') {
+                depth -= 1;
+                j += 2;
+            } else {
+                j += 1;
+            }
+        }
+        (depth == 0).then_some(j)
+    }
+
+    /// The end of the string at `i` (past its closing quote); `None` when it is never
+    /// closed.
+    fn string_end(&self, i: usize) -> Option<usize> {
+        let mut j = i + 1;
+        while j < self.chars.len() {
+            match self.chars[j].1 {
+                '\\' => j += 2,
+                '"' => return Some(j + 1),
+                _ => j += 1,
+            }
+        }
+        None
+    }
+
+    /// The end of the character literal at `i`.
+    fn char_end(&self, i: usize) -> usize {
+        let mut j = if self.at(i + 1) == Some('\\') {
+            i + 4
+        } else {
+            i + 3
+        };
+        while j <= self.chars.len() && self.at(j - 1) != Some('\'') && j < i + 12 {
+            j += 1;
+        }
+        j
+    }
+
+    /// The word at `i` and where it ends: a name or number, or a raw string (`r"…"`,
+    /// `r#"…"#`, `br"…"`, `b"…"`) or raw identifier (`r#name`); `None` for a raw string
+    /// that is never closed.
+    fn word_end(&self, i: usize) -> Option<(Tok, usize)> {
+        let mut j = i + 1;
+        while j < self.chars.len() && is_word_char(self.chars[j].1) {
+            j += 1;
+        }
+        let word = &self.text[self.byte(i)..self.byte(j)];
+        if !(matches!(word, "r" | "br" | "b") && matches!(self.at(j), Some('#' | '"'))) {
+            return Some((Tok::Word, j));
+        }
+        let mut hashes = 0;
+        while self.at(j + hashes) == Some('#') {
+            hashes += 1;
+        }
+        if self.at(j + hashes) == Some('"') && (word != "b" || hashes == 0) {
+            return self
+                .raw_string_end(j + hashes + 1, hashes, word == "b")
+                .map(|k| (Tok::Str, k));
+        }
+        j += hashes;
+        while j < self.chars.len() && is_word_char(self.chars[j].1) {
+            j += 1;
+        }
+        Some((Tok::Word, j))
+    }
+
+    /// The end of a raw string whose text starts at `k`, closed by `"` and `hashes` `#`s
+    /// (`escapes`: a byte string, where `\` escapes); `None` when it is never closed.
+    fn raw_string_end(&self, mut k: usize, hashes: usize, escapes: bool) -> Option<usize> {
+        while k < self.chars.len() {
+            if escapes && self.chars[k].1 == '\\' {
+                k += 2;
+                continue;
+            }
+            if self.chars[k].1 == '"' && (0..hashes).all(|h| self.at(k + 1 + h) == Some('#')) {
+                return Some(k + 1 + hashes);
+            }
+            k += 1;
+        }
+        None
+    }
 }
 
 /// The position of the document's opening `(` (or 1:1).
