@@ -5,7 +5,7 @@
 
 use crate::bench::Report;
 use crate::bench::report::sci;
-use crate::effect::{DrawPath, Effect, Emitter, Param, Range};
+use crate::effect::{Effect, Emitter, Param, Range};
 use crate::gpu::GpuContext;
 use crate::gpu::timer::{GpuTimer, median};
 use crate::gpu::types::StateLayout;
@@ -324,9 +324,6 @@ fn measure_row(
 
     let lib = ShaderLibrary::embedded();
     let mut frame = FrameResources::new(ctx);
-    // The automatic choice as a player on this adapter makes it.
-    frame.auto_tiles = ctx.profile.tile_raster;
-    frame.splat_dense_only = ctx.profile.splat_dense_only;
     frame.allow_tiles = TilePass::supported(&ctx.device);
     let mut sort = SortPass::new(ctx, &lib)?;
     let mut billboard = BillboardPass::new(ctx, &lib, &frame, DrawTarget::hdr())?;
@@ -1040,7 +1037,6 @@ pub fn run(ctx: &GpuContext, opts: &PerfOptions) -> anyhow::Result<Report> {
     state.report(&mut report);
     report.json["resolution"] = serde_json::json!([opts.size.0, opts.size.1]);
     report.json["timing"] = serde_json::Value::String(timer.source.label().into());
-    let _ = DrawPath::Auto;
     Ok(report)
 }
 

@@ -261,7 +261,7 @@ impl BillboardPass {
         sampler: &wgpu::Sampler,
         motion: bool,
     ) {
-        for d in items.iter().filter(|d| !d.splat && !d.tiles) {
+        for d in items.iter().filter(|d| d.is_billboard()) {
             if d.trail.is_none_or(|(_, sprite)| sprite) {
                 self.ensure_pipeline(ctx, d.variant);
                 if motion {
@@ -334,7 +334,7 @@ impl BillboardPass {
     ) {
         let mut sorted: Vec<&DrawItem> = items
             .iter()
-            .filter(|d| !d.splat && !d.tiles && wanted(d))
+            .filter(|d| d.is_billboard() && wanted(d))
             .collect();
         sorted.sort_by_key(|d| d.draw_key());
         pass.set_index_buffer(self.quad_indices.slice(..), wgpu::IndexFormat::Uint32);

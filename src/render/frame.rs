@@ -12,8 +12,8 @@ use crate::effect::{
     BlendMode, DrawPath, Effect, FlipbookMode, Look, SPLAT_BELOW_PX, SPLAT_PX_PER_QUAD, Streak,
     TILES_ABOVE_PX, TILES_MIN_FILL_PX,
 };
-use crate::gpu::GpuContext;
 use crate::gpu::types::{CameraUniform, LookUniform, PARAMS_STRIDE, StateLayout};
+use crate::gpu::{AdapterProfile, GpuContext};
 use crate::render::camera::Camera;
 use crate::render::look::{
     RAMP_WIDTH, ROWS_PER_EMITTER, bake_look_curves, bake_ramp, gradient_key, look_curve_params,
@@ -74,6 +74,11 @@ pub struct DrawItem {
 }
 
 impl DrawItem {
+    /// Whether the billboards draw it (neither the splat nor the tiles do).
+    pub fn is_billboard(&self) -> bool {
+        !self.splat && !self.tiles
+    }
+
     /// The order of a frame's draws: alpha-blended layers first, as given (back to
     /// front), then the light by emitter (each emitter's instances share a pipeline and a
     /// sprite; light adds up in any order).
@@ -148,14 +153,8 @@ pub struct FrameResources {
     pub allow_splat: bool,
     /// Soft edges read the host's depth buffer instead of the preset's ground plane.
     pub soft_depth: bool,
-    /// The automatic path sends large sprites to the tile rasteriser (the adapter
-    /// profile's `tile_raster`).
-    pub auto_tiles: bool,
     /// The tile rasteriser exists (the device's limits allow it).
     pub allow_tiles: bool,
-    /// The automatic path splats only dense emitters (the adapter profile's
-    /// `splat_dense_only`).
-    pub splat_dense_only: bool,
     /// This frame's look blocks on their way to `looks`.
     look_bytes: Vec<u8>,
 }
@@ -481,8 +480,6 @@ impl FrameResources {
             trims: HashMap::new(),
             allow_splat: true,
             soft_depth: false,
-            auto_tiles: false,
-            splat_dense_only: false,
             allow_tiles: false,
             look_bytes: Vec::new(),
         }
@@ -836,6 +833,7 @@ impl FrameResources {
             .filter(|_| b.trail.is_some())
             .map(|t| (t.segments(), t.draw_sprite));
         let (splat, tiles) = self.choose_path(
+            &ctx.profile,
             &e.look,
             PathScene {
                 size_px,
@@ -936,8 +934,9 @@ impl FrameResources {
 
     /// The draw path of an emitter with look `look` in `scene`: (splat, tiles); neither is
     /// the billboards. The look's `draw_path` forces one (where the emitter can take it);
-    /// `Auto` chooses from the projected size, the count and the adapter profile.
-    fn choose_path(&self, look: &Look, scene: PathScene) -> (bool, bool) {
+    /// `Auto` chooses from the projected size, the count and the adapter `profile`
+    /// (`tile_raster`, `splat_dense_only`).
+    fn choose_path(&self, profile: &AdapterProfile, look: &Look, scene: PathScene) -> (bool, bool) {
         let PathScene {
             size_px,
             quads,
@@ -947,7 +946,7 @@ impl FrameResources {
         } = scene;
         // Dense enough for the splat's whole-target clear and resolve to pay.
         let dense =
-            !self.splat_dense_only || quads as f32 * SPLAT_PX_PER_QUAD >= tw as f32 * th as f32;
+            !profile.splat_dense_only || quads as f32 * SPLAT_PX_PER_QUAD >= tw as f32 * th as f32;
         let splat = self.allow_splat
             && look.blend == BlendMode::Additive
             && !trail
@@ -971,7 +970,7 @@ impl FrameResources {
                     // several instances (a runtime host's batch) keeps billboards: a grid
                     // of 100 torches measured 6.5 ms a frame with the tiles, 2.8 without.
                     let fill = quads as f32 * size_px * size_px;
-                    self.auto_tiles
+                    profile.tile_raster
                         && instances == 1
                         && size_px >= TILES_ABOVE_PX
                         && fill >= TILES_MIN_FILL_PX

@@ -371,8 +371,6 @@ impl Player {
         // The splat tests the host's depth itself: without the view, billboards (tested by
         // the pass's depth attachment) draw every particle.
         self.frame.allow_splat = depth.is_some() || self.settings.depth_format.is_none();
-        self.frame.auto_tiles = self.ctx.profile.tile_raster;
-        self.frame.splat_dense_only = self.ctx.profile.splat_dense_only;
         self.frame.allow_tiles = self.tiles.is_some();
         let members: Vec<Vec<Option<BatchMember<'_>>>> = self
             .batches
@@ -565,7 +563,7 @@ impl Player {
     pub(crate) fn draws_under_tiles(&self, layers: Layers) -> bool {
         self.items
             .iter()
-            .any(|d| !d.splat && !d.tiles && under_tiles(d, layers))
+            .any(|d| d.is_billboard() && under_tiles(d, layers))
     }
 
     /// The rest of [`Player::draw_layers`]: the tiles (unless `tiles` is false: resolved
@@ -634,7 +632,7 @@ impl Player {
     /// The layers that hold particles to draw, as last recorded.
     pub fn drawn_layers(&self) -> Layers {
         let mut layers = Layers::NONE;
-        for d in self.items.iter().filter(|d| !d.splat && !d.tiles) {
+        for d in self.items.iter().filter(|d| d.is_billboard()) {
             layers |= Layers::of(d);
         }
         if self.splatted || self.tiles.as_ref().is_some_and(TilePass::drawn) {
