@@ -71,13 +71,16 @@ struct SimParams {
     collide_c: vec4<f32>,
     // x: first slot this step updates, y: how many (wrapping at the capacity): the ring's
     // live window plus this step's spawns; every other slot is dead in both buffers.
+    // zw: the most children each of the emitter's two events may spawn this step (its
+    // cap per second over the step; the event scan reads them).
     update_window: vec4<u32>,
     // Tiny state: x, y: the step's start on the emitter's clock (double-single hi, lo, as
     // f32 bits), z: the birth table's first sequence number, w: its entries (`flags` holds
     // the table's index mask).
     tiny: vec4<u32>,
     // Tiny state: x: the birth table's oldest entry's first spawn counter (low 32 bits),
-    // y: the counters from it to the newest spawn, zw: unused.
+    // y: the counters from it to the newest spawn, z: the step's number (the event
+    // scan's stamp), w: unused.
     tiny_b: vec4<u32>,
 }
 

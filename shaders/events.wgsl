@@ -34,7 +34,7 @@
 #import "workgroup_scan.wgsl"
 
 struct ScanConfig {
-    // The rule's index, the child's capacity, the most children a step, flags
+    // The rule's index, the child's capacity, the child list's room per step, flags
     // (INHERIT_COLOR, RIBBON).
     rule_capacity_cap: vec4<u32>,
     // xyz: the parent's simulation origin minus the child's, w: the inherited fraction
@@ -60,6 +60,12 @@ const GROUP: u32 = 256u;
 const PER_THREAD: u32 = 4u;
 const BLOCK: u32 = 1024u;
 
+
+// The most children this rule may spawn this step: its cap per second over the step
+// (the parent's SimParams), within the child list's room per step.
+fn step_cap() -> u32 {
+    return min(cfg.rule_capacity_cap.z, params.update_window[2u + cfg.rule_capacity_cap.x]);
+}
 
 // The count word of the i-th slot of the parent's window (its children, BORN_BIT when
 // born this step); 0 past the window.
@@ -141,7 +147,7 @@ fn scan_blocks(@builtin(local_invocation_index) lid: u32) {
             event_in.stamp = params.tiny_b.z;
         }
         blocks[0] = event_in.count;
-        let n = min(running, cfg.rule_capacity_cap.z);
+        let n = min(running, step_cap());
         event_in.count += n;
         event_in.dropped += running - n;
         event_in.total += running;
@@ -164,7 +170,7 @@ fn write_list(
     // This thread's first child's place among this scan's children.
     var at = blocks[1u + b] + incl - n;
     let start = blocks[0];
-    let cap = cfg.rule_capacity_cap.z;
+    let cap = step_cap();
     let capacity = params.capacity;
     let flags = cfg.rule_capacity_cap.w;
     for (var k = 0u; k < PER_THREAD; k++) {

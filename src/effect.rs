@@ -16,12 +16,12 @@ pub use curve::{
     rows_key,
 };
 pub use events::{CountRange, Event, MAX_CHILDREN_PER_EVENT, MAX_EVENTS_PER_EMITTER, Trigger};
-pub use trail::{MAX_TRAIL_POINTS, Trail, TrailMode};
+pub use trail::{MAX_TRAIL_POINTS, Trail, TrailLayout, TrailMode};
 use validate::Checker;
 pub use validate::ValidationError;
 
 /// The preset format version this build writes (and the newest it reads).
-pub const CURRENT_VERSION: u32 = 2;
+pub const CURRENT_VERSION: u32 = 3;
 
 /// A whole fire effect: a seed, time settings and a list of emitter layers.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -143,9 +143,11 @@ pub struct Emitter {
     /// (a curve's keys are `(seconds, rate)`; a range or two curves pick one rate or one
     /// blend per instance, from its seed).
     pub spawn_rate_per_sec: Param,
-    /// At most this many spawns per step (a long step can't cause a burst). 0 = automatic:
-    /// enough for the rate at a step of 1/15 s.
-    pub max_spawn_per_step: u32,
+    /// At most this many continuous spawns per second of simulated time, whatever the
+    /// step (a rate curve's peaks are clipped to it; bursts are not capped). 0 = no cap.
+    /// A step of `dt` from `t` may spawn `⌊cap·(t + dt)⌋ − ⌊cap·t⌋`, so the cap per second
+    /// is the same at any step size.
+    pub max_spawn_per_sec: f32,
     /// One-shot bursts.
     pub bursts: Vec<Burst>,
     /// Lifetime range, seconds; each particle draws its own.
@@ -884,6 +886,25 @@ impl Default for Effect {
     }
 }
 
+impl TimeSettings {
+    /// The step settings counted in time are laid out for: the fixed step, or in
+    /// frame-delta mode a 60 Hz frame (at most the largest frame step).
+    pub fn nominal_step_secs(&self) -> f32 {
+        match self.mode {
+            TimeMode::FixedStep => self.step_secs,
+            TimeMode::FrameDelta => self.max_frame_dt_secs.min(1.0 / 60.0),
+        }
+    }
+
+    /// The longest single step this clock can take, seconds.
+    pub fn longest_step_secs(&self) -> f32 {
+        match self.mode {
+            TimeMode::FixedStep => self.step_secs,
+            TimeMode::FrameDelta => self.max_frame_dt_secs,
+        }
+    }
+}
+
 impl Default for TimeSettings {
     fn default() -> Self {
         Self {
@@ -915,7 +936,7 @@ impl Default for Emitter {
             enabled: true,
             capacity: 4096,
             spawn_rate_per_sec: Param::Constant(1800.0),
-            max_spawn_per_step: 0,
+            max_spawn_per_sec: 0.0,
             bursts: Vec::new(),
             lifetime_secs: Range::new(0.6, 1.4),
             shape: Shape::Disc {
@@ -1029,6 +1050,15 @@ impl Default for Range {
     }
 }
 
+/// How many events of a cap of `per_sec` per second fall in the step `[t0, t0 + dt)`:
+/// `⌊rate·(t0 + dt)⌋ − ⌊rate·t0⌋`, so that every second of simulated time allows the same
+/// number whatever the step size (a cap counted per step would change with the step).
+pub fn rate_allowance(per_sec: f64, t0_secs: f64, dt_secs: f64) -> u64 {
+    // A hair of tolerance: 1/120 s steps must land on whole multiples of 1/rate.
+    let at = |t: f64| (per_sec * t + 1e-9).floor().max(0.0);
+    (at(t0_secs + dt_secs) - at(t0_secs)).max(0.0) as u64
+}
+
 /// Largest capacity a single emitter may ask for (device limits may be lower).
 pub const MAX_CAPACITY: u32 = 1 << 28;
 
@@ -1093,15 +1123,10 @@ impl Emitter {
         v
     }
 
-    /// The spawn cap per step actually used (see [`Emitter::max_spawn_per_step`]).
-    pub fn effective_spawn_cap(&self) -> u32 {
-        if self.max_spawn_per_step > 0 {
-            self.max_spawn_per_step
-        } else {
-            // Enough for the continuous rate at a 1/15 s step, plus any burst.
-            let burst_max = self.bursts.iter().map(|b| b.count).max().unwrap_or(0);
-            let per_step = (f64::from(self.spawn_rate_per_sec.bounds().1) / 15.0).ceil() as u64;
-            (per_step.max(1) + burst_max as u64).min(u32::MAX as u64) as u32
-        }
+    /// The continuous spawns the cap allows in the step `[t0, t0 + dt)` of simulated time
+    /// (`None`: no cap). See [`Emitter::max_spawn_per_sec`].
+    pub fn spawn_cap_between(&self, t0_secs: f64, dt_secs: f64) -> Option<u64> {
+        (self.max_spawn_per_sec > 0.0)
+            .then(|| rate_allowance(f64::from(self.max_spawn_per_sec), t0_secs, dt_secs))
     }
 }

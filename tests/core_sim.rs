@@ -199,39 +199,44 @@ fn exact_spawn_counts_over_time() {
     }
 }
 
-/// The per-step cap drops the excess and counts it; a huge frame-delta step cannot burst.
+/// The spawn cap is a rate: it drops the excess and counts it, and allows the same number
+/// per second at any step size (a cap counted per step would change with the step); a huge
+/// frame-delta step spawns no more than the cap's share of it.
 #[test]
-fn spawn_cap_per_step_is_enforced_and_counted() {
+fn spawn_cap_per_second_is_enforced_counted_and_independent_of_the_step() {
     let ctx = gpu();
     let e = Emitter {
         spawn_rate_per_sec: ignis::effect::Param::Constant(12_000.0),
-        max_spawn_per_step: 40,
+        max_spawn_per_sec: 2400.0,
         ..plain_emitter()
     };
     let mut effect = bare_effect(e);
-    let sim = run_gpu(&ctx, &effect, 1.0 / 60.0, 10);
-    let stats = sim.planner.emitters[0].stats;
-    assert_eq!(stats.spawned, 400, "10 steps × cap 40");
-    assert_eq!(
-        stats.dropped_by_cap,
-        2000 - 400,
-        "12000/s × 10/60 s requested"
-    );
-    assert_eq!(alive_of(&sim.read_particles(0).expect("read")), 400);
+    for (dt, steps) in [
+        (1.0 / 30.0, 5),
+        (1.0 / 60.0, 10),
+        (1.0 / 120.0, 20),
+        (1.0 / 240.0, 40),
+    ] {
+        let sim = run_gpu(&ctx, &effect, dt, steps);
+        let stats = sim.planner.emitters[0].stats;
+        assert_eq!(stats.spawned, 400, "2400/s × 1/6 s at dt {dt}");
+        assert_eq!(
+            stats.dropped_by_cap,
+            2000 - 400,
+            "12000/s × 1/6 s requested"
+        );
+        assert_eq!(alive_of(&sim.read_particles(0).expect("read")), 400);
+    }
 
     // Frame-delta mode with a one-second hitch: dt is clamped to max_frame_dt_secs and the
-    // automatic cap (rate / 15 per step) bounds the burst.
-    effect.emitters[0].max_spawn_per_step = 0;
+    // cap bounds the burst to its share of the clamped step.
     effect.time.mode = TimeMode::FrameDelta;
     effect.time.max_frame_dt_secs = 0.1;
     let mut stepper = Stepper::default();
     let plan = stepper.advance(1.0, &effect.time);
     assert_eq!((plan.steps, plan.dt_secs), (1, 0.1));
     let sim = run_gpu(&ctx, &effect, plan.dt_secs, plan.steps);
-    assert_eq!(
-        sim.planner.emitters[0].stats.spawned, 800,
-        "automatic cap = 12000/15"
-    );
+    assert_eq!(sim.planner.emitters[0].stats.spawned, 240, "2400/s × 0.1 s");
 }
 
 /// Too small a pool: the overwrite of still-alive particles is counted, never silent.
@@ -369,7 +374,7 @@ fn every_shape_spawns_inside_itself() {
         let e = Emitter {
             capacity: 4000,
             spawn_rate_per_sec: ignis::effect::Param::Constant(3000.0 * 120.0),
-            max_spawn_per_step: 3000,
+            max_spawn_per_sec: 3000.0 * 120.0,
             shape: shape.clone(),
             transform: transform.clone(),
             ..plain_emitter()
@@ -410,7 +415,7 @@ fn direction_spread_is_respected() {
         let e = Emitter {
             capacity: 4000,
             spawn_rate_per_sec: ignis::effect::Param::Constant(3000.0 * 120.0),
-            max_spawn_per_step: 3000,
+            max_spawn_per_sec: 3000.0 * 120.0,
             shape: shape.clone(),
             direction,
             spread_deg: if matches!(shape, Shape::Cone { .. }) {

@@ -102,7 +102,8 @@ fn expected_list(
         rule_capacity_cap: [
             0,
             effect.emitters[1].capacity,
-            ev.max_per_step,
+            // This step's allowance of the cap per second (within the list's room).
+            p.update_window[2].min(ignis::sim::events::step_cap(effect, 0, 0)),
             u32::from(ev.inherit_color),
         ],
         delta_inherit: [delta.x, delta.y, delta.z, ev.inherit_velocity],
@@ -121,15 +122,17 @@ fn expected_list(
 #[test]
 fn death_children_match_the_cpu_mirror_including_the_cap() {
     // One block of the scan; then a parent window of several blocks wrapping its ring.
-    check_against_the_mirror(1024, 900.0, 12, false);
+    // The caps per second allow 12.5 and 100.5 children per 1/60 s step: 12 or 13, 100
+    // or 101, alternating (`p.update_window[2]` in the mirror).
+    check_against_the_mirror(1024, 900.0, 750.0, false);
     // Children that inherit the parent's colour carry its age at the event.
-    check_against_the_mirror(4096, 9_000.0, 100, true);
+    check_against_the_mirror(4096, 9_000.0, 6030.0, true);
 }
 
 fn check_against_the_mirror(
     parent_capacity: u32,
     parent_rate: f32,
-    max_per_step: u32,
+    max_per_sec: f32,
     inherit_color: bool,
 ) {
     let ctx = strict_gpu();
@@ -139,7 +142,7 @@ fn check_against_the_mirror(
         probability: 0.8,
         inherit_velocity: 0.5,
         inherit_color,
-        max_per_step,
+        max_per_sec,
         ..Event::default()
     };
     let mut effect = parent_and_child(event, parent_rate);

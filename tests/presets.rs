@@ -210,7 +210,7 @@ fn thesis_preset_is_frame_rate_dependent_and_a_fixed_step_is_not() {
         time_secs: 0.0,
         count: 2000,
     }];
-    em.max_spawn_per_step = 2000;
+    em.max_spawn_per_sec = 0.0;
     em.lifetime_secs = Range::new(5.0, 5.0);
     let (fast, _) = mean_height_after_1s(&ctx, &e, 120);
     let (slow, _) = mean_height_after_1s(&ctx, &e, 15);
@@ -809,7 +809,7 @@ fn version_1_fixture_keeps_loading() {
     assert_eq!(e.emitters[2].look.sprite, Sprite::Spark);
     // Fields version-1 files leave out mean what they meant in version 1.
     assert!(flames.enabled);
-    assert_eq!(flames.max_spawn_per_step, 0);
+    assert_eq!(flames.max_spawn_per_sec, 0.0);
     assert_eq!(flames.transform.position_m, [0.0; 3]);
     assert!(flames.forces.turbulence.is_none());
     assert!(flames.collisions.ground.is_none());
@@ -845,6 +845,33 @@ fn every_version_1_preset_migrates_to_the_shipped_version_2() {
         n += 1;
     }
     assert_eq!(n, 7, "the seven presets shipped in version 1");
+}
+
+/// Every shipped preset as it was last stored in version 2 (`tests/fixtures/v2_last/`,
+/// frozen) migrates to exactly the shipped version-3 preset: counts per step become rates
+/// and spans at the preset's own step (a trail of 6 points every 2 steps of 1/120 s spans
+/// 0.1 s; 64 children a step are 7680 a second).
+#[test]
+fn every_version_2_preset_migrates_to_the_shipped_version_3() {
+    let dir = fixture("v2_last");
+    let mut n = 0;
+    for path in preset::list(&dir) {
+        let text = std::fs::read_to_string(&path).expect("read");
+        assert!(text.contains("version: 2,"), "{}", path.display());
+        let old = preset::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let name = path.file_name().expect("name");
+        let new = preset::load(&presets_dir().join(name)).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(old, new, "{}", path.display());
+        // The ribbon spans the same time at the preset's step as it did.
+        for (a, b) in old.emitters.iter().zip(&new.emitters) {
+            if let (Some(t), Some(u)) = (&a.look.trail, &b.look.trail) {
+                let step = new.time.step_secs;
+                assert_eq!(t.layout(step), u.layout(step));
+            }
+        }
+        n += 1;
+    }
+    assert_eq!(n, 8, "the eight presets shipped in version 2");
 }
 
 /// Saving over a preset while the write fails midway (a full disk) or the process dies
@@ -988,12 +1015,12 @@ fn saved_text_is_readable() {
     let effect = preset::load(&presets_dir().join("torch.ron")).expect("torch");
     preset::save(&effect, &path).expect("save");
     let text = std::fs::read_to_string(&path).expect("read");
-    assert!(text.starts_with("// ignis effect preset, format version 2."));
+    assert!(text.starts_with("// ignis effect preset, format version 3."));
     assert!(!text.contains("Some("), "{text}");
     assert!(!text.contains("Effect("), "{text}");
     assert!(!text.contains("#![enable"), "{text}");
     for needle in [
-        "\n    version: 2,\n",
+        "\n    version: 3,\n",
         "\n    name: \"torch\",\n",
         "mode: FixedStep",
         "shape: Disc(radius_m: 0.055, normal: (0.0, 1.0, 0.0)),",
@@ -1011,7 +1038,7 @@ fn saved_text_is_readable() {
         assert!(line.chars().count() <= 100, "long line: {line}");
     }
     // Every field is written out: the file does not depend on this build's defaults.
-    assert!(text.contains("max_spawn_per_step: 0,"));
+    assert!(text.contains("max_spawn_per_sec: 0.0,"));
     assert!(text.contains("kill_on_sphere_contact: false,"));
     // Loads back with the loader's options, and re-saving is byte-identical.
     assert_eq!(preset::load(&path).expect("load"), effect);
@@ -1379,7 +1406,7 @@ fn emitter() -> BoxedStrategy<Emitter> {
             any::<bool>(),
             1u32..=MAX_CAPACITY,
             fl(0.0, 1e9),
-            any::<u32>(),
+            fl(0.0, 1e9),
             proptest::collection::vec(burst, 0..3),
             range(1e-3, 1e4),
             shape(),
@@ -1419,7 +1446,7 @@ fn emitter() -> BoxedStrategy<Emitter> {
                 enabled,
                 capacity,
                 spawn_rate_per_sec: ignis::effect::Param::Constant(rate),
-                max_spawn_per_step: cap,
+                max_spawn_per_sec: cap,
                 bursts,
                 lifetime_secs: lifetime,
                 shape,

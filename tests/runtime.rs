@@ -895,3 +895,66 @@ fn an_instance_added_to_a_sorted_batch_shows_its_smoke() {
         "the new instance's smoke covers only {shown} pixels"
     );
 }
+
+/// A frame runs every step it needs, on both sides of the parameter ring's 32 steps: a
+/// preset whose step needs 16 or 40 steps a frame plays at real time (nothing dropped),
+/// batched and with a simulation of its own, and its particles are bit-identical to a
+/// simulation stepped that many steps in separate submissions. (Steps of 2^-10 and 2^-12
+/// s: frames of whole steps, exactly.)
+#[test]
+fn a_frame_runs_every_step_it_needs_beyond_one_chunk() {
+    let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+    let ctx = ignis::gpu::GpuContext::from_device(&host.device, &host.queue);
+    for (effect, label) in [
+        (batchable_campfire(), "batched"),
+        (preset("campfire"), "own"),
+    ] {
+        for (steps_per_frame, step) in [(16u32, 1.0 / 1024.0), (40, 1.0 / 4096.0)] {
+            let mut effect = effect.clone();
+            effect.time.step_secs = step;
+            effect.time.max_substeps = 64;
+            let frame_secs = f64::from(steps_per_frame) * f64::from(step);
+            let mut player = host.player(&effect);
+            let id = player.add_instance(Mat4::IDENTITY, 3).expect("instance");
+            let frames = 6;
+            for _ in 0..frames {
+                let mut enc = host.device.create_command_encoder(&Default::default());
+                player.advance(frame_secs);
+                player.record(&mut enc, &host.camera, None);
+                host.queue.submit([enc.finish()]);
+            }
+            let stats = player.clock_stats();
+            assert_eq!(
+                (stats.steps, stats.dropped_steps),
+                (steps_per_frame, 0),
+                "{label}, {steps_per_frame} steps a frame"
+            );
+            let time = player.time_secs(id).expect("instance");
+            assert_eq!(
+                time,
+                f64::from(frames) * frame_secs,
+                "{label}, {steps_per_frame} steps a frame"
+            );
+            let placed = player.instance_effect(id).expect("instance").clone();
+            let mut sim =
+                ignis::sim::GpuSim::new(&ctx, ignis::shaders::ShaderLibrary::embedded(), &placed)
+                    .expect("sim");
+            for _ in 0..frames {
+                sim.step(&placed, step, steps_per_frame).expect("step");
+            }
+            let flames = sim.read_particles(1).expect("read");
+            assert!(
+                flames.iter().any(|p| p.is_alive()),
+                "{label}: the flames live"
+            );
+            for e in 0..effect.emitters.len() {
+                let played = player.particles(id, e).expect("read");
+                let alone = sim.read_particles(e).expect("read");
+                assert!(
+                    bytemuck::cast_slice::<_, u8>(&played) == bytemuck::cast_slice::<_, u8>(&alone),
+                    "{label}, {steps_per_frame} steps a frame: emitter {e} differs"
+                );
+            }
+        }
+    }
+}

@@ -67,7 +67,8 @@ fn ribbon_points_are_the_recorded_positions_of_one_life() {
     e.forces.gravity_m_per_s2 = [0.0, -3.0, 0.0];
     e.look.trail = Some(Trail {
         points,
-        every_steps: every,
+        // `every` steps of the effect's 1/120 s step between points.
+        length_secs: (points * every) as f32 / 120.0,
         ..Trail::default()
     });
     let effect = bare_effect(e);
@@ -121,6 +122,64 @@ fn ribbon_points_are_the_recorded_positions_of_one_life() {
     assert!(checked > 1000, "{checked} points checked");
 }
 
+/// The ribbon spans the same simulated time at any step: one particle flying with a
+/// trail of 6 points over 0.1 s, stepped at 1/30 to 1/240 s for the same 0.5 s — the ages
+/// recorded in its ring (read back from the GPU) run back 0.1 s from the newest point, in
+/// `points` (or, on a step coarser than the spacing, one a step) entries.
+#[test]
+fn the_trail_spans_the_same_seconds_at_any_step() {
+    let ctx = gpu();
+    let mut e = plain_emitter();
+    e.capacity = 4;
+    e.spawn_rate_per_sec = Param::Constant(0.0);
+    e.bursts = vec![Burst {
+        time_secs: 0.0,
+        count: 1,
+    }];
+    e.lifetime_secs = Range::new(5.0, 5.0);
+    e.look.trail = Some(Trail {
+        points: 6,
+        length_secs: 0.1,
+        ..Trail::default()
+    });
+    for (step, kept) in [
+        (1.0 / 30.0, 3),
+        (1.0 / 60.0, 6),
+        (1.0 / 120.0, 6),
+        (1.0 / 240.0, 6),
+    ] {
+        let mut effect = bare_effect(e.clone());
+        effect.time.step_secs = step;
+        let layout = e.look.trail.as_ref().expect("trail").layout(step);
+        assert_eq!(layout.points, kept, "step {step}");
+        assert!(
+            (layout.span_secs(step) - 0.1).abs() < 1e-6,
+            "step {step}: {layout:?}"
+        );
+        let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
+        let steps = (0.5 / step).round() as u32;
+        sim.step(&effect, step, steps).expect("step");
+        let ring = sim.read_trail(0).expect("read").expect("a trail");
+        assert_eq!(ring.points, kept);
+        let slot = (0..4)
+            .find(|&s| ring.entries[s * kept as usize][3] > 0.0)
+            .expect("the particle's ring");
+        let ages: Vec<f32> = ring.entries[slot * kept as usize..][..kept as usize]
+            .iter()
+            .map(|p| p[3])
+            .collect();
+        let newest = ages.iter().copied().fold(f32::MIN, f32::max);
+        let oldest = ages.iter().copied().fold(f32::MAX, f32::min);
+        // The entries are `every` steps apart: the span minus one spacing.
+        let want = 0.1 - f64::from(layout.every) * f64::from(step);
+        assert!(
+            (f64::from(newest - oldest) - want).abs() < 1e-4,
+            "step {step}: ages {ages:?}, span {} s, want {want}",
+            newest - oldest
+        );
+    }
+}
+
 /// One particle flying straight across the view with a ribbon and no sprite: the lit
 /// pixels run from the particle back to its oldest point, not beyond.
 #[test]
@@ -141,7 +200,8 @@ fn the_ribbon_lights_the_pixels_between_the_particle_and_its_tail() {
     e.look.size_m = Param::Constant(0.05);
     e.look.trail = Some(Trail {
         points,
-        every_steps: every,
+        // `every` steps of side_view's 1/60 s step between points.
+        length_secs: (points * every) as f32 * DT,
         width: 1.0,
         tail_width: 1.0,
         tail_opacity: 1.0,
@@ -196,6 +256,8 @@ fn a_trail_too_large_for_the_device_is_a_clear_error() {
     e.spawn_rate_per_sec = Param::Constant(0.0);
     e.look.trail = Some(Trail {
         points: 64,
+        // A point every 1/120 s step: all 64 kept.
+        length_secs: 64.0 / 120.0,
         ..Trail::default()
     });
     let effect = bare_effect(e);

@@ -57,7 +57,7 @@ pub fn scene_emitter(scene: Scene, integrator: Integrator, n: u32) -> Emitter {
         name: "bench".into(),
         capacity: n,
         spawn_rate_per_sec: Param::Constant(0.0),
-        max_spawn_per_step: n,
+        max_spawn_per_sec: 0.0,
         bursts: vec![Burst {
             time_secs: 0.0,
             count: n,

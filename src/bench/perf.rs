@@ -67,7 +67,7 @@ pub fn scaled_campfire(n: u64, max_pool: u64) -> Effect {
                 seed_offset: i as u32,
                 ..flames.clone()
             };
-            e.max_spawn_per_step = 0;
+            e.max_spawn_per_sec = 0.0;
             e.look.size_m = e.look.size_m.scaled(scale.min(1.0));
             // The flames alone: no smoke from their deaths (the events' cost has a row of
             // its own in the module table).
@@ -548,7 +548,7 @@ fn module_costs(ctx: &GpuContext, opts: &PerfOptions) -> Result<Vec<(String, f64
     child.spawn_rate_per_sec = crate::effect::Param::Constant(0.0);
     events.emitters[0].events = vec![crate::effect::Event {
         emitter: child.name.clone(),
-        max_per_step: 4096,
+        max_per_sec: 4096.0 * 120.0,
         ..Default::default()
     }];
     events.emitters.push(child);

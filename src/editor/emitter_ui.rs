@@ -58,9 +58,9 @@ ui, "Name", "Unique name of this layer", |ui| {
         );
         row_ui(
 ui,
-            "Max spawn / step",
-            "At most this many spawns per step, so a long step cannot cause a burst. 0 = automatic (the rate at a 1/15 s step)",
-            |ui| ui.add(DragValue::new(&mut e.max_spawn_per_step).range(0..=UI_MAX_CAPACITY).speed(1.0)),
+            "Max spawn / s",
+            "At most this many continuous spawns per second of simulated time, at any step size (clips a rate curve's peaks; bursts are not capped). 0 = no cap",
+            |ui| ui.add(DragValue::new(&mut e.max_spawn_per_sec).range(0.0..=1e9).speed(10.0)),
         );
         row_ui(
 ui,

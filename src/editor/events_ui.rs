@@ -113,8 +113,8 @@ fn event_grid_ui(ui: &mut Ui, ev: &mut Event, others: &[String]) {
             ui.label("Inherit colour").on_hover_text("Multiply the child's colour by the parent's colour at the event (a white child gradient takes the parent's colour)");
             ui.checkbox(&mut ev.inherit_color, "parent's colour");
             ui.end_row();
-            let label = ui.label("Cap / step").on_hover_text("At most this many children a step; the rest are dropped and counted in Stats");
-            ui.add(DragValue::new(&mut ev.max_per_step).range(1..=1 << 20).speed(1.0))
+            let label = ui.label("Cap / s").on_hover_text("At most this many children per second of simulated time, at any step size; the rest are dropped and counted in Stats");
+            ui.add(DragValue::new(&mut ev.max_per_sec).range(1.0..=1e8).speed(10.0))
                 .labelled_by(label.id);
             ui.end_row();
         });

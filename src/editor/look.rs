@@ -277,7 +277,7 @@ fn trail_rows_ui(ui: &mut Ui, look: &mut Look) {
 /// The points a trail through a particle's last positions keeps (a row of an open grid).
 fn trail_points_row_ui(ui: &mut Ui, t: &mut Trail) {
     let label = ui.label("Trail points").on_hover_text(
-        "Positions kept per particle, and how many simulation steps apart they are recorded",
+        "Positions kept per particle, and how far back they reach in seconds of simulated time (a step coarser than the spacing keeps fewer: one per step)",
     );
     ui.horizontal(|ui| {
         ui.add(
@@ -287,10 +287,11 @@ fn trail_points_row_ui(ui: &mut Ui, t: &mut Trail) {
         )
         .labelled_by(label.id);
         ui.add(
-            DragValue::new(&mut t.every_steps)
-                .range(1..=120)
-                .prefix("every ")
-                .suffix(" steps"),
+            DragValue::new(&mut t.length_secs)
+                .range(1e-3..=60.0)
+                .speed(0.005)
+                .prefix("over ")
+                .suffix(" s"),
         )
         .labelled_by(label.id);
     });

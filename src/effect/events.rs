@@ -87,9 +87,10 @@ pub struct Event {
     /// The child's colour is multiplied by the parent's colour at the event (its colour
     /// ramp at its age then, to 1/255): a white child ramp takes the parent's colour.
     pub inherit_color: bool,
-    /// At most this many children per step (whole effect); the rest are dropped and
-    /// counted in the child's statistics.
-    pub max_per_step: u32,
+    /// At most this many children per second of simulated time (whole effect), whatever
+    /// the step: a step of `dt` from `t` takes at most `⌊cap·(t + dt)⌋ − ⌊cap·t⌋`; the rest
+    /// are dropped and counted in the child's statistics.
+    pub max_per_sec: f32,
 }
 
 impl Default for Event {
@@ -102,7 +103,7 @@ impl Default for Event {
             rate_per_sec: 10.0,
             inherit_velocity: 0.3,
             inherit_color: false,
-            max_per_step: 1024,
+            max_per_sec: 122_880.0,
         }
     }
 }
@@ -229,9 +230,7 @@ impl Effect {
                 c.num(|| p("probability"), ev.probability, 0.0, 1.0);
                 c.num(|| p("rate_per_sec"), ev.rate_per_sec, 0.0, 1000.0);
                 c.num(|| p("inherit_velocity"), ev.inherit_velocity, -10.0, 10.0);
-                if ev.max_per_step == 0 || ev.max_per_step > 1 << 20 {
-                    c.push(p("max_per_step"), ev.max_per_step, "must be in 1..=1048576");
-                }
+                c.num(|| p("max_per_sec"), ev.max_per_sec, 1.0, 1e8);
             }
             if e.look.ribbon_per_parent() && !self.event_fed(i) {
                 c.push(

@@ -19,12 +19,12 @@ pub const MAX_TRAIL_POINTS: u32 = 64;
 /// What a ribbon passes through.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum TrailMode {
-    /// Each particle's own last positions (`points`, one every `every_steps` steps).
+    /// Each particle's own last positions (`points` over the last `length_secs`).
     #[default]
     History,
     /// The particles each parent's events spawned, in order: every particle joined to its
     /// parent's previous child while both live (an emitter fed by events only; `points`
-    /// and `every_steps` are not used). Smoke lines behind debris, lightning-like chains.
+    /// and `length_secs` are not used). Smoke lines behind debris, lightning-like chains.
     PerParent,
 }
 
@@ -49,11 +49,12 @@ pub struct Trail {
     #[serde(skip_serializing_if = "is_history")]
     pub mode: TrailMode,
     /// Positions kept per particle (the ribbon has one segment fewer, plus the one to the
-    /// particle itself): 2..=64.
+    /// particle itself): 2..=64. A step too coarse to record them all over `length_secs`
+    /// keeps fewer (one per step), so the ribbon's length never depends on the step.
     pub points: u32,
-    /// A position is recorded every this many simulation steps (the trail spans
-    /// `points × every_steps` steps).
-    pub every_steps: u32,
+    /// How far back the ribbon reaches, seconds of simulated time: a point is recorded
+    /// every `length_secs / points` (rounded to whole steps, see [`Trail::layout`]).
+    pub length_secs: f32,
     /// The ribbon's width at the particle as a multiple of the particle's size.
     pub width: f32,
     /// The width at the tail as a fraction of the width at the particle (per parent: at
@@ -75,7 +76,7 @@ impl Default for Trail {
         Self {
             mode: TrailMode::History,
             points: 12,
-            every_steps: 2,
+            length_secs: 0.2,
             width: 1.0,
             tail_width: 0.2,
             tail_opacity: 0.0,
@@ -94,13 +95,12 @@ impl Trail {
                 &format!("must be in 2..={MAX_TRAIL_POINTS}"),
             );
         }
-        if !(1..=120).contains(&self.every_steps) {
-            c.push(
-                format!("{path}.every_steps"),
-                self.every_steps,
-                "must be in 1..=120",
-            );
-        }
+        c.num(
+            || format!("{path}.length_secs"),
+            self.length_secs,
+            1e-4,
+            60.0,
+        );
         c.num(|| format!("{path}.width"), self.width, 0.0, 100.0);
         c.num(|| format!("{path}.tail_width"), self.tail_width, 0.0, 1.0);
         c.num(
@@ -111,23 +111,55 @@ impl Trail {
         );
     }
 
-    /// Segments drawn per particle: one per recorded point but the newest (the segment
-    /// from the particle to the newest point older than its current step replaces it);
-    /// per parent, one (to the parent's previous child).
-    pub fn segments(&self) -> u32 {
+    /// How the ring records the trail at steps of `step_secs`: a point every
+    /// `round(length / (points·step))` steps (at least one), and as many points as span
+    /// `length_secs` at that spacing (at most `points`, at least 2). The ribbon then spans
+    /// `points × every × step` = `length_secs` whenever the step divides the spacing (or
+    /// the length, on steps coarser than the spacing).
+    pub fn layout(&self, step_secs: f32) -> TrailLayout {
         match self.mode {
-            TrailMode::History => self.points.saturating_sub(1).max(1),
-            TrailMode::PerParent => 1,
+            TrailMode::PerParent => TrailLayout {
+                points: 1,
+                every: 1,
+            },
+            TrailMode::History => {
+                let (len, dt) = (f64::from(self.length_secs), f64::from(step_secs).max(1e-9));
+                let points = self.points.clamp(2, MAX_TRAIL_POINTS);
+                let every = (len / (f64::from(points) * dt)).round().clamp(1.0, 1e6) as u32;
+                let fit = (len / (f64::from(every) * dt)).round();
+                TrailLayout {
+                    points: fit.clamp(2.0, f64::from(points)) as u32,
+                    every,
+                }
+            }
         }
     }
 
-    /// Ring entries per slot: the recorded points, or per parent one link (the previous
-    /// child's slot and birth stamp, this particle's birth stamp).
-    pub fn ring_points(&self) -> u32 {
+    /// Segments drawn per particle at steps of `step_secs`: one per recorded point but the
+    /// newest (the segment from the particle to the newest point older than its current
+    /// step replaces it); per parent, one (to the parent's previous child).
+    pub fn segments(&self, step_secs: f32) -> u32 {
         match self.mode {
-            TrailMode::History => self.points,
+            TrailMode::History => self.layout(step_secs).points.saturating_sub(1).max(1),
             TrailMode::PerParent => 1,
         }
+    }
+}
+
+/// A trail's ring at a given step size ([`Trail::layout`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct TrailLayout {
+    /// Ring entries per slot: the recorded points, or per parent one link (the previous
+    /// child's slot and birth stamp, this particle's birth stamp).
+    pub points: u32,
+    /// Steps between two recorded points.
+    pub every: u32,
+}
+
+impl TrailLayout {
+    /// The simulated time the ribbon spans at steps of `step_secs`, seconds.
+    pub fn span_secs(&self, step_secs: f32) -> f64 {
+        f64::from(self.points) * f64::from(self.every) * f64::from(step_secs)
     }
 }
 

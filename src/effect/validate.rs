@@ -235,6 +235,7 @@ impl Emitter {
             (0.0, 1e9),
             1e7,
         );
+        c.num(|| p("max_spawn_per_sec"), self.max_spawn_per_sec, 0.0, 1e9);
         for (b, burst) in self.bursts.iter().enumerate() {
             c.num(
                 || p(&format!("bursts[{b}].time_secs")),

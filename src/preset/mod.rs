@@ -42,6 +42,7 @@ mod layout;
 mod locate;
 mod tokens;
 mod v1;
+mod v2;
 
 pub use atomic::{write_atomic, write_atomic_with};
 pub use errors::PresetError;
@@ -162,20 +163,22 @@ pub fn parse_str(text: &str, path: &str) -> Result<Effect, PresetError> {
 /// Reads a file of format `version` (1..=[`CURRENT_VERSION`]) and brings it up to the current
 /// format.
 ///
-/// Version 1 is read through its frozen types (`v1.rs`) and converted field by field into
-/// the same effect in today's model. When the format changes again (version 3):
+/// Versions 1 and 2 are read through their frozen types (`v1.rs`, `v2.rs`) and converted
+/// field by field into the same effect in today's model. When the format changes again
+/// (version 4):
 ///
-/// 1. copy the version-2 types that change into a frozen `mod v2` and keep them unchanged
-///    from then on (and point `v1`'s conversion at them, or chain the two);
-/// 2. add `2 => deserialize::<v2::Effect>(…).map(Effect::from)` below, with the conversion
+/// 1. copy the version-3 types that change into a frozen `mod v3` and keep them unchanged
+///    from then on (and point the older conversions at them, or chain them);
+/// 2. add `3 => deserialize::<v3::Effect>(…).map(Effect::from)` below, with the conversion
 ///    written out field by field (renamed fields, new fields with the value that reproduces
 ///    the old look, changed units);
-/// 3. keep `tests/fixtures/v1_campfire.ron` and `v2_…` loading (their tests compare them
-///    with what the conversion should give).
+/// 3. keep `tests/fixtures/v1…` and `v2/…` loading (their tests compare them with what the
+///    conversion should give).
 fn migrate(version: u64, text: &str, path: &str, tokens: &[Token]) -> Result<Effect, PresetError> {
     match version {
         1 => deserialize::<v1::Effect>(text, path, tokens).map(Effect::from),
-        2 => deserialize::<Effect>(text, path, tokens),
+        2 => deserialize::<v2::Effect>(text, path, tokens).map(Effect::from),
+        3 => deserialize::<Effect>(text, path, tokens),
         // `parse_str` refuses 0 and versions above CURRENT_VERSION before calling this.
         other => Err(PresetError::Parse {
             path: path.to_owned(),

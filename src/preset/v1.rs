@@ -6,7 +6,8 @@
 //! What changed in version 2: the spawn rate, the size and the spin became [`Param`]s
 //! (constant, range, curve or two curves); the look gained `opacity`; forces gained
 //! `drag_over_life` and `speed_over_life`, turbulence and the flame pull `over_life` (all
-//! defaulting to a constant 1, so version-1 files read them as they were).
+//! defaulting to a constant 1, so version-1 files read them as they were). Version 3's
+//! changes (counts per step as rates, `crate::preset::v2`) apply here too.
 
 use serde::Deserialize;
 
@@ -111,7 +112,7 @@ impl Default for Emitter {
             enabled: e.enabled,
             capacity: e.capacity,
             spawn_rate_per_sec: 1800.0,
-            max_spawn_per_step: e.max_spawn_per_step,
+            max_spawn_per_step: 0,
             bursts: e.bursts,
             lifetime_secs: e.lifetime_secs,
             shape: e.shape,
@@ -169,26 +170,32 @@ impl From<Effect> for crate::effect::Effect {
     fn from(v: Effect) -> Self {
         // A version above 1 never reaches this reader; 0 is refused before it.
         let _ = v.version;
+        let time = v.time;
         Self {
             version: CURRENT_VERSION,
             name: v.name,
             seed: v.seed,
-            time: v.time,
+            emitters: v
+                .emitters
+                .into_iter()
+                .map(|e| e.into_current(&time))
+                .collect(),
+            time,
             camera: v.camera,
-            emitters: v.emitters.into_iter().map(Into::into).collect(),
             post: v.post,
         }
     }
 }
 
-impl From<Emitter> for crate::effect::Emitter {
-    fn from(e: Emitter) -> Self {
-        Self {
+impl Emitter {
+    fn into_current(self, time: &TimeSettings) -> crate::effect::Emitter {
+        let e = self;
+        crate::effect::Emitter {
             name: e.name,
             enabled: e.enabled,
             capacity: e.capacity,
             spawn_rate_per_sec: Param::Constant(e.spawn_rate_per_sec),
-            max_spawn_per_step: e.max_spawn_per_step,
+            max_spawn_per_sec: super::v2::per_sec(e.max_spawn_per_step, time),
             bursts: e.bursts,
             lifetime_secs: e.lifetime_secs,
             shape: e.shape,

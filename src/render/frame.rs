@@ -831,7 +831,10 @@ impl FrameResources {
             .trail
             .as_ref()
             .filter(|_| b.trail.is_some())
-            .map(|t| (t.segments(), t.draw_sprite));
+            .map(|t| {
+                let step = first.effect.time.nominal_step_secs();
+                (t.segments(step), t.draw_sprite)
+            });
         let (splat, tiles) = self.choose_path(
             &ctx.profile,
             &e.look,

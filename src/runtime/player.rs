@@ -134,8 +134,9 @@ pub struct Player {
     pub(super) snapshots: super::seeking::SeekSnapshots,
 }
 
-/// Steps one `record` runs at most (the simulation's per-submit parameter ring); more
-/// are dropped like the stepper's hitch guard.
+/// Steps one chunk of a `record` runs (the simulation's parameter ring holds this many
+/// steps' blocks): a record runs as many chunks as its planned steps need, each with its
+/// parameter copies recorded before its pass.
 pub(super) const MAX_STEPS_PER_RECORD: u32 = 32;
 
 impl Player {
@@ -297,7 +298,7 @@ impl Player {
         };
         let steps = match self.effect.time.mode {
             TimeMode::FrameDelta => plan.steps.max(self.pending.0).min(1),
-            TimeMode::FixedStep => (self.pending.0 + plan.steps).min(MAX_STEPS_PER_RECORD),
+            TimeMode::FixedStep => self.pending_within_cap(plan.steps),
         };
         self.pending = (steps, dt_secs);
         self.alpha = plan.alpha;
@@ -313,11 +314,23 @@ impl Player {
             TimeMode::FrameDelta => time.max_frame_dt_secs.min(1.0 / 60.0),
         };
         let steps = match time.mode {
-            TimeMode::FixedStep => (self.pending.0 + 1).min(MAX_STEPS_PER_RECORD),
+            TimeMode::FixedStep => self.pending_within_cap(1),
             TimeMode::FrameDelta => 1,
         };
         self.pending = (steps, dt_secs);
         self.alpha = 1.0;
+    }
+
+    /// The steps pending after `more` join them: at most the preset's `max_substeps` (the
+    /// stepper's hitch guard; frames advanced without a record add up), the excess counted
+    /// as dropped like the stepper's own.
+    fn pending_within_cap(&mut self, more: u32) -> u32 {
+        let wanted = u64::from(self.pending.0) + u64::from(more);
+        let cap = u64::from(self.effect.time.max_substeps.max(1));
+        if wanted > cap {
+            self.stepper.dropped_steps += wanted - cap;
+        }
+        wanted.min(cap) as u32
     }
 
     /// Pauses or resumes the clock (a paused effect is still drawn).
@@ -495,8 +508,40 @@ impl Player {
             return;
         }
         encoder.push_debug_group("ignis: update particles");
-        // Every batch's parameter blocks first (their copies precede the pass), then one
-        // compute pass for every instance's steps.
+        // Batches in chunks of the parameter ring's size (each chunk's copies precede its
+        // pass); instances with a simulation of their own take every step at once (they
+        // chunk their own ring).
+        let mut pass = None;
+        let mut left = steps;
+        while left > 0 {
+            let chunk = left.min(MAX_STEPS_PER_RECORD);
+            drop(pass.take());
+            self.record_batches(encoder, &mut pass, chunk, dt_secs);
+            left -= chunk;
+        }
+        for instance in self.instances.iter_mut() {
+            let (Backing::Own(sim), effect) = instance.state_mut() else {
+                continue;
+            };
+            let plans = sim.plan(effect, dt_secs, steps as usize);
+            sim.record_into(encoder, &mut pass, effect, &plans);
+        }
+        drop(pass);
+        encoder.pop_debug_group();
+        self.take_snapshot_if_due(encoder);
+    }
+
+    /// Records `steps` (at most [`MAX_STEPS_PER_RECORD`]) steps of `dt_secs` of every
+    /// batch: their parameter blocks' copies, then their dispatches in `pass` (opened on
+    /// first need).
+    fn record_batches(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        pass: &mut Option<wgpu::ComputePass<'static>>,
+        steps: u32,
+        dt_secs: f32,
+    ) {
+        // Every batch's parameter blocks first (their copies precede the pass).
         let mut effects: Vec<Option<(&Effect, u64)>> = Vec::new();
         for (b, batch) in self.batches.iter_mut().enumerate() {
             effects.clear();
@@ -517,20 +562,9 @@ impl Player {
                 steps as usize,
             );
         }
-        let mut pass = None;
         for batch in &mut self.batches {
-            batch.dispatch(encoder, &mut pass, &self.effect);
+            batch.dispatch(encoder, pass, &self.effect);
         }
-        for instance in self.instances.iter_mut() {
-            let (Backing::Own(sim), effect) = instance.state_mut() else {
-                continue;
-            };
-            let plans = sim.plan(effect, dt_secs, steps as usize);
-            sim.record_into(encoder, &mut pass, effect, &plans);
-        }
-        drop(pass);
-        encoder.pop_debug_group();
-        self.take_snapshot_if_due(encoder);
     }
 
     /// Draws every instance's particles into the host's open render pass (alpha-blended

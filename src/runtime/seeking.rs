@@ -187,12 +187,12 @@ impl Player {
     /// [`Player::seek`] with fixed steps: the steps those frames take (counted on the CPU),
     /// replayed from the latest snapshot at or before them.
     fn seek_fixed_steps(&mut self, frames: u64, frame_dt_secs: f64) {
-        // Each frame runs its steps, as many as a record takes (as playing does).
+        // Each frame runs its steps (as playing does: the stepper's cap, then every step).
         let mut stepper = Stepper::default();
         let (mut steps, mut alpha) = (0u64, 1.0);
         for _ in 0..frames {
             let plan = stepper.advance(frame_dt_secs, &self.effect.time);
-            steps += u64::from(plan.steps.min(MAX_STEPS_PER_RECORD));
+            steps += u64::from(plan.steps);
             alpha = plan.alpha;
         }
         self.restart();

@@ -366,7 +366,7 @@ impl InstanceBatch {
                         };
                         let width = if p.update_window[1] > capacity {
                             let mut whole = *p;
-                            whole.update_window = [0, capacity, 0, 0];
+                            whole.update_window[..2].copy_from_slice(&[0, capacity]);
                             block.copy_from_slice(bytemuck::bytes_of(&whole));
                             capacity
                         } else {

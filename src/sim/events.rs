@@ -120,13 +120,17 @@ pub fn rules_of(e: &Emitter) -> [EventRule; MAX_EVENTS_PER_EMITTER] {
     rules
 }
 
-/// The most children a step of event `k` of `parent` can spawn into `child`.
+/// The room event `k` of `parent` needs in its child's spawn list per step: the most its
+/// cap per second allows in the effect's longest step (each step's own allowance,
+/// `SimParams::event_caps`, is at most this), within the child's capacity.
 pub fn step_cap(effect: &Effect, parent: usize, k: usize) -> u32 {
     let ev = &effect.emitters[parent].events[k];
     let child = effect
         .event_target(ev)
         .map_or(1, |c| effect.emitters[c].capacity);
-    ev.max_per_step.min(child).max(1)
+    let longest = f64::from(effect.time.longest_step_secs());
+    let most = (f64::from(ev.max_per_sec) * longest).floor() + 1.0;
+    (most.min(f64::from(child)) as u32).max(1)
 }
 
 /// The children one parent slot's rule asks for this step and the event's key: the CPU

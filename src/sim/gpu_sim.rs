@@ -558,8 +558,8 @@ impl GpuSim {
         for e in &effect.emitters {
             self.ctx.check_capacity(&e.name, e.capacity)?;
             if let Some(t) = &e.look.trail {
-                self.ctx
-                    .check_trail(&e.name, e.capacity.max(1), t.ring_points())?;
+                let points = t.layout(effect.time.nominal_step_secs()).points;
+                self.ctx.check_trail(&e.name, e.capacity.max(1), points)?;
             }
         }
         self.emitters.truncate(effect.emitters.len());
@@ -846,14 +846,15 @@ impl GpuSim {
         self.ctx.queue.submit([enc.finish()]);
     }
 
-    /// Plans `steps` steps of `dt_secs` (at most 32: the params ring holds that many).
+    /// Plans `steps` steps of `dt_secs` ([`GpuSim::record`] records any number: the
+    /// params ring holds 32 steps, later ones are copied in by the encoder).
     pub fn plan(
         &mut self,
         effect: &Effect,
         dt_secs: f32,
         steps: usize,
     ) -> Vec<Vec<Option<SimParams>>> {
-        (0..steps.min(STEPS_PER_SUBMIT))
+        (0..steps)
             .map(|_| self.planner.plan_step(effect, dt_secs))
             .collect()
     }
@@ -876,6 +877,8 @@ impl GpuSim {
     /// [`GpuSim::record`] into an open compute pass of `enc` (opened on first need), so
     /// that several simulations (a player's instances) share one pass. A simulation that
     /// counts alive particles ends the pass before its last step to clear its counters.
+    /// Plans beyond the params ring's 32 steps run in further chunks: the pass is ended
+    /// and the encoder copies each chunk's blocks into the ring before its steps.
     pub fn record_into(
         &mut self,
         enc: &mut wgpu::CommandEncoder,
@@ -889,6 +892,33 @@ impl GpuSim {
                 self.upload_births(e, plans);
             }
         }
+        self.write_scan_configs(effect);
+        let chunks = plans.len().div_ceil(STEPS_PER_SUBMIT);
+        for (c, chunk) in plans.chunks(STEPS_PER_SUBMIT).enumerate() {
+            let (blocks, windows) = self.param_blocks(chunk);
+            if c == 0 {
+                // Written before the submission runs: the first chunk's blocks.
+                self.ctx.queue.write_buffer(&self.params_buffer, 0, &blocks);
+            } else {
+                drop(pass.take());
+                let staging = wgpu::util::DeviceExt::create_buffer_init(
+                    &self.ctx.device,
+                    &wgpu::util::BufferInitDescriptor {
+                        label: Some("GpuSim::params chunk"),
+                        contents: &blocks,
+                        usage: wgpu::BufferUsages::COPY_SRC,
+                    },
+                );
+                enc.copy_buffer_to_buffer(&staging, 0, &self.params_buffer, 0, blocks.len() as u64);
+            }
+            self.dispatch_steps(enc, pass, effect, chunk, &windows, c + 1 == chunks);
+        }
+    }
+
+    /// The parameter blocks of up to 32 steps' plans, as the params ring holds them, and
+    /// each (step, emitter)'s update window.
+    fn param_blocks(&self, plans: &[Vec<Option<SimParams>>]) -> (Vec<u8>, Vec<u32>) {
+        let n_emitters = self.emitters.len();
         let mut blocks = vec![0u8; plans.len() * n_emitters * PARAMS_STRIDE as usize];
         let mut windows = vec![0u32; plans.len() * n_emitters];
         for (s, plan) in plans.iter().enumerate() {
@@ -907,7 +937,7 @@ impl GpuSim {
                         || p.capacity != em.capacity
                         || p.update_window[1] > em.capacity
                     {
-                        p.update_window = [0, em.capacity, 0, 0];
+                        p.update_window[..2].copy_from_slice(&[0, em.capacity]);
                     }
                     windows[s * n_emitters + e] = p.update_window[1];
                     if em.layout == StateLayout::Tiny {
@@ -918,8 +948,22 @@ impl GpuSim {
                 }
             }
         }
-        self.ctx.queue.write_buffer(&self.params_buffer, 0, &blocks);
-        self.write_scan_configs(effect);
+        (blocks, windows)
+    }
+
+    /// Records the steps of `plans` (one chunk, its blocks in the params ring);
+    /// `last_chunk`: the record's last steps (the alive counter is cleared before its
+    /// last step).
+    fn dispatch_steps(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        pass: &mut Option<wgpu::ComputePass<'static>>,
+        effect: &Effect,
+        plans: &[Vec<Option<SimParams>>],
+        windows: &[u32],
+        last_chunk: bool,
+    ) {
+        let n_emitters = self.emitters.len();
         let order = effect.update_order();
         // One compute pass for as many dispatches as possible (wgpu orders dependent
         // dispatches inside a pass): on lavapipe each pass costs about as much as a small
@@ -928,7 +972,7 @@ impl GpuSim {
         let update = Arc::clone(&self.update);
         let update = lock(&update);
         for (s, plan) in plans.iter().enumerate() {
-            if clear_counters && s + 1 == plans.len() {
+            if clear_counters && last_chunk && s + 1 == plans.len() {
                 // The update counts alive particles (COUNT_ALIVE) into the counter: clear
                 // it before the last step only, whose count is the one read (one break
                 // of the pass per record, not one per emitter and step).

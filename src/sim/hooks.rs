@@ -178,11 +178,10 @@ impl EmitterHooks {
             .iter()
             .map(|&(p, k)| step_cap(effect, p, k))
             .sum();
-        let trail = e
-            .look
-            .trail
-            .as_ref()
-            .map(|t| (t.ring_points(), t.every_steps, t.mode));
+        let trail = e.look.trail.as_ref().map(|t| {
+            let layout = t.layout(effect.time.nominal_step_secs());
+            (layout.points, layout.every, t.mode)
+        });
         if e.events.is_empty() && list_len == 0 && trail.is_none() {
             return None;
         }
