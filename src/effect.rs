@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 mod curve;
 mod events;
+mod stability;
 mod trail;
 mod validate;
 
@@ -16,6 +17,9 @@ pub use curve::{
     rows_key,
 };
 pub use events::{CountRange, Event, MAX_CHILDREN_PER_EVENT, MAX_EVENTS_PER_EMITTER, Trigger};
+pub use stability::{
+    GROWTH_LIMIT, StabilityWarning, Stiffness, largest_stable_step, lifetime_growth,
+};
 pub use trail::{MAX_TRAIL_POINTS, Trail, TrailLayout, TrailMode};
 use validate::Checker;
 pub use validate::ValidationError;

@@ -4,7 +4,8 @@
 
 use crate::effect::Effect;
 use crate::gpu::GpuContext;
-use crate::render::{Composite, OrbitCamera};
+use crate::gpu::timer::GpuTimer;
+use crate::render::{Camera, Composite, OrbitCamera};
 use crate::runtime::{InstanceId, Player, PlayerError, PlayerSettings};
 use crate::shaders::{ShaderLibrary, ShaderSourceDir};
 use crate::sim::SimError;
@@ -90,6 +91,33 @@ impl Headless {
         let camera = self.camera.view(size);
         self.composite
             .render_image(&self.ctx, &mut self.player, &camera)
+    }
+
+    /// Simulates and draws one frame of `frame_dt_secs` for `camera` with each part timed
+    /// apart by `timer` (GPU timestamps where the adapter has them, else the wall clock
+    /// around a drained queue), in milliseconds: update, record (sort, splat, the tiles'
+    /// passes), particle draws, composite (bloom and tonemap).
+    pub fn timed_frame(
+        &mut self,
+        timer: &GpuTimer,
+        frame_dt_secs: f64,
+        camera: &Camera,
+    ) -> [f64; 4] {
+        self.player.advance(frame_dt_secs);
+        let Self {
+            ctx,
+            player,
+            composite,
+            ..
+        } = self;
+        let update = timer.time(ctx, |enc| player.simulate(enc));
+        let record = timer.time(ctx, |enc| player.record(enc, camera, None));
+        let mut layered = crate::Layers::NONE;
+        let draw = timer.time(ctx, |enc| {
+            layered = composite.draw_particles(ctx, enc, player, camera);
+        });
+        let post = timer.time(ctx, |enc| composite.post(ctx, enc, player, layered));
+        [update, record, draw, post]
     }
 
     /// Alive particles over all emitters (blocking readback of the GPU counters).

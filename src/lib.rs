@@ -96,3 +96,5 @@ pub mod export;
 #[cfg(feature = "editor")]
 #[doc(hidden)]
 pub mod hot_reload;
+#[cfg(feature = "editor")]
+pub mod tune;

@@ -133,6 +133,10 @@ enum Command {
     /// Export a flipbook or an image sequence for game engines: real alpha, emissive and
     /// motion-vector passes, seamless loops, a JSON sidecar.
     Export(ignis::export::cli::ExportArgs),
+    /// The speed–accuracy trade on an effect: every setting's image error against a
+    /// converged reference next to its cost, the frontier, and the cheapest settings
+    /// within a budget as a tuned preset.
+    Tune(ignis::tune::cli::TuneArgs),
     /// Measure: `accuracy` (integrators' error vs cost), `perf` (throughput), `presets`
     /// (the shipped effects), `runtime` (instances in a host's frame), `export` or
     /// `adapters` (software adaptations).
@@ -339,6 +343,7 @@ fn main() {
             &adapter_profile,
         ),
         Some(Command::Export(args)) => export(&args, &adapter_profile),
+        Some(Command::Tune(args)) => tune(&args, &adapter_profile),
         Some(Command::Check { paths }) => check(&paths),
         Some(Command::Sprites { out }) => write_sprites(&out),
         Some(Command::Bench { kind }) => bench(kind, &adapter_profile),
@@ -446,6 +451,45 @@ fn render(
             1000.0 / median
         );
     }
+    Ok(())
+}
+
+/// `ignis tune`: the options and the preset checked first (nothing is written on a bad
+/// one), the sweep with a progress bar, the table, then the files.
+fn tune(args: &ignis::tune::cli::TuneArgs, profile: &ProfileRequest) -> anyhow::Result<()> {
+    let budget = args.budget()?;
+    let effect = ignis::preset::load(&args.preset)?;
+    let opts = args.options(&effect)?;
+    let ctx = context(profile)?;
+    let mut sweep = ignis::tune::Sweep::new(&ctx, &effect, opts)?;
+    let bar = indicatif::ProgressBar::new(1).with_style(
+        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} frames {elapsed}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar.set_message(format!("tuning \"{}\"", effect.name));
+    let start = Instant::now();
+    ignis::tune::run_sweep(&mut sweep, |done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    })?;
+    bar.finish_and_clear();
+    for (label, why) in &sweep.skipped {
+        eprintln!("skipped {label}: {why}");
+    }
+    let report = ignis::tune::TuneReport::new(&sweep, budget, &ctx.info.name)?;
+    println!("{}", report.markdown());
+    let files = report.write(&effect, &args.out)?;
+    println!(
+        "{} candidates in {:.1} s on {}; wrote {}",
+        report.results.len(),
+        start.elapsed().as_secs_f64(),
+        ctx.info.name,
+        files
+            .iter()
+            .map(|f| f.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
     Ok(())
 }
 
@@ -712,7 +756,13 @@ fn check(paths: &[PathBuf]) -> anyhow::Result<()> {
     let mut failures = 0;
     for p in &presets {
         match ignis::preset::load(p) {
-            Ok(e) => println!("ok   {} ({} emitters)", p.display(), e.emitters.len()),
+            Ok(e) => {
+                println!("ok   {} ({} emitters)", p.display(), e.emitters.len());
+                // Valid but unstable at its step: a warning, not a failure.
+                for w in e.stability_warnings() {
+                    eprintln!("WARN {}: {w}", p.display());
+                }
+            }
             Err(e) => {
                 failures += 1;
                 eprintln!("FAIL {e}");

@@ -380,7 +380,10 @@ fn tiny_ages_stay_exact_late_in_a_run() {
             );
         }
     }
-    assert!((290..=310).contains(&alive), "{alive} alive");
+    // About 300 born in the last second (400/s, lives of 0.5–1 s), and a few of the
+    // last 100 s step's 1024 (no spawn cap: spread over the step, those born in its last
+    // second may live on).
+    assert!((290..=330).contains(&alive), "{alive} alive");
 }
 
 /// Capacity 1, capacities that are not multiples of the 256-wide workgroup, and zero

@@ -256,17 +256,10 @@ fn measure(
         if frame == UNTIMED_FRAMES {
             parts = Default::default();
         }
-        run.player.advance(1.0 / 60.0);
-        let Headless {
-            player, composite, ..
-        } = &mut run;
-        parts[0].push(timer.time(ctx, |enc| player.simulate(enc)));
-        parts[1].push(timer.time(ctx, |enc| player.record(enc, &camera, None)));
-        let mut layered = crate::Layers::NONE;
-        parts[2].push(timer.time(ctx, |enc| {
-            layered = composite.draw_particles(ctx, enc, player, &camera);
-        }));
-        parts[3].push(timer.time(ctx, |enc| composite.post(ctx, enc, player, layered)));
+        let times = run.timed_frame(timer, 1.0 / 60.0, &camera);
+        for (p, t) in parts.iter_mut().zip(times) {
+            p.push(t);
+        }
     }
     let [update_ms, sort_ms, draw_ms, composite_ms] = parts.map(|mut p| median(&mut p));
     let row = Row {
