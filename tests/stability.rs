@@ -556,3 +556,93 @@ fn embedded_bench_figures_cover_every_integrator() {
         ignis::editor::measured::measured_for(Integrator::Exponential, 1.0 / 60.0)[0].rms_rel_error;
     assert!(exp * 100.0 < euler);
 }
+
+/// The stability warning agrees with the GPU on both sides of its boundary: under a drag
+/// of 240/s, explicit and semi-implicit Euler at k·dt = 1.85 are called stable and their
+/// particles' velocities decay on the GPU; at k·dt = 2.18 they are called unstable — the
+/// warning names the drag and a step that would be stable — and the velocities blow up.
+#[test]
+fn the_stability_warning_agrees_with_the_gpu_on_both_sides() {
+    let ctx = gpu();
+    for integrator in [Integrator::ExplicitEuler, Integrator::SemiImplicitEuler] {
+        for (step, unstable) in [(1.0 / 130.0, false), (1.0 / 110.0, true)] {
+            let e = Emitter {
+                spawn_rate_per_sec: ignis::effect::Param::Constant(200.0),
+                speed_m_per_s: ignis::effect::Range::new(1.0, 1.0),
+                integrator,
+                forces: ignis::effect::Forces {
+                    drag_per_sec: 240.0,
+                    ..plain_emitter().forces
+                },
+                ..plain_emitter()
+            };
+            let mut effect = bare_effect(e);
+            effect.time.step_secs = step;
+            let warnings = effect.stability_warnings();
+            assert_eq!(
+                !warnings.is_empty(),
+                unstable,
+                "{integrator:?} at {step}: {warnings:?}"
+            );
+            if let Some(w) = warnings.first() {
+                assert_eq!(w.field, "emitters[0].forces.drag_per_sec");
+                let stable = w.stable_step_secs.expect("a stable step");
+                // Just past k·dt = 2: where (k·dt − 1)^(life/dt) reaches 2 over 1 s.
+                let growth = (240.0 * stable - 1.0).powf(1.0 / stable);
+                assert!((growth - 2.0).abs() < 1e-6, "{stable}: growth {growth}");
+                assert!(stable > 2.0 / 240.0 && stable < 2.01 / 240.0, "{stable}");
+                let text = w.to_string();
+                assert!(
+                    text.contains("drag_per_sec") && text.contains("stable"),
+                    "{text}"
+                );
+            }
+            let sim = run_gpu(&ctx, &effect, step, (0.5 / step) as u32);
+            let fastest = sim
+                .read_particles(0)
+                .expect("read")
+                .iter()
+                .filter(|p| p.is_alive())
+                .map(|p| {
+                    let v = p.vel_life;
+                    let s = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                    if s.is_finite() { s } else { f32::INFINITY }
+                })
+                .fold(0.0f32, f32::max);
+            if unstable {
+                assert!(fastest > 1e3, "{integrator:?} at {step}: fastest {fastest}");
+            } else {
+                assert!(fastest < 1.0, "{integrator:?} at {step}: fastest {fastest}");
+            }
+        }
+    }
+}
+
+/// `ignis check` reports an emitter that is unstable at its step (a warning: the preset
+/// is valid), naming the field and the stable step.
+#[test]
+fn ignis_check_warns_of_an_unstable_emitter() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("stiff.ron");
+    let mut effect = bare_effect(Emitter {
+        forces: ignis::effect::Forces {
+            drag_per_sec: 300.0,
+            ..plain_emitter().forces
+        },
+        ..plain_emitter()
+    });
+    effect.time.step_secs = 1.0 / 100.0;
+    ignis::preset::save(&effect, &path).expect("save");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_ignis"))
+        .arg("check")
+        .arg(&path)
+        .output()
+        .expect("run ignis");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "a warning is not a failure: {stderr}");
+    assert!(
+        stderr.contains("WARN") && stderr.contains("emitters[0].forces.drag_per_sec"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("a step of at most"), "{stderr}");
+}

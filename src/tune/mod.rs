@@ -23,7 +23,7 @@ pub use candidate::{
 pub use frontier::{Budget, choose, pareto};
 pub use image_error::{ErrorAccumulator, ImageError, Rgb, rgb_of};
 pub use report::{ModuleRow, TuneReport};
-pub use sweep::{Measured, Sweep, SweepOptions, measure_against_reference};
+pub use sweep::{Measured, Sweep, SweepOptions, measure_against_reference, measure_pair};
 
 /// Why a tune could not run or choose.
 #[derive(Debug, thiserror::Error)]

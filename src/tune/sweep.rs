@@ -468,16 +468,29 @@ pub fn measure_against_reference(
     effect: &Effect,
     opts: &SweepOptions,
 ) -> Result<ImageError, TuneError> {
+    let step = candidate::reference_step(effect);
+    let reference = candidate::reference(authored, 1.0 / opts.fps, step);
+    measure_pair(ctx, &reference, effect, opts)
+}
+
+/// The error of `effect`'s frames against `reference`'s over the span of `opts` (the two
+/// played side by side, each at steps it can keep up with).
+pub fn measure_pair(
+    ctx: &GpuContext,
+    reference: &Effect,
+    effect: &Effect,
+    opts: &SweepOptions,
+) -> Result<ImageError, TuneError> {
     let frame_secs = 1.0 / opts.fps;
-    let lib = || ShaderLibrary::discover(None);
-    let settings = || crate::PlayerSettings {
-        asset_dir: opts.asset_dir.clone(),
-        ..crate::render::Composite::player_settings()
+    let play = |e: &Effect| {
+        let settings = crate::PlayerSettings {
+            asset_dir: opts.asset_dir.clone(),
+            ..crate::render::Composite::player_settings()
+        };
+        let e = runnable(e.clone(), frame_secs);
+        Headless::with_settings(ctx, e, ShaderLibrary::discover(None), settings)
     };
-    let reference = candidate::reference(authored, frame_secs, candidate::reference_step(effect));
-    let mut a = Headless::with_settings(ctx, reference, lib(), settings())?;
-    let mut b =
-        Headless::with_settings(ctx, runnable(effect.clone(), frame_secs), lib(), settings())?;
+    let (mut a, mut b) = (play(reference)?, play(effect)?);
     let mut acc = ErrorAccumulator::default();
     for _ in 0..opts.frames() {
         a.advance(frame_secs);
