@@ -876,23 +876,6 @@ fn the_library_opens_the_shipped_presets() {
     assert_eq!(state.running, torch);
 }
 
-#[test]
-fn the_time_section_shows_the_measured_accuracy_of_the_integrator() {
-    let harness = panel_harness(campfire_state());
-    assert!(
-        harness
-            .query_by_label_contains("as measured (H100")
-            .is_some()
-    );
-    // One line per measured scene (closed form, turbulent).
-    assert_eq!(
-        harness
-            .query_all_by_label_contains("ns/particle-step")
-            .count(),
-        2
-    );
-}
-
 /// The preset workflow: a dirty marker after an edit, Revert back to the saved effect,
 /// Save-as name validation, a confirm before a load discards edits, and an external edit
 /// of the loaded preset re-applied (or held for confirmation while there are edits).
@@ -1591,4 +1574,94 @@ fn the_trail_mode_is_chosen_in_the_panel() {
     harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     harness.run();
     assert_eq!(mode(&harness.state().effect), Some(TrailMode::History));
+}
+
+/// Steps the measurement the panel asks for, with the panel drawn between steps, until it
+/// ends or `stop_after` frames have run; returns whether the progress bar and Cancel
+/// showed while it ran.
+fn run_measure(
+    harness: &mut Harness<'_, EditorState>,
+    ctx: &GpuContext,
+    running: &mut Option<ignis::tune::Sweep>,
+    stop_after: Option<u32>,
+) -> bool {
+    let (mut saw_cancel, mut frames) = (false, 0);
+    loop {
+        {
+            let state = harness.state_mut();
+            let effect = state.running.clone();
+            ignis::editor::measure_ui::drive(
+                ctx,
+                &effect,
+                None,
+                &mut state.measure,
+                running,
+                std::time::Duration::from_millis(1),
+            );
+        }
+        harness.step();
+        frames += 1;
+        if running.is_none() || stop_after.is_some_and(|n| frames >= n) {
+            return saw_cancel;
+        }
+        saw_cancel |= harness.query_by_label("Cancel measurement").is_some()
+            && harness.state().measure.progress.is_some();
+    }
+}
+
+/// Time ▸ Measure this effect: a measurement shows its progress and cancels; a small one
+/// completes with a frontier whose rows apply a candidate's settings as one edit, which
+/// one undo takes back.
+#[test]
+fn the_time_section_measures_the_effect_and_applies_a_frontier_point() {
+    let ctx = common::gpu();
+    let mut state = EditorState::new(Effect::default(), "test");
+    state.measure.size = (48, 27);
+    state.measure.span_secs = 0.3;
+    let mut harness = panel_harness(state);
+    harness.get_by_label("Measure").click_accesskit();
+    harness.run();
+    let mut running = None;
+    assert!(run_measure(&mut harness, &ctx, &mut running, Some(5)));
+    harness.get_by_label("Cancel measurement").click_accesskit();
+    // The progress bar asks for frames until the sweep is dropped: step, not run.
+    harness.step();
+    run_measure(&mut harness, &ctx, &mut running, None);
+    assert!(running.is_none());
+    let message = harness.state().measure.message.clone();
+    assert!(
+        matches!(&message, Some(Err(m)) if m.contains("cancelled")),
+        "{message:?}"
+    );
+    assert!(harness.state().measure.report.is_none());
+
+    harness.get_by_label("Measure").click_accesskit();
+    harness.run();
+    run_measure(&mut harness, &ctx, &mut running, None);
+    let report = harness.state().measure.report.clone().expect("a report");
+    assert!(
+        report.results.len() > 25,
+        "{} candidates",
+        report.results.len()
+    );
+    // A frontier point that changes the effect: its row applies it.
+    let before = harness.state().effect.clone();
+    let i = *report
+        .frontier
+        .iter()
+        .find(|&&i| report.results[i].candidate.apply(&before) != before)
+        .expect("a frontier point that changes the effect");
+    let label = report.results[i].label.clone();
+    harness.get_by_label(&label).click_accesskit();
+    harness.run();
+    let after = harness.state().effect.clone();
+    assert_eq!(after, report.results[i].candidate.apply(&before), "{label}");
+    assert_ne!(after, before);
+    harness.get_by_label("Undo").click_accesskit();
+    harness.run();
+    assert_eq!(
+        harness.state().effect,
+        before,
+        "one undo restores the effect"
+    );
 }

@@ -538,25 +538,6 @@ fn fixed_step_is_frame_rate_independent() {
     let _ = Transform::default();
 }
 
-/// The panel's figures come from the committed bench results: every integrator has both
-/// scenes, and the exponential integrator is far more accurate than explicit Euler.
-#[test]
-fn embedded_bench_figures_cover_every_integrator() {
-    for integrator in Integrator::ALL {
-        let m = ignis::editor::measured::measured_for(integrator, 1.0 / 60.0);
-        assert_eq!(m.len(), 2, "{integrator:?}");
-        assert!(
-            m.iter()
-                .all(|x| (x.dt_secs - 1.0 / 60.0).abs() < 1e-9 && x.cost_ns > 0.0)
-        );
-    }
-    let euler = ignis::editor::measured::measured_for(Integrator::ExplicitEuler, 1.0 / 60.0)[0]
-        .rms_rel_error;
-    let exp =
-        ignis::editor::measured::measured_for(Integrator::Exponential, 1.0 / 60.0)[0].rms_rel_error;
-    assert!(exp * 100.0 < euler);
-}
-
 /// The stability warning agrees with the GPU on both sides of its boundary: under a drag
 /// of 240/s, explicit and semi-implicit Euler at k·dt = 1.85 are called stable and their
 /// particles' velocities decay on the GPU; at k·dt = 2.18 they are called unstable — the

@@ -55,6 +55,10 @@ pub(super) fn wants_fresh_device(peak: u64, slots: u64) -> bool {
 /// The time an export may take of each editor frame.
 const EXPORT_BUDGET: Duration = Duration::from_millis(40);
 
+/// Wall time a frame gives a measurement in progress (Time ▸ Measure this effect): the
+/// editor stays interactive while it runs.
+const MEASURE_BUDGET: Duration = Duration::from_millis(30);
+
 /// Everything that exists once the window does.
 pub(super) struct Gfx {
     pub(super) window: Arc<Window>,
@@ -101,6 +105,8 @@ pub(super) struct Gfx {
     pub(super) state_textures: Option<([egui::TextureHandle; 3], u64)>,
     /// The export the Export section started, stepped a little every frame.
     pub(super) export: Option<crate::export::Export>,
+    /// Time ▸ Measure this effect: the sweep in progress.
+    pub(super) sweep: Option<crate::tune::Sweep>,
 }
 
 /// The shader folder's watcher and the reloader that rebuilds affected pipelines.
@@ -258,6 +264,7 @@ impl Gfx {
             shader_watch,
             sprite_watch: None,
             export: None,
+            sweep: None,
             state_textures: None,
             peak_slots: 0,
             wants_fresh_device: false,
@@ -518,6 +525,14 @@ impl Gfx {
             &mut state.export,
             &mut self.export,
             EXPORT_BUDGET,
+        );
+        super::measure_ui::drive(
+            &self.ctx,
+            &state.running,
+            state.asset_dir(),
+            &mut state.measure,
+            &mut self.sweep,
+            MEASURE_BUDGET,
         );
         self.profiler.end_stage(&self.ctx);
     }

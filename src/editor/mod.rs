@@ -14,7 +14,7 @@ mod forces_ui;
 mod gfx;
 pub mod inspect;
 pub mod look;
-pub mod measured;
+pub mod measure_ui;
 pub mod panel;
 mod present;
 pub mod profile;

@@ -86,7 +86,13 @@ pub fn panel_ui(ui: &mut Ui, state: &mut EditorState) {
                 },
             );
             section_ui(ui, "time", "Time", "", (true, open("time")), |ui| {
-                time_ui(ui, &mut state.effect, &mut state.playback, state.selected);
+                time_ui(
+                    ui,
+                    &mut state.effect,
+                    &mut state.playback,
+                    state.selected,
+                    &mut state.measure,
+                );
             });
             section_ui(ui, "look", "Look", &name, (false, open("look")), |ui| {
                 let sprite_error = state
@@ -275,6 +281,20 @@ fn problems_ui(ui: &mut Ui, state: &mut EditorState) {
                 ui.label(format!("… and {} more", state.validation_errors.len() - 6));
             }
         });
+    }
+    // Valid but unstable at its step: shown as the edit is made, before it plays out.
+    let unstable = state.effect.stability_warnings();
+    if !unstable.is_empty() {
+        egui::Frame::group(ui.style())
+            .fill(Color32::from_rgb(64, 50, 18))
+            .stroke(egui::Stroke::new(1.0, Color32::from_rgb(220, 170, 60)))
+            .show(ui, |ui| {
+                ui.set_width(ui.available_width());
+                ui.label(RichText::new("Unstable at this step: particles will blow up.").strong());
+                for w in &unstable {
+                    ui.label(w.to_string());
+                }
+            });
     }
     if !state.shader_errors.is_empty() {
         error_box_ui(ui, |ui| {

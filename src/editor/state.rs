@@ -140,6 +140,8 @@ pub struct EditorState {
     pub pending: Option<PendingAction>,
     /// The Export section and the export it runs.
     pub export: super::export_ui::ExportPanel,
+    /// Time ▸ Measure this effect: its settings, progress and last result.
+    pub measure: super::measure_ui::MeasurePanel,
 }
 
 /// Actions that discard unsaved edits, so they ask first.
@@ -185,6 +187,7 @@ impl EditorState {
             loaded_path: None,
             pending: None,
             export: Default::default(),
+            measure: Default::default(),
             source: source.into(),
         }
     }

@@ -1,15 +1,21 @@
-//! The panel's Time section: the step mode, the integrator, the measured accuracy and the
-//! stability hints.
+//! The panel's Time section: the step mode, the integrator, each emitter's stability at
+//! its step, and "Measure this effect" (`measure_ui.rs`).
 
 use egui::{Color32, DragValue, Ui};
 
-use crate::effect::{Effect, Emitter, Integrator, TimeMode};
+use crate::effect::{Effect, Integrator, TimeMode};
 
 use super::panel::{drag, grid, row_ui};
 use super::state::Playback;
 
 /// Time stepping, playback and the integrator of each emitter with its stability hint.
-pub fn time_ui(ui: &mut Ui, effect: &mut Effect, playback: &mut Playback, selected: usize) {
+pub fn time_ui(
+    ui: &mut Ui,
+    effect: &mut Effect,
+    playback: &mut Playback,
+    selected: usize,
+    measure: &mut super::measure_ui::MeasurePanel,
+) {
     ui.horizontal(|ui| {
         super::timeline::playback_buttons_ui(ui, playback);
         if playback.is_paused {
@@ -125,10 +131,8 @@ ui,
             }
         }
     });
-    if let Some(e) = effect.emitters.get(selected) {
-        measured_ui(ui, e.integrator, step_secs(effect));
-    }
     stability_ui(ui, effect);
+    super::measure_ui::measure_ui(ui, measure, effect);
 }
 
 /// The step the integrators see: the fixed step, or the largest frame-delta step.
@@ -139,75 +143,36 @@ pub fn step_secs(effect: &Effect) -> f32 {
     }
 }
 
-/// What the accuracy bench measured for `integrator` near `dt_secs` (the committed H100
-/// results embedded in the binary), cached because the figures are parsed from JSON.
-fn measured_ui(ui: &mut Ui, integrator: Integrator, dt_secs: f32) {
-    type Cache = Option<((Integrator, u32), Vec<super::measured::Measured>)>;
-    static CACHE: std::sync::Mutex<Cache> = std::sync::Mutex::new(None);
-    let key = (integrator, dt_secs.to_bits());
-    let figures = match CACHE.lock() {
-        Ok(mut cache) => {
-            if cache.as_ref().is_none_or(|(k, _)| *k != key) {
-                let figures = super::measured::measured_for(integrator, dt_secs as f64);
-                *cache = Some((key, figures));
-            }
-            cache.as_ref().map(|(_, f)| f.clone()).unwrap_or_default()
-        }
-        Err(_) => Vec::new(),
-    };
-    if figures.is_empty() {
-        return;
-    }
-    ui.weak(format!(
-        "{} as measured (H100, T = 2 s):",
-        integrator.label()
-    ))
-    .on_hover_text(
-        "From the committed accuracy bench (bench/results/accuracy-nvidia-h100-80gb.json): \
-             RMS position error relative to the reference solution after 2 s, and the update \
-             cost per particle and step, at the measured step nearest to this one",
-    );
-    for m in figures {
-        ui.weak(format!(
-            "  {}: error {:.1e} at dt {:.4} s, {:.2} ns/particle-step",
-            m.scene, m.rms_rel_error, m.dt_secs, m.cost_ns
-        ));
-    }
-}
-
-/// k·dt of the step the integrator sees (the worst case in frame-delta mode).
-pub fn drag_times_dt(effect: &Effect, emitter: &Emitter) -> f32 {
-    emitter.forces.drag_per_sec * step_secs(effect)
-}
-
-/// The drag stability hint for every emitter: k·dt against the integrator's limit.
+/// Each emitter's stability at the step the integrator sees: how much an error grows
+/// over a particle's life (`Effect::stability_warnings`, from the stiffest terms of its
+/// forces) and the largest stable step.
 fn stability_ui(ui: &mut Ui, effect: &Effect) {
+    let step = f64::from(step_secs(effect));
     egui::Grid::new("stability_grid")
         .num_columns(3)
         .spacing([10.0, 2.0])
         .show(ui, |ui| {
             ui.weak("emitter");
             ui.weak("integrator");
-            ui.weak("drag·dt / limit")
-                .on_hover_text("Linear drag v' = −k·v is stable for k·dt below the method's limit; above it the velocity oscillates and grows");
+            ui.weak("stability at this step").on_hover_text(
+                "How much an error grows over a particle's life under the emitter's stiffest forces (drag, flame pull, attractor, vortex, turbulence), and the largest step that keeps it below 2×",
+            );
             ui.end_row();
-            for e in &effect.emitters {
-                let kdt = drag_times_dt(effect, e);
+            for e in effect.emitters.iter().filter(|e| e.enabled) {
                 ui.label(&e.name);
                 ui.label(e.integrator.label());
-                match e.integrator.drag_stability_limit() {
-                    Some(limit) if kdt > limit => {
-                        ui.colored_label(
-                            ui.visuals().error_fg_color,
-                            format!("{kdt:.3} > {limit:.3}: unstable"),
-                        );
-                    }
-                    Some(limit) => {
-                        ui.label(format!("{kdt:.3} / {limit:.3}"));
-                    }
-                    None => {
-                        ui.label(format!("{kdt:.3} / ∞"));
-                    }
+                let growth = e.growth_at(step);
+                if e.stateless {
+                    ui.label("exact (stateless)");
+                } else if growth > crate::effect::GROWTH_LIMIT {
+                    let stable = crate::effect::largest_stable_step(e)
+                        .map_or("none".to_owned(), |s| format!("≤ {s:.4} s"));
+                    ui.colored_label(
+                        ui.visuals().error_fg_color,
+                        format!("unstable: ×{growth:.1e}; stable {stable}"),
+                    );
+                } else {
+                    ui.label("stable");
                 }
                 ui.end_row();
             }
