@@ -311,11 +311,25 @@ fn time_settings_and_the_drag_stability_hint() {
     assert_eq!(harness.state().running.time.speed, 0.5);
     assert!(harness.query_by_label_contains("unstable").is_none());
 
-    // k·dt = 300 /s × 0.1 s = 30, far past explicit Euler's limit of 2.
+    // k·dt = 300 /s × 0.1 s = 30, far past the Euler methods' limit of 2: the Time
+    // section's row says so, and the header names the field and a stable step as the
+    // edit is made.
     open_section(&mut harness, "Forces");
     harness.get_by_label("Drag").set_value_accesskit(300.0);
     harness.run();
-    assert!(harness.query_by_label_contains("unstable").is_some());
+    assert!(harness.query_by_label_contains("unstable: ×").is_some());
+    let warnings = harness.state().effect.stability_warnings();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    let text = warnings[0].to_string();
+    assert!(
+        text.starts_with("emitters[0].forces.drag_per_sec: "),
+        "{text}"
+    );
+    assert!(text.contains("a step of at most"), "{text}");
+    assert!(
+        harness.query_by_label(&text).is_some(),
+        "the header shows {text}"
+    );
     harness.get_by_label("Pause").click_accesskit();
     harness.run();
     assert!(harness.state().playback.is_paused);
