@@ -71,8 +71,6 @@ struct SimParams {
     collide_c: vec4<f32>,
     // x: first slot this step updates, y: how many (wrapping at the capacity): the ring's
     // live window plus this step's spawns; every other slot is dead in both buffers.
-    // zw: the most children each of the emitter's two events may spawn this step (its
-    // cap per second over the step; the event scan reads them).
     update_window: vec4<u32>,
     // Tiny state: x, y: the step's start on the emitter's clock (double-single hi, lo, as
     // f32 bits), z: the birth table's first sequence number, w: its entries (`flags` holds

@@ -4,8 +4,8 @@
 // is the same whatever the scheduling. Three passes over blocks of BLOCK slots:
 // `count_blocks` sums each block's children, `scan_blocks` (one workgroup) turns the sums
 // into each block's offset and settles the list's header, `write_list` writes each
-// block's entries from its offset. At most `cap` children a step; the rest are counted as
-// dropped. The first scan of a step into a child (its header's stamp is an older step's)
+// block's entries from its offset. At most what the event's cap allows a step (a bucket of
+// tokens refilled at its rate per second, `take_tokens`); the rest are counted as dropped. The first scan of a step into a child (its header's stamp is an older step's)
 // moves the child's ring head past the last step's children and starts an empty list
 // stamped with this step's number; each scan appends, so a child fed by several events
 // gets them in update order. A child none of whose parents ran this step sees a stale
@@ -22,9 +22,9 @@
 //
 // Group 0: binding 0 the parent's SimParams (dynamic offset), 1 its event buffer, 2 the
 // child's list (header + entries), 3 this rule's ScanConfig, 4 the scan's scratch (word 0
-// the list position this scan starts at, one word per block, then two words per parent
-// slot: its last child's slot and stamp), 5 the child's trail ring (a placeholder unless
-// RIBBON).
+// the list position this scan starts at, one word per block of the parent's capacity, the
+// cap's bucket and this step's allowance, then two words per parent slot: its last child's
+// slot and stamp), 5 the child's trail ring (a placeholder unless RIBBON).
 // Mirrored by `scan_events` in src/sim/events.rs (the links are read by `Link` in
 // src/sim/trails.rs).
 #import "common.wgsl"
@@ -40,6 +40,8 @@ struct ScanConfig {
     // xyz: the parent's simulation origin minus the child's, w: the inherited fraction
     // of the parent's velocity.
     delta_inherit: vec4<f32>,
+    // The event's cap: x children per second, y the burst its bucket holds; zw unused.
+    cap: vec4<f32>,
 }
 
 @group(0) @binding(1) var<storage, read> event_out: EventOut;
@@ -61,10 +63,21 @@ const PER_THREAD: u32 = 4u;
 const BLOCK: u32 = 1024u;
 
 
-// The most children this rule may spawn this step: its cap per second over the step
-// (the parent's SimParams), within the child list's room per step.
-fn step_cap() -> u32 {
-    return min(cfg.rule_capacity_cap.z, params.update_window[2u + cfg.rule_capacity_cap.x]);
+// Where the scratch keeps the cap's bucket (tokens short of full, f32 bits; zero: full)
+// and then this step's allowance: after the block sums.
+fn bucket_at() -> u32 {
+    return 1u + (params.capacity + BLOCK - 1u) / BLOCK;
+}
+
+// Takes up to `asked` children from the cap's bucket (src/effect.rs `RateCap::take`, the
+// same f32 arithmetic in the same order): a full bucket holds `cfg.cap.y`, the step adds
+// `cfg.cap.x · dt` before it takes, what is left is kept. Within the list's room.
+fn take_tokens(asked: u32) -> u32 {
+    let burst = cfg.cap.y;
+    let available = (burst - bitcast<f32>(blocks[bucket_at()])) + cfg.cap.x * params.dt_secs;
+    let n = min(min(asked, u32(floor(max(available, 0.0)))), cfg.rule_capacity_cap.z);
+    blocks[bucket_at()] = bitcast<u32>(burst - min(available - f32(n), burst));
+    return n;
 }
 
 // The count word of the i-th slot of the parent's window (its children, BORN_BIT when
@@ -83,7 +96,7 @@ fn count_of(i: u32) -> u32 {
 
 // Where parent `slot`'s last child (slot, stamp) is kept in the scratch.
 fn last_child_at(slot: u32) -> u32 {
-    return 1u + (params.capacity + BLOCK - 1u) / BLOCK + 2u * slot;
+    return bucket_at() + 2u + 2u * slot;
 }
 
 // The children of one thread's PER_THREAD slots of the window, from the i-th.
@@ -147,7 +160,8 @@ fn scan_blocks(@builtin(local_invocation_index) lid: u32) {
             event_in.stamp = params.tiny_b.z;
         }
         blocks[0] = event_in.count;
-        let n = min(running, step_cap());
+        let n = take_tokens(running);
+        blocks[bucket_at() + 1u] = n;
         event_in.count += n;
         event_in.dropped += running - n;
         event_in.total += running;
@@ -170,7 +184,8 @@ fn write_list(
     // This thread's first child's place among this scan's children.
     var at = blocks[1u + b] + incl - n;
     let start = blocks[0];
-    let cap = step_cap();
+    // This step's allowance (scan_blocks took it from the cap's bucket).
+    let cap = blocks[bucket_at() + 1u];
     let capacity = params.capacity;
     let flags = cfg.rule_capacity_cap.w;
     for (var k = 0u; k < PER_THREAD; k++) {

@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 mod curve;
 mod events;
+mod rate_cap;
 mod stability;
 mod trail;
 mod validate;
@@ -17,6 +18,7 @@ pub use curve::{
     rows_key,
 };
 pub use events::{CountRange, Event, MAX_CHILDREN_PER_EVENT, MAX_EVENTS_PER_EMITTER, Trigger};
+pub use rate_cap::{CAP_BURST_SECS, RateCap, cap_burst};
 pub use stability::{
     GROWTH_LIMIT, StabilityWarning, Stiffness, largest_stable_step, lifetime_growth,
 };
@@ -148,9 +150,8 @@ pub struct Emitter {
     /// blend per instance, from its seed).
     pub spawn_rate_per_sec: Param,
     /// At most this many continuous spawns per second of simulated time, whatever the
-    /// step (a rate curve's peaks are clipped to it; bursts are not capped). 0 = no cap.
-    /// A step of `dt` from `t` may spawn `⌊cap·(t + dt)⌋ − ⌊cap·t⌋`, so the cap per second
-    /// is the same at any step size.
+    /// step (a rate curve's peaks are clipped to it; bursts are not capped), with bursts of
+    /// a tenth of a second's worth let through ([`RateCap`]). 0 = no cap.
     pub max_spawn_per_sec: f32,
     /// One-shot bursts.
     pub bursts: Vec<Burst>,
@@ -1054,15 +1055,6 @@ impl Default for Range {
     }
 }
 
-/// How many events of a cap of `per_sec` per second fall in the step `[t0, t0 + dt)`:
-/// `⌊rate·(t0 + dt)⌋ − ⌊rate·t0⌋`, so that every second of simulated time allows the same
-/// number whatever the step size (a cap counted per step would change with the step).
-pub fn rate_allowance(per_sec: f64, t0_secs: f64, dt_secs: f64) -> u64 {
-    // A hair of tolerance: 1/120 s steps must land on whole multiples of 1/rate.
-    let at = |t: f64| (per_sec * t + 1e-9).floor().max(0.0);
-    (at(t0_secs + dt_secs) - at(t0_secs)).max(0.0) as u64
-}
-
 /// Largest capacity a single emitter may ask for (device limits may be lower).
 pub const MAX_CAPACITY: u32 = 1 << 28;
 
@@ -1125,12 +1117,5 @@ impl Emitter {
             v.push("trail");
         }
         v
-    }
-
-    /// The continuous spawns the cap allows in the step `[t0, t0 + dt)` of simulated time
-    /// (`None`: no cap). See [`Emitter::max_spawn_per_sec`].
-    pub fn spawn_cap_between(&self, t0_secs: f64, dt_secs: f64) -> Option<u64> {
-        (self.max_spawn_per_sec > 0.0)
-            .then(|| rate_allowance(f64::from(self.max_spawn_per_sec), t0_secs, dt_secs))
     }
 }

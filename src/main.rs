@@ -479,6 +479,9 @@ fn tune(args: &ignis::tune::cli::TuneArgs, profile: &ProfileRequest) -> anyhow::
     let report = ignis::tune::TuneReport::new(&sweep, budget, &ctx.info.name)?;
     println!("{}", report.markdown());
     let files = report.write(&effect, &args.out)?;
+    if let Some(e) = report.over_budget() {
+        bail!("{e} (the measurements are in {})", args.out.display());
+    }
     println!(
         "{} candidates in {:.1} s on {}; wrote {}",
         report.results.len(),

@@ -200,8 +200,9 @@ fn exact_spawn_counts_over_time() {
 }
 
 /// The spawn cap is a rate: it drops the excess and counts it, and allows the same number
-/// per second at any step size (a cap counted per step would change with the step); a huge
-/// frame-delta step spawns no more than the cap's share of it.
+/// at any step size — a full bucket of a tenth of a second's worth, then the rate (a cap
+/// counted per step would change with the step); a huge frame-delta step spawns no more
+/// than the bucket and the cap's share of it.
 #[test]
 fn spawn_cap_per_second_is_enforced_counted_and_independent_of_the_step() {
     let ctx = gpu();
@@ -219,24 +220,27 @@ fn spawn_cap_per_second_is_enforced_counted_and_independent_of_the_step() {
     ] {
         let sim = run_gpu(&ctx, &effect, dt, steps);
         let stats = sim.planner.emitters[0].stats;
-        assert_eq!(stats.spawned, 400, "2400/s × 1/6 s at dt {dt}");
+        assert_eq!(stats.spawned, 640, "240 + 2400/s × 1/6 s at dt {dt}");
         assert_eq!(
             stats.dropped_by_cap,
-            2000 - 400,
+            2000 - 640,
             "12000/s × 1/6 s requested"
         );
-        assert_eq!(alive_of(&sim.read_particles(0).expect("read")), 400);
+        assert_eq!(alive_of(&sim.read_particles(0).expect("read")), 640);
     }
 
     // Frame-delta mode with a one-second hitch: dt is clamped to max_frame_dt_secs and the
-    // cap bounds the burst to its share of the clamped step.
+    // cap bounds the burst to its bucket and its share of the clamped step.
     effect.time.mode = TimeMode::FrameDelta;
     effect.time.max_frame_dt_secs = 0.1;
     let mut stepper = Stepper::default();
     let plan = stepper.advance(1.0, &effect.time);
     assert_eq!((plan.steps, plan.dt_secs), (1, 0.1));
     let sim = run_gpu(&ctx, &effect, plan.dt_secs, plan.steps);
-    assert_eq!(sim.planner.emitters[0].stats.spawned, 240, "2400/s × 0.1 s");
+    assert_eq!(
+        sim.planner.emitters[0].stats.spawned, 480,
+        "240 + 2400/s × 0.1 s"
+    );
 }
 
 /// Too small a pool: the overwrite of still-alive particles is counted, never silent.

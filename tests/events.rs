@@ -66,13 +66,14 @@ fn parent_and_child(event: Event, parent_rate: f32) -> Effect {
     }
 }
 
-/// The CPU mirror of one step: the parent's records for its window and the scan's list.
+/// The CPU mirror of one step: the parent's records for its window and the scan's list,
+/// within what the event's cap (`bucket`, carried from step to step) allows.
 fn expected_list(
     effect: &Effect,
     sim: &GpuSim,
     p: &SimParams,
-    before: &[Particle],
-    after: &[Particle],
+    (before, after): (&[Particle], &[Particle]),
+    bucket: &mut ignis::effect::RateCap,
 ) -> (Vec<ignis::sim::events::EventSpawn>, u32) {
     let rule = rules_of(&effect.emitters[0])[0];
     let mut records = Vec::new();
@@ -98,22 +99,27 @@ fn expected_list(
     }
     let delta = (sim.planner.emitters[0].origin() - sim.planner.emitters[1].origin()).as_vec3();
     let ev = &effect.emitters[0].events[0];
+    let room = ignis::sim::events::step_cap(effect, 0, 0);
     let cfg = ScanConfig {
         rule_capacity_cap: [
             0,
             effect.emitters[1].capacity,
-            // This step's allowance of the cap per second (within the list's room).
-            p.update_window[2].min(ignis::sim::events::step_cap(effect, 0, 0)),
+            room,
             u32::from(ev.inherit_color),
         ],
         delta_inherit: [delta.x, delta.y, delta.z, ev.inherit_velocity],
+        ..Default::default()
     };
-    scan_events(
+    let (mut list, asked) = scan_events(
         (p.update_window[0], p.update_window[1]),
         p.capacity,
         &records,
         &cfg,
-    )
+    );
+    // The cap's bucket lets the first of them through (in slot order).
+    let allowed = bucket.take(asked.min(room), ev.max_per_sec, p.dt_secs);
+    list.truncate(allowed as usize);
+    (list, asked)
 }
 
 /// Step by step, the children born equal the CPU mirror's list: count (capped), slots,
@@ -122,8 +128,8 @@ fn expected_list(
 #[test]
 fn death_children_match_the_cpu_mirror_including_the_cap() {
     // One block of the scan; then a parent window of several blocks wrapping its ring.
-    // The caps per second allow 12.5 and 100.5 children per 1/60 s step: 12 or 13, 100
-    // or 101, alternating (`p.update_window[2]` in the mirror).
+    // The caps per second refill 12.5 and 100.5 children per 1/60 s step into buckets of
+    // 75 and 603: once a bucket has drained, 12 or 13, 100 or 101, alternating.
     check_against_the_mirror(1024, 900.0, 750.0, false);
     // Children that inherit the parent's colour carry its age at the event.
     check_against_the_mirror(4096, 9_000.0, 6030.0, true);
@@ -152,6 +158,7 @@ fn check_against_the_mirror(
     let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
     let (mut head, mut last_count, mut dropped, mut capped_steps) = (0u32, 0u32, 0u32, 0);
     let child_cap = effect.emitters[1].capacity;
+    let mut bucket = ignis::effect::RateCap::default();
     for step in 0..60 {
         sim.sync(&effect).expect("sync");
         let before = sim.read_particles(0).expect("read");
@@ -161,7 +168,7 @@ fn check_against_the_mirror(
         let child = sim.read_particles(1).expect("read");
         let header = sim.read_event_header(1).expect("read").expect("a child");
         let p = plans[0][0].expect("parent planned");
-        let (list, total) = expected_list(&effect, &sim, &p, &before, &after);
+        let (list, total) = expected_list(&effect, &sim, &p, (&before, &after), &mut bucket);
         head = (head + last_count) % child_cap;
         assert_eq!(header.head, head, "step {step}: head");
         assert_eq!(header.count as usize, list.len(), "step {step}: count");

@@ -140,6 +140,38 @@ fn a_sweep_of_the_campfire_gives_a_frontier_and_a_tuned_preset_within_budget() {
     check_frontier(&report);
     check_zero_vortex(&report, &effect.emitters[flames].name, 2.0);
     check_tuned(&ctx, &report, &effect, &opts, 2.0);
+    check_impossible_budget(&sweep, &effect, &ctx.info.name);
+}
+
+/// A budget no candidate meets: the error names the best reached; the measurements are
+/// written, no tuned preset.
+fn check_impossible_budget(sweep: &Sweep, effect: &Effect, adapter: &str) {
+    let report = TuneReport::new(sweep, Budget::ErrorMean(1e-6), adapter).expect("report");
+    assert_eq!(report.chosen, None);
+    let best = report
+        .results
+        .iter()
+        .map(|m| m.error.mean)
+        .fold(f64::INFINITY, f64::min);
+    let message = report.over_budget().expect("over budget").to_string();
+    assert!(
+        message.contains("no candidate is within") && message.contains(&format!("{best:.3}/255")),
+        "{message}"
+    );
+    let dir = tempfile::tempdir().expect("tempdir");
+    let files = report.write(effect, dir.path()).expect("write");
+    assert_eq!(files.len(), 3, "{files:?}");
+    assert!(!dir.path().join("campfire.tuned.ron").exists());
+}
+
+/// A second preset's references converge too (the campfire's are checked with its sweep).
+#[test]
+fn the_torch_references_converge() {
+    let ctx = gpu();
+    let mut sweep = Sweep::new(&ctx, &preset("torch"), small(0.5)).expect("sweep");
+    run_sweep(&mut sweep, |_, _| {}).expect("run");
+    let report = TuneReport::new(&sweep, Budget::ErrorMean(2.0), &ctx.info.name).expect("report");
+    check_reference_converges(&report);
 }
 
 fn check_reference_converges(report: &TuneReport) {
@@ -234,7 +266,7 @@ fn check_tuned(
     let tuned = ignis::preset::load(&tuned_path).expect("the tuned preset loads");
     tuned.validate().expect("and validates");
     let again = measure_against_reference(ctx, effect, &tuned, opts).expect("measure");
-    let chosen = &report.results[report.chosen];
+    let chosen = &report.results[report.chosen.expect("a candidate within the budget")];
     assert!(again.mean <= budget, "measured again: {again:?}");
     assert_eq!(
         again.mean, chosen.error.mean,

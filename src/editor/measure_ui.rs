@@ -130,12 +130,15 @@ fn finish(ctx: &GpuContext, sweep: &Sweep, panel: &mut MeasurePanel) {
     panel.progress = None;
     match TuneReport::new(sweep, Budget::ErrorMean(panel.budget_error), &ctx.info.name) {
         Ok(r) => {
-            panel.message = Some(Ok(format!(
-                "{} candidates; within {}/255 the cheapest is {}",
-                r.results.len(),
-                panel.budget_error,
-                r.results[r.chosen].label
-            )));
+            panel.message = Some(match r.chosen {
+                Some(c) => Ok(format!(
+                    "{} candidates; within {}/255 the cheapest is {}",
+                    r.results.len(),
+                    panel.budget_error,
+                    r.results[c].label
+                )),
+                None => Err(r.over_budget().map(|e| e.to_string()).unwrap_or_default()),
+            });
             panel.report = Some(r);
         }
         Err(e) => panel.message = Some(Err(e.to_string())),
@@ -268,12 +271,14 @@ fn chart_ui(ui: &mut Ui, report: &TuneReport, pick: &mut Option<usize>) {
                     .radius(6.0)
                     .color(Color32::WHITE),
             );
-            plot.points(
-                Points::new("chosen", vec![xy(report.chosen)])
-                    .shape(MarkerShape::Circle)
-                    .radius(6.0)
-                    .color(Color32::from_rgb(255, 120, 60)),
-            );
+            if let Some(c) = report.chosen {
+                plot.points(
+                    Points::new("chosen", vec![xy(c)])
+                        .shape(MarkerShape::Circle)
+                        .radius(6.0)
+                        .color(Color32::from_rgb(255, 120, 60)),
+                );
+            }
         });
     if response.response.clicked()
         && let Some(pos) = response.response.interact_pointer_pos()
@@ -316,7 +321,7 @@ fn frontier_rows_ui(ui: &mut Ui, report: &TuneReport, pick: &mut Option<usize>) 
             ui.end_row();
             for &i in &report.frontier {
                 let m = &report.results[i];
-                let chosen = i == report.chosen;
+                let chosen = Some(i) == report.chosen;
                 if ui
                     .selectable_label(chosen, &m.label)
                     .on_hover_text("Apply these settings to the effect (one undo step)")

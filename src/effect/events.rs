@@ -88,8 +88,9 @@ pub struct Event {
     /// ramp at its age then, to 1/255): a white child ramp takes the parent's colour.
     pub inherit_color: bool,
     /// At most this many children per second of simulated time (whole effect), whatever
-    /// the step: a step of `dt` from `t` takes at most `⌊cap·(t + dt)⌋ − ⌊cap·t⌋`; the rest
-    /// are dropped and counted in the child's statistics.
+    /// the step, with bursts of a tenth of a second's worth let through (a bucket of
+    /// tokens, [`super::RateCap`]); the rest are dropped and counted in the child's
+    /// statistics.
     pub max_per_sec: f32,
 }
 

@@ -240,8 +240,7 @@ pub struct SimParams {
     pub collide_c: [f32; 4],
     /// The slots this step updates: first slot, count (wrapping at the capacity) — the
     /// ring's live window plus this step's spawns; every other slot is dead in both
-    /// state buffers. Then the most children each of the emitter's two events may spawn
-    /// this step (its cap per second over the step, [`crate::effect::rate_allowance`]).
+    /// state buffers; unused, unused.
     pub update_window: [u32; 4],
     /// Tiny state: the step's start on the emitter's clock as a double-single (hi, lo; f32
     /// bits), the birth table's first sequence number and its number of entries.

@@ -8,8 +8,9 @@
 //! `length_secs` (the span its points cover), an emitter's `max_spawn_per_step` became
 //! `max_spawn_per_sec` and an event's `max_per_step` became `max_per_sec`. A version-2
 //! file converts at its own step (`time`'s fixed step, or a 60 Hz frame in frame-delta
-//! mode), so it plays as it did at that step. An automatic spawn cap (0) becomes no cap:
-//! it only ever bound on steps longer than 1/15 s.
+//! mode), so it plays as it did at that step wherever its caps did not bind (a cap per
+//! second lets a tenth of a second's worth through at once, `crate::effect::RateCap`). An
+//! automatic spawn cap (0) becomes no cap: it only ever bound on steps longer than 1/15 s.
 
 use serde::Deserialize;
 

@@ -79,11 +79,14 @@ pub struct EventHeader {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ScanConfig {
-    /// The rule's index, the child's capacity, the most children a step, flags
-    /// ([`scan_flags`]).
+    /// The rule's index, the child's capacity, the child list's room per step ([`step_cap`]),
+    /// flags ([`scan_flags`]).
     pub rule_capacity_cap: [u32; 4],
     /// The parent's simulation origin minus the child's, and the inherited fraction.
     pub delta_inherit: [f32; 4],
+    /// The event's cap: children per second, the burst its bucket holds
+    /// ([`crate::effect::RateCap`]); unused, unused.
+    pub cap: [f32; 4],
 }
 
 /// A scan's flags: its children inherit the parent's colour (bit 0), they are linked
@@ -121,15 +124,16 @@ pub fn rules_of(e: &Emitter) -> [EventRule; MAX_EVENTS_PER_EMITTER] {
 }
 
 /// The room event `k` of `parent` needs in its child's spawn list per step: the most its
-/// cap per second allows in the effect's longest step (each step's own allowance,
-/// `SimParams::event_caps`, is at most this), within the child's capacity.
+/// cap lets through in one step (a full bucket and the effect's longest step's refill,
+/// [`crate::effect::RateCap`]), within the child's capacity.
 pub fn step_cap(effect: &Effect, parent: usize, k: usize) -> u32 {
     let ev = &effect.emitters[parent].events[k];
     let child = effect
         .event_target(ev)
         .map_or(1, |c| effect.emitters[c].capacity);
     let longest = f64::from(effect.time.longest_step_secs());
-    let most = (f64::from(ev.max_per_sec) * longest).floor() + 1.0;
+    let burst = f64::from(crate::effect::cap_burst(ev.max_per_sec));
+    let most = (burst + f64::from(ev.max_per_sec) * longest).floor() + 1.0;
     (most.min(f64::from(child)) as u32).max(1)
 }
 

@@ -1063,6 +1063,12 @@ impl GpuSim {
                         scan_flags(ev.inherit_color, scan.linked),
                     ],
                     delta_inherit: [delta.x, delta.y, delta.z, ev.inherit_velocity],
+                    cap: [
+                        ev.max_per_sec,
+                        crate::effect::cap_burst(ev.max_per_sec),
+                        0.0,
+                        0.0,
+                    ],
                 };
                 configs.push((i, k, cfg));
             }
@@ -1419,8 +1425,14 @@ impl GpuSim {
                 enc.clear_buffer(b, 0, None);
             }
             enc.clear_buffer(&s.counters, 0, None);
-            if let Some(list) = s.hooks.as_ref().and_then(|ev| ev.list.as_ref()) {
-                enc.clear_buffer(list, 0, None);
+            if let Some(hooks) = s.hooks.as_ref() {
+                if let Some(list) = &hooks.list {
+                    enc.clear_buffer(list, 0, None);
+                }
+                // The events' caps start with full buckets again.
+                for scan in &hooks.scans {
+                    enc.clear_buffer(&scan.blocks, 0, None);
+                }
             }
             s.current = 0;
             s.whole_pool_until = f64::NEG_INFINITY;

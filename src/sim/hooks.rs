@@ -255,12 +255,12 @@ impl EmitterHooks {
                     usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                     mapped_at_creation: false,
                 }),
-                // Where the list starts, a sum per block, and for a ribbon per parent each
-                // parent slot's last child.
+                // Where the list starts, a sum per block, the cap's bucket and this step's
+                // allowance, and for a ribbon per parent each parent slot's last child.
                 blocks: storage_buffer(
                     device,
                     "EmitterHooks::scan_blocks",
-                    4 * (1
+                    4 * (3
                         + u64::from(capacity.div_ceil(EVENT_SCAN_BLOCK))
                         + if linked { 2 * u64::from(capacity) } else { 0 }),
                 ),

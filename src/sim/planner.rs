@@ -3,7 +3,7 @@
 
 use std::collections::VecDeque;
 
-use crate::effect::{Collisions, Effect, Emitter, Forces, Param, Shape, rate_allowance};
+use crate::effect::{Collisions, Effect, Emitter, Forces, Param, RateCap, Shape};
 use crate::gpu::types::{SimParams, double_single};
 use crate::rng;
 
@@ -92,6 +92,8 @@ impl LiveWindow {
 #[derive(Clone, Debug, Default)]
 pub struct EmitterPlanner {
     accumulator: f64,
+    /// The spawn cap's bucket (`Emitter::max_spawn_per_sec`).
+    spawn_cap: RateCap,
     spawned_total: u64,
     /// Running statistics.
     pub stats: SpawnStats,
@@ -178,13 +180,6 @@ impl EffectPlanner {
             );
             // The step's number: the event scan stamps a child's list with it.
             params.tiny_b[2] = self.step_index as u32;
-            // Each event's cap over this step (the scan reads them beside the window).
-            let [_, _, caps @ ..] = &mut params.update_window;
-            *caps = [0; 2];
-            for (cap, ev) in caps.iter_mut().zip(&e.events) {
-                let n = rate_allowance(f64::from(ev.max_per_sec), t0, f64::from(dt_secs));
-                *cap = n.min(u64::from(u32::MAX)) as u32;
-            }
             sink(i, Some(&params));
         }
         self.time_secs += dt_secs as f64;
@@ -312,9 +307,11 @@ impl EmitterPlanner {
         let continuous = self.accumulator.floor();
         self.accumulator -= continuous;
         let mut continuous = continuous as u64;
-        let cap = e.spawn_cap_between(self.clock_secs, dt).unwrap_or(u64::MAX);
-        let capped = continuous > cap;
-        if capped {
+        let mut capped = false;
+        if e.max_spawn_per_sec > 0.0 {
+            let asked = continuous.min(u64::from(u32::MAX)) as u32;
+            let cap = u64::from(self.spawn_cap.take(asked, e.max_spawn_per_sec, dt as f32));
+            capped = cap < continuous;
             self.stats.dropped_by_cap += continuous - cap;
             continuous = cap;
         }

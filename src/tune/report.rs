@@ -46,8 +46,9 @@ pub struct TuneReport {
     pub frontier: Vec<usize>,
     /// The effect as authored (an index into `results`).
     pub authored: usize,
-    /// The candidate the budget chooses.
-    pub chosen: usize,
+    /// The candidate the budget chooses (`None`: no candidate is within it; see
+    /// [`TuneReport::over_budget`]).
+    pub chosen: Option<usize>,
     /// The reference at half its step against the reference.
     pub reference_check: Option<ImageError>,
     /// Each module's contribution.
@@ -57,8 +58,8 @@ pub struct TuneReport {
 }
 
 impl TuneReport {
-    /// The report of a finished sweep; an error naming the best reached when no candidate
-    /// is within the budget.
+    /// The report of a finished sweep (an error only when the effect as authored did not
+    /// run).
     pub fn new(sweep: &Sweep, budget: Budget, adapter: &str) -> Result<Self, TuneError> {
         let results = sweep.results.clone();
         let authored = results
@@ -69,7 +70,7 @@ impl TuneReport {
                 best: "the effect as authored did not run".into(),
             })?;
         let points: Vec<(f64, f64)> = results.iter().map(|m| (m.error.mean, m.frame_ms)).collect();
-        let chosen = choose(&points, budget).ok_or_else(|| over_budget(&results, budget))?;
+        let chosen = choose(&points, budget);
         let threshold = match budget {
             Budget::ErrorMean(e) => e,
             Budget::FrameMs(_) => INVISIBLE_MEAN,
@@ -100,13 +101,21 @@ impl TuneReport {
         })
     }
 
-    /// The chosen candidate's effect (the authored one with its changes), as a preset.
-    pub fn tuned_effect(&self, authored: &Effect) -> Effect {
-        let mut e = self.results[self.chosen].candidate.apply(authored);
+    /// Why no candidate was chosen: the budget and the best reached (`None`: one was).
+    pub fn over_budget(&self) -> Option<TuneError> {
+        self.chosen
+            .is_none()
+            .then(|| over_budget(&self.results, self.budget))
+    }
+
+    /// The chosen candidate's effect (the authored one with its changes), as a preset;
+    /// `None` when none is within the budget.
+    pub fn tuned_effect(&self, authored: &Effect) -> Option<Effect> {
+        let mut e = self.results[self.chosen?].candidate.apply(authored);
         // A finer step keeps playing in real time down to 30 frames a second.
         let needed = super::candidate::steps_per_frame(1.0 / 30.0, e.time.step_secs);
         e.time.max_substeps = e.time.max_substeps.max(needed);
-        e
+        Some(e)
     }
 
     /// The frontier as a Markdown table, then the modules.
@@ -114,7 +123,7 @@ impl TuneReport {
         let mut s = self.heading();
         s.push_str("| | candidate | mean error (of 255) | p99 | worst frame | update ms | frame ms |\n|---|---|---|---|---|---|---|\n");
         let mut rows: Vec<usize> = self.frontier.clone();
-        for i in [self.authored, self.chosen] {
+        for i in [Some(self.authored), self.chosen].into_iter().flatten() {
             if !rows.contains(&i) {
                 rows.push(i);
             }
@@ -126,6 +135,9 @@ impl TuneReport {
         });
         for i in rows {
             s.push_str(&self.row(i));
+        }
+        if let Some(e) = self.over_budget() {
+            s.push_str(&format!("\n{e}: no tuned preset.\n"));
         }
         s.push_str(&self.modules_markdown());
         s
@@ -164,7 +176,7 @@ impl TuneReport {
 
     fn row(&self, i: usize) -> String {
         let m = &self.results[i];
-        let mark = match (i == self.authored, i == self.chosen) {
+        let mark = match (i == self.authored, Some(i) == self.chosen) {
             (true, true) => "A ✓",
             (true, false) => "A",
             (false, true) => "✓",
@@ -204,10 +216,13 @@ impl TuneReport {
     }
 
     /// The tuned preset's text: what changed and what it costs or saves in a comment at
-    /// the top, then the preset.
+    /// the top, then the preset; the over-budget error when none is chosen.
     pub fn tuned_text(&self, authored: &Effect) -> Result<String, TuneError> {
-        let (a, c) = (&self.results[self.authored], &self.results[self.chosen]);
-        let change = if self.chosen == self.authored {
+        let (Some(chosen), Some(effect)) = (self.chosen, self.tuned_effect(authored)) else {
+            return Err(over_budget(&self.results, self.budget));
+        };
+        let (a, c) = (&self.results[self.authored], &self.results[chosen]);
+        let change = if chosen == self.authored {
             "nothing: the effect as authored is the choice".to_owned()
         } else {
             c.label.clone()
@@ -226,7 +241,6 @@ impl TuneReport {
             c.frame_ms,
             a.frame_ms,
         );
-        let effect = self.tuned_effect(authored);
         effect.validate().map_err(crate::PlayerError::Invalid)?;
         let ron = crate::preset::to_ron(&effect).map_err(|e| TuneError::Write {
             path: "tuned preset".into(),
@@ -235,22 +249,26 @@ impl TuneReport {
         Ok(format!("{comment}{}{ron}\n", crate::preset::file_header()))
     }
 
-    /// Writes `NAME.tune.json`, `NAME.tune.md`, `NAME.frontier.svg` and `NAME.tuned.ron`
-    /// into `dir` (each file whole or not at all); returns their paths.
+    /// Writes `NAME.tune.json`, `NAME.tune.md`, `NAME.frontier.svg` and, when a candidate
+    /// is within the budget, `NAME.tuned.ron` into `dir` (each file whole or not at all);
+    /// returns their paths.
     pub fn write(&self, authored: &Effect, dir: &Path) -> Result<Vec<PathBuf>, TuneError> {
         let stem = crate::preset::file_stem(&self.effect);
-        let tuned = self.tuned_text(authored)?;
+        let tuned = match self.chosen {
+            Some(_) => Some(self.tuned_text(authored)?),
+            None => None,
+        };
         let json = serde_json::to_string_pretty(self).map_err(|e| TuneError::Write {
             path: "json".into(),
             message: e.to_string(),
         })?;
         let svg = super::svg::frontier_svg(self);
-        let files = [
+        let mut files = vec![
             (format!("{stem}.tune.json"), json),
             (format!("{stem}.tune.md"), self.markdown()),
             (format!("{stem}.frontier.svg"), svg),
-            (format!("{stem}.tuned.ron"), tuned),
         ];
+        files.extend(tuned.map(|t| (format!("{stem}.tuned.ron"), t)));
         let err = |p: &Path, e: std::io::Error| TuneError::Write {
             path: p.display().to_string(),
             message: e.to_string(),

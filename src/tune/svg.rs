@@ -63,11 +63,14 @@ fn draw<'a>(r: &TuneReport, out: &'a mut String) -> Result<(), Box<dyn std::erro
         .label("frontier")
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], blue));
     chart.draw_series(front.iter().map(|&p| Circle::new(p, 4, blue.filled())))?;
-    for (i, name, color) in [
-        (r.authored, "as authored", BLACK),
+    let marks = [
+        (Some(r.authored), "as authored", BLACK),
         (r.chosen, "chosen", RED),
-    ] {
-        let p = pts[i];
+    ];
+    for (i, name, color) in marks {
+        let Some(p) = i.map(|i| pts[i]) else {
+            continue;
+        };
         chart
             .draw_series([Circle::new(p, 8, color.stroke_width(2))])?
             .label(name)

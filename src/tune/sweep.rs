@@ -138,6 +138,10 @@ pub struct Sweep {
     check: ErrorAccumulator,
     queue: VecDeque<(Role, Candidate)>,
     running: Option<Running>,
+    /// The player of the last run, kept for the next one: an edit to the next candidate's
+    /// effect and a restart build only the pipelines it lacks (a new player per candidate
+    /// compiled every pipeline again: most of the sweep's time).
+    spare: Option<Headless>,
     /// Every candidate measured so far, the effect as authored first.
     pub results: Vec<Measured>,
     /// Candidates that could not run, and why.
@@ -174,6 +178,7 @@ impl Sweep {
             check: ErrorAccumulator::default(),
             queue,
             running: None,
+            spare: None,
             results: Vec::new(),
             skipped: Vec::new(),
             combined: false,
@@ -308,17 +313,28 @@ impl Sweep {
     }
 
     fn start(
-        &self,
+        &mut self,
         role: Role,
         candidate: Candidate,
         effect: Effect,
     ) -> Result<Running, TuneError> {
-        let settings = crate::PlayerSettings {
-            asset_dir: self.opts.asset_dir.clone(),
-            ..crate::render::Composite::player_settings()
+        let run = match self.spare.take() {
+            // The same frames as a new player's: the edit keeps nothing of the last run
+            // once restarted (tests/tune.rs measures a tuned preset again on a new one).
+            Some(mut run) => {
+                run.player.set_effect(&effect)?;
+                run.player.restart();
+                run
+            }
+            None => {
+                let settings = crate::PlayerSettings {
+                    asset_dir: self.opts.asset_dir.clone(),
+                    ..crate::render::Composite::player_settings()
+                };
+                let lib = ShaderLibrary::discover(None);
+                Headless::with_settings(&self.ctx, effect, lib, settings)?
+            }
         };
-        let lib = ShaderLibrary::discover(None);
-        let run = Headless::with_settings(&self.ctx, effect, lib, settings)?;
         let camera = run.camera.view(self.opts.size);
         Ok(Running {
             role,
