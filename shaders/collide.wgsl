@@ -15,8 +15,16 @@ struct Collided {
     vel: vec3<f32>,
     killed: bool,
     // An impact: the particle touched a collider moving into it faster than the rest
-    // speed, or was killed by it (a collision event fires).
+    // speed (beyond what the constant acceleration adds in one step: a particle resting
+    // on the ground is not hitting it at every step, whatever the step), or was killed
+    // by it (a collision event fires).
     hit: bool,
+}
+
+// Whether touching a collider of normal `n` at velocity `vel` is an impact.
+fn is_impact(vel: vec3<f32>, n: vec3<f32>) -> bool {
+    let settle = max(0.0, -dot(params.accel_drag.xyz, n)) * params.dt_secs;
+    return -dot(vel, n) > params.collide_b.x + settle;
 }
 
 fn bounce(vel: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
@@ -72,7 +80,7 @@ fn collide(old_pos: vec3<f32>, pos_in: vec3<f32>, vel_in: vec3<f32>) -> Collided
             var n = contact - s.xyz;
             let len = length(n);
             n = select(vec3<f32>(0.0, 1.0, 0.0), n / len, len > 1e-6);
-            impact = impact || -dot(vel, n) > params.collide_b.x;
+            impact = impact || is_impact(vel, n);
             pos = s.xyz + n * (s.w * 1.0001);
             vel = bounce(vel, n);
         }
@@ -81,7 +89,7 @@ fn collide(old_pos: vec3<f32>, pos_in: vec3<f32>, vel_in: vec3<f32>) -> Collided
         if params.ground.w > 0.5 {
             return Collided(pos, vel, true, true);
         }
-        impact = impact || -vel.y > params.collide_b.x;
+        impact = impact || is_impact(vel, vec3<f32>(0.0, 1.0, 0.0));
         pos.y = params.ground.x;
         vel = bounce(vel, vec3<f32>(0.0, 1.0, 0.0));
     }

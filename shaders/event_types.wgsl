@@ -17,7 +17,8 @@ struct EventRule {
 // visits; BORN_BIT set when the particle was born this step), then a record per rule and slot, written only when it asks for children
 // (`RECORD_WORDS` words from `2 · capacity + (rule · capacity + slot) · RECORD_WORDS`:
 // position xyz (the parent's simulation space), the event's key, velocity xyz, the
-// parent's normalised age (f32 bits)).
+// parent's normalised age × 255 (bits 0–7) and the number of the event's first child in
+// the parent's life (bits 8–31: over-life children are keyed by it)).
 // The scan reads every count but only the records of slots with children.
 struct EventOut {
     rules: array<EventRule, 2>,

@@ -202,13 +202,16 @@ fn write_list(
         let pos = bitcast<vec3<f32>>(vec3<u32>(event_out.words[r], event_out.words[r + 1u], event_out.words[r + 2u]));
         let vel = bitcast<vec3<f32>>(vec3<u32>(event_out.words[r + 4u], event_out.words[r + 5u], event_out.words[r + 6u]));
         let key = event_out.words[r + 3u];
-        // The parent's normalised age to 1/255, and whether the child inherits its colour.
-        let t = u32(bitcast<f32>(event_out.words[r + 7u]) * 255.0 + 0.5);
+        // The parent's normalised age to 1/255, whether the child inherits its colour, and
+        // the number of the event's first child (its children's numbers follow).
+        let packed = event_out.words[r + 7u];
+        let t = packed & 0xFFu;
+        let first = packed >> 8u;
         let color = (t << 16u) | ((flags & INHERIT_COLOR) << 24u);
         for (var j = 0u; j < c && at + j < cap; j++) {
             event_in.list[start + at + j] = EventSpawn(
                 vec4<f32>(pos + cfg.delta_inherit.xyz, bitcast<f32>(key)),
-                vec4<f32>(vel * cfg.delta_inherit.w, bitcast<f32>(color | j)),
+                vec4<f32>(vel * cfg.delta_inherit.w, bitcast<f32>(color | ((first + j) & 0xFFFFu))),
             );
         }
         if (flags & RIBBON) != 0u && at < cap {

@@ -28,6 +28,10 @@ const TRIGGER_OVER_LIFE: u32 = 3u;
 const TRIGGER_NONE: u32 = 0xFFFFFFFFu;
 // Keep in sync with MAX_CHILDREN_PER_EVENT (src/effect/events.rs).
 const MAX_CHILDREN: u32 = 64u;
+// A collision's ordinal is the parent's age in these units (keep in sync with
+// COLLISION_ORDINALS_PER_SEC in src/sim/events.rs): the same bounce draws the same
+// children at any step, where the age's own bits would differ with the step.
+const COLLISION_ORDINALS_PER_SEC: f32 = 16.0;
 
 @group(1) @binding(0) var<storage, read_write> event_out: EventOut;
 @group(1) @binding(1) var<storage, read> event_in: EventIn;
@@ -104,13 +108,16 @@ fn emit_events(slot: u32, p: Particle, born: bool, was_alive: bool, alive: bool,
         var fired = false;
         var n = 0u;
         var ordinal = 0u;
+        // Over life: the first child's number in the parent's life (children are keyed by
+        // it, so the k-th child is the same whatever step it falls in).
+        var first = 0u;
         switch rule.trigger {
             case TRIGGER_DEATH: {
                 fired = lived && !alive;
             }
             case TRIGGER_COLLISION: {
                 fired = lived && hit;
-                ordinal = bitcast<u32>(p.pos_age.w);
+                ordinal = u32(floor(p.pos_age.w * COLLISION_ORDINALS_PER_SEC));
             }
             case TRIGGER_BIRTH: {
                 fired = born;
@@ -122,7 +129,7 @@ fn emit_events(slot: u32, p: Particle, born: bool, was_alive: bool, alive: bool,
                     let a1 = min(p.pos_age.w, p.vel_life.w);
                     let k0 = floor(rule.rate * a0);
                     n = u32(max(floor(rule.rate * a1) - k0, 0.0));
-                    ordinal = u32(k0);
+                    first = u32(k0);
                 }
             }
         }
@@ -147,8 +154,10 @@ fn emit_events(slot: u32, p: Particle, born: bool, was_alive: bool, alive: bool,
             event_out.words[at + 4u] = vel.x;
             event_out.words[at + 5u] = vel.y;
             event_out.words[at + 6u] = vel.z;
-            // The parent's normalised age (its colour, for children that inherit it).
-            event_out.words[at + 7u] = bitcast<u32>(clamp(p.pos_age.w / p.vel_life.w, 0.0, 1.0));
+            // The parent's normalised age to 1/255 (its colour, for children that inherit
+            // it), and above it the first child's number (over life).
+            let t = u32(clamp(p.pos_age.w / p.vel_life.w, 0.0, 1.0) * 255.0 + 0.5);
+            event_out.words[at + 7u] = (first << 8u) | t;
         }
     }
 }

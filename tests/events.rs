@@ -82,7 +82,8 @@ fn expected_list(
         let rel = (slot + p.capacity - p.spawn_head) % p.capacity;
         let born = rel < p.spawn_count;
         let a = &after[slot as usize];
-        let (n, key) = event_of(&rule, 0, p, slot, &before[slot as usize], a, born, false);
+        let (n, key, first_child) =
+            event_of(&rule, 0, p, slot, &before[slot as usize], a, born, false);
         records.push((
             slot,
             EventRecord {
@@ -94,6 +95,7 @@ fn expected_list(
                     f32::from_bits(key),
                 ],
                 parent_t: (a.pos_age[3] / a.vel_life[3]).clamp(0.0, 1.0),
+                first_child,
             },
         ));
     }
@@ -705,4 +707,87 @@ fn inherited_colour_tints_the_children() {
             "{path:?} own colour: {r} {g} {b}"
         );
     }
+}
+
+/// The children of the events of `effect` (emitter 1) after `secs` at steps of `dt`: their
+/// lifetimes' bits (drawn from their keys: the same bits, the same particle), sorted.
+fn children_at_step(effect: &Effect, dt: f32, secs: f32) -> Vec<u32> {
+    let ctx = gpu();
+    let mut effect = effect.clone();
+    effect.time.step_secs = dt;
+    let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
+    sim.step(&effect, dt, (secs / dt).round() as u32)
+        .expect("step");
+    let mut lives: Vec<u32> = sim
+        .read_particles(1)
+        .expect("read")
+        .iter()
+        .filter(|p| p.is_alive())
+        .map(|p| p.vel_life[3].to_bits())
+        .collect();
+    lives.sort_unstable();
+    lives
+}
+
+/// Events' children are the same particles at any step: an over-life child is keyed by
+/// its number in its parent's life (not by the step it falls in), a bounce by the parent's
+/// age in 1/64 s (not by the age's bits, which differ with the step) — so the image of an
+/// effect with events converges as the step shrinks (`ignis tune`'s references).
+#[test]
+fn the_children_of_events_are_the_same_particles_at_any_step() {
+    // Over life: 20 parents living 1 s, 30 children a second each.
+    let mut over_life = parent_and_child(
+        Event {
+            trigger: Trigger::OverLife,
+            rate_per_sec: 30.0,
+            ..Event::default()
+        },
+        0.0,
+    );
+    over_life.emitters[0].bursts = vec![Burst {
+        time_secs: 0.0,
+        count: 20,
+    }];
+    over_life.emitters[0].lifetime_secs = Range::new(1.0, 1.0);
+    let a = children_at_step(&over_life, 1.0 / 60.0, 0.55);
+    assert_eq!(a.len(), 20 * 16, "born at 0: 0.55 s old");
+    assert_eq!(a, children_at_step(&over_life, 1.0 / 240.0, 0.55));
+    assert_eq!(a, children_at_step(&over_life, 1.0 / 20.0, 0.55));
+
+    // Collisions: sparks bouncing on the ground, a child per bounce.
+    let mut bounce = parent_and_child(
+        Event {
+            trigger: Trigger::Collision,
+            ..Event::default()
+        },
+        0.0,
+    );
+    let p = &mut bounce.emitters[0];
+    p.bursts = vec![Burst {
+        time_secs: 0.0,
+        count: 200,
+    }];
+    p.lifetime_secs = Range::new(5.0, 5.0);
+    p.transform.position_m = [0.0, 0.5, 0.0];
+    p.speed_m_per_s = Range::new(1.0, 3.0);
+    p.forces.gravity_m_per_s2 = [0.0, -9.81, 0.0];
+    p.collisions.ground = Some(GroundPlane::default());
+    p.collisions.elasticity = 0.6;
+    // The same children, but for bounces whose age straddles a 1/16 s mark between two
+    // steps, and for the last, near-resting hops: fewer as the step shrinks.
+    let finest = children_at_step(&bounce, 1.0 / 960.0, 2.0);
+    let shared_with_finest = |dt: f32| {
+        let a = children_at_step(&bounce, dt, 2.0);
+        let shared = a.iter().filter(|x| finest.binary_search(x).is_ok()).count();
+        shared as f64 / a.len().max(finest.len()) as f64
+    };
+    let (coarse, fine) = (
+        shared_with_finest(1.0 / 120.0),
+        shared_with_finest(1.0 / 480.0),
+    );
+    assert!(finest.len() > 400, "{} bounces", finest.len());
+    assert!(
+        fine > 0.8 && fine > coarse,
+        "shared: {coarse} at 1/120 s, {fine} at 1/480 s"
+    );
 }

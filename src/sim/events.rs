@@ -45,7 +45,14 @@ pub struct EventRecord {
     pub vel_key: [f32; 4],
     /// The parent's normalised age.
     pub parent_t: f32,
+    /// The number of the event's first child in the parent's life (over life; 0 for the
+    /// other triggers): its children are numbered on from it.
+    pub first_child: u32,
 }
+
+/// A collision's ordinal is the parent's age in these units (`COLLISION_ORDINALS_PER_SEC`
+/// in `shaders/events_on.wgsl`): one bounce draws the same children at any step.
+pub const COLLISION_ORDINALS_PER_SEC: f32 = 16.0;
 
 /// One entry of a child's spawn list (`EventSpawn`).
 #[repr(C)]
@@ -137,8 +144,8 @@ pub fn step_cap(effect: &Effect, parent: usize, k: usize) -> u32 {
     (most.min(f64::from(child)) as u32).max(1)
 }
 
-/// The children one parent slot's rule asks for this step and the event's key: the CPU
-/// mirror of `emit_events` (`shaders/events_on.wgsl`). `before`/`after`: the slot's state
+/// The children one parent slot's rule asks for this step, the event's key and the number
+/// of its first child: the CPU mirror of `emit_events` (`shaders/events_on.wgsl`). `before`/`after`: the slot's state
 /// at the step's start and end; `born`: spawned this step; `hit`: a collider impact.
 #[allow(clippy::too_many_arguments)]
 pub fn event_of(
@@ -150,19 +157,19 @@ pub fn event_of(
     after: &Particle,
     born: bool,
     hit: bool,
-) -> (u32, u32) {
+) -> (u32, u32, u32) {
     let cap = p.capacity;
     let total =
         (u64::from(p.spawn_base_hi) << 32 | u64::from(p.spawn_base_lo)) + u64::from(p.spawn_count);
     let counter = slot_counter(slot, total, cap);
     let lived = born || before.is_alive();
     let alive = after.is_alive();
-    let (mut n, mut ordinal, mut fired) = (0u32, 0u32, false);
+    let (mut n, mut ordinal, mut fired, mut first) = (0u32, 0u32, false, 0u32);
     match rule.trigger {
         0 => fired = lived && !alive,
         1 => {
             fired = lived && hit;
-            ordinal = after.pos_age[3].to_bits();
+            ordinal = (after.pos_age[3] * COLLISION_ORDINALS_PER_SEC).floor() as u32;
         }
         2 => fired = born,
         3 => {
@@ -171,10 +178,10 @@ pub fn event_of(
                 let a1 = after.pos_age[3].min(after.vel_life[3]);
                 let k0 = (rule.rate * a0).floor();
                 n = ((rule.rate * a1).floor() - k0).max(0.0) as u32;
-                ordinal = k0 as u32;
+                first = k0 as u32;
             }
         }
-        _ => return (0, 0),
+        _ => return (0, 0, 0),
     }
     let h = pcg4d([
         p.seed ^ slot.wrapping_mul(0x9E37_79B9),
@@ -193,7 +200,7 @@ pub fn event_of(
             0
         };
     }
-    (n.min(MAX_CHILDREN_PER_EVENT), key)
+    (n.min(MAX_CHILDREN_PER_EVENT), key, first)
 }
 
 /// The spawn list a scan makes of one rule's records over the parent's window (the CPU
@@ -219,6 +226,7 @@ pub fn scan_events(
         let n = r.pos_count[3].to_bits();
         let t = (r.parent_t * 255.0 + 0.5) as u32;
         let color = (t << 16) | ((cfg.rule_capacity_cap[3] & 1) << 24);
+        let first = r.first_child;
         for j in 0..n {
             if total + j < cap {
                 list.push(EventSpawn {
@@ -232,7 +240,7 @@ pub fn scan_events(
                         r.vel_key[0] * d[3],
                         r.vel_key[1] * d[3],
                         r.vel_key[2] * d[3],
-                        f32::from_bits(color | j),
+                        f32::from_bits(color | (first.wrapping_add(j) & 0xFFFF)),
                     ],
                 });
             }

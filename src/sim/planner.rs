@@ -315,16 +315,24 @@ impl EmitterPlanner {
             self.stats.dropped_by_cap += continuous - cap;
             continuous = cap;
         }
+        let in_step = |b: &&crate::effect::Burst| {
+            let t = b.time_secs as f64;
+            !fed && t >= t0_secs && t < t0_secs + dt
+        };
         let burst: u64 = e
             .bursts
             .iter()
-            .filter(|_| !fed)
-            .filter(|b| {
-                let t = b.time_secs as f64;
-                t >= t0_secs && t < t0_secs + dt
-            })
+            .filter(in_step)
             .map(|b| b.count as u64)
             .sum();
+        // A step of bursts alone: its particles are born at the (first) burst's moment,
+        // whatever the step (ages the same at any step size).
+        let burst_frac = e
+            .bursts
+            .iter()
+            .filter(in_step)
+            .map(|b| (b.time_secs as f64 - t0_secs) / dt)
+            .fold(f64::INFINITY, f64::min);
         let mut count = continuous + burst;
         let capacity = e.capacity.max(1) as u64;
         if count > capacity {
@@ -335,6 +343,8 @@ impl EmitterPlanner {
         let (frac0, frac_step) = if burst == 0 && !capped && expected > 0.0 {
             let per = 1.0 / expected;
             ((1.0 - acc_before) * per, per)
+        } else if continuous == 0 && burst > 0 {
+            (burst_frac.clamp(0.0, 1.0), 0.0)
         } else if count > 0 {
             (0.5 / count as f64, 1.0 / count as f64)
         } else {
