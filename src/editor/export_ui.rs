@@ -163,22 +163,9 @@ pub fn export_ui(ui: &mut Ui, panel: &mut ExportPanel) {
         {
             panel.start_requested = true;
         }
-        if let Some((done, total)) = panel.progress {
-            let f = done as f32 / total.max(1) as f32;
-            ui.add(egui::ProgressBar::new(f).show_percentage());
-            // Keep frames coming while the export runs.
-            ui.ctx().request_repaint();
-        }
+        super::panel::progress_ui(ui, panel.progress.map(|(d, t)| (d as usize, t as usize)));
     });
-    match &panel.message {
-        Some(Ok(m)) => {
-            ui.label(m);
-        }
-        Some(Err(m)) => {
-            ui.colored_label(ui.visuals().error_fg_color, m);
-        }
-        None => {}
-    }
+    super::panel::outcome_ui(ui, panel.message.as_ref());
     preview_ui(ui, panel);
 }
 

@@ -213,21 +213,9 @@ fn controls_ui(ui: &mut Ui, panel: &mut MeasurePanel) {
         } else if ui.button("Measure").clicked() {
             panel.start_requested = true;
         }
-        if let Some((done, total)) = panel.progress {
-            let f = done as f32 / total.max(1) as f32;
-            ui.add(egui::ProgressBar::new(f).show_percentage());
-            ui.ctx().request_repaint();
-        }
+        super::panel::progress_ui(ui, panel.progress);
     });
-    match &panel.message {
-        Some(Ok(m)) => {
-            ui.weak(m);
-        }
-        Some(Err(m)) => {
-            ui.colored_label(ui.visuals().error_fg_color, m);
-        }
-        None => {}
-    }
+    super::panel::outcome_ui(ui, panel.message.as_ref());
 }
 
 /// The chart: log10 of the frame time (x) and of the error (y); hovering a point names

@@ -380,6 +380,28 @@ pub(super) fn error_box_ui(ui: &mut Ui, add: impl FnOnce(&mut Ui)) {
 // ---------------------------------------------------------------------------------------
 // Small widget helpers.
 
+/// A job's progress bar (done of total), while it runs; frames keep coming meanwhile.
+pub(super) fn progress_ui(ui: &mut Ui, progress: Option<(usize, usize)>) {
+    if let Some((done, total)) = progress {
+        let f = done as f32 / total.max(1) as f32;
+        ui.add(egui::ProgressBar::new(f).show_percentage());
+        ui.ctx().request_repaint();
+    }
+}
+
+/// A job's outcome: its message, or its error in the error colour.
+pub(super) fn outcome_ui(ui: &mut Ui, outcome: Option<&Result<String, String>>) {
+    match outcome {
+        Some(Ok(m)) => {
+            ui.label(m);
+        }
+        Some(Err(m)) => {
+            ui.colored_label(ui.visuals().error_fg_color, m);
+        }
+        None => {}
+    }
+}
+
 /// A labelled grid row: the label names the widget for accessibility (and tests) and
 /// both carry the tooltip.
 pub(crate) fn row_ui(
