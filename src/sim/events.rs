@@ -20,7 +20,7 @@ const TRIGGER_NONE: u32 = u32::MAX;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct EventRule {
-    /// [`Trigger::index`], or `u32::MAX` for none.
+    /// [`crate::effect::Trigger::index`], or `u32::MAX` for none.
     pub trigger: u32,
     /// Fewest children per event.
     pub count_min: u32,
