@@ -897,7 +897,7 @@ fn an_instance_added_to_a_sorted_batch_shows_its_smoke() {
 }
 
 /// A frame runs every step it needs, on both sides of the parameter ring's 32 steps: a
-/// preset whose step needs 16 or 40 steps a frame plays at real time (nothing dropped),
+/// preset whose step needs 16, 40 or 72 steps a frame plays at real time (nothing dropped),
 /// batched and with a simulation of its own, and its particles are bit-identical to a
 /// simulation stepped that many steps in separate submissions. (Steps of 2^-10 and 2^-12
 /// s: frames of whole steps, exactly.)
@@ -909,10 +909,14 @@ fn a_frame_runs_every_step_it_needs_beyond_one_chunk() {
         (batchable_campfire(), "batched"),
         (preset("campfire"), "own"),
     ] {
-        for (steps_per_frame, step) in [(16u32, 1.0 / 1024.0), (40, 1.0 / 4096.0)] {
+        for (steps_per_frame, step) in [
+            (16u32, 1.0 / 1024.0),
+            (40, 1.0 / 4096.0),
+            (72, 1.0 / 4096.0),
+        ] {
             let mut effect = effect.clone();
             effect.time.step_secs = step;
-            effect.time.max_substeps = 64;
+            effect.time.max_substeps = 128;
             let frame_secs = f64::from(steps_per_frame) * f64::from(step);
             let mut player = host.player(&effect);
             let id = player.add_instance(Mat4::IDENTITY, 3).expect("instance");

@@ -416,6 +416,9 @@ pub struct GpuSim {
     update: SharedUpdate,
     params_buffer: wgpu::Buffer,
     params_slots: usize,
+    /// The blocks of a record's chunks after the first (copied into the params ring by the
+    /// encoder before each chunk's steps); grown as needed, kept between records.
+    later_chunks: Option<wgpu::Buffer>,
     pub(super) emitters: Vec<EmitterState>,
     /// CPU planning (time, spawn counts).
     pub planner: EffectPlanner,
@@ -522,6 +525,7 @@ impl GpuSim {
                 mapped_at_creation: false,
             }),
             params_slots: 1,
+            later_chunks: None,
             emitters: Vec::new(),
             planner: EffectPlanner::default(),
         };
@@ -893,26 +897,53 @@ impl GpuSim {
             }
         }
         self.write_scan_configs(effect);
-        let chunks = plans.len().div_ceil(STEPS_PER_SUBMIT);
-        for (c, chunk) in plans.chunks(STEPS_PER_SUBMIT).enumerate() {
-            let (blocks, windows) = self.param_blocks(chunk);
-            if c == 0 {
-                // Written before the submission runs: the first chunk's blocks.
-                self.ctx.queue.write_buffer(&self.params_buffer, 0, &blocks);
-            } else {
-                drop(pass.take());
-                let staging = wgpu::util::DeviceExt::create_buffer_init(
-                    &self.ctx.device,
-                    &wgpu::util::BufferInitDescriptor {
-                        label: Some("GpuSim::params chunk"),
-                        contents: &blocks,
-                        usage: wgpu::BufferUsages::COPY_SRC,
-                    },
-                );
-                enc.copy_buffer_to_buffer(&staging, 0, &self.params_buffer, 0, blocks.len() as u64);
-            }
-            self.dispatch_steps(enc, pass, effect, chunk, &windows, c + 1 == chunks);
+        let chunks: Vec<(Vec<u8>, Vec<u32>)> = plans
+            .chunks(STEPS_PER_SUBMIT)
+            .map(|chunk| self.param_blocks(chunk))
+            .collect();
+        // Written before the submission runs: the first chunk's blocks into the ring, the
+        // others after one another into `later_chunks`.
+        if let Some((first, _)) = chunks.first() {
+            self.ctx.queue.write_buffer(&self.params_buffer, 0, first);
         }
+        let later: Vec<u8> = chunks
+            .iter()
+            .skip(1)
+            .flat_map(|c| c.0.iter().copied())
+            .collect();
+        let staging = self.later_chunks_buffer(later.len() as u64);
+        if let Some(buffer) = &staging {
+            self.ctx.queue.write_buffer(buffer, 0, &later);
+        }
+        let mut at = 0u64;
+        for (c, (chunk, (blocks, windows))) in
+            plans.chunks(STEPS_PER_SUBMIT).zip(&chunks).enumerate()
+        {
+            if let (true, Some(buffer)) = (c > 0, &staging) {
+                // The chunk's blocks into the ring once the steps before have run.
+                drop(pass.take());
+                let len = blocks.len() as u64;
+                enc.copy_buffer_to_buffer(buffer, at, &self.params_buffer, 0, len);
+                at += len;
+            }
+            self.dispatch_steps(enc, pass, effect, chunk, windows, c + 1 == chunks.len());
+        }
+    }
+
+    /// `later_chunks`, at least `bytes` long (`None` for none).
+    fn later_chunks_buffer(&mut self, bytes: u64) -> Option<wgpu::Buffer> {
+        if bytes == 0 {
+            return None;
+        }
+        if self.later_chunks.as_ref().is_none_or(|b| b.size() < bytes) {
+            self.later_chunks = Some(self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("GpuSim::later_chunks"),
+                size: bytes.next_power_of_two(),
+                usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }));
+        }
+        self.later_chunks.clone()
     }
 
     /// The parameter blocks of up to 32 steps' plans, as the params ring holds them, and
