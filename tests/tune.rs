@@ -4,6 +4,9 @@
 //! flagged, the same seed gives the same particles at every step, and bad options are
 //! refused with nothing written.
 
+// `ignis tune` and the `ignis` binary: the default `editor` feature.
+#![cfg(feature = "editor")]
+
 mod common;
 
 use std::path::{Path, PathBuf};
