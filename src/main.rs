@@ -92,6 +92,10 @@ enum Command {
         /// recreates it and keeps the effect).
         #[arg(long, hide = true)]
         lose_device_at: Option<u32>,
+        /// Start Time ▸ Measure this effect at launch over this span, seconds (with
+        /// --frames and --screenshot: a picture of its chart).
+        #[arg(long)]
+        measure_span: Option<f64>,
     },
     /// Write the built-in procedural sprites as PNGs (straight alpha), to start a
     /// texture from.
@@ -307,6 +311,7 @@ fn main() {
             select,
             draft,
             lose_device_at,
+            measure_span,
         }) => edit(EditOptions {
             frames: frames.or(screenshot.as_ref().map(|_| 60)),
             preset,
@@ -319,6 +324,7 @@ fn main() {
             select,
             draft,
             lose_device_at,
+            measure_span,
             adapter_profile,
         }),
         Some(Command::Render {

@@ -58,6 +58,9 @@ pub struct EditOptions {
     pub draft: Option<bool>,
     /// Destroy the GPU device after this frame (tests the recovery from a lost device).
     pub lose_device_at: Option<u32>,
+    /// Start Time ▸ Measure this effect at launch over this span, seconds (scripted runs
+    /// and screenshots).
+    pub measure_span: Option<f64>,
 }
 
 /// Opens the editor window and runs until it is closed (or `--frames` are done).
@@ -81,6 +84,10 @@ pub fn run(options: EditOptions) -> anyhow::Result<Option<RunReport>> {
                 state.loaded_path = Some(path.clone());
             }
             state.open_sections = options.sections.clone();
+            if let Some(span) = options.measure_span {
+                state.measure.span_secs = span;
+                state.measure.start_requested = true;
+            }
             if let Some(i) = options
                 .select
                 .as_ref()

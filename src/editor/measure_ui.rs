@@ -237,8 +237,10 @@ fn chart_ui(ui: &mut Ui, report: &TuneReport, pick: &mut Option<usize>) {
         .allow_drag(false)
         .allow_zoom(false)
         .allow_scroll(false)
-        .x_axis_label("frame ms (log10)")
-        .y_axis_label("error /255 (log10)")
+        .x_axis_label("frame ms")
+        .y_axis_label("error /255")
+        .x_axis_formatter(|m, _| power_of_ten(m.value))
+        .y_axis_formatter(|m, _| power_of_ten(m.value))
         .label_formatter(|h| {
             let p = match h {
                 egui_plot::HoverPosition::NearDataPoint { position, .. } => position,
@@ -282,6 +284,17 @@ fn chart_ui(ui: &mut Ui, report: &TuneReport, pick: &mut Option<usize>) {
             .filter(|(_, d)| *d <= 10.0)
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .map(|(i, _)| i);
+    }
+}
+
+/// A logarithmic axis's mark as the value it stands for (`-1` → `0.1`).
+fn power_of_ten(log10: f64) -> String {
+    let v = 10f64.powf(log10);
+    if v >= 10.0 {
+        format!("{v:.0}")
+    } else {
+        let digits = (-log10.floor()).max(0.0) as usize + 1;
+        format!("{v:.digits$}")
     }
 }
 
