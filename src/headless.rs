@@ -111,7 +111,7 @@ impl Headless {
             ..
         } = self;
         let update = timer.time(ctx, |enc| player.simulate(enc));
-        let record = timer.time(ctx, |enc| player.record(enc, camera, None));
+        let record = timer.time(ctx, |enc| player.record_sampling(enc, camera, None));
         let mut layered = crate::Layers::NONE;
         let draw = timer.time(ctx, |enc| {
             layered = composite.draw_particles(ctx, enc, player, camera);

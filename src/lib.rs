@@ -61,10 +61,14 @@
 pub(crate) mod runtime;
 
 pub use effect::Effect;
+/// The math library of the API (`Mat4`, `Vec3`): hosts on another `glam` version use this one
+/// or pass plain `[[f32; 4]; 4]` arrays.
+pub use glam;
 pub use gpu::{AdapterProfile, ProfileKind, ProfileRequest, ProfileSetting};
 pub use runtime::{
-    Camera, ClockStats, EmitterStats, EventCount, InstanceId, Layers, PLAYER_SHADERS,
-    ParticleCount, ParticleInfo, Player, PlayerError, PlayerSettings,
+    Camera, ClockStats, EmitterStats, EventCount, HostTargets, InstanceId, IntoMat4, Layers,
+    MissingLimit, PLAYER_SHADERS, ParticleCount, ParticleInfo, Player, PlayerError, PlayerSettings,
+    STORAGE_BUFFERS_REQUIRED, required_limits,
 };
 pub use shaders::ShaderError;
 pub use sim::planner::SpawnStats;

@@ -77,6 +77,10 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ("bloom.wgsl", include_str!("../shaders/bloom.wgsl")),
     ("clear.wgsl", include_str!("../shaders/clear.wgsl")),
     (
+        "depth_resolve.wgsl",
+        include_str!("../shaders/depth_resolve.wgsl"),
+    ),
+    (
         "workgroup_scan.wgsl",
         include_str!("../shaders/workgroup_scan.wgsl"),
     ),
@@ -123,6 +127,7 @@ pub const ENTRY_FILES: &[&str] = &[
     "tonemap.wgsl",
     "bloom.wgsl",
     "clear.wgsl",
+    "depth_resolve.wgsl",
 ];
 
 /// A shader problem, located in the file the user edits.

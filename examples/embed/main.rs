@@ -13,7 +13,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use glam::{Mat4, Vec3, vec3};
-use ignis::{Camera, Player, PlayerSettings};
+use ignis::{Camera, HostTargets, Player, PlayerSettings};
 use scene::Scene;
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, WindowEvent};
@@ -78,7 +78,13 @@ impl Host {
             &instance,
             Some(&surface),
         ))?;
-        let (device, queue) = pollster::block_on(adapter.request_device(&Default::default()))?;
+        // ignis: the limits its players need (compute, storage buffers), named in the error
+        // if the adapter lacks one.
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+                required_limits: ignis::required_limits().using_resolution(adapter.limits()),
+                ..Default::default()
+            }))?;
         let size = window.inner_size();
         let mut config = (surface.get_default_config(&adapter, size.width, size.height))
             .ok_or("the adapter cannot present to this window")?;
@@ -150,11 +156,16 @@ impl Host {
         // that the soft edges sample.
         let camera = Camera::new(view, proj, size);
         let depth = Some(&self.scene.depth);
-        self.torches.record(&mut enc, &camera, depth);
-        self.campfire.record(&mut enc, &camera, depth);
+        self.torches.record(&mut enc, &camera, depth)?;
+        self.campfire.record(&mut enc, &camera, depth)?;
         {
-            // ignis, 3: the particles inside the host's pass (depth read-only).
-            let mut pass = self.scene.pass(&mut enc, false);
+            // ignis, 3: the particles in a pass on the host's views (depth read-only).
+            let targets = HostTargets {
+                color: &self.scene.hdr,
+                resolve_target: None,
+                depth,
+            };
+            let mut pass = targets.begin_pass(&mut enc);
             self.torches.draw(&mut pass);
             self.campfire.draw(&mut pass);
         }

@@ -11,7 +11,7 @@ pub struct Scene {
     tonemap: wgpu::RenderPipeline,
     vertices: (wgpu::Buffer, u32),
     uniforms: (wgpu::Buffer, wgpu::BindGroup),
-    hdr: wgpu::TextureView,
+    pub hdr: wgpu::TextureView,
     /// The depth the opaque pass writes and the particles test against and sample.
     pub depth: wgpu::TextureView,
     tone_group: wgpu::BindGroup,
@@ -97,40 +97,30 @@ impl Scene {
     ) {
         let uniforms = [clip_from_world.to_cols_array().as_slice(), &fire].concat();
         queue.write_buffer(&self.uniforms.0, 0, bytemuck::cast_slice(&uniforms));
-        let mut pass = self.pass(enc, true);
+        let mut pass = self.pass(enc);
         pass.set_pipeline(&self.lit);
         pass.set_bind_group(0, &self.uniforms.1, &[]);
         pass.set_vertex_buffer(0, self.vertices.0.slice(..));
         pass.draw(0..self.vertices.1, 0..1);
     }
 
-    /// A pass over the HDR image and the depth: the opaque one clears and writes depth;
-    /// the transparent one loads both, depth read-only (so the particles may sample it).
-    pub fn pass<'a>(
-        &'a self,
-        enc: &'a mut wgpu::CommandEncoder,
-        opaque: bool,
-    ) -> wgpu::RenderPass<'a> {
+    /// The opaque pass over the HDR image and the depth: clears both, writes depth and
+    /// stores it (the particles sample it after).
+    fn pass<'a>(&'a self, enc: &'a mut wgpu::CommandEncoder) -> wgpu::RenderPass<'a> {
         let sky = wgpu::Color {
             r: 0.004,
             g: 0.006,
             b: 0.015,
             a: 1.0,
         };
-        let load = if opaque {
-            wgpu::LoadOp::Clear(sky)
-        } else {
-            wgpu::LoadOp::Load
-        };
-        let depth_ops = opaque.then_some(wgpu::Operations {
-            load: wgpu::LoadOp::Clear(1.0),
-            store: wgpu::StoreOp::Store,
-        });
         enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            color_attachments: &[Some(attachment(&self.hdr, load))],
+            color_attachments: &[Some(attachment(&self.hdr, wgpu::LoadOp::Clear(sky)))],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &self.depth,
-                depth_ops,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
                 stencil_ops: None,
             }),
             ..Default::default()

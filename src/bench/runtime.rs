@@ -161,7 +161,7 @@ fn measure(
         let start = Instant::now();
         player.advance(1.0 / 60.0);
         let mut enc = host.ctx.device.create_command_encoder(&Default::default());
-        player.record(&mut enc, &camera, Some(&host.depth));
+        player.record(&mut enc, &camera, Some(&host.depth))?;
         let recorded = Instant::now();
         host.pass(&mut enc, |pass| player.draw(pass));
         let commands = enc.finish();
@@ -175,9 +175,11 @@ fn measure(
         cpu.push(cpu_us);
         cpu_draw.push(cpu_draw_us);
         player.advance(1.0 / 60.0);
+        let mut recorded = Ok(());
         record.push(timer.time(&host.ctx, |enc| {
-            player.record(enc, &camera, Some(&host.depth))
+            recorded = player.record(enc, &camera, Some(&host.depth));
         }));
+        recorded?;
         draw.push(timer.time(&host.ctx, |enc| host.pass(enc, |pass| player.draw(pass))));
     }
     Ok(Row {

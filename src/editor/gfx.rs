@@ -354,7 +354,7 @@ impl Gfx {
             Some(t) => {
                 t.scope(&mut encoder, "update", |enc| player.simulate(enc));
                 t.scope(&mut encoder, "sort + splat", |enc| {
-                    player.record(enc, &camera, None)
+                    player.record_sampling(enc, &camera, None)
                 });
                 t.scope(&mut encoder, "draw + composite", |enc| {
                     composite.draw(ctx, enc, player, &camera)

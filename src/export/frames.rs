@@ -100,7 +100,7 @@ impl FrameRenderer {
         player: &mut Player,
     ) -> Result<RawFrame, ExportError> {
         let mut enc = ctx.device.create_command_encoder(&Default::default());
-        player.record(&mut enc, &self.camera, None);
+        player.record_sampling(&mut enc, &self.camera, None);
         let view = self.color.create_view(&Default::default());
         {
             let mut pass = match self.background {

@@ -4,6 +4,8 @@
 
 use glam::{DMat4, Mat4, Vec3};
 
+use super::matrix::IntoMat4;
+
 use crate::effect::CameraHint;
 use crate::gpu::types::CameraUniform;
 
@@ -150,12 +152,55 @@ impl Camera {
     /// depth along −z) and
     /// `clip_from_view` (view → wgpu clip space, depth 0..1) matrices, drawing into a
     /// target of `size_px` pixels.
-    pub fn new(view_from_world: Mat4, clip_from_view: Mat4, size_px: (u32, u32)) -> Self {
+    ///
+    /// Both accept a `glam::Mat4` (`ignis::glam`) or a plain column-major
+    /// `[[f32; 4]; 4]`, as another math library's `to_cols_array_2d` gives it.
+    pub fn new(
+        view_from_world: impl IntoMat4,
+        clip_from_view: impl IntoMat4,
+        size_px: (u32, u32),
+    ) -> Self {
         Self::from_parts(
-            view_from_world.as_dmat4(),
-            clip_from_view.as_dmat4(),
+            view_from_world.into_mat4().as_dmat4(),
+            clip_from_view.into_mat4().as_dmat4(),
             size_px,
         )
+    }
+
+    /// A camera from the host's combined `clip_from_world` (projection × view, wgpu clip
+    /// space, depth 0..1, reversed Z included) and the eye's position in world space, for
+    /// hosts that keep only the product. The view is rebuilt from the matrix's rows (the
+    /// camera's right and up axes, and its forward axis from the perspective row, or for
+    /// an orthographic projection from right × up) and the projection is what remains:
+    /// the result draws exactly as [`Camera::new`] with the two apart.
+    pub fn from_view_proj(
+        clip_from_world: impl IntoMat4,
+        eye: impl Into<Vec3>,
+        size_px: (u32, u32),
+    ) -> Self {
+        let clip_from_world = clip_from_world.into_mat4().as_dmat4();
+        let eye = eye.into().as_dvec3();
+        let row = |i: usize| clip_from_world.row(i).truncate();
+        let right = row(0).normalize_or(glam::DVec3::X);
+        let up = row(1).normalize_or(glam::DVec3::Y);
+        let perspective = row(3).length() > 1e-9 * row(0).length().max(1e-30);
+        let forward = if perspective {
+            row(3).normalize()
+        } else {
+            up.cross(right).normalize_or(glam::DVec3::NEG_Z)
+        };
+        // Orthonormal, right-handed: x right, y up, z back (the view looks down −z).
+        let back = -forward;
+        let up = back.cross(right).normalize_or(up);
+        let right = up.cross(back);
+        let view_from_world = DMat4::from_cols(
+            glam::DVec4::new(right.x, up.x, back.x, 0.0),
+            glam::DVec4::new(right.y, up.y, back.y, 0.0),
+            glam::DVec4::new(right.z, up.z, back.z, 0.0),
+            glam::DVec4::new(-right.dot(eye), -up.dot(eye), -back.dot(eye), 1.0),
+        );
+        let clip_from_view = clip_from_world * view_from_world.inverse();
+        Self::from_parts(view_from_world, clip_from_view, size_px)
     }
 
     fn from_parts(view_from_world: DMat4, clip_from_view: DMat4, size: (u32, u32)) -> Self {
@@ -166,6 +211,19 @@ impl Camera {
             clip_from_world: clip_from_view * view_from_world,
             eye: view_from_world.inverse().w_axis.truncate(),
             motion_secs: 0.0,
+        }
+    }
+
+    /// The same camera over a world placed by `host_from_world` in this camera's world
+    /// (a rotation: the presets' y-up world inside a z-up host).
+    pub(crate) fn with_world_from(self, host_from_world: DMat4) -> Self {
+        Self {
+            motion_secs: self.motion_secs,
+            ..Self::from_parts(
+                self.view_from_world * host_from_world,
+                self.clip_from_view,
+                self.size,
+            )
         }
     }
 

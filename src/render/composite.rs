@@ -96,7 +96,7 @@ impl Composite {
         player: &mut Player,
         camera: &Camera,
     ) {
-        player.record(enc, camera, None);
+        player.record_sampling(enc, camera, None);
         self.draw(ctx, enc, player, camera);
     }
 

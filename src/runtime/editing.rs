@@ -28,6 +28,7 @@ pub const PLAYER_SHADERS: &[&str] = &[
     "splat.wgsl",
     "tiles.wgsl",
     "sort.wgsl",
+    "depth_resolve.wgsl",
 ];
 
 impl Player {
@@ -180,6 +181,7 @@ impl Player {
                 }
             }
             "sort.wgsl" => self.sort.rebuild(&self.ctx, &lib)?,
+            "depth_resolve.wgsl" => self.host_depth.rebuild(&self.ctx, &lib)?,
             _ => return Ok(()),
         }
         // Pipelines built later (a new variant, an edit's new integrator) use it too.

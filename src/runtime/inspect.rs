@@ -170,7 +170,12 @@ impl Player {
                 .particles(id, i)?
                 .into_iter()
                 .filter(Particle::is_alive);
-            out.extend(alive.map(|p| (p.position() + origin, p.velocity())));
+            out.extend(alive.map(|p| {
+                (
+                    self.to_host(p.position() + origin),
+                    self.to_host(p.velocity()),
+                )
+            }));
         }
         Ok(out)
     }

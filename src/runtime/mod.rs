@@ -2,7 +2,10 @@
 //! host's wgpu frame — its compute work in the host's encoder, its particles in the
 //! host's render pass, tested against the host's depth buffer.
 
+mod device_check;
 mod editing;
+mod host_depth;
+mod host_targets;
 mod inspect;
 mod instances;
 mod layers;
@@ -12,7 +15,10 @@ mod remap;
 mod seeking;
 
 pub use crate::render::Camera;
+pub use crate::render::matrix::IntoMat4;
+pub use device_check::{MissingLimit, STORAGE_BUFFERS_REQUIRED, required_limits};
 pub use editing::PLAYER_SHADERS;
+pub use host_targets::HostTargets;
 pub use inspect::{ClockStats, EmitterStats, EventCount, ParticleCount};
 pub use instances::InstanceId;
 pub use layers::Layers;

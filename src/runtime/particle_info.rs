@@ -22,7 +22,7 @@ pub struct ParticleInfo {
     pub age_secs: f32,
     /// Lifetime, seconds.
     pub lifetime_secs: f32,
-    /// World position, metres.
+    /// Position in the host's world, metres.
     pub position_m: Vec3,
     /// Velocity, m/s.
     pub velocity_m_per_s: Vec3,
@@ -50,7 +50,7 @@ impl Player {
         pixel: Vec2,
         radius_px: f32,
     ) -> Result<Option<ParticleInfo>, PlayerError> {
-        let clip_from_world = camera.clip_from_world_mat4();
+        let clip_from_world = self.preset_camera(camera).clip_from_world_mat4();
         let (w, h) = camera.size_px();
         let size = Vec2::new(w as f32, h as f32);
         let mut best: Option<(f32, usize, u32)> = None;
@@ -114,14 +114,17 @@ impl Player {
             slot,
             age_secs: p.pos_age[3],
             lifetime_secs: p.vel_life[3],
-            position_m: p.position() + origin,
-            velocity_m_per_s: p.velocity(),
+            position_m: self.to_host(p.position() + origin),
+            velocity_m_per_s: self.to_host(p.velocity()),
             forces: forces_on(
                 p,
                 &params,
                 Modules::of(e),
                 over_life_now(e, p, &params, slot),
-            ),
+            )
+            .into_iter()
+            .map(|(name, f)| (name, self.to_host(f)))
+            .collect(),
         }))
     }
 

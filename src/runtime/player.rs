@@ -3,14 +3,17 @@
 
 use std::path::PathBuf;
 
-use glam::Mat4;
+use glam::{Mat4, Quat, Vec3};
 
 use crate::effect::{BlendMode, Effect, TimeMode, ValidationError};
 use crate::gpu::{AdapterProfile, GpuContext, Uploads};
 use crate::render::billboard::{BillboardPass, DrawTarget};
+use crate::render::matrix::IntoMat4;
 use crate::render::sort::SortPass;
 use crate::render::{Camera, DrawItem, FrameResources, Scene, SplatPass, TilePass};
 use crate::runtime::Layers;
+use crate::runtime::device_check::{MissingLimit, missing_limits};
+use crate::runtime::host_depth::HostDepth;
 use crate::runtime::instances::{Backing, Instance, InstanceId, Slab};
 use crate::shaders::{ShaderError, ShaderLibrary};
 use crate::sim::batch::{BatchMember, InstanceBatch, batchable};
@@ -45,6 +48,13 @@ pub struct PlayerSettings {
     /// The choices that differ between GPUs and software adapters; `None`: from the
     /// device's adapter type.
     pub adapter_profile: Option<AdapterProfile>,
+    /// The host world's up axis (+Y by default; `Vec3::Z` for a z-up host). Presets are
+    /// made y-up: gravity, buoyancy, wind and the preset's ground and colliders are
+    /// turned with the world by the shortest rotation from +Y to this axis (for +Z: a
+    /// preset's +Z becomes the host's −Y, as a y-up glTF scene imports into a z-up one).
+    /// Instances' transforms, cameras and the positions the player reports are all in
+    /// the host's world.
+    pub world_up: Vec3,
 }
 
 impl PlayerSettings {
@@ -59,7 +69,14 @@ impl PlayerSettings {
             batch_instances: true,
             shader_dir: None,
             adapter_profile: None,
+            world_up: Vec3::Y,
         }
+    }
+
+    /// The rotation from the presets' y-up world to the host's (`None`: the host is y-up).
+    pub(crate) fn host_from_preset(&self) -> Option<Quat> {
+        let up = self.world_up.normalize_or(Vec3::Y);
+        (up.dot(Vec3::Y) < 1.0 - 1e-7).then(|| Quat::from_rotation_arc(Vec3::Y, up))
     }
 }
 
@@ -78,9 +95,24 @@ pub enum PlayerError {
     /// The instance was removed.
     #[error("no such instance (it was removed)")]
     NoInstance,
+    /// The host's device lacks limits the player needs (each named with both values).
+    #[error(
+        "the device's limits are too low for ignis: {}; request ignis::required_limits() when creating the device (docs/embedding.md: what the host provides)",
+        list(.0)
+    )]
+    DeviceLimits(Vec<MissingLimit>),
+    /// The device refused to build the player's pipelines for these settings (a colour
+    /// format that cannot blend, a sample count the formats do not support…).
+    #[error("the device refused the player's pipelines for these settings: {0}")]
+    Device(String),
+    /// The depth view handed to [`Player::record`] cannot be used for soft edges and
+    /// occlusion; that frame was recorded without it (particles tested only by the
+    /// pass's depth attachment), so the fire still shows.
+    #[error("the host's depth cannot be sampled: {0}; the frame was drawn without soft edges")]
+    HostDepth(String),
 }
 
-fn list(errors: &[ValidationError]) -> String {
+fn list(errors: &[impl ToString]) -> String {
     errors
         .iter()
         .map(ToString::to_string)
@@ -128,6 +160,8 @@ pub struct Player {
     splatted: bool,
     /// Whether records prepare the motion pass ([`Player::draw_motion`]).
     motion_pass: bool,
+    /// The host's depth as the passes sample it.
+    pub(super) host_depth: HostDepth,
     /// `simulate` ran since the last `record`, which then does not run it again.
     pub(super) simulated: bool,
     /// Snapshots a seek can start from (`Player::keep_seek_snapshots`).
@@ -149,6 +183,27 @@ impl Player {
         settings: PlayerSettings,
     ) -> Result<Self, PlayerError> {
         effect.validate().map_err(PlayerError::Invalid)?;
+        let missing = missing_limits(&device.limits());
+        if !missing.is_empty() {
+            return Err(PlayerError::DeviceLimits(missing));
+        }
+        // Whatever else the host's device refuses is an error, not a panic in its
+        // uncaptured-error handler.
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let built = Self::build(device, queue, effect, settings);
+        match pollster::block_on(scope.pop()) {
+            Some(e) => Err(PlayerError::Device(e.to_string())),
+            None => built,
+        }
+    }
+
+    /// Builds the player's pipelines and resources ([`Player::new`] after its checks).
+    fn build(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        effect: &Effect,
+        settings: PlayerSettings,
+    ) -> Result<Self, PlayerError> {
         let ctx = GpuContext::from_device(device, queue).with_profile(settings.adapter_profile);
         let library = match &settings.shader_dir {
             Some(dir) => ShaderLibrary::from_dir(dir),
@@ -193,6 +248,7 @@ impl Player {
             uploads: Uploads::new(device),
             splatted: false,
             motion_pass: false,
+            host_depth: HostDepth::new(),
             simulated: false,
             snapshots: Default::default(),
         })
@@ -209,13 +265,15 @@ impl Player {
     }
 
     /// Adds an instance at `world_from_effect` (rotation and translation; scale is
-    /// ignored) with its own `seed`. It starts empty, at time 0 of its own. Creates only
-    /// its particle buffers: no pipeline is built and no other instance is touched.
+    /// ignored; a `Mat4` or a column-major `[[f32; 4]; 4]`) with its own `seed`. It
+    /// starts empty, at time 0 of its own. Creates only its particle buffers: no pipeline
+    /// is built and no other instance is touched.
     pub fn add_instance(
         &mut self,
-        world_from_effect: Mat4,
+        world_from_effect: impl IntoMat4,
         seed: u32,
     ) -> Result<InstanceId, PlayerError> {
+        let world_from_effect = self.preset_from_host(world_from_effect.into_mat4());
         let effect = Instance::effect_for(&self.effect, world_from_effect, seed);
         let state = self.backing(&effect)?;
         self.snapshots.clear();
@@ -260,7 +318,8 @@ impl Player {
     /// Moves an instance (call it every frame for a carried torch): new particles spawn
     /// at the new place, living ones keep their world-space motion. Returns false if `id`
     /// was removed.
-    pub fn set_transform(&mut self, id: InstanceId, world_from_effect: Mat4) -> bool {
+    pub fn set_transform(&mut self, id: InstanceId, world_from_effect: impl IntoMat4) -> bool {
+        let world_from_effect = self.preset_from_host(world_from_effect.into_mat4());
         let Some(instance) = self.instances.get_mut(id) else {
             return false;
         };
@@ -273,7 +332,33 @@ impl Player {
 
     /// Where an instance is, if it exists.
     pub fn transform(&self, id: InstanceId) -> Option<Mat4> {
-        self.instances.get(id).map(|i| i.world_from_effect)
+        let host = self.settings.host_from_preset().map(Mat4::from_quat);
+        self.instances
+            .get(id)
+            .map(|i| host.map_or(i.world_from_effect, |h| h * i.world_from_effect))
+    }
+
+    /// A host-world transform in the presets' y-up world (see
+    /// [`PlayerSettings::world_up`]).
+    fn preset_from_host(&self, host: Mat4) -> Mat4 {
+        match self.settings.host_from_preset() {
+            Some(q) => Mat4::from_quat(q.inverse()) * host,
+            None => host,
+        }
+    }
+
+    /// The host's camera seen from the presets' y-up world.
+    pub(super) fn preset_camera(&self, camera: &Camera) -> Camera {
+        match self.settings.host_from_preset() {
+            Some(q) => camera.with_world_from(glam::DMat4::from_quat(q.as_dquat())),
+            None => *camera,
+        }
+    }
+
+    /// A position or direction the simulation holds (presets' y-up world) in the host's
+    /// world.
+    pub(super) fn to_host(&self, v: Vec3) -> Vec3 {
+        self.settings.host_from_preset().map_or(v, |q| q * v)
     }
 
     /// How many instances there are.
@@ -369,16 +454,38 @@ impl Player {
     /// as a billboard (the pass's depth test is then the only one). Call it once per
     /// submitted encoder (its uploads go through the queue); draw the result in as many
     /// passes as needed.
+    ///
+    /// The depth may be multisampled (it is then copied to one sample first) and of a
+    /// depth-stencil format (its depth aspect is read); it must have the player's depth
+    /// format and sample count, and the host's opaque pass must store it
+    /// (`StoreOp::Store`: a discarded depth cannot be detected and hides or shows
+    /// particles at random). A depth that cannot be used — no `TEXTURE_BINDING` usage, a
+    /// transient attachment, another size, format or sample count — is an error,
+    /// [`PlayerError::HostDepth`] naming the fix; the frame is then recorded as without
+    /// a depth view, so the fire still shows.
     pub fn record(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         camera: &Camera,
         scene_depth: Option<&wgpu::TextureView>,
+    ) -> Result<(), PlayerError> {
+        let (depth, refused) = self.host_depth_view(encoder, camera, scene_depth);
+        self.record_sampling(encoder, camera, depth.as_ref());
+        refused.map_or(Ok(()), |why| Err(PlayerError::HostDepth(why)))
+    }
+
+    /// [`Player::record`] with the depth view the passes sample already made (the
+    /// editor's, the export's and the composite's own targets: none).
+    pub(crate) fn record_sampling(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        camera: &Camera,
+        depth: Option<&wgpu::TextureView>,
     ) {
+        let camera = &self.preset_camera(camera);
         if !std::mem::take(&mut self.simulated) {
             self.record_steps(encoder);
         }
-        let depth = scene_depth.filter(|_| self.settings.depth_format.is_some());
         self.billboard.set_scene_depth(&self.ctx, depth);
         self.frame.soft_depth = depth.is_some();
         // The splat tests the host's depth itself: without the view, billboards (tested by
@@ -434,6 +541,30 @@ impl Player {
             self.motion_pass,
         );
         self.uploads.finish(encoder);
+    }
+
+    /// The view of the host's depth the passes sample (see [`HostDepth`]), or why the
+    /// one handed over cannot be.
+    fn host_depth_view(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        camera: &Camera,
+        scene_depth: Option<&wgpu::TextureView>,
+    ) -> (Option<wgpu::TextureView>, Option<String>) {
+        let Some(view) = scene_depth else {
+            return (None, None);
+        };
+        let Some(format) = self.settings.depth_format else {
+            let why = "the player was created without a depth format \
+                       (PlayerSettings::depth_format)";
+            return (None, Some(why.into()));
+        };
+        let expected = (format, self.settings.sample_count.max(1));
+        let size = camera.size_px();
+        match (self.host_depth).sampled(&self.ctx, &self.library, encoder, view, size, expected) {
+            Ok(v) => (Some(v), None),
+            Err(why) => (None, Some(why)),
+        }
     }
 
     /// The groups of instances drawn together, far to near by their mean depth along
