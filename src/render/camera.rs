@@ -320,3 +320,36 @@ impl Camera {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A host's `proj * view` and eye give the camera its view and projection apart:
+    /// perspective, reversed-Z and orthographic, any orientation.
+    #[test]
+    fn a_view_projection_and_eye_give_the_same_camera() {
+        let eye = Vec3::new(1.5, 2.0, -3.0);
+        let view = glam::camera::rh::view::look_at_mat4(eye, Vec3::new(0.2, 0.5, 0.4), Vec3::Z);
+        let projections = [
+            glam::camera::rh::proj::directx::perspective(0.9, 1.5, 0.1, 80.0),
+            glam::camera::rh::proj::directx::perspective(0.9, 1.5, 80.0, 0.1),
+            glam::camera::rh::proj::directx::orthographic(-4.0, 4.0, -3.0, 3.0, 0.5, 20.0),
+        ];
+        for proj in projections {
+            let apart = Camera::new(view, proj, (640, 480));
+            let product = Camera::from_view_proj((proj * view).to_cols_array_2d(), eye, (640, 480));
+            let close = |a: Mat4, b: Mat4| a.abs_diff_eq(b, 1e-4);
+            assert!(close(
+                apart.view_from_world_mat4(),
+                product.view_from_world_mat4()
+            ));
+            assert!(close(
+                apart.clip_from_view_mat4(),
+                product.clip_from_view_mat4()
+            ));
+            assert!(apart.eye().abs_diff_eq(product.eye(), 1e-4));
+            assert!(apart.forward().abs_diff_eq(product.forward(), 1e-5));
+        }
+    }
+}
