@@ -25,8 +25,8 @@ pub struct ViewPlayer {
     generation: u64,
     /// The view's colour format and samples it was built for.
     target: (wgpu::TextureFormat, u32),
-    /// The last error logged (each distinct one is logged once).
-    pub(crate) last_error: Option<String>,
+    /// The last error its view's frame logged (each distinct one is logged once).
+    pub last_error: Option<String>,
 }
 
 /// Every player, by (preset, render-world view entity).

@@ -1,0 +1,141 @@
+//! A headless Bevy app for the plugin's tests: lavapipe or any adapter, no window, frames
+//! of exactly 1/60 s, a camera into an image that the tests read back.
+
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use bevy::app::PluginsState;
+use bevy::camera::RenderTarget;
+use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
+use bevy::prelude::*;
+use bevy::render::RenderPlugin;
+use bevy::render::render_resource::TextureFormat;
+use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
+use bevy::time::TimeUpdateStrategy;
+use bevy::window::ExitCondition;
+use bevy_ignis::{IgnisPlayers, IgnisPlugin, IgnisPreset};
+
+/// The test image's size.
+pub const SIZE: (u32, u32) = (200, 150);
+
+/// The repository's presets.
+pub fn presets() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../presets")
+}
+
+/// A headless app reading assets from `assets` (watching them when `watch`), with the
+/// plugin, ready to spawn into.
+pub fn app(assets: &Path, watch: bool) -> App {
+    let mut app = App::new();
+    app.add_plugins(
+        DefaultPlugins
+            .set(AssetPlugin {
+                file_path: assets.to_string_lossy().into_owned(),
+                watch_for_changes_override: Some(watch),
+                ..default()
+            })
+            .set(WindowPlugin {
+                primary_window: None,
+                exit_condition: ExitCondition::DontExit,
+                ..default()
+            })
+            .set(RenderPlugin {
+                synchronous_pipeline_compilation: true,
+                ..default()
+            })
+            .disable::<bevy::winit::WinitPlugin>()
+            // The render world stays in this thread: the tests read its players, and
+            // each update renders its own frame.
+            .disable::<bevy::render::pipelined_rendering::PipelinedRenderingPlugin>(),
+    )
+    .add_plugins(IgnisPlugin {
+        asset_root: assets.to_path_buf(),
+    })
+    .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(
+        1.0 / 60.0,
+    )))
+    .insert_resource(ClearColor(Color::BLACK));
+    while app.plugins_state() == PluginsState::Adding {
+        bevy::tasks::tick_global_task_pools_on_main_thread();
+    }
+    app.finish();
+    app.cleanup();
+    app
+}
+
+/// An LDR image target of the test size and a camera into it at `eye` looking at
+/// `target`: no tonemapping or dithering (the image is what was drawn).
+pub fn camera(app: &mut App, eye: Vec3, target: Vec3) -> Handle<Image> {
+    let image = Image::new_target_texture(SIZE.0, SIZE.1, TextureFormat::Rgba8UnormSrgb, None);
+    let handle = app.world_mut().resource_mut::<Assets<Image>>().add(image);
+    app.world_mut().spawn((
+        Camera3d::default(),
+        RenderTarget::from(handle.clone()),
+        Tonemapping::None,
+        DebandDither::Disabled,
+        Transform::from_translation(eye).looking_at(target, Vec3::Y),
+    ));
+    handle
+}
+
+/// Loads `path` and updates until it is loaded (so that entities spawned next start on
+/// a known frame).
+pub fn load(app: &mut App, path: &str) -> Handle<IgnisPreset> {
+    let handle: Handle<IgnisPreset> = app.world().resource::<AssetServer>().load(path.to_owned());
+    for _ in 0..600 {
+        if app
+            .world()
+            .resource::<Assets<IgnisPreset>>()
+            .get(&handle)
+            .is_some()
+        {
+            return handle;
+        }
+        app.update();
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    panic!("{path} did not load");
+}
+
+/// Runs `frames` frames.
+pub fn run(app: &mut App, frames: u32) {
+    for _ in 0..frames {
+        app.update();
+    }
+}
+
+/// The next frame's image as RGBA8 (sRGB), read back through a screenshot.
+pub fn capture(app: &mut App, target: &Handle<Image>) -> Vec<[u8; 4]> {
+    let slot: Arc<Mutex<Option<Image>>> = Arc::default();
+    let out = slot.clone();
+    app.world_mut()
+        .spawn(Screenshot::image(target.clone()))
+        .observe(move |shot: On<ScreenshotCaptured>| {
+            if let Ok(mut s) = out.lock() {
+                *s = Some(shot.image.clone());
+            }
+        });
+    for _ in 0..30 {
+        app.update();
+        let taken = slot.lock().ok().and_then(|mut s| s.take());
+        if let Some(image) = taken {
+            let bytes = image.data.expect("screenshot bytes");
+            return bytes
+                .chunks_exact(4)
+                .map(|c| [c[0], c[1], c[2], c[3]])
+                .collect();
+        }
+    }
+    panic!("no screenshot");
+}
+
+/// The render world's players.
+pub fn players(app: &App) -> &IgnisPlayers {
+    app.get_sub_app(bevy::render::RenderApp)
+        .expect("render app")
+        .world()
+        .resource::<IgnisPlayers>()
+}
