@@ -4,7 +4,7 @@
 mod common;
 
 use bevy::prelude::*;
-use bevy_ignis::IgnisEffect;
+use bevy_ignis::{IgnisEffect, ignis};
 use common::SIZE;
 
 /// The eye and target of the occlusion scene.
@@ -103,4 +103,150 @@ fn a_mesh_in_front_hides_the_fire_exactly() {
         beside > 150,
         "only {beside} pixels beside the wall show fire"
     );
+}
+
+/// The particles of every instance of the torch, by seed, after `frames` frames; the
+/// instances with seeds in `despawned` are despawned after `despawn_at` frames (`None`:
+/// they are never spawned).
+fn torch_particles(
+    seeds: std::ops::Range<u32>,
+    despawned: &[u32],
+    despawn_at: Option<u32>,
+    frames: u32,
+) -> Vec<(u32, Vec<Vec<ignis::gpu::types::Particle>>)> {
+    let mut app = common::app(&common::presets(), false);
+    common::camera(&mut app, Vec3::new(0.0, 3.0, 12.0), Vec3::ZERO);
+    let preset = common::load(&mut app, "torch.ron");
+    let mut entities = Vec::new();
+    for seed in seeds {
+        if despawn_at.is_none() && despawned.contains(&seed) {
+            continue;
+        }
+        let at = Transform::from_xyz((seed % 10) as f32 - 5.0, 0.0, (seed / 10) as f32 * -2.0);
+        let e = app.world_mut().spawn((IgnisEffect::new(preset.clone(), seed), at)).id();
+        entities.push((seed, e));
+    }
+    let first = despawn_at.unwrap_or(0);
+    common::run(&mut app, first);
+    for (seed, e) in &entities {
+        if despawned.contains(seed) {
+            app.world_mut().despawn(*e);
+        }
+    }
+    common::run(&mut app, frames - first);
+    let vp = common::players(&app).any_of(preset.id()).expect("a player");
+    let emitters = vp.player.effect().emitters.len();
+    let mut out = Vec::new();
+    for (seed, e) in entities.iter().filter(|(s, _)| !despawned.contains(s)) {
+        let (id, _) = vp.instances[e];
+        let particles = (0..emitters)
+            .map(|em| vp.player.particles(id, em).expect("readback"))
+            .collect();
+        out.push((*seed, particles));
+    }
+    out
+}
+
+/// 50 torches, 25 despawned after 20 frames: the other 25 are bit-identical to a run
+/// where the 25 never existed.
+#[test]
+fn despawned_instances_leave_the_others_untouched() {
+    let despawned: Vec<u32> = (1..=50).filter(|s| s % 2 == 0).collect();
+    let kept = torch_particles(1..51, &despawned, Some(20), 50);
+    let alone = torch_particles(1..51, &despawned, None, 50);
+    assert_eq!(kept.len(), 25);
+    let mut alive = 0;
+    for ((seed, a), (seed_b, b)) in kept.iter().zip(&alone) {
+        assert_eq!(seed, seed_b);
+        for (em, (pa, pb)) in a.iter().zip(b).enumerate() {
+            alive += pa.iter().filter(|p| p.is_alive()).count();
+            let (ba, bb): (&[u8], &[u8]) = (bytemuck::cast_slice(pa), bytemuck::cast_slice(pb));
+            assert!(ba == bb, "torch {seed}, emitter {em}: particles differ");
+        }
+    }
+    assert!(alive > 25 * 20, "only {alive} particles alive");
+}
+
+/// Pixels where green clearly leads red: the edited (green) fire.
+fn green_pixels(image: &[[u8; 4]]) -> usize {
+    image.iter().filter(|p| p[1] > p[0].saturating_add(40)).count()
+}
+
+/// Updates `app` (waiting for the file watcher between frames) until `done` holds.
+fn until(app: &mut bevy::app::App, what: &str, mut done: impl FnMut(&mut bevy::app::App) -> bool) {
+    for _ in 0..400 {
+        app.update();
+        if done(app) {
+            return;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(25));
+    }
+    panic!("timed out waiting for {what}");
+}
+
+/// An edited preset written over the loaded file reaches the running effect within a
+/// few frames (its fire turns green on screen); a broken file leaves the last good
+/// effect playing, and the asset server reports the error.
+#[test]
+fn an_edited_preset_hot_reloads_and_a_broken_one_keeps_the_last_good() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let file = dir.path().join("torch.ron");
+    std::fs::copy(common::presets().join("torch.ron"), &file).expect("copy");
+    let textures = dir.path().join("textures");
+    std::fs::create_dir(&textures).expect("textures");
+    for e in std::fs::read_dir(common::presets().join("textures")).expect("textures") {
+        let e = e.expect("entry");
+        std::fs::copy(e.path(), textures.join(e.file_name())).expect("copy texture");
+    }
+    let mut app = common::app(dir.path(), true);
+    let target = common::camera(&mut app, Vec3::new(0.0, 1.3, 2.5), Vec3::new(0.0, 1.3, 0.0));
+    let preset = common::load(&mut app, "torch.ron");
+    app.world_mut().spawn(IgnisEffect::new(preset.clone(), 5));
+    common::run(&mut app, 30);
+    let before = common::capture(&mut app, &target);
+    assert!(green_pixels(&before) < 10, "{} green pixels before", green_pixels(&before));
+
+    let original = std::fs::read_to_string(&file).expect("read");
+    let green = stops_to_green(&original);
+    assert_ne!(green, original);
+    std::fs::write(&file, &green).expect("write");
+    let id = preset.id();
+    until(&mut app, "the edit to reach the player", |app| {
+        common::players(app).any_of(id).is_some_and(|vp| {
+            let stops = &vp.player.effect().emitters[0].look.color_over_life;
+            stops.iter().all(|s| s.rgba[0] == 0.0)
+        })
+    });
+    common::run(&mut app, 30);
+    let after = common::capture(&mut app, &target);
+    assert!(green_pixels(&after) > 100, "{} green pixels after", green_pixels(&after));
+
+    std::fs::write(&file, "(version: 3, emitters: [ broken").expect("write");
+    until(&mut app, "the broken file's error", |app| {
+        let server = app.world().resource::<AssetServer>();
+        matches!(server.load_state(&preset), bevy::asset::LoadState::Failed(_))
+    });
+    if let bevy::asset::LoadState::Failed(e) = app.world().resource::<AssetServer>().load_state(&preset) {
+        assert!(e.to_string().contains("torch.ron"), "{e}");
+    }
+    common::run(&mut app, 20);
+    let kept = common::capture(&mut app, &target);
+    assert!(green_pixels(&kept) > 100, "the last good effect stopped: {}", green_pixels(&kept));
+}
+
+/// `text` with every colour stop's red and blue zeroed and green full (alpha kept).
+fn stops_to_green(text: &str) -> String {
+    let mut out = String::new();
+    let mut rest = text;
+    while let Some(at) = rest.find("rgba: (") {
+        let (head, tail) = rest.split_at(at + "rgba: (".len());
+        out.push_str(head);
+        let mut parts = tail.splitn(4, ',');
+        let (_, _, _) = (parts.next(), parts.next(), parts.next());
+        let remainder = parts.next().unwrap_or("");
+        out.push_str("0.0, 1.0, 0.0,");
+        rest = remainder;
+    }
+    out.push_str(rest);
+    out
 }
