@@ -123,7 +123,10 @@ fn torch_particles(
             continue;
         }
         let at = Transform::from_xyz((seed % 10) as f32 - 5.0, 0.0, (seed / 10) as f32 * -2.0);
-        let e = app.world_mut().spawn((IgnisEffect::new(preset.clone(), seed), at)).id();
+        let e = app
+            .world_mut()
+            .spawn((IgnisEffect::new(preset.clone(), seed), at))
+            .id();
         entities.push((seed, e));
     }
     let first = despawn_at.unwrap_or(0);
@@ -169,7 +172,10 @@ fn despawned_instances_leave_the_others_untouched() {
 
 /// Pixels where green clearly leads red: the edited (green) fire.
 fn green_pixels(image: &[[u8; 4]]) -> usize {
-    image.iter().filter(|p| p[1] > p[0].saturating_add(40)).count()
+    image
+        .iter()
+        .filter(|p| p[1] > p[0].saturating_add(40))
+        .count()
 }
 
 /// Updates `app` (waiting for the file watcher between frames) until `done` holds.
@@ -204,7 +210,11 @@ fn an_edited_preset_hot_reloads_and_a_broken_one_keeps_the_last_good() {
     app.world_mut().spawn(IgnisEffect::new(preset.clone(), 5));
     common::run(&mut app, 30);
     let before = common::capture(&mut app, &target);
-    assert!(green_pixels(&before) < 10, "{} green pixels before", green_pixels(&before));
+    assert!(
+        green_pixels(&before) < 10,
+        "{} green pixels before",
+        green_pixels(&before)
+    );
 
     let original = std::fs::read_to_string(&file).expect("read");
     let green = stops_to_green(&original);
@@ -219,19 +229,32 @@ fn an_edited_preset_hot_reloads_and_a_broken_one_keeps_the_last_good() {
     });
     common::run(&mut app, 30);
     let after = common::capture(&mut app, &target);
-    assert!(green_pixels(&after) > 100, "{} green pixels after", green_pixels(&after));
+    assert!(
+        green_pixels(&after) > 100,
+        "{} green pixels after",
+        green_pixels(&after)
+    );
 
     std::fs::write(&file, "(version: 3, emitters: [ broken").expect("write");
     until(&mut app, "the broken file's error", |app| {
         let server = app.world().resource::<AssetServer>();
-        matches!(server.load_state(&preset), bevy::asset::LoadState::Failed(_))
+        matches!(
+            server.load_state(&preset),
+            bevy::asset::LoadState::Failed(_)
+        )
     });
-    if let bevy::asset::LoadState::Failed(e) = app.world().resource::<AssetServer>().load_state(&preset) {
+    if let bevy::asset::LoadState::Failed(e) =
+        app.world().resource::<AssetServer>().load_state(&preset)
+    {
         assert!(e.to_string().contains("torch.ron"), "{e}");
     }
     common::run(&mut app, 20);
     let kept = common::capture(&mut app, &target);
-    assert!(green_pixels(&kept) > 100, "the last good effect stopped: {}", green_pixels(&kept));
+    assert!(
+        green_pixels(&kept) > 100,
+        "the last good effect stopped: {}",
+        green_pixels(&kept)
+    );
 }
 
 /// `text` with every colour stop's red and blue zeroed and green full (alpha kept).
