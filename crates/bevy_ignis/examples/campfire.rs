@@ -18,6 +18,9 @@ use bevy::time::TimeUpdateStrategy;
 use bevy::window::ExitCondition;
 use bevy_ignis::{IgnisEffect, IgnisPlugin};
 
+/// The night sky.
+const NIGHT: ClearColor = ClearColor(Color::srgb(0.01, 0.012, 0.03));
+
 /// The headless image's size.
 const SHOT: (u32, u32) = (960, 540);
 
@@ -41,6 +44,7 @@ fn main() -> Result<(), String> {
         None => {
             let mut app = App::new();
             app.add_plugins((DefaultPlugins.set(asset_plugin()), ignis_plugin()))
+                .insert_resource(NIGHT)
                 .add_systems(
                     Startup,
                     |commands: Commands,
@@ -92,6 +96,7 @@ fn headless(frames: u32, screenshot: Option<PathBuf>) -> Result<(), String> {
             .disable::<bevy::winit::WinitPlugin>(),
     )
     .add_plugins(ignis_plugin())
+    .insert_resource(NIGHT)
     .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(
         1.0 / 60.0,
     )));
@@ -165,21 +170,22 @@ fn scene(
     commands.spawn((
         Mesh3d(meshes.add(Cuboid::new(0.8, 0.5, 0.5))),
         MeshMaterial3d(stone),
-        Transform::from_xyz(-0.9, 0.25, 1.6),
+        Transform::from_xyz(-0.55, 0.25, 1.2),
     ));
     let campfire = assets.load("campfire.ron");
     commands.spawn((IgnisEffect::new(campfire, 7), Transform::default()));
     let torch = assets.load("torch.ron");
     for (seed, x) in [(1, -2.5), (2, 2.5), (3, 0.0)] {
         let z = if x == 0.0 { -3.0 } else { -1.0 };
+        // The torch preset burns at the top of a 1 m handle: its origin is the foot.
         commands.spawn((
-            Mesh3d(meshes.add(Cylinder::new(0.06, 1.5))),
+            Mesh3d(meshes.add(Cylinder::new(0.05, 1.0))),
             MeshMaterial3d(wood.clone()),
-            Transform::from_xyz(x, 0.75, z),
+            Transform::from_xyz(x, 0.5, z),
         ));
         commands.spawn((
             IgnisEffect::new(torch.clone(), seed),
-            Transform::from_xyz(x, 1.5, z),
+            Transform::from_xyz(x, 0.0, z),
         ));
     }
     // The fire's glow on the ground and the moon.
