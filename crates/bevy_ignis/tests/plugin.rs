@@ -273,3 +273,34 @@ fn stops_to_green(text: &str) -> String {
     out.push_str(rest);
     out
 }
+
+/// `IgnisSeek` moves the preset's instances to the time asked (a cut-scene's jump), and
+/// is removed once applied.
+#[test]
+fn a_seek_moves_the_effect_to_the_time_asked() {
+    let mut app = common::app(&common::presets(), false);
+    common::camera(&mut app, Vec3::new(0.0, 1.3, 2.5), Vec3::new(0.0, 1.3, 0.0));
+    let preset = common::load(&mut app, "torch.ron");
+    let entity = app
+        .world_mut()
+        .spawn(IgnisEffect::new(preset.clone(), 5))
+        .id();
+    common::run(&mut app, 20);
+    let time = |app: &bevy::app::App| {
+        let vp = common::players(app).any_of(preset.id()).expect("player");
+        vp.player.time_secs(vp.instances[&entity].0).expect("time")
+    };
+    let before = time(&app);
+    app.world_mut()
+        .entity_mut(entity)
+        .insert(bevy_ignis::IgnisSeek(2.0));
+    app.update();
+    let after = time(&app);
+    assert!(before < 0.5, "{before} s before the seek");
+    // The seek, then at most this frame's 1/60 s (the steps it has recorded).
+    assert!(
+        (2.0..=2.0 + 1.0 / 60.0 + 1e-9).contains(&after),
+        "{after} s after seeking to 2 s"
+    );
+    assert!(app.world().get::<bevy_ignis::IgnisSeek>(entity).is_none());
+}
