@@ -66,9 +66,9 @@ pub use effect::Effect;
 pub use glam;
 pub use gpu::{AdapterProfile, ProfileKind, ProfileRequest, ProfileSetting};
 pub use runtime::{
-    Camera, ClockStats, EmitterStats, EventCount, HostTargets, InstanceId, IntoMat4, Layers,
-    MissingLimit, PLAYER_SHADERS, ParticleCount, ParticleInfo, Player, PlayerError, PlayerSettings,
-    STORAGE_BUFFERS_REQUIRED, required_limits,
+    Camera, ClockStats, EffectLight, EmitterStats, EventCount, HostTargets, InstanceId, IntoMat4,
+    Layers, MissingLimit, PLAYER_SHADERS, ParticleCount, ParticleInfo, Player, PlayerError,
+    PlayerSettings, STORAGE_BUFFERS_REQUIRED, required_limits,
 };
 pub use shaders::ShaderError;
 pub use sim::planner::SpawnStats;

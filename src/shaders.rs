@@ -80,6 +80,7 @@ pub const EMBEDDED: &[(&str, &str)] = &[
         "depth_resolve.wgsl",
         include_str!("../shaders/depth_resolve.wgsl"),
     ),
+    ("light.wgsl", include_str!("../shaders/light.wgsl")),
     (
         "workgroup_scan.wgsl",
         include_str!("../shaders/workgroup_scan.wgsl"),
@@ -128,6 +129,7 @@ pub const ENTRY_FILES: &[&str] = &[
     "bloom.wgsl",
     "clear.wgsl",
     "depth_resolve.wgsl",
+    "light.wgsl",
 ];
 
 /// A shader problem, located in the file the user edits.

@@ -910,3 +910,114 @@ fn a_depth_the_player_cannot_sample_is_an_error_and_the_fire_still_shows() {
         "{message:?}"
     );
 }
+
+/// Records `frames` frames of every player and waits for the GPU after each, so that the
+/// light estimate's readbacks complete (a host's frames do this over time).
+fn advance_and_wait(players: &mut [&mut Player], host: &Host, frames: u32) {
+    for _ in 0..frames {
+        advance(players, host, 1);
+        let _ = host.device.poll(wgpu::PollType::wait_indefinitely());
+    }
+}
+
+/// The effect's light is where its light is: still particles at one point give a light
+/// there (in the host's world: the instance's place, a z-up world turned), of their colour,
+/// with no spread; its power adds up per particle, goes as the sprite's area and the
+/// intensity.
+#[test]
+fn the_effect_light_sits_on_the_particles_with_their_colour_and_power() {
+    let lit = |kind: HostKind, size_m: f32, intensity: f32| {
+        let host = Host::of(kind, vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+        let mut disc = still_disc(0.0);
+        disc.emitters[0].look.size_m = ignis::effect::Param::Constant(size_m);
+        disc.emitters[0].look.intensity = intensity;
+        let mut player = host.player(&disc);
+        player.set_light_estimate(true);
+        let id = player
+            .add_instance(Mat4::from_translation(vec3(1.0, 2.0, 3.0)), 1)
+            .expect("instance");
+        advance_and_wait(&mut [&mut player], &host, 60);
+        let alive = player.count_particles(id).expect("count")[0].alive;
+        (player.effect_light(id).expect("a light"), alive)
+    };
+    let (light, alive) = lit(HostKind::default(), 1.0, 1.0);
+    assert!(alive >= 3, "{alive} particles alive");
+    assert!(
+        light.position.abs_diff_eq(vec3(1.0, 2.2, 3.0), 1e-5),
+        "{light:?}"
+    );
+    let [r, g, b] = light.color;
+    assert!(
+        (r - 1.0).abs() < 1e-6 && (g - 0.8).abs() < 1e-5 && (b - 0.6).abs() < 1e-5,
+        "{light:?}"
+    );
+    assert!(light.radius_m < 1e-2, "{light:?}");
+    let luma =
+        0.2126 * light.rgb_power[0] + 0.7152 * light.rgb_power[1] + 0.0722 * light.rgb_power[2];
+    assert!((light.power - luma).abs() < 1e-5 * luma, "{light:?}");
+    let (bigger, _) = lit(HostKind::default(), 2.0, 1.0);
+    let (brighter, _) = lit(HostKind::default(), 1.0, 3.0);
+    assert!(
+        (bigger.power / light.power - 4.0).abs() < 1e-4,
+        "{bigger:?}"
+    );
+    assert!(
+        (brighter.power / light.power - 3.0).abs() < 1e-4,
+        "{brighter:?}"
+    );
+    let z_up = HostKind {
+        z_up: true,
+        ..HostKind::default()
+    };
+    let (turned, _) = lit(z_up, 1.0, 1.0);
+    assert!(
+        turned.position.abs_diff_eq(vec3(1.0, 2.0, 3.2), 1e-5),
+        "{turned:?}"
+    );
+}
+
+/// The campfire's light flickers as its flames do, from where they burn, two frames behind
+/// the simulation, and costs nothing unless asked for.
+#[test]
+fn the_campfire_light_flickers_from_its_flames() {
+    let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+    let mut fire = host.player(&preset("campfire"));
+    let id = fire.add_instance(Mat4::IDENTITY, 3).expect("instance");
+    advance_and_wait(&mut [&mut fire], &host, 30);
+    assert_eq!(fire.effect_light(id), None, "no light without the estimate");
+    fire.set_light_estimate(true);
+    // A frame's sums are copied in its record, mapped at the next, read at the one after.
+    advance_and_wait(&mut [&mut fire], &host, 2);
+    assert_eq!(
+        fire.effect_light(id),
+        None,
+        "read before the GPU could map it"
+    );
+    advance(&mut [&mut fire], &host, 1);
+    assert!(
+        fire.effect_light(id).is_some(),
+        "the light arrives two frames later"
+    );
+    let mut powers = Vec::new();
+    for _ in 0..40 {
+        advance_and_wait(&mut [&mut fire], &host, 1);
+        let light = fire.effect_light(id).expect("light");
+        assert!(
+            light.position.y > 0.1 && light.position.y < 1.5,
+            "{light:?}"
+        );
+        assert!(
+            light.position.x.abs() < 0.5 && light.position.z.abs() < 0.5,
+            "{light:?}"
+        );
+        assert!(
+            light.color[0] == 1.0 && light.color[2] < light.color[1],
+            "warm: {light:?}"
+        );
+        powers.push(f64::from(light.power));
+    }
+    let mean = powers.iter().sum::<f64>() / powers.len() as f64;
+    let sd = (powers.iter().map(|p| (p - mean).powi(2)).sum::<f64>() / powers.len() as f64).sqrt();
+    eprintln!("campfire light: power {mean:.4} ± {sd:.4}");
+    assert!(mean > 0.0 && sd / mean > 0.01, "no flicker: {mean} ± {sd}");
+}

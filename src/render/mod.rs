@@ -8,6 +8,7 @@ pub mod composite;
 pub mod depth_resolve;
 pub mod frame;
 pub(crate) mod image_groups;
+pub mod light;
 pub mod look;
 pub mod matrix;
 pub mod sort;

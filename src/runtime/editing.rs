@@ -29,6 +29,7 @@ pub const PLAYER_SHADERS: &[&str] = &[
     "tiles.wgsl",
     "sort.wgsl",
     "depth_resolve.wgsl",
+    "light.wgsl",
 ];
 
 impl Player {
@@ -182,6 +183,11 @@ impl Player {
             }
             "sort.wgsl" => self.sort.rebuild(&self.ctx, &lib)?,
             "depth_resolve.wgsl" => self.host_depth.rebuild(&self.ctx, &lib)?,
+            "light.wgsl" => {
+                if let Some(pass) = &mut self.light.pass {
+                    pass.rebuild(&self.ctx, &lib)?;
+                }
+            }
             _ => return Ok(()),
         }
         // Pipelines built later (a new variant, an edit's new integrator) use it too.

@@ -170,6 +170,20 @@ impl<T> Slab<T> {
         self.slots.iter().filter_map(|(_, i)| i.as_ref())
     }
 
+    /// Every item with its handle, in slot order.
+    pub fn iter_with_ids(&self) -> impl Iterator<Item = (InstanceId, &T)> {
+        self.slots
+            .iter()
+            .enumerate()
+            .filter_map(|(index, (generation, i))| {
+                let id = InstanceId {
+                    index: index as u32,
+                    generation: *generation,
+                };
+                i.as_ref().map(|i| (id, i))
+            })
+    }
+
     /// Every item, mutably.
     pub fn iter_mut(&mut self) -> impl Iterator<Item = &mut T> {
         self.slots.iter_mut().filter_map(|(_, i)| i.as_mut())

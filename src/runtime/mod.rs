@@ -4,6 +4,7 @@
 
 mod device_check;
 mod editing;
+mod effect_light;
 mod host_depth;
 mod host_targets;
 mod inspect;
@@ -18,6 +19,7 @@ pub use crate::render::Camera;
 pub use crate::render::matrix::IntoMat4;
 pub use device_check::{MissingLimit, STORAGE_BUFFERS_REQUIRED, required_limits};
 pub use editing::PLAYER_SHADERS;
+pub use effect_light::EffectLight;
 pub use host_targets::HostTargets;
 pub use inspect::{ClockStats, EmitterStats, EventCount, ParticleCount};
 pub use instances::InstanceId;

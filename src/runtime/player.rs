@@ -52,8 +52,8 @@ pub struct PlayerSettings {
     /// made y-up: gravity, buoyancy, wind and the preset's ground and colliders are
     /// turned with the world by the shortest rotation from +Y to this axis (for +Z: a
     /// preset's +Z becomes the host's −Y, as a y-up glTF scene imports into a z-up one).
-    /// Instances' transforms, cameras and the positions the player reports are all in
-    /// the host's world.
+    /// Instances' transforms, cameras and the positions and lights the player reports
+    /// are all in the host's world; an unrotated instance burns along the host's up.
     pub world_up: Vec3,
 }
 
@@ -162,6 +162,8 @@ pub struct Player {
     motion_pass: bool,
     /// The host's depth as the passes sample it.
     pub(super) host_depth: HostDepth,
+    /// The instances' light, when estimated.
+    pub(super) light: super::effect_light::LightEstimate,
     /// `simulate` ran since the last `record`, which then does not run it again.
     pub(super) simulated: bool,
     /// Snapshots a seek can start from (`Player::keep_seek_snapshots`).
@@ -249,6 +251,7 @@ impl Player {
             splatted: false,
             motion_pass: false,
             host_depth: HostDepth::new(),
+            light: Default::default(),
             simulated: false,
             snapshots: Default::default(),
         })
@@ -333,16 +336,18 @@ impl Player {
     /// Where an instance is, if it exists.
     pub fn transform(&self, id: InstanceId) -> Option<Mat4> {
         let host = self.settings.host_from_preset().map(Mat4::from_quat);
-        self.instances
-            .get(id)
-            .map(|i| host.map_or(i.world_from_effect, |h| h * i.world_from_effect))
+        self.instances.get(id).map(|i| match host {
+            Some(h) => h * i.world_from_effect * h.inverse(),
+            None => i.world_from_effect,
+        })
     }
 
     /// A host-world transform in the presets' y-up world (see
-    /// [`PlayerSettings::world_up`]).
+    /// [`PlayerSettings::world_up`]): the same motion seen from the turned world, so that
+    /// an unrotated instance in a z-up host burns along +Z.
     fn preset_from_host(&self, host: Mat4) -> Mat4 {
         match self.settings.host_from_preset() {
-            Some(q) => Mat4::from_quat(q.inverse()) * host,
+            Some(q) => Mat4::from_quat(q.inverse()) * host * Mat4::from_quat(q),
             None => host,
         }
     }
@@ -497,7 +502,8 @@ impl Player {
             .iter()
             .map(|b| (0..b.active()).map(|slot| b.member(slot)).collect())
             .collect();
-        let groups = Self::draw_groups(&self.instances, &members, camera);
+        let (groups, ids) = Self::draw_groups(&self.instances, &members, camera);
+        let owners = light_owners(&groups, &ids);
         let groups: Vec<&[Option<Scene<'_>>]> = groups.iter().map(Vec::as_slice).collect();
         self.items = self.frame.prepare(
             &self.ctx,
@@ -540,6 +546,9 @@ impl Player {
             &self.frame.sprites.sampler,
             self.motion_pass,
         );
+        drop(groups);
+        drop(members);
+        self.record_light(encoder, &owners);
         self.uploads.finish(encoder);
     }
 
@@ -571,25 +580,30 @@ impl Player {
     /// the view (a far group's smoke lies under a nearer group's): each batch is one
     /// group (its members by segment; one sort orders their smoke together), each
     /// instance with a simulation of its own another.
+    #[allow(clippy::type_complexity)]
     fn draw_groups<'a>(
         instances: &'a Slab<Instance>,
         members: &'a [Vec<Option<BatchMember<'a>>>],
         camera: &Camera,
-    ) -> Vec<Vec<Option<Scene<'a>>>> {
+    ) -> (Vec<Vec<Option<Scene<'a>>>>, Vec<Vec<Option<InstanceId>>>) {
         let (eye, forward) = (camera.eye_f64(), camera.forward().as_dvec3());
         let depth =
             |i: &Instance| (i.world_from_effect.w_axis.truncate().as_dvec3() - eye).dot(forward);
-        let mut groups: Vec<(f64, Vec<Option<Scene<'a>>>)> =
+        type Member<'a> = Option<(InstanceId, Scene<'a>)>;
+        let mut groups: Vec<(f64, Vec<Member<'a>>)> =
             members.iter().map(|m| (0.0, vec![None; m.len()])).collect();
         let mut counts = vec![0u32; groups.len()];
-        for i in instances.iter() {
+        for (id, i) in instances.iter_with_ids() {
             match &i.state {
                 Backing::Own(sim) => groups.push((
                     depth(i),
-                    vec![Some(Scene {
-                        sim: sim.as_ref(),
-                        effect: i.effect(),
-                    })],
+                    vec![Some((
+                        id,
+                        Scene {
+                            sim: sim.as_ref(),
+                            effect: i.effect(),
+                        },
+                    ))],
                 )),
                 Backing::Batched { batch, slot } => {
                     let (Some(g), Some(Some(m))) = (
@@ -601,10 +615,13 @@ impl Player {
                     g.0 += depth(i);
                     counts[*batch] += 1;
                     if let Some(s) = g.1.get_mut(*slot as usize) {
-                        *s = Some(Scene {
-                            sim: m,
-                            effect: i.effect(),
-                        });
+                        *s = Some((
+                            id,
+                            Scene {
+                                sim: m,
+                                effect: i.effect(),
+                            },
+                        ));
                     }
                 }
             }
@@ -614,7 +631,13 @@ impl Player {
         }
         groups.retain(|g| g.1.iter().any(Option::is_some));
         groups.sort_by(|a, b| b.0.total_cmp(&a.0));
-        groups.into_iter().map(|g| g.1).collect()
+        groups
+            .into_iter()
+            .map(|(_, g)| {
+                let ids = g.iter().map(|m| m.as_ref().map(|(id, _)| *id)).collect();
+                (g.into_iter().map(|m| m.map(|(_, s)| s)).collect(), ids)
+            })
+            .unzip()
     }
 
     /// Records only the steps [`Player::advance`] planned for every instance, with no sort
@@ -831,4 +854,30 @@ mod tests {
         send::<super::Player>();
         send::<super::InstanceId>();
     }
+}
+
+/// Who each look slot of a frame measures, for the light estimate: the instance and the
+/// emitter's simulation origin, in the order `FrameResources::prepare` gives the slots
+/// (each group's emitters in turn, each with the group's members).
+fn light_owners(
+    groups: &[Vec<Option<Scene<'_>>>],
+    ids: &[Vec<Option<InstanceId>>],
+) -> Vec<Option<super::effect_light::LightOwner>> {
+    let mut owners = Vec::new();
+    for (group, ids) in groups.iter().zip(ids) {
+        let emitters = group
+            .iter()
+            .flatten()
+            .next()
+            .map_or(0, |s| s.effect.emitters.len());
+        for e in 0..emitters {
+            for (scene, id) in group.iter().zip(ids) {
+                owners.push(scene.as_ref().zip(*id).map(|(s, id)| {
+                    let origin = s.sim.planner().emitters.get(e).map(|p| p.origin());
+                    (id, origin.unwrap_or_default())
+                }));
+            }
+        }
+    }
+    owners
 }

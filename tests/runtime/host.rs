@@ -186,10 +186,12 @@ impl Host {
         Player::new(&self.device, &self.queue, effect, self.settings()).expect("player")
     }
 
-    /// An instance transform given y-up, in this host's world.
+    /// An instance transform given y-up, in this host's world (the same motion in the
+    /// turned world: the identity stays the identity).
     pub fn place(&self, y_up: Mat4) -> Mat4 {
         if self.kind.z_up {
-            Mat4::from_quat(z_up()) * y_up
+            let r = Mat4::from_quat(z_up());
+            r * y_up * r.inverse()
         } else {
             y_up
         }

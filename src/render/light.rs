@@ -1,0 +1,483 @@
+//! The effect's light (`shaders/light.wgsl`): the light the additive particles alive now
+//! emit, summed per instance and emitter on the GPU, and read back without stalling — a
+//! ring of readback buffers, each mapped when the GPU is done with it, so results arrive a
+//! frame or two after the frame they measure.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use crate::effect::BlendMode;
+use crate::gpu::GpuContext;
+use crate::render::frame::StateVariant;
+use crate::render::{DrawItem, FrameResources};
+use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
+use crate::sim::gpu_sim::dispatch_size;
+
+/// One emitter of one instance's light, in its simulation space: Σ E.rgb, Σ Y, Σ Y·p,
+/// Σ Y·|p|² (E the emitted light, Y its luminance, p the particle's position).
+pub type LightSums = [f32; 8];
+
+/// Bytes of one job's uniform (a dynamic offset's alignment).
+const JOB_STRIDE: u64 = 256;
+/// Readbacks in flight at most (a fourth frame's light is skipped until one is free).
+const RING: usize = 3;
+
+/// The light pass: its pipelines, its buffers, and the readbacks in flight.
+pub struct LightPass<T> {
+    layout: wgpu::BindGroupLayout,
+    pipeline_layout: wgpu::PipelineLayout,
+    module: wgpu::ShaderModule,
+    sums: HashMap<StateVariant, Option<wgpu::ComputePipeline>>,
+    total: wgpu::ComputePipeline,
+    /// Partials, totals and jobs, and their group (grown as needed).
+    buffers: Option<Buffers>,
+    ring: Vec<Readback<T>>,
+    next: usize,
+}
+
+struct Buffers {
+    partials: u64,
+    totals: u64,
+    jobs: u64,
+    totals_buffer: wgpu::Buffer,
+    jobs_buffer: wgpu::Buffer,
+    group: wgpu::BindGroup,
+}
+
+/// A readback buffer and what it holds: `None` free, else the frame's owners (look slots
+/// in totals order), whether its map was asked for, and whether it has completed.
+struct Readback<T> {
+    buffer: wgpu::Buffer,
+    size: u64,
+    pending: Option<Pending<T>>,
+}
+
+struct Pending<T> {
+    owners: Vec<Option<T>>,
+    mapping: bool,
+    done: Arc<AtomicBool>,
+}
+
+/// What one job of a frame sums.
+struct Job {
+    item: usize,
+    partial_base: u32,
+    groups: u32,
+    total_base: u32,
+}
+
+impl<T: Clone> LightPass<T> {
+    /// Builds the pipelines from `lib` (the look and state groups are `frame`'s).
+    pub fn new(
+        ctx: &GpuContext,
+        lib: &ShaderLibrary,
+        frame: &FrameResources,
+    ) -> Result<Self, ShaderError> {
+        let storage = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: false },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let layout = ctx
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("LightPass::layout"),
+                entries: &[
+                    storage(0),
+                    storage(1),
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 2,
+                        visibility: wgpu::ShaderStages::COMPUTE,
+                        ty: wgpu::BindingType::Buffer {
+                            ty: wgpu::BufferBindingType::Uniform,
+                            has_dynamic_offset: true,
+                            min_binding_size: wgpu::BufferSize::new(16),
+                        },
+                        count: None,
+                    },
+                ],
+            });
+        let pipeline_layout = ctx
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("LightPass::pipeline_layout"),
+                bind_group_layouts: &[
+                    Some(&frame.frame_layout),
+                    Some(&frame.particle_layout),
+                    Some(&layout),
+                ],
+                immediate_size: 0,
+            });
+        let (module, sums, total) = Self::build(ctx, lib, &pipeline_layout)?;
+        Ok(Self {
+            layout,
+            pipeline_layout,
+            module,
+            sums,
+            total,
+            buffers: None,
+            ring: Vec::new(),
+            next: 0,
+        })
+    }
+
+    #[allow(clippy::type_complexity)]
+    fn build(
+        ctx: &GpuContext,
+        lib: &ShaderLibrary,
+        layout: &wgpu::PipelineLayout,
+    ) -> Result<
+        (
+            wgpu::ShaderModule,
+            HashMap<StateVariant, Option<wgpu::ComputePipeline>>,
+            wgpu::ComputePipeline,
+        ),
+        ShaderError,
+    > {
+        let composed = lib.compose("light.wgsl")?;
+        create_checked(&ctx.device, &composed, lib, |module| {
+            let full = StateVariant::default();
+            let sum = Self::sum_pipeline(ctx, layout, module, full);
+            let total = crate::render::compute_pipeline(
+                ctx,
+                "LightPass::total",
+                layout,
+                module,
+                "light_total",
+                &[],
+            );
+            (module.clone(), HashMap::from([(full, Some(sum))]), total)
+        })
+    }
+
+    fn sum_pipeline(
+        ctx: &GpuContext,
+        layout: &wgpu::PipelineLayout,
+        module: &wgpu::ShaderModule,
+        state: StateVariant,
+    ) -> wgpu::ComputePipeline {
+        let constants = state.constants();
+        crate::render::compute_pipeline(
+            ctx,
+            "LightPass::sum",
+            layout,
+            module,
+            "light_sum",
+            &constants,
+        )
+    }
+
+    /// Rebuilds the pipelines; keeps the old ones on error.
+    pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
+        let (module, sums, total) = Self::build(ctx, lib, &self.pipeline_layout)?;
+        (self.module, self.sums, self.total) = (module, sums, total);
+        Ok(())
+    }
+
+    /// Records the sums of every additive item's instances and their copy into a free
+    /// readback buffer (nothing when all are in flight). The results come from
+    /// [`LightPass::collect`] once the GPU has finished, each with what `owner` said of its
+    /// look slot (the instance and emitter it measures).
+    pub fn record(
+        &mut self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        frame: &FrameResources,
+        items: &[DrawItem],
+        owner: impl Fn(usize) -> Option<T>,
+    ) {
+        let Some(ring) = self.free_readback(ctx) else {
+            return;
+        };
+        let (jobs, partials, totals) = plan(items);
+        if jobs.is_empty() {
+            return;
+        }
+        self.ensure_buffers(ctx, partials, totals, jobs.len() as u64);
+        self.ensure_variants(ctx, items, &jobs);
+        let Some(b) = &self.buffers else {
+            return;
+        };
+        let mut bytes = vec![0u8; jobs.len() * JOB_STRIDE as usize];
+        for (k, j) in jobs.iter().enumerate() {
+            let words = [
+                j.partial_base,
+                j.groups,
+                j.total_base,
+                items[j.item].members,
+            ];
+            bytes[k * JOB_STRIDE as usize..][..16].copy_from_slice(bytemuck::cast_slice(&words));
+        }
+        ctx.queue.write_buffer(&b.jobs_buffer, 0, &bytes);
+        self.dispatch(enc, frame, items, &jobs);
+        let owners = jobs
+            .iter()
+            .flat_map(|j| {
+                let d = &items[j.item];
+                (0..d.members as usize).map(move |m| d.look_slot + m)
+            })
+            .map(owner)
+            .collect();
+        let r = &mut self.ring[ring];
+        let size = u64::from(totals) * 32;
+        enc.copy_buffer_to_buffer(&b.totals_buffer, 0, &r.buffer, 0, size.min(r.size));
+        r.pending = Some(Pending {
+            owners,
+            mapping: false,
+            done: Arc::new(AtomicBool::new(false)),
+        });
+        self.next = (ring + 1) % RING;
+    }
+
+    /// The two passes over `jobs`.
+    fn dispatch(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        frame: &FrameResources,
+        items: &[DrawItem],
+        jobs: &[Job],
+    ) {
+        let Some(b) = &self.buffers else {
+            return;
+        };
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("LightPass"),
+            timestamp_writes: None,
+        });
+        for (k, j) in jobs.iter().enumerate() {
+            let d = &items[j.item];
+            let (Some(particles), Some(Some(sum))) =
+                (frame.particle_group(d.key), self.sums.get(&d.variant.state))
+            else {
+                continue;
+            };
+            pass.set_bind_group(
+                0,
+                &frame.frame_group,
+                &[FrameResources::look_offset(d.look_slot)],
+            );
+            pass.set_bind_group(1, particles, &[]);
+            pass.set_bind_group(2, &b.group, &[(k as u64 * JOB_STRIDE) as u32]);
+            pass.set_pipeline(sum);
+            let (x, y) = dispatch_size(d.width);
+            pass.dispatch_workgroups(x, y, d.members);
+            pass.set_pipeline(&self.total);
+            pass.dispatch_workgroups(d.members.div_ceil(64), 1, 1);
+        }
+    }
+
+    /// The newest finished frame's sums with their owners, if one finished since the
+    /// last call (never waits: it polls the device once).
+    pub fn collect(&mut self, ctx: &GpuContext) -> Option<Vec<(T, LightSums)>> {
+        let _ = ctx.device.poll(wgpu::PollType::Poll);
+        let mut newest = None;
+        for k in 1..=RING {
+            let i = (self.next + RING - k) % RING;
+            let Some(r) = self.ring.get_mut(i) else {
+                continue;
+            };
+            let done = (r.pending.as_ref()).is_some_and(|p| p.done.load(Ordering::Acquire));
+            if !done {
+                continue;
+            }
+            let Some(p) = r.pending.take() else {
+                continue;
+            };
+            let sums = read_sums(&r.buffer, &p.owners);
+            r.buffer.unmap();
+            newest = newest.or(Some(sums));
+        }
+        newest
+    }
+
+    /// Asks for the maps of the readbacks recorded before (call after the submission that
+    /// holds their copies: a player's next record).
+    pub fn map_recorded(&mut self) {
+        for r in &mut self.ring {
+            if let Some(p) = &mut r.pending
+                && !p.mapping
+            {
+                p.mapping = true;
+                let flag = p.done.clone();
+                r.buffer
+                    .slice(..)
+                    .map_async(wgpu::MapMode::Read, move |res| {
+                        if res.is_ok() {
+                            flag.store(true, Ordering::Release);
+                        }
+                    });
+            }
+        }
+    }
+
+    /// A readback buffer with nothing in flight (made on first need), or none.
+    fn free_readback(&mut self, ctx: &GpuContext) -> Option<usize> {
+        while self.ring.len() < RING {
+            self.ring.push(Readback {
+                buffer: readback_buffer(ctx, 32),
+                size: 32,
+                pending: None,
+            });
+        }
+        let i = self.next;
+        self.ring[i].pending.is_none().then_some(i)
+    }
+
+    fn ensure_buffers(&mut self, ctx: &GpuContext, partials: u32, totals: u32, jobs: u64) {
+        let (p, t) = (
+            u64::from(partials.max(1)) * 32,
+            u64::from(totals.max(1)) * 32,
+        );
+        let j = jobs * JOB_STRIDE;
+        let fits = self
+            .buffers
+            .as_ref()
+            .is_some_and(|b| b.partials >= p && b.totals >= t && b.jobs >= j);
+        if !fits {
+            let grow =
+                |have: Option<u64>, need: u64| need.max(have.unwrap_or(0)).next_power_of_two();
+            let p = grow(self.buffers.as_ref().map(|b| b.partials), p);
+            let t = grow(self.buffers.as_ref().map(|b| b.totals), t);
+            let j = grow(self.buffers.as_ref().map(|b| b.jobs), j);
+            self.buffers = Some(Buffers::new(ctx, &self.layout, p, t, j));
+        }
+        let t = self.buffers.as_ref().map_or(32, |b| b.totals);
+        for r in self
+            .ring
+            .iter_mut()
+            .filter(|r| r.pending.is_none() && r.size < t)
+        {
+            r.buffer = readback_buffer(ctx, t);
+            r.size = t;
+        }
+    }
+
+    fn ensure_variants(&mut self, ctx: &GpuContext, items: &[DrawItem], jobs: &[Job]) {
+        for j in jobs {
+            let state = items[j.item].variant.state;
+            if !self.sums.contains_key(&state) {
+                let p = crate::render::scoped_variant(
+                    ctx,
+                    format_args!("light variant {state:?}"),
+                    || Self::sum_pipeline(ctx, &self.pipeline_layout, &self.module, state),
+                );
+                self.sums.insert(state, p);
+            }
+        }
+    }
+}
+
+impl Buffers {
+    fn new(
+        ctx: &GpuContext,
+        layout: &wgpu::BindGroupLayout,
+        partials: u64,
+        totals: u64,
+        jobs: u64,
+    ) -> Self {
+        let buffer = |label, size, usage| {
+            ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let storage = wgpu::BufferUsages::STORAGE;
+        let p = buffer("LightPass::partials", partials, storage);
+        let totals_buffer = buffer(
+            "LightPass::totals",
+            totals,
+            storage | wgpu::BufferUsages::COPY_SRC,
+        );
+        let j = buffer(
+            "LightPass::jobs",
+            jobs,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
+        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("LightPass::group"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: p.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: totals_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &j,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(16),
+                    }),
+                },
+            ],
+        });
+        Self {
+            partials,
+            totals,
+            jobs,
+            totals_buffer,
+            jobs_buffer: j,
+            group,
+        }
+    }
+}
+
+/// The frame's jobs (every additive item with particles), and the partials and totals
+/// they need.
+fn plan(items: &[DrawItem]) -> (Vec<Job>, u32, u32) {
+    let (mut jobs, mut partials, mut totals) = (Vec::new(), 0, 0);
+    for (item, d) in items.iter().enumerate() {
+        if d.blend != BlendMode::Additive || d.width == 0 {
+            continue;
+        }
+        let (x, y) = dispatch_size(d.width);
+        jobs.push(Job {
+            item,
+            partial_base: partials,
+            groups: x * y,
+            total_base: totals,
+        });
+        partials += x * y * d.members;
+        totals += d.members;
+    }
+    (jobs, partials, totals)
+}
+
+fn readback_buffer(ctx: &GpuContext, size: u64) -> wgpu::Buffer {
+    ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("LightPass::readback"),
+        size,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    })
+}
+
+/// The mapped `buffer`'s totals, with their owners.
+fn read_sums<T: Clone>(buffer: &wgpu::Buffer, owners: &[Option<T>]) -> Vec<(T, LightSums)> {
+    let Ok(view) = buffer.slice(..).get_mapped_range() else {
+        return Vec::new();
+    };
+    let floats: &[f32] = bytemuck::cast_slice(&view);
+    owners
+        .iter()
+        .enumerate()
+        .filter_map(|(k, owner)| {
+            let s = floats.get(k * 8..k * 8 + 8)?;
+            let mut sums = [0.0; 8];
+            sums.copy_from_slice(s);
+            Some((owner.clone()?, sums))
+        })
+        .collect()
+}

@@ -1,0 +1,133 @@
+//! [`EffectLight`]: the light an instance's fire gives its scene, estimated each frame
+//! from the additive particles alive (the GPU sums their emitted light and its
+//! luminance-weighted moments; `render::light`) and read back a frame or two later.
+
+use std::collections::HashMap;
+
+use glam::{DVec3, Vec3};
+
+use super::{InstanceId, Player};
+use crate::render::light::{LightPass, LightSums};
+
+/// The light of one instance, as a point light a host can place in its scene.
+///
+/// Estimated from the additive (emissive) particles alive in a recent frame: each
+/// particle's emitted light E = colour × alpha × opacity × intensity × its sprite's area
+/// (m², the sprite's brightness integrated over the quad); the light sits at the
+/// luminance-weighted centroid of the particles, and flickers as they do.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EffectLight {
+    /// The light-weighted centroid of the particles, in the host's world (metres).
+    pub position: Vec3,
+    /// The light's colour, linear RGB with its largest channel 1.
+    pub color: [f32; 3],
+    /// Its power: the summed luminance of the emitted light (HDR colour × m²). A host
+    /// scales it to its own light units (Bevy's lumens, a renderer's watts).
+    pub power: f32,
+    /// The emitted light per channel (linear RGB × m²; `color` × the largest of them).
+    pub rgb_power: [f32; 3],
+    /// How far the light is spread: the luminance-weighted RMS distance of the particles
+    /// from `position` (metres; an area light's radius, or a point light's softening).
+    pub radius_m: f32,
+}
+
+/// Who a light total belongs to: the instance and the emitter's simulation origin.
+pub(super) type LightOwner = (InstanceId, DVec3);
+
+/// The estimate's state in a player: the pass (built on first need) and the latest
+/// lights.
+#[derive(Default)]
+pub(super) struct LightEstimate {
+    pub pass: Option<LightPass<LightOwner>>,
+    pub on: bool,
+    pub latest: HashMap<InstanceId, EffectLight>,
+}
+
+impl Player {
+    /// Estimates each instance's light from now on (`on`), read with
+    /// [`Player::effect_light`]: a small compute pass per additive emitter and a readback
+    /// that never stalls (the light of a frame arrives one or two frames later). Off by
+    /// default.
+    pub fn set_light_estimate(&mut self, on: bool) {
+        self.light.on = on;
+        if !on {
+            self.light.latest.clear();
+        }
+    }
+
+    /// Instance `id`'s light as last read back (see [`EffectLight`]); `None` before the
+    /// first readback, with the estimate off, or for an instance with no light alive.
+    pub fn effect_light(&self, id: InstanceId) -> Option<EffectLight> {
+        self.light.latest.get(&id).copied()
+    }
+
+    /// Collects finished readbacks, asks for the last record's maps, and records this
+    /// frame's sums (after `frame.prepare`: the items and looks are this frame's).
+    pub(super) fn record_light(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        owners: &[Option<LightOwner>],
+    ) {
+        if !self.light.on {
+            return;
+        }
+        if self.light.pass.is_none() {
+            match LightPass::new(&self.ctx, &self.library, &self.frame) {
+                Ok(p) => self.light.pass = Some(p),
+                Err(e) => {
+                    log::error!("the effect light's shader failed; no light estimate: {e}");
+                    self.light.on = false;
+                    return;
+                }
+            }
+        }
+        let Some(pass) = self.light.pass.as_mut() else {
+            return;
+        };
+        if let Some(sums) = pass.collect(&self.ctx) {
+            let host = self.settings.host_from_preset();
+            self.light.latest = lights(&sums, host);
+        }
+        pass.map_recorded();
+        let owner = |slot: usize| owners.get(slot).copied().flatten();
+        pass.record(&self.ctx, enc, &self.frame, &self.items, owner);
+    }
+}
+
+/// Each instance's light from its emitters' sums.
+fn lights(
+    sums: &[(LightOwner, LightSums)],
+    host: Option<glam::Quat>,
+) -> HashMap<InstanceId, EffectLight> {
+    // Σ E.rgb, Σ Y, Σ Y·p, Σ Y·|p|² in world space, per instance (f64).
+    let mut totals: HashMap<InstanceId, ([f64; 3], f64, DVec3, f64)> = HashMap::new();
+    for ((id, origin), s) in sums {
+        let t = totals.entry(*id).or_default();
+        let y = f64::from(s[3]);
+        let yp = DVec3::new(f64::from(s[4]), f64::from(s[5]), f64::from(s[6]));
+        for c in 0..3 {
+            t.0[c] += f64::from(s[c]);
+        }
+        t.1 += y;
+        t.2 += yp + *origin * y;
+        t.3 += f64::from(s[7]) + 2.0 * origin.dot(yp) + origin.length_squared() * y;
+    }
+    totals
+        .into_iter()
+        .filter(|(_, t)| t.1 > 0.0)
+        .map(|(id, (rgb, y, yp, ypp))| {
+            let centre = yp / y;
+            let spread = (ypp / y - centre.length_squared()).max(0.0).sqrt();
+            let peak = rgb.iter().copied().fold(0.0, f64::max).max(1e-30);
+            let position = centre.as_vec3();
+            let light = EffectLight {
+                position: host.map_or(position, |q| q * position),
+                color: rgb.map(|c| (c / peak) as f32),
+                power: y as f32,
+                rgb_power: rgb.map(|c| c as f32),
+                radius_m: spread as f32,
+            };
+            (id, light)
+        })
+        .collect()
+}
