@@ -105,8 +105,8 @@ fn lights(
         let t = totals.entry(*id).or_default();
         let y = f64::from(s[3]);
         let yp = DVec3::new(f64::from(s[4]), f64::from(s[5]), f64::from(s[6]));
-        for c in 0..3 {
-            t.0[c] += f64::from(s[c]);
+        for (sum, add) in t.0.iter_mut().zip(s) {
+            *sum += f64::from(*add);
         }
         t.1 += y;
         t.2 += yp + *origin * y;

@@ -16,7 +16,7 @@ use bevy::render::render_resource::TextureFormat;
 use bevy::render::view::screenshot::{Screenshot, save_to_disk};
 use bevy::time::TimeUpdateStrategy;
 use bevy::window::ExitCondition;
-use bevy_ignis::{IgnisEffect, IgnisPlugin};
+use bevy_ignis::{IgnisEffect, IgnisLight, IgnisPlugin};
 
 /// The night sky.
 const NIGHT: ClearColor = ClearColor(Color::srgb(0.01, 0.012, 0.03));
@@ -140,7 +140,8 @@ fn headless_scene(
 }
 
 /// The ground, a log pile's stones, three posts with torches, a box in front of the
-/// fire, a moonlit sky's light, and the camera (into `target`, or the window).
+/// fire, the moon, the campfire's own flickering light, and the camera (into `target`,
+/// or the window).
 fn scene(
     mut commands: Commands,
     assets: Res<AssetServer>,
@@ -173,7 +174,11 @@ fn scene(
         Transform::from_xyz(-0.55, 0.25, 1.2),
     ));
     let campfire = assets.load("campfire.ron");
-    commands.spawn((IgnisEffect::new(campfire, 7), Transform::default()));
+    commands.spawn((
+        IgnisEffect::new(campfire, 7),
+        IgnisLight::default(),
+        Transform::default(),
+    ));
     let torch = assets.load("torch.ron");
     for (seed, x) in [(1, -2.5), (2, 2.5), (3, 0.0)] {
         let z = if x == 0.0 { -3.0 } else { -1.0 };
@@ -188,16 +193,7 @@ fn scene(
             Transform::from_xyz(x, 0.0, z),
         ));
     }
-    // The fire's glow on the ground and the moon.
-    commands.spawn((
-        PointLight {
-            color: Color::srgb(1.0, 0.55, 0.25),
-            intensity: 60_000.0,
-            range: 12.0,
-            ..default()
-        },
-        Transform::from_xyz(0.0, 0.6, 0.0),
-    ));
+    // The moon; the fire lights the ground itself (IgnisLight on the campfire).
     commands.spawn((
         DirectionalLight {
             color: Color::srgb(0.55, 0.62, 0.9),

@@ -12,7 +12,7 @@ use crate::asset::IgnisPreset;
 /// emitter) and its clock: Bevy's virtual time, so pausing `Time<Virtual>` pauses them.
 /// Despawning the entity removes the instance.
 #[derive(Component, Clone, Debug)]
-#[require(Transform)]
+#[require(Transform, Visibility)]
 pub struct IgnisEffect {
     /// The preset (`asset_server.load("effects/torch.ron")`).
     pub preset: Handle<IgnisPreset>,

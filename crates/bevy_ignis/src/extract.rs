@@ -35,6 +35,8 @@ pub struct ExtractedInstance {
     pub seed: u32,
     /// Its world transform (column-major).
     pub world: [[f32; 4]; 4],
+    /// It lights the scene (an [`IgnisLight`](crate::IgnisLight)): its light is estimated.
+    pub light: bool,
 }
 
 /// The render world's copy of the presets and this frame's instances and seeks.
@@ -74,7 +76,14 @@ pub fn clear_seeks(mut pending: ResMut<PendingSeeks>) {
 /// Render world: copies the instances, the seeks and every loaded or reloaded preset.
 pub fn extract_ignis(
     mut out: ResMut<ExtractedIgnis>,
-    effects: Extract<Query<(Entity, &IgnisEffect, &GlobalTransform)>>,
+    effects: Extract<
+        Query<(
+            Entity,
+            &IgnisEffect,
+            &GlobalTransform,
+            Has<crate::IgnisLight>,
+        )>,
+    >,
     presets: Extract<Res<Assets<IgnisPreset>>>,
     mut events: Extract<MessageReader<AssetEvent<IgnisPreset>>>,
     pending: Extract<Res<PendingSeeks>>,
@@ -97,7 +106,7 @@ pub fn extract_ignis(
         }
     }
     out.instances.clear();
-    for (entity, effect, transform) in &effects {
+    for (entity, effect, transform, light) in &effects {
         let id = effect.preset.id();
         if !effect.playing {
             continue;
@@ -114,6 +123,7 @@ pub fn extract_ignis(
             preset: id,
             seed: effect.seed,
             world: transform.to_matrix().to_cols_array_2d(),
+            light,
         });
     }
     out.seeks.clone_from(&pending.0);

@@ -27,12 +27,14 @@ mod asset;
 mod draw;
 mod effect;
 mod extract;
+mod light;
 mod players;
 
 pub use asset::{IgnisLoadError, IgnisPreset, IgnisPresetLoader};
 pub use effect::{IgnisEffect, IgnisSeek};
 pub use extract::IgnisAssetRoot;
 pub use ignis;
+pub use light::{EffectLights, IgnisLight, IgnisLightOf};
 pub use players::{IgnisPlayers, ViewPlayer};
 
 use bevy::core_pipeline::core_3d::main_transparent_pass_3d;
@@ -64,12 +66,16 @@ impl Plugin for IgnisPlugin {
             .init_asset_loader::<IgnisPresetLoader>()
             .init_resource::<extract::PendingSeeks>()
             .insert_resource(IgnisAssetRoot(self.asset_root.clone()))
+            .init_resource::<EffectLights>()
             .add_systems(First, extract::clear_seeks)
+            .add_systems(PostUpdate, light::update_lights)
             .add_systems(Last, extract::take_seeks);
+        let lights = app.world().resource::<EffectLights>().clone();
         let Some(render_app) = app.get_sub_app_mut(RenderApp) else {
             return;
         };
         render_app
+            .insert_resource(lights)
             .init_resource::<extract::ExtractedIgnis>()
             .init_resource::<IgnisPlayers>()
             .add_systems(ExtractSchedule, extract::extract_ignis)

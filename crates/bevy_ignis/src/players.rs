@@ -58,7 +58,9 @@ pub fn prepare_players(
     device: Res<RenderDevice>,
     queue: Res<RenderQueue>,
     time: Res<Time>,
+    lights: Res<crate::EffectLights>,
 ) {
+    publish_lights(&players, &lights);
     let wanted: HashSet<AssetId<IgnisPreset>> =
         extracted.instances.iter().map(|i| i.preset).collect();
     let mut alive = HashSet::new();
@@ -82,6 +84,8 @@ pub fn prepare_players(
                     .into_mut(),
             };
             sync_instances(vp, &extracted, preset);
+            let lit = (extracted.instances.iter()).any(|i| i.preset == preset && i.light);
+            vp.player.set_light_estimate(lit);
             for (_, secs) in extracted.seeks.iter().filter(|(p, _)| *p == preset) {
                 vp.player.seek(*secs, time.delta_secs_f64().max(1.0 / 60.0));
             }
@@ -171,4 +175,22 @@ fn sync_instances(vp: &mut ViewPlayer, extracted: &ExtractedIgnis, preset: Asset
         }
         keep
     });
+}
+
+/// Shares the lights the players last read back with the main world (the first view's
+/// player of each preset speaks for its instances).
+fn publish_lights(players: &IgnisPlayers, lights: &crate::EffectLights) {
+    let Ok(mut out) = lights.0.lock() else {
+        return;
+    };
+    out.clear();
+    let mut views: Vec<_> = players.players.iter().collect();
+    views.sort_by_key(|((_, view), _)| std::cmp::Reverse(*view));
+    for (_, vp) in views {
+        for (entity, (id, _)) in &vp.instances {
+            if let Some(light) = vp.player.effect_light(*id) {
+                out.insert(*entity, light);
+            }
+        }
+    }
 }

@@ -304,3 +304,57 @@ fn a_seek_moves_the_effect_to_the_time_asked() {
     );
     assert!(app.world().get::<bevy_ignis::IgnisSeek>(entity).is_none());
 }
+
+/// `IgnisLight` gives the effect a point light that follows the flames: placed among
+/// them, warm, and flickering from frame to frame as the particles do.
+#[test]
+fn the_campfire_lights_the_scene_with_a_flickering_light() {
+    let mut app = common::app(&common::presets(), false);
+    common::camera(&mut app, EYE, LOOK_AT);
+    let preset = common::load(&mut app, "campfire.ron");
+    let fire = app
+        .world_mut()
+        .spawn((
+            IgnisEffect::new(preset, 3),
+            bevy_ignis::IgnisLight::default(),
+            Transform::from_xyz(2.0, 0.0, -1.0),
+        ))
+        .id();
+    common::run(&mut app, 40);
+    let mut intensities = Vec::new();
+    for _ in 0..30 {
+        app.update();
+        let world = app.world_mut();
+        let mut lights =
+            world.query::<(&bevy_ignis::IgnisLightOf, &PointLight, &GlobalTransform)>();
+        let found: Vec<_> = lights.iter(world).collect();
+        assert_eq!(found.len(), 1, "one light for the one lit effect");
+        let (of, light, at) = found[0];
+        assert_eq!(of.0, fire);
+        let p = at.translation();
+        assert!(
+            (p.x - 2.0).abs() < 0.5 && (p.z + 1.0).abs() < 0.5,
+            "light at {p}"
+        );
+        assert!(p.y > 0.1 && p.y < 1.5, "light at {p}");
+        let c = light.color.to_linear();
+        assert!(c.red >= c.green && c.green > c.blue, "warm: {c:?}");
+        intensities.push(f64::from(light.intensity));
+    }
+    let mean = intensities.iter().sum::<f64>() / intensities.len() as f64;
+    let sd = (intensities.iter().map(|i| (i - mean).powi(2)).sum::<f64>()
+        / intensities.len() as f64)
+        .sqrt();
+    eprintln!("campfire light in Bevy: {mean:.0} ± {sd:.0} lm");
+    assert!(mean > 10_000.0 && sd / mean > 0.01, "{mean} ± {sd} lm");
+    app.world_mut()
+        .entity_mut(fire)
+        .remove::<bevy_ignis::IgnisLight>();
+    common::run(&mut app, 3);
+    let world = app.world_mut();
+    let left = world
+        .query::<&bevy_ignis::IgnisLightOf>()
+        .iter(world)
+        .count();
+    assert_eq!(left, 0, "the light goes with the component");
+}
