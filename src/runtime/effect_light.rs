@@ -7,6 +7,7 @@ use std::collections::HashMap;
 use glam::{DVec3, Vec3};
 
 use super::{InstanceId, Player};
+use crate::render::Scene;
 use crate::render::light::{LightPass, LightSums};
 
 /// The light of one instance, as a point light a host can place in its scene.
@@ -130,4 +131,30 @@ fn lights(
             (id, light)
         })
         .collect()
+}
+
+/// Who each look slot of a frame measures, for the light estimate: the instance and the
+/// emitter's simulation origin, in the order `FrameResources::prepare` gives the slots
+/// (each group's emitters in turn, each with the group's members).
+pub(super) fn light_owners(
+    groups: &[Vec<Option<Scene<'_>>>],
+    ids: &[Vec<Option<InstanceId>>],
+) -> Vec<Option<LightOwner>> {
+    let mut owners = Vec::new();
+    for (group, ids) in groups.iter().zip(ids) {
+        let emitters = group
+            .iter()
+            .flatten()
+            .next()
+            .map_or(0, |s| s.effect.emitters.len());
+        for e in 0..emitters {
+            for (scene, id) in group.iter().zip(ids) {
+                owners.push(scene.as_ref().zip(*id).map(|(s, id)| {
+                    let origin = s.sim.planner().emitters.get(e).map(|p| p.origin());
+                    (id, origin.unwrap_or_default())
+                }));
+            }
+        }
+    }
+    owners
 }

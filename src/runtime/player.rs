@@ -503,7 +503,7 @@ impl Player {
             .map(|b| (0..b.active()).map(|slot| b.member(slot)).collect())
             .collect();
         let (groups, ids) = Self::draw_groups(&self.instances, &members, camera);
-        let owners = light_owners(&groups, &ids);
+        let owners = super::effect_light::light_owners(&groups, &ids);
         let groups: Vec<&[Option<Scene<'_>>]> = groups.iter().map(Vec::as_slice).collect();
         self.items = self.frame.prepare(
             &self.ctx,
@@ -854,30 +854,4 @@ mod tests {
         send::<super::Player>();
         send::<super::InstanceId>();
     }
-}
-
-/// Who each look slot of a frame measures, for the light estimate: the instance and the
-/// emitter's simulation origin, in the order `FrameResources::prepare` gives the slots
-/// (each group's emitters in turn, each with the group's members).
-fn light_owners(
-    groups: &[Vec<Option<Scene<'_>>>],
-    ids: &[Vec<Option<InstanceId>>],
-) -> Vec<Option<super::effect_light::LightOwner>> {
-    let mut owners = Vec::new();
-    for (group, ids) in groups.iter().zip(ids) {
-        let emitters = group
-            .iter()
-            .flatten()
-            .next()
-            .map_or(0, |s| s.effect.emitters.len());
-        for e in 0..emitters {
-            for (scene, id) in group.iter().zip(ids) {
-                owners.push(scene.as_ref().zip(*id).map(|(s, id)| {
-                    let origin = s.sim.planner().emitters.get(e).map(|p| p.origin());
-                    (id, origin.unwrap_or_default())
-                }));
-            }
-        }
-    }
-    owners
 }

@@ -73,17 +73,18 @@ pub fn clear_seeks(mut pending: ResMut<PendingSeeks>) {
     pending.0.clear();
 }
 
+/// What extraction reads of an effect entity.
+type EffectItem = (
+    Entity,
+    &'static IgnisEffect,
+    &'static GlobalTransform,
+    Has<crate::IgnisLight>,
+);
+
 /// Render world: copies the instances, the seeks and every loaded or reloaded preset.
 pub fn extract_ignis(
     mut out: ResMut<ExtractedIgnis>,
-    effects: Extract<
-        Query<(
-            Entity,
-            &IgnisEffect,
-            &GlobalTransform,
-            Has<crate::IgnisLight>,
-        )>,
-    >,
+    effects: Extract<Query<EffectItem>>,
     presets: Extract<Res<Assets<IgnisPreset>>>,
     mut events: Extract<MessageReader<AssetEvent<IgnisPreset>>>,
     pending: Extract<Res<PendingSeeks>>,
