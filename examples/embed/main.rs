@@ -22,6 +22,9 @@ use winit::window::{Window, WindowId};
 
 type Error = Box<dyn std::error::Error>;
 
+/// The host's light strength per unit of the campfire's light power (its scene's units).
+const FIRE_LIGHT_PER_UNIT: f32 = 7.5;
+
 fn main() -> Result<(), Error> {
     let mut app = App {
         frames: None,
@@ -58,6 +61,8 @@ struct Host {
     scene: Scene,
     torches: Player,
     campfire: Player,
+    /// The campfire's instance (its light lights the scene).
+    fire: ignis::InstanceId,
     frame: u32,
     last: Instant,
     yaw: f32,
@@ -111,7 +116,9 @@ impl Host {
         for (seed, post) in posts.iter().enumerate() {
             torches.add_instance(Mat4::from_translation(*post), seed as u32 + 1)?;
         }
-        campfire.add_instance(Mat4::IDENTITY, 7)?;
+        let fire = campfire.add_instance(Mat4::IDENTITY, 7)?;
+        // ignis: the campfire's own light (estimated from its flames) lights the scene.
+        campfire.set_light_estimate(true);
 
         let scene = Scene::new(
             &device,
@@ -128,6 +135,7 @@ impl Host {
             scene,
             torches,
             campfire,
+            fire,
             frame: 0,
             last: Instant::now(),
             yaw: 0.6,
@@ -150,8 +158,15 @@ impl Host {
         self.campfire.advance(dt_secs);
 
         let mut enc = self.device.create_command_encoder(&Default::default());
-        let flicker = 2.5 + 0.4 * (self.frame as f32 * 0.37).sin();
-        (self.scene).draw_opaque(&self.queue, &mut enc, proj * view, [0.0, 0.5, 0.0, flicker]);
+        // The fire's light, as the campfire's flames give it (two frames behind them).
+        let fire = self
+            .campfire
+            .effect_light(self.fire)
+            .map_or([0.0, 0.5, 0.0, 0.0], |l| {
+                let p = l.position;
+                [p.x, p.y, p.z, l.power * FIRE_LIGHT_PER_UNIT]
+            });
+        (self.scene).draw_opaque(&self.queue, &mut enc, proj * view, fire);
         // ignis, 2: the simulation and sorting, after the opaque pass wrote the depth
         // that the soft edges sample.
         let camera = Camera::new(view, proj, size);
