@@ -8,8 +8,9 @@
 // Contract:
 // - group 0: 0 `camera`, 1 `looks` (dynamic offset per emitter), 2 `ramps`, as splat.wgsl.
 // - group 1: the state buffers, as splat.wgsl.
-// - group 2: 0 `partials` (2 × vec4 per workgroup: (ΣE.rgb, ΣY), (ΣY·p, ΣY·|p|²)), 1 `totals`
-//   (the same per instance), 2 `job` (dynamic offset per dispatch).
+// - group 2: 0 `sums`: the partials (2 × vec4 per workgroup: (ΣE.rgb, ΣY), (ΣY·p, ΣY·|p|²)),
+//   then the totals (the same per instance) from `job.total_base` on; 2 `job` (dynamic
+//   offset per dispatch). One buffer for both: a device's 8 storage buffers per stage.
 #import "common.wgsl"
 #import "rng.wgsl"
 #import "look.wgsl"
@@ -29,14 +30,13 @@ struct LightJob {
     partial_base: u32,
     // Workgroups (partials) per instance.
     groups_per_member: u32,
-    // The first total of this dispatch's first instance.
+    // The first total of this dispatch's first instance (after every partial).
     total_base: u32,
     // Instances in the dispatch.
     members: u32,
 }
 
-@group(2) @binding(0) var<storage, read_write> partials: array<vec4<f32>>;
-@group(2) @binding(1) var<storage, read_write> totals: array<vec4<f32>>;
+@group(2) @binding(0) var<storage, read_write> sums_out: array<vec4<f32>>;
 @group(2) @binding(2) var<uniform> job: LightJob;
 
 // Rec. 709 luminance of linear RGB.
@@ -90,8 +90,8 @@ fn light_sum(
     }
     if lid == 0u && group < job.groups_per_member {
         let at = (job.partial_base + wg.z * job.groups_per_member + group) * 2u;
-        partials[at] = sums[0][0];
-        partials[at + 1u] = sums[0][1];
+        sums_out[at] = sums[0][0];
+        sums_out[at + 1u] = sums[0][1];
     }
 }
 
@@ -105,9 +105,9 @@ fn light_total(@builtin(global_invocation_id) id: vec3<u32>) {
     var b = vec4<f32>(0.0);
     let first = job.partial_base + member * job.groups_per_member;
     for (var k = 0u; k < job.groups_per_member; k++) {
-        a += partials[(first + k) * 2u];
-        b += partials[(first + k) * 2u + 1u];
+        a += sums_out[(first + k) * 2u];
+        b += sums_out[(first + k) * 2u + 1u];
     }
-    totals[(job.total_base + member) * 2u] = a;
-    totals[(job.total_base + member) * 2u + 1u] = b;
+    sums_out[(job.total_base + member) * 2u] = a;
+    sums_out[(job.total_base + member) * 2u + 1u] = b;
 }

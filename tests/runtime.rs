@@ -965,8 +965,10 @@ fn the_effect_light_sits_on_the_particles_with_their_colour_and_power() {
         (brighter.power / light.power - 3.0).abs() < 1e-4,
         "{brighter:?}"
     );
+    // A z-up host on the least device the player takes.
     let z_up = HostKind {
         z_up: true,
+        limits: Some(ignis::required_limits()),
         ..HostKind::default()
     };
     let (turned, _) = lit(z_up, 1.0, 1.0);

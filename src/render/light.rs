@@ -36,11 +36,11 @@ pub struct LightPass<T> {
     next: usize,
 }
 
+/// The sums buffer (partials, then totals) and the jobs' uniforms, with their sizes.
 struct Buffers {
-    partials: u64,
-    totals: u64,
+    sums: u64,
     jobs: u64,
-    totals_buffer: wgpu::Buffer,
+    sums_buffer: wgpu::Buffer,
     jobs_buffer: wgpu::Buffer,
     group: wgpu::BindGroup,
 }
@@ -90,7 +90,6 @@ impl<T: Clone> LightPass<T> {
                 label: Some("LightPass::layout"),
                 entries: &[
                     storage(0),
-                    storage(1),
                     wgpu::BindGroupLayoutEntry {
                         binding: 2,
                         visibility: wgpu::ShaderStages::COMPUTE,
@@ -199,7 +198,7 @@ impl<T: Clone> LightPass<T> {
         if jobs.is_empty() {
             return;
         }
-        self.ensure_buffers(ctx, partials, totals, jobs.len() as u64);
+        self.ensure_buffers(ctx, partials + totals, totals, jobs.len() as u64);
         self.ensure_variants(ctx, items, &jobs);
         let Some(b) = &self.buffers else {
             return;
@@ -209,7 +208,7 @@ impl<T: Clone> LightPass<T> {
             let words = [
                 j.partial_base,
                 j.groups,
-                j.total_base,
+                partials + j.total_base,
                 items[j.item].members,
             ];
             bytes[k * JOB_STRIDE as usize..][..16].copy_from_slice(bytemuck::cast_slice(&words));
@@ -226,7 +225,8 @@ impl<T: Clone> LightPass<T> {
             .collect();
         let r = &mut self.ring[ring];
         let size = u64::from(totals) * 32;
-        enc.copy_buffer_to_buffer(&b.totals_buffer, 0, &r.buffer, 0, size.min(r.size));
+        let from = u64::from(partials) * 32;
+        enc.copy_buffer_to_buffer(&b.sums_buffer, from, &r.buffer, 0, size.min(r.size));
         r.pending = Some(Pending {
             owners,
             mapping: false,
@@ -329,30 +329,21 @@ impl<T: Clone> LightPass<T> {
         self.ring[i].pending.is_none().then_some(i)
     }
 
-    fn ensure_buffers(&mut self, ctx: &GpuContext, partials: u32, totals: u32, jobs: u64) {
-        let (p, t) = (
-            u64::from(partials.max(1)) * 32,
-            u64::from(totals.max(1)) * 32,
-        );
+    /// Buffers for `sums` vec4 pairs (partials, then totals), readbacks for `totals`
+    /// pairs, and `jobs` uniforms.
+    fn ensure_buffers(&mut self, ctx: &GpuContext, sums: u32, totals: u32, jobs: u64) {
+        let s = u64::from(sums.max(1)) * 32;
         let j = jobs * JOB_STRIDE;
-        let fits = self
-            .buffers
-            .as_ref()
-            .is_some_and(|b| b.partials >= p && b.totals >= t && b.jobs >= j);
+        let fits = (self.buffers.as_ref()).is_some_and(|b| b.sums >= s && b.jobs >= j);
         if !fits {
             let grow =
                 |have: Option<u64>, need: u64| need.max(have.unwrap_or(0)).next_power_of_two();
-            let p = grow(self.buffers.as_ref().map(|b| b.partials), p);
-            let t = grow(self.buffers.as_ref().map(|b| b.totals), t);
+            let s = grow(self.buffers.as_ref().map(|b| b.sums), s);
             let j = grow(self.buffers.as_ref().map(|b| b.jobs), j);
-            self.buffers = Some(Buffers::new(ctx, &self.layout, p, t, j));
+            self.buffers = Some(Buffers::new(ctx, &self.layout, s, j));
         }
-        let t = self.buffers.as_ref().map_or(32, |b| b.totals);
-        for r in self
-            .ring
-            .iter_mut()
-            .filter(|r| r.pending.is_none() && r.size < t)
-        {
+        let t = (u64::from(totals.max(1)) * 32).next_power_of_two();
+        for r in (self.ring.iter_mut()).filter(|r| r.pending.is_none() && r.size < t) {
             r.buffer = readback_buffer(ctx, t);
             r.size = t;
         }
@@ -374,13 +365,7 @@ impl<T: Clone> LightPass<T> {
 }
 
 impl Buffers {
-    fn new(
-        ctx: &GpuContext,
-        layout: &wgpu::BindGroupLayout,
-        partials: u64,
-        totals: u64,
-        jobs: u64,
-    ) -> Self {
+    fn new(ctx: &GpuContext, layout: &wgpu::BindGroupLayout, sums: u64, jobs: u64) -> Self {
         let buffer = |label, size, usage| {
             ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -389,34 +374,22 @@ impl Buffers {
                 mapped_at_creation: false,
             })
         };
-        let storage = wgpu::BufferUsages::STORAGE;
-        let p = buffer("LightPass::partials", partials, storage);
-        let totals_buffer = buffer(
-            "LightPass::totals",
-            totals,
-            storage | wgpu::BufferUsages::COPY_SRC,
-        );
-        let j = buffer(
-            "LightPass::jobs",
-            jobs,
-            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        );
+        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+        let sums_buffer = buffer("LightPass::sums", sums, usage);
+        let usage = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
+        let jobs_buffer = buffer("LightPass::jobs", jobs, usage);
         let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("LightPass::group"),
             layout,
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
-                    resource: p.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: totals_buffer.as_entire_binding(),
+                    resource: sums_buffer.as_entire_binding(),
                 },
                 wgpu::BindGroupEntry {
                     binding: 2,
                     resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &j,
+                        buffer: &jobs_buffer,
                         offset: 0,
                         size: wgpu::BufferSize::new(16),
                     }),
@@ -424,11 +397,10 @@ impl Buffers {
             ],
         });
         Self {
-            partials,
-            totals,
+            sums,
             jobs,
-            totals_buffer,
-            jobs_buffer: j,
+            sums_buffer,
+            jobs_buffer,
             group,
         }
     }

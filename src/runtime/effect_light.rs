@@ -73,13 +73,18 @@ impl Player {
             return;
         }
         if self.light.pass.is_none() {
-            match LightPass::new(&self.ctx, &self.library, &self.frame) {
-                Ok(p) => self.light.pass = Some(p),
-                Err(e) => {
-                    log::error!("the effect light's shader failed; no light estimate: {e}");
-                    self.light.on = false;
-                    return;
-                }
+            // Built in an error scope: whatever the host's device refuses is logged, not a
+            // panic in its error handler.
+            let scope = self
+                .ctx
+                .device
+                .push_error_scope(wgpu::ErrorFilter::Validation);
+            let built = LightPass::new(&self.ctx, &self.library, &self.frame);
+            let refused = pollster::block_on(scope.pop());
+            match (built, refused) {
+                (Ok(p), None) => self.light.pass = Some(p),
+                (Err(e), _) => return self.light_failed(&e),
+                (_, Some(e)) => return self.light_failed(&e),
             }
         }
         let Some(pass) = self.light.pass.as_mut() else {
@@ -92,6 +97,14 @@ impl Player {
         pass.map_recorded();
         let owner = |slot: usize| owners.get(slot).copied().flatten();
         pass.record(&self.ctx, enc, &self.frame, &self.items, owner);
+    }
+}
+
+impl Player {
+    /// Turns the estimate off after its pass could not be built, saying why.
+    fn light_failed(&mut self, why: &dyn std::fmt::Display) {
+        log::error!("the effect light cannot be estimated on this device: {why}");
+        self.light.on = false;
     }
 }
 
