@@ -293,7 +293,10 @@ fn only_dependent_pipelines_rebuild() {
     assert_eq!(rig.reload(&["count.wgsl"]).rebuilt, vec!["count.wgsl"]);
     let mut look = rig.reload(&["look.wgsl"]).rebuilt;
     look.sort();
-    assert_eq!(look, vec!["billboard.wgsl", "splat.wgsl", "tiles.wgsl"]);
+    assert_eq!(
+        look,
+        vec!["billboard.wgsl", "light.wgsl", "splat.wgsl", "tiles.wgsl"]
+    );
     let mut all = rig.reload(&["common.wgsl"]).rebuilt;
     all.sort();
     assert_eq!(
@@ -302,6 +305,7 @@ fn only_dependent_pipelines_rebuild() {
             "billboard.wgsl",
             "count.wgsl",
             "events.wgsl",
+            "light.wgsl",
             "sort.wgsl",
             "splat.wgsl",
             "tiles.wgsl",
