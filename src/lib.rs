@@ -29,23 +29,11 @@
 //! );
 //! let mut encoder = device.create_command_encoder(&Default::default());
 //! // ... the host's opaque pass writes `depth` here ...
-//! player.record(&mut encoder, &camera, Some(depth));
+//! player.record(&mut encoder, &camera, Some(depth))?;
 //! {
-//!     let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-//!         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-//!             view: color,
-//!             depth_slice: None,
-//!             resolve_target: None,
-//!             ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
-//!         })],
-//!         // Read-only depth: the particles test against it and also sample it.
-//!         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-//!             view: depth,
-//!             depth_ops: None,
-//!             stencil_ops: None,
-//!         }),
-//!         ..Default::default()
-//!     });
+//!     // Colour loaded, depth read-only: the particles test against it and sample it.
+//!     let targets = ignis::HostTargets { color, resolve_target: None, depth: Some(depth) };
+//!     let mut pass = targets.begin_pass(&mut encoder);
 //!     player.draw(&mut pass);
 //! }
 //! queue.submit([encoder.finish()]);

@@ -195,15 +195,8 @@ fn until(app: &mut bevy::app::App, what: &str, mut done: impl FnMut(&mut bevy::a
 /// effect playing, and the asset server reports the error.
 #[test]
 fn an_edited_preset_hot_reloads_and_a_broken_one_keeps_the_last_good() {
-    let dir = tempfile::tempdir().expect("temp dir");
+    let dir = common::temp_presets("torch.ron", str::to_owned);
     let file = dir.path().join("torch.ron");
-    std::fs::copy(common::presets().join("torch.ron"), &file).expect("copy");
-    let textures = dir.path().join("textures");
-    std::fs::create_dir(&textures).expect("textures");
-    for e in std::fs::read_dir(common::presets().join("textures")).expect("textures") {
-        let e = e.expect("entry");
-        std::fs::copy(e.path(), textures.join(e.file_name())).expect("copy texture");
-    }
     let mut app = common::app(dir.path(), true);
     let target = common::camera(&mut app, Vec3::new(0.0, 1.3, 2.5), Vec3::new(0.0, 1.3, 0.0));
     let preset = common::load(&mut app, "torch.ron");
@@ -357,4 +350,60 @@ fn the_campfire_lights_the_scene_with_a_flickering_light() {
         .iter(world)
         .count();
     assert_eq!(left, 0, "the light goes with the component");
+}
+
+/// Soft edges against Bevy's depth: the torch's flames (soft distance 0.8 m here) fade
+/// where they come near a wall just behind them, against the same flames before an empty
+/// background (the preset's own ground fade is the same in both).
+#[test]
+fn flames_fade_where_they_meet_bevys_geometry() {
+    let dir = common::temp_presets("torch.ron", |t| {
+        t.replace("look: (", "look: (soft_ground_m: 0.8, ")
+    });
+    let frame = |wall: bool, fire: bool| {
+        let mut app = common::app(dir.path(), false);
+        let target = common::camera(&mut app, Vec3::new(0.0, 1.3, 2.0), Vec3::new(0.0, 1.3, 0.0));
+        let preset = common::load(&mut app, "torch.ron");
+        let world = app.world_mut();
+        let slab = world
+            .resource_mut::<Assets<Mesh>>()
+            .add(Cuboid::new(4.0, 4.0, 0.1));
+        let blue = world
+            .resource_mut::<Assets<StandardMaterial>>()
+            .add(StandardMaterial {
+                base_color: Color::srgb(0.05, 0.05, 0.1),
+                unlit: true,
+                ..default()
+            });
+        if wall {
+            world.spawn((
+                Mesh3d(slab),
+                MeshMaterial3d(blue),
+                Transform::from_xyz(0.0, 1.5, -0.3),
+            ));
+        }
+        if fire {
+            world.spawn(IgnisEffect::new(preset, 5));
+        }
+        common::run(&mut app, 60);
+        common::capture(&mut app, &target)
+    };
+    let light = |with: &[[u8; 4]], without: &[[u8; 4]]| -> f64 {
+        with.iter()
+            .zip(without)
+            .map(|(a, b)| {
+                (0..3)
+                    .map(|c| f64::from(a[c].saturating_sub(b[c])))
+                    .sum::<f64>()
+            })
+            .sum()
+    };
+    let before_wall = light(&frame(true, true), &frame(true, false));
+    let before_nothing = light(&frame(false, true), &frame(false, false));
+    eprintln!("flame light before the wall {before_wall:.0}, before nothing {before_nothing:.0}");
+    assert!(before_nothing > 2000.0, "the torch shows: {before_nothing}");
+    assert!(
+        before_wall < 0.7 * before_nothing && before_wall > 0.02 * before_nothing,
+        "before the wall {before_wall}, before nothing {before_nothing}"
+    );
 }

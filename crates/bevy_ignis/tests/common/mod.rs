@@ -139,3 +139,18 @@ pub fn players(app: &App) -> &IgnisPlayers {
         .world()
         .resource::<IgnisPlayers>()
 }
+
+/// A temporary asset folder holding the repository's `name` preset, as `edit` rewrites its
+/// text, and its textures.
+pub fn temp_presets(name: &str, edit: impl Fn(&str) -> String) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let text = std::fs::read_to_string(presets().join(name)).expect("preset");
+    std::fs::write(dir.path().join(name), edit(&text)).expect("write preset");
+    let textures = dir.path().join("textures");
+    std::fs::create_dir(&textures).expect("textures");
+    for e in std::fs::read_dir(presets().join("textures")).expect("textures") {
+        let e = e.expect("entry");
+        std::fs::copy(e.path(), textures.join(e.file_name())).expect("copy texture");
+    }
+    dir
+}
