@@ -684,16 +684,19 @@ fn reversed_z_hosts_hide_and_soften_the_fire() {
         view_proj_only: true,
         ..HostKind::default()
     };
-    for path in [
-        ignis::effect::DrawPath::Billboard,
-        ignis::effect::DrawPath::Splat,
-        ignis::effect::DrawPath::Tiles,
-    ] {
+    for path in ALL_PATHS {
         hides_the_fire_in(kind.clone(), &on_path(path), true);
     }
     soft_edges_fade(kind.clone(), ignis::effect::DrawPath::Billboard);
     soft_edges_fade(kind, ignis::effect::DrawPath::Tiles);
 }
+
+/// Every draw path: the billboards, and the splat's and the tiles' own depth tests.
+const ALL_PATHS: [ignis::effect::DrawPath; 3] = [
+    ignis::effect::DrawPath::Billboard,
+    ignis::effect::DrawPath::Splat,
+    ignis::effect::DrawPath::Tiles,
+];
 
 /// The campfire with its additive layers on `path` (the splat's and the tiles' own
 /// depth tests, or billboards).
@@ -717,11 +720,7 @@ fn msaa_hosts_get_occlusion_and_soft_edges() {
         samples: 4,
         ..HostKind::default()
     };
-    for path in [
-        ignis::effect::DrawPath::Billboard,
-        ignis::effect::DrawPath::Splat,
-        ignis::effect::DrawPath::Tiles,
-    ] {
+    for path in ALL_PATHS {
         hides_the_fire_in(msaa.clone(), &on_path(path), true);
     }
     let single = HostKind {
@@ -754,11 +753,7 @@ fn depth_stencil_hosts_hide_the_fire() {
         depth: wgpu::TextureFormat::Depth24PlusStencil8,
         ..HostKind::default()
     };
-    for path in [
-        ignis::effect::DrawPath::Billboard,
-        ignis::effect::DrawPath::Splat,
-        ignis::effect::DrawPath::Tiles,
-    ] {
+    for path in ALL_PATHS {
         hides_the_fire_in(kind.clone(), &on_path(path), true);
     }
 }

@@ -8,18 +8,17 @@
 //! the presets folder, by default the repository's).
 
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
-use bevy::app::PluginsState;
 use bevy::camera::{Hdr, RenderTarget};
 use bevy::diagnostic::{DiagnosticPath, DiagnosticsStore};
 use bevy::prelude::*;
-use bevy::render::RenderPlugin;
 use bevy::render::diagnostic::RenderDiagnosticsPlugin;
 use bevy::render::render_resource::TextureFormat;
-use bevy::time::TimeUpdateStrategy;
-use bevy::window::ExitCondition;
-use bevy_ignis::{IgnisEffect, IgnisPlugin};
+use bevy_ignis::IgnisEffect;
+
+#[path = "common/headless.rs"]
+mod headless;
 
 /// One measured configuration.
 struct Row {
@@ -77,39 +76,8 @@ fn measure(
     (size, msaa): ((u32, u32), u32),
     frames: usize,
 ) -> Result<(Row, String), String> {
-    let mut app = App::new();
-    app.add_plugins(
-        DefaultPlugins
-            .set(AssetPlugin {
-                file_path: presets.to_string_lossy().into_owned(),
-                ..default()
-            })
-            .set(WindowPlugin {
-                primary_window: None,
-                exit_condition: ExitCondition::DontExit,
-                ..default()
-            })
-            .set(RenderPlugin {
-                synchronous_pipeline_compilation: true,
-                ..default()
-            })
-            .disable::<bevy::winit::WinitPlugin>()
-            .disable::<bevy::render::pipelined_rendering::PipelinedRenderingPlugin>(),
-    )
-    .add_plugins((
-        RenderDiagnosticsPlugin,
-        IgnisPlugin {
-            asset_root: presets.to_path_buf(),
-        },
-    ))
-    .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(
-        1.0 / 60.0,
-    )));
-    while app.plugins_state() == PluginsState::Adding {
-        bevy::tasks::tick_global_task_pools_on_main_thread();
-    }
-    app.finish();
-    app.cleanup();
+    let mut app = headless::headless_app(presets, false);
+    app.add_plugins(RenderDiagnosticsPlugin);
     let image = Image::new_target_texture(size.0, size.1, TextureFormat::Rgba8UnormSrgb, None);
     let target = app.world_mut().resource_mut::<Assets<Image>>().add(image);
     let side = (torches as f32).sqrt().ceil().max(1.0) as u32;

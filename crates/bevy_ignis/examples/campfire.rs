@@ -6,17 +6,15 @@
 //! frames of 1/60 s and saves the last.
 
 use std::path::PathBuf;
-use std::time::Duration;
 
-use bevy::app::PluginsState;
 use bevy::camera::{Hdr, RenderTarget};
 use bevy::prelude::*;
-use bevy::render::RenderPlugin;
 use bevy::render::render_resource::TextureFormat;
 use bevy::render::view::screenshot::{Screenshot, save_to_disk};
-use bevy::time::TimeUpdateStrategy;
-use bevy::window::ExitCondition;
 use bevy_ignis::{IgnisEffect, IgnisLight, IgnisPlugin};
+
+#[path = "common/headless.rs"]
+mod headless;
 
 /// The night sky.
 const NIGHT: ClearColor = ClearColor(Color::srgb(0.01, 0.012, 0.03));
@@ -80,31 +78,8 @@ fn ignis_plugin() -> IgnisPlugin {
 
 /// Renders `frames` frames of 1/60 s into an image and saves the last as `screenshot`.
 fn headless(frames: u32, screenshot: Option<PathBuf>) -> Result<(), String> {
-    let mut app = App::new();
-    app.add_plugins(
-        DefaultPlugins
-            .set(asset_plugin())
-            .set(WindowPlugin {
-                primary_window: None,
-                exit_condition: ExitCondition::DontExit,
-                ..default()
-            })
-            .set(RenderPlugin {
-                synchronous_pipeline_compilation: true,
-                ..default()
-            })
-            .disable::<bevy::winit::WinitPlugin>(),
-    )
-    .add_plugins(ignis_plugin())
-    .insert_resource(NIGHT)
-    .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(
-        1.0 / 60.0,
-    )));
-    while app.plugins_state() == PluginsState::Adding {
-        bevy::tasks::tick_global_task_pools_on_main_thread();
-    }
-    app.finish();
-    app.cleanup();
+    let mut app = headless::headless_app(&presets(), false);
+    app.insert_resource(NIGHT);
     let image = Image::new_target_texture(SHOT.0, SHOT.1, TextureFormat::Rgba8UnormSrgb, None);
     let target = app.world_mut().resource_mut::<Assets<Image>>().add(image);
     app.world_mut()

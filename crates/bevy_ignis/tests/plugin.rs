@@ -354,7 +354,8 @@ fn the_campfire_lights_the_scene_with_a_flickering_light() {
 
 /// Soft edges against Bevy's depth: the torch's flames (soft distance 0.8 m here) fade
 /// where they come near a wall just behind them, against the same flames before an empty
-/// background (the preset's own ground fade is the same in both).
+/// background (the preset's own ground fade is the same in both). Measured: 0.46 of the
+/// light; 0.77 with the soft distance 0 (what the wall hides, and sRGB's clipping).
 #[test]
 fn flames_fade_where_they_meet_bevys_geometry() {
     let dir = common::temp_presets("torch.ron", |t| {
@@ -403,7 +404,7 @@ fn flames_fade_where_they_meet_bevys_geometry() {
     eprintln!("flame light before the wall {before_wall:.0}, before nothing {before_nothing:.0}");
     assert!(before_nothing > 2000.0, "the torch shows: {before_nothing}");
     assert!(
-        before_wall < 0.7 * before_nothing && before_wall > 0.02 * before_nothing,
+        before_wall < 0.6 * before_nothing && before_wall > 0.02 * before_nothing,
         "before the wall {before_wall}, before nothing {before_nothing}"
     );
 }

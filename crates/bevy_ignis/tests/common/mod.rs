@@ -3,20 +3,19 @@
 
 #![allow(dead_code)]
 
+#[path = "../../examples/common/headless.rs"]
+mod headless;
+
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use bevy::app::PluginsState;
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
 use bevy::prelude::*;
-use bevy::render::RenderPlugin;
 use bevy::render::render_resource::TextureFormat;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
-use bevy::time::TimeUpdateStrategy;
-use bevy::window::ExitCondition;
-use bevy_ignis::{IgnisPlayers, IgnisPlugin, IgnisPreset};
+use bevy_ignis::{IgnisPlayers, IgnisPreset};
 
 /// The test image's size.
 pub const SIZE: (u32, u32) = (200, 150);
@@ -27,42 +26,10 @@ pub fn presets() -> PathBuf {
 }
 
 /// A headless app reading assets from `assets` (watching them when `watch`), with the
-/// plugin, ready to spawn into.
+/// plugin, ready to spawn into; a black background.
 pub fn app(assets: &Path, watch: bool) -> App {
-    let mut app = App::new();
-    app.add_plugins(
-        DefaultPlugins
-            .set(AssetPlugin {
-                file_path: assets.to_string_lossy().into_owned(),
-                watch_for_changes_override: Some(watch),
-                ..default()
-            })
-            .set(WindowPlugin {
-                primary_window: None,
-                exit_condition: ExitCondition::DontExit,
-                ..default()
-            })
-            .set(RenderPlugin {
-                synchronous_pipeline_compilation: true,
-                ..default()
-            })
-            .disable::<bevy::winit::WinitPlugin>()
-            // The render world stays in this thread: the tests read its players, and
-            // each update renders its own frame.
-            .disable::<bevy::render::pipelined_rendering::PipelinedRenderingPlugin>(),
-    )
-    .add_plugins(IgnisPlugin {
-        asset_root: assets.to_path_buf(),
-    })
-    .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(
-        1.0 / 60.0,
-    )))
-    .insert_resource(ClearColor(Color::BLACK));
-    while app.plugins_state() == PluginsState::Adding {
-        bevy::tasks::tick_global_task_pools_on_main_thread();
-    }
-    app.finish();
-    app.cleanup();
+    let mut app = headless::headless_app(assets, watch);
+    app.insert_resource(ClearColor(Color::BLACK));
     app
 }
 
