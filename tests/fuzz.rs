@@ -2,7 +2,9 @@
 //! shader composer (`#import` resolution), with proptest over arbitrary and mutated text.
 //! Neither may panic or hang: every input gives an effect or a located error.
 //! `PROPTEST_CASES` sets the cases (CI: the default 256 each; long runs: see
-//! `docs/architecture.md#tests`). Inputs that once failed are kept as regression tests.
+//! `docs/architecture.md#tests`). Every case runs under a time limit ([`CASE_LIMIT`]): a
+//! hang fails the test instead of stalling CI. Inputs that once failed are kept as
+//! regression tests.
 #![cfg(feature = "editor")]
 
 use proptest::prelude::*;
@@ -30,6 +32,33 @@ fn mutated(base: &str, edits: &[(f64, u8, u8)], cut: f64) -> String {
     String::from_utf8_lossy(&bytes).into_owned()
 }
 
+/// How long one case may take (a parse takes microseconds to milliseconds).
+const CASE_LIMIT: std::time::Duration = std::time::Duration::from_secs(10);
+
+/// Runs `work` on a thread of its own and returns its result, or an error naming the
+/// input when it has not finished within [`CASE_LIMIT`] (the hung thread is left behind;
+/// the test fails).
+fn within_limit<T: Send + 'static>(
+    what: &str,
+    work: impl FnOnce() -> T + Send + 'static,
+) -> Result<T, TestCaseError> {
+    within(CASE_LIMIT, what, work)
+}
+
+/// [`within_limit`] with another limit.
+fn within<T: Send + 'static>(
+    limit: std::time::Duration,
+    what: &str,
+    work: impl FnOnce() -> T + Send + 'static,
+) -> Result<T, TestCaseError> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(work());
+    });
+    rx.recv_timeout(limit)
+        .map_err(|_| TestCaseError::fail(format!("no result within {limit:?}: {what}")))
+}
+
 const PRESETS: [&str; 3] = [
     include_str!("../presets/campfire.ron"),
     include_str!("../presets/torch.ron"),
@@ -39,7 +68,8 @@ const PRESETS: [&str; 3] = [
 proptest! {
     #[test]
     fn the_preset_loader_never_panics_on_arbitrary_text(text in "\\PC{0,400}") {
-        let _ = ignis::preset::parse_str(&text, "fuzz.ron");
+        let input = text.clone();
+        within_limit(&text, move || ignis::preset::parse_str(&input, "fuzz.ron").is_ok())?;
     }
 
     #[test]
@@ -49,9 +79,13 @@ proptest! {
         cut in 0.0f64..1.0,
     ) {
         let text = mutated(PRESETS[which], &edits, 0.5 + cut / 2.0);
-        if let Err(e) = ignis::preset::parse_str(&text, "fuzz.ron") {
+        let input = text.clone();
+        let parsed = within_limit(&text, move || {
+            ignis::preset::parse_str(&input, "fuzz.ron").map_err(|e| e.to_string())
+        })?;
+        if let Err(e) = parsed {
             // A located, non-empty message.
-            prop_assert!(!e.to_string().is_empty());
+            prop_assert!(!e.is_empty());
         }
     }
 
@@ -81,10 +115,23 @@ proptest! {
             std::fs::write(dir.path().join(name), lines.join("\n")).expect("write");
         }
         let lib = ShaderLibrary::from_dir(dir.path());
-        if let Err(e) = lib.compose("entry.wgsl") {
-            prop_assert!(!e.to_string().is_empty());
+        let composed = within_limit(&format!("{files:?}"), move || {
+            lib.compose("entry.wgsl").map(|_| ()).map_err(|e| e.to_string())
+        })?;
+        if let Err(e) = composed {
+            prop_assert!(!e.is_empty());
         }
     }
+}
+
+/// The time limit fails a case that hangs (a case that sleeps past it), and passes one
+/// that finishes.
+#[test]
+fn a_hung_case_fails_instead_of_stalling() {
+    let limit = std::time::Duration::from_millis(50);
+    let hung = within(limit, "sleeps", move || std::thread::sleep(limit * 20));
+    assert!(hung.is_err_and(|e| e.to_string().contains("no result within")));
+    assert_eq!(within(limit, "returns", || 7).ok(), Some(7));
 }
 
 /// The text at a 1-based line and character column.
