@@ -436,6 +436,25 @@ mod tests {
         }
     }
 
+    /// Between keys, a smooth curve is the cubic Hermite segment with PCHIP's
+    /// (Fritsch–Butland) tangents, worked out by hand: keys (0, 0), (1, 1), (3, 2) have
+    /// slopes 1 and 1/2, the inner tangent 9/13 (weights 5 and 4), the end tangents the
+    /// one-sided slopes; at a local extreme the tangent is 0.
+    #[test]
+    fn smooth_curves_are_pchip_hermite_segments_between_keys() {
+        let c = curve(&[(0.0, 0.0), (1.0, 1.0), (3.0, 2.0)], true);
+        // t = 0.5: h10·1 + h01·1 + h11·(9/13) with h10 = 1/8, h01 = 1/2, h11 = −1/8.
+        assert!((c.eval(0.5) - 7.0 / 13.0).abs() < 1e-12, "{}", c.eval(0.5));
+        // t = 2 (h = 2): h00·1 + h10·2·(9/13) + h01·2 + h11·2·(1/2).
+        assert!((c.eval(2.0) - 80.5 / 52.0).abs() < 1e-12, "{}", c.eval(2.0));
+        // t = 0.25: h00 = 27/32, h10 = 9/64, h01 = 5/32, h11 = −3/64.
+        let quarter = 9.0 / 64.0 + 5.0 / 32.0 - 3.0 / 64.0 * 9.0 / 13.0;
+        assert!((c.eval(0.25) - quarter).abs() < 1e-12, "{}", c.eval(0.25));
+        let peak = curve(&[(0.0, 0.0), (1.0, 1.0), (2.0, 0.0)], true);
+        assert!((peak.eval(0.5) - 0.625).abs() < 1e-12, "{}", peak.eval(0.5));
+        assert!((peak.eval(1.5) - 0.625).abs() < 1e-12, "{}", peak.eval(1.5));
+    }
+
     #[test]
     fn smooth_curves_never_overshoot_their_keys() {
         let c = curve(
