@@ -91,6 +91,51 @@ fn premultiplied_export_composites_like_the_render_over_a_background() {
     assert!(worst <= 4.0, "worst error {worst}/255");
 }
 
+/// Straight alpha is the premultiplied colour divided by a coverage that also counts the
+/// light: `A' = max(A, min(1, max C))`, and `rgb·A'` gives the premultiplied colour back
+/// (in linear light, to the 8-bit quantisation) — an export that forgot to divide, or
+/// divided by the wrong coverage, fails.
+#[test]
+fn straight_alpha_is_the_premultiplied_colour_over_its_coverage() {
+    let effect = preset("campfire");
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (pre, straight) = (dir.path().join("pre"), dir.path().join("straight"));
+    export(&effect, sequence(&pre, 2, 1.5));
+    export(
+        &effect,
+        ExportSettings {
+            alpha: AlphaMode::Straight,
+            ..sequence(&straight, 2, 1.5)
+        },
+    );
+    let (mut sum, mut worst, mut n, mut divided) = (0.0f64, 0.0f32, 0usize, 0usize);
+    for k in 0..2 {
+        let c = linear(&rgba8(&frame_path(&pre, "color", k)));
+        let s = linear(&rgba8(&frame_path(&straight, "color", k)));
+        for (c, s) in c.iter().zip(&s) {
+            let coverage = c[3].max(c[0].max(c[1]).max(c[2]).min(1.0));
+            assert!(
+                (s[3] - coverage).abs() <= 1.5 / 255.0,
+                "alpha {} for {c:?}",
+                s[3]
+            );
+            if s[3] < 0.98 && s[3] > 0.05 {
+                divided += 1;
+            }
+            for ch in 0..3 {
+                let d = (s[ch] * s[3] - c[ch]).abs();
+                sum += f64::from(d);
+                worst = worst.max(d);
+                n += 1;
+            }
+        }
+    }
+    let mean = sum / n as f64;
+    assert!(divided > 50, "only {divided} partly covered pixels");
+    assert!(mean <= 0.5 / 255.0, "mean error {:.3}/255", mean * 255.0);
+    assert!(worst <= 6.0 / 255.0, "worst error {:.2}/255", worst * 255.0);
+}
+
 /// Frame k of a flipbook is frame k of the sequence export with the same settings.
 #[test]
 fn flipbook_cells_are_the_sequence_frames() {
