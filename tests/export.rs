@@ -136,6 +136,79 @@ fn straight_alpha_is_the_premultiplied_colour_over_its_coverage() {
     assert!(worst <= 6.0 / 255.0, "worst error {:.2}/255", worst * 255.0);
 }
 
+/// The emissive pass is the colour pass's additive light: the colour pass minus the
+/// emissive pass is what the same frames give with every additive layer at intensity 0
+/// (the smoke alone: the flames still simulate and still give birth to it), and that
+/// export's emissive pass is black.
+#[test]
+fn the_emissive_pass_is_the_colour_passs_additive_light() {
+    let effect = preset("campfire");
+    let mut dark = effect.clone();
+    for e in &mut dark.emitters {
+        if e.look.blend == ignis::effect::BlendMode::Additive {
+            e.look.intensity = 0.0;
+        }
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (lit, smoke) = (dir.path().join("lit"), dir.path().join("smoke"));
+    let passes = Passes {
+        color: true,
+        emissive: true,
+        motion: false,
+    };
+    for (e, out) in [(&effect, &lit), (&dark, &smoke)] {
+        // The preset's own camera: a fitted one would frame the dark flames differently.
+        let settings = ExportSettings {
+            passes,
+            format: Format::Exr,
+            camera: CameraMode::Preset,
+            ..sequence(out, 2, 1.5)
+        };
+        export(e, settings);
+    }
+    let exr = |dir: &Path, pass: &str, k: u32| -> Vec<[f32; 4]> {
+        let path = dir.join(format!("campfire_{pass}_{k:04}.exr"));
+        let image = exr::prelude::read_first_rgba_layer_from_file(
+            &path,
+            |size, _| {
+                (
+                    size.width(),
+                    vec![[0.0f32; 4]; size.width() * size.height()],
+                )
+            },
+            |(w, px), at, (r, g, b, a): (f32, f32, f32, f32)| {
+                px[at.y() * *w + at.x()] = [r, g, b, a];
+            },
+        )
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        image.layer_data.channel_data.pixels.1
+    };
+    let (mut light, mut worst, mut smoky) = (0.0f32, 0.0f32, 0usize);
+    for k in 0..2 {
+        let (color, emissive) = (exr(&lit, "color", k), exr(&lit, "emissive", k));
+        let (alone, none) = (exr(&smoke, "color", k), exr(&smoke, "emissive", k));
+        for i in 0..color.len() {
+            for c in 0..3 {
+                worst = worst.max((color[i][c] - emissive[i][c] - alone[i][c]).abs());
+                assert!(
+                    none[i][c].abs() < 1e-6,
+                    "emissive light without additive layers"
+                );
+            }
+            light += emissive[i][0];
+            smoky += usize::from(alone[i][3] > 0.05);
+        }
+    }
+    assert!(
+        light > 10.0 && smoky > 50,
+        "light {light}, smoky pixels {smoky}"
+    );
+    assert!(
+        worst < 2e-3,
+        "colour − emissive differs from the smoke alone by {worst}"
+    );
+}
+
 /// Frame k of a flipbook is frame k of the sequence export with the same settings.
 #[test]
 fn flipbook_cells_are_the_sequence_frames() {
