@@ -136,6 +136,56 @@ fn straight_alpha_is_the_premultiplied_colour_over_its_coverage() {
     assert!(worst <= 6.0 / 255.0, "worst error {:.2}/255", worst * 255.0);
 }
 
+/// Frame `k` of `pass` in an EXR export in `dir`: linear RGBA per pixel.
+fn exr(dir: &Path, pass: &str, k: u32) -> Vec<[f32; 4]> {
+    let path = dir.join(format!("campfire_{pass}_{k:04}.exr"));
+    let image = exr::prelude::read_first_rgba_layer_from_file(
+        &path,
+        |size, _| {
+            (
+                size.width(),
+                vec![[0.0f32; 4]; size.width() * size.height()],
+            )
+        },
+        |(w, px), at, (r, g, b, a): (f32, f32, f32, f32)| {
+            px[at.y() * *w + at.x()] = [r, g, b, a];
+        },
+    )
+    .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    image.layer_data.channel_data.pixels.1
+}
+
+/// A preset's exposure scales the exported light and leaves coverage alone: the campfire
+/// at exposure 2.5 is 2.5× its light at exposure 1 (EXR, linear), alpha unchanged.
+#[test]
+fn exposure_scales_the_exported_light() {
+    let effect = preset("campfire");
+    let mut bright = effect.clone();
+    bright.post.exposure = 2.5;
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (one, more) = (dir.path().join("one"), dir.path().join("more"));
+    for (e, out) in [(&effect, &one), (&bright, &more)] {
+        let settings = ExportSettings {
+            format: Format::Exr,
+            camera: CameraMode::Preset,
+            ..sequence(out, 2, 1.5)
+        };
+        export(e, settings);
+    }
+    let (mut lit, mut worst) = (0usize, 0.0f32);
+    for k in 0..2 {
+        for (a, b) in exr(&one, "color", k).iter().zip(&exr(&more, "color", k)) {
+            for c in 0..3 {
+                worst = worst.max((b[c] - 2.5 * a[c]).abs() / (1.0 + b[c]));
+            }
+            assert!((a[3] - b[3]).abs() < 1e-3, "coverage {} → {}", a[3], b[3]);
+            lit += usize::from(a[0] > 0.05);
+        }
+    }
+    assert!(lit > 50, "only {lit} lit pixels");
+    assert!(worst < 2e-3, "light not 2.5×: relative error {worst}");
+}
+
 /// The emissive pass is the colour pass's additive light: the colour pass minus the
 /// emissive pass is what the same frames give with every additive layer at intensity 0
 /// (the smoke alone: the flames still simulate and still give birth to it), and that
@@ -166,23 +216,6 @@ fn the_emissive_pass_is_the_colour_passs_additive_light() {
         };
         export(e, settings);
     }
-    let exr = |dir: &Path, pass: &str, k: u32| -> Vec<[f32; 4]> {
-        let path = dir.join(format!("campfire_{pass}_{k:04}.exr"));
-        let image = exr::prelude::read_first_rgba_layer_from_file(
-            &path,
-            |size, _| {
-                (
-                    size.width(),
-                    vec![[0.0f32; 4]; size.width() * size.height()],
-                )
-            },
-            |(w, px), at, (r, g, b, a): (f32, f32, f32, f32)| {
-                px[at.y() * *w + at.x()] = [r, g, b, a];
-            },
-        )
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        image.layer_data.channel_data.pixels.1
-    };
     let (mut light, mut worst, mut smoky) = (0.0f32, 0.0f32, 0usize);
     for k in 0..2 {
         let (color, emissive) = (exr(&lit, "color", k), exr(&lit, "emissive", k));
