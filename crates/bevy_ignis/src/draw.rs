@@ -7,8 +7,8 @@ use bevy::prelude::*;
 use bevy::render::camera::ExtractedCamera;
 use bevy::render::diagnostic::RecordDiagnostics;
 use bevy::render::render_resource::TextureUsages;
-use bevy::render::renderer::{RenderContext, ViewQuery};
-use bevy::render::view::{ExtractedView, ViewDepthStencilTexture, ViewTarget};
+use bevy::render::renderer::{FlushCommands, RenderContext, ViewQuery};
+use bevy::render::view::{ExtractedView, Msaa, ViewDepthStencilTexture, ViewTarget};
 use ignis::HostTargets;
 
 use crate::players::IgnisPlayers;
@@ -24,19 +24,28 @@ pub fn sampleable_depth(mut cameras: Query<&mut Camera3d>) {
     }
 }
 
-/// Core3d, after the transparent pass: records and draws this view's players.
+/// Core3d, after the transparent pass: records and draws the players of this view's
+/// target kind. The first view to record a player this frame runs its steps; a later one
+/// first submits the work recorded so far (earlier views' cameras went through the queue,
+/// which this view's record writes again), then records its own sort and splat.
 pub fn draw_players(
     view: ViewQuery<(
         &ExtractedCamera,
         &ExtractedView,
         &ViewTarget,
         &ViewDepthStencilTexture,
+        &Msaa,
     )>,
     mut players: ResMut<IgnisPlayers>,
+    mut flush: FlushCommands,
     mut ctx: RenderContext,
 ) {
-    let entity = view.entity();
-    let (camera, extracted, target, depth) = view.into_inner();
+    let (camera, extracted, target, depth, msaa) = view.into_inner();
+    let kind = (target.main_texture_format(), msaa.samples());
+    let ours = |key: &crate::players::PlayerKey| (key.1, key.2) == kind;
+    if (players.players.iter()).any(|(k, vp)| ours(k) && vp.recorded > 0) {
+        flush.flush();
+    }
     let Some(size) = camera.physical_viewport_size else {
         return;
     };
@@ -59,10 +68,11 @@ pub fn draw_players(
     let diagnostics = diagnostics.as_deref();
     let encoder = ctx.command_encoder();
     let span = diagnostics.time_span(encoder, "ignis");
-    for ((_, v), vp) in players.players.iter_mut() {
-        if *v != entity {
+    for (key, vp) in players.players.iter_mut() {
+        if !ours(key) {
             continue;
         }
+        vp.recorded += 1;
         if let Err(e) = vp.player.record(encoder, &ignis_camera, sampled) {
             let message = e.to_string();
             if vp.last_error.as_ref() != Some(&message) {

@@ -1,6 +1,8 @@
-//! The render world's players: one per preset and camera view (a player records its
-//! camera through the queue, and Bevy submits every view's work at once), each with the
-//! instances of its preset, kept in step with the main world's entities.
+//! The render world's players: one per preset and kind of view target (colour format and
+//! MSAA samples: the pipelines are built for them), each with the instances of its preset,
+//! kept in step with the main world's entities. A player's clock advances once a frame and
+//! its steps are recorded once, by the first view that draws it; every other view of the
+//! same target kind records only its own sort and splat and draws the same particles.
 
 use std::collections::{HashMap, HashSet};
 
@@ -15,7 +17,8 @@ use crate::extract::{ExtractedIgnis, ExtractedPreset};
 /// Bevy's 3D depth: `Depth32Float`, reversed Z (1 near, 0 far).
 pub const BEVY_DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
-/// A player of one preset for one view, and its instances by main-world entity.
+/// A player of one preset for one kind of view target, and its instances by main-world
+/// entity.
 pub struct ViewPlayer {
     /// The player.
     pub player: Player,
@@ -27,34 +30,40 @@ pub struct ViewPlayer {
     target: (wgpu::TextureFormat, u32),
     /// The last error its view's frame logged (each distinct one is logged once).
     pub last_error: Option<String>,
+    /// Views that recorded it this frame (a later view submits the earlier ones' work
+    /// first: the camera goes through the queue).
+    pub(crate) recorded: u32,
 }
 
-/// Every player, by (preset, render-world view entity).
+/// What a player is built for: its preset, and the views' colour format and MSAA samples.
+pub type PlayerKey = (AssetId<IgnisPreset>, wgpu::TextureFormat, u32);
+
+/// Every player, by preset and target kind.
 #[derive(Resource, Default)]
 pub struct IgnisPlayers {
     /// The players.
-    pub players: HashMap<(AssetId<IgnisPreset>, Entity), ViewPlayer>,
+    pub players: HashMap<PlayerKey, ViewPlayer>,
 }
 
 impl IgnisPlayers {
-    /// The player of `preset` for the first view that has one (tests and tools: its
-    /// particles, its instances).
+    /// A player of `preset` (tests and tools: its particles, its instances; with views of
+    /// several target kinds, the one of the lowest sample count).
     pub fn any_of(&self, preset: AssetId<IgnisPreset>) -> Option<&ViewPlayer> {
         self.players
             .iter()
-            .filter(|((p, _), _)| *p == preset)
-            .min_by_key(|((_, view), _)| *view)
+            .filter(|((p, _, _), _)| *p == preset)
+            .min_by_key(|((_, _, samples), _)| *samples)
             .map(|(_, v)| v)
     }
 }
 
 /// Render world, once per frame before the views render: makes or updates the player of
-/// every preset for every 3D view, adds, moves and removes instances, applies seeks, and
-/// advances the clocks by Bevy's (virtual) frame time.
+/// every preset for every kind of 3D view target, adds, moves and removes instances,
+/// applies seeks, and advances the clocks by Bevy's (virtual) frame time.
 pub fn prepare_players(
     mut players: ResMut<IgnisPlayers>,
     extracted: Res<ExtractedIgnis>,
-    views: Query<(Entity, &ViewTarget, &Msaa), With<Camera3d>>,
+    views: Query<(&ViewTarget, &Msaa), With<Camera3d>>,
     device: Res<RenderDevice>,
     queue: Res<RenderQueue>,
     time: Res<Time>,
@@ -64,25 +73,26 @@ pub fn prepare_players(
     let wanted: HashSet<AssetId<IgnisPreset>> =
         extracted.instances.iter().map(|i| i.preset).collect();
     let mut alive = HashSet::new();
-    for (view, target, msaa) in &views {
-        let key = (target.main_texture_format(), msaa.samples());
+    let kinds: HashSet<_> = (views.iter())
+        .map(|(target, msaa)| (target.main_texture_format(), msaa.samples()))
+        .collect();
+    for &(format, samples) in &kinds {
         for &preset in &wanted {
             let Some(entry) = extracted.presets.get(&preset) else {
                 continue;
             };
-            alive.insert((preset, view));
-            let slot = players.players.get_mut(&(preset, view));
-            let Some(vp) = ready(slot, entry, key, device.wgpu_device(), &queue) else {
+            let key = (preset, format, samples);
+            alive.insert(key);
+            let slot = players.players.get_mut(&key);
+            let target = (format, samples);
+            let Some(vp) = ready(slot, entry, target, device.wgpu_device(), &queue) else {
                 continue;
             };
             let vp = match vp {
                 Ready::Kept(vp) => vp,
-                Ready::New(vp) => players
-                    .players
-                    .entry((preset, view))
-                    .insert_entry(*vp)
-                    .into_mut(),
+                Ready::New(vp) => players.players.entry(key).insert_entry(*vp).into_mut(),
             };
+            vp.recorded = 0;
             sync_instances(vp, &extracted, preset);
             let lit = (extracted.instances.iter()).any(|i| i.preset == preset && i.light);
             vp.player.set_light_estimate(lit);
@@ -136,6 +146,7 @@ fn ready<'a>(
                     generation: entry.generation,
                     target: key,
                     last_error: None,
+                    recorded: 0,
                 }))),
                 Err(e) => {
                     error!("ignis: cannot play a preset in this view: {e}");
@@ -177,15 +188,15 @@ fn sync_instances(vp: &mut ViewPlayer, extracted: &ExtractedIgnis, preset: Asset
     });
 }
 
-/// Shares the lights the players last read back with the main world (the first view's
-/// player of each preset speaks for its instances).
+/// Shares the lights the players last read back with the main world (the player of each
+/// preset with the fewest samples speaks for its instances).
 fn publish_lights(players: &IgnisPlayers, lights: &crate::EffectLights) {
     let Ok(mut out) = lights.0.lock() else {
         return;
     };
     out.clear();
     let mut views: Vec<_> = players.players.iter().collect();
-    views.sort_by_key(|((_, view), _)| std::cmp::Reverse(*view));
+    views.sort_by_key(|((_, _, samples), _)| std::cmp::Reverse(*samples));
     for (_, vp) in views {
         for (entity, (id, _)) in &vp.instances {
             if let Some(light) = vp.player.effect_light(*id) {

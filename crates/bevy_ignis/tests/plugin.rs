@@ -408,3 +408,45 @@ fn flames_fade_where_they_meet_bevys_geometry() {
         "before the wall {before_wall}, before nothing {before_nothing}"
     );
 }
+
+/// Two cameras see one simulation: one player for the preset (the same target kind), its
+/// clock advanced once a frame — as with one camera — and each view draws the fire from
+/// its own side.
+#[test]
+fn two_cameras_draw_one_simulation() {
+    let run = |cameras: usize| {
+        let mut app = common::app(&common::presets(), false);
+        let targets: Vec<_> = [Vec3::new(0.0, 1.3, 2.5), Vec3::new(2.5, 1.3, 0.0)]
+            .into_iter()
+            .take(cameras)
+            .map(|eye| common::camera(&mut app, eye, Vec3::new(0.0, 1.2, 0.0)))
+            .collect();
+        let preset = common::load(&mut app, "torch.ron");
+        let torch = app
+            .world_mut()
+            .spawn(IgnisEffect::new(preset.clone(), 5))
+            .id();
+        common::run(&mut app, 30);
+        app.world_mut().resource_mut::<Time<Virtual>>().pause();
+        let players = common::players(&app);
+        assert_eq!(players.players.len(), 1, "one player for both views");
+        let vp = players.any_of(preset.id()).expect("player");
+        let time = vp.player.time_secs(vp.instances[&torch].0).expect("time");
+        let images: Vec<_> = targets
+            .iter()
+            .map(|t| common::capture(&mut app, t))
+            .collect();
+        (time, images)
+    };
+    let (one, _) = run(1);
+    let (two, images) = run(2);
+    assert_eq!(
+        one, two,
+        "two views advanced the clock differently from one"
+    );
+    for (k, image) in images.iter().enumerate() {
+        let lit = image.iter().filter(|p| p[0] > 120).count();
+        assert!(lit > 100, "view {k}: only {lit} lit pixels");
+    }
+    assert_ne!(images[0], images[1], "both views drew the same image");
+}
