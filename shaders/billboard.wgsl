@@ -4,10 +4,10 @@
 // instances' pools are segments of one state buffer, each with its own look.
 //
 // Contract:
-// - group 0: binding 0 `camera` (CameraUniform), 1 `looks` (one LookSlot per instance of
-//   the draw, from a dynamic offset) — keep in sync with `src/gpu/types.rs`.
-// - group 1: binding 0 `prev` (state before the last step), 1 `cur` (state after it), 2
-//   `order` (sorted: buffer indices of the batch's slots, farthest first).
+// - groups 0 and 1: particle_bindings.wgsl — `camera`, `looks` (one LookSlot per instance
+//   of the draw, from a dynamic offset; keep in sync with `src/gpu/types.rs`), `ramps`;
+//   `prev` (state before the last step), `cur` (after it), `order` (sorted: buffer
+//   indices of the batch's slots, farthest first), the packed views and the births.
 // - Unsorted, quad q is slot q mod W of instance q / W's live window (W: the widest
 //   window of the draw's instances); sorted, quad q is `order[q]`.
 // - Dead slots (and flat quads at or behind the camera) emit a degenerate quad outside the
@@ -20,21 +20,7 @@
 // The ribbon of an emitter with a trail (TRAIL: `segments` quads per particle).
 #import "trail.wgsl"
 
-@group(0) @binding(0) var<uniform> camera: CameraUniform;
-// Storage, not uniform: see params.wgsl (lavapipe's uniform inlining).
-@group(0) @binding(1) var<storage, read> looks: array<LookSlot>;
-// The look of the instance this invocation draws (look.wgsl reads it).
-var<private> look: LookUniform;
-@group(0) @binding(2) var ramps: texture_2d<f32>;
-@group(1) @binding(0) var<storage, read> prev: array<Particle>;
-@group(1) @binding(1) var<storage, read> cur: array<Particle>;
-// Back-to-front slot order (sort.wgsl), read only by the alpha-blended pipeline.
-@group(1) @binding(2) var<storage, read> order: array<u32>;
-// The same state buffers seen as packed state (src/gpu/types.rs `PackedParticle`).
-@group(1) @binding(3) var<storage, read> prev_packed: array<PackedParticle>;
-@group(1) @binding(4) var<storage, read> cur_packed: array<PackedParticle>;
-// A tiny-state emitter's birth table (births.wgsl).
-@group(1) @binding(5) var<storage, read> births: array<Birth>;
+#import "particle_bindings.wgsl"
 // The sprite: linear, premultiplied, mipmapped (src/render/sprites.rs).
 @group(2) @binding(0) var sprite_tex: texture_2d<f32>;
 @group(2) @binding(1) var sprite_sampler: sampler;

@@ -6,24 +6,16 @@
 // workgroups' partials. The CPU reads the totals back a frame or two later.
 //
 // Contract:
-// - group 0: 0 `camera`, 1 `looks` (dynamic offset per emitter), 2 `ramps`, as splat.wgsl.
-// - group 1: the state buffers, as splat.wgsl.
+// - groups 0 and 1: particle_bindings.wgsl (camera, looks with a dynamic offset per
+//   emitter, ramps; the state buffers).
 // - group 2: 0 `sums`: the partials (2 × vec4 per workgroup: (ΣE.rgb, ΣY), (ΣY·p, ΣY·|p|²)),
 //   then the totals (the same per instance) from `job.total_base` on; 2 `job` (dynamic
 //   offset per dispatch). One buffer for both: a device's 8 storage buffers per stage.
 #import "common.wgsl"
 #import "rng.wgsl"
 #import "look.wgsl"
+#import "particle_bindings.wgsl"
 
-@group(0) @binding(0) var<uniform> camera: CameraUniform;
-@group(0) @binding(1) var<storage, read> looks: array<LookSlot>;
-var<private> look: LookUniform;
-@group(0) @binding(2) var ramps: texture_2d<f32>;
-@group(1) @binding(0) var<storage, read> prev: array<Particle>;
-@group(1) @binding(1) var<storage, read> cur: array<Particle>;
-@group(1) @binding(3) var<storage, read> prev_packed: array<PackedParticle>;
-@group(1) @binding(4) var<storage, read> cur_packed: array<PackedParticle>;
-@group(1) @binding(5) var<storage, read> births: array<Birth>;
 
 struct LightJob {
     // The first partial of this dispatch's first instance.

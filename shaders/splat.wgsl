@@ -6,8 +6,8 @@
 // emitters always use billboards.
 //
 // Contract:
-// - group 0: 0 `camera`, 1 `look` (dynamic offset per emitter), as billboard.wgsl.
-// - group 1: 0 `prev`, 1 `cur` (state buffers).
+// - groups 0 and 1: particle_bindings.wgsl (camera, looks with a dynamic offset per
+//   emitter, ramps; the state buffers).
 // - group 2: 0 `accum` (3 × u32 per pixel: R, G, B in units of 1/FIXED_SCALE), 1
 //   `scene_depth` (the host's depth, tested at every pixel a particle adds light to
 //   when it is the viewport's size).
@@ -16,19 +16,8 @@
 #import "common.wgsl"
 #import "rng.wgsl"
 #import "look.wgsl"
+#import "particle_bindings.wgsl"
 
-@group(0) @binding(0) var<uniform> camera: CameraUniform;
-// The looks of the dispatch's instances (workgroup z is the instance), as billboard.wgsl.
-@group(0) @binding(1) var<storage, read> looks: array<LookSlot>;
-// The look of the instance this invocation splats (look.wgsl reads it).
-var<private> look: LookUniform;
-@group(0) @binding(2) var ramps: texture_2d<f32>;
-@group(1) @binding(0) var<storage, read> prev: array<Particle>;
-@group(1) @binding(1) var<storage, read> cur: array<Particle>;
-@group(1) @binding(3) var<storage, read> prev_packed: array<PackedParticle>;
-@group(1) @binding(4) var<storage, read> cur_packed: array<PackedParticle>;
-// A tiny-state emitter's birth table (births.wgsl).
-@group(1) @binding(5) var<storage, read> births: array<Birth>;
 @group(2) @binding(0) var<storage, read_write> accum: array<atomic<u32>>;
 @group(2) @binding(1) var scene_depth: texture_depth_2d;
 

@@ -11,7 +11,7 @@
 // host's pass composites the result: dst · T + C.
 //
 // Contract:
-// - group 0, 1: as billboard.wgsl (camera, looks, ramps; the state and the sort's order).
+// - groups 0 and 1: particle_bindings.wgsl (camera, looks, ramps; the state and the sort's order).
 // - group 2: the emitter's sprite and sampler (shade).
 // - group 3 (compute): 0 `sprites` (one TileSprite per quad of the frame's tile items),
 //   2 `bin_lists` (per bin, the sprites over it in draw order, one list after another,
@@ -30,16 +30,7 @@
 #import "workgroup_scan.wgsl"
 #import "tile_lists.wgsl"
 
-@group(0) @binding(0) var<uniform> camera: CameraUniform;
-@group(0) @binding(1) var<storage, read> looks: array<LookSlot>;
-var<private> look: LookUniform;
-@group(0) @binding(2) var ramps: texture_2d<f32>;
-@group(1) @binding(0) var<storage, read> prev: array<Particle>;
-@group(1) @binding(1) var<storage, read> cur: array<Particle>;
-@group(1) @binding(2) var<storage, read> order: array<u32>;
-@group(1) @binding(3) var<storage, read> prev_packed: array<PackedParticle>;
-@group(1) @binding(4) var<storage, read> cur_packed: array<PackedParticle>;
-@group(1) @binding(5) var<storage, read> births: array<Birth>;
+#import "particle_bindings.wgsl"
 @group(2) @binding(0) var sprite_tex: texture_2d<f32>;
 @group(2) @binding(1) var sprite_sampler: sampler;
 @group(3) @binding(0) var<storage, read_write> sprites: array<TileSprite>;

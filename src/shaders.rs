@@ -82,6 +82,10 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ),
     ("light.wgsl", include_str!("../shaders/light.wgsl")),
     (
+        "particle_bindings.wgsl",
+        include_str!("../shaders/particle_bindings.wgsl"),
+    ),
+    (
         "workgroup_scan.wgsl",
         include_str!("../shaders/workgroup_scan.wgsl"),
     ),
