@@ -503,7 +503,11 @@ impl Player {
             .map(|b| (0..b.active()).map(|slot| b.member(slot)).collect())
             .collect();
         let (groups, ids) = Self::draw_groups(&self.instances, &members, camera);
-        let owners = super::effect_light::light_owners(&groups, &ids);
+        // Who each look slot measures: only for the light estimate, when it is on.
+        let owners = match self.light.on {
+            true => super::effect_light::light_owners(&groups, &ids),
+            false => Vec::new(),
+        };
         let groups: Vec<&[Option<Scene<'_>>]> = groups.iter().map(Vec::as_slice).collect();
         self.items = self.frame.prepare(
             &self.ctx,
