@@ -61,7 +61,13 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u3
         out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
         return out;
     }
-    let corner = quad_corner(qd, vertex & 3u);
+    return quad_vertex(qd, vertex & 3u);
+}
+
+// Corner `vi` of the living quad `qd`.
+fn quad_vertex(qd: Quad, vi: u32) -> VsOut {
+    var out: VsOut;
+    let corner = quad_corner(qd, vi);
     out.clip = corner.clip;
     let flat_w = quad_flat_w(qd);
     if flat_w >= 0.0 {
@@ -133,9 +139,12 @@ fn trail_vertex(vertex: u32, inst: u32) -> VsOut {
 
 @fragment
 fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
-    var tex = textureSample(sprite_tex, sprite_sampler, in.uv0);
+    // A lit layer's motion pass weighs the coverage of its RTBA map (lit.wgsl).
+    let uv0 = select(in.uv0, rtba_uv(in.uv0), LIT);
+    let uv1 = select(in.uv1, rtba_uv(in.uv1), LIT);
+    var tex = textureSample(sprite_tex, sprite_sampler, uv0);
     if FLIPBOOK && FLIP_BLEND {
-        tex = mix(tex, textureSample(sprite_tex, sprite_sampler, in.uv1), in.blend_height.x);
+        tex = mix(tex, textureSample(sprite_tex, sprite_sampler, uv1), in.blend_height.x);
     }
     // The sprite is premultiplied: its rgb already carries its alpha (and the colour its
     // own alpha and, additive, the intensity).
@@ -150,20 +159,9 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
         a *= in.blend_height.x;
         rgb *= in.blend_height.x;
     }
-    if SOFT {
-        // Soft particles: fade out towards the ground plane instead of a hard cut.
-        let fade = clamp(in.blend_height.y, 0.0, 1.0);
-        a *= fade;
-        rgb *= fade;
-    }
-    if SOFT_DEPTH {
-        // Soft particles against the host's scene: fade over the soft-edge distance
-        // between this fragment and what the host drew behind it (view-space distances).
-        let scene = textureLoad(scene_depth, vec2<i32>(in.clip.xy), 0);
-        let fade = clamp((view_distance(scene) - view_distance(in.clip.z)) * in.blend_height.y, 0.0, 1.0);
-        a *= fade;
-        rgb *= fade;
-    }
+    let fade = edge_fade(in.clip, in.blend_height.y);
+    a *= fade;
+    rgb *= fade;
     if MOTION {
         // Weighted by the cube of the visible weight: where sparks cross, the brightest
         // one's motion wins rather than a mean that fits neither.
@@ -171,6 +169,65 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
         return vec4<f32>(in.color.xy * k, 0.0, k);
     }
     return vec4<f32>(rgb, a);
+}
+
+// The soft edges' fade of a fragment at `clip` (its position) with the ground fade's
+// argument `height` (SOFT_DEPTH: 1 / the soft-edge distance): 1 without them.
+fn edge_fade(clip: vec4<f32>, height: f32) -> f32 {
+    var fade = 1.0;
+    if SOFT {
+        // Soft particles: fade out towards the ground plane instead of a hard cut.
+        fade = clamp(height, 0.0, 1.0);
+    }
+    if SOFT_DEPTH {
+        // Soft particles against the host's scene: fade over the soft-edge distance
+        // between this fragment and what the host drew behind it (view-space distances).
+        let scene = textureLoad(scene_depth, vec2<i32>(clip.xy), 0);
+        fade = clamp((view_distance(scene) - view_distance(clip.z)) * height, 0.0, 1.0);
+    }
+    return fade;
+}
+
+// A lit quad's corner (lit.wgsl): the billboard's, its six-way light flat.
+struct VsLit {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) uv0: vec2<f32>,
+    @location(1) uv1: vec2<f32>,
+    // The emitted colour (the colour over life × the emission) and the coverage.
+    @location(2) @interpolate(flat) color: vec4<f32>,
+    @location(3) blend_height: vec2<f32>,
+    @location(4) @interpolate(flat) l0: vec4<f32>,
+    @location(5) @interpolate(flat) l1: vec4<f32>,
+    @location(6) @interpolate(flat) l2: vec4<f32>,
+    @location(7) @interpolate(flat) l3: vec4<f32>,
+    @location(8) @interpolate(flat) l4: vec4<f32>,
+}
+
+@vertex
+fn vs_lit(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u32) -> VsLit {
+    var out: VsLit;
+    let qd = load_quad((vertex >> 2u) + inst);
+    if !qd.d.alive {
+        out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+        return out;
+    }
+    let v = quad_vertex(qd, vertex & 3u);
+    let l = quad_sixway(qd);
+    return VsLit(v.clip, v.uv0, v.uv1, vec4<f32>(v.color.rgb * lit.ambient.w, v.color.a), v.blend_height, l[0], l[1], l[2], l[3], l[4]);
+}
+
+@fragment
+fn fs_lit(in: VsLit) -> @location(0) vec4<f32> {
+    var rtba = textureSample(sprite_tex, sprite_sampler, rtba_uv(in.uv0));
+    var lbfe = textureSample(sprite_tex, sprite_sampler, lbfe_uv(in.uv0));
+    if FLIPBOOK && FLIP_BLEND {
+        rtba = mix(rtba, textureSample(sprite_tex, sprite_sampler, rtba_uv(in.uv1)), in.blend_height.x);
+        lbfe = mix(lbfe, textureSample(sprite_tex, sprite_sampler, lbfe_uv(in.uv1)), in.blend_height.x);
+    }
+    let l = array<vec4<f32>, 5>(in.l0, in.l1, in.l2, in.l3, in.l4);
+    let rgb = sixway_rgb(l, rtba, lbfe) + in.color.rgb * lbfe.a;
+    let fade = edge_fade(in.clip, in.blend_height.y);
+    return vec4<f32>(rgb, in.color.a * rtba.a) * fade;
 }
 
 // The view-space distance in front of the camera of a depth-buffer value.

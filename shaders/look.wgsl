@@ -72,11 +72,30 @@ struct LookUniform {
     tiny_c: vec4<u32>,
 }
 
+// A lit layer's light (lit.wgsl; keep in sync with `LitUniform` in src/render/lit.rs),
+// in the emitter's simulation space (the world's axes). Zero for unlit layers.
+struct LitUniform {
+    // xyz: towards the sun, w: the effect light's gain (`self_light`).
+    sun_dir: vec4<f32>,
+    // rgb: the sun's colour, w: host point lights in `points` (0..=4).
+    sun_color: vec4<f32>,
+    // rgb: ambient, w: emission (the colour over life's share that glows by itself).
+    ambient: vec4<f32>,
+    // rgb: albedo, w: unused.
+    albedo: vec4<f32>,
+    // The effect's own light, written on the GPU each frame (light.wgsl `light_apply`):
+    // xyz its light-weighted centre, w its spread² (m²); rgb its power, w: luminance.
+    self_pos: vec4<f32>,
+    self_rgb: vec4<f32>,
+    // Host point lights, two vec4 each: (position, range in m), (colour × intensity, 0).
+    points: array<vec4<f32>, 8>,
+}
+
 // A look at the 512-byte stride of the looks buffer (src/render/frame.rs; the draws
 // read their instances' looks as `array<LookSlot>`).
 struct LookSlot {
     look: LookUniform,
-    pad: array<vec4<u32>, 14>,
+    lit: LitUniform,
 }
 
 override INTERPOLATE: bool = true;

@@ -5,6 +5,7 @@
 // Contract: as look.wgsl, plus `looks: array<LookSlot>` (a draw's instances) and `order:
 // array<u32>` (the sort's back-to-front buffer indices), and the look modules below.
 #import "look.wgsl"
+#import "lit.wgsl"
 
 // Pipeline variants: each look module is compiled in only when an emitter uses it.
 override SORTED: bool = false;
@@ -14,6 +15,8 @@ override STREAK: bool = false;
 override SOFT: bool = false;
 // Soft edges against the host's depth buffer (replaces SOFT's ground plane).
 override SOFT_DEPTH: bool = false;
+// Lit smoke (lit.wgsl): six-way maps shaded by the instance's `LitUniform`.
+override LIT: bool = false;
 
 // Which instance of the draw and which slot of its pool quad `q` is, or none.
 // Unsorted, quad q is slot q mod W of instance q / W's live window (W: the widest window
@@ -64,6 +67,9 @@ fn load_quad(q: u32) -> Quad {
         return out;
     }
     look = looks[ks.x].look;
+    if LIT {
+        lit = looks[ks.x].lit;
+    }
     let slot = ks.y;
     let pair = load_pair(slot);
     out.d = drawn(pair[0], pair[1]);
@@ -138,14 +144,29 @@ fn quad_corner(qd: Quad, vi: u32) -> Corner {
         out.clip = vec4<f32>(end.xy + off_px / half_vp, end.z, end.w);
         out.world = select(d.pos - tail, d.pos, corner.x > 0.0);
     } else {
-        // Random initial rotation plus spin over the particle's age.
-        let angle = (qd.rnd.y - 0.5) * look.extra.z + qd.lc.z * d.life;
-        let cs = vec2<f32>(cos(angle), sin(angle));
+        let cs = quad_turn(qd);
         let c = vec2<f32>(corner.x * cs.x - corner.y * cs.y, corner.x * cs.y + corner.y * cs.x);
         out.world = d.pos + (camera.right_alpha.xyz * c.x + camera.up.xyz * c.y) * (0.5 * size);
         out.clip = look.clip_from_sim * vec4<f32>(out.world, 1.0);
     }
     return out;
+}
+
+// The cosine and sine of quad `qd`'s turn in the image plane: its random initial
+// rotation plus its spin over its age.
+fn quad_turn(qd: Quad) -> vec2<f32> {
+    let angle = (qd.rnd.y - 0.5) * look.extra.z + qd.lc.z * qd.d.life;
+    return vec2<f32>(cos(angle), sin(angle));
+}
+
+// A lit quad's six-way light, packed (lit.wgsl): at its particle, in its sprite's turned
+// frame, times the albedo and its opacity.
+fn quad_sixway(qd: Quad) -> array<vec4<f32>, 5> {
+    let cs = quad_turn(qd);
+    let r = camera.right_alpha.xyz;
+    let u = camera.up.xyz;
+    let s = sixway_axes(qd.d.pos, r * cs.x + u * cs.y, u * cs.x - r * cs.y, lit.albedo.rgb * qd.color.a);
+    return pack_sixway(s);
 }
 
 // The clip w that every corner of quad `qd` shares, or a negative number where its

@@ -140,12 +140,17 @@ fn atlas_scale() -> vec2<f32> {
 fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     let q = (wg.y * nwg.x + wg.x) * 256u + lid;
     let index = job.counts.x + q;
+    // A lit item's sprites are followed by their six-way light (`lit_record`).
+    let records = select(job.counts.y, 2u * job.counts.y, LIT);
     if q >= job.counts.y {
         // The rest of the item's last block: no sprite.
-        if q < (job.counts.y + BLOCK - 1u) / BLOCK * BLOCK {
+        if q >= records && q < (records + BLOCK - 1u) / BLOCK * BLOCK {
             sprites[index].bounds = vec4<i32>(1, 1, 0, 0);
         }
         return;
+    }
+    if LIT {
+        lit_record(q, index + job.counts.y);
     }
     let s = project_quad(q);
     sprites[index].bounds = s.bounds;
@@ -166,6 +171,22 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
         sprites[index].z_row = s.z_row;
         sprites[index].w_row = s.w_row;
     }
+}
+
+// Writes lit quad `q`'s six-way light (lit.wgsl, packed) into sprite `at`: a record
+// with no pixels (the bins skip it) in five of its fields, read by `sprite_light`.
+fn lit_record(q: u32, at: u32) {
+    sprites[at].bounds = vec4<i32>(1, 1, 0, 0);
+    let qd = load_quad(q);
+    if !qd.d.alive {
+        return;
+    }
+    let l = quad_sixway(qd);
+    sprites[at].map = l[0];
+    sprites[at].offset = l[1];
+    sprites[at].uv_box = l[2];
+    sprites[at].color = l[3];
+    sprites[at].frames = l[4];
 }
 
 // Quad `q` of the job's item projected (empty bounds when it draws nothing).
@@ -219,6 +240,10 @@ fn project_quad(q: u32) -> TileSprite {
     }
     s.uv_box = vec4<f32>(min(c0.uv, c3.uv), max(c0.uv, c3.uv));
     s.color = qd.color;
+    if LIT {
+        // A lit sprite's own colour is its glow (lit.wgsl).
+        s.color = vec4<f32>(qd.color.rgb * lit.ambient.w, qd.color.a);
+    }
     // The flipbook's cells, found here once: the shade maps frame coordinates to the
     // atlas with one multiply-add (the look's `atlas_uv`, rearranged).
     var frames = vec3<f32>(0.0);
@@ -627,14 +652,22 @@ fn sprite_light(i: u32, k: u32, p: vec2<i32>) -> vec4<f32> {
     ddy *= grad.xy;
     let uv1 = vec3<f32>(uv, 1.0);
     let frames = cache_frames[k];
-    var tex = textureSampleGrad(sprite_tex, sprite_sampler, uv * grad.xy + frames.xy, ddx, ddy);
-    if FLIPBOOK && FLIP_BLEND {
-        let next = textureSampleGrad(sprite_tex, sprite_sampler, uv * grad.xy + frames.zw, ddx, ddy);
-        tex = mix(tex, next, grad.z);
-    }
     let color = cache_color[k];
-    var a = color.a * tex.a;
-    var rgb = color.rgb * tex.rgb;
+    var a: f32;
+    var rgb: vec3<f32>;
+    if LIT {
+        let c = lit_light(i, uv * grad.xy, frames, grad.z, ddx, ddy);
+        a = color.a * c.a;
+        rgb = c.rgb + color.rgb * c.w;
+    } else {
+        var tex = textureSampleGrad(sprite_tex, sprite_sampler, uv * grad.xy + frames.xy, ddx, ddy);
+        if FLIPBOOK && FLIP_BLEND {
+            let next = textureSampleGrad(sprite_tex, sprite_sampler, uv * grad.xy + frames.zw, ddx, ddy);
+            tex = mix(tex, next, grad.z);
+        }
+        a = color.a * tex.a;
+        rgb = color.rgb * tex.rgb;
+    }
     if SOFT {
         let fade = clamp(dot(cache_ground[k].xyz, uv1), 0.0, 1.0);
         a *= fade;
@@ -647,6 +680,31 @@ fn sprite_light(i: u32, k: u32, p: vec2<i32>) -> vec4<f32> {
         rgb *= fade;
     }
     return vec4<f32>(rgb, a);
+}
+
+// Lit sprite `i`'s texel at `uv` (frame coordinates with the atlas scale applied;
+// `frames`: the two frames' atlas offsets, `next` the second's weight), under the
+// six-way light of its record (`lit_record`).
+fn lit_light(i: u32, uv: vec2<f32>, frames: vec4<f32>, next: f32, ddx: vec2<f32>, ddy: vec2<f32>) -> LitTexel {
+    let r = sprites[i + job.counts.y];
+    let l = array<vec4<f32>, 5>(r.map, r.offset, r.uv_box, r.color, r.frames);
+    let half = vec2<f32>(0.5, 1.0);
+    let dx = ddx * half;
+    let dy = ddy * half;
+    var rtba = textureSampleGrad(sprite_tex, sprite_sampler, rtba_uv(uv + frames.xy), dx, dy);
+    var lbfe = textureSampleGrad(sprite_tex, sprite_sampler, lbfe_uv(uv + frames.xy), dx, dy);
+    if FLIPBOOK && FLIP_BLEND {
+        rtba = mix(rtba, textureSampleGrad(sprite_tex, sprite_sampler, rtba_uv(uv + frames.zw), dx, dy), next);
+        lbfe = mix(lbfe, textureSampleGrad(sprite_tex, sprite_sampler, lbfe_uv(uv + frames.zw), dx, dy), next);
+    }
+    return LitTexel(sixway_rgb(l, rtba, lbfe), rtba.a, lbfe.a);
+}
+
+// A lit sprite's texel: its lit colour, coverage and emissive mask (premultiplied).
+struct LitTexel {
+    rgb: vec3<f32>,
+    a: f32,
+    w: f32,
 }
 
 // Light `c` (premultiplied colour, coverage) blended into `acc` (rgb: premultiplied colour,

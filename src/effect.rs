@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 mod curve;
 mod events;
+mod lit;
 mod rate_cap;
 mod stability;
 mod trail;
@@ -18,6 +19,7 @@ pub use curve::{
     rows_key,
 };
 pub use events::{CountRange, Event, MAX_CHILDREN_PER_EVENT, MAX_EVENTS_PER_EMITTER, Trigger};
+pub use lit::{Lighting, Lit, SixWayMaps};
 pub use rate_cap::{CAP_BURST_SECS, RateCap, cap_burst};
 pub use stability::{
     GROWTH_LIMIT, StabilityWarning, Stiffness, largest_stable_step, lifetime_growth,
@@ -47,6 +49,8 @@ pub struct Effect {
     pub emitters: Vec<Emitter>,
     /// The HDR composite: exposure and bloom.
     pub post: Post,
+    /// The sun and ambient light of lit layers (a host may set its own).
+    pub lighting: Lighting,
 }
 
 /// The HDR composite applied to the whole image: exposure, optional bloom, ACES tonemap.
@@ -701,6 +705,10 @@ pub struct Look {
     pub blend: BlendMode,
     /// Which draw path renders them.
     pub draw_path: DrawPath,
+    /// Shade an alpha-blended layer with six-way lightmaps (see [`Lit`]; its maps
+    /// replace `sprite`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lit: Option<Lit>,
 }
 
 /// The two draw paths; both render the same look.
@@ -887,6 +895,7 @@ impl Default for Effect {
             camera: CameraHint::default(),
             emitters: vec![Emitter::default()],
             post: Post::default(),
+            lighting: Lighting::default(),
         }
     }
 }
@@ -1045,6 +1054,7 @@ impl Default for Look {
             intensity: 1.6,
             blend: BlendMode::Additive,
             draw_path: DrawPath::Auto,
+            lit: None,
         }
     }
 }

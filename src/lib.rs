@@ -55,8 +55,9 @@ pub use glam;
 pub use gpu::{AdapterProfile, ProfileKind, ProfileRequest, ProfileSetting};
 pub use runtime::{
     Camera, ClockStats, EffectLight, EmitterStats, EventCount, HostTargets, InstanceId, IntoMat4,
-    Layers, MissingLimit, PLAYER_SHADERS, ParticleCount, ParticleInfo, Player, PlayerError,
-    PlayerSettings, STORAGE_BUFFERS_REQUIRED, required_limits,
+    Layers, MAX_POINT_LIGHTS, MissingLimit, PLAYER_SHADERS, ParticleCount, ParticleInfo, Player,
+    PlayerError, PlayerSettings, PointLight, STORAGE_BUFFERS_REQUIRED, SceneLighting,
+    required_limits,
 };
 pub use shaders::ShaderError;
 pub use sim::planner::SpawnStats;

@@ -98,7 +98,7 @@ enum Command {
         measure_span: Option<f64>,
     },
     /// Write the built-in procedural sprites as PNGs (straight alpha), to start a
-    /// texture from.
+    /// texture from, and the built-in six-way smoke maps (linear RTBA/LBFE pairs).
     Sprites {
         /// Output folder.
         #[arg(long, default_value = "sprites")]
@@ -822,6 +822,26 @@ fn write_sprites(out: &Path) -> anyhow::Result<()> {
         img.save(&path)
             .with_context(|| format!("writing {}", path.display()))?;
         println!("wrote {}", path.display());
+    }
+    write_sixway_sprites(out)
+}
+
+/// The built-in six-way smoke maps (the puff and the puff sheet) as linear RGBA PNG
+/// pairs in Unity's packing: `*_sixway_rtba.png` (right, top, back, alpha) and
+/// `*_sixway_lbfe.png` (left, bottom, front, emissive).
+fn write_sixway_sprites(out: &Path) -> anyhow::Result<()> {
+    use ignis::render::sixway_maps::{PUFF_SEED, puff, puff_sheet, to_png_linear};
+    for (name, maps) in [
+        ("smoke_puff", puff(PUFF_SEED)),
+        ("smoke_puff_sheet", puff_sheet(PUFF_SEED)),
+    ] {
+        for (packing, img) in [("rtba", &maps.rtba), ("lbfe", &maps.lbfe)] {
+            let path = out.join(format!("{name}_sixway_{packing}.png"));
+            to_png_linear(img)
+                .save(&path)
+                .with_context(|| format!("writing {}", path.display()))?;
+            println!("wrote {}", path.display());
+        }
     }
     Ok(())
 }

@@ -64,6 +64,7 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ("births.wgsl", include_str!("../shaders/births.wgsl")),
     ("count.wgsl", include_str!("../shaders/count.wgsl")),
     ("look.wgsl", include_str!("../shaders/look.wgsl")),
+    ("lit.wgsl", include_str!("../shaders/lit.wgsl")),
     ("quad.wgsl", include_str!("../shaders/quad.wgsl")),
     ("billboard.wgsl", include_str!("../shaders/billboard.wgsl")),
     ("tiles.wgsl", include_str!("../shaders/tiles.wgsl")),
@@ -81,6 +82,10 @@ pub const EMBEDDED: &[(&str, &str)] = &[
         include_str!("../shaders/depth_resolve.wgsl"),
     ),
     ("light.wgsl", include_str!("../shaders/light.wgsl")),
+    (
+        "light_apply.wgsl",
+        include_str!("../shaders/light_apply.wgsl"),
+    ),
     (
         "particle_bindings.wgsl",
         include_str!("../shaders/particle_bindings.wgsl"),
@@ -134,6 +139,7 @@ pub const ENTRY_FILES: &[&str] = &[
     "clear.wgsl",
     "depth_resolve.wgsl",
     "light.wgsl",
+    "light_apply.wgsl",
 ];
 
 /// A shader problem, located in the file the user edits.

@@ -13,8 +13,8 @@ use common::*;
 use ignis::effect::{
     Attractor, BlendMode, Bloom, CURRENT_VERSION, CameraHint, Collisions, ColorStop, Effect,
     Emitter, Falloff, FlamePull, Flipbook, FlipbookMode, Forces, GroundPlane, Gusts, Integrator,
-    Look, MAX_CAPACITY, Param, Post, Range, Shape, SpawnNoise, SphereCollider, Sprite, Streak,
-    TimeMode, TimeSettings, Transform, Turbulence, Vortex,
+    Lighting, Lit, Look, MAX_CAPACITY, Param, Post, Range, Shape, SixWayMaps, SpawnNoise,
+    SphereCollider, Sprite, Streak, TimeMode, TimeSettings, Transform, Turbulence, Vortex,
 };
 use ignis::headless::Headless;
 use ignis::preset::{self, PresetError};
@@ -1352,6 +1352,20 @@ fn look() -> BoxedStrategy<Look> {
             |(sprite, size_m, opacity, mut stops, intensity, blend, extra)| {
                 let (flip, spin_deg_per_s, rotation_random_deg, streak) = extra;
                 stops.sort_by(|a, b| a.t.total_cmp(&b.t));
+                // Lit smoke: alpha-blended, camera-facing sprites.
+                let lit = (blend == BlendMode::Alpha && streak.is_none()).then(|| Lit {
+                    maps: match (&sprite, flip.is_some()) {
+                        (Sprite::Image(p), _) => SixWayMaps::Images {
+                            rtba: p.clone(),
+                            lbfe: format!("{p}.lbfe.png"),
+                        },
+                        (_, true) => SixWayMaps::PuffSheet,
+                        (_, false) => SixWayMaps::Puff,
+                    },
+                    albedo: [0.25, 0.5, 0.75],
+                    emission: intensity,
+                    self_light: rotation_random_deg,
+                });
                 // -0.0 sorts before 0.0 but the validator compares with <, so both orders pass.
                 Look {
                     sprite,
@@ -1377,6 +1391,7 @@ fn look() -> BoxedStrategy<Look> {
                         length_secs,
                         max_length_m,
                     }),
+                    lit,
                     // Fields added later keep their defaults here.
                     ..Look::default()
                 }
@@ -1523,6 +1538,11 @@ fn effect() -> BoxedStrategy<Effect> {
                     exposure: 1.5,
                     bloom: (seed % 2 == 0).then(Bloom::default),
                     alpha_downscale: 1 + seed % 4,
+                },
+                lighting: Lighting {
+                    sun_direction: [0.3, 1.0, -0.2],
+                    sun_color: [0.2, 0.25, (seed % 5) as f32],
+                    ambient: [0.01, 0.02, 0.03],
                 },
             }
         })

@@ -4,8 +4,8 @@
 //! (`events.rs`, `trail.rs`) with the same [`Checker`].
 
 use super::{
-    CURRENT_VERSION, Collisions, Effect, Emitter, FlipbookMode, Forces, Look, MAX_CAPACITY,
-    MAX_COLOR_STOPS, MAX_CURVE_KEYS, MAX_SPHERES, Param, Range, Shape, Sprite,
+    BlendMode, CURRENT_VERSION, Collisions, Effect, Emitter, FlipbookMode, Forces, Look,
+    MAX_CAPACITY, MAX_COLOR_STOPS, MAX_CURVE_KEYS, MAX_SPHERES, Param, Range, Shape, Sprite,
 };
 
 /// A validation failure: the field path and what is wrong with its value.
@@ -202,6 +202,7 @@ impl Effect {
         c.num(|| "camera.pitch_deg".into(), cam.pitch_deg, -89.9, 89.9);
         c.num(|| "camera.fov_y_deg".into(), cam.fov_y_deg, 1.0, 170.0);
         c.num(|| "post.exposure".into(), self.post.exposure, 1e-3, 1e3);
+        self.lighting.check(c);
         if !(1..=4).contains(&self.post.alpha_downscale) {
             c.push(
                 "post.alpha_downscale".into(),
@@ -544,6 +545,23 @@ impl Look {
         }
         if let Some(t) = &self.trail {
             t.check(&p("look.trail"), c);
+        }
+        if let Some(l) = &self.lit {
+            l.check(p, c);
+            if self.blend != BlendMode::Alpha {
+                c.push(
+                    p("look.lit"),
+                    "Some(..)",
+                    "lights alpha-blended layers only (blend: Alpha)",
+                );
+            }
+            if self.streak.is_some() {
+                c.push(
+                    p("look.lit"),
+                    "Some(..)",
+                    "lights camera-facing sprites only: remove the streak",
+                );
+            }
         }
         if let Some(s) = &self.streak {
             c.num(|| p("look.streak.length_secs"), s.length_secs, 0.0, 10.0);

@@ -183,6 +183,7 @@ impl From<Effect> for crate::effect::Effect {
             time,
             camera: v.camera,
             post: v.post,
+            lighting: Default::default(),
         }
     }
 }
@@ -281,6 +282,7 @@ impl From<Look> for crate::effect::Look {
             intensity: l.intensity,
             blend: l.blend,
             draw_path: l.draw_path,
+            lit: None,
         }
     }
 }

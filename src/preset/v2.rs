@@ -228,6 +228,7 @@ impl From<Effect> for crate::effect::Effect {
             time,
             camera: v.camera,
             post: v.post,
+            lighting: Default::default(),
         }
     }
 }
@@ -292,6 +293,7 @@ impl Look {
             intensity: l.intensity,
             blend: l.blend,
             draw_path: l.draw_path,
+            lit: None,
         }
     }
 }

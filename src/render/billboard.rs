@@ -157,6 +157,11 @@ impl BillboardPass {
             ADDITIVE
         };
         let constants = v.constants();
+        // Lit layers shade with the six-way maps (the motion pass only weighs coverage).
+        let (vs, fs) = match v.lit && !v.motion {
+            true => ("vs_lit", "fs_lit"),
+            false => ("vs_main", "fs_main"),
+        };
         let options = wgpu::PipelineCompilationOptions {
             constants: &constants,
             zero_initialize_workgroup_memory: true,
@@ -167,7 +172,7 @@ impl BillboardPass {
                 layout: Some(layout),
                 vertex: wgpu::VertexState {
                     module,
-                    entry_point: Some("vs_main"),
+                    entry_point: Some(vs),
                     compilation_options: options.clone(),
                     buffers: &[],
                 },
@@ -177,7 +182,7 @@ impl BillboardPass {
                 multisample: target.multisample(),
                 fragment: Some(wgpu::FragmentState {
                     module,
-                    entry_point: Some("fs_main"),
+                    entry_point: Some(fs),
                     compilation_options: options,
                     targets: &[Some(wgpu::ColorTargetState {
                         format: target.color_format,

@@ -15,6 +15,7 @@ use crate::effect::{
 use crate::gpu::types::{CameraUniform, LookUniform, PARAMS_STRIDE, StateLayout};
 use crate::gpu::{AdapterProfile, GpuContext};
 use crate::render::camera::Camera;
+use crate::render::lit::{LitUniform, SceneLighting, write_lit};
 use crate::render::look::{
     RAMP_WIDTH, ROWS_PER_EMITTER, bake_look_curves, bake_ramp, gradient_key, look_curve_params,
 };
@@ -47,6 +48,9 @@ pub struct DrawItem {
     pub index: usize,
     /// The look uniform slot of the group's first instance (the others follow).
     pub look_slot: usize,
+    /// The group of instances it draws (its index in the frame; items of one group
+    /// share their instances, member by member).
+    pub group: usize,
     /// Instances (segments) the draw covers.
     pub members: u32,
     /// Key of the cached particle bind group.
@@ -157,6 +161,12 @@ pub struct FrameResources {
     pub allow_tiles: bool,
     /// This frame's look blocks on their way to `looks`.
     look_bytes: Vec<u8>,
+    /// The light lit layers are drawn in (the host's, or the effect's own `lighting`
+    /// when `None`).
+    pub lighting: Option<SceneLighting>,
+    /// Each look slot's simulation-space origin in the last `prepare` (the effect's
+    /// light is moved between emitters' spaces with them).
+    pub slot_origins: Vec<glam::DVec3>,
 }
 
 /// Emitter `i` across a group's instances (`FrameResources::group_looks`).
@@ -282,6 +292,8 @@ pub struct LookVariant {
     pub trail: bool,
     /// How the shaders read the emitter's state (both draw paths).
     pub state: StateVariant,
+    /// Lit smoke: six-way maps under the slot's `LitUniform` (`lit.wgsl`).
+    pub lit: bool,
 }
 
 /// How look.wgsl reads an emitter's state: its layout and whether positions are closed
@@ -318,6 +330,7 @@ impl LookVariant {
             motion: false,
             trail: false,
             state,
+            lit: look.lit.is_some() && look.blend == BlendMode::Alpha,
         }
     }
 
@@ -329,6 +342,7 @@ impl LookVariant {
             flipbook: false,
             flip_blend: false,
             streak: false,
+            lit: false,
             ..self
         }
     }
@@ -353,11 +367,12 @@ impl LookVariant {
             motion: false,
             trail: false,
             state: StateVariant::default(),
+            lit: false,
         }
     }
 
     /// The override constants of this variant's billboard pipeline.
-    pub fn constants(self) -> [(&'static str, f64); 10] {
+    pub fn constants(self) -> [(&'static str, f64); 11] {
         let b = |v: bool| if v { 1.0 } else { 0.0 };
         let [layout, stateless] = self.state.constants();
         [
@@ -369,6 +384,7 @@ impl LookVariant {
             ("SOFT_DEPTH", b(self.soft && self.soft_depth)),
             ("MOTION", b(self.motion)),
             ("TRAIL", b(self.trail)),
+            ("LIT", b(self.lit)),
             layout,
             stateless,
         ]
@@ -482,6 +498,8 @@ impl FrameResources {
             soft_depth: false,
             allow_tiles: false,
             look_bytes: Vec::new(),
+            lighting: None,
+            slot_origins: Vec::new(),
         }
     }
 
@@ -638,8 +656,14 @@ impl FrameResources {
         blocks.resize(slots * PARAMS_STRIDE as usize, 0);
         let mut items = Vec::new();
         let mut slot = 0;
+        self.slot_origins.clear();
         for (n, group) in groups.iter().enumerate() {
             for i in 0..emitters(group) {
+                self.slot_origins.extend(group.iter().map(|s| {
+                    s.as_ref()
+                        .and_then(|s| s.sim.planner().emitters.get(i).map(|p| p.origin()))
+                        .unwrap_or_default()
+                }));
                 let block = &mut blocks[slot * PARAMS_STRIDE as usize..]
                     [..group.len() * PARAMS_STRIDE as usize];
                 let view = GroupView {
@@ -652,6 +676,7 @@ impl FrameResources {
                 let item = self.prepare_emitter(ctx, &view, i, sort, block);
                 items.extend(item.map(|d| DrawItem {
                     look_slot: slot,
+                    group: n,
                     ..d
                 }));
                 slot += group.len();
@@ -674,6 +699,11 @@ impl FrameResources {
         items
     }
 
+    /// The looks buffer (a `LookSlot` per slot; written by the lit layers' light pass).
+    pub fn looks_buffer(&self) -> &wgpu::Buffer {
+        &self.looks
+    }
+
     /// Uploads the looks the last [`FrameResources::prepare`] built, through `uploads`
     /// with a copy recorded into `enc` (outside a pass).
     pub fn upload_looks(&self, uploads: &mut crate::gpu::Uploads, enc: &mut wgpu::CommandEncoder) {
@@ -688,7 +718,9 @@ impl FrameResources {
     fn base_look(&mut self, effect: &Effect, i: usize, sprite: &SpriteTexture) -> LookUniform {
         let e = &effect.emitters[i];
         let mut u = look_uniform(&e.look, ROWS_PER_EMITTER * i as u32, 0, sprite.integral);
-        if self.trim_sprites && e.look.streak.is_none() {
+        // Six-way maps hold two images side by side: their quads are not trimmed.
+        let lit = e.look.lit.is_some() && e.look.blend == BlendMode::Alpha;
+        if self.trim_sprites && e.look.streak.is_none() && !lit {
             let (rows, cols) = e
                 .look
                 .flipbook
@@ -703,6 +735,37 @@ impl FrameResources {
                 .or_insert_with(|| sprite.trim_rect(rows, cols, threshold));
         }
         u
+    }
+
+    /// Writes lit emitter `i`'s `LitUniform` of every instance of the group into `block`
+    /// (each in its simulation space; the effect's own light is added on the GPU).
+    fn write_lit_looks(
+        &self,
+        view: &GroupView<'_, '_>,
+        i: usize,
+        lit: &crate::effect::Lit,
+        block: &mut [u8],
+    ) {
+        for (k, scene) in view.group.iter().enumerate() {
+            let Some(scene) = scene else {
+                continue;
+            };
+            let own;
+            let lighting = match &self.lighting {
+                Some(l) => l,
+                None => {
+                    own = SceneLighting::from(&scene.effect.lighting);
+                    &own
+                }
+            };
+            let origin =
+                (scene.sim.planner().emitters.get(i)).map_or(glam::DVec3::ZERO, |p| p.origin());
+            let u = LitUniform::new(lit, lighting, origin);
+            write_lit(
+                &mut block[k * PARAMS_STRIDE as usize..][..PARAMS_STRIDE as usize],
+                &u,
+            );
+        }
     }
 
     /// Emitter `i`'s look uniform of one instance, from the group's `base`, its pool and
@@ -794,7 +857,15 @@ impl FrameResources {
     ) -> Option<DrawItem> {
         let first = view.group.iter().flatten().next()?;
         let e = first.effect.emitters.get(i)?;
-        let (sprite, error) = self.sprites.resolve(ctx, &e.look.sprite, view.asset_dir);
+        let (sprite, error) = match e
+            .look
+            .lit
+            .as_ref()
+            .filter(|_| e.look.blend == BlendMode::Alpha)
+        {
+            Some(lit) => self.sprites.resolve_lit(ctx, &lit.maps, view.asset_dir),
+            None => self.sprites.resolve(ctx, &e.look.sprite, view.asset_dir),
+        };
         if let Some(err) = error.filter(|_| view.first_group) {
             self.sprite_errors.push((i, err));
         }
@@ -817,6 +888,14 @@ impl FrameResources {
             .max()
             .unwrap_or(0);
         write_looks(block, &looks, width, b.capacity);
+        if let Some(lit) = e
+            .look
+            .lit
+            .as_ref()
+            .filter(|_| e.look.blend == BlendMode::Alpha)
+        {
+            self.write_lit_looks(view, i, lit, block);
+        }
         if !e.enabled {
             return None;
         }
@@ -857,6 +936,7 @@ impl FrameResources {
         Some(DrawItem {
             index: i,
             look_slot: 0,
+            group: 0,
             members: n,
             key,
             capacity: b.capacity,

@@ -10,6 +10,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use crate::effect::BlendMode;
 use crate::gpu::GpuContext;
 use crate::render::frame::StateVariant;
+use crate::render::light_apply::ItemTotals;
 use crate::render::{DrawItem, FrameResources};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 use crate::sim::gpu_sim::dispatch_size;
@@ -179,29 +180,28 @@ impl<T: Clone> LightPass<T> {
         Ok(())
     }
 
-    /// Records the sums of every additive item's instances and their copy into a free
-    /// readback buffer (nothing when all are in flight). The results come from
-    /// [`LightPass::collect`] once the GPU has finished, each with what `owner` said of its
-    /// look slot (the instance and emitter it measures).
+    /// Records the sums of every additive item's instances and returns where each item's
+    /// totals are in [`LightPass::sums_buffer`] (for the lit layers, `light_apply.rs`).
+    /// With `owner`, also their copy into a free readback buffer (nothing when all are in
+    /// flight): the results come from [`LightPass::collect`] once the GPU has finished,
+    /// each with what `owner` said of its look slot (the instance and emitter it
+    /// measures).
     pub fn record(
         &mut self,
         ctx: &GpuContext,
         enc: &mut wgpu::CommandEncoder,
         frame: &FrameResources,
         items: &[DrawItem],
-        owner: impl Fn(usize) -> Option<T>,
-    ) {
-        let Some(ring) = self.free_readback(ctx) else {
-            return;
-        };
+        owner: Option<&dyn Fn(usize) -> Option<T>>,
+    ) -> Vec<ItemTotals> {
         let (jobs, partials, totals) = plan(items);
         if jobs.is_empty() {
-            return;
+            return Vec::new();
         }
         self.ensure_buffers(ctx, partials + totals, totals, jobs.len() as u64);
         self.ensure_variants(ctx, items, &jobs);
         let Some(b) = &self.buffers else {
-            return;
+            return Vec::new();
         };
         let mut bytes = vec![0u8; jobs.len() * JOB_STRIDE as usize];
         for (k, j) in jobs.iter().enumerate() {
@@ -215,6 +215,33 @@ impl<T: Clone> LightPass<T> {
         }
         ctx.queue.write_buffer(&b.jobs_buffer, 0, &bytes);
         self.dispatch(enc, frame, items, &jobs);
+        let out = jobs
+            .iter()
+            .map(|j| (j.item, partials + j.total_base))
+            .collect();
+        if let Some(owner) = owner {
+            self.record_readback(enc, items, &jobs, (partials, totals), owner);
+        }
+        out
+    }
+
+    /// The buffer of the last record's sums (partials, then totals).
+    pub fn sums_buffer(&self) -> Option<&wgpu::Buffer> {
+        self.buffers.as_ref().map(|b| &b.sums_buffer)
+    }
+
+    /// Copies the totals into a free readback buffer with their owners.
+    fn record_readback(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        items: &[DrawItem],
+        jobs: &[Job],
+        (partials, totals): (u32, u32),
+        owner: &dyn Fn(usize) -> Option<T>,
+    ) {
+        let (Some(ring), Some(b)) = (self.free_readback(), &self.buffers) else {
+            return;
+        };
         let owners = jobs
             .iter()
             .flat_map(|j| {
@@ -316,17 +343,11 @@ impl<T: Clone> LightPass<T> {
         }
     }
 
-    /// A readback buffer with nothing in flight (made on first need), or none.
-    fn free_readback(&mut self, ctx: &GpuContext) -> Option<usize> {
-        while self.ring.len() < RING {
-            self.ring.push(Readback {
-                buffer: readback_buffer(ctx, 32),
-                size: 32,
-                pending: None,
-            });
-        }
+    /// A readback buffer with nothing in flight, or none.
+    fn free_readback(&self) -> Option<usize> {
         let i = self.next;
-        self.ring[i].pending.is_none().then_some(i)
+        let r = self.ring.get(i)?;
+        r.pending.is_none().then_some(i)
     }
 
     /// Buffers for `sums` vec4 pairs (partials, then totals), readbacks for `totals`
@@ -341,6 +362,13 @@ impl<T: Clone> LightPass<T> {
             let s = grow(self.buffers.as_ref().map(|b| b.sums), s);
             let j = grow(self.buffers.as_ref().map(|b| b.jobs), j);
             self.buffers = Some(Buffers::new(ctx, &self.layout, s, j));
+        }
+        while self.ring.len() < RING {
+            self.ring.push(Readback {
+                buffer: readback_buffer(ctx, 32),
+                size: 32,
+                pending: None,
+            });
         }
         let t = (u64::from(totals.max(1)) * 32).next_power_of_two();
         for r in (self.ring.iter_mut()).filter(|r| r.pending.is_none() && r.size < t) {

@@ -11,8 +11,9 @@ use std::sync::Arc;
 
 use image::{Rgba, Rgba32FImage};
 
-use crate::effect::Sprite;
+use crate::effect::{SixWayMaps, Sprite};
 use crate::gpu::GpuContext;
+use crate::render::sixway_maps;
 
 /// Side of a built-in sprite (one frame), pixels.
 pub const BUILT_IN_SIZE: u32 = 128;
@@ -162,6 +163,9 @@ pub struct SpriteError {
 pub struct SpriteLibrary {
     built_in: HashMap<Sprite, Arc<SpriteTexture>>,
     files: HashMap<PathBuf, Result<Arc<SpriteTexture>, SpriteError>>,
+    /// Six-way maps (built-in, and pairs of files by their resolved paths), each pair in
+    /// one texture: RTBA on the left, LBFE on the right (`sixway_maps::combined`).
+    lit: HashMap<SixWayMaps, Result<Arc<SpriteTexture>, SpriteError>>,
     /// Trilinear, clamp-to-edge.
     pub sampler: wgpu::Sampler,
     next_id: u64,
@@ -182,6 +186,7 @@ impl SpriteLibrary {
         Self {
             built_in: HashMap::new(),
             files: HashMap::new(),
+            lit: HashMap::new(),
             sampler,
             next_id: 1,
             generation: 0,
@@ -222,6 +227,50 @@ impl SpriteLibrary {
         }
     }
 
+    /// The six-way maps `maps` in one texture (RTBA left, LBFE right); PNG paths are
+    /// relative to `base_dir`. A pair that fails to load gives the built-in puff and the
+    /// error.
+    pub fn resolve_lit(
+        &mut self,
+        ctx: &GpuContext,
+        maps: &SixWayMaps,
+        base_dir: Option<&Path>,
+    ) -> (Arc<SpriteTexture>, Option<SpriteError>) {
+        let key = match maps {
+            SixWayMaps::Images { rtba, lbfe } => SixWayMaps::Images {
+                rtba: resolve_path(rtba, base_dir).display().to_string(),
+                lbfe: resolve_path(lbfe, base_dir).display().to_string(),
+            },
+            built_in => built_in.clone(),
+        };
+        if !self.lit.contains_key(&key) {
+            let images = match &key {
+                SixWayMaps::Puff => Ok(sixway_maps::puff(sixway_maps::PUFF_SEED)),
+                SixWayMaps::PuffSheet => Ok(sixway_maps::puff_sheet(sixway_maps::PUFF_SEED)),
+                SixWayMaps::Images { rtba, lbfe } => {
+                    sixway_maps::load_pair(Path::new(rtba), Path::new(lbfe))
+                }
+            };
+            let id = self.take_id();
+            let label = format!("six-way {key:?}");
+            let loaded =
+                images.map(|m| Arc::new(upload(ctx, &sixway_maps::combined(&m), id, &label)));
+            if let Err(e) = &loaded {
+                log::warn!("{e}");
+            }
+            self.lit.insert(key.clone(), loaded);
+            self.generation += 1;
+        }
+        match self.lit.get(&key) {
+            Some(Ok(t)) => (t.clone(), None),
+            Some(Err(e)) => {
+                let e = e.clone();
+                (self.resolve_lit(ctx, &SixWayMaps::Puff, None).0, Some(e))
+            }
+            None => (self.built_in(ctx, &Sprite::SoftDisc), None),
+        }
+    }
+
     /// Forgets cached files among `changed` (they reload on the next `resolve`). Returns
     /// true when any was cached.
     pub fn invalidate(&mut self, changed: &[PathBuf]) -> bool {
@@ -231,7 +280,14 @@ impl SpriteLibrary {
                 .iter()
                 .any(|c| c == p || (c.file_name() == p.file_name() && same_file(c, p)))
         });
-        let dropped = before != self.files.len();
+        let lit_before = self.lit.len();
+        self.lit.retain(|m, _| match m {
+            SixWayMaps::Images { rtba, lbfe } => ![rtba, lbfe]
+                .iter()
+                .any(|p| changed.iter().any(|c| same_path(c, Path::new(p)))),
+            _ => true,
+        });
+        let dropped = before != self.files.len() || lit_before != self.lit.len();
         if dropped {
             self.generation += 1;
         }
@@ -246,9 +302,15 @@ impl SpriteLibrary {
     /// Existing folders holding the file sprites in use, missing ones included (to watch
     /// for changes: a PNG created or fixed there is picked up).
     pub fn watched_dirs(&self) -> Vec<PathBuf> {
+        let lit = self.lit.keys().flat_map(|m| match m {
+            SixWayMaps::Images { rtba, lbfe } => vec![PathBuf::from(rtba), PathBuf::from(lbfe)],
+            _ => Vec::new(),
+        });
         let mut dirs: Vec<PathBuf> = self
             .files
             .keys()
+            .cloned()
+            .chain(lit)
             .filter_map(|p| p.parent().map(Path::to_path_buf))
             .map(|d| {
                 if d.as_os_str().is_empty() {
@@ -283,6 +345,11 @@ impl SpriteLibrary {
         self.built_in.insert(key, tex.clone());
         tex
     }
+}
+
+/// Whether `changed` names `p` (the same path, or the same file by another path).
+fn same_path(changed: &Path, p: &Path) -> bool {
+    changed == p || (changed.file_name() == p.file_name() && same_file(changed, p))
 }
 
 fn same_file(a: &Path, b: &Path) -> bool {

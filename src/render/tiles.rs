@@ -162,6 +162,13 @@ fn grid_bins(size: (u32, u32)) -> u64 {
     u64::from(bx) * u64::from(by)
 }
 
+/// The sprites an item takes: one per quad, and a lit item's six-way light after them
+/// (`tiles.wgsl` `lit_record`).
+fn item_sprites(d: &DrawItem) -> u32 {
+    let quads = d.width * d.members;
+    if d.variant.lit { 2 * quads } else { quads }
+}
+
 /// Whether `sprites` quads (whole blocks) fit the tile path's buffers at `size` on a
 /// device whose storage bindings take `limit` bytes.
 fn fits(size: (u32, u32), sprites: u64, limit: u64) -> bool {
@@ -174,7 +181,7 @@ fn item_firsts(order: &[&DrawItem]) -> Vec<u32> {
     let mut firsts = Vec::with_capacity(order.len() + 1);
     firsts.push(0u32);
     for d in order {
-        let n = (d.width * d.members).next_multiple_of(BLOCK);
+        let n = item_sprites(d).next_multiple_of(BLOCK);
         firsts.push(firsts[firsts.len() - 1] + n);
     }
     firsts
@@ -611,7 +618,7 @@ impl TilePass {
                 pass.set_bind_group(3, &b.group, &[(k as u64 * JOB_STRIDE) as u32]);
                 if stage == 0 {
                     // The item's last block is filled up with empty sprites.
-                    let (x, y) = dispatch_size((d.width * d.members).next_multiple_of(BLOCK));
+                    let (x, y) = dispatch_size(item_sprites(d).next_multiple_of(BLOCK));
                     pass.dispatch_workgroups(x, y, 1);
                 } else {
                     // Only the bins holding some of the item's sprites (the bin scan lists

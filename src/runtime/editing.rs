@@ -30,6 +30,7 @@ pub const PLAYER_SHADERS: &[&str] = &[
     "sort.wgsl",
     "depth_resolve.wgsl",
     "light.wgsl",
+    "light_apply.wgsl",
 ];
 
 impl Player {
@@ -185,6 +186,11 @@ impl Player {
             "depth_resolve.wgsl" => self.host_depth.rebuild(&self.ctx, &lib)?,
             "light.wgsl" => {
                 if let Some(pass) = &mut self.light.pass {
+                    pass.rebuild(&self.ctx, &lib)?;
+                }
+            }
+            "light_apply.wgsl" => {
+                if let Some(pass) = &mut self.light.apply {
                     pass.rebuild(&self.ctx, &lib)?;
                 }
             }

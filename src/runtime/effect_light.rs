@@ -7,8 +7,13 @@ use std::collections::HashMap;
 use glam::{DVec3, Vec3};
 
 use super::{InstanceId, Player};
+use crate::gpu::GpuContext;
+use crate::render::DrawItem;
 use crate::render::Scene;
+use crate::render::frame::FrameResources;
 use crate::render::light::{LightPass, LightSums};
+use crate::render::light_apply::SelfLightPass;
+use crate::shaders::ShaderLibrary;
 
 /// The light of one instance, as a point light a host can place in its scene.
 ///
@@ -40,6 +45,10 @@ pub(super) type LightOwner = (InstanceId, DVec3);
 #[derive(Default)]
 pub(super) struct LightEstimate {
     pub pass: Option<LightPass<LightOwner>>,
+    /// The lit layers' share of the light (built with `pass`).
+    pub apply: Option<SelfLightPass>,
+    /// The passes could not be built on this device (logged once; not tried again).
+    pub failed: bool,
     pub on: bool,
     pub latest: HashMap<InstanceId, EffectLight>,
 }
@@ -61,50 +70,74 @@ impl Player {
     pub fn effect_light(&self, id: InstanceId) -> Option<EffectLight> {
         self.light.latest.get(&id).copied()
     }
+}
 
-    /// Collects finished readbacks, asks for the last record's maps, and records this
-    /// frame's sums (after `frame.prepare`: the items and looks are this frame's).
-    pub(super) fn record_light(
+/// What the light pass reads of a player's frame.
+pub(super) struct LightFrame<'a> {
+    pub ctx: &'a GpuContext,
+    pub library: &'a ShaderLibrary,
+    pub frame: &'a FrameResources,
+    pub items: &'a [DrawItem],
+    /// The host's world from the preset's (`PlayerSettings::world_up`).
+    pub host: Option<glam::Quat>,
+}
+
+impl LightEstimate {
+    /// Records the light pass when the estimate is on or a lit layer is drawn (after
+    /// `frame.prepare`, before the draws): collects finished readbacks, asks for the last
+    /// record's maps, records this frame's sums and their readback (the estimate), and
+    /// hands the lit layers their share on the GPU (`light_apply`).
+    pub(super) fn record(
         &mut self,
+        f: &LightFrame<'_>,
         enc: &mut wgpu::CommandEncoder,
         owners: &[Option<LightOwner>],
     ) {
-        if !self.light.on {
+        let lit = f.items.iter().any(|d| d.variant.lit);
+        if (!self.on && !lit) || self.failed {
             return;
         }
-        if self.light.pass.is_none() {
+        if self.pass.is_none() || self.apply.is_none() {
             // Built in an error scope: whatever the host's device refuses is logged, not a
             // panic in its error handler.
-            let scope = self
-                .ctx
-                .device
-                .push_error_scope(wgpu::ErrorFilter::Validation);
-            let built = LightPass::new(&self.ctx, &self.library, &self.frame);
+            let scope = f.ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
+            let built = LightPass::new(f.ctx, f.library, f.frame)
+                .and_then(|p| Ok((p, SelfLightPass::new(f.ctx, f.library)?)));
             let refused = pollster::block_on(scope.pop());
             match (built, refused) {
-                (Ok(p), None) => self.light.pass = Some(p),
-                (Err(e), _) => return self.light_failed(&e),
-                (_, Some(e)) => return self.light_failed(&e),
+                (Ok((p, a)), None) => (self.pass, self.apply) = (Some(p), Some(a)),
+                (Err(e), _) => return self.failed_with(&e),
+                (_, Some(e)) => return self.failed_with(&e),
             }
         }
-        let Some(pass) = self.light.pass.as_mut() else {
+        let Some(pass) = self.pass.as_mut() else {
             return;
         };
-        if let Some(sums) = pass.collect(&self.ctx) {
-            let host = self.settings.host_from_preset();
-            self.light.latest = lights(&sums, host);
-        }
-        pass.map_recorded();
         let owner = |slot: usize| owners.get(slot).copied().flatten();
-        pass.record(&self.ctx, enc, &self.frame, &self.items, owner);
+        let readback: Option<&dyn Fn(usize) -> Option<LightOwner>> = match self.on {
+            true => Some(&owner),
+            false => None,
+        };
+        if self.on {
+            if let Some(sums) = pass.collect(f.ctx) {
+                self.latest = lights(&sums, f.host);
+            }
+            pass.map_recorded();
+        }
+        let totals = pass.record(f.ctx, enc, f.frame, f.items, readback);
+        if let (true, Some(apply), Some(sums)) = (lit, self.apply.as_mut(), pass.sums_buffer()) {
+            apply.record(f.ctx, enc, f.frame, f.items, &totals, sums);
+        }
     }
-}
 
-impl Player {
-    /// Turns the estimate off after its pass could not be built, saying why.
-    fn light_failed(&mut self, why: &dyn std::fmt::Display) {
-        log::error!("the effect light cannot be estimated on this device: {why}");
-        self.light.on = false;
+    /// Turns the estimate off after its passes could not be built, saying why.
+    fn failed_with(&mut self, why: &dyn std::fmt::Display) {
+        log::error!(
+            "the effect light cannot be estimated on this device (lit layers are drawn \
+             without it): {why}"
+        );
+        self.on = false;
+        self.failed = true;
     }
 }
 

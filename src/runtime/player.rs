@@ -518,6 +518,16 @@ impl Player {
             self.settings.asset_dir.as_deref(),
         );
         self.frame.upload_looks(&mut self.uploads, encoder);
+        // The effect's light: read back for the estimate, and handed to lit layers on the
+        // GPU before they are drawn.
+        let light = super::effect_light::LightFrame {
+            ctx: &self.ctx,
+            library: &self.library,
+            frame: &self.frame,
+            items: &self.items,
+            host: self.settings.host_from_preset(),
+        };
+        self.light.record(&light, encoder, &owners);
         self.sort
             .record_items(&self.ctx, encoder, &self.items, camera);
         self.splatted = self.splat.splat(
@@ -552,7 +562,6 @@ impl Player {
         );
         drop(groups);
         drop(members);
-        self.record_light(encoder, &owners);
         self.uploads.finish(encoder);
     }
 

@@ -1,0 +1,160 @@
+//! The effect's light handed to its lit layers on the GPU (`shaders/light_apply.wgsl`):
+//! after the light pass sums each additive emitter's light per instance, one small
+//! dispatch adds up each instance's emitters, moves the result into each lit emitter's
+//! simulation space and writes it into that look slot's `LitUniform` — the same frame,
+//! with no readback.
+
+use crate::gpu::GpuContext;
+use crate::render::DrawItem;
+use crate::render::frame::FrameResources;
+use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
+
+/// Where an item's totals start in the light pass's sums buffer (entries of two vec4s).
+pub type ItemTotals = (usize, u32);
+
+/// The apply pass: its pipeline, its plan buffer and the group over the frame's buffers.
+pub struct SelfLightPass {
+    layout: wgpu::BindGroupLayout,
+    pipeline_layout: wgpu::PipelineLayout,
+    pipeline: wgpu::ComputePipeline,
+    plan: Option<wgpu::Buffer>,
+}
+
+impl SelfLightPass {
+    /// Builds the pipeline from `lib`.
+    pub fn new(ctx: &GpuContext, lib: &ShaderLibrary) -> Result<Self, ShaderError> {
+        let entry = |binding, read_only| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let layout = ctx
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("SelfLightPass::layout"),
+                entries: &[entry(0, true), entry(1, false), entry(2, true)],
+            });
+        let pipeline_layout = ctx
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("SelfLightPass::pipeline_layout"),
+                bind_group_layouts: &[Some(&layout)],
+                immediate_size: 0,
+            });
+        let pipeline = Self::build(ctx, lib, &pipeline_layout)?;
+        Ok(Self {
+            layout,
+            pipeline_layout,
+            pipeline,
+            plan: None,
+        })
+    }
+
+    fn build(
+        ctx: &GpuContext,
+        lib: &ShaderLibrary,
+        layout: &wgpu::PipelineLayout,
+    ) -> Result<wgpu::ComputePipeline, ShaderError> {
+        let composed = lib.compose("light_apply.wgsl")?;
+        create_checked(&ctx.device, &composed, lib, |module| {
+            let label = "SelfLightPass::apply";
+            crate::render::compute_pipeline(ctx, label, layout, module, "light_apply", &[])
+        })
+    }
+
+    /// Rebuilds the pipeline; keeps the old one on error.
+    pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
+        self.pipeline = Self::build(ctx, lib, &self.pipeline_layout)?;
+        Ok(())
+    }
+
+    /// Records the apply of the frame's lit items: `totals` says where each additive
+    /// item's totals are in `sums` (the light pass's buffer, recorded before).
+    pub fn record(
+        &mut self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        frame: &FrameResources,
+        items: &[DrawItem],
+        totals: &[ItemTotals],
+        sums: &wgpu::Buffer,
+    ) {
+        let words = plan(items, totals, &frame.slot_origins);
+        let targets = words.first().map_or(0, |w| w[0]);
+        if targets == 0 {
+            return;
+        }
+        let bytes: &[u8] = bytemuck::cast_slice(&words);
+        let size = (bytes.len() as u64).next_power_of_two().max(256);
+        if self.plan.as_ref().is_none_or(|b| b.size() < size) {
+            self.plan = Some(ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("SelfLightPass::plan"),
+                size,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }));
+        }
+        let Some(plan) = &self.plan else {
+            return;
+        };
+        ctx.queue.write_buffer(plan, 0, bytes);
+        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("SelfLightPass::group"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: sums.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: frame.looks_buffer().as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: plan.as_entire_binding(),
+                },
+            ],
+        });
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("SelfLightPass"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.dispatch_workgroups(targets.div_ceil(64), 1, 1);
+    }
+}
+
+/// The plan `light_apply.wgsl` reads: the targets' count, a header per lit look slot
+/// (slot, first source, sources), then the sources — each additive item of the same
+/// group, the same member: the offset between the two emitters' origins and the total's
+/// index.
+pub fn plan(items: &[DrawItem], totals: &[ItemTotals], origins: &[glam::DVec3]) -> Vec<[u32; 4]> {
+    let targets: Vec<(usize, usize, usize)> = items
+        .iter()
+        .filter(|d| d.variant.lit)
+        .flat_map(|d| (0..d.members as usize).map(move |m| (d.look_slot + m, d.group, m)))
+        .collect();
+    let mut words = vec![[targets.len() as u32, 0, 0, 0]];
+    words.resize(1 + targets.len(), [0; 4]);
+    for (t, (slot, group, m)) in targets.iter().enumerate() {
+        let first = words.len() as u32;
+        let origin = origins.get(*slot).copied().unwrap_or_default();
+        for (item, total) in totals {
+            let Some(d) = items.get(*item).filter(|d| d.group == *group) else {
+                continue;
+            };
+            let source = origins.get(d.look_slot + m).copied().unwrap_or_default();
+            let delta = (source - origin).as_vec3().to_array().map(f32::to_bits);
+            words.push([delta[0], delta[1], delta[2], total + *m as u32]);
+        }
+        words[1 + t] = [*slot as u32, first, words.len() as u32 - first, 0];
+    }
+    words
+}
