@@ -24,8 +24,8 @@ pub const SHEET_GRID: u32 = 4;
 /// The built-in maps' seed.
 pub const PUFF_SEED: u32 = 7;
 /// Extinction at density 1, per unit of the sprite's half-width: a puff's dense core
-/// takes about e⁻¹² of the light through it.
-pub const EXTINCTION: f32 = 8.0;
+/// takes about e⁻⁸ of the light through it.
+pub const EXTINCTION: f32 = 16.0;
 
 /// A frame's (or a flipbook's) six-way maps, straight and linear.
 #[derive(Clone, Debug, PartialEq)]
