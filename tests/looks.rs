@@ -760,7 +760,7 @@ fn reference_images() {
     let bless = std::env::var_os("IGNIS_BLESS").is_some();
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut rendered = Vec::new();
-    for name in ["campfire", "torch", "spark_fountain", "candle"] {
+    for name in ["campfire", "torch", "spark_fountain", "candle", "bonfire"] {
         let preset = root.join("presets").join(format!("{name}.ron"));
         let effect = ignis::preset::load(&preset).expect("preset");
         let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
