@@ -12,9 +12,7 @@ use std::path::Path;
 use glam::{Mat4, Vec3, vec3};
 use host::Host;
 use ignis::Player;
-use ignis::effect::{
-    BlendMode, DrawPath, Effect, Lighting, Lit, Param, Range, SixWayMaps, Sprite,
-};
+use ignis::effect::{BlendMode, DrawPath, Effect, Lighting, Lit, Param, Range, SixWayMaps, Sprite};
 use ignis::render::sixway_maps::{EXTINCTION, PUFF_SEED, puff, puff_density};
 
 /// The maps' texels of the flat test pair (bytes): RTBA and LBFE.
@@ -144,8 +142,7 @@ fn the_six_way_mix_equals_the_cpu_formula_on_both_paths() {
     let six = flat_six();
     let lit = six_way(six, sun, lighting.sun_color);
     let mean = six.iter().sum::<f32>() / 6.0;
-    let want: [f32; 3] =
-        std::array::from_fn(|c| ALBEDO[c] * (lit[c] + lighting.ambient[c] * mean));
+    let want: [f32; 3] = std::array::from_fn(|c| ALBEDO[c] * (lit[c] + lighting.ambient[c] * mean));
     for path in [DrawPath::Billboard, DrawPath::Tiles] {
         let smoke = still_smoke(maps.clone(), lighting.clone(), path);
         let (frame, tiled) = render(&smoke, |_| {});
@@ -219,7 +216,11 @@ fn the_effects_own_light_lights_its_smoke_from_where_it_burns() {
     }
     let frame = frame.expect("a frame");
     let light = light.expect("the fire's light");
-    assert!(light.position.abs_diff_eq(SMOKE - vec3(0.0, 0.6, 0.0), 1e-5));
+    assert!(
+        light
+            .position
+            .abs_diff_eq(SMOKE - vec3(0.0, 0.6, 0.0), 1e-5)
+    );
     let e = light.rgb_power.map(|c| c / 0.36);
     let lit = six_way(flat_six(), -Vec3::Y, e);
     let want: [f32; 3] = std::array::from_fn(|c| ALBEDO[c] * lit[c]);
@@ -266,7 +267,8 @@ fn a_puff_is_brighter_toward_its_light_and_glows_at_the_rim_when_backlit() {
         // Core and rim, from the puff's radius on screen (its farthest lit pixel).
         let radius = (0..w * h)
             .filter(|&i| luma(frame.rgba[i as usize]) > 1e-3)
-            .map(|i| (i % w) as f32 - w as f32 / 2.0).map(f32::abs)
+            .map(|i| (i % w) as f32 - w as f32 / 2.0)
+            .map(f32::abs)
             .fold(0.0, f32::max);
         assert!(radius > 15.0, "{path:?}: the puff is {radius} pixels wide");
         let core = |dx: f32, dy: f32| dx.hypot(dy) < 0.25 * radius;
@@ -289,7 +291,11 @@ fn a_puff_is_brighter_toward_its_light_and_glows_at_the_rim_when_backlit() {
 fn generated_six_way_maps_are_deterministic_lit_as_named_and_cover_as_the_density() {
     let a = puff(PUFF_SEED);
     assert_eq!(a, puff(PUFF_SEED), "bit-identical for one seed");
-    assert_ne!(a.rtba, puff(PUFF_SEED + 1).rtba, "another seed, another puff");
+    assert_ne!(
+        a.rtba,
+        puff(PUFF_SEED + 1).rtba,
+        "another seed, another puff"
+    );
     let (w, h) = a.rtba.dimensions();
     // Mean of channel `c` of `img` over the covered texels where `keep`.
     let mean = |img: &image::Rgba32FImage, c: usize, keep: &dyn Fn(u32, u32) -> bool| {
@@ -306,17 +312,26 @@ fn generated_six_way_maps_are_deterministic_lit_as_named_and_cover_as_the_densit
         mean(&a.rtba, 1, &|_, y| y < h / 2),
         mean(&a.rtba, 1, &|_, y| y >= h / 2),
     );
-    assert!(top > bottom + 0.15, "lit from +Y: top {top}, bottom {bottom}");
+    assert!(
+        top > bottom + 0.15,
+        "lit from +Y: top {top}, bottom {bottom}"
+    );
     let (right, left) = (
         mean(&a.rtba, 0, &|x, _| x >= w / 2),
         mean(&a.rtba, 0, &|x, _| x < w / 2),
     );
-    assert!(right > left + 0.15, "lit from +X: right {right}, left {left}");
+    assert!(
+        right > left + 0.15,
+        "lit from +X: right {right}, left {left}"
+    );
     let (lleft, lright) = (
         mean(&a.lbfe, 0, &|x, _| x < w / 2),
         mean(&a.lbfe, 0, &|x, _| x >= w / 2),
     );
-    assert!(lleft > lright + 0.15, "lit from −X: left {lleft}, right {lright}");
+    assert!(
+        lleft > lright + 0.15,
+        "lit from −X: left {lleft}, right {lright}"
+    );
     // Coverage: 1 − exp(−σ ∫ ρ dz) over the sprite's depth [−1, 1], at the texel centres.
     let n = 4 * w;
     let mut worst = 0.0f32;

@@ -335,6 +335,9 @@ impl Gfx {
         self.composite.exposure = state.view.exposure;
         self.composite.draft = state.view.draft;
         self.player.set_asset_dir(state.asset_dir());
+        let lights_grid = state.view.show_grid && state.view.fire_lights_grid;
+        self.player.set_light_estimate(lights_grid);
+        state.fire_light = self.player.effect_light(self.instance);
         let mut encoder = self
             .ctx
             .device

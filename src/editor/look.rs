@@ -77,6 +77,7 @@ pub fn look_ui(
         return;
     };
     look_fields_ui(ui, &mut e.look);
+    super::panel::grid("lit_grid").show(ui, |ui| super::lighting_ui::lit_rows_ui(ui, &mut e.look));
     if let Some(err) = sprite_error {
         ui.colored_label(Color32::from_rgb(255, 110, 90), err);
     }

@@ -13,6 +13,7 @@ pub mod export_ui;
 mod forces_ui;
 mod gfx;
 pub mod inspect;
+mod lighting_ui;
 pub mod look;
 pub mod measure_ui;
 pub mod panel;

@@ -110,6 +110,9 @@ pub fn panel_ui(ui: &mut Ui, state: &mut EditorState) {
             });
             section_ui(ui, "view", "View", "", (false, open("view")), |ui| {
                 view_ui(ui, &mut state.view, &mut state.frame_requested);
+                ui.separator();
+                ui.label("Scene light (lit smoke; saved with the preset)");
+                super::lighting_ui::lighting_ui(ui, &mut state.effect.lighting);
             });
             section_ui(ui, "stats", "Stats", "", (true, open("stats")), |ui| {
                 stats_ui(ui, &state.stats, &state.running);
@@ -531,6 +534,12 @@ pub fn view_ui(ui: &mut Ui, view: &mut ViewSettings, frame_requested: &mut bool)
 ui, "Ground grid", "Draw the y = 0 grid (0.5 m cells)", |ui| {
             ui.checkbox(&mut view.show_grid, "")
         });
+        row_ui(
+            ui,
+            "Fire lights grid",
+            "The grid is lit by the effect's own light (its additive particles, measured on the GPU each frame): it flickers with the flames",
+            |ui| ui.checkbox(&mut view.fire_lights_grid, ""),
+        );
         row_ui(
             ui,
             "Mouse collider",

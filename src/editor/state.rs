@@ -14,6 +14,8 @@ pub struct ViewSettings {
     pub exposure: f32,
     /// Draw the ground grid (y = 0, 0.5 m spacing).
     pub show_grid: bool,
+    /// Light the grid with the effect's own light (`EditorState::fire_light`).
+    pub fire_lights_grid: bool,
     /// Draw the wireframe of every emitter's spawn shape.
     pub show_gizmos: bool,
     /// Render the viewport at this fraction of its pixel size (upscaled when shown).
@@ -34,6 +36,7 @@ impl Default for ViewSettings {
         Self {
             exposure: 1.0,
             show_grid: true,
+            fire_lights_grid: true,
             show_gizmos: true,
             render_scale: 1.0,
             draft: false,
@@ -97,6 +100,8 @@ pub struct EditorState {
     pub shader_errors: Vec<String>,
     /// Sprites that failed to load: (emitter index, message); the soft disc is drawn.
     pub sprite_errors: Vec<(usize, String)>,
+    /// The effect's own light as last measured (the grid is lit by it).
+    pub fire_light: Option<crate::runtime::EffectLight>,
     /// Panel sections to open (all others closed) on the next frame, then cleared.
     pub open_sections: Option<Vec<String>>,
     /// The last simulation failure (the simulation pauses), until playback resumes.
@@ -167,6 +172,7 @@ impl EditorState {
             validation_errors,
             gpu_rejected: None,
             sprite_errors: Vec::new(),
+            fire_light: None,
             open_sections: None,
             sim_error: None,
             device_notice: None,

@@ -6,6 +6,7 @@ use glam::{Mat4, Vec3, Vec4};
 
 use crate::effect::{Effect, Emitter, Shape};
 use crate::render::OrbitCamera;
+use crate::runtime::EffectLight;
 
 use super::state::EditorState;
 
@@ -56,7 +57,8 @@ pub fn viewport_ui(
     if state.view.show_grid {
         // After the image and additive too, so the sum is the same in either order and
         // an opaque image cannot hide the grid.
-        draw_grid(&painter, &projector);
+        let light = state.fire_light.filter(|_| state.view.fire_lights_grid);
+        draw_grid(&painter, &projector, light.as_ref(), state.view.exposure);
     }
     if state.view.show_gizmos {
         for (i, e) in state.effect.emitters.iter().enumerate() {
@@ -272,22 +274,40 @@ impl Projector {
     }
 }
 
-fn draw_grid(painter: &egui::Painter, projector: &Projector) {
+/// The light on the ground (normal +Y) at `p` from the effect's light `l`: its power
+/// over the squared distance (softened by its spread) times the cosine, a grey ground's
+/// share, at the viewport's exposure — times the gain the embed example lights its
+/// ground with (the effect light's power is in sprite units, not a host's lumens).
+fn ground_light(l: &EffectLight, p: Vec3, exposure: f32) -> [f32; 3] {
+    const GROUND_ALBEDO: f32 = 0.3 * 7.5;
+    let to = l.position - p;
+    let d2 = to.length_squared() + l.radius_m * l.radius_m;
+    let cos = (to.y / d2.sqrt().max(1e-6)).max(0.0);
+    let k = GROUND_ALBEDO * exposure * cos / d2.max(1e-4) / std::f32::consts::PI;
+    l.rgb_power.map(|c| c * k)
+}
+
+fn draw_grid(
+    painter: &egui::Painter,
+    projector: &Projector,
+    light: Option<&EffectLight>,
+    exposure: f32,
+) {
     const HALF_EXTENT_M: f32 = 5.0;
     const CELL_M: f32 = 0.5;
     let n = (HALF_EXTENT_M / CELL_M) as i32;
+    // Lit by the fire, a line is drawn in pieces, each in the light at its middle.
+    let pieces = if light.is_some() { 40 } else { 1 };
     for k in -n..=n {
         let v = k as f32 * CELL_M;
         // Additive (premultiplied, zero alpha): light added over the image.
         let gray = if k == 0 {
-            61
+            61u8
         } else if k % 2 == 0 {
             33
         } else {
             19
         };
-        let color = Color32::from_rgb_additive(gray, gray, gray);
-        let stroke = Stroke::new(1.0, color);
         for (a, b) in [
             (
                 Vec3::new(v, 0.0, -HALF_EXTENT_M),
@@ -298,8 +318,17 @@ fn draw_grid(painter: &egui::Painter, projector: &Projector) {
                 Vec3::new(HALF_EXTENT_M, 0.0, v),
             ),
         ] {
-            if let Some(s) = projector.segment(a, b) {
-                painter.line_segment(s, stroke);
+            for i in 0..pieces {
+                let (p, q) = (
+                    a.lerp(b, i as f32 / pieces as f32),
+                    a.lerp(b, (i + 1) as f32 / pieces as f32),
+                );
+                let lit = light.map_or([0.0; 3], |l| ground_light(l, (p + q) * 0.5, exposure));
+                let c = lit.map(|e| (f32::from(gray) + e * 255.0).min(255.0) as u8);
+                if let Some(s) = projector.segment(p, q) {
+                    let color = Color32::from_rgb_additive(c[0], c[1], c[2]);
+                    painter.line_segment(s, Stroke::new(1.0, color));
+                }
             }
         }
     }
