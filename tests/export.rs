@@ -192,7 +192,13 @@ fn exposure_scales_the_exported_light() {
 /// export's emissive pass is black.
 #[test]
 fn the_emissive_pass_is_the_colour_passs_additive_light() {
-    let effect = preset("campfire");
+    let mut effect = preset("campfire");
+    // The smoke lit by the night alone: the flames' light on it would go with them.
+    for e in &mut effect.emitters {
+        if let Some(l) = e.look.lit.as_mut() {
+            l.self_light = 0.0;
+        }
+    }
     let mut dark = effect.clone();
     for e in &mut dark.emitters {
         if e.look.blend == ignis::effect::BlendMode::Additive {
@@ -205,6 +211,7 @@ fn the_emissive_pass_is_the_colour_passs_additive_light() {
         color: true,
         emissive: true,
         motion: false,
+        sixway: false,
     };
     for (e, out) in [(&effect, &lit), (&dark, &smoke)] {
         // The preset's own camera: a fitted one would frame the dark flames differently.
@@ -361,6 +368,7 @@ fn motion_vectors_predict_the_next_frame() {
         color: true,
         emissive: false,
         motion: true,
+        sixway: false,
     };
     let summary = export(&effect, s);
     let scale = summary.sidecar.motion_vector_scale;
@@ -546,4 +554,81 @@ fn the_export_command_writes_a_flipbook_and_refuses_bad_settings() {
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("--loop needs at least 2 frames"), "{err}");
+}
+
+/// `--passes sixway`: the lit smoke's six-way lightmaps in Unity's packing, named in the
+/// sidecar. A flat-mapped puff gives, in each channel, the map of that axis times the
+/// albedo's luminance (a unit white light from the camera's right, top, back, left,
+/// bottom, front), its coverage in RTBA's alpha and its own glow in LBFE's.
+#[test]
+fn the_sixway_passes_hold_each_axis_in_unitys_packing() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut effect = common::still_smoke(
+        common::flat_maps(dir.path()),
+        ignis::effect::Lighting::default(),
+        ignis::effect::DrawPath::Billboard,
+    );
+    effect.emitters[0].name = "campfire".into();
+    if let Some(l) = effect.emitters[0].look.lit.as_mut() {
+        l.emission = 0.5;
+    }
+    effect.name = "campfire".into();
+    let out = dir.path().join("out");
+    let settings = ExportSettings {
+        passes: Passes {
+            color: true,
+            emissive: false,
+            motion: false,
+            sixway: true,
+        },
+        format: Format::Exr,
+        start_secs: 0.1,
+        ..sequence(&out, 1, 0.1)
+    };
+    let summary = export(&effect, settings);
+    let names: Vec<String> = summary
+        .files
+        .iter()
+        .map(|f| f.display().to_string())
+        .collect();
+    let sidecar = std::fs::read_to_string(out.join("campfire.json")).expect("sidecar");
+    let json: serde_json::Value = serde_json::from_str(&sidecar).expect("json");
+    assert_eq!(
+        json["passes"],
+        serde_json::json!(["color", "sixway_rtba", "sixway_lbfe"]),
+        "{names:?}"
+    );
+    let packing = json["sixway_packing"].as_str().unwrap_or_default();
+    assert!(
+        packing.contains("R lit from the camera's right") && packing.contains("A emissive"),
+        "{packing}"
+    );
+    let (w, h) = (64usize, 64usize);
+    let centre = |pass: &str| exr(&out, pass, 0)[h / 2 * w + w / 2];
+    let y = |c: [f32; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    let albedo = y(common::ALBEDO);
+    let map = |b: u8| albedo * f32::from(b) / 255.0;
+    let (rtba, lbfe) = (centre("sixway_rtba"), centre("sixway_lbfe"));
+    let want_rtba = [
+        map(common::FLAT_RTBA[0]),
+        map(common::FLAT_RTBA[1]),
+        map(common::FLAT_RTBA[2]),
+        1.0,
+    ];
+    let want_lbfe = [
+        map(common::FLAT_LBFE[0]),
+        map(common::FLAT_LBFE[1]),
+        map(common::FLAT_LBFE[2]),
+        0.5,
+    ];
+    for c in 0..4 {
+        assert!(
+            (rtba[c] - want_rtba[c]).abs() < 2e-3,
+            "RTBA {rtba:?}, want {want_rtba:?}"
+        );
+        assert!(
+            (lbfe[c] - want_lbfe[c]).abs() < 2e-3,
+            "LBFE {lbfe:?}, want {want_lbfe:?}"
+        );
+    }
 }

@@ -7,77 +7,26 @@ mod common;
 #[path = "runtime/host.rs"]
 mod host;
 
-use std::path::Path;
-
 use glam::{Mat4, Vec3, vec3};
 use host::Host;
 use ignis::Player;
-use ignis::effect::{BlendMode, DrawPath, Effect, Lighting, Lit, Param, Range, SixWayMaps, Sprite};
+use ignis::effect::{BlendMode, DrawPath, Effect, Lighting, Param, Range, SixWayMaps};
 use ignis::render::sixway_maps::{EXTINCTION, PUFF_SEED, puff, puff_density};
 
-/// The maps' texels of the flat test pair (bytes): RTBA and LBFE.
-const FLAT_RTBA: [u8; 4] = [51, 102, 153, 255];
-const FLAT_LBFE: [u8; 4] = [26, 77, 128, 0];
-const ALBEDO: [f32; 3] = [0.5, 0.6, 0.7];
-/// Where the smoke puff hangs, and the camera (looking down −Z: the sprite's back is −Z).
-const SMOKE: Vec3 = vec3(0.0, 0.5, 0.0);
+/// Where the puff hangs, and the camera (looking down −Z: the sprite's back is −Z).
+const SMOKE: Vec3 = Vec3::from_array(common::SMOKE);
 const EYE: Vec3 = vec3(0.0, 0.5, 4.0);
-
-/// One still, alpha-blended, lit particle at `SMOKE`, 1.5 m wide, opaque white.
-fn still_smoke(maps: SixWayMaps, lighting: Lighting, path: DrawPath) -> Effect {
-    let mut e = common::plain_emitter();
-    e.name = "smoke".into();
-    e.capacity = 4;
-    e.spawn_rate_per_sec = Param::Constant(0.0);
-    e.bursts = vec![ignis::effect::Burst {
-        time_secs: 0.0,
-        count: 1,
-    }];
-    e.lifetime_secs = Range::new(100.0, 100.0);
-    e.transform.position_m = SMOKE.into();
-    e.look.sprite = Sprite::SoftDisc;
-    e.look.size_m = Param::Constant(1.5);
-    e.look.rotation_random_deg = 0.0;
-    e.look.spin_deg_per_s = Param::Constant(0.0);
-    e.look.blend = BlendMode::Alpha;
-    e.look.draw_path = path;
-    e.look.color_over_life = common::flat_color([1.0, 1.0, 1.0, 1.0]);
-    e.look.lit = Some(Lit {
-        maps,
-        albedo: ALBEDO,
-        emission: 0.0,
-        self_light: 0.0,
-    });
-    let mut effect = common::bare_effect(e);
-    effect.lighting = lighting;
-    effect
-}
-
-/// Writes the flat six-way pair (every texel alike) into `dir`.
-fn flat_maps(dir: &Path) -> SixWayMaps {
-    let write = |name: &str, texel: [u8; 4]| {
-        let path = dir.join(name);
-        image::RgbaImage::from_pixel(16, 16, image::Rgba(texel))
-            .save(&path)
-            .expect("png");
-        path.display().to_string()
-    };
-    SixWayMaps::Images {
-        rtba: write("flat_rtba.png", FLAT_RTBA),
-        lbfe: write("flat_lbfe.png", FLAT_LBFE),
-    }
-}
 
 /// The flat maps' six lightmaps: +X, +Y, +Z (back), −X, −Y, −Z (front).
 fn flat_six() -> [f32; 6] {
     let c = |b: u8| f32::from(b) / 255.0;
     [
-        c(FLAT_RTBA[0]),
-        c(FLAT_RTBA[1]),
-        c(FLAT_RTBA[2]),
-        c(FLAT_LBFE[0]),
-        c(FLAT_LBFE[1]),
-        c(FLAT_LBFE[2]),
+        c(common::FLAT_RTBA[0]),
+        c(common::FLAT_RTBA[1]),
+        c(common::FLAT_RTBA[2]),
+        c(common::FLAT_LBFE[0]),
+        c(common::FLAT_LBFE[1]),
+        c(common::FLAT_LBFE[2]),
     ]
 }
 
@@ -132,7 +81,7 @@ fn assert_close(got: [f32; 4], want: [f32; 3], what: &str) {
 #[test]
 fn the_six_way_mix_equals_the_cpu_formula_on_both_paths() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let maps = flat_maps(dir.path());
+    let maps = common::flat_maps(dir.path());
     let sun = vec3(0.6, 0.5, -0.62);
     let lighting = Lighting {
         sun_direction: sun.to_array(),
@@ -142,9 +91,10 @@ fn the_six_way_mix_equals_the_cpu_formula_on_both_paths() {
     let six = flat_six();
     let lit = six_way(six, sun, lighting.sun_color);
     let mean = six.iter().sum::<f32>() / 6.0;
-    let want: [f32; 3] = std::array::from_fn(|c| ALBEDO[c] * (lit[c] + lighting.ambient[c] * mean));
+    let want: [f32; 3] =
+        std::array::from_fn(|c| common::ALBEDO[c] * (lit[c] + lighting.ambient[c] * mean));
     for path in [DrawPath::Billboard, DrawPath::Tiles] {
-        let smoke = still_smoke(maps.clone(), lighting.clone(), path);
+        let smoke = common::still_smoke(maps.clone(), lighting.clone(), path);
         let (frame, tiled) = render(&smoke, |_| {});
         assert_eq!(tiled, path == DrawPath::Tiles, "the tiles drew it");
         assert_close(centre(&frame), want, &format!("sun and ambient, {path:?}"));
@@ -160,14 +110,16 @@ fn the_six_way_mix_equals_the_cpu_formula_on_both_paths() {
         sun_color: [0.0; 3],
         ambient: [0.0; 3],
         point_lights: vec![point],
+        own_light: 1.0,
+        glow: 1.0,
     };
-    let smoke = still_smoke(maps, lighting, DrawPath::Billboard);
+    let smoke = common::still_smoke(maps, lighting, DrawPath::Billboard);
     let (frame, _) = render(&smoke, |p| p.set_lighting(Some(host_light)));
     let (r2, range2) = (0.64f32, 16.0f32);
     let window = (1.0 - (r2 / range2).powi(2)).powi(2);
     let e = point.color.map(|c| c * window / r2);
     let lit = six_way(six, Vec3::X, e);
-    let want: [f32; 3] = std::array::from_fn(|c| ALBEDO[c] * lit[c]);
+    let want: [f32; 3] = std::array::from_fn(|c| common::ALBEDO[c] * lit[c]);
     assert_close(centre(&frame), want, "a host point light");
 }
 
@@ -182,7 +134,7 @@ fn the_effects_own_light_lights_its_smoke_from_where_it_burns() {
         sun_color: [0.0; 3],
         ambient: [0.0; 3],
     };
-    let mut effect = still_smoke(flat_maps(dir.path()), dark, DrawPath::Billboard);
+    let mut effect = common::still_smoke(common::flat_maps(dir.path()), dark, DrawPath::Billboard);
     if let Some(l) = effect.emitters[0].look.lit.as_mut() {
         l.self_light = 1.0;
     }
@@ -223,7 +175,7 @@ fn the_effects_own_light_lights_its_smoke_from_where_it_burns() {
     );
     let e = light.rgb_power.map(|c| c / 0.36);
     let lit = six_way(flat_six(), -Vec3::Y, e);
-    let want: [f32; 3] = std::array::from_fn(|c| ALBEDO[c] * lit[c]);
+    let want: [f32; 3] = std::array::from_fn(|c| common::ALBEDO[c] * lit[c]);
     // The centre pixel: the smoke over the fire's glow (the fire lies 0.6 m lower, out of
     // the centre's way: its sprite is 0.3 m wide).
     assert_close(centre(&frame), want, "lit by its own fire");
@@ -257,7 +209,7 @@ fn a_puff_is_brighter_toward_its_light_and_glows_at_the_rim_when_backlit() {
         sum / f64::from(n.max(1))
     };
     for path in [DrawPath::Billboard, DrawPath::Tiles] {
-        let right = still_smoke(SixWayMaps::Puff, lighting(Vec3::X), path);
+        let right = common::still_smoke(SixWayMaps::Puff, lighting(Vec3::X), path);
         let (frame, _) = render(&right, |_| {});
         let (r, l) = (
             mean_where(&frame, &|dx, _| dx > 5.0),
@@ -273,11 +225,11 @@ fn a_puff_is_brighter_toward_its_light_and_glows_at_the_rim_when_backlit() {
         assert!(radius > 15.0, "{path:?}: the puff is {radius} pixels wide");
         let core = |dx: f32, dy: f32| dx.hypot(dy) < 0.25 * radius;
         let rim = |dx: f32, dy: f32| (0.6 * radius..0.9 * radius).contains(&dx.hypot(dy));
-        let back = still_smoke(SixWayMaps::Puff, lighting(-Vec3::Z), path);
+        let back = common::still_smoke(SixWayMaps::Puff, lighting(-Vec3::Z), path);
         let (frame, _) = render(&back, |_| {});
         let (c, e) = (mean_where(&frame, &core), mean_where(&frame, &rim));
         assert!(e > 1.5 * c, "{path:?} back-lit: rim {e}, core {c}");
-        let front = still_smoke(SixWayMaps::Puff, lighting(Vec3::Z), path);
+        let front = common::still_smoke(SixWayMaps::Puff, lighting(Vec3::Z), path);
         let (frame, _) = render(&front, |_| {});
         let (c, e) = (mean_where(&frame, &core), mean_where(&frame, &rim));
         assert!(c > e, "{path:?} front-lit: rim {e}, core {c}");

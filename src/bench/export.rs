@@ -28,6 +28,7 @@ pub fn run(
         color: true,
         emissive: true,
         motion: true,
+        sixway: false,
     };
     let mut configs = Vec::new();
     for passes in [
@@ -35,6 +36,7 @@ pub fn run(
             color: true,
             emissive: false,
             motion: false,
+            sixway: false,
         },
         all,
     ] {

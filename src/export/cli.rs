@@ -39,7 +39,8 @@ pub struct ExportArgs {
     /// straight or premultiplied.
     #[arg(long, value_enum, default_value = "premultiplied")]
     pub alpha: AlphaMode,
-    /// Passes, comma-separated: color, emissive, motion.
+    /// Passes, comma-separated: color, emissive, motion, sixway (the smoke's six-way
+    /// lightmaps, two files, for an engine to relight).
     #[arg(long, default_value = "color", value_delimiter = ',')]
     pub passes: Vec<String>,
     /// The instance's seed (default: the preset's).
@@ -91,15 +92,17 @@ impl ExportArgs {
             color: false,
             emissive: false,
             motion: false,
+            sixway: false,
         };
         for p in &self.passes {
             match p.trim() {
                 "color" => passes.color = true,
                 "emissive" => passes.emissive = true,
                 "motion" => passes.motion = true,
+                "sixway" => passes.sixway = true,
                 other => {
                     return Err(format!(
-                        "--passes: unknown pass {other:?} (color, emissive, motion)"
+                        "--passes: unknown pass {other:?} (color, emissive, motion, sixway)"
                     ));
                 }
             }

@@ -41,6 +41,9 @@ impl Encoder {
                 .iter()
                 .map(|&[r, g, b, _]| store_light([r, g, b], format))
                 .collect(),
+            // Lightmaps: linear and straight, as they were packed.
+            "sixway_rtba" => frame.sixway[0].clone(),
+            "sixway_lbfe" => frame.sixway[1].clone(),
             "motion" => {
                 let (w, h) = self.settings.frame_size;
                 let to_uv = [1.0 / w as f32, 1.0 / h as f32];

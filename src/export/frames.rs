@@ -19,6 +19,9 @@ pub(super) struct RawFrame {
     pub emissive: Vec<[f32; 4]>,
     /// Weighted mean motion in pixels over the frame interval (empty when off).
     pub motion: Vec<[f32; 2]>,
+    /// The six-way lightmaps of the alpha-blended layers, straight: RTBA and LBFE
+    /// (empty when off; `sixway_pass.rs`).
+    pub sixway: [Vec<[f32; 4]>; 2],
 }
 
 impl RawFrame {
@@ -34,6 +37,11 @@ impl RawFrame {
         for (a, b) in self.motion.iter_mut().zip(&other.motion) {
             (0..2).for_each(|k| mix(&mut a[k], b[k]));
         }
+        for (mine, theirs) in self.sixway.iter_mut().zip(&other.sixway) {
+            for (a, b) in mine.iter_mut().zip(theirs) {
+                (0..4).for_each(|k| mix(&mut a[k], b[k]));
+            }
+        }
     }
 }
 
@@ -45,6 +53,8 @@ pub(super) struct FrameRenderer {
     color: wgpu::Texture,
     emissive: Option<wgpu::Texture>,
     motion: Option<wgpu::Texture>,
+    /// The six-way passes' target (each of its renders read back in turn).
+    sixway: Option<wgpu::Texture>,
 }
 
 impl FrameRenderer {
@@ -69,6 +79,7 @@ impl FrameRenderer {
             color: texture("Export::color"),
             emissive: target(settings.passes.emissive, "Export::emissive"),
             motion: target(settings.passes.motion, "Export::motion"),
+            sixway: target(settings.passes.sixway, "Export::sixway"),
         }
     }
 
@@ -126,6 +137,8 @@ impl FrameRenderer {
         let color = read(&mut enc, &self.color);
         let emissive = self.emissive.as_ref().map(|t| read(&mut enc, t));
         let motion = self.motion.as_ref().map(|t| read(&mut enc, t));
+        let sixway = (self.sixway.as_ref())
+            .map(|t| super::sixway_pass::record(ctx, &mut enc, player, &self.camera, t));
         ctx.queue.submit([enc.finish()]);
         let exposure = player.effect().post.exposure;
         let lit = |p: [f32; 4]| [p[0] * exposure, p[1] * exposure, p[2] * exposure, p[3]];
@@ -144,6 +157,13 @@ impl FrameRenderer {
         };
         if let Some(e) = &emissive {
             frame.emissive = texels(ctx, e)?.into_iter().map(lit).collect();
+        }
+        if let Some(readbacks) = &sixway {
+            let renders = readbacks
+                .iter()
+                .map(|r| texels(ctx, r))
+                .collect::<Result<Vec<_>, _>>()?;
+            frame.sixway = super::sixway_pass::pack(&renders);
         }
         if let Some(m) = &motion {
             frame.motion = texels(ctx, m)?
@@ -201,7 +221,10 @@ fn begin_clear_pass<'a>(
 }
 
 /// An `Rgba16Float` or `Rgba32Float` readback's texels as f32.
-fn texels(ctx: &GpuContext, copy: &TextureReadback) -> Result<Vec<[f32; 4]>, ExportError> {
+pub(super) fn texels(
+    ctx: &GpuContext,
+    copy: &TextureReadback,
+) -> Result<Vec<[f32; 4]>, ExportError> {
     let bytes = map_read(ctx, &copy.buffer)?;
     let rows = copy
         .rows(&bytes)

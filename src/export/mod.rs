@@ -22,6 +22,7 @@ mod frames;
 mod framing;
 mod settings;
 mod sidecar;
+mod sixway_pass;
 mod writer;
 
 use std::path::PathBuf;
@@ -272,6 +273,7 @@ impl Export {
                 color: true,
                 emissive: false,
                 motion: false,
+                sixway: false,
             },
             background: None,
             ..self.settings.clone()

@@ -99,7 +99,14 @@ pub struct Passes {
     pub emissive: bool,
     /// Screen-space motion to the next frame in RG, centred at 0.5.
     pub motion: bool,
+    /// The alpha-blended (smoke) layers' six-way lightmaps, for an engine to relight:
+    /// two files, `sixway_rtba` and `sixway_lbfe` (see [`SIXWAY_PACKING`]).
+    pub sixway: bool,
 }
+
+/// The packing of the six-way passes, as the sidecar states it (Unity's Six Way
+/// shader's): lit by a unit white light from each axis of the camera's frame.
+pub const SIXWAY_PACKING: &str = "sixway_rtba: R lit from the camera's right, G from above (camera up), B from behind (away from the camera), A coverage; sixway_lbfe: R from the left, G from below, B from the front (the camera's side), A emissive (the layers' own glow); linear, straight alpha, the alpha-blended layers only";
 
 impl Passes {
     /// The names of the passes that are on.
@@ -108,6 +115,8 @@ impl Passes {
             (self.color, "color"),
             (self.emissive, "emissive"),
             (self.motion, "motion"),
+            (self.sixway, "sixway_rtba"),
+            (self.sixway, "sixway_lbfe"),
         ]
         .into_iter()
         .filter_map(|(on, n)| on.then_some(n))
@@ -167,6 +176,7 @@ impl ExportSettings {
                 color: true,
                 emissive: false,
                 motion: false,
+                sixway: false,
             },
             seed: None,
             camera: CameraMode::Fit,
@@ -247,8 +257,8 @@ impl ExportSettings {
             ));
         }
         let p = self.passes;
-        if !(p.color || p.emissive || p.motion) {
-            return bad("--passes: name at least one of color, emissive, motion".into());
+        if !(p.color || p.emissive || p.motion || p.sixway) {
+            return bad("--passes: name at least one of color, emissive, motion, sixway".into());
         }
         Ok(())
     }

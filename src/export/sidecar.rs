@@ -52,6 +52,9 @@ pub struct Sidecar {
     pub compositing: &'static str,
     /// The passes written, each a file (or atlas) of its own.
     pub passes: Vec<&'static str>,
+    /// What the six-way passes hold (with `--passes sixway`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sixway_packing: Option<&'static str>,
     /// Motion pass: motion in frame UV (x right, y down) to the next frame =
     /// (value − 0.5) × this.
     pub motion_vector_scale: f32,
@@ -109,6 +112,10 @@ impl Sidecar {
                 (false, _) => "linear: result = color * alpha + background * (1 - alpha)",
             },
             passes: settings.passes.names(),
+            sixway_packing: settings
+                .passes
+                .sixway
+                .then_some(super::settings::SIXWAY_PACKING),
             motion_vector_scale,
             camera: settings.camera.name(),
             preset: effect.name.clone(),

@@ -24,6 +24,12 @@ pub struct SceneLighting {
     pub ambient: [f32; 3],
     /// Point lights (at most [`MAX_POINT_LIGHTS`] are used: the first ones).
     pub point_lights: Vec<PointLight>,
+    /// Multiplies the effect's own light on its lit layers (1: as the preset says; 0: a
+    /// host that lights the smoke with the effect's light itself, or the export's
+    /// six-way passes).
+    pub own_light: f32,
+    /// Multiplies the lit layers' glow (their `emission`; 1: as the preset says).
+    pub glow: f32,
 }
 
 /// A host's point light as lit layers see it.
@@ -44,6 +50,8 @@ impl From<&Lighting> for SceneLighting {
             sun_color: l.sun_color,
             ambient: l.ambient,
             point_lights: Vec::new(),
+            own_light: 1.0,
+            glow: 1.0,
         }
     }
 }
@@ -84,9 +92,9 @@ impl LitUniform {
         let [ar, ag, ab] = scene.ambient;
         let [lr, lg, lb] = lit.albedo;
         Self {
-            sun_dir: sun.extend(lit.self_light).to_array(),
+            sun_dir: sun.extend(lit.self_light * scene.own_light).to_array(),
             sun_color: [r, g, b, used as f32],
-            ambient: [ar, ag, ab, lit.emission],
+            ambient: [ar, ag, ab, lit.emission * scene.glow],
             albedo: [lr, lg, lb, 0.0],
             self_pos: [0.0; 4],
             self_rgb: [0.0; 4],

@@ -122,3 +122,62 @@ pub fn play_steps(ctx: &GpuContext, player: &mut ignis::Player, steps: u32) {
 pub fn flat_color(rgba: [f32; 4]) -> Vec<ColorStop> {
     vec![ColorStop { t: 0.0, rgba }, ColorStop { t: 1.0, rgba }]
 }
+
+// ---------------------------------------------------------------------------------------
+// Lit smoke (tests/lit.rs, tests/export.rs).
+
+/// The maps' texels of the flat test pair (bytes): RTBA and LBFE.
+pub const FLAT_RTBA: [u8; 4] = [51, 102, 153, 255];
+pub const FLAT_LBFE: [u8; 4] = [26, 77, 128, 255];
+pub const ALBEDO: [f32; 3] = [0.5, 0.6, 0.7];
+/// Where the lit test puff hangs.
+pub const SMOKE: [f32; 3] = [0.0, 0.5, 0.0];
+
+/// One still, alpha-blended, lit particle at `SMOKE`, 1.5 m wide, opaque white.
+pub fn still_smoke(
+    maps: ignis::effect::SixWayMaps,
+    lighting: ignis::effect::Lighting,
+    path: ignis::effect::DrawPath,
+) -> Effect {
+    let mut e = plain_emitter();
+    e.name = "smoke".into();
+    e.capacity = 4;
+    e.spawn_rate_per_sec = ignis::effect::Param::Constant(0.0);
+    e.bursts = vec![ignis::effect::Burst {
+        time_secs: 0.0,
+        count: 1,
+    }];
+    e.lifetime_secs = Range::new(100.0, 100.0);
+    e.transform.position_m = SMOKE;
+    e.look.sprite = ignis::effect::Sprite::SoftDisc;
+    e.look.size_m = ignis::effect::Param::Constant(1.5);
+    e.look.rotation_random_deg = 0.0;
+    e.look.spin_deg_per_s = ignis::effect::Param::Constant(0.0);
+    e.look.blend = ignis::effect::BlendMode::Alpha;
+    e.look.draw_path = path;
+    e.look.color_over_life = flat_color([1.0, 1.0, 1.0, 1.0]);
+    e.look.lit = Some(ignis::effect::Lit {
+        maps,
+        albedo: ALBEDO,
+        emission: 0.0,
+        self_light: 0.0,
+    });
+    let mut effect = bare_effect(e);
+    effect.lighting = lighting;
+    effect
+}
+
+/// Writes the flat six-way pair (every texel alike) into `dir`.
+pub fn flat_maps(dir: &std::path::Path) -> ignis::effect::SixWayMaps {
+    let write = |name: &str, texel: [u8; 4]| {
+        let path = dir.join(name);
+        image::RgbaImage::from_pixel(16, 16, image::Rgba(texel))
+            .save(&path)
+            .expect("png");
+        path.display().to_string()
+    };
+    ignis::effect::SixWayMaps::Images {
+        rtba: write("flat_rtba.png", FLAT_RTBA),
+        lbfe: write("flat_lbfe.png", FLAT_LBFE),
+    }
+}
