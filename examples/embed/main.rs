@@ -13,7 +13,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use glam::{Mat4, Vec3, vec3};
-use ignis::{Camera, HostTargets, Player, PlayerSettings};
+use ignis::{Camera, HostTargets, Player, PlayerSettings, PointLight, SceneLighting};
 use scene::Scene;
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, WindowEvent};
@@ -24,6 +24,10 @@ type Error = Box<dyn std::error::Error>;
 
 /// The host's light strength per unit of the campfire's light power (its scene's units).
 const FIRE_LIGHT_PER_UNIT: f32 = 7.5;
+/// The host's moon and sky (`scene.wgsl` lights its geometry with the same).
+const MOON_DIRECTION: Vec3 = vec3(-0.3, 1.0, 0.4);
+const MOON_RGB: [f32; 3] = [0.04, 0.05, 0.09];
+const SKY_RGB: [f32; 3] = [0.015, 0.015, 0.025];
 
 fn main() -> Result<(), Error> {
     let mut app = App {
@@ -63,6 +67,8 @@ struct Host {
     campfire: Player,
     /// The campfire's instance (its light lights the scene).
     fire: ignis::InstanceId,
+    /// The torches' instances (their lights light the campfire's smoke).
+    torch_ids: Vec<ignis::InstanceId>,
     frame: u32,
     last: Instant,
     yaw: f32,
@@ -113,12 +119,15 @@ impl Host {
             vec3(2.5, 0.0, -1.0),
             vec3(0.0, 0.0, -3.0),
         ];
+        let mut torch_ids = Vec::new();
         for (seed, post) in posts.iter().enumerate() {
-            torches.add_instance(Mat4::from_translation(*post), seed as u32 + 1)?;
+            torch_ids.push(torches.add_instance(Mat4::from_translation(*post), seed as u32 + 1)?);
         }
         let fire = campfire.add_instance(Mat4::IDENTITY, 7)?;
-        // ignis: the campfire's own light (estimated from its flames) lights the scene.
+        // ignis: the campfire's own light (estimated from its flames) lights the scene,
+        // and each effect's light lights the other's smoke.
         campfire.set_light_estimate(true);
+        torches.set_light_estimate(true);
 
         let scene = Scene::new(
             &device,
@@ -136,6 +145,7 @@ impl Host {
             torches,
             campfire,
             fire,
+            torch_ids,
             frame: 0,
             last: Instant::now(),
             yaw: 0.6,
@@ -167,6 +177,14 @@ impl Host {
                 [p.x, p.y, p.z, l.power * FIRE_LIGHT_PER_UNIT]
             });
         (self.scene).draw_opaque(&self.queue, &mut enc, proj * view, fire);
+        // ignis: the smoke is lit by the host's moon and sky and by the other effect's
+        // fire (its own flames light it already).
+        let torch_lights = (self.torch_ids.iter())
+            .filter_map(|id| self.torches.effect_light(*id))
+            .collect();
+        let campfire_light = self.campfire.effect_light(self.fire).into_iter().collect();
+        self.campfire.set_lighting(Some(night(torch_lights)));
+        self.torches.set_lighting(Some(night(campfire_light)));
         // ignis, 2: the simulation and sorting, after the opaque pass wrote the depth
         // that the soft edges sample.
         let camera = Camera::new(view, proj, size);
@@ -202,6 +220,27 @@ impl Host {
             }
             None => Ok(()),
         }
+    }
+}
+
+/// The host's moon and sky, and the effect lights of `fires` as point lights (in the
+/// host's units: `FIRE_LIGHT_PER_UNIT`, reaching 6 m).
+fn night(fires: Vec<ignis::EffectLight>) -> SceneLighting {
+    let point_lights = fires
+        .iter()
+        .map(|l| PointLight {
+            position: l.position,
+            color: l.rgb_power.map(|c| c * FIRE_LIGHT_PER_UNIT),
+            range_m: 6.0,
+        })
+        .collect();
+    SceneLighting {
+        sun_direction: MOON_DIRECTION,
+        sun_color: MOON_RGB,
+        ambient: SKY_RGB,
+        point_lights,
+        own_light: 1.0,
+        glow: 1.0,
     }
 }
 
