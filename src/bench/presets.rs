@@ -55,14 +55,23 @@ struct Row {
 /// Frames run before the timed ones of each row.
 const UNTIMED_FRAMES: usize = 10;
 
-/// The path choices measured. The billboards first: the other paths' images are
-/// compared with theirs.
-const PATHS: [(&str, Option<DrawPath>); 4] = [
-    ("billboard", Some(DrawPath::Billboard)),
-    ("auto", None),
-    ("splat", Some(DrawPath::Splat)),
-    ("tiles", Some(DrawPath::Tiles)),
+/// The path choices measured: a label, the path forced on every emitter, and whether
+/// lit layers are drawn unlit (`lit: None`; measured only for presets with lit smoke:
+/// the lit rows' cost is theirs minus these, in one run). The billboards first: the
+/// other paths' images are compared with theirs.
+const PATHS: [(&str, Option<DrawPath>, bool); 6] = [
+    ("billboard", Some(DrawPath::Billboard), false),
+    ("auto", None, false),
+    ("splat", Some(DrawPath::Splat), false),
+    ("tiles", Some(DrawPath::Tiles), false),
+    ("billboard unlit", Some(DrawPath::Billboard), true),
+    ("tiles unlit", Some(DrawPath::Tiles), true),
 ];
+
+/// Whether any emitter of `effect` is lit smoke.
+fn has_lit(effect: &Effect) -> bool {
+    effect.emitters.iter().any(|e| e.look.lit.is_some())
+}
 
 /// Runs every preset, size and path, `opts.passes` times over.
 pub fn run(ctx: &GpuContext, opts: &PresetsOptions) -> Result<Report, PlayerError> {
@@ -82,7 +91,7 @@ pub fn run(ctx: &GpuContext, opts: &PresetsOptions) -> Result<Report, PlayerErro
     // were up to twice as slow on the H100 (first use of each path's pipelines and
     // memory, the GPU's clocks).
     if let (Some((path, effect)), Some(&size)) = (effects.first(), opts.sizes.first()) {
-        for choice in PATHS {
+        for choice in PATHS.into_iter().filter(|c| !c.2 || has_lit(effect)) {
             measure(ctx, &timer, path, effect, size, choice, opts)?;
         }
     }
@@ -94,9 +103,19 @@ pub fn run(ctx: &GpuContext, opts: &PresetsOptions) -> Result<Report, PlayerErro
         for (path, effect) in &effects {
             for &size in &opts.sizes {
                 let mut reference = None;
-                for (label, forced) in PATHS {
-                    let (mut row, mut run) =
-                        measure(ctx, &timer, path, effect, size, (label, forced), opts)?;
+                for (label, forced, unlit) in PATHS {
+                    if unlit && !has_lit(effect) {
+                        continue;
+                    }
+                    let (mut row, mut run) = measure(
+                        ctx,
+                        &timer,
+                        path,
+                        effect,
+                        size,
+                        (label, forced, unlit),
+                        opts,
+                    )?;
                     println!(
                         "pass {pass}: {} {}x{} {label}: frame {:.3} ms",
                         row.preset, size.0, size.1, row.frame_ms
@@ -106,7 +125,7 @@ pub fn run(ctx: &GpuContext, opts: &PresetsOptions) -> Result<Report, PlayerErro
                         let image = run.render(size)?;
                         let reference = reference.get_or_insert(image.clone());
                         (row.diff_mean, row.diff_max) = image_diff(reference, &image);
-                        if row.diff_max > 8 {
+                        if row.diff_max > 8 && !unlit {
                             report_difference(reference, &image, &row, opts);
                         }
                         row.pass_frame_ms = vec![row.frame_ms];
@@ -229,13 +248,16 @@ fn measure(
     path: &Path,
     effect: &Effect,
     size: (u32, u32),
-    (label, forced): (&'static str, Option<DrawPath>),
+    (label, forced, unlit): (&'static str, Option<DrawPath>, bool),
     opts: &PresetsOptions,
 ) -> Result<(Row, Headless), PlayerError> {
     let mut effect = effect.clone();
-    if let Some(p) = forced {
-        for e in &mut effect.emitters {
+    for e in &mut effect.emitters {
+        if let Some(p) = forced {
             e.look.draw_path = p;
+        }
+        if unlit {
+            e.look.lit = None;
         }
     }
     let settings = crate::PlayerSettings {
@@ -288,7 +310,9 @@ fn report(ctx: &GpuContext, timer: &GpuTimer, opts: &PresetsOptions, rows: &[Row
          (billboards, the splat's and the tiles' composite into the target), composite \
          (bloom + tonemap). `frame` is their sum. `auto` is the preset's own draw-path \
          choice; `billboard`, `splat` and `tiles` force every emitter onto one path (same \
-         process, same run). Every row is measured in {} passes over the whole run (the \
+         process, same run); for presets with lit smoke, `billboard unlit` and `tiles \
+         unlit` draw it unlit (no six-way shading, no light pass): the lit layers' cost is \
+         the difference. Every row is measured in {} passes over the whole run (the \
          lent H100 has slow states that double every part of a frame for seconds at a time): \
          the parts shown are the row's fastest pass's, and every pass's frame is listed. The \
          last column compares the next frame's image with the billboards' (8-bit levels; the \

@@ -32,7 +32,7 @@ use crate::gpu::GpuContext;
 use crate::runtime::{InstanceId, Player, PlayerError, PlayerSettings};
 
 pub use encode::{decode_motion, linear_to_srgb, srgb_to_linear};
-pub use settings::{AlphaMode, CameraMode, ExportSettings, Format, Layout, Passes};
+pub use settings::{AlphaMode, CameraMode, ExportSettings, Format, Layout, Passes, SIXWAY_PACKING};
 pub use sidecar::Sidecar;
 
 use frames::{FrameRenderer, RawFrame};
