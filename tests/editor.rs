@@ -1679,3 +1679,42 @@ fn the_time_section_measures_the_effect_and_applies_a_frontier_point() {
         "one undo restores the effect"
     );
 }
+
+/// Look ▸ Lit (six-way) switches a smoke layer's lighting off and back on (with the
+/// defaults), each an undo step, and a streak turns it off (a lit layer faces the
+/// camera); View ▸ Fire lights grid is a view setting, not an edit.
+#[test]
+fn the_lit_rows_switch_lit_smoke_and_the_view_lights_the_grid() {
+    let mut harness = panel_harness(campfire_state());
+    open_section(&mut harness, "Look");
+    let lit = |h: &Harness<'_, EditorState>| h.state().effect.emitters[0].look.lit.clone();
+    assert!(lit(&harness).is_some(), "the campfire's smoke is lit");
+    let undos = harness.state().history.undo_len();
+    harness.get_by_label("Lit (six-way)").click_accesskit();
+    harness.run();
+    assert_eq!(lit(&harness), None);
+    harness.get_by_label("Lit (six-way)").click_accesskit();
+    harness.run();
+    assert_eq!(lit(&harness), Some(ignis::effect::Lit::default()));
+    assert!(
+        harness.state().history.undo_len() >= undos + 2,
+        "each switch is an undo step"
+    );
+    harness.get_by_label("stretch").click_accesskit();
+    harness.run();
+    assert_eq!(lit(&harness), None, "a streak is not lit");
+    assert!(harness.state().effect.validate().is_ok());
+
+    harness.get_by_label("View").click_accesskit();
+    harness.run();
+    let effect = harness.state().effect.clone();
+    assert!(harness.state().view.fire_lights_grid);
+    harness.get_by_label("Fire lights grid").click_accesskit();
+    harness.run();
+    assert!(!harness.state().view.fire_lights_grid);
+    assert_eq!(
+        harness.state().effect,
+        effect,
+        "a view setting edits nothing"
+    );
+}

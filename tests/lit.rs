@@ -302,3 +302,69 @@ fn generated_six_way_maps_are_deterministic_lit_as_named_and_cover_as_the_densit
     }
     assert!(worst < 0.03, "coverage differs by {worst}");
 }
+
+/// Impossible lit settings are refused with the field named and the fix; a missing or
+/// mismatched pair of maps draws the built-in puff and says which file and why.
+#[test]
+fn bad_lit_settings_and_missing_maps_name_the_field_or_the_file() {
+    let mut effect =
+        common::still_smoke(SixWayMaps::Puff, Lighting::default(), DrawPath::Billboard);
+    effect.emitters[0].look.blend = BlendMode::Additive;
+    if let Some(l) = effect.emitters[0].look.lit.as_mut() {
+        l.albedo[1] = 1.5;
+    }
+    effect.lighting.sun_direction = [0.0; 3];
+    let errors = effect.validate().expect_err("refused");
+    let text: Vec<String> = errors.iter().map(ToString::to_string).collect();
+    let has = |path: &str, what: &str| text.iter().any(|t| t.starts_with(path) && t.contains(what));
+    assert!(
+        has("emitters[0].look.lit", "alpha-blended layers only"),
+        "{text:?}"
+    );
+    assert!(
+        has("emitters[0].look.lit.albedo[1]", "must be ≤ 1"),
+        "{text:?}"
+    );
+    assert!(has("lighting.sun_direction", "zero vector"), "{text:?}");
+
+    let dir = tempfile::tempdir().expect("tempdir");
+    let missing = SixWayMaps::Images {
+        rtba: dir.path().join("nowhere_rtba.png").display().to_string(),
+        lbfe: dir.path().join("nowhere_lbfe.png").display().to_string(),
+    };
+    image::RgbaImage::new(8, 8)
+        .save(dir.path().join("small.png"))
+        .expect("png");
+    image::RgbaImage::new(16, 16)
+        .save(dir.path().join("large.png"))
+        .expect("png");
+    let mismatched = SixWayMaps::Images {
+        rtba: dir.path().join("large.png").display().to_string(),
+        lbfe: dir.path().join("small.png").display().to_string(),
+    };
+    for (maps, file, why) in [
+        (missing, "nowhere_rtba.png", "cannot read it"),
+        (mismatched, "small.png", "the pair must match"),
+    ] {
+        let smoke = common::still_smoke(maps, Lighting::default(), DrawPath::Billboard);
+        let mut errors = Vec::new();
+        let (frame, _) = render(&smoke, |_| {});
+        let host = Host::new(EYE, SMOKE);
+        let mut player = host.player(&smoke);
+        player.add_instance(Mat4::IDENTITY, 1).expect("instance");
+        player.advance(1.0 / 60.0);
+        let _ = host.frame([0.0; 3], &[], &mut [&mut player], true);
+        errors.extend(player.sprite_errors());
+        assert!(
+            errors.len() == 1 && errors[0].1.contains(file) && errors[0].1.contains(why),
+            "{errors:?}"
+        );
+        // The built-in puff is drawn instead: the smoke still shows.
+        let lit = frame
+            .rgba
+            .iter()
+            .filter(|p| p[0] + p[1] + p[2] > 1e-3)
+            .count();
+        assert!(lit > 100, "{lit} pixels of smoke");
+    }
+}

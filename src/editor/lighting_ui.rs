@@ -62,6 +62,10 @@ fn hdr_color_row(ui: &mut Ui, label: &str, tip: &str, rgb: &mut [f32; 3]) {
 /// the maps, the albedo, the glow and the effect light's share.
 pub fn lit_rows_ui(ui: &mut Ui, look: &mut Look) {
     let alpha = look.blend == BlendMode::Alpha;
+    // Switched to additive blending or a streak above: no longer a lit layer.
+    if look.lit.is_some() && (!alpha || look.streak.is_some()) {
+        look.lit = None;
+    }
     let tip = "Shade this alpha-blended layer with six-way lightmaps: lit by the effect's own flames, the sun and ambient (View) and a host's lights; the maps replace the sprite";
     row_ui(ui, "Lit (six-way)", tip, |ui| {
         ui.add_enabled_ui(alpha && look.streak.is_none(), |ui| {
@@ -114,7 +118,15 @@ pub fn lit_rows_ui(ui: &mut Ui, look: &mut Look) {
         ui,
         "Albedo",
         "The smoke's colour under white light (linear)",
-        |ui| ui.color_edit_button_rgb(&mut lit.albedo),
+        |ui| {
+            // A copy: egui's colour round trip must not edit the preset by showing it.
+            let mut albedo = lit.albedo;
+            let r = ui.color_edit_button_rgb(&mut albedo);
+            if r.changed() {
+                lit.albedo = albedo;
+            }
+            r
+        },
     );
     row_ui(
         ui,
