@@ -579,6 +579,10 @@ fn an_instance_added_to_a_sorted_batch_shows_its_smoke() {
     let mut smoke = preset("torch");
     smoke.emitters.retain(|e| e.look.blend == BlendMode::Alpha);
     assert!(!smoke.emitters.is_empty(), "the torch has smoke");
+    // Without its flames the lit smoke has only the dim night: drawn unlit, it shows.
+    for e in &mut smoke.emitters {
+        e.look.lit = None;
+    }
     let at = |x: f32| Mat4::from_translation(vec3(x, 0.0, 0.0));
     let mut player = host.player(&smoke);
     player.add_instance(at(-1.2), 1).expect("instance");

@@ -182,6 +182,8 @@ fn streaks_stay_billboards() {
         length_secs: 0.05,
         max_length_m: 0.3,
     });
+    // A lit layer faces the camera: the streaked smoke is drawn unlit.
+    effect.emitters[0].look.lit = None;
     let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
     for _ in 0..20 {
         run.advance(1.0 / 60.0);
