@@ -250,3 +250,75 @@ fn an_edit_forgets_the_snapshots_and_seeks_land_on_steps() {
         assert!((t - f64::from(k) * step).abs() < 1e-9, "step {k}: at {t} s");
     }
 }
+
+/// The editor's timeline playback (`editor::timeline::play`, what its frame loop calls):
+/// at 0.25× and 2× the effect's clock advances by a quarter and twice the frames' time; a
+/// step while parked after a seek moves exactly one step; a loop region wraps back to its
+/// start once the clock passes its end, and never runs past it by more than a frame.
+#[test]
+fn timeline_playback_speed_parked_steps_and_the_loop_region() {
+    use ignis::editor::state::Playback;
+    use ignis::editor::timeline::play;
+    let ctx = gpu();
+    let effect = ignis::Effect::default_campfire();
+    let step = f64::from(effect.time.step_secs);
+    let mut run = unbatched(&ctx, effect);
+    let id = run.instance;
+    let mut frames = |run: &mut Headless, playback: &mut Playback, n: u32| {
+        let mut times = Vec::new();
+        for _ in 0..n {
+            play(&mut run.player, id, playback, false, 1.0 / FPS);
+            let mut enc = ctx.device.create_command_encoder(&Default::default());
+            run.player.simulate(&mut enc);
+            ctx.queue.submit([enc.finish()]);
+            times.push(run.player.time_secs(id).expect("time"));
+        }
+        times
+    };
+    let now = |run: &Headless| run.player.time_secs(id).expect("time");
+    let mut playback = Playback {
+        speed: 0.25,
+        ..Playback::default()
+    };
+    frames(&mut run, &mut playback, 60);
+    assert!((now(&run) - 0.25).abs() <= step, "0.25×: {}", now(&run));
+    playback.speed = 2.0;
+    frames(&mut run, &mut playback, 60);
+    assert!((now(&run) - 2.25).abs() <= step, "2×: {}", now(&run));
+
+    // Parked at 1 s by a seek, a step is one step.
+    playback.seek_to = Some(1.0);
+    frames(&mut run, &mut playback, 1);
+    assert!(playback.is_paused && (now(&run) - 1.0).abs() <= 0.5 * step);
+    let parked = now(&run);
+    playback.step_requested = true;
+    frames(&mut run, &mut playback, 1);
+    assert!(
+        (now(&run) - parked - step).abs() < 1e-9,
+        "one step: {}",
+        now(&run)
+    );
+    frames(&mut run, &mut playback, 10);
+    assert!(
+        (now(&run) - parked - step).abs() < 1e-9,
+        "paused: {}",
+        now(&run)
+    );
+
+    // Playing in the loop region 0.5–1.0 s: it wraps, and stays within it.
+    playback.is_paused = false;
+    playback.speed = 1.0;
+    playback.loop_region = Some((0.5, 1.0));
+    let times = frames(&mut run, &mut playback, 120);
+    let wraps = times.windows(2).filter(|w| w[1] < w[0]).count();
+    assert!(
+        wraps >= 2,
+        "{wraps} wraps in 2 s of a 0.5 s loop: {times:?}"
+    );
+    assert!(
+        times
+            .iter()
+            .all(|t| *t >= 0.5 - step && *t < 1.0 + 1.0 / FPS + step),
+        "{times:?}"
+    );
+}

@@ -520,7 +520,13 @@ impl Gfx {
     pub(super) fn simulate(&mut self, state: &mut EditorState, frame_dt_secs: f64) {
         let reloaded = self.reload_changed_shaders(state);
         let edited = self.apply_running(state) || reloaded;
-        self.play(&mut state.playback, edited, frame_dt_secs);
+        super::timeline::play(
+            &mut self.player,
+            self.instance,
+            &mut state.playback,
+            edited,
+            frame_dt_secs,
+        );
         super::export_ui::drive(
             &self.ctx,
             &state.running,

@@ -4,13 +4,14 @@
 //! goes (`Player::seek`: from the nearest earlier snapshot with fixed steps; a frame-delta
 //! effect replays the frames played), so the state shown is exactly the one playing would
 //! reach. While parked (paused after a seek), an edit re-simulates to the same time. The
-//! frame loop applies the requests here too (`Gfx::play`).
+//! frame loop applies the requests with [`play`], on the editor's player.
 
 use egui::{Color32, Sense, Stroke, Ui, vec2};
 
 use crate::effect::{Effect, TimeMode};
+use crate::runtime::{InstanceId, Player};
 
-use super::state::EditorState;
+use super::state::{EditorState, Playback};
 
 /// The frame rate seeks replay at (the frame-delta mode's frame time).
 pub const SEEK_FRAME_DT_SECS: f64 = 1.0 / 60.0;
@@ -169,80 +170,79 @@ pub fn timeline_ui(ui: &mut Ui, state: &mut EditorState) {
     });
 }
 
-impl super::gfx::Gfx {
-    /// The timeline's requests — restart, seek, step, speed, loop — then this frame's
-    /// advance; `edited`: the effect or a shader changed this frame (a parked view is
-    /// re-simulated to its time).
-    pub(super) fn play(
-        &mut self,
-        playback: &mut super::state::Playback,
-        edited: bool,
-        frame_dt_secs: f64,
-    ) {
-        if playback.restart_requested {
-            playback.restart_requested = false;
-            playback.parked_at = None;
-            playback.frame_times.clear();
-            self.player.restart();
-        }
-        if !playback.is_paused {
-            playback.parked_at = None;
-        }
-        // The timeline's seek, or an edit while parked: replayed to that time.
-        let seek = playback
-            .seek_to
-            .take()
-            .or(playback.parked_at.filter(|_| edited));
-        if let Some(t) = seek {
-            playback.is_paused = true;
-            playback.parked_at = Some(t);
-            self.seek(playback, t);
-        }
-        if playback.step_requested {
-            playback.step_requested = false;
-            playback.is_paused = true;
-            match playback.parked_at {
-                // Parked after a seek: a seek one step later (an edit then keeps it).
-                Some(t) => {
-                    let t = t + step_secs(self.player.effect());
-                    playback.parked_at = Some(t);
-                    self.seek(playback, t);
-                }
-                None => self.player.step(),
+/// The timeline's requests — restart, seek, step, speed, loop — then this frame's advance
+/// of `player` (its `instance` is the one whose clock the loop region watches); `edited`:
+/// the effect or a shader changed this frame (a parked view is re-simulated to its time).
+pub fn play(
+    player: &mut Player,
+    instance: InstanceId,
+    playback: &mut Playback,
+    edited: bool,
+    frame_dt_secs: f64,
+) {
+    if playback.restart_requested {
+        playback.restart_requested = false;
+        playback.parked_at = None;
+        playback.frame_times.clear();
+        player.restart();
+    }
+    if !playback.is_paused {
+        playback.parked_at = None;
+    }
+    // The timeline's seek, or an edit while parked: replayed to that time.
+    let seek_to = playback
+        .seek_to
+        .take()
+        .or(playback.parked_at.filter(|_| edited));
+    if let Some(t) = seek_to {
+        playback.is_paused = true;
+        playback.parked_at = Some(t);
+        seek(player, playback, t);
+    }
+    if playback.step_requested {
+        playback.step_requested = false;
+        playback.is_paused = true;
+        match playback.parked_at {
+            // Parked after a seek: a seek one step later (an edit then keeps it).
+            Some(t) => {
+                let t = t + step_secs(player.effect());
+                playback.parked_at = Some(t);
+                seek(player, playback, t);
             }
-        }
-        self.player.set_paused(playback.is_paused);
-        let dt = frame_dt_secs * f64::from(playback.speed.clamp(0.05, 8.0));
-        self.player.advance(dt);
-        if !playback.is_paused {
-            if self.player.effect().time.mode == crate::effect::TimeMode::FrameDelta {
-                playback.frame_times.push(dt);
-            }
-            // The loop region: back to its start once the clock passes its end.
-            let now = self.player.time_secs(self.instance).unwrap_or_default();
-            if let Some((a, _)) = playback.loop_region.filter(|(a, b)| b > a && now >= *b) {
-                self.seek(playback, a);
-            }
+            None => player.step(),
         }
     }
+    player.set_paused(playback.is_paused);
+    let dt = frame_dt_secs * f64::from(playback.speed.clamp(0.05, 8.0));
+    player.advance(dt);
+    if !playback.is_paused {
+        if player.effect().time.mode == crate::effect::TimeMode::FrameDelta {
+            playback.frame_times.push(dt);
+        }
+        // The loop region: back to its start once the clock passes its end.
+        let now = player.time_secs(instance).unwrap_or_default();
+        if let Some((a, _)) = playback.loop_region.filter(|(a, b)| b > a && now >= *b) {
+            seek(player, playback, a);
+        }
+    }
+}
 
-    /// Puts the player at `t`: a fixed-step effect seeks (from the snapshot before it);
-    /// a frame-delta effect replays the frames played so far up to `t` (then 1/60 s
-    /// frames), the only way to reach the same state.
-    fn seek(&mut self, playback: &mut super::state::Playback, t: f64) {
-        let time = self.player.effect().time.clone();
-        let speed = f64::from(time.speed).max(1e-6);
-        if time.mode == crate::effect::TimeMode::FixedStep {
-            // One frame per step: the seek lands on the step nearest `t`.
-            let step = f64::from(time.step_secs);
-            self.player.seek(t / speed, step / speed);
-            playback.frame_times.clear();
-            return;
-        }
-        let frames = frames_until(&playback.frame_times, t, &time);
-        self.player.replay(&frames);
-        playback.frame_times = frames;
+/// Puts `player` at `t`: a fixed-step effect seeks (from the snapshot before it); a
+/// frame-delta effect replays the frames played so far up to `t` (then 1/60 s frames),
+/// the only way to reach the same state.
+fn seek(player: &mut Player, playback: &mut Playback, t: f64) {
+    let time = player.effect().time.clone();
+    let speed = f64::from(time.speed).max(1e-6);
+    if time.mode == crate::effect::TimeMode::FixedStep {
+        // One frame per step: the seek lands on the step nearest `t`.
+        let step = f64::from(time.step_secs);
+        player.seek(t / speed, step / speed);
+        playback.frame_times.clear();
+        return;
     }
+    let frames = frames_until(&playback.frame_times, t, &time);
+    player.replay(&frames);
+    playback.frame_times = frames;
 }
 
 #[cfg(test)]
