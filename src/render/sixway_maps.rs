@@ -13,7 +13,7 @@ use std::path::Path;
 
 use image::{Rgba, Rgba32FImage};
 
-use crate::render::sprites::SpriteError;
+use crate::render::sprites::{SpriteError, read_png};
 
 /// Side of the built-in puff, pixels (and density cells per side).
 pub const PUFF_SIZE: u32 = 128;
@@ -185,25 +185,10 @@ pub fn to_png_linear(img: &Rgba32FImage) -> image::RgbaImage {
     })
 }
 
-/// Reads a pair of six-way PNGs (linear, straight; 8 or 16 bits), which must be the same
-/// size. An error names the file and the problem.
+/// Reads a pair of six-way PNGs (linear, straight; 8 or 16 bits; at most 4096 a side),
+/// which must be the same size. An error names the file and the problem.
 pub fn load_pair(rtba: &Path, lbfe: &Path) -> Result<SixWayImages, SpriteError> {
-    let load = |path: &Path| -> Result<Rgba32FImage, SpriteError> {
-        let err = |reason: String| SpriteError {
-            path: path.display().to_string(),
-            reason,
-        };
-        let bytes = std::fs::read(path).map_err(|e| err(format!("cannot read it ({e})")))?;
-        let img = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
-            .map_err(|e| err(format!("not a readable PNG ({e})")))?;
-        let (w, h) = (img.width(), img.height());
-        if w == 0 || h == 0 || w > 4096 || h > 8192 {
-            return Err(err(format!(
-                "{w}×{h} pixels; six-way maps must be 1..=4096 wide and 1..=8192 high"
-            )));
-        }
-        Ok(img.into_rgba32f())
-    };
+    let load = |path: &Path| read_png(path, 4096).map(image::DynamicImage::into_rgba32f);
     let (a, b) = (load(rtba)?, load(lbfe)?);
     if a.dimensions() != b.dimensions() {
         return Err(SpriteError {

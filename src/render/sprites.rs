@@ -368,8 +368,9 @@ pub fn resolve_path(rel: &str, base_dir: Option<&Path>) -> PathBuf {
     }
 }
 
-/// Loads a PNG as linear, premultiplied RGBA.
-pub fn load_png(path: &Path) -> Result<Rgba32FImage, SpriteError> {
+/// Reads the PNG at `path`, at most `max_side` pixels a side; an error names the file
+/// and the problem.
+pub fn read_png(path: &Path, max_side: u32) -> Result<image::DynamicImage, SpriteError> {
     let err = |reason: String| SpriteError {
         path: path.display().to_string(),
         reason,
@@ -378,11 +379,18 @@ pub fn load_png(path: &Path) -> Result<Rgba32FImage, SpriteError> {
     let img = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
         .map_err(|e| err(format!("not a readable PNG ({e})")))?;
     let (w, h) = (img.width(), img.height());
-    if w == 0 || h == 0 || w > 8192 || h > 8192 {
+    if w == 0 || h == 0 || w > max_side || h > max_side {
         return Err(err(format!(
-            "{w}×{h} pixels; sprites must be 1..=8192 a side"
+            "{w}×{h} pixels; sprites must be 1..={max_side} a side"
         )));
     }
+    Ok(img)
+}
+
+/// Loads a PNG as linear, premultiplied RGBA.
+pub fn load_png(path: &Path) -> Result<Rgba32FImage, SpriteError> {
+    let img = read_png(path, 8192)?;
+    let (w, h) = (img.width(), img.height());
     let rgba = img.to_rgba8();
     let mut out = Rgba32FImage::new(w, h);
     for (src, dst) in rgba.pixels().zip(out.pixels_mut()) {
