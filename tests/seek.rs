@@ -264,7 +264,7 @@ fn timeline_playback_speed_parked_steps_and_the_loop_region() {
     let step = f64::from(effect.time.step_secs);
     let mut run = unbatched(&ctx, effect);
     let id = run.instance;
-    let mut frames = |run: &mut Headless, playback: &mut Playback, n: u32| {
+    let frames = |run: &mut Headless, playback: &mut Playback, n: u32| {
         let mut times = Vec::new();
         for _ in 0..n {
             play(&mut run.player, id, playback, false, 1.0 / FPS);
