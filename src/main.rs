@@ -92,6 +92,10 @@ enum Command {
         /// recreates it and keeps the effect).
         #[arg(long, hide = true)]
         lose_device_at: Option<u32>,
+        /// With --lose-device-at N: edit the effect twice before the loss and undo once
+        /// after it (a recovery test; the report says what it ended with).
+        #[arg(long, hide = true)]
+        edit_around_loss: bool,
         /// Start Time ▸ Measure this effect at launch over this span, seconds (with
         /// --frames and --screenshot: a picture of its chart).
         #[arg(long)]
@@ -311,6 +315,7 @@ fn main() {
             select,
             draft,
             lose_device_at,
+            edit_around_loss,
             measure_span,
         }) => edit(EditOptions {
             frames: frames.or(screenshot.as_ref().map(|_| 60)),
@@ -324,6 +329,7 @@ fn main() {
             select,
             draft,
             lose_device_at,
+            edit_around_loss,
             measure_span,
             adapter_profile,
         }),

@@ -161,3 +161,21 @@ fn the_editor_recovers_from_a_lost_device() {
         "no device-lost notice in the panel ({notice} pixels)"
     );
 }
+
+/// A device lost after two edits keeps the effect and its undo history: an undo after
+/// the recovery goes back to the first edit, in the panel and in what the new device
+/// plays.
+#[test]
+fn a_lost_device_keeps_the_edits_and_their_undo_history() {
+    let (report, image) = run_editor(40, &["--lose-device-at", "10", "--edit-around-loss"]);
+    println!("{report}");
+    assert!(
+        report.contains("GPU device lost and recreated 1 time(s)"),
+        "no recovery in the report: {report}"
+    );
+    assert!(
+        report.contains("edits around the loss: 1 undo step(s) left, flames intensity 0.3 in the panel, 0.3 playing"),
+        "the edits or their history were not kept: {report}"
+    );
+    assert_panel_and_fire(&image, 1000);
+}

@@ -58,6 +58,9 @@ pub struct EditOptions {
     pub draft: Option<bool>,
     /// Destroy the GPU device after this frame (tests the recovery from a lost device).
     pub lose_device_at: Option<u32>,
+    /// With `lose_device_at`: edit the effect twice before the loss and undo once after
+    /// it (`scripted_edits.rs`); the report says what the run ended with.
+    pub edit_around_loss: bool,
     /// Start Time ▸ Measure this effect at launch over this span, seconds (scripted runs
     /// and screenshots).
     pub measure_span: Option<f64>,
@@ -209,6 +212,9 @@ impl App {
             return Ok(false);
         };
         gfx.reload_changed_sprites();
+        if let (true, Some(n)) = (self.options.edit_around_loss, self.options.lose_device_at) {
+            super::scripted_edits::apply(&mut self.state, gfx.log.index, n);
+        }
         let tick = gfx.log.tick(self.options.frames);
         let ui = gfx.run_ui(&mut self.state, &mut self.camera);
         gfx.simulate(&mut self.state, tick.dt_secs);
@@ -304,7 +310,14 @@ impl App {
             }
             return Ok(false);
         }
-        self.report = Some(gfx.run_report(&mut self.state, self.devices_recreated));
+        let mut report = gfx.run_report(&mut self.state, self.devices_recreated);
+        if self.options.edit_around_loss {
+            report.edits = Some(super::scripted_edits::summary(
+                &self.state,
+                gfx.player.effect(),
+            ));
+        }
+        self.report = Some(report);
         Ok(true)
     }
 

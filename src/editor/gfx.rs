@@ -436,6 +436,7 @@ impl Gfx {
             adapter: self.ctx.info.name.clone(),
             profile: self.profiler.report(WARMUP_FRAMES),
             devices_recreated,
+            edits: None,
         }
     }
     /// Makes the player follow `state.running` (plus the mouse collider); on a GPU

@@ -22,6 +22,7 @@ pub mod profile;
 pub mod report;
 pub mod retained;
 pub mod screenshot;
+mod scripted_edits;
 pub mod state;
 pub mod stats;
 mod time_ui;

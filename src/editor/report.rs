@@ -82,6 +82,8 @@ pub struct RunReport {
     pub devices_recreated: u32,
     /// With the retained window image: (frames painted in full, viewport-only frames).
     pub ui_repaints: Option<(u64, u64)>,
+    /// `--edit-around-loss`: what the scripted edits ended with.
+    pub edits: Option<String>,
 }
 
 impl std::fmt::Display for RunReport {
@@ -117,6 +119,9 @@ impl std::fmt::Display for RunReport {
                 "\nGPU device lost and recreated {} time(s); the effect and its undo history were kept",
                 self.devices_recreated
             )?;
+        }
+        if let Some(edits) = &self.edits {
+            write!(f, "\n{edits}")?;
         }
         if let Some(profile) = &self.profile {
             write!(f, "\n{profile}")?;
