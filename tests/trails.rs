@@ -274,6 +274,11 @@ fn a_trail_too_large_for_the_device_is_a_clear_error() {
 /// Parents flying straight out of the origin (each on a ray of its own) that leave still
 /// children over their lives, drawn as a ribbon per parent.
 fn ribbon_effect() -> Effect {
+    ribbon_effect_at(30.0)
+}
+
+/// [`ribbon_effect`] with children spawned at `rate_per_sec` over each parent's life.
+fn ribbon_effect_at(rate_per_sec: f32) -> Effect {
     let parent = Emitter {
         name: "parent".into(),
         capacity: 6,
@@ -284,7 +289,7 @@ fn ribbon_effect() -> Effect {
         events: vec![Event {
             trigger: Trigger::OverLife,
             emitter: "ribbon".into(),
-            rate_per_sec: 30.0,
+            rate_per_sec,
             inherit_velocity: 0.0,
             ..Event::default()
         }],
@@ -313,11 +318,23 @@ fn ribbon_effect() -> Effect {
 /// are reused many times.
 #[test]
 fn a_ribbon_per_parent_joins_each_parents_children_in_order() {
+    joins_children_in_order(ribbon_effect(), 128);
+}
+
+/// The same with several children per parent per step (360 a second at 120 steps a
+/// second: three each step), in a pool four times as large.
+#[test]
+fn a_ribbon_per_parent_joins_several_children_a_step_in_spawn_order() {
+    let mut effect = ribbon_effect_at(360.0);
+    effect.emitters[1].capacity = 512;
+    joins_children_in_order(effect, 512);
+}
+
+fn joins_children_in_order(effect: Effect, capacity: usize) {
     let ctx = gpu();
-    let effect = ribbon_effect();
     let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
     let (mut segments, mut rays_seen, mut births) = (0usize, 0usize, 0usize);
-    let mut stamps = vec![0u32; 128];
+    let mut stamps = vec![0u32; capacity];
     for step in 0..180 {
         sim.step(&effect, DT, 1).expect("step");
         let children = sim.read_particles(1).expect("read");
@@ -346,6 +363,7 @@ fn a_ribbon_per_parent_joins_each_parents_children_in_order() {
                     .total_cmp(&children[b].pos_age[3])
                     .reverse()
             });
+            spawn_order_within_steps(ray, &children, capacity);
             // Each child but the oldest is joined to the one before it on its ray.
             for pair in ray.windows(2) {
                 let got = links[pair[1]].drawn_prev(&links);
@@ -372,6 +390,32 @@ fn a_ribbon_per_parent_joins_each_parents_children_in_order() {
     );
     // 180 steps of about 120 children a second in 128 slots: every slot used a few times.
     assert!(births > 300, "{births} children born");
+}
+
+/// Orders each run of `ray` (sorted oldest first) born in one step — same age, same
+/// place — as they were spawned: one parent's children of a step take consecutive slots
+/// of the ring (wrapping at `capacity`), from the run's first free slot on.
+fn spawn_order_within_steps(
+    ray: &mut [usize],
+    children: &[ignis::gpu::types::Particle],
+    capacity: usize,
+) {
+    let mut start = 0;
+    while start < ray.len() {
+        let age = children[ray[start]].pos_age[3];
+        let len = ray[start..]
+            .iter()
+            .take_while(|&&s| children[s].pos_age[3] == age)
+            .count();
+        let run = &mut ray[start..start + len];
+        let first = run
+            .iter()
+            .copied()
+            .find(|&s| !run.contains(&((s + capacity - 1) % capacity)))
+            .unwrap_or(run[0]);
+        run.sort_by_key(|&s| (s + capacity - first) % capacity);
+        start += len;
+    }
 }
 
 /// Two children of one parent, still and side by side across the view: the ribbon per
