@@ -2,10 +2,11 @@
 //! `ignis render`, tests and benches — a client of the public API like any program that
 //! embeds ignis.
 
+use crate::composite::Composite;
 use crate::effect::Effect;
 use crate::gpu::GpuContext;
 use crate::gpu::timer::GpuTimer;
-use crate::render::{Camera, Composite, OrbitCamera};
+use crate::render::{Camera, OrbitCamera};
 use crate::runtime::{InstanceId, Player, PlayerError, PlayerSettings};
 use crate::shaders::{ShaderLibrary, ShaderSourceDir};
 use crate::sim::SimError;

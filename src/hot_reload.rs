@@ -10,8 +10,8 @@ use std::time::{Duration, Instant};
 
 use notify_debouncer_full::{DebounceEventResult, Debouncer, RecommendedCache, new_debouncer};
 
+use crate::composite::Composite;
 use crate::gpu::GpuContext;
-use crate::render::Composite;
 use crate::runtime::Player;
 use crate::shaders::{ENTRY_FILES, ShaderError, ShaderLibrary};
 

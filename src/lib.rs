@@ -63,6 +63,8 @@ pub use shaders::ShaderError;
 pub use sim::planner::SpawnStats;
 
 #[doc(hidden)]
+pub mod composite;
+#[doc(hidden)]
 pub mod effect;
 #[doc(hidden)]
 pub mod gpu;

@@ -418,7 +418,7 @@ fn render(
     // PNG sprites are relative to the preset file.
     let settings = ignis::PlayerSettings {
         asset_dir: preset.and_then(Path::parent).map(Path::to_path_buf),
-        ..ignis::render::Composite::player_settings()
+        ..ignis::composite::Composite::player_settings()
     };
     let mut run = Headless::with_settings(&ctx, effect, lib, settings)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;

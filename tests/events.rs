@@ -521,7 +521,7 @@ fn events_are_frame_rate_independent_and_seekable() {
     // Seeking: played to 2 s at 60 fps with snapshots every 0.75 s, back to 1 s.
     let settings = ignis::PlayerSettings {
         batch_instances: false,
-        ..ignis::render::Composite::player_settings()
+        ..ignis::composite::Composite::player_settings()
     };
     let mut run =
         ignis::headless::Headless::with_settings(&ctx, effect, ShaderLibrary::embedded(), settings)
@@ -586,7 +586,7 @@ fn adding_and_removing_events_live_moves_instances_between_batches_and_own_sims(
     assert!(ignis::sim::batch::batchable(&torch));
     let settings = ignis::PlayerSettings {
         batch_instances: true,
-        ..ignis::render::Composite::player_settings()
+        ..ignis::composite::Composite::player_settings()
     };
     let mut run =
         ignis::headless::Headless::with_settings(&ctx, torch, ShaderLibrary::embedded(), settings)

@@ -10,11 +10,11 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use common::*;
+use ignis::composite::Composite;
 use ignis::effect::Effect;
 use ignis::gpu::GpuContext;
 use ignis::gpu::types::Particle;
 use ignis::hot_reload::{FileWatcher, ShaderReloader, wgsl_names};
-use ignis::render::Composite;
 use ignis::shaders::{EMBEDDED, ShaderLibrary};
 use ignis::{InstanceId, Player, PlayerSettings};
 

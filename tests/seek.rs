@@ -18,7 +18,7 @@ const FPS: f64 = 60.0;
 fn unbatched(ctx: &ignis::gpu::GpuContext, effect: ignis::Effect) -> Headless {
     let settings = ignis::PlayerSettings {
         batch_instances: false,
-        ..ignis::render::Composite::player_settings()
+        ..ignis::composite::Composite::player_settings()
     };
     Headless::with_settings(ctx, effect, ShaderLibrary::embedded(), settings).expect("headless")
 }
@@ -51,7 +51,7 @@ fn seeking_gives_the_played_state_bit_for_bit_for_every_shipped_preset() {
         let settings = ignis::PlayerSettings {
             asset_dir: path.parent().map(std::path::Path::to_path_buf),
             batch_instances: false,
-            ..ignis::render::Composite::player_settings()
+            ..ignis::composite::Composite::player_settings()
         };
         let mut run = Headless::with_settings(&ctx, effect, ShaderLibrary::embedded(), settings)
             .expect("headless");

@@ -325,7 +325,7 @@ fn tiles_are_deterministic_and_the_automatic_choice_follows_the_profile() {
     let ctx = base.clone().with_profile(Some(AdapterProfile::GPU));
     let settings = ignis::PlayerSettings {
         batch_instances: true,
-        ..ignis::render::Composite::player_settings()
+        ..ignis::composite::Composite::player_settings()
     };
     let torch = ignis::preset::load("presets/torch.ron".as_ref()).expect("torch");
     let mut run = Headless::with_settings(&ctx, torch, ShaderLibrary::embedded(), settings)

@@ -43,7 +43,7 @@ fn frames_of(effect: &Effect, opts: &SweepOptions) -> Vec<Vec<u8>> {
     // The preset's sprite paths are relative to its folder.
     let settings = ignis::PlayerSettings {
         asset_dir: opts.asset_dir.clone(),
-        ..ignis::render::Composite::player_settings()
+        ..ignis::composite::Composite::player_settings()
     };
     let mut run =
         Headless::with_settings(&ctx, effect.clone(), ShaderLibrary::embedded(), settings)

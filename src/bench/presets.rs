@@ -262,7 +262,7 @@ fn measure(
     }
     let settings = crate::PlayerSettings {
         asset_dir: path.parent().map(Path::to_path_buf),
-        ..crate::render::Composite::player_settings()
+        ..crate::composite::Composite::player_settings()
     };
     let name = effect.name.clone();
     let mut run =

@@ -9,10 +9,11 @@ use std::time::{Duration, Instant};
 use anyhow::{Context as _, anyhow};
 use winit::window::Window;
 
+use crate::composite::Composite;
 use crate::effect::Effect;
 use crate::gpu::GpuContext;
 use crate::hot_reload::{FileWatcher, ShaderReloader, wgsl_names};
-use crate::render::{Composite, OrbitCamera};
+use crate::render::OrbitCamera;
 use crate::runtime::{InstanceId, Player, PlayerSettings};
 use crate::shaders::{ShaderLibrary, ShaderSourceDir};
 

@@ -2,6 +2,10 @@
 
 use std::sync::Arc;
 
+/// Storage buffers per shader stage the tile rasteriser binds (`render::tiles`): a device
+/// is asked for up to this many, where its adapter allows.
+pub const TILE_STORAGE_BUFFERS: u32 = 13;
+
 /// Failures to get a usable GPU.
 #[derive(Debug, thiserror::Error)]
 pub enum GpuError {
@@ -31,6 +35,9 @@ pub enum GpuError {
         /// Largest capacity that fits.
         max_capacity: u64,
     },
+    /// Reading a buffer back from the GPU failed.
+    #[error("GPU readback failed: {0}")]
+    Readback(String),
     /// A trail's ring of positions needs more than one storage binding holds.
     #[error(
         "emitter \"{emitter}\": a trail of {points} points over {capacity} slots needs {needed_bytes} bytes, but this adapter's max_storage_buffer_binding_size is {limit_bytes} bytes; use fewer trail points or a smaller capacity"
@@ -93,7 +100,7 @@ impl GpuContext {
         limits.max_storage_buffers_per_shader_stage = supported
             .max_storage_buffers_per_shader_stage
             .max(limits.max_storage_buffers_per_shader_stage)
-            .min(crate::render::tiles::STORAGE_BUFFERS_NEEDED);
+            .min(TILE_STORAGE_BUFFERS);
         // Blending into 32-bit float targets where the adapter can (the export's
         // accumulation of bright additive light; f16 rounds it by a few percent); the
         // adapter's own format features (the tiles' compute resolve reads and writes the
@@ -191,9 +198,13 @@ impl GpuContext {
     /// Checks that `capacity` slots fit in one storage binding, naming the limit if not.
     /// Fails with a clear message when emitter `emitter`'s trail ring does not fit one
     /// storage binding.
-    pub fn check_trail(&self, emitter: &str, capacity: u32, points: u32) -> Result<(), GpuError> {
+    pub fn check_trail(
+        &self,
+        emitter: &str,
+        (capacity, points): (u32, u32),
+        needed_bytes: u64,
+    ) -> Result<(), GpuError> {
         let limit_bytes = self.device.limits().max_storage_buffer_binding_size;
-        let needed_bytes = crate::sim::trails::ring_bytes(capacity, points);
         if needed_bytes > limit_bytes {
             return Err(GpuError::TrailTooLarge {
                 emitter: emitter.to_owned(),

@@ -138,3 +138,26 @@ pub fn compute_storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLa
         count: None,
     }
 }
+
+/// A compute pipeline of `entry` in `module` with override `constants`.
+pub fn compute_pipeline(
+    ctx: &GpuContext,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+    constants: &[(&str, f64)],
+) -> wgpu::ComputePipeline {
+    ctx.device
+        .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
+            layout: Some(layout),
+            module,
+            entry_point: Some(entry),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants,
+                ..Default::default()
+            },
+            cache: None,
+        })
+}

@@ -37,7 +37,7 @@ pub struct AdapterProfile {
     /// (`tiles.wgsl`) instead of the billboards.
     pub tile_raster: bool,
     /// The automatic draw path splats small particles only where they are dense (a quad
-    /// per [`crate::effect::SPLAT_PX_PER_QUAD`] pixels of the target or more): the splat
+    /// per `effect::SPLAT_PX_PER_QUAD` pixels of the target or more): the splat
     /// clears and resolves the whole target, which costs a GPU more than a few thousand
     /// small billboards. Off, every small additive sprite splats (lavapipe: the thesis
     /// preset's 16384 points at 1920×1080 took 92.6 ms a frame splatted, 109.1 as

@@ -1,5 +1,7 @@
-//! Reading a texture back: a copy into a mappable buffer with rows padded to wgpu's
-//! alignment, and the rows without their padding.
+//! Reading back: a mappable buffer's bytes ([`map_read`]), and a texture's copy into one
+//! with rows padded to wgpu's alignment, and the rows without their padding.
+
+use super::{GpuContext, GpuError};
 
 /// A texture's copy on its way to the CPU.
 pub struct TextureReadback {
@@ -61,4 +63,25 @@ impl TextureReadback {
             })
             .collect()
     }
+}
+
+/// Maps a `MAP_READ` buffer and copies its bytes out (blocking).
+pub fn map_read(ctx: &GpuContext, staging: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    staging.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    ctx.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| GpuError::Readback(e.to_string()))?;
+    rx.recv()
+        .map_err(|e| GpuError::Readback(e.to_string()))?
+        .map_err(|e| GpuError::Readback(e.to_string()))?;
+    let data = staging
+        .slice(..)
+        .get_mapped_range()
+        .map_err(|e| GpuError::Readback(e.to_string()))?
+        .to_vec();
+    staging.unmap();
+    Ok(data)
 }

@@ -3,7 +3,7 @@
 //! disagree with the wall clock), always labelled with its source.
 
 use crate::gpu::GpuContext;
-use crate::sim::gpu_sim::map_read;
+use crate::gpu::readback::map_read;
 
 /// Where a duration came from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

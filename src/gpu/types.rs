@@ -127,17 +127,6 @@ pub enum StateLayout {
 }
 
 impl StateLayout {
-    /// The layout an emitter's modules ask for.
-    pub fn of(modules: crate::sim::Modules) -> Self {
-        if modules.contains(crate::sim::Modules::TINY) {
-            Self::Tiny
-        } else if modules.contains(crate::sim::Modules::PACKED) {
-            Self::Packed
-        } else {
-            Self::Full
-        }
-    }
-
     /// Bytes one slot occupies.
     pub fn slot_bytes(self) -> u64 {
         match self {

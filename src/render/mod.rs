@@ -4,7 +4,6 @@ pub mod billboard;
 pub mod bloom;
 pub mod camera;
 pub mod clear;
-pub mod composite;
 pub mod depth_resolve;
 pub mod frame;
 pub(crate) mod image_groups;
@@ -20,10 +19,10 @@ pub mod sprites;
 pub mod tiles;
 pub mod tonemap;
 
+pub use crate::gpu::compute_pipeline;
 pub use billboard::BillboardPass;
 pub use camera::Camera;
 pub use camera::OrbitCamera;
-pub use composite::Composite;
 pub use frame::{DrawItem, FrameResources, Scene};
 pub use splat::SplatPass;
 pub use tiles::TilePass;
@@ -192,29 +191,6 @@ pub fn resolve_pipeline(
                 targets: &[Some(color)],
             }),
             multiview_mask: None,
-            cache: None,
-        })
-}
-
-/// A compute pipeline of `entry` in `module` with override `constants`.
-pub fn compute_pipeline(
-    ctx: &GpuContext,
-    label: &str,
-    layout: &wgpu::PipelineLayout,
-    module: &wgpu::ShaderModule,
-    entry: &str,
-    constants: &[(&str, f64)],
-) -> wgpu::ComputePipeline {
-    ctx.device
-        .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(label),
-            layout: Some(layout),
-            module,
-            entry_point: Some(entry),
-            compilation_options: wgpu::PipelineCompilationOptions {
-                constants,
-                ..Default::default()
-            },
             cache: None,
         })
 }

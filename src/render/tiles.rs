@@ -69,7 +69,7 @@ type BinPipes = [wgpu::ComputePipeline; 8];
 
 /// Storage buffers per shader stage the tile passes bind (the looks, the six state
 /// views, the tiles' six): a device created with fewer draws every quad as a billboard.
-pub const STORAGE_BUFFERS_NEEDED: u32 = 13;
+pub const STORAGE_BUFFERS_NEEDED: u32 = crate::gpu::context::TILE_STORAGE_BUFFERS;
 
 /// Project, bin, shade and resolve.
 pub struct TilePass {

@@ -280,7 +280,7 @@ fn batch_shape(effect: &Effect) -> Vec<(u32, StateLayout)> {
         .map(|(i, e)| {
             (
                 e.capacity.max(1),
-                StateLayout::of(Modules::in_effect(effect, i)),
+                Modules::in_effect(effect, i).state_layout(),
             )
         })
         .collect()

@@ -120,7 +120,7 @@ impl InstanceBatch {
         let instance_bytes: u64 = effect
             .emitters
             .iter()
-            .map(|e| 2 * StateLayout::of(Modules::of(e)).bytes(e.capacity.max(1)))
+            .map(|e| 2 * Modules::of(e).state_layout().bytes(e.capacity.max(1)))
             .sum();
         let slots = (ctx.max_capacity() / u64::from(largest))
             .min(BATCH_STATE_BYTES / instance_bytes.max(1))
@@ -147,7 +147,7 @@ impl InstanceBatch {
         };
         for (i, e) in effect.emitters.iter().enumerate() {
             ctx.check_capacity(&e.name, e.capacity.max(1).saturating_mul(slots))?;
-            let layout = StateLayout::of(Modules::of(e));
+            let layout = Modules::of(e).state_layout();
             let mut pool = batch.pool(e.capacity.max(1), layout);
             pool.life_range = (e.lifetime_secs.min, e.lifetime_secs.max);
             pool.salt = crate::rng::emitter_salt(i as u32, e.seed_offset);

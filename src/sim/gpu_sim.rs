@@ -563,13 +563,15 @@ impl GpuSim {
             self.ctx.check_capacity(&e.name, e.capacity)?;
             if let Some(t) = &e.look.trail {
                 let points = t.layout(effect.time.nominal_step_secs()).points;
-                self.ctx.check_trail(&e.name, e.capacity.max(1), points)?;
+                let bytes = super::trails::ring_bytes(e.capacity.max(1), points);
+                self.ctx
+                    .check_trail(&e.name, (e.capacity.max(1), points), bytes)?;
             }
         }
         self.emitters.truncate(effect.emitters.len());
         for (i, e) in effect.emitters.iter().enumerate() {
             let capacity = e.capacity.max(1);
-            let layout = StateLayout::of(Modules::in_effect(effect, i));
+            let layout = Modules::in_effect(effect, i).state_layout();
             match self.emitters.get(i) {
                 Some(s) if s.capacity == capacity && s.layout == layout => {}
                 // Switching the layout restarts the pool (nothing to convert in place), and
@@ -1546,23 +1548,8 @@ pub fn read_buffer(
     map_read(ctx, &staging)
 }
 
-/// Maps a `MAP_READ` buffer and copies its bytes out (blocking).
+/// Maps a `MAP_READ` buffer and copies its bytes out (blocking): [`crate::gpu::readback::map_read`]
+/// with the simulation's error.
 pub fn map_read(ctx: &GpuContext, staging: &wgpu::Buffer) -> Result<Vec<u8>, SimError> {
-    let (tx, rx) = std::sync::mpsc::channel();
-    staging.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
-    ctx.device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| SimError::Readback(e.to_string()))?;
-    rx.recv()
-        .map_err(|e| SimError::Readback(e.to_string()))?
-        .map_err(|e| SimError::Readback(e.to_string()))?;
-    let data = staging
-        .slice(..)
-        .get_mapped_range()
-        .map_err(|e| SimError::Readback(e.to_string()))?
-        .to_vec();
-    staging.unmap();
-    Ok(data)
+    Ok(crate::gpu::readback::map_read(ctx, staging)?)
 }

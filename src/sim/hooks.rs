@@ -85,7 +85,7 @@ impl HookPipes {
         let src = lib.compose("events.wgsl")?;
         let scan = create_checked(&ctx.device, &src, lib, |module| {
             ["count_blocks", "scan_blocks", "write_list"].map(|entry| {
-                crate::render::compute_pipeline(
+                crate::gpu::compute_pipeline(
                     ctx,
                     "HookPipes::scan",
                     &self.scan_pipeline_layout,

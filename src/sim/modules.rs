@@ -190,3 +190,17 @@ pub fn over_life_params(e: &Emitter) -> [&Param; 4] {
 pub fn bake_over_life(e: &Emitter) -> [Vec<[f32; 4]>; 2] {
     crate::effect::bake_rows(over_life_params(e), [false; 4], [1.0; 4])
 }
+
+impl Modules {
+    /// The state layout these modules ask for.
+    pub fn state_layout(self) -> crate::gpu::types::StateLayout {
+        use crate::gpu::types::StateLayout;
+        if self.contains(Modules::TINY) {
+            StateLayout::Tiny
+        } else if self.contains(Modules::PACKED) {
+            StateLayout::Packed
+        } else {
+            StateLayout::Full
+        }
+    }
+}

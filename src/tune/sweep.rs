@@ -329,7 +329,7 @@ impl Sweep {
             None => {
                 let settings = crate::PlayerSettings {
                     asset_dir: self.opts.asset_dir.clone(),
-                    ..crate::render::Composite::player_settings()
+                    ..crate::composite::Composite::player_settings()
                 };
                 let lib = ShaderLibrary::discover(None);
                 Headless::with_settings(&self.ctx, effect, lib, settings)?
@@ -501,7 +501,7 @@ pub fn measure_pair(
     let play = |e: &Effect| {
         let settings = crate::PlayerSettings {
             asset_dir: opts.asset_dir.clone(),
-            ..crate::render::Composite::player_settings()
+            ..crate::composite::Composite::player_settings()
         };
         let e = runnable(e.clone(), frame_secs);
         Headless::with_settings(ctx, e, ShaderLibrary::discover(None), settings)

@@ -1,0 +1,135 @@
+//! The layers the imports keep (docs/architecture.md): `gpu` (with `shaders`, `rng`) →
+//! the model (`effect`, `preset`) → `sim` → `render` → `runtime` → the clients (`composite`,
+//! `headless`, `export`, `editor`, `bench`, `tune`, `hot_reload`). No module names one
+//! above it: every `crate::…` path in `src/` (code, and doc links) is read and its target's
+//! layer compared with the file's.
+
+use std::path::Path;
+
+/// The layer of a top-level module (`None`: the crate root, which ties them together).
+fn layer(module: &str) -> Option<u32> {
+    Some(match module {
+        "gpu" | "shaders" | "rng" => 0,
+        "effect" | "preset" => 1,
+        "sim" => 2,
+        "render" => 3,
+        "runtime" => 4,
+        "composite" | "headless" | "export" | "editor" | "bench" | "tune" | "hot_reload" => 5,
+        _ => return None,
+    })
+}
+
+/// Every `.rs` file under `dir`.
+fn sources(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
+    for entry in std::fs::read_dir(dir).expect("src").flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            sources(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// The top-level modules a line names through `crate::`: `crate::a::…` and each first
+/// name of `crate::{a, b::…}`.
+fn named(line: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut rest = line;
+    while let Some(at) = rest.find("crate::") {
+        rest = &rest[at + "crate::".len()..];
+        if let Some(group) = rest.strip_prefix('{') {
+            let inner = group.split('}').next().unwrap_or_default();
+            out.extend(inner.split(',').filter_map(|p| {
+                let first = p.trim().split("::").next()?.trim();
+                (!first.is_empty()).then(|| first.to_owned())
+            }));
+        } else {
+            let name: String = rest
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_')
+                .collect();
+            out.push(name);
+        }
+    }
+    out
+}
+
+/// The layer check itself, on `(file, top-level module, text)`: every breach as
+/// "file:line names `target` (layer n) from `module` (layer m)".
+fn breaches(files: &[(String, String, String)]) -> Vec<String> {
+    let mut found = Vec::new();
+    for (file, module, text) in files {
+        let Some(own) = layer(module) else {
+            continue;
+        };
+        for (n, line) in text.lines().enumerate() {
+            for target in named(line) {
+                if let Some(theirs) = layer(&target).filter(|t| *t > own) {
+                    found.push(format!(
+                        "{file}:{} names `{target}` (layer {theirs}) from `{module}` (layer {own})",
+                        n + 1
+                    ));
+                }
+            }
+        }
+    }
+    found
+}
+
+#[test]
+fn no_module_imports_one_above_it() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut paths = Vec::new();
+    sources(&root, &mut paths);
+    let files: Vec<(String, String, String)> = paths
+        .iter()
+        .map(|p| {
+            let rel = p.strip_prefix(&root).expect("under src");
+            let first = rel.components().next().expect("a component");
+            let module = first
+                .as_os_str()
+                .to_string_lossy()
+                .trim_end_matches(".rs")
+                .to_owned();
+            let text = std::fs::read_to_string(p).expect("read");
+            (rel.display().to_string(), module, text)
+        })
+        .collect();
+    assert!(files.len() > 100, "{} source files", files.len());
+    let unknown: Vec<&String> = files
+        .iter()
+        .map(|f| &f.1)
+        .filter(|m| layer(m).is_none() && !["lib", "main"].contains(&m.as_str()))
+        .collect();
+    assert!(unknown.is_empty(), "modules with no layer: {unknown:?}");
+    let found = breaches(&files);
+    assert!(
+        found.is_empty(),
+        "imports above their layer:\n{}",
+        found.join("\n")
+    );
+}
+
+/// The check finds what it must: a `gpu` file naming `sim`, a grouped `use` naming
+/// `runtime` from `render`, and lets a client name anything.
+#[test]
+fn the_layer_check_catches_an_import_from_above() {
+    let file = |f: &str, m: &str, t: &str| (f.to_owned(), m.to_owned(), t.to_owned());
+    let found = breaches(&[
+        file("gpu/timer.rs", "gpu", "use crate::sim::gpu_sim::map_read;"),
+        file(
+            "render/x.rs",
+            "render",
+            "use crate::{gpu::GpuContext, runtime::Player};",
+        ),
+        file(
+            "editor/y.rs",
+            "editor",
+            "use crate::{render::Camera, runtime::Player};",
+        ),
+    ]);
+    assert_eq!(found.len(), 2, "{found:?}");
+    assert!(found[0].starts_with("gpu/timer.rs:1 names `sim`"));
+    assert!(found[1].starts_with("render/x.rs:1 names `runtime`"));
+}
