@@ -5,107 +5,28 @@
 use std::collections::HashMap;
 
 use std::path::Path;
-use std::sync::Arc;
 
 use crate::effect::rows_key;
 use crate::effect::{
-    BlendMode, DrawPath, Effect, FlipbookMode, Look, SPLAT_BELOW_PX, SPLAT_PX_PER_QUAD, Streak,
-    TILES_ABOVE_PX, TILES_MIN_FILL_PX,
+    BlendMode, DrawPath, Look, SPLAT_BELOW_PX, SPLAT_PX_PER_QUAD, TILES_ABOVE_PX, TILES_MIN_FILL_PX,
 };
-use crate::gpu::types::{CameraUniform, LookUniform, PARAMS_STRIDE, StateLayout};
+use crate::gpu::types::{CameraUniform, PARAMS_STRIDE};
 use crate::gpu::{AdapterProfile, GpuContext};
 use crate::render::camera::Camera;
-use crate::render::lit::{LitUniform, SceneLighting, write_lit};
+use crate::render::lit::SceneLighting;
 use crate::render::look::{
     RAMP_WIDTH, ROWS_PER_EMITTER, bake_look_curves, bake_ramp, gradient_key, look_curve_params,
 };
 use crate::render::sort::{SortJob, SortMember};
-use crate::render::sprites::{SpriteError, SpriteLibrary, SpriteTexture};
+use crate::render::sprites::{SpriteError, SpriteLibrary};
 use crate::sim::Modules;
-use crate::sim::gpu_sim::SimState;
 
-/// One simulation to draw: its state and the effect it runs (one instance of a player).
-#[derive(Clone, Copy)]
-pub struct Scene<'a> {
-    /// The particles.
-    pub sim: &'a dyn SimState,
-    /// The effect they follow (looks, forces for closed-form emitters).
-    pub effect: &'a Effect,
-}
+mod looks;
 
-/// Instances drawn together, one draw per emitter: their pools are segments of one set
-/// of state buffers (a batch; `members[k]` owns segment k, `None` an empty segment), or
-/// one instance's own buffers.
-pub type SceneGroup<'a> = [Option<Scene<'a>>];
-
-/// Looks one draw reads at most (a batch's instances).
-pub const LOOKS_PER_DRAW: usize = crate::sim::batch::BATCH_SLOTS as usize;
-
-/// One emitter of a group of instances to draw this frame.
-#[derive(Clone, Debug)]
-pub struct DrawItem {
-    /// Emitter index in its effect (the colour ramp's row).
-    pub index: usize,
-    /// The look uniform slot of the group's first instance (the others follow).
-    pub look_slot: usize,
-    /// The group of instances it draws (its index in the frame; items of one group
-    /// share their instances, member by member).
-    pub group: usize,
-    /// Instances (segments) the draw covers.
-    pub members: u32,
-    /// Key of the cached particle bind group.
-    pub key: (u64, usize, bool),
-    /// Slots of each instance's pool.
-    pub capacity: u32,
-    /// Quads per instance: the widest live window of the group.
-    pub width: u32,
-    /// The back-to-front sort of the group's slots (alpha-blended emitters).
-    pub sort: Option<SortJob>,
-    /// Blend mode.
-    pub blend: BlendMode,
-    /// The path chosen for this frame: the compute splat.
-    pub splat: bool,
-    /// The path chosen for this frame: the compute tile rasteriser (`tiles.rs`).
-    pub tiles: bool,
-    /// The billboard pipeline variant.
-    pub variant: LookVariant,
-    /// The sprite texture.
-    pub sprite: Arc<SpriteTexture>,
-    /// The particles' largest size on screen at the emitter's distance, pixels.
-    pub size_px: f32,
-    /// The trail's ribbon: segments per particle, and whether the sprite is drawn too.
-    pub trail: Option<(u32, bool)>,
-}
-
-impl DrawItem {
-    /// Whether the billboards draw it (neither the splat nor the tiles do).
-    pub fn is_billboard(&self) -> bool {
-        !self.splat && !self.tiles
-    }
-
-    /// The order of a frame's draws: alpha-blended layers first, as given (back to
-    /// front), then the light by emitter (each emitter's instances share a pipeline and a
-    /// sprite; light adds up in any order).
-    pub fn draw_key(&self) -> (u8, usize) {
-        match self.blend {
-            BlendMode::Alpha => (0, 0),
-            BlendMode::Additive => (1, self.index),
-        }
-    }
-
-    /// A large additive billboard that a draft render draws at half resolution
-    /// (streaks stay sharp: they are thin however long).
-    pub fn is_glow(&self) -> bool {
-        !self.splat
-            && !self.tiles
-            && self.blend == BlendMode::Additive
-            && !self.variant.streak
-            && self.size_px >= GLOW_MIN_PX
-    }
-}
-
-/// Billboards at least this large on screen (pixels at full resolution) count as glow.
-pub const GLOW_MIN_PX: f32 = 12.0;
+pub use super::draw_item::{DrawItem, GLOW_MIN_PX, LOOKS_PER_DRAW, Scene, SceneGroup};
+pub use super::variant::{LookVariant, StateVariant};
+pub use looks::look_uniform;
+use looks::{GroupLooks, write_looks};
 
 /// What `prepare` draws one group with.
 struct GroupView<'g, 'a> {
@@ -169,18 +90,6 @@ pub struct FrameResources {
     pub slot_origins: Vec<glam::DVec3>,
 }
 
-/// Emitter `i` across a group's instances (`FrameResources::group_looks`).
-struct GroupLooks<'s> {
-    /// Each instance's look (`None`: the instance has no such emitter or nothing alive).
-    looks: Vec<Option<LookUniform>>,
-    /// Each instance's part of the sort (alpha-blended emitters).
-    members: Vec<SortMember>,
-    /// The pool the instances' segments are in.
-    pool: Option<crate::sim::gpu_sim::EmitterBuffers<'s>>,
-    /// The nearest instance's distance from the camera (m).
-    distance: f32,
-}
-
 /// What the automatic draw path looks at: the particles' largest projected size (pixels),
 /// the quads of the draw (the widest live window × the instances: at least the live
 /// particles), the instances, whether a trail's ribbon is drawn, and the target's size.
@@ -190,205 +99,6 @@ struct PathScene {
     instances: u32,
     trail: bool,
     target_px: (u32, u32),
-}
-
-/// Writes the draw's looks into `block` (one per instance, at `PARAMS_STRIDE`), each with
-/// the draw's widest window `width`; a missing instance gets an empty segment of its pool
-/// of `capacity` slots (no window, nothing drawn).
-fn write_looks(block: &mut [u8], looks: &[Option<LookUniform>], width: u32, capacity: u32) {
-    for (k, u) in looks.iter().enumerate() {
-        let mut u = u.unwrap_or(LookUniform {
-            ring_b: [0, 0, capacity, 0],
-            ..LookUniform::default()
-        });
-        u.ring[3] = width;
-        block[k * PARAMS_STRIDE as usize..][..size_of::<LookUniform>()]
-            .copy_from_slice(bytemuck::bytes_of(&u));
-    }
-}
-
-/// The look uniform of an emitter (everything but the matrices, the ground height and
-/// stateless motion, which depend on the frame). `ramp_row` is the emitter's colour ramp
-/// row (its curve rows follow it), `salt` its per-particle random salt, `sprite_integral` the sprite's ∫ brightness.
-pub fn look_uniform(look: &Look, ramp_row: u32, salt: u32, sprite_integral: f32) -> LookUniform {
-    let (rows, cols, mode, fps, random_start) = match &look.flipbook {
-        Some(f) => {
-            let (mode, fps) = match f.mode {
-                FlipbookMode::OverLife => (0, 0.0),
-                FlipbookMode::FrameRate { fps } => (1, fps),
-                FlipbookMode::Frames(_) => (2, 0.0),
-            };
-            (
-                f.rows.max(1),
-                f.cols.max(1),
-                mode,
-                fps,
-                u32::from(f.random_start),
-            )
-        }
-        None => (1, 1, 0, 0.0, 0),
-    };
-    let blend = match look.blend {
-        BlendMode::Additive => 0,
-        BlendMode::Alpha => 1,
-    };
-    let streak = look.streak.unwrap_or(Streak {
-        length_secs: 0.0,
-        max_length_m: 0.0,
-    });
-    let inv_soft = if look.soft_ground_m > 0.0 {
-        1.0 / look.soft_ground_m
-    } else {
-        0.0
-    };
-    LookUniform {
-        // x, y: the trail's width and opacity at its tail (fractions; trail.wgsl).
-        size_intensity: [
-            look.trail.as_ref().map_or(1.0, |t| t.tail_width),
-            look.trail.as_ref().map_or(1.0, |t| t.tail_opacity),
-            look.intensity,
-            0.0,
-        ],
-        ids: [ramp_row, blend, rows, cols],
-        flags: [mode, random_start, salt, 0],
-        extra: [
-            sprite_integral,
-            0.0,
-            look.rotation_random_deg.to_radians(),
-            fps,
-        ],
-        // x: the trail's width (× the particle's size; trail.wgsl).
-        spin_streak: [
-            look.trail.as_ref().map_or(0.0, |t| t.width),
-            0.0,
-            streak.length_secs,
-            streak.max_length_m,
-        ],
-        soft: [0.0, inv_soft, 0.0, 0.0],
-        trim: [0.0, 0.0, 1.0, 1.0],
-        ..LookUniform::default()
-    }
-}
-
-/// Which billboard pipeline variant draws an emitter: the look modules it uses (each is
-/// compiled out of the others).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct LookVariant {
-    /// Premultiplied alpha, drawn through the sort order (else additive).
-    pub alpha: bool,
-    /// Flipbook atlas lookup.
-    pub flipbook: bool,
-    /// Cross-fade between flipbook frames.
-    pub flip_blend: bool,
-    /// Velocity-stretched quads.
-    pub streak: bool,
-    /// Ground-plane depth fade.
-    pub soft: bool,
-    /// Fade against the host's depth buffer (replaces the ground-plane fade).
-    pub soft_depth: bool,
-    /// The motion pass: screen-space motion weighted by visibility, added up.
-    pub motion: bool,
-    /// The trail's ribbon (segments between recorded positions) instead of the sprite.
-    pub trail: bool,
-    /// How the shaders read the emitter's state (both draw paths).
-    pub state: StateVariant,
-    /// Lit smoke: six-way maps under the slot's `LitUniform` (`lit.wgsl`).
-    pub lit: bool,
-}
-
-/// How look.wgsl reads an emitter's state: its layout and whether positions are closed
-/// form (stateless). Pipeline constants of both draw paths, not branches: a CPU adapter
-/// would run every layout's code for every particle.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub struct StateVariant {
-    /// The state layout (how a slot is stored).
-    pub layout: StateLayout,
-    /// Closed-form (stateless) positions.
-    pub stateless: bool,
-}
-
-impl StateVariant {
-    /// The override constants `STATE_LAYOUT` and `STATELESS`.
-    pub fn constants(self) -> [(&'static str, f64); 2] {
-        [
-            ("STATE_LAYOUT", f64::from(self.layout.index())),
-            ("STATELESS", if self.stateless { 1.0 } else { 0.0 }),
-        ]
-    }
-}
-
-impl LookVariant {
-    /// The variant a look needs, for state read as `state`.
-    pub fn of(look: &Look, state: StateVariant) -> Self {
-        Self {
-            alpha: look.blend == BlendMode::Alpha,
-            flipbook: look.flipbook.is_some(),
-            flip_blend: look.flipbook.as_ref().is_some_and(|f| f.blend_frames),
-            streak: look.streak.is_some(),
-            soft: look.soft_ground_m > 0.0,
-            soft_depth: false,
-            motion: false,
-            trail: false,
-            state,
-            lit: look.lit.is_some() && look.blend == BlendMode::Alpha,
-        }
-    }
-
-    /// The ribbon variant of this look (no flipbook, no streak: a ribbon samples the
-    /// sprite's middle column across its width).
-    pub fn with_trail(self) -> Self {
-        Self {
-            trail: true,
-            flipbook: false,
-            flip_blend: false,
-            streak: false,
-            lit: false,
-            ..self
-        }
-    }
-
-    /// This variant's motion pass.
-    pub fn with_motion(self) -> Self {
-        Self {
-            motion: true,
-            ..self
-        }
-    }
-
-    /// The plain variant of a blend mode (full state, no look modules).
-    pub fn basic(alpha: bool) -> Self {
-        Self {
-            alpha,
-            flipbook: false,
-            flip_blend: false,
-            streak: false,
-            soft: false,
-            soft_depth: false,
-            motion: false,
-            trail: false,
-            state: StateVariant::default(),
-            lit: false,
-        }
-    }
-
-    /// The override constants of this variant's billboard pipeline.
-    pub fn constants(self) -> [(&'static str, f64); 11] {
-        let b = |v: bool| if v { 1.0 } else { 0.0 };
-        let [layout, stateless] = self.state.constants();
-        [
-            ("SORTED", b(self.alpha)),
-            ("FLIPBOOK", b(self.flipbook)),
-            ("FLIP_BLEND", b(self.flip_blend)),
-            ("STREAK", b(self.streak)),
-            ("SOFT", b(self.soft && !self.soft_depth)),
-            ("SOFT_DEPTH", b(self.soft && self.soft_depth)),
-            ("MOTION", b(self.motion)),
-            ("TRAIL", b(self.trail)),
-            ("LIT", b(self.lit)),
-            layout,
-            stateless,
-        ]
-    }
 }
 
 impl FrameResources {
@@ -713,137 +423,6 @@ impl FrameResources {
         }
     }
 
-    /// Emitter `i`'s look of every instance (its salt, place and ring are set per
-    /// instance by `member_look`): the look's settings and the sprite's trim.
-    fn base_look(&mut self, effect: &Effect, i: usize, sprite: &SpriteTexture) -> LookUniform {
-        let e = &effect.emitters[i];
-        let mut u = look_uniform(&e.look, ROWS_PER_EMITTER * i as u32, 0, sprite.integral);
-        // Six-way maps hold two images side by side: their quads are not trimmed.
-        let lit = e.look.lit.is_some() && e.look.blend == BlendMode::Alpha;
-        if self.trim_sprites && e.look.streak.is_none() && !lit {
-            let (rows, cols) = e
-                .look
-                .flipbook
-                .as_ref()
-                .map_or((1, 1), |f| (f.rows, f.cols));
-            // What is invisible at intensity 1 shows when the light is multiplied.
-            let gain = (e.look.intensity * effect.post.exposure).max(1.0);
-            let threshold = crate::render::sprites::TRIM_THRESHOLD / gain;
-            u.trim = *self
-                .trims
-                .entry((sprite.id, rows, cols, threshold.to_bits()))
-                .or_insert_with(|| sprite.trim_rect(rows, cols, threshold));
-        }
-        u
-    }
-
-    /// Writes lit emitter `i`'s `LitUniform` of every instance of the group into `block`
-    /// (each in its simulation space; the effect's own light is added on the GPU).
-    fn write_lit_looks(
-        &self,
-        view: &GroupView<'_, '_>,
-        i: usize,
-        lit: &crate::effect::Lit,
-        block: &mut [u8],
-    ) {
-        for (k, scene) in view.group.iter().enumerate() {
-            let Some(scene) = scene else {
-                continue;
-            };
-            let own;
-            let lighting = match &self.lighting {
-                Some(l) => l,
-                None => {
-                    own = SceneLighting::from(&scene.effect.lighting);
-                    &own
-                }
-            };
-            let origin =
-                (scene.sim.planner().emitters.get(i)).map_or(glam::DVec3::ZERO, |p| p.origin());
-            let u = LitUniform::new(lit, lighting, origin);
-            write_lit(
-                &mut block[k * PARAMS_STRIDE as usize..][..PARAMS_STRIDE as usize],
-                &u,
-            );
-        }
-    }
-
-    /// Emitter `i`'s look uniform of one instance, from the group's `base`, its pool and
-    /// its part of the group's sort (`None`: no pool).
-    fn member_look<'s>(
-        &self,
-        view: &GroupView<'_, '_>,
-        scene: &Scene<'s>,
-        i: usize,
-        base: &LookUniform,
-    ) -> Option<(
-        LookUniform,
-        crate::sim::gpu_sim::EmitterBuffers<'s>,
-        SortMember,
-    )> {
-        let (sim, effect) = (scene.sim, scene.effect);
-        let e = effect.emitters.get(i)?;
-        let origin = sim
-            .planner()
-            .emitters
-            .get(i)
-            .map(|p| p.origin())
-            .unwrap_or_default();
-        let mut u = *base;
-        u.flags[2] = crate::rng::pcg4d([effect.seed, i as u32, e.seed_offset, 0x5EED_100C])[0];
-        u.clip_from_sim = view.camera.clip_from_sim(origin).to_cols_array_2d();
-        let ground = e.collisions.ground.as_ref().map_or(0.0, |g| g.height_m);
-        u.soft[0] = (f64::from(ground) - origin.y) as f32;
-        if Modules::in_effect(effect, i).contains(Modules::STATELESS) {
-            // Closed-form evaluation at the render time (between the last two steps).
-            let planner = sim.planner();
-            let t = planner.time_secs - (1.0 - view.alpha as f64) * planner.last_dt_secs as f64;
-            let a = e.forces.constant_acceleration();
-            let w = e.forces.wind_m_per_s;
-            u.motion_a = [a.x, a.y, a.z, e.forces.drag_per_sec];
-            u.motion_b = [w[0], w[1], w[2], t.rem_euclid(4096.0) as f32];
-        }
-        let mut b = sim.emitter_buffers(i)?;
-        if !self.live_window_only {
-            b.window = crate::sim::planner::LiveWindow::all(b.capacity);
-        }
-        // The ring, for packed state's re-derived lifetimes; the capacity and the live
-        // window's length (ring_b.zw) place the draws' and the splat's invocations.
-        u.soft[2] = b.life_range.0;
-        u.soft[3] = b.life_range.1;
-        u.ring = [
-            (b.spawned_total % u64::from(b.capacity.max(1))) as u32,
-            b.spawned_total as u32,
-            (b.spawned_total >> 32) as u32,
-            0,
-        ];
-        // w: the live window's length (it ends at the ring's head, ring.x).
-        u.ring_b = [b.seed_salt.0, b.seed_salt.1, b.capacity, b.window.len];
-        [u.tiny, u.tiny_b, u.tiny_c] = b.tiny;
-        // The trail's newest entries are from before the last step (trail.wgsl).
-        u.tiny_c[1] = b.last_step;
-        // An emitter that inherits its parent's colour: the parent's ramp row + 1.
-        u.tiny_c[2] = effect
-            .color_parent(i)
-            .map_or(0, |p| ROWS_PER_EMITTER * p as u32 + 1);
-        u.flags[3] = b.slot_base;
-        // The window ends at the ring's head (u.ring[0]).
-        let cap = b.capacity.max(1);
-        let sort = SortMember {
-            eye: (view.camera.eye_f64() - origin)
-                .as_vec3()
-                .extend(0.0)
-                .to_array(),
-            window: [
-                (u.ring[0] + cap - b.window.len.min(cap)) % cap,
-                b.window.len,
-                b.slot_base,
-                0,
-            ],
-        };
-        Some((u, b, sort))
-    }
-
     /// Writes emitter `i`'s look uniform of every instance of a group into `block` and
     /// returns its draw (look slot left for the caller), or `None` when it has no pool or
     /// is disabled. The first group's emitters also bake the shared colour ramps.
@@ -950,39 +529,6 @@ impl FrameResources {
             size_px,
             trail,
         })
-    }
-
-    /// Emitter `i`'s look in every instance of the group (from `base`), each instance's
-    /// sort member, the pool the instances share and the nearest instance's distance from
-    /// the camera (it decides the projected size, and so the path).
-    fn group_looks<'s>(
-        &self,
-        view: &GroupView<'_, 's>,
-        i: usize,
-        base: &LookUniform,
-    ) -> GroupLooks<'s> {
-        let mut out = GroupLooks {
-            looks: Vec::with_capacity(view.group.len()),
-            members: Vec::new(),
-            pool: None,
-            distance: f32::INFINITY,
-        };
-        for scene in view.group {
-            let Some((scene, (u, b, sort))) = scene
-                .as_ref()
-                .and_then(|s| Some((s, self.member_look(view, s, i, base)?)))
-            else {
-                out.looks.push(None);
-                out.members.push(SortMember::default());
-                continue;
-            };
-            let placed = glam::Vec3::from(scene.effect.emitters[i].transform.position_m);
-            out.distance = out.distance.min((view.camera.eye() - placed).length());
-            out.members.push(sort);
-            out.looks.push(Some(u));
-            out.pool.get_or_insert(b);
-        }
-        out
     }
 
     /// The sort job of an alpha-blended emitter (drawn back to front through the sort's

@@ -5,6 +5,7 @@ pub mod bloom;
 pub mod camera;
 pub mod clear;
 pub mod depth_resolve;
+pub mod draw_item;
 pub mod frame;
 pub(crate) mod image_groups;
 pub mod light;
@@ -18,6 +19,7 @@ pub mod splat;
 pub mod sprites;
 pub mod tiles;
 pub mod tonemap;
+pub mod variant;
 
 pub use crate::gpu::compute_pipeline;
 pub use billboard::BillboardPass;
