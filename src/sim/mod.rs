@@ -8,9 +8,11 @@ pub mod gpu_sim;
 pub mod hooks;
 pub mod modules;
 pub mod planner;
+pub mod sim_state;
 pub mod snapshot;
 pub mod stepper;
 pub mod trails;
+pub mod update_pass;
 
 pub use cpu_reference::CpuSim;
 pub use gpu_sim::{GpuSim, SimError};
