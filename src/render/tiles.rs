@@ -18,6 +18,14 @@ use crate::render::image_groups::ImageGroups;
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 use crate::sim::gpu_sim::dispatch_size;
 
+mod buffers;
+mod compute_resolve;
+mod sizing;
+
+use buffers::TileBuffers;
+use compute_resolve::ComputeResolve;
+use sizing::*;
+
 /// Pixels per tile side (one workgroup each; keep in sync with `TILE` in tiles.wgsl).
 pub const TILE_PX: u32 = 16;
 /// Pixels per bin side (keep in sync with `BIN` in tiles.wgsl).
@@ -54,13 +62,6 @@ struct Built {
     resolve: wgpu::RenderPipeline,
     /// The compute resolve, where the adapter can read and write the target in place.
     resolve_over: Option<wgpu::ComputePipeline>,
-}
-
-/// The compute resolve's target layout and pipeline layout.
-struct ComputeResolve {
-    /// The target's layout (group 2) and groups.
-    images: ImageGroups,
-    layout: wgpu::PipelineLayout,
 }
 
 /// The binning's passes: count per block, scan per bin, the bins' starts, the lists; then
@@ -121,125 +122,6 @@ pub enum TileStages {
     /// Everything: project, bin and shade.
     #[default]
     All,
-}
-
-/// The frame's buffers for one target size and sprite capacity.
-struct TileBuffers {
-    size: (u32, u32),
-    /// Sprites the buffers hold (whole blocks).
-    capacity: u32,
-    /// Entries the bins' lists hold in all.
-    list_capacity: u32,
-    /// Jobs the job buffer holds.
-    jobs: u32,
-    job_buffer: wgpu::Buffer,
-    /// The resolve's draw arguments, a flag per tile and the shaded tiles' list.
-    touched: wgpu::Buffer,
-    /// Each item's shade dispatch arguments, written by the bin.
-    dispatch_args: wgpu::Buffer,
-    group: wgpu::BindGroup,
-    bin_group: wgpu::BindGroup,
-    resolve_group: wgpu::BindGroup,
-    depth: Option<wgpu::TextureView>,
-    /// Everything else the group binds (kept alive with it).
-    _lists: [wgpu::Buffer; 4],
-}
-
-/// Tiles and bins across a target of `size` pixels.
-fn grid(size: (u32, u32), cell: u32) -> (u32, u32) {
-    (size.0.div_ceil(cell).max(1), size.1.div_ceil(cell).max(1))
-}
-
-/// Tiles across a target of `size` pixels.
-fn grid_tiles(size: (u32, u32)) -> u64 {
-    let (tx, ty) = grid(size, TILE_PX);
-    u64::from(tx) * u64::from(ty)
-}
-
-/// Bins across a target of `size` pixels.
-fn grid_bins(size: (u32, u32)) -> u64 {
-    let (bx, by) = grid(size, BIN_PX);
-    u64::from(bx) * u64::from(by)
-}
-
-/// The sprites an item takes: one per quad, and a lit item's six-way light after them
-/// (`tiles.wgsl` `lit_record`).
-fn item_sprites(d: &DrawItem) -> u32 {
-    let quads = d.width * d.members;
-    if d.variant.lit { 2 * quads } else { quads }
-}
-
-/// Whether `sprites` quads (whole blocks) fit the tile path's buffers at `size` on a
-/// device whose storage bindings take `limit` bytes.
-fn fits(size: (u32, u32), sprites: u64, limit: u64) -> bool {
-    grid_bins(size) <= MAX_BINS && sprites.next_power_of_two() * SPRITE_BYTES <= limit
-}
-
-/// The sprites of the frame's items in whole blocks: each item's first sprite (then the
-/// frame's), its quads rounded up to blocks.
-fn item_firsts(order: &[&DrawItem]) -> Vec<u32> {
-    let mut firsts = Vec::with_capacity(order.len() + 1);
-    firsts.push(0u32);
-    for d in order {
-        let n = item_sprites(d).next_multiple_of(BLOCK);
-        firsts.push(firsts[firsts.len() - 1] + n);
-    }
-    firsts
-}
-
-/// Entries for the bins' lists of `order`'s sprites (`sprites`, whole blocks) at `size`:
-/// every bin for each when that is small, else about twice what their projected sizes
-/// cover (a bin whose list does not fit is shaded from the sprites directly).
-fn list_entries(order: &[&DrawItem], size: (u32, u32), sprites: u32, limit: u64) -> u32 {
-    let every = grid_bins(size) * u64::from(sprites);
-    let covered: f64 = order
-        .iter()
-        .map(|d| {
-            let side = (f64::from(d.size_px) * 1.5 / f64::from(BIN_PX)).ceil() + 1.0;
-            f64::from(d.width * d.members) * side * side
-        })
-        .sum();
-    let estimate = (2.0 * covered) as u64;
-    let cap = (limit.min(MAX_LIST_BYTES) / LIST_ENTRY_BYTES).min(u64::from(u32::MAX));
-    // In powers of two: room to grow before the buffer is made again.
-    every
-        .min(estimate.max(1 << 20).next_power_of_two())
-        .min(cap)
-        .max(1) as u32
-}
-
-/// Chunks the tile lists' passes read at most: every bin's list in chunks of `CHUNK`
-/// (`job.counts2.w`).
-fn chunk_capacity(list_capacity: u32, size: (u32, u32)) -> u32 {
-    (u64::from(list_capacity).div_ceil(CHUNK) + grid_bins(size)) as u32
-}
-
-/// `bin_meta` words for the tiles' lists (tile_lists.wgsl `tl_*`): the chunks and places
-/// per bin, tile and chunk, then the lists' entries — twice the bins' lists' (a sprite
-/// over several tiles is listed on each), within the storage binding's limit. Lists that
-/// do not fit are shaded from the bins' lists. `bin_words`: the bins' words before them;
-/// `limit`: the storage binding's limit in bytes.
-/// `entries`: the lists' entries when set (tests), else twice the bins'.
-fn tile_list_words(
-    (list_capacity, entries): (u32, Option<u32>),
-    size: (u32, u32),
-    bin_words: u64,
-    limit: u64,
-) -> u64 {
-    let bins = grid_bins(size);
-    let chunks = u64::from(chunk_capacity(list_capacity, size));
-    let places = 130 * bins + 1 + 128 * chunks;
-    let room = (limit / 4).saturating_sub(bin_words + places);
-    let entries = entries.map_or(2 * u64::from(list_capacity), u64::from);
-    places + entries.min(room)
-}
-
-/// The frame's tile items in draw order: alpha-blended first (as given: back to front),
-/// then the light by emitter (as the billboards draw them).
-fn draw_order(items: &[DrawItem]) -> Vec<&DrawItem> {
-    let mut order: Vec<&DrawItem> = items.iter().filter(|d| d.tiles).collect();
-    order.sort_by_key(|d| d.draw_key());
-    order
 }
 
 impl TilePass {
@@ -700,199 +582,6 @@ impl TilePass {
         self.buffers = None;
     }
 
-    /// Uploads one job per item (`TileJob`: its first sprite and quads, the frame's
-    /// sprites, the lists' capacity; its index, the item count, the blocks and the chunks'
-    /// capacity; every item's first sprite), the resolve's draw arguments (six vertices per shaded tile, counted
-    /// by the shade) and the shades' dispatch arguments (bins counted by the bin scan, 64
-    /// tiles each).
-    fn upload_jobs(&self, ctx: &GpuContext, order: &[&DrawItem], firsts: &[u32]) {
-        let Some(b) = self.buffers.as_ref() else {
-            return;
-        };
-        let mut jobs = vec![0u32; order.len() * JOB_STRIDE as usize / 4];
-        let items = order.len() as u32;
-        let total = firsts[firsts.len() - 1];
-        let blocks = total / BLOCK;
-        for (k, (job, d)) in jobs
-            .chunks_mut(JOB_STRIDE as usize / 4)
-            .zip(order)
-            .enumerate()
-        {
-            let n = d.width * d.members;
-            let head = [
-                firsts[k],
-                n,
-                total,
-                b.list_capacity,
-                k as u32,
-                items,
-                blocks,
-                chunk_capacity(b.list_capacity, b.size),
-            ];
-            job[..8].copy_from_slice(&head);
-            job[8..8 + firsts.len()].copy_from_slice(firsts);
-        }
-        ctx.queue
-            .write_buffer(&b.job_buffer, 0, bytemuck::cast_slice(&jobs));
-        ctx.queue
-            .write_buffer(&b.touched, 0, bytemuck::cast_slice(&[6u32, 0, 0, 0]));
-        let args: Vec<u32> = order.iter().flat_map(|_| [0u32, 64, 1, 0]).collect();
-        ctx.queue
-            .write_buffer(&b.dispatch_args, 0, bytemuck::cast_slice(&args));
-    }
-
-    /// Creates the buffers for `size`, `sprites` quads (capacity in powers of two),
-    /// `lists` list entries and `jobs` dispatches unless the current ones hold them;
-    /// rebinds a new depth view.
-    fn ensure_buffers(
-        &mut self,
-        ctx: &GpuContext,
-        size: (u32, u32),
-        (sprites, list_capacity): (u32, u32),
-        jobs: u32,
-        depth: Option<&wgpu::TextureView>,
-    ) {
-        if let Some(b) = &self.buffers
-            && b.size == size
-            && b.capacity >= sprites
-            && b.list_capacity >= list_capacity
-            && (self.list_capacity.is_none() || b.list_capacity == list_capacity)
-            && b.jobs >= jobs
-            && b.depth.as_ref() == depth
-        {
-            return;
-        }
-        let capacity = sprites.next_power_of_two().max(BLOCK);
-        let jobs = jobs.next_power_of_two().max(4);
-        let (bx, by) = grid(size, BIN_PX);
-        let bins = u64::from(bx * by);
-        let buffer = |label: &str, bytes: u64, usage: wgpu::BufferUsages| {
-            ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: bytes.max(16),
-                usage: usage | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            })
-        };
-        let none = wgpu::BufferUsages::empty();
-        let indirect = wgpu::BufferUsages::INDIRECT;
-        let c = u64::from(capacity);
-        // `touched`: the resolve's arguments, a flag per tile, the shaded tiles, and each
-        // item's bins.
-        let touched_words = TOUCHED_FLAGS + 2 * grid_tiles(size) + MAX_ITEMS as u64 * bins;
-        // `bin_meta`: counts and places per bin and block, each bin's total and start; then
-        // the tiles' lists (tile_lists.wgsl).
-        let bin_words = 2 * bins * (c / u64::from(BLOCK)) + 2 * bins + 1;
-        let limit = ctx.device.limits().max_storage_buffer_binding_size;
-        let tile_words = tile_list_words(
-            (list_capacity, self.tile_list_capacity),
-            size,
-            bin_words,
-            limit,
-        );
-        let meta_words = bin_words + tile_words;
-        let lists = [
-            buffer("TilePass::sprites", c * SPRITE_BYTES, none),
-            buffer("TilePass::touched", touched_words * 4, indirect),
-            buffer(
-                "TilePass::bin_lists",
-                u64::from(list_capacity) * LIST_ENTRY_BYTES,
-                none,
-            ),
-            buffer("TilePass::bin_meta", meta_words * 4, none),
-            buffer(
-                "TilePass::accum",
-                u64::from(size.0) * u64::from(size.1) * 8,
-                none,
-            ),
-        ];
-        let job_buffer = buffer("TilePass::jobs", u64::from(jobs) * JOB_STRIDE, none);
-        // Each item's shade, then the tile lists' chunk passes.
-        let dispatch_args = buffer(
-            "TilePass::dispatch_args",
-            (MAX_ITEMS as u64 + 1) * 16,
-            indirect,
-        );
-        let depth_view = depth.unwrap_or(&self.no_depth);
-        let [tile_group, bin_group, resolve_group] =
-            self.bind_groups(ctx, &lists, (&job_buffer, &dispatch_args), depth_view);
-        let [sprites_buf, touched, bin_lists, meta, accum] = lists;
-        self.buffers = Some(TileBuffers {
-            size,
-            capacity,
-            list_capacity,
-            jobs,
-            job_buffer,
-            touched,
-            dispatch_args,
-            group: tile_group,
-            bin_group,
-            resolve_group,
-            depth: depth.cloned(),
-            _lists: [sprites_buf, bin_lists, meta, accum],
-        });
-    }
-
-    /// The tile group (`lists`: sprites, touched, bin lists, bin meta, accumulation; the
-    /// host's depth view; the jobs), the bin passes' group (the same and the dispatch
-    /// arguments) and the resolve's group (accumulation and touched), over new buffers.
-    fn bind_groups(
-        &self,
-        ctx: &GpuContext,
-        lists: &[wgpu::Buffer; 5],
-        (job_buffer, dispatch_args): (&wgpu::Buffer, &wgpu::Buffer),
-        depth_view: &wgpu::TextureView,
-    ) -> [wgpu::BindGroup; 3] {
-        let group = |layout, args: Option<&wgpu::Buffer>| {
-            let mut entries: Vec<wgpu::BindGroupEntry<'_>> = lists
-                .iter()
-                .enumerate()
-                .map(|(i, b)| wgpu::BindGroupEntry {
-                    binding: [0, 1, 2, 3, 4][i],
-                    resource: b.as_entire_binding(),
-                })
-                .collect();
-            entries.push(wgpu::BindGroupEntry {
-                binding: 5,
-                resource: wgpu::BindingResource::TextureView(depth_view),
-            });
-            entries.push(wgpu::BindGroupEntry {
-                binding: 6,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: job_buffer,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(JOB_STRIDE),
-                }),
-            });
-            entries.extend(args.map(|a| wgpu::BindGroupEntry {
-                binding: 7,
-                resource: a.as_entire_binding(),
-            }));
-            ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("TilePass::group"),
-                layout,
-                entries: &entries,
-            })
-        };
-        let tile_group = group(&self.tile_layout, None);
-        let bin_group = group(&self.bin_group_layout, Some(dispatch_args));
-        let resolve_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("TilePass::resolve_group"),
-            layout: &self.resolve_group_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: lists[4].as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: lists[1].as_entire_binding(),
-                },
-            ],
-        });
-        [tile_group, bin_group, resolve_group]
-    }
-
     /// Composites the last record's tiles into an open render pass of the target's
     /// formats (nothing when it drew nothing).
     pub fn resolve(&self, pass: &mut wgpu::RenderPass<'_>, frame: &FrameResources) {
@@ -961,51 +650,5 @@ impl TilePass {
     /// Whether the last record drew anything.
     pub fn drawn(&self) -> bool {
         self.drawn
-    }
-}
-
-impl ComputeResolve {
-    /// Group 2 binding 2, the target (read and written in place), after the frame and
-    /// the resolve's groups; `None` where `target` is not a single-sample HDR image or the
-    /// device cannot read and write one in place (Vulkan adapters can, asked for their own
-    /// format features: the layout is tried in an error scope, which works on a host's
-    /// device too).
-    fn new(
-        ctx: &GpuContext,
-        target: DrawTarget,
-        frame_layout: &wgpu::BindGroupLayout,
-        resolve_layout: &wgpu::BindGroupLayout,
-    ) -> Option<Self> {
-        let d = &ctx.device;
-        let adapter_formats = d
-            .features()
-            .contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES);
-        if !adapter_formats
-            || target.color_format != crate::render::HDR_FORMAT
-            || target.sample_count > 1
-        {
-            return None;
-        }
-        let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
-        let images = ImageGroups::new(
-            ctx,
-            "TilePass::image",
-            2,
-            wgpu::StorageTextureAccess::ReadWrite,
-        );
-        if let Some(err) = pollster::block_on(scope.pop()) {
-            log::info!("the tiles are resolved by draws: {err}");
-            return None;
-        }
-        let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("TilePass::resolve_over_layout"),
-            bind_group_layouts: &[
-                Some(frame_layout),
-                Some(resolve_layout),
-                Some(images.layout()),
-            ],
-            immediate_size: 0,
-        });
-        Some(Self { images, layout })
     }
 }
