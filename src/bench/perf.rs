@@ -19,11 +19,9 @@ use crate::shaders::ShaderLibrary;
 use crate::sim::{GpuSim, Modules, SimError};
 
 mod report;
-#[allow(unused_imports)]
 use report::*;
 
 mod costs;
-#[allow(unused_imports)]
 use costs::*;
 
 /// The 2006 thesis's measurements (GeForce 8800, points only): texture side → fps.
