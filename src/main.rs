@@ -680,7 +680,13 @@ fn bench(kind: BenchKind, profile: &ProfileRequest) -> anyhow::Result<()> {
             out,
             name,
         } => {
-            let opts = perf_options(&ctx, sides, size, repeats, module_capacity);
+            let opts = ignis::bench::perf::PerfOptions::for_adapter(
+                &ctx,
+                sides,
+                size,
+                repeats,
+                module_capacity,
+            );
             let report = ignis::bench::perf::run(&ctx, &opts)?;
             save_report(&report, &out, name, "perf", &ctx)?;
         }
@@ -705,40 +711,6 @@ fn preset_files(paths: Vec<PathBuf>) -> Vec<PathBuf> {
             }
         })
         .collect()
-}
-
-/// `bench perf`'s options: on a software adapter smaller defaults (sides up to 2048², 1M
-/// billboards, a 1M-particle module pool); 0 or none given means the default.
-fn perf_options(
-    ctx: &GpuContext,
-    sides: Vec<u32>,
-    size: (u32, u32),
-    repeats: usize,
-    module_capacity: u32,
-) -> ignis::bench::perf::PerfOptions {
-    let cpu = ctx.profile.is_software();
-    let sides = if sides.is_empty() {
-        let mut s = vec![64, 128, 256, 512, 1024, 2048];
-        if !cpu {
-            s.extend([4096, 8192, 11586]);
-        }
-        s
-    } else {
-        sides
-    };
-    ignis::bench::perf::PerfOptions {
-        sides,
-        size,
-        repeats: repeats.max(1),
-        billboard_limit: if cpu { 1 << 20 } else { 1 << 26 },
-        module_capacity: if module_capacity > 0 {
-            module_capacity
-        } else if cpu {
-            1 << 20
-        } else {
-            1 << 24
-        },
-    }
 }
 
 fn check(paths: &[PathBuf]) -> anyhow::Result<()> {
@@ -810,44 +782,10 @@ fn check(paths: &[PathBuf]) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// `ignis sprites`: the built-in sprites as straight-alpha sRGB PNGs.
+/// `ignis sprites`: the built-in sprites and six-way smoke maps as PNGs.
 fn write_sprites(out: &Path) -> anyhow::Result<()> {
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    for sprite in ignis::effect::Sprite::BUILT_IN {
-        let img = ignis::render::sprites::to_png_rgba(&ignis::render::sprites::generate(&sprite));
-        let name = format!(
-            "{}.png",
-            sprite
-                .label()
-                .split(' ')
-                .take(2)
-                .collect::<Vec<_>>()
-                .join("_")
-        );
-        let path = out.join(name);
-        img.save(&path)
-            .with_context(|| format!("writing {}", path.display()))?;
+    for path in ignis::render::sprites::write_built_ins(out)? {
         println!("wrote {}", path.display());
-    }
-    write_sixway_sprites(out)
-}
-
-/// The built-in six-way smoke maps (the puff and the puff sheet) as linear RGBA PNG
-/// pairs in Unity's packing: `*_sixway_rtba.png` (right, top, back, alpha) and
-/// `*_sixway_lbfe.png` (left, bottom, front, emissive).
-fn write_sixway_sprites(out: &Path) -> anyhow::Result<()> {
-    use ignis::render::sixway_maps::{PUFF_SEED, puff, puff_sheet, to_png_linear};
-    for (name, maps) in [
-        ("smoke_puff", puff(PUFF_SEED)),
-        ("smoke_puff_sheet", puff_sheet(PUFF_SEED)),
-    ] {
-        for (packing, img) in [("rtba", &maps.rtba), ("lbfe", &maps.lbfe)] {
-            let path = out.join(format!("{name}_sixway_{packing}.png"));
-            to_png_linear(img)
-                .save(&path)
-                .with_context(|| format!("writing {}", path.display()))?;
-            println!("wrote {}", path.display());
-        }
     }
     Ok(())
 }

@@ -49,6 +49,42 @@ pub struct PerfOptions {
     pub module_capacity: u32,
 }
 
+impl PerfOptions {
+    /// `bench perf`'s options for `ctx`'s adapter: on a software adapter smaller defaults (sides up to 2048², 1M
+    /// billboards, a 1M-particle module pool); 0 or none given means the default.
+    pub fn for_adapter(
+        ctx: &crate::gpu::GpuContext,
+        sides: Vec<u32>,
+        size: (u32, u32),
+        repeats: usize,
+        module_capacity: u32,
+    ) -> PerfOptions {
+        let cpu = ctx.profile.is_software();
+        let sides = if sides.is_empty() {
+            let mut s = vec![64, 128, 256, 512, 1024, 2048];
+            if !cpu {
+                s.extend([4096, 8192, 11586]);
+            }
+            s
+        } else {
+            sides
+        };
+        PerfOptions {
+            sides,
+            size,
+            repeats: repeats.max(1),
+            billboard_limit: if cpu { 1 << 20 } else { 1 << 26 },
+            module_capacity: if module_capacity > 0 {
+                module_capacity
+            } else if cpu {
+                1 << 20
+            } else {
+                1 << 24
+            },
+        }
+    }
+}
+
 /// The default campfire's flames, scaled to `n` particles: sizes shrink with √n so the
 /// lit area (and the total light) stays that of the 4096-particle original. Pools larger
 /// than one storage binding are split into several emitters.

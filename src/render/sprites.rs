@@ -644,3 +644,41 @@ fn value_noise(x: f32, y: f32) -> f32 {
     let (sx, sy) = (s(fx), s(fy));
     a + (b - a) * sx + (c - a) * sy + (a - b - c + d) * sx * sy
 }
+
+/// Writes the built-in sprites into `out` (created if missing) as straight-alpha sRGB
+/// PNGs, and the built-in six-way smoke maps (the puff and its sheet) as linear RGBA PNG
+/// pairs in Unity's packing: `*_sixway_rtba.png` (right, top, back, alpha) and
+/// `*_sixway_lbfe.png` (left, bottom, front, emissive). Returns the files written.
+pub fn write_built_ins(out: &Path) -> Result<Vec<PathBuf>, SpriteError> {
+    let err = |path: &Path, e: &dyn std::fmt::Display| SpriteError {
+        path: path.display().to_string(),
+        reason: e.to_string(),
+    };
+    std::fs::create_dir_all(out).map_err(|e| err(out, &e))?;
+    let mut written = Vec::new();
+    let mut save = |img: image::RgbaImage, name: String| {
+        let path = out.join(name);
+        img.save(&path).map_err(|e| err(&path, &e))?;
+        written.push(path);
+        Ok::<(), SpriteError>(())
+    };
+    for sprite in Sprite::BUILT_IN {
+        let name = sprite
+            .label()
+            .split(' ')
+            .take(2)
+            .collect::<Vec<_>>()
+            .join("_");
+        save(to_png_rgba(&generate(&sprite)), format!("{name}.png"))?;
+    }
+    use sixway_maps::{PUFF_SEED, puff, puff_sheet, to_png_linear};
+    for (name, maps) in [
+        ("smoke_puff", puff(PUFF_SEED)),
+        ("smoke_puff_sheet", puff_sheet(PUFF_SEED)),
+    ] {
+        for (packing, img) in [("rtba", &maps.rtba), ("lbfe", &maps.lbfe)] {
+            save(to_png_linear(img), format!("{name}_sixway_{packing}.png"))?;
+        }
+    }
+    Ok(written)
+}
