@@ -1,8 +1,8 @@
-//! The layers the imports keep (docs/architecture.md): `gpu` (with `shaders`, `rng`) →
-//! the model (`effect`, `preset`) → `sim` → `render` → `runtime` → the clients (`composite`,
-//! `headless`, `export`, `editor`, `bench`, `tune`, `hot_reload`). No module names one
-//! above it: every `crate::…` path in `src/` (code, and doc links) is read and its target's
-//! layer compared with the file's.
+//! The house rules the source keeps (docs/architecture.md). Layers: `gpu` (with
+//! `shaders`, `rng`) → the model (`effect`, `preset`) → `sim` → `render` → `runtime` → the
+//! clients (`composite`, `headless`, `export`, `editor`, `bench`, `tune`, `hot_reload`); no
+//! module names one above it — every `crate::…` path in `src/` (code, and doc links) is
+//! read and its target's layer compared with the file's. And no file over 800 lines.
 
 use std::path::Path;
 
@@ -132,4 +132,20 @@ fn the_layer_check_catches_an_import_from_above() {
     assert_eq!(found.len(), 2, "{found:?}");
     assert!(found[0].starts_with("gpu/timer.rs:1 names `sim`"));
     assert!(found[1].starts_with("render/x.rs:1 names `runtime`"));
+}
+
+/// One concern per file: no source file over 800 lines (split a file by type first).
+#[test]
+fn no_source_file_is_over_800_lines() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut paths = Vec::new();
+    sources(&root, &mut paths);
+    let long: Vec<String> = paths
+        .iter()
+        .filter_map(|p| {
+            let n = std::fs::read_to_string(p).expect("read").lines().count();
+            (n > 800).then(|| format!("{} ({n} lines)", p.display()))
+        })
+        .collect();
+    assert!(long.is_empty(), "files over 800 lines: {long:?}");
 }
