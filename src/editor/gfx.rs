@@ -405,7 +405,13 @@ impl Gfx {
             self.frame_camera(camera);
         }
         self.refresh_stats(state, false);
-        self.update_inspect(state, camera);
+        let inspected = super::inspect::Inspected {
+            player: &self.player,
+            instance: self.instance,
+            viewport_px: self.viewport_px,
+            frame: self.log.index,
+        };
+        super::inspect::update_inspect(&inspected, state, camera);
         self.log.record(tick, cpu);
         if self.log.index > 1 {
             state

@@ -9,9 +9,8 @@
 
 use egui::{Align2, Color32, FontId, Painter, Rect, pos2};
 
-use crate::runtime::ParticleInfo;
+use crate::runtime::{InstanceId, ParticleInfo, Player};
 
-use super::gfx::Gfx;
 use super::state::EditorState;
 
 /// How far from the pointer a particle may be to be picked, in render pixels.
@@ -92,71 +91,74 @@ pub struct Inspect {
     pub state_images: Option<StateImages>,
 }
 
-impl Gfx {
-    /// After the draw: picks or follows the inspected particle (a blocking readback,
-    /// only while Inspect is on).
-    pub(super) fn update_inspect(
-        &mut self,
-        state: &mut EditorState,
-        camera: &crate::render::OrbitCamera,
-    ) {
-        self.update_state_view(state);
-        let inspect = &mut state.inspect;
-        if !state.view.inspect {
-            inspect.pointer = None;
-            inspect.pinned = None;
-            inspect.shown = None;
-            return;
-        }
-        let view = camera.view(self.viewport_px);
-        let (w, h) = view.size_px();
-        let pick = |gfx: &Self, p: [f32; 2]| {
-            let pixel = glam::Vec2::new(p[0] * w as f32, p[1] * h as f32);
-            gfx.player
-                .pick_particle(gfx.instance, &view, pixel, PICK_RADIUS_PX)
-                .unwrap_or_else(|err| {
-                    log::warn!("inspecting particles: {err}");
-                    None
-                })
-        };
-        if std::mem::take(&mut inspect.pin_requested) {
-            inspect.pinned = inspect
-                .pointer
-                .and_then(|p| pick(self, p))
-                .map(|i| (i.emitter, i.slot));
-        }
-        inspect.shown = match inspect.pinned {
-            Some((e, slot)) => self
-                .player
-                .inspect_particle(self.instance, e, slot)
-                .unwrap_or_default(),
-            None => inspect.pointer.and_then(|p| pick(self, p)),
-        };
-    }
+/// The player's particles as the Inspect view asks them of the editor's one instance.
+pub(super) struct Inspected<'a> {
+    pub player: &'a Player,
+    pub instance: InstanceId,
+    /// The viewport's render size, pixels.
+    pub viewport_px: (u32, u32),
+    /// The frame's number (the state view refreshes every few frames).
+    pub frame: u64,
 }
 
-impl Gfx {
-    /// The state view's images of the selected emitter, every few frames while it is on.
-    fn update_state_view(&mut self, state: &mut EditorState) {
-        if !state.view.state_view {
-            state.inspect.state_images = None;
-            return;
+/// After the draw: picks or follows the inspected particle (a blocking readback, only
+/// while Inspect is on), and refreshes the state view.
+pub(super) fn update_inspect(
+    gfx: &Inspected<'_>,
+    state: &mut EditorState,
+    camera: &crate::render::OrbitCamera,
+) {
+    update_state_view(gfx, state);
+    let inspect = &mut state.inspect;
+    if !state.view.inspect {
+        inspect.pointer = None;
+        inspect.pinned = None;
+        inspect.shown = None;
+        return;
+    }
+    let view = camera.view(gfx.viewport_px);
+    let (w, h) = view.size_px();
+    let pick = |p: [f32; 2]| {
+        let pixel = glam::Vec2::new(p[0] * w as f32, p[1] * h as f32);
+        gfx.player
+            .pick_particle(gfx.instance, &view, pixel, PICK_RADIUS_PX)
+            .unwrap_or_else(|err| {
+                log::warn!("inspecting particles: {err}");
+                None
+            })
+    };
+    if std::mem::take(&mut inspect.pin_requested) {
+        inspect.pinned = inspect.pointer.and_then(pick).map(|i| (i.emitter, i.slot));
+    }
+    inspect.shown = match inspect.pinned {
+        Some((e, slot)) => gfx
+            .player
+            .inspect_particle(gfx.instance, e, slot)
+            .unwrap_or_default(),
+        None => inspect.pointer.and_then(pick),
+    };
+}
+
+/// The state view's images of the selected emitter, every few frames while it is on.
+fn update_state_view(gfx: &Inspected<'_>, state: &mut EditorState) {
+    if !state.view.state_view {
+        state.inspect.state_images = None;
+        return;
+    }
+    let e = state.selected;
+    let stale = state
+        .inspect
+        .state_images
+        .as_ref()
+        .is_none_or(|s| s.emitter != e);
+    if !stale && !gfx.frame.is_multiple_of(STATE_VIEW_EVERY_FRAMES) {
+        return;
+    }
+    match gfx.player.particles(gfx.instance, e) {
+        Ok(particles) => {
+            state.inspect.state_images = Some(StateImages::of(e, gfx.frame, &particles));
         }
-        let e = state.selected;
-        let stale = state
-            .inspect
-            .state_images
-            .as_ref()
-            .is_none_or(|s| s.emitter != e);
-        if !stale && !self.log.index.is_multiple_of(STATE_VIEW_EVERY_FRAMES) {
-            return;
-        }
-        match self.player.particles(self.instance, e) {
-            Ok(particles) => {
-                state.inspect.state_images = Some(StateImages::of(e, self.log.index, &particles));
-            }
-            Err(err) => log::warn!("reading the state of emitter {e}: {err}"),
-        }
+        Err(err) => log::warn!("reading the state of emitter {e}: {err}"),
     }
 }
 

@@ -5,6 +5,7 @@
 use std::collections::HashMap;
 
 use std::path::Path;
+use std::sync::Arc;
 
 use crate::effect::rows_key;
 use crate::effect::{
@@ -18,7 +19,7 @@ use crate::render::look::{
     RAMP_WIDTH, ROWS_PER_EMITTER, bake_look_curves, bake_ramp, gradient_key, look_curve_params,
 };
 use crate::render::sort::{SortJob, SortMember};
-use crate::render::sprites::{SpriteError, SpriteLibrary};
+use crate::render::sprites::{SpriteError, SpriteLibrary, SpriteTexture};
 use crate::sim::Modules;
 
 mod looks;
@@ -426,6 +427,26 @@ impl FrameResources {
     /// Writes emitter `i`'s look uniform of every instance of a group into `block` and
     /// returns its draw (look slot left for the caller), or `None` when it has no pool or
     /// is disabled. The first group's emitters also bake the shared colour ramps.
+    /// Emitter `i`'s texture: its six-way maps when lit, else its sprite (a load error is
+    /// reported once, by the first group).
+    fn emitter_sprite(
+        &mut self,
+        ctx: &GpuContext,
+        view: &GroupView<'_, '_>,
+        i: usize,
+        look: &Look,
+    ) -> Arc<SpriteTexture> {
+        let lit = look.lit.as_ref().filter(|_| look.blend == BlendMode::Alpha);
+        let (sprite, error) = match lit {
+            Some(lit) => self.sprites.resolve_lit(ctx, &lit.maps, view.asset_dir),
+            None => self.sprites.resolve(ctx, &look.sprite, view.asset_dir),
+        };
+        if let Some(err) = error.filter(|_| view.first_group) {
+            self.sprite_errors.push((i, err));
+        }
+        sprite
+    }
+
     fn prepare_emitter(
         &mut self,
         ctx: &GpuContext,
@@ -436,18 +457,7 @@ impl FrameResources {
     ) -> Option<DrawItem> {
         let first = view.group.iter().flatten().next()?;
         let e = first.effect.emitters.get(i)?;
-        let (sprite, error) = match e
-            .look
-            .lit
-            .as_ref()
-            .filter(|_| e.look.blend == BlendMode::Alpha)
-        {
-            Some(lit) => self.sprites.resolve_lit(ctx, &lit.maps, view.asset_dir),
-            None => self.sprites.resolve(ctx, &e.look.sprite, view.asset_dir),
-        };
-        if let Some(err) = error.filter(|_| view.first_group) {
-            self.sprite_errors.push((i, err));
-        }
+        let sprite = self.emitter_sprite(ctx, view, i, &e.look);
         if view.first_group {
             // Emitter i of every instance shares ramp row i: the first group's look bakes it.
             self.upload_ramp(ctx, i, &e.look);
