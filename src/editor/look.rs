@@ -379,9 +379,13 @@ fn sprite_rows_ui(ui: &mut Ui, look: &mut Look) {
         });
     }
     ui.end_row();
-    let Some(f) = &mut look.flipbook else {
-        return;
-    };
+    if let Some(f) = &mut look.flipbook {
+        flipbook_rows_ui(ui, f);
+    }
+}
+
+/// A flipbook's rows (of an open grid): its frames, their timing, blending and start.
+fn flipbook_rows_ui(ui: &mut Ui, f: &mut Flipbook) {
     let label = ui
         .label("Frames")
         .on_hover_text("Rows × columns of the atlas");

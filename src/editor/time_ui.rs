@@ -71,68 +71,74 @@ ui,
             |ui| ui.add(drag(&mut t.speed, 0.0..=10.0, 0.01, "×").min_decimals(2)),
         );
         if let Some(e) = effect.emitters.get_mut(selected) {
-            let label = ui
-                .label("Integrator")
-                .on_hover_text("Integration method of the selected emitter");
-            egui::ComboBox::from_id_salt("integrator")
-                .selected_text(e.integrator.label())
-                .width(150.0)
-                .show_ui(ui, |ui| {
-                    for i in Integrator::ALL {
-                        ui.selectable_value(&mut e.integrator, i, i.label());
-                    }
-                })
-                .response
-                .labelled_by(label.id);
-            ui.end_row();
-            row_ui(
-                ui,
-                "Stateless",
-                "Closed form instead of steps: each particle's position is evaluated from its spawn record and age (exact, cheaper). Only for constant acceleration and linear drag",
-                |ui| {
-                    let r = ui.checkbox(&mut e.stateless, "closed form");
-                    if r.changed() && e.stateless {
-                        e.packed_state = false;
-                        e.tiny_state = false;
-                    }
-                    r
-                },
-            );
-            // Three radio buttons, each named by its own text (not by the row's label).
-            let tip = "Bytes stored per particle. 32 B: f32 position, velocity, age, lifetime. 20 B packed: f16 velocity, 16-bit life fraction, lifetime re-derived from the spawn hash. 10 B tiny: f16 position, shared-exponent velocity, age from a table of each step's births. Smaller moves less memory for huge pools, at the accuracy cost `ignis bench accuracy` reports (\"+ packed\", \"+ tiny\" rows). Switching restarts this emitter's particles";
-            ui.label("State size").on_hover_text(tip);
-            ui.horizontal(|ui| {
-                let before = (e.packed_state, e.tiny_state);
-                let mut size = if e.tiny_state {
-                    10
-                } else if e.packed_state {
-                    20
-                } else {
-                    32
-                };
-                for (bytes, text) in [(32, "32 B"), (20, "20 B packed"), (10, "10 B tiny")] {
-                    ui.radio_value(&mut size, bytes, text).on_hover_text(tip);
-                }
-                e.packed_state = size == 20;
-                e.tiny_state = size == 10;
-                if (e.packed_state, e.tiny_state) != before && size != 32 {
-                    e.stateless = false;
-                }
-            });
-            ui.end_row();
-            let blockers = e.stateless_blockers();
-            if e.stateless && !blockers.is_empty() {
-                ui.label("");
-                ui.colored_label(
-                    ui.visuals().warn_fg_color,
-                    format!("turn off: {}", blockers.join(", ")),
-                );
-                ui.end_row();
-            }
+            emitter_time_rows_ui(ui, e);
         }
     });
     stability_ui(ui, effect);
     super::measure_ui::measure_ui(ui, measure, effect);
+}
+
+/// The selected emitter's rows (of an open grid): its integrator, closed form and state
+/// size.
+fn emitter_time_rows_ui(ui: &mut Ui, e: &mut crate::effect::Emitter) {
+    let label = ui
+        .label("Integrator")
+        .on_hover_text("Integration method of the selected emitter");
+    egui::ComboBox::from_id_salt("integrator")
+        .selected_text(e.integrator.label())
+        .width(150.0)
+        .show_ui(ui, |ui| {
+            for i in Integrator::ALL {
+                ui.selectable_value(&mut e.integrator, i, i.label());
+            }
+        })
+        .response
+        .labelled_by(label.id);
+    ui.end_row();
+    row_ui(
+        ui,
+        "Stateless",
+        "Closed form instead of steps: each particle's position is evaluated from its spawn record and age (exact, cheaper). Only for constant acceleration and linear drag",
+        |ui| {
+            let r = ui.checkbox(&mut e.stateless, "closed form");
+            if r.changed() && e.stateless {
+                e.packed_state = false;
+                e.tiny_state = false;
+            }
+            r
+        },
+    );
+    // Three radio buttons, each named by its own text (not by the row's label).
+    let tip = "Bytes stored per particle. 32 B: f32 position, velocity, age, lifetime. 20 B packed: f16 velocity, 16-bit life fraction, lifetime re-derived from the spawn hash. 10 B tiny: f16 position, shared-exponent velocity, age from a table of each step's births. Smaller moves less memory for huge pools, at the accuracy cost `ignis bench accuracy` reports (\"+ packed\", \"+ tiny\" rows). Switching restarts this emitter's particles";
+    ui.label("State size").on_hover_text(tip);
+    ui.horizontal(|ui| {
+        let before = (e.packed_state, e.tiny_state);
+        let mut size = if e.tiny_state {
+            10
+        } else if e.packed_state {
+            20
+        } else {
+            32
+        };
+        for (bytes, text) in [(32, "32 B"), (20, "20 B packed"), (10, "10 B tiny")] {
+            ui.radio_value(&mut size, bytes, text).on_hover_text(tip);
+        }
+        e.packed_state = size == 20;
+        e.tiny_state = size == 10;
+        if (e.packed_state, e.tiny_state) != before && size != 32 {
+            e.stateless = false;
+        }
+    });
+    ui.end_row();
+    let blockers = e.stateless_blockers();
+    if e.stateless && !blockers.is_empty() {
+        ui.label("");
+        ui.colored_label(
+            ui.visuals().warn_fg_color,
+            format!("turn off: {}", blockers.join(", ")),
+        );
+        ui.end_row();
+    }
 }
 
 /// The step the integrators see: the fixed step, or the largest frame-delta step.
