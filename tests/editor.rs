@@ -1718,3 +1718,19 @@ fn the_lit_rows_switch_lit_smoke_and_the_view_lights_the_grid() {
         "a view setting edits nothing"
     );
 }
+
+/// Export ▸ Six-way passes asks the export for the lit smoke's six-way lightmaps.
+#[test]
+fn the_export_section_asks_for_the_sixway_passes() {
+    let mut harness = panel_harness(campfire_state());
+    open_section(&mut harness, "Export");
+    assert!(!harness.state().export.settings.passes.sixway);
+    harness.get_by_label("Six-way passes").click_accesskit();
+    harness.run();
+    assert!(harness.state().export.settings.passes.sixway);
+    let names = harness.state().export.settings.passes.names();
+    assert!(
+        names.contains(&"sixway_rtba") && names.contains(&"sixway_lbfe"),
+        "{names:?}"
+    );
+}

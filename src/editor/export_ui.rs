@@ -175,125 +175,144 @@ fn drag(v: &mut u32, max: u32) -> egui::DragValue<'_> {
 }
 
 fn settings_ui(ui: &mut Ui, panel: &mut ExportPanel) {
-    use super::panel::row_ui as row;
-    let s = &mut panel.settings;
     egui::Grid::new("export_grid")
         .num_columns(2)
         .show(ui, |ui| {
-            row(
-                ui,
-                "Sequence",
-                "One file per frame instead of one atlas",
-                |ui| ui.checkbox(&mut panel.sequence, ""),
-            );
-            if !panel.sequence {
-                row(ui, "Columns", "Frames per atlas row", |ui| {
-                    ui.add(drag(&mut panel.cols, 64))
-                });
-                row(
-                    ui,
-                    "Rows",
-                    "Atlas rows; frames run row-major from the top left",
-                    |ui| ui.add(drag(&mut panel.rows, 64)),
-                );
-            }
-            if panel.sequence {
-                let frames = s.frames.get_or_insert(60);
-                row(ui, "Frames", "How many frames the sequence holds", |ui| {
-                    ui.add(drag(frames, 100_000))
-                });
-            } else {
-                // A flipbook holds as many frames as it has cells.
-                s.frames = None;
-            }
-            row(ui, "Width", "One frame's width in pixels", |ui| {
-                ui.add(drag(&mut s.frame_size.0, 4096))
-            });
-            row(ui, "Height", "One frame's height in pixels", |ui| {
-                ui.add(drag(&mut s.frame_size.1, 4096))
-            });
-            row(ui, "Start", "Effect time of the first frame", |ui| {
-                ui.add(
-                    egui::DragValue::new(&mut s.start_secs)
-                        .range(0.0..=600.0)
-                        .speed(0.05)
-                        .suffix(" s"),
-                )
-            });
-            row(ui, "Frame rate", "Frames per second of effect time", |ui| {
-                ui.add(
-                    egui::DragValue::new(&mut s.fps)
-                        .range(1.0..=240.0)
-                        .suffix(" fps"),
-                )
-            });
-            row(
-                ui,
-                "Seamless loop",
-                "The last frame flows into the first",
-                |ui| ui.checkbox(&mut s.looped, ""),
-            );
-            row(
-                ui,
-                "Format",
-                "8-bit or 16-bit sRGB PNG, or half-float linear EXR",
-                |ui| {
-                    choice(
-                        ui,
-                        "export_format",
-                        &mut s.format,
-                        &[Format::Png8, Format::Png16, Format::Exr],
-                        Format::name,
-                    )
-                },
-            );
-            row(
-                ui,
-                "Alpha",
-                "Premultiplied composites exactly: C + B·(1 − A)",
-                |ui| {
-                    choice(
-                        ui,
-                        "export_alpha",
-                        &mut s.alpha,
-                        &[AlphaMode::Premultiplied, AlphaMode::Straight],
-                        AlphaMode::name,
-                    )
-                },
-            );
-            row(ui, "Color pass", "Light and coverage (RGBA)", |ui| {
-                ui.checkbox(&mut s.passes.color, "")
-            });
-            row(ui, "Emissive pass", "The additive light alone", |ui| {
-                ui.checkbox(&mut s.passes.emissive, "")
-            });
-            row(
-                ui,
-                "Motion pass",
-                "Screen motion to the next frame in RG",
-                |ui| ui.checkbox(&mut s.passes.motion, ""),
-            );
-            row(
-                ui,
-                "Camera",
-                "Fitted to the whole span, orthographic, or the preset's",
-                |ui| {
-                    choice(
-                        ui,
-                        "export_camera",
-                        &mut s.camera,
-                        &[CameraMode::Fit, CameraMode::Ortho, CameraMode::Preset],
-                        CameraMode::name,
-                    )
-                },
-            );
-            row(
-                ui,
-                "Folder",
-                "Where the files go (created if missing)",
-                |ui| ui.text_edit_singleline(&mut panel.out_dir),
-            );
+            layout_rows(ui, panel);
+            output_rows(ui, panel);
         });
+}
+
+/// The export's layout and span (rows of an open grid): atlas or sequence, frames, size,
+/// start, rate, loop.
+fn layout_rows(ui: &mut Ui, panel: &mut ExportPanel) {
+    use super::panel::row_ui as row;
+    let s = &mut panel.settings;
+    row(
+        ui,
+        "Sequence",
+        "One file per frame instead of one atlas",
+        |ui| ui.checkbox(&mut panel.sequence, ""),
+    );
+    if !panel.sequence {
+        row(ui, "Columns", "Frames per atlas row", |ui| {
+            ui.add(drag(&mut panel.cols, 64))
+        });
+        row(
+            ui,
+            "Rows",
+            "Atlas rows; frames run row-major from the top left",
+            |ui| ui.add(drag(&mut panel.rows, 64)),
+        );
+    }
+    if panel.sequence {
+        let frames = s.frames.get_or_insert(60);
+        row(ui, "Frames", "How many frames the sequence holds", |ui| {
+            ui.add(drag(frames, 100_000))
+        });
+    } else {
+        // A flipbook holds as many frames as it has cells.
+        s.frames = None;
+    }
+    row(ui, "Width", "One frame's width in pixels", |ui| {
+        ui.add(drag(&mut s.frame_size.0, 4096))
+    });
+    row(ui, "Height", "One frame's height in pixels", |ui| {
+        ui.add(drag(&mut s.frame_size.1, 4096))
+    });
+    row(ui, "Start", "Effect time of the first frame", |ui| {
+        ui.add(
+            egui::DragValue::new(&mut s.start_secs)
+                .range(0.0..=600.0)
+                .speed(0.05)
+                .suffix(" s"),
+        )
+    });
+    row(ui, "Frame rate", "Frames per second of effect time", |ui| {
+        ui.add(
+            egui::DragValue::new(&mut s.fps)
+                .range(1.0..=240.0)
+                .suffix(" fps"),
+        )
+    });
+    row(
+        ui,
+        "Seamless loop",
+        "The last frame flows into the first",
+        |ui| ui.checkbox(&mut s.looped, ""),
+    );
+}
+
+/// The export's output (rows of an open grid): format, alpha, passes, camera, folder.
+fn output_rows(ui: &mut Ui, panel: &mut ExportPanel) {
+    use super::panel::row_ui as row;
+    let s = &mut panel.settings;
+    row(
+        ui,
+        "Format",
+        "8-bit or 16-bit sRGB PNG, or half-float linear EXR",
+        |ui| {
+            choice(
+                ui,
+                "export_format",
+                &mut s.format,
+                &[Format::Png8, Format::Png16, Format::Exr],
+                Format::name,
+            )
+        },
+    );
+    row(
+        ui,
+        "Alpha",
+        "Premultiplied composites exactly: C + B·(1 − A)",
+        |ui| {
+            choice(
+                ui,
+                "export_alpha",
+                &mut s.alpha,
+                &[AlphaMode::Premultiplied, AlphaMode::Straight],
+                AlphaMode::name,
+            )
+        },
+    );
+    row(ui, "Color pass", "Light and coverage (RGBA)", |ui| {
+        ui.checkbox(&mut s.passes.color, "")
+    });
+    row(ui, "Emissive pass", "The additive light alone", |ui| {
+        ui.checkbox(&mut s.passes.emissive, "")
+    });
+    row(
+        ui,
+        "Motion pass",
+        "Screen motion to the next frame in RG",
+        |ui| ui.checkbox(&mut s.passes.motion, ""),
+    );
+    row(
+        ui,
+        "Six-way passes",
+        "The lit smoke's six-way lightmaps (RTBA and LBFE, Unity's packing), for an engine to relight the flipbook",
+        |ui| ui.checkbox(&mut s.passes.sixway, ""),
+    );
+    row(
+        ui,
+        "Camera",
+        "Fitted to the whole span, orthographic, or the preset's",
+        |ui| {
+            choice(
+                ui,
+                "export_camera",
+                &mut s.camera,
+                &[CameraMode::Fit, CameraMode::Ortho, CameraMode::Preset],
+                CameraMode::name,
+            )
+        },
+    );
+    row(
+        ui,
+        "Folder",
+        "Where the files go (created if missing)",
+        |ui| ui.text_edit_singleline(&mut panel.out_dir),
+    );
 }
 
 /// A combo box over `options`, named by `name`.
