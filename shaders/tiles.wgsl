@@ -149,10 +149,12 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
         }
         return;
     }
+    // The particle is loaded once for both records.
+    let qd = load_quad(q);
     if LIT {
-        lit_record(q, index + job.counts.y);
+        lit_record(qd, index + job.counts.y);
     }
-    let s = project_quad(q);
+    let s = project_quad(qd);
     sprites[index].bounds = s.bounds;
     if s.bounds.x > s.bounds.z {
         return;
@@ -173,11 +175,10 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
     }
 }
 
-// Writes lit quad `q`'s six-way light (lit.wgsl, packed) into sprite `at`: a record
+// Writes lit quad `qd`'s six-way light (lit.wgsl, packed) into sprite `at`: a record
 // with no pixels (the bins skip it) in five of its fields, read by `sprite_light`.
-fn lit_record(q: u32, at: u32) {
+fn lit_record(qd: Quad, at: u32) {
     sprites[at].bounds = vec4<i32>(1, 1, 0, 0);
-    let qd = load_quad(q);
     if !qd.d.alive {
         return;
     }
@@ -189,11 +190,10 @@ fn lit_record(q: u32, at: u32) {
     sprites[at].frames = l[4];
 }
 
-// Quad `q` of the job's item projected (empty bounds when it draws nothing).
-fn project_quad(q: u32) -> TileSprite {
+// Quad `qd` of the job's item projected (empty bounds when it draws nothing).
+fn project_quad(qd: Quad) -> TileSprite {
     var s: TileSprite;
     s.bounds = vec4<i32>(1, 1, 0, 0);
-    let qd = load_quad(q);
     if !qd.d.alive {
         return s;
     }

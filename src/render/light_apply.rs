@@ -18,6 +18,8 @@ pub struct SelfLightPass {
     pipeline_layout: wgpu::PipelineLayout,
     pipeline: wgpu::ComputePipeline,
     plan: Option<wgpu::Buffer>,
+    /// The group over (sums, looks, plan), kept while those buffers are the same.
+    group: Option<([wgpu::Buffer; 3], wgpu::BindGroup)>,
 }
 
 impl SelfLightPass {
@@ -43,6 +45,7 @@ impl SelfLightPass {
             pipeline_layout,
             pipeline,
             plan: None,
+            group: None,
         })
     }
 
@@ -94,31 +97,39 @@ impl SelfLightPass {
             return;
         };
         ctx.queue.write_buffer(plan, 0, bytes);
-        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("SelfLightPass::group"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: sums.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: frame.looks_buffer().as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: plan.as_entire_binding(),
-                },
-            ],
-        });
+        let buffers = [sums.clone(), frame.looks_buffer().clone(), plan.clone()];
+        if self.group.as_ref().is_none_or(|(b, _)| *b != buffers) {
+            let group = self.bind_group(ctx, &buffers);
+            self.group = Some((buffers, group));
+        }
+        let Some((_, group)) = &self.group else {
+            return;
+        };
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("SelfLightPass"),
             timestamp_writes: None,
         });
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &group, &[]);
+        pass.set_bind_group(0, group, &[]);
         pass.dispatch_workgroups(targets.div_ceil(64), 1, 1);
+    }
+}
+
+impl SelfLightPass {
+    /// The group over `[sums, looks, plan]`.
+    fn bind_group(&self, ctx: &GpuContext, buffers: &[wgpu::Buffer; 3]) -> wgpu::BindGroup {
+        let entries: Vec<wgpu::BindGroupEntry<'_>> = (0u32..)
+            .zip(buffers)
+            .map(|(binding, b)| wgpu::BindGroupEntry {
+                binding,
+                resource: b.as_entire_binding(),
+            })
+            .collect();
+        ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("SelfLightPass::group"),
+            layout: &self.layout,
+            entries: &entries,
+        })
     }
 }
 
