@@ -443,7 +443,8 @@ fn render(
     }
     let elapsed = start.elapsed().as_secs_f64();
     println!(
-        "rendered {frames} frames ({written} written to {}) of \"{}\" at {}x{}: {} particles alive, {:.2} ms per frame on {}",
+        "rendered {frames} frames ({written} written to {}) of \"{}\" at {}x{}: {} particles \
+            alive, {:.2} ms per frame on {}",
         out.display(),
         run.effect().name,
         size.0,
@@ -458,7 +459,8 @@ fn render(
         let mut last = frame_ms[tail..].to_vec();
         let median = ignis::gpu::timer::median(&mut last);
         println!(
-            "last {} frames: median {median:.2} ms simulate + draw + read back ({:.1} fps), PNG writing excluded",
+            "last {} frames: median {median:.2} ms simulate + draw + read back ({:.1} fps), PNG \
+                writing excluded",
             last.len(),
             1000.0 / median
         );

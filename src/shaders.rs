@@ -583,7 +583,8 @@ pub fn create_checked<T>(
         Some(err) => Err(ShaderError::Pipeline {
             file: lib.display_path(&composed.entry),
             message: format!(
-                "the GPU rejected the pipeline (check bindings and struct layouts against src/gpu/types.rs): {err}"
+                "the GPU rejected the pipeline (check bindings and struct layouts against \
+                    src/gpu/types.rs): {err}"
             ),
         }),
     }

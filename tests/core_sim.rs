@@ -146,7 +146,8 @@ fn gpu_matches_cpu_reference_with_every_module() {
             }
         }
         eprintln!(
-            "{integrator:?} (curves {curves}): {alive} alive, worst position error {worst:e}, {bad} beyond 2e-4"
+            "{integrator:?} (curves {curves}): {alive} alive, worst position error {worst:e}, \
+                {bad} beyond 2e-4"
         );
         assert!(alive > 300);
         // Allow a handful of contact-amplified outliers, never a systematic mismatch.
@@ -637,7 +638,9 @@ fn packed_state_follows_the_full_state() {
         worst_vel = worst_vel.max((q.velocity() - p.velocity()).length());
     }
     println!(
-        "packed vs full after {steps} steps: worst |Δx| {worst_pos:.2e} m, |Δv| {worst_vel:.2e} m/s, |Δage|/life {worst_age:.2e}, {borderline} of {alive} at the end of life differ in liveness"
+        "packed vs full after {steps} steps: worst |Δx| {worst_pos:.2e} m, |Δv| {worst_vel:.2e} \
+            m/s, |Δage|/life {worst_age:.2e}, {borderline} of {alive} at the end of life differ \
+            in liveness"
     );
     assert!(alive > 1500, "{alive} alive");
     assert!(
@@ -717,7 +720,9 @@ fn tiny_state_follows_the_full_state() {
     let rms_pos = (sum_pos2 / alive as f64).sqrt();
     let rms_vel = (sum_vel2 / alive as f64).sqrt();
     println!(
-        "tiny vs full after {steps} steps: |Δx| rms {rms_pos:.2e} worst {worst_pos:.2e} m, |Δv| rms {rms_vel:.2e} worst {worst_vel:.2e} m/s, |Δage| {worst_age:.2e} s, {borderline} of {alive} differ in liveness"
+        "tiny vs full after {steps} steps: |Δx| rms {rms_pos:.2e} worst {worst_pos:.2e} m, |Δv| \
+            rms {rms_vel:.2e} worst {worst_vel:.2e} m/s, |Δage| {worst_age:.2e} s, {borderline} \
+            of {alive} differ in liveness"
     );
     assert!(alive > 1500, "{alive} alive");
     assert!(borderline <= 2, "{borderline} liveness mismatches");

@@ -174,7 +174,10 @@ fn a_lost_device_keeps_the_edits_and_their_undo_history() {
         "no recovery in the report: {report}"
     );
     assert!(
-        report.contains("edits around the loss: 1 undo step(s) left, flames intensity 0.3 in the panel, 0.3 playing"),
+        report.contains(
+            "edits around the loss: 1 undo step(s) left, flames intensity 0.3 in \
+            the panel, 0.3 playing"
+        ),
         "the edits or their history were not kept: {report}"
     );
     assert_panel_and_fire(&image, 1000);

@@ -125,8 +125,10 @@ fn original(name: &str) -> &'static str {
         .expect("embedded")
 }
 
-const ZERO_FORCE: &str = "fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age: f32, life: f32, time: f32) -> vec3<f32> {\n    return vec3<f32>(0.0);";
-const FORCE_FN: &str = "fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age: f32, life: f32, time: f32) -> vec3<f32> {";
+const ZERO_FORCE: &str = "fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age: f32, life: f32, \
+    time: f32) -> vec3<f32> {\n    return vec3<f32>(0.0);";
+const FORCE_FN: &str = "fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age: f32, life: f32, \
+    time: f32) -> vec3<f32> {";
 
 /// A valid edit (the force function returns zero) changes the simulated state after the
 /// reload: velocities stop changing. The particles survive the reload.
@@ -179,7 +181,8 @@ fn broken_edits_keep_the_last_good_pipeline() {
         (
             "forces.wgsl",
             FORCE_FN,
-            "fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age: f32, life: f32, time: f32) -> f32 {",
+            "fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age: f32, life: f32, time: f32) -> \
+                f32 {",
             Some("forces.wgsl:"),
         ),
         (

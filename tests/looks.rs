@@ -782,7 +782,8 @@ fn reference_images() {
         let want = image::open(&reference)
             .unwrap_or_else(|e| {
                 panic!(
-                    "{}: {e} (regenerate with IGNIS_BLESS=1 cargo test --release --test looks reference_images)",
+                    "{}: {e} (regenerate with IGNIS_BLESS=1 cargo test --release --test looks \
+                        reference_images)",
                     reference.display()
                 )
             })
@@ -793,7 +794,9 @@ fn reference_images() {
             let out = std::env::temp_dir().join(format!("ignis-{name}-actual.png"));
             let _ = img.save(&out);
             panic!(
-                "{name} differs from {} by {diff:.3} > {TOLERANCE} (actual frame: {}); if the change is deliberate, regenerate with IGNIS_BLESS=1 cargo test --release --test looks reference_images",
+                "{name} differs from {} by {diff:.3} > {TOLERANCE} (actual frame: {}); if the \
+                    change is deliberate, regenerate with IGNIS_BLESS=1 cargo test --release \
+                    --test looks reference_images",
                 reference.display(),
                 out.display()
             );

@@ -175,8 +175,10 @@ fn validation_and_import_errors_are_located() {
     std::fs::write(
         &forces,
         original.replace(
-            "fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age: f32, life: f32, time: f32) -> vec3<f32> {",
-            "fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age: f32, life: f32, time: f32) -> f32 {",
+            "fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age: f32, life: f32, time: f32) -> \
+                vec3<f32> {",
+            "fn acceleration(pos: vec3<f32>, vel: vec3<f32>, age: f32, life: f32, time: f32) -> \
+                f32 {",
         ),
     )
     .expect("write");

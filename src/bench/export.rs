@@ -71,7 +71,10 @@ pub fn run(
     }
     let mut r = Report::new("ignis export: how long an export takes", ctx);
     r.para(&format!(
-        "`{}`, seed {}, camera fitted to the span, premultiplied 8-bit PNG. Wall time of the whole export: sampling the span, rendering it small to frame it, rendering every frame, reading it back, encoding and writing the files (after one small export has built the pipelines).",
+        "`{}`, seed {}, camera fitted to the span, premultiplied 8-bit PNG. Wall time of the \
+            whole export: sampling the span, rendering it small to frame it, rendering every \
+            frame, reading it back, encoding and writing the files (after one small export has \
+            built the pipelines).",
         effect.name, effect.seed
     ));
     let table: Vec<Vec<String>> = rows

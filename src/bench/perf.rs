@@ -24,6 +24,9 @@ use report::*;
 mod costs;
 use costs::*;
 
+mod draws;
+use draws::*;
+
 /// The 2006 thesis's measurements (GeForce 8800, points only): texture side → fps.
 pub const THESIS_FPS: [(u32, f64); 7] = [
     (64, 5300.0),
@@ -364,118 +367,11 @@ fn measure_row(
     // Re-run one step so the state is a real one again (the copy wrote into `previous`).
     sim.step(&effect, 1.0 / 60.0, 1)?;
 
-    let lib = ShaderLibrary::embedded();
-    let mut frame = FrameResources::new(ctx);
-    frame.allow_tiles = TilePass::supported(&ctx.device);
-    let mut sort = SortPass::new(ctx, &lib)?;
-    let mut billboard = BillboardPass::new(ctx, &lib, &frame, DrawTarget::hdr())?;
-    let mut splat = SplatPass::new(ctx, &lib, &frame, DrawTarget::hdr())?;
-    let mut tiles = frame
-        .allow_tiles
-        .then(|| TilePass::new(ctx, &lib, &frame, DrawTarget::hdr()))
-        .transpose()?;
-    let tonemap = TonemapPass::new(ctx, &lib)?;
-    let camera = OrbitCamera::from_hint(&effect.camera);
-    let size = opts.size;
-    let targets = crate::render::Targets::new(ctx, size);
-    let scene = [Some(crate::render::Scene {
-        sim: &sim,
-        effect: &effect,
-    })];
-    let items = frame.prepare(ctx, &[&scene], &camera.view(size), 1.0, &mut sort, None);
-    let mut uploads = crate::gpu::Uploads::new(&ctx.device);
-    let mut enc = ctx.device.create_command_encoder(&Default::default());
-    frame.upload_looks(&mut uploads, &mut enc);
-    uploads.finish(&enc);
-    ctx.queue.submit([enc.finish()]);
-    let auto_path = if items.iter().all(|d| d.splat) {
-        "splat"
-    } else if items.iter().all(|d| d.tiles) {
-        "tiles"
-    } else {
-        "billboard"
-    };
-    let with_path = |splat: bool, tiles: bool| -> Vec<DrawItem> {
-        items
-            .iter()
-            .map(|d| DrawItem {
-                splat,
-                tiles,
-                ..d.clone()
-            })
-            .collect()
-    };
-    let (all_billboard, all_splat) = (with_path(false, false), with_path(true, false));
-    let all_tiles = with_path(false, true);
-    billboard.prepare(ctx, &all_billboard, &frame.sprites.sampler, false);
-    let billboard_ms = (n <= opts.billboard_limit).then(|| {
-        time_median(&timer, ctx, opts.repeats.min(3), |enc| {
-            let mut pass = load_hdr_pass(enc, &targets.hdr_view);
-            billboard.draw(&mut pass, &frame, &all_billboard, |_| true);
-        })
-    });
-    // Splat: clear + compute splat + its resolve into the HDR target.
-    let splat_ms = {
-        let mut samples = Vec::new();
-        for _ in 0..opts.repeats {
-            samples.push(timer.time(ctx, |enc| {
-                splat.splat(ctx, enc, &frame, &all_splat, size, None);
-                splat.resolve(&mut load_hdr_pass(enc, &targets.hdr_view), &frame);
-            }));
-        }
-        median(&mut samples)
-    };
-    // Tiles: project, bin, shade and the resolve into the HDR target (by compute where
-    // the adapter can, as the composite does).
-    let (mut tiles_stages_ms, mut tiles_resolve_ms) = (None, None);
-    let hdr = &targets.hdr_view;
-    let tiles_ms = tiles.as_mut().and_then(|t| {
-        let mut enc = ctx.device.create_command_encoder(&Default::default());
-        let fits = t.record(ctx, &mut enc, &frame, &all_tiles, size, None);
-        ctx.queue.submit([enc.finish()]);
-        let resolve = |t: &mut TilePass, enc: &mut wgpu::CommandEncoder| {
-            if !t.resolve_into(ctx, enc, &frame, hdr, size) {
-                t.resolve(&mut load_hdr_pass(enc, hdr), &frame);
-            }
-        };
-        let time = |t: &mut TilePass, stages| {
-            t.set_stages(stages);
-            time_median(&timer, ctx, opts.repeats, |enc| {
-                t.record(ctx, enc, &frame, &all_tiles, size, None);
-                resolve(t, enc);
-            })
-        };
-        fits.then(|| {
-            tiles_stages_ms = Some([TileStages::Project, TileStages::Bin].map(|s| time(t, s)));
-            let all = time(t, TileStages::All);
-            // The last record stays shaded: each resolve timed alone.
-            let by_compute = t
-                .can_resolve_into(size)
-                .then(|| time_median(&timer, ctx, opts.repeats, |enc| resolve(t, enc)));
-            let by_draw = time_median(&timer, ctx, opts.repeats, |enc| {
-                t.resolve(&mut load_hdr_pass(enc, hdr), &frame);
-            });
-            tiles_resolve_ms = Some((by_compute, by_draw));
-            all
-        })
-    });
-    // Composite: the tonemap.
-    let composite_ms = time_median(&timer, ctx, opts.repeats, |enc| {
-        tonemap.record(
-            ctx,
-            enc,
-            &targets.hdr_view,
-            None,
-            None,
-            None,
-            (&targets.ldr_view, targets.size),
-            1.0,
-        );
-    });
-    let draw = match auto_path {
-        "splat" => splat_ms,
-        "tiles" => tiles_ms.unwrap_or(f64::NAN),
-        _ => billboard_ms.unwrap_or(f64::NAN),
+    let d = draw_costs(ctx, opts, n, (&sim, &effect), &timer)?;
+    let draw = match d.auto_path {
+        "splat" => d.splat_ms,
+        "tiles" => d.tiles_ms.unwrap_or(f64::NAN),
+        _ => d.billboard_ms.unwrap_or(f64::NAN),
     };
     Ok(PerfRow {
         particles: n,
@@ -483,14 +379,14 @@ fn measure_row(
         update_ms,
         lean_update_ms,
         copy_ms,
-        billboard_ms,
-        splat_ms,
-        tiles_ms,
-        tiles_stages_ms,
-        tiles_resolve_ms,
-        composite_ms,
-        auto_path,
-        frame_ms: update_ms + draw + composite_ms,
+        billboard_ms: d.billboard_ms,
+        splat_ms: d.splat_ms,
+        tiles_ms: d.tiles_ms,
+        tiles_stages_ms: d.tiles_stages_ms,
+        tiles_resolve_ms: d.tiles_resolve_ms,
+        composite_ms: d.composite_ms,
+        auto_path: d.auto_path,
+        frame_ms: update_ms + draw + d.composite_ms,
     })
 }
 

@@ -175,7 +175,8 @@ fn report_difference(
         }
     }
     println!(
-        "  {} {} {}: {over} pixels over 8/255, the largest {worst}/255 at {at:?}: {:?} (billboards {:?})",
+        "  {} {} {}: {over} pixels over 8/255, the largest {worst}/255 at {at:?}: {:?} \
+            (billboards {:?})",
         row.preset,
         row.size,
         row.path,

@@ -18,7 +18,8 @@ impl Report {
         let command = std::env::args().collect::<Vec<_>>().join(" ");
         let info = &ctx.info;
         let markdown = format!(
-            "# {title}\n\n- adapter: {} ({:?}, {:?})\n- driver: {} {}\n- command: `{command}`\n- date: {}\n\n",
+            "# {title}\n\n- adapter: {} ({:?}, {:?})\n- driver: {} {}\n- command: \
+                `{command}`\n- date: {}\n\n",
             info.name,
             info.device_type,
             info.backend,

@@ -211,8 +211,18 @@ fn report(
         ctx,
     );
     r.para(&format!(
-        "`{}` at {}×{}: a host HDR target and depth buffer; medians of {} frames after a warm-up past the longest lifetime, {} frames at 60 fps. `record` = the instances' simulation steps and the smoke's sort; `draw` = every instance's billboards in the host's pass, soft edges against its depth. CPU = the API calls of a frame (advance, record, draw and finishing the encoder; encoding, not waiting), and of it the draw. GPU times: {}.",
-        opts.effect.name, opts.size.0, opts.size.1, opts.frames, opts.frames, timer.source.label()
+        "`{}` at {}×{}: a host HDR target and depth buffer; medians of {} frames after a \
+            warm-up past the longest lifetime, {} frames at 60 fps. `record` = the instances' \
+            simulation steps and the smoke's sort; `draw` = every instance's billboards in the \
+            host's pass, soft edges against its depth. CPU = the API calls of a frame (advance, \
+            record, draw and finishing the encoder; encoding, not waiting), and of it the draw. \
+            GPU times: {}.",
+        opts.effect.name,
+        opts.size.0,
+        opts.size.1,
+        opts.frames,
+        opts.frames,
+        timer.source.label()
     ));
     let row = |x: &Row| {
         vec![
@@ -243,8 +253,14 @@ fn report(
     let extra = (many.record_ms + many.draw_ms) - (one.record_ms + one.draw_ms);
     let per = extra / f64::from(many.instances.saturating_sub(1).max(1));
     r.para(&format!(
-        "{} instances cost {:.3} ms more than one emitter with the same particles: {:.4} ms ({:.1} µs) of GPU time per extra instance (its own dispatches, sort and draw calls); CPU {:.1} µs per instance.",
-        many.instances, extra, per, per * 1e3, (many.cpu_us - one.cpu_us) / f64::from(many.instances.saturating_sub(1).max(1))
+        "{} instances cost {:.3} ms more than one emitter with the same particles: {:.4} ms \
+            ({:.1} µs) of GPU time per extra instance (its own dispatches, sort and draw \
+            calls); CPU {:.1} µs per instance.",
+        many.instances,
+        extra,
+        per,
+        per * 1e3,
+        (many.cpu_us - one.cpu_us) / f64::from(many.instances.saturating_sub(1).max(1))
     ));
     r.json["runtime"] = serde_json::json!({
         "effect": opts.effect.name,

@@ -253,7 +253,8 @@ fn curve_plot(ui: &mut Ui, id: egui::Id, p: &mut Param, spec: &ParamSpec) {
     }
     paint_plot(ui, outer, rect, &view, p, spec, resp.hover_pos());
     resp.on_hover_text(format!(
-        "{name}: drag a key to move it, click elsewhere to add one, right-click a key to delete it (time: {})",
+        "{name}: drag a key to move it, click elsewhere to add one, right-click a key to delete \
+            it (time: {})",
         spec.t_unit
     ));
     ui.data_mut(|d| d.insert_temp(id, st));

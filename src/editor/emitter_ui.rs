@@ -26,8 +26,7 @@ pub fn emitter_ui(ui: &mut Ui, effect: &mut Effect, selected: &mut usize) {
 /// The selected emitter's own fields (name, shape, placement, spawning, bursts).
 fn emitter_fields_ui(ui: &mut Ui, e: &mut Emitter) {
     grid("emitter_grid").show(ui, |ui| {
-        row_ui(
-ui, "Name", "Unique name of this layer", |ui| {
+        row_ui(ui, "Name", "Unique name of this layer", |ui| {
             ui.add(egui::TextEdit::singleline(&mut e.name).desired_width(180.0))
         });
         shape_ui(ui, &mut e.shape);
@@ -52,20 +51,29 @@ ui, "Name", "Unique name of this layer", |ui| {
         param_row(
             ui,
             "Spawn rate",
-            "Continuous emission, particles per second, over the effect's time (a range or two curves: one rate or blend per instance, from its seed)",
+            "Continuous emission, particles per second, over the effect's time (a range or two \
+                curves: one rate or blend per instance, from its seed)",
             &mut e.spawn_rate_per_sec,
             &SPAWN_RATE,
         );
         row_ui(
-ui,
+            ui,
             "Max spawn / s",
-            "At most this many continuous spawns per second of simulated time, at any step size (clips a rate curve's peaks; bursts are not capped). 0 = no cap",
-            |ui| ui.add(DragValue::new(&mut e.max_spawn_per_sec).range(0.0..=1e9).speed(10.0)),
+            "At most this many continuous spawns per second of simulated time, at any step size \
+                (clips a rate curve's peaks; bursts are not capped). 0 = no cap",
+            |ui| {
+                ui.add(
+                    DragValue::new(&mut e.max_spawn_per_sec)
+                        .range(0.0..=1e9)
+                        .speed(10.0),
+                )
+            },
         );
         row_ui(
-ui,
+            ui,
             "Capacity",
-            "Particle slots in this emitter's ring. Keep it above rate × max lifetime, or living particles are recycled. Changing it keeps the particles that fit",
+            "Particle slots in this emitter's ring. Keep it above rate × max lifetime, or \
+                living particles are recycled. Changing it keeps the particles that fit",
             |ui| {
                 ui.add(
                     DragValue::new(&mut e.capacity)
@@ -103,9 +111,10 @@ ui,
             "",
         );
         row_ui(
-ui,
+            ui,
             "Spread",
-            "Half-angle of the cone of initial directions, degrees (a Cone shape uses its own angle)",
+            "Half-angle of the cone of initial directions, degrees (a Cone shape uses its own \
+                angle)",
             |ui| ui.add(drag(&mut e.spread_deg, 0.0..=180.0, 0.2, "°")),
         );
         range_ui(
@@ -379,9 +388,10 @@ pub fn next_seed(seed: u32) -> u32 {
 /// The effect seed, the emitter's seed offset and its spawn noise.
 pub fn randomness_ui(ui: &mut Ui, effect: &mut Effect, selected: usize) {
     grid("randomness_grid").show(ui, |ui| {
-        let label = ui
-            .label("Seed")
-            .on_hover_text("Master seed: every random number is a hash of the seed, the emitter, the slot and the spawn counter");
+        let label = ui.label("Seed").on_hover_text(
+            "Master seed: every random number is a hash of the seed, the \
+                emitter, the slot and the spawn counter",
+        );
         ui.horizontal(|ui| {
             ui.add(DragValue::new(&mut effect.seed).speed(1.0))
                 .labelled_by(label.id);
@@ -398,32 +408,34 @@ pub fn randomness_ui(ui: &mut Ui, effect: &mut Effect, selected: usize) {
             return;
         };
         row_ui(
-ui,
+            ui,
             "Seed offset",
-            "Added to the seed for this emitter's stream (two emitters with the same settings differ by it)",
+            "Added to the seed for this emitter's stream (two emitters with the same settings \
+                differ by it)",
             |ui| ui.add(DragValue::new(&mut e.seed_offset).speed(1.0)),
         );
         let n = &mut e.spawn_noise;
         row_ui(
-ui,
+            ui,
             "Noise frequency",
-            "Spatial frequency of the noise that moves spawn positions and tilts directions, per metre",
+            "Spatial frequency of the noise that moves spawn positions and tilts directions, \
+                per metre",
             |ui| ui.add(drag(&mut n.frequency_per_m, 0.0..=100.0, 0.02, " /m")),
         );
         row_ui(
-ui,
+            ui,
             "Position amplitude",
             "How far the noise moves spawn positions, metres",
             |ui| ui.add(drag(&mut n.position_amplitude_m, 0.0..=10.0, 0.002, " m")),
         );
         row_ui(
-ui,
+            ui,
             "Direction amplitude",
             "How far the noise tilts the initial direction (fraction of the direction vector)",
             |ui| ui.add(drag(&mut n.direction_amplitude, 0.0..=10.0, 0.005, "")),
         );
         row_ui(
-ui,
+            ui,
             "Scroll speed",
             "How fast the noise field scrolls in time (flicker rate), per second",
             |ui| ui.add(drag(&mut n.scroll_per_sec, -100.0..=100.0, 0.02, " /s")),

@@ -50,7 +50,10 @@ pub fn events_ui(ui: &mut Ui, effect: &mut Effect, selected: usize) {
     } else if e.events.len() < MAX_EVENTS_PER_EMITTER
         && ui
             .button("Add event")
-            .on_hover_text("Spawn particles of another emitter when this one's die, collide, are born, or while they live")
+            .on_hover_text(
+                "Spawn particles of another emitter when this one's die, collide, \
+                are born, or while they live",
+            )
             .clicked()
     {
         e.events.push(Event {
@@ -67,7 +70,9 @@ fn event_grid_ui(ui: &mut Ui, ev: &mut Event, others: &[String]) {
         .spacing([10.0, 5.0])
         .min_col_width(96.0)
         .show(ui, |ui| {
-            let label = ui.label("Spawn").on_hover_text("The emitter whose particles this event spawns");
+            let label = ui
+                .label("Spawn")
+                .on_hover_text("The emitter whose particles this event spawns");
             egui::ComboBox::from_id_salt("event_target")
                 .selected_text(ev.emitter.as_str())
                 .show_ui(ui, |ui| {
@@ -78,7 +83,11 @@ fn event_grid_ui(ui: &mut Ui, ev: &mut Event, others: &[String]) {
                 .response
                 .labelled_by(label.id);
             ui.end_row();
-            let label = ui.label("When").on_hover_text("Death: the step a particle dies. Collision: each impact on the ground or a sphere faster than the rest speed. Birth: the step it is born. Over life: at a rate while it lives");
+            let label = ui.label("When").on_hover_text(
+                "Death: the step a particle dies. \
+                Collision: each impact on the ground or a sphere faster than the rest speed. \
+                Birth: the step it is born. Over life: at a rate while it lives",
+            );
             egui::ComboBox::from_id_salt("event_trigger")
                 .selected_text(ev.trigger.label())
                 .show_ui(ui, |ui| {
@@ -90,32 +99,66 @@ fn event_grid_ui(ui: &mut Ui, ev: &mut Event, others: &[String]) {
                 .labelled_by(label.id);
             ui.end_row();
             if ev.trigger == Trigger::OverLife {
-                let label = ui.label("Rate").on_hover_text("Children per second per living particle");
-                ui.add(DragValue::new(&mut ev.rate_per_sec).range(0.0..=1000.0).speed(0.1).suffix(" /s"))
-                    .labelled_by(label.id);
+                let label = ui
+                    .label("Rate")
+                    .on_hover_text("Children per second per living particle");
+                ui.add(
+                    DragValue::new(&mut ev.rate_per_sec)
+                        .range(0.0..=1000.0)
+                        .speed(0.1)
+                        .suffix(" /s"),
+                )
+                .labelled_by(label.id);
             } else {
-                let label = ui.label("Count").on_hover_text("Children per event: each event draws a count in this range");
+                let label = ui
+                    .label("Count")
+                    .on_hover_text("Children per event: each event draws a count in this range");
                 ui.horizontal(|ui| {
                     count_ui(ui, &mut ev.count);
                 })
                 .response
                 .labelled_by(label.id);
                 ui.end_row();
-                let label = ui.label("Chance").on_hover_text("The chance that an event spawns at all (1 = every event)");
-                ui.add(DragValue::new(&mut ev.probability).range(0.0..=1.0).speed(0.002).max_decimals(3))
-                    .labelled_by(label.id);
+                let label = ui
+                    .label("Chance")
+                    .on_hover_text("The chance that an event spawns at all (1 = every event)");
+                ui.add(
+                    DragValue::new(&mut ev.probability)
+                        .range(0.0..=1.0)
+                        .speed(0.002)
+                        .max_decimals(3),
+                )
+                .labelled_by(label.id);
             }
             ui.end_row();
-            let label = ui.label("Inherit velocity").on_hover_text("The fraction of the parent's velocity a child starts with, on top of its own spawn speed");
-            ui.add(DragValue::new(&mut ev.inherit_velocity).range(-10.0..=10.0).speed(0.01))
-                .labelled_by(label.id);
+            let label = ui.label("Inherit velocity").on_hover_text(
+                "The fraction of the \
+                parent's velocity a child starts with, on top of its own spawn speed",
+            );
+            ui.add(
+                DragValue::new(&mut ev.inherit_velocity)
+                    .range(-10.0..=10.0)
+                    .speed(0.01),
+            )
+            .labelled_by(label.id);
             ui.end_row();
-            ui.label("Inherit colour").on_hover_text("Multiply the child's colour by the parent's colour at the event (a white child gradient takes the parent's colour)");
+            ui.label("Inherit colour").on_hover_text(
+                "Multiply the child's colour by the \
+                parent's colour at the event (a white child gradient takes the parent's colour)",
+            );
             ui.checkbox(&mut ev.inherit_color, "parent's colour");
             ui.end_row();
-            let label = ui.label("Cap / s").on_hover_text("At most this many children per second of simulated time, at any step size; the rest are dropped and counted in Stats");
-            ui.add(DragValue::new(&mut ev.max_per_sec).range(1.0..=1e8).speed(10.0))
-                .labelled_by(label.id);
+            let label = ui.label("Cap / s").on_hover_text(
+                "At most this many children per \
+                second of simulated time, at any step size; the rest are dropped and counted in \
+                Stats",
+            );
+            ui.add(
+                DragValue::new(&mut ev.max_per_sec)
+                    .range(1.0..=1e8)
+                    .speed(10.0),
+            )
+            .labelled_by(label.id);
             ui.end_row();
         });
 }

@@ -290,7 +290,8 @@ fn output_rows(ui: &mut Ui, panel: &mut ExportPanel) {
     row(
         ui,
         "Six-way passes",
-        "The lit smoke's six-way lightmaps (RTBA and LBFE, Unity's packing), for an engine to relight the flipbook",
+        "The lit smoke's six-way lightmaps (RTBA and LBFE, Unity's packing), for an engine to \
+            relight the flipbook",
         |ui| ui.checkbox(&mut s.passes.sixway, ""),
     );
     row(

@@ -19,10 +19,17 @@ pub fn forces_ui(ui: &mut Ui, effect: &mut Effect, selected: usize) {
     let f = &mut e.forces;
     grid("forces_grid").show(ui, |ui| {
         row_ui(
-ui,
+            ui,
             "Buoyancy",
             "Upward acceleration of hot gas along +Y, m/s² (the 2006 thesis's negative gravity)",
-            |ui| ui.add(drag(&mut f.buoyancy_m_per_s2, -1000.0..=1000.0, 0.05, " m/s²")),
+            |ui| {
+                ui.add(drag(
+                    &mut f.buoyancy_m_per_s2,
+                    -1000.0..=1000.0,
+                    0.05,
+                    " m/s²",
+                ))
+            },
         );
         vec3_ui(
             ui,
@@ -34,9 +41,10 @@ ui,
             "",
         );
         row_ui(
-ui,
+            ui,
             "Drag",
-            "Linear drag rate k, per second: the velocity relaxes toward the wind with time constant 1/k",
+            "Linear drag rate k, per second: the velocity relaxes toward the wind with time \
+                constant 1/k",
             |ui| ui.add(drag(&mut f.drag_per_sec, 0.0..=1000.0, 0.01, " /s")),
         );
         param_row(
@@ -49,7 +57,8 @@ ui,
         param_row(
             ui,
             "Speed over life",
-            "Multiplies how far the particle moves each step over its life (1 = as its velocity says)",
+            "Multiplies how far the particle moves each step over its life (1 = as its velocity \
+                says)",
             &mut f.speed_over_life,
             &multiplier("Speed over life curve"),
         );

@@ -13,11 +13,21 @@ pub fn lighting_ui(ui: &mut Ui, lighting: &mut Lighting) {
     grid("lighting_grid").show(ui, |ui| {
         let d = lighting.sun_unit();
         let (mut bearing, mut height) = (d.x.atan2(d.z).to_degrees(), d.y.asin().to_degrees());
-        let tip = "Where the sun (or the moon) is: its height above the horizon and its bearing around +Y (0° = +Z, towards the default camera). Saved with the preset; a host sets its own";
+        let tip = "Where the sun (or the moon) is: its height above the horizon and its bearing \
+            around +Y (0° = +Z, towards the default camera). Saved with the preset; a host sets \
+            its own";
         let changed = row_ui(ui, "Sun", tip, |ui| {
             ui.horizontal(|ui| {
-                let a = ui.add(DragValue::new(&mut height).range(-90.0..=90.0).suffix("° up"));
-                let b = ui.add(DragValue::new(&mut bearing).range(-180.0..=180.0).suffix("°"));
+                let a = ui.add(
+                    DragValue::new(&mut height)
+                        .range(-90.0..=90.0)
+                        .suffix("° up"),
+                );
+                let b = ui.add(
+                    DragValue::new(&mut bearing)
+                        .range(-180.0..=180.0)
+                        .suffix("°"),
+                );
                 a | b
             })
             .inner
@@ -27,8 +37,19 @@ pub fn lighting_ui(ui: &mut Ui, lighting: &mut Lighting) {
             let (h, b) = (height.to_radians(), bearing.to_radians());
             lighting.sun_direction = [h.cos() * b.sin(), h.sin(), h.cos() * b.cos()];
         }
-        hdr_color_row(ui, "Sun colour", "The sun's colour times its strength (linear; 1 lights a white sprite white)", &mut lighting.sun_color);
-        hdr_color_row(ui, "Ambient", "Light from every direction (linear): the sky", &mut lighting.ambient);
+        hdr_color_row(
+            ui,
+            "Sun colour",
+            "The sun's colour times its strength (linear; 1 lights \
+            a white sprite white)",
+            &mut lighting.sun_color,
+        );
+        hdr_color_row(
+            ui,
+            "Ambient",
+            "Light from every direction (linear): the sky",
+            &mut lighting.ambient,
+        );
     });
 }
 
@@ -66,7 +87,8 @@ pub fn lit_rows_ui(ui: &mut Ui, look: &mut Look) {
     if look.lit.is_some() && (!alpha || look.streak.is_some()) {
         look.lit = None;
     }
-    let tip = "Shade this alpha-blended layer with six-way lightmaps: lit by the effect's own flames, the sun and ambient (View) and a host's lights; the maps replace the sprite";
+    let tip = "Shade this alpha-blended layer with six-way lightmaps: lit by the effect's own \
+        flames, the sun and ambient (View) and a host's lights; the maps replace the sprite";
     row_ui(ui, "Lit (six-way)", tip, |ui| {
         ui.add_enabled_ui(alpha && look.streak.is_none(), |ui| {
             let mut on = look.lit.is_some();
@@ -81,7 +103,9 @@ pub fn lit_rows_ui(ui: &mut Ui, look: &mut Look) {
     let Some(lit) = look.lit.as_mut() else {
         return;
     };
-    let tip = "The built-in puff (or its 4 × 4 flipbook, ray-marched by ignis) or a pair of PNGs: RTBA (right, top, back, alpha) and LBFE (left, bottom, front, emissive), linear, as EmberGen and Unity's Six Way shader use";
+    let tip = "The built-in puff (or its 4 × 4 flipbook, ray-marched by ignis) or a pair of \
+        PNGs: RTBA (right, top, back, alpha) and LBFE (left, bottom, front, emissive), linear, \
+        as EmberGen and Unity's Six Way shader use";
     row_ui(ui, "Lightmaps", tip, |ui| {
         let text = match &lit.maps {
             SixWayMaps::Puff => "puff",
@@ -131,7 +155,8 @@ pub fn lit_rows_ui(ui: &mut Ui, look: &mut Look) {
     row_ui(
         ui,
         "Glow",
-        "How much of the colour over life the smoke emits itself, where the maps' emissive mask says (embers in the smoke)",
+        "How much of the colour over life the smoke emits itself, where the maps' emissive mask \
+            says (embers in the smoke)",
         |ui| {
             ui.add(
                 DragValue::new(&mut lit.emission)
@@ -143,7 +168,8 @@ pub fn lit_rows_ui(ui: &mut Ui, look: &mut Look) {
     row_ui(
         ui,
         "Fire light",
-        "How strongly the effect's own light (its additive layers, measured each frame) lights this layer: 1 = its power over the squared distance",
+        "How strongly the effect's own light (its additive layers, measured each frame) lights \
+            this layer: 1 = its power over the squared distance",
         |ui| {
             ui.add(
                 DragValue::new(&mut lit.self_light)

@@ -61,7 +61,8 @@ pub fn look_ui(
         .min_col_width(96.0)
         .show(ui, |ui| {
             let label = ui.label("Exposure").on_hover_text(
-                "Viewport exposure: multiplies the HDR image before the ACES tonemap (a view setting, not part of the preset)",
+                "Viewport exposure: multiplies the HDR image before the ACES tonemap (a view \
+                    setting, not part of the preset)",
             );
             ui.add(
                 egui::Slider::new(&mut view.exposure, 0.05..=8.0)
@@ -104,7 +105,8 @@ fn post_ui(ui: &mut Ui, post: &mut Post) {
     }
     ui.end_row();
     let label = ui.label("Smoke resolution").on_hover_text(
-        "Alpha-blended layers (smoke) are drawn at 1/n of the resolution and upsampled in the composite: soft smoke looks the same and costs n² less fill",
+        "Alpha-blended layers (smoke) are drawn at 1/n of the resolution and upsampled in the \
+            composite: soft smoke looks the same and costs n² less fill",
     );
     ui.horizontal(|ui| {
         for (n, text) in [(1, "full"), (2, "½"), (4, "¼")] {
@@ -152,7 +154,9 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
         .min_col_width(96.0)
         .show(ui, |ui| {
             sprite_rows_ui(ui, look);
-            let label_tip = "Additive: light adds up, order-independent (fire, sparks). Alpha: premultiplied over, darkens what is behind (smoke); alpha layers are drawn first, sorted back to front";
+            let label_tip = "Additive: light adds up, order-independent (fire, sparks). Alpha: \
+                premultiplied over, darkens what is behind (smoke); alpha layers are drawn \
+                first, sorted back to front";
             ui.label("Blend").on_hover_text(label_tip);
             ui.horizontal(|ui| {
                 for b in [BlendMode::Additive, BlendMode::Alpha] {
@@ -162,23 +166,40 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
             });
             ui.end_row();
             let label = ui.label("Draw path").on_hover_text(format!(
-                "auto: compute splat when particles project below {SPLAT_BELOW_PX} px, blend additively and have no streak; on GPUs the tile rasteriser from {TILES_ABOVE_PX} px; billboards otherwise. billboard: instanced quads. splat: compute splat (additive only; alpha falls back to billboards). tiles: the compute tile rasteriser (alpha-blended emitters take it together or not at all)"
+                "auto: compute splat when particles project below {SPLAT_BELOW_PX} px, blend \
+                    additively and have no streak; on GPUs the tile rasteriser from \
+                    {TILES_ABOVE_PX} px; billboards otherwise. billboard: instanced quads. \
+                    splat: compute splat (additive only; alpha falls back to billboards). \
+                    tiles: the compute tile rasteriser (alpha-blended emitters take it together \
+                    or not at all)"
             ));
             egui::ComboBox::from_id_salt("draw_path")
                 .selected_text(draw_path_label(look.draw_path))
                 .show_ui(ui, |ui| {
-                    for d in [DrawPath::Auto, DrawPath::Billboard, DrawPath::Splat, DrawPath::Tiles] {
+                    for d in [
+                        DrawPath::Auto,
+                        DrawPath::Billboard,
+                        DrawPath::Splat,
+                        DrawPath::Tiles,
+                    ] {
                         ui.selectable_value(&mut look.draw_path, d, draw_path_label(d));
                     }
                 })
                 .response
                 .labelled_by(label.id);
             ui.end_row();
-            param_row(ui, "Size", "Billboard diameter over the particle's life, metres", &mut look.size_m, &SIZE);
+            param_row(
+                ui,
+                "Size",
+                "Billboard diameter over the particle's life, metres",
+                &mut look.size_m,
+                &SIZE,
+            );
             param_row(
                 ui,
                 "Opacity",
-                "Multiplies the particle's contribution over its life: its light when additive, its coverage when alpha",
+                "Multiplies the particle's contribution over its life: its light when additive, \
+                    its coverage when alpha",
                 &mut look.opacity,
                 &OPACITY,
             );
@@ -197,32 +218,52 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
             param_row(
                 ui,
                 "Spin",
-                "Angular velocity over the particle's life, degrees per second (a range: each particle spins at its own rate)",
+                "Angular velocity over the particle's life, degrees per second (a range: each \
+                    particle spins at its own rate)",
                 &mut look.spin_deg_per_s,
                 &SPIN,
             );
-            let label = ui
-                .label("Streak")
-                .on_hover_text("Stretch each billboard from where the particle was (length seconds ago) to where it is: spark trails");
+            let label = ui.label("Streak").on_hover_text(
+                "Stretch each billboard from where the particle was (length \
+                    seconds ago) to where it is: spark trails",
+            );
             ui.horizontal(|ui| {
                 let mut on = look.streak.is_some();
                 if ui.checkbox(&mut on, "stretch").changed() {
                     look.streak = on.then(Streak::default);
                 }
                 if let Some(s) = &mut look.streak {
-                    ui.add(DragValue::new(&mut s.length_secs).range(0.0..=1.0).speed(0.001).suffix(" s"))
-                        .labelled_by(label.id);
-                    ui.add(DragValue::new(&mut s.max_length_m).range(0.0..=100.0).speed(0.01).prefix("≤ ").suffix(" m"))
-                        .labelled_by(label.id);
+                    ui.add(
+                        DragValue::new(&mut s.length_secs)
+                            .range(0.0..=1.0)
+                            .speed(0.001)
+                            .suffix(" s"),
+                    )
+                    .labelled_by(label.id);
+                    ui.add(
+                        DragValue::new(&mut s.max_length_m)
+                            .range(0.0..=100.0)
+                            .speed(0.01)
+                            .prefix("≤ ")
+                            .suffix(" m"),
+                    )
+                    .labelled_by(label.id);
                 }
             });
             ui.end_row();
             trail_rows_ui(ui, look);
-            let label = ui
-                .label("Soft ground")
-                .on_hover_text("Fade sprites over this distance above the ground plane (the emitter's ground collider, else y = 0) instead of cutting them: soft particles. 0 = off");
-            ui.add(DragValue::new(&mut look.soft_ground_m).range(0.0..=10.0).speed(0.002).suffix(" m"))
-                .labelled_by(label.id);
+            let label = ui.label("Soft ground").on_hover_text(
+                "Fade sprites over this distance above the ground plane (the \
+                    emitter's ground collider, else y = 0) instead of cutting them: soft \
+                    particles. 0 = off",
+            );
+            ui.add(
+                DragValue::new(&mut look.soft_ground_m)
+                    .range(0.0..=10.0)
+                    .speed(0.002)
+                    .suffix(" m"),
+            )
+            .labelled_by(label.id);
             ui.end_row();
             let label = ui
                 .label("Intensity")
@@ -238,7 +279,8 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
         });
     ui.add_space(4.0);
     ui.label("Colour over life").on_hover_text(
-        "Colour (linear RGB) and alpha over the normalised age: 0 = birth, 1 = death. Click the bar to add a stop, drag a handle to move it, right-click a handle to remove it",
+        "Colour (linear RGB) and alpha over the normalised age: 0 = birth, 1 = death. Click the \
+            bar to add a stop, drag a handle to move it, right-click a handle to remove it",
     );
     gradient_editor_ui(ui, &mut look.color_over_life);
     color_stops_ui(ui, &mut look.color_over_life);
@@ -248,7 +290,9 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
 /// open grid).
 fn trail_rows_ui(ui: &mut Ui, look: &mut Look) {
     let label = ui.label("Trail").on_hover_text(
-        "A ribbon (drawn by the billboards) through each particle's last positions, recorded every few steps, or — an emitter fed by events — one per parent through the particles it spawned, in order; the velocity streak is the cheaper option",
+        "A ribbon (drawn by the billboards) through each particle's last positions, recorded \
+            every few steps, or — an emitter fed by events — one per parent through the \
+            particles it spawned, in order; the velocity streak is the cheaper option",
     );
     ui.horizontal(|ui| {
         let mut on = look.trail.is_some();
@@ -278,7 +322,8 @@ fn trail_rows_ui(ui: &mut Ui, look: &mut Look) {
 /// The points a trail through a particle's last positions keeps (a row of an open grid).
 fn trail_points_row_ui(ui: &mut Ui, t: &mut Trail) {
     let label = ui.label("Trail points").on_hover_text(
-        "Positions kept per particle, and how far back they reach in seconds of simulated time (a step coarser than the spacing keeps fewer: one per step)",
+        "Positions kept per particle, and how far back they reach in seconds of simulated time \
+            (a step coarser than the spacing keeps fewer: one per step)",
     );
     ui.horizontal(|ui| {
         ui.add(
@@ -305,7 +350,8 @@ fn trail_width_rows_ui(ui: &mut Ui, look: &mut Look) {
         return;
     };
     let label = ui.label("Trail width").on_hover_text(
-        "Width at the particle (× its size), then the width and opacity at the tail as fractions of it; sprite: draw the particle's sprite too",
+        "Width at the particle (× its size), then the width and opacity at the tail as \
+            fractions of it; sprite: draw the particle's sprite too",
     );
     ui.horizontal(|ui| {
         ui.add(
@@ -336,9 +382,10 @@ fn trail_width_rows_ui(ui: &mut Ui, look: &mut Look) {
 
 /// The sprite picker, the PNG path and the flipbook (rows of an open grid).
 fn sprite_rows_ui(ui: &mut Ui, look: &mut Look) {
-    let label = ui
-        .label("Sprite")
-        .on_hover_text("Built-in procedural sprites, or a PNG with alpha (path relative to the preset file; reloads when the file changes)");
+    let label = ui.label("Sprite").on_hover_text(
+        "Built-in procedural sprites, or a PNG with alpha (path relative to the \
+            preset file; reloads when the file changes)",
+    );
     let is_image = matches!(look.sprite, Sprite::Image(_));
     egui::ComboBox::from_id_salt("sprite")
         .selected_text(if is_image {
@@ -365,9 +412,10 @@ fn sprite_rows_ui(ui: &mut Ui, look: &mut Look) {
         ui.text_edit_singleline(path).labelled_by(label.id);
         ui.end_row();
     }
-    ui
-        .label("Flipbook")
-        .on_hover_text("Treat the sprite as an atlas of rows × columns frames (row-major from the top left) and animate it");
+    ui.label("Flipbook").on_hover_text(
+        "Treat the sprite as an atlas of rows × columns frames (row-major from \
+            the top left) and animate it",
+    );
     let mut on = look.flipbook.is_some();
     if ui.checkbox(&mut on, "animate").changed() {
         look.flipbook = on.then(|| {
@@ -397,7 +445,8 @@ fn flipbook_rows_ui(ui: &mut Ui, f: &mut Flipbook) {
     });
     ui.end_row();
     let label = ui.label("Frame timing").on_hover_text(
-        "Over life: first frame at birth, last at death. Frame rate: a fixed rate, looping. Curve: the frame over life, as a parameter",
+        "Over life: first frame at birth, last at death. Frame rate: a fixed rate, looping. \
+            Curve: the frame over life, as a parameter",
     );
     let frames = f.rows * f.cols;
     ui.horizontal(|ui| {
@@ -435,7 +484,8 @@ fn flipbook_rows_ui(ui: &mut Ui, f: &mut Flipbook) {
         param_row(
             ui,
             "Frame",
-            "The flipbook frame over the particle's life (0 = first; fractions blend when blending frames)",
+            "The flipbook frame over the particle's life (0 = first; fractions blend when \
+                blending frames)",
             p,
             &spec,
         );
@@ -638,7 +688,8 @@ pub fn color_stops_ui(ui: &mut Ui, stops: &mut Vec<ColorStop>) {
     if ui
         .add_enabled(can_add, egui::Button::new("Add stop"))
         .on_hover_text(format!(
-            "Insert a stop in the widest gap, coloured as the gradient there (at most {MAX_COLOR_STOPS})"
+            "Insert a stop in the widest gap, coloured as the gradient there (at most \
+                {MAX_COLOR_STOPS})"
         ))
         .clicked()
     {

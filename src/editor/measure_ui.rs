@@ -163,8 +163,12 @@ pub fn apply_pick(panel: &mut MeasurePanel, effect: &mut Effect) -> bool {
 /// The Measure block: controls, progress, the chart and the frontier's rows.
 pub fn measure_ui(ui: &mut Ui, panel: &mut MeasurePanel, effect: &mut Effect) {
     ui.separator();
-    ui.strong("Measure this effect")
-        .on_hover_text("Play every integrator × step, state size, module switched off and draw path against a converged reference (RK4 at a sixteenth of the step) and compare the frames: image error against frame time on this GPU (`ignis tune` on the command line)");
+    ui.strong("Measure this effect").on_hover_text(
+        "Play every integrator × step, state size, module switched off and draw \
+            path against a converged reference (RK4 at a sixteenth of the step) and compare the \
+            frames: image error against frame time on this GPU (`ignis tune` on the command \
+            line)",
+    );
     controls_ui(ui, panel);
     if let Some(report) = &panel.report {
         let mut pick = None;

@@ -223,14 +223,20 @@ fn preset_file_ui(ui: &mut Ui, state: &mut EditorState) {
         .on_hover_text("The RON preset file Save writes and Load reads");
         if ui
             .button("Save")
-            .on_hover_text("Write the edited effect (valid effects only; atomic: a crash never leaves half a file)")
+            .on_hover_text(
+                "Write the edited effect (valid effects only; atomic: a crash never \
+                leaves half a file)",
+            )
             .clicked()
         {
             state.save_preset();
         }
         if ui
             .button("Load")
-            .on_hover_text("Replace the effect with this preset (undoable; asks first when there are unsaved edits)")
+            .on_hover_text(
+                "Replace the effect with this preset (undoable; asks first when \
+                there are unsaved edits)",
+            )
             .clicked()
         {
             state.request_load();
@@ -531,13 +537,16 @@ pub(super) fn grid(id: &str) -> egui::Grid {
 pub fn view_ui(ui: &mut Ui, view: &mut ViewSettings, frame_requested: &mut bool) {
     grid("view_grid").show(ui, |ui| {
         row_ui(
-ui, "Ground grid", "Draw the y = 0 grid (0.5 m cells)", |ui| {
-            ui.checkbox(&mut view.show_grid, "")
-        });
+            ui,
+            "Ground grid",
+            "Draw the y = 0 grid (0.5 m cells)",
+            |ui| ui.checkbox(&mut view.show_grid, ""),
+        );
         row_ui(
             ui,
             "Fire lights grid",
-            "The grid is lit by the effect's own light (its additive particles, measured on the GPU each frame): it flickers with the flames",
+            "The grid is lit by the effect's own light (its additive particles, measured on the \
+                GPU each frame): it flickers with the flames",
             |ui| ui.checkbox(&mut view.fire_lights_grid, ""),
         );
         row_ui(
@@ -549,29 +558,36 @@ ui, "Ground grid", "Draw the y = 0 grid (0.5 m cells)", |ui| {
         row_ui(
             ui,
             "Inspect",
-            "Show the particle under the pointer — its slot, age, lifetime, position, velocity and the forces on it now; click one to pin it",
+            "Show the particle under the pointer — its slot, age, lifetime, position, velocity \
+                and the forces on it now; click one to pin it",
             |ui| ui.checkbox(&mut view.inspect, ""),
         );
         row_ui(
             ui,
             "State view",
-            "The selected emitter's state buffer as images, one texel per slot: position, velocity and age as colours",
+            "The selected emitter's state buffer as images, one texel per slot: position, \
+                velocity and age as colours",
             |ui| ui.checkbox(&mut view.state_view, ""),
         );
         row_ui(
-ui, "Shape gizmos", "Draw every emitter's spawn shape as a wireframe", |ui| {
-            ui.checkbox(&mut view.show_gizmos, "")
-        });
+            ui,
+            "Shape gizmos",
+            "Draw every emitter's spawn shape as a wireframe",
+            |ui| ui.checkbox(&mut view.show_gizmos, ""),
+        );
         row_ui(
-ui,
+            ui,
             "Render scale",
-            "Render the viewport at this fraction of its pixel size and upscale it (faster on slow GPUs)",
+            "Render the viewport at this fraction of its pixel size and upscale it (faster on \
+                slow GPUs)",
             |ui| ui.add(egui::Slider::new(&mut view.render_scale, 0.25..=1.0).fixed_decimals(2)),
         );
         row_ui(
             ui,
             "Draft glow",
-            "Draw large additive sprites (flame tongues) at half the render resolution and alpha-blended layers (smoke) at half their own: a quarter of their fill, slightly softer (on by default on software adapters)",
+            "Draw large additive sprites (flame tongues) at half the render resolution and \
+                alpha-blended layers (smoke) at half their own: a quarter of their fill, \
+                slightly softer (on by default on software adapters)",
             |ui| ui.checkbox(&mut view.draft, ""),
         );
     });

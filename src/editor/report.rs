@@ -95,7 +95,9 @@ impl std::fmt::Display for RunReport {
         };
         write!(
             f,
-            "edit: {} frames, median frame {:.1} ms ({:.1} fps), median CPU wall time (sim + render recording) {:.1} ms; window {}x{}, viewport {}x{} px, {} particles alive, on {}",
+            "edit: {} frames, median frame {:.1} ms ({:.1} fps), median CPU wall time (sim + \
+                render recording) {:.1} ms; window {}x{}, viewport {}x{} px, {} particles \
+                alive, on {}",
             self.frames,
             self.median_frame_secs * 1e3,
             fps,
@@ -110,13 +112,15 @@ impl std::fmt::Display for RunReport {
         if let Some((full, live)) = self.ui_repaints {
             write!(
                 f,
-                "\nretained UI: {full} frames painted in full, {live} only over the viewport and timeline"
+                "\nretained UI: {full} frames painted in full, {live} only over the viewport \
+                    and timeline"
             )?;
         }
         if self.devices_recreated > 0 {
             write!(
                 f,
-                "\nGPU device lost and recreated {} time(s); the effect and its undo history were kept",
+                "\nGPU device lost and recreated {} time(s); the effect and its undo history \
+                    were kept",
                 self.devices_recreated
             )?;
         }

@@ -42,7 +42,8 @@ pub(super) fn summary(state: &EditorState, playing: &Effect) -> String {
             .map_or(f32::NAN, |e| e.look.intensity)
     };
     format!(
-        "edits around the loss: {} undo step(s) left, {EMITTER} intensity {} in the panel, {} playing",
+        "edits around the loss: {} undo step(s) left, {EMITTER} intensity {} in the panel, {} \
+            playing",
         state.history.undo_len(),
         intensity(&state.effect),
         intensity(playing)

@@ -25,7 +25,9 @@ pub fn time_ui(
     let t = &mut effect.time;
     grid("time_grid").show(ui, |ui| {
         ui.label("Mode").on_hover_text(
-            "Fixed step: an accumulator runs whole steps, so the result does not depend on the frame rate. Frame delta: one step per frame of the frame's duration (the 2006 thesis's mode)",
+            "Fixed step: an accumulator runs whole steps, so the result does not depend on the \
+                frame rate. Frame delta: one step per frame of the frame's duration (the 2006 \
+                thesis's mode)",
         );
         ui.horizontal(|ui| {
             ui.radio_value(&mut t.mode, TimeMode::FixedStep, "Fixed step");
@@ -48,13 +50,21 @@ pub fn time_ui(
         });
         ui.end_row();
         row_ui(
-ui,
+            ui,
             "Max substeps",
-            "At most this many fixed steps per frame; the rest of the time is dropped and counted (Stats)",
-            |ui| ui.add_enabled(is_fixed, DragValue::new(&mut t.max_substeps).range(1..=256).speed(0.1)),
+            "At most this many fixed steps per frame; the rest of the time is dropped and \
+                counted (Stats)",
+            |ui| {
+                ui.add_enabled(
+                    is_fixed,
+                    DragValue::new(&mut t.max_substeps)
+                        .range(1..=256)
+                        .speed(0.1),
+                )
+            },
         );
         row_ui(
-ui,
+            ui,
             "Max frame dt",
             "Frame-delta mode: a longer frame is clamped to this step, seconds",
             |ui| {
@@ -65,7 +75,7 @@ ui,
             },
         );
         row_ui(
-ui,
+            ui,
             "Sim speed",
             "Simulation speed multiplier (1 = real time)",
             |ui| ui.add(drag(&mut t.speed, 0.0..=10.0, 0.01, "×").min_decimals(2)),
@@ -98,7 +108,8 @@ fn emitter_time_rows_ui(ui: &mut Ui, e: &mut crate::effect::Emitter) {
     row_ui(
         ui,
         "Stateless",
-        "Closed form instead of steps: each particle's position is evaluated from its spawn record and age (exact, cheaper). Only for constant acceleration and linear drag",
+        "Closed form instead of steps: each particle's position is evaluated from its spawn \
+            record and age (exact, cheaper). Only for constant acceleration and linear drag",
         |ui| {
             let r = ui.checkbox(&mut e.stateless, "closed form");
             if r.changed() && e.stateless {
@@ -109,7 +120,11 @@ fn emitter_time_rows_ui(ui: &mut Ui, e: &mut crate::effect::Emitter) {
         },
     );
     // Three radio buttons, each named by its own text (not by the row's label).
-    let tip = "Bytes stored per particle. 32 B: f32 position, velocity, age, lifetime. 20 B packed: f16 velocity, 16-bit life fraction, lifetime re-derived from the spawn hash. 10 B tiny: f16 position, shared-exponent velocity, age from a table of each step's births. Smaller moves less memory for huge pools, at the accuracy cost `ignis bench accuracy` reports (\"+ packed\", \"+ tiny\" rows). Switching restarts this emitter's particles";
+    let tip = "Bytes stored per particle. 32 B: f32 position, velocity, age, lifetime. 20 B \
+        packed: f16 velocity, 16-bit life fraction, lifetime re-derived from the spawn hash. 10 \
+        B tiny: f16 position, shared-exponent velocity, age from a table of each step's births. \
+        Smaller moves less memory for huge pools, at the accuracy cost `ignis bench accuracy` \
+        reports (\"+ packed\", \"+ tiny\" rows). Switching restarts this emitter's particles";
     ui.label("State size").on_hover_text(tip);
     ui.horizontal(|ui| {
         let before = (e.packed_state, e.tiny_state);
@@ -161,7 +176,9 @@ fn stability_ui(ui: &mut Ui, effect: &Effect) {
             ui.weak("emitter");
             ui.weak("integrator");
             ui.weak("stability at this step").on_hover_text(
-                "How much an error grows over a particle's life under the emitter's stiffest forces (drag, flame pull, attractor, vortex, turbulence), and the largest step that keeps it below 2×",
+                "How much an error grows over a particle's life under the emitter's stiffest \
+                    forces (drag, flame pull, attractor, vortex, turbulence), and the largest \
+                    step that keeps it below 2×",
             );
             ui.end_row();
             for e in effect.emitters.iter().filter(|e| e.enabled) {

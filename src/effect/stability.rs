@@ -59,7 +59,8 @@ impl std::fmt::Display for StabilityWarning {
         match self.stable_step_secs {
             Some(s) => write!(
                 f,
-                "; a step of at most {} is stable, or lower the value, or use the exponential integrator",
+                "; a step of at most {} is stable, or lower the value, or use the exponential \
+                    integrator",
                 secs_label(s)
             ),
             None => write!(f, "; lower the value"),

@@ -303,21 +303,24 @@ impl Emitter {
             c.push(
                 p("packed_state"),
                 true,
-                "cannot be combined with `stateless` (stateless emitters store spawn records, not state); turn one off",
+                "cannot be combined with `stateless` (stateless emitters store spawn records, \
+                    not state); turn one off",
             );
         }
         if self.tiny_state && self.stateless {
             c.push(
                 p("tiny_state"),
                 true,
-                "cannot be combined with `stateless` (stateless emitters store spawn records, not state); turn one off",
+                "cannot be combined with `stateless` (stateless emitters store spawn records, \
+                    not state); turn one off",
             );
         }
         if self.tiny_state && self.packed_state {
             c.push(
                 p("tiny_state"),
                 true,
-                "cannot be combined with `packed_state` (one state layout per emitter: 20 or 10 bytes); turn one off",
+                "cannot be combined with `packed_state` (one state layout per emitter: 20 or 10 \
+                    bytes); turn one off",
             );
         }
     }

@@ -106,7 +106,10 @@ pub struct Passes {
 
 /// The packing of the six-way passes, as the sidecar states it (Unity's Six Way
 /// shader's): lit by a unit white light from each axis of the camera's frame.
-pub const SIXWAY_PACKING: &str = "sixway_rtba: R lit from the camera's right, G from above (camera up), B from behind (away from the camera), A coverage; sixway_lbfe: R from the left, G from below, B from the front (the camera's side), A emissive (the layers' own glow); linear, straight alpha, the alpha-blended layers only";
+pub const SIXWAY_PACKING: &str = "sixway_rtba: R lit from the camera's right, G from above \
+    (camera up), B from behind (away from the camera), A coverage; sixway_lbfe: R from the \
+    left, G from below, B from the front (the camera's side), A emissive (the layers' own \
+    glow); linear, straight alpha, the alpha-blended layers only";
 
 impl Passes {
     /// The names of the passes that are on.
@@ -222,13 +225,15 @@ impl ExportSettings {
             }
             if n > cols * rows {
                 return bad(format!(
-                    "--frames {n} does not fit a {cols}x{rows} flipbook: give at most {} frames or a larger grid",
+                    "--frames {n} does not fit a {cols}x{rows} flipbook: give at most {} frames \
+                        or a larger grid",
                     cols * rows
                 ));
             }
             if u64::from(cols * w) > 16384 || u64::from(rows * h) > 16384 {
                 return bad(format!(
-                    "a {cols}x{rows} flipbook of {w}x{h} frames is {}x{} pixels: atlases are at most 16384 on a side (smaller frames or grid)",
+                    "a {cols}x{rows} flipbook of {w}x{h} frames is {}x{} pixels: atlases are at \
+                        most 16384 on a side (smaller frames or grid)",
                     cols * w,
                     rows * h
                 ));

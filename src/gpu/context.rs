@@ -11,7 +11,8 @@ pub const TILE_STORAGE_BUFFERS: u32 = 13;
 pub enum GpuError {
     /// No adapter matched.
     #[error(
-        "no GPU adapter found ({0}); install a Vulkan driver (e.g. Mesa's lavapipe: apt install mesa-vulkan-drivers) or set WGPU_BACKEND"
+        "no GPU adapter found ({0}); install a Vulkan driver (e.g. Mesa's lavapipe: apt install \
+            mesa-vulkan-drivers) or set WGPU_BACKEND"
     )]
     NoAdapter(String),
     /// The device request failed.
@@ -19,7 +20,9 @@ pub enum GpuError {
     Device(String),
     /// A capacity needs more than a device limit allows.
     #[error(
-        "emitter \"{emitter}\": capacity {capacity} needs {needed_bytes} bytes per state buffer, but this adapter's {limit} is {limit_bytes} bytes (at most {max_capacity} particles); lower the capacity"
+        "emitter \"{emitter}\": capacity {capacity} needs {needed_bytes} bytes per state \
+            buffer, but this adapter's {limit} is {limit_bytes} bytes (at most {max_capacity} \
+            particles); lower the capacity"
     )]
     CapacityTooLarge {
         /// Emitter name.
@@ -40,7 +43,9 @@ pub enum GpuError {
     Readback(String),
     /// A trail's ring of positions needs more than one storage binding holds.
     #[error(
-        "emitter \"{emitter}\": a trail of {points} points over {capacity} slots needs {needed_bytes} bytes, but this adapter's max_storage_buffer_binding_size is {limit_bytes} bytes; use fewer trail points or a smaller capacity"
+        "emitter \"{emitter}\": a trail of {points} points over {capacity} slots needs \
+            {needed_bytes} bytes, but this adapter's max_storage_buffer_binding_size is \
+            {limit_bytes} bytes; use fewer trail points or a smaller capacity"
     )]
     TrailTooLarge {
         /// Emitter name.

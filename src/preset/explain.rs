@@ -126,7 +126,8 @@ impl<'a> Site<'a> {
             .filter(|t| t.kind == Tok::Str && t.pos.line != t.end_pos.line)
             .map(|t| {
                 format!(
-                    " (the string starting at {} runs over several lines: is a closing `\"` missing?)",
+                    " (the string starting at {} runs over several lines: is a closing `\"` \
+                        missing?)",
                     t.pos
                 )
             })

@@ -150,7 +150,8 @@ impl SpriteTexture {
 /// A sprite that could not be loaded.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error(
-    "sprite {path}: {reason} — drawing the built-in soft disc instead; fix the file or the path (relative to the preset)"
+    "sprite {path}: {reason} — drawing the built-in soft disc instead; fix the file or the path \
+        (relative to the preset)"
 )]
 pub struct SpriteError {
     /// The file as resolved.

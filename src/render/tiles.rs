@@ -124,43 +124,37 @@ pub enum TileStages {
     All,
 }
 
-impl TilePass {
-    /// Whether `device` was created with the limits the tile passes need.
-    pub fn supported(device: &wgpu::Device) -> bool {
-        device.limits().max_storage_buffers_per_shader_stage >= STORAGE_BUFFERS_NEEDED
-    }
+/// The tile passes' bind group and pipeline layouts.
+struct TileLayouts {
+    tile: wgpu::BindGroupLayout,
+    sprite: wgpu::BindGroupLayout,
+    resolve_group: wgpu::BindGroupLayout,
+    compute: wgpu::PipelineLayout,
+    bin_group: wgpu::BindGroupLayout,
+    bin: wgpu::PipelineLayout,
+    list: wgpu::PipelineLayout,
+    resolve: wgpu::PipelineLayout,
+    empty_group: wgpu::BindGroup,
+}
 
-    /// Builds the pipelines from `lib`; the resolve draws into `target`, and the tiles
-    /// test against its depth when it has one.
-    pub fn new(
-        ctx: &GpuContext,
-        lib: &ShaderLibrary,
-        frame: &FrameResources,
-        target: DrawTarget,
-    ) -> Result<Self, ShaderError> {
-        let d = &ctx.device;
+impl TileLayouts {
+    /// Group 0 is the frame's everywhere; the compute passes add the particles, the sprites
+    /// and the tile group; the bin and list passes bind one group of their own at 3.
+    fn new(d: &wgpu::Device, frame: &FrameResources) -> Self {
         let tile_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("TilePass::tile_layout"),
-            entries: &Self::tile_entries(),
+            entries: &TilePass::tile_entries(),
         });
         let sprite_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("TilePass::sprite_layout"),
             entries: &[
                 wgpu::BindGroupLayoutEntry {
-                    binding: 0,
                     visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
+                    ..crate::gpu::fragment_texture_entry(0, true)
                 },
                 wgpu::BindGroupLayoutEntry {
-                    binding: 1,
                     visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
+                    ..crate::gpu::fragment_sampler_entry(1)
                 },
             ],
         });
@@ -196,7 +190,7 @@ impl TilePass {
         });
         let bin_group_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("TilePass::bin_group_layout"),
-            entries: &Self::bin_entries(),
+            entries: &TilePass::bin_entries(),
         });
         let empty_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("TilePass::empty_layout"),
@@ -229,26 +223,56 @@ impl TilePass {
             bind_group_layouts: &[Some(&frame.frame_layout), Some(&resolve_group_layout)],
             immediate_size: 0,
         });
+        Self {
+            tile: tile_layout,
+            sprite: sprite_layout,
+            resolve_group: resolve_group_layout,
+            compute: compute_layout,
+            bin_group: bin_group_layout,
+            bin: bin_layout,
+            list: list_layout,
+            resolve: resolve_layout,
+            empty_group,
+        }
+    }
+}
+
+impl TilePass {
+    /// Whether `device` was created with the limits the tile passes need.
+    pub fn supported(device: &wgpu::Device) -> bool {
+        device.limits().max_storage_buffers_per_shader_stage >= STORAGE_BUFFERS_NEEDED
+    }
+
+    /// Builds the pipelines from `lib`; the resolve draws into `target`, and the tiles
+    /// test against its depth when it has one.
+    pub fn new(
+        ctx: &GpuContext,
+        lib: &ShaderLibrary,
+        frame: &FrameResources,
+        target: DrawTarget,
+    ) -> Result<Self, ShaderError> {
+        let d = &ctx.device;
+        let l = TileLayouts::new(d, frame);
         let compute_resolve =
-            ComputeResolve::new(ctx, target, &frame.frame_layout, &resolve_group_layout);
+            ComputeResolve::new(ctx, target, &frame.frame_layout, &l.resolve_group);
         let built = Self::build(
             ctx,
             lib,
-            [&compute_layout, &bin_layout, &list_layout, &resolve_layout],
+            [&l.compute, &l.bin, &l.list, &l.resolve],
             compute_resolve.as_ref().map(|c| &c.layout),
             target,
         )?;
         Ok(Self {
             target,
-            tile_layout,
-            resolve_group_layout,
+            tile_layout: l.tile,
+            resolve_group_layout: l.resolve_group,
             no_depth: crate::gpu::placeholder_depth(d, "TilePass::no_depth"),
-            compute_layout,
-            bin_group_layout,
-            bin_layout,
-            list_layout,
-            empty_group,
-            resolve_layout,
+            compute_layout: l.compute,
+            bin_group_layout: l.bin_group,
+            bin_layout: l.bin,
+            list_layout: l.list,
+            empty_group: l.empty_group,
+            resolve_layout: l.resolve,
             module: built.module,
             variants: built.variants,
             bin: built.bin,
@@ -256,10 +280,7 @@ impl TilePass {
             compute_resolve,
             resolve_over: built.resolve_over,
             compute_resolve_on: true,
-            sprites: crate::render::sprites::SpriteGroups::new(
-                "TilePass::sprite_group",
-                sprite_layout,
-            ),
+            sprites: crate::render::sprites::SpriteGroups::new("TilePass::sprite_group", l.sprite),
             buffers: None,
             drawn: false,
             list_capacity: None,

@@ -121,7 +121,10 @@ impl TuneReport {
     /// The frontier as a Markdown table, then the modules.
     pub fn markdown(&self) -> String {
         let mut s = self.heading();
-        s.push_str("| | candidate | mean error (of 255) | p99 | worst frame | update ms | frame ms |\n|---|---|---|---|---|---|---|\n");
+        s.push_str(
+            "| | candidate | mean error (of 255) | p99 | worst frame | update ms | frame \
+            ms |\n|---|---|---|---|---|---|---|\n",
+        );
         let mut rows: Vec<usize> = self.frontier.clone();
         for i in [Some(self.authored), self.chosen].into_iter().flatten() {
             if !rows.contains(&i) {
@@ -170,7 +173,10 @@ impl TuneReport {
                     .fold(f64::INFINITY, f64::min)
             ));
         }
-        s.push_str("The frontier (no other candidate is both cheaper and more accurate), the effect as authored (A) and the choice (✓):\n\n");
+        s.push_str(
+            "The frontier (no other candidate is both cheaper and more accurate), the \
+            effect as authored (A) and the choice (✓):\n\n",
+        );
         s
     }
 

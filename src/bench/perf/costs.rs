@@ -18,10 +18,28 @@ pub(super) fn module_costs(
         e.spawn_noise.position_amplitude_m = 0.0;
         e.spawn_noise.direction_amplitude = 0.0;
     }
+    let variants = module_variants(&plain)?;
+    let samples = time_variants(ctx, opts, &variants, &plain, &timer)?;
+    let rows = variants
+        .iter()
+        .zip(samples)
+        .map(|((name, _, _), mut s)| {
+            let best = s.iter().copied().fold(f64::INFINITY, f64::min);
+            (name.clone(), median(&mut s), best)
+        })
+        .collect();
+    Ok(rows)
+}
+
+/// A row of the module table: its name, the effect and the shader library it runs on.
+type Variant = (String, Effect, ShaderLibrary);
+
+/// The module table's rows: the bare and compiled-out baselines, then each module on.
+fn module_variants(plain: &Effect) -> Result<Vec<Variant>, SimError> {
     let bare_lib = ShaderLibrary::embedded()
         .without_modules()
         .map_err(SimError::Shader)?;
-    let mut variants: Vec<(String, Effect, ShaderLibrary)> = vec![
+    let mut variants: Vec<Variant> = vec![
         (
             "bare: module code removed from the source".to_owned(),
             plain.clone(),
@@ -92,8 +110,13 @@ pub(super) fn module_costs(
             ShaderLibrary::embedded(),
         ));
     }
-    // Events: the pool's particles spawn one child each on death into a small emitter (the
-    // records of every slot written each step, the scan, the child's update).
+    variants.push(events_variant(plain));
+    Ok(variants)
+}
+
+/// Events: the pool's particles spawn one child each on death into a small emitter (the
+/// records of every slot written each step, the scan, the child's update).
+fn events_variant(plain: &Effect) -> Variant {
     let mut events = plain.clone();
     let mut child = events.emitters[0].clone();
     child.name = "event child".into();
@@ -106,14 +129,24 @@ pub(super) fn module_costs(
     }];
     events.emitters.push(child);
     let mods = Modules::in_effect(&events, 0);
-    variants.push((
+    (
         format!(
             "events on (death → a 4096-slot child) [{}]",
             mods.names().join(", ")
         ),
         events,
         ShaderLibrary::embedded(),
-    ));
+    )
+}
+
+/// The update's GPU time of every variant (ms samples, one list per variant).
+fn time_variants(
+    ctx: &GpuContext,
+    opts: &PerfOptions,
+    variants: &[Variant],
+    plain: &Effect,
+    timer: &GpuTimer,
+) -> Result<Vec<Vec<f64>>, SimError> {
     // Every variant on one pool, filled like the throughput rows' (66 steps: every slot
     // alive), and no other large pool alive: on the H100 the same one-step update of a
     // 16.8M pool measured 0.41 ms with one such pool allocated, 0.74 ms with two and
@@ -128,8 +161,8 @@ pub(super) fn module_costs(
     let per_round = opts.repeats.max(1);
     let mut samples = vec![Vec::new(); variants.len()];
     let is_stateless = |e: &Effect| e.emitters.iter().any(|e| e.stateless);
-    let mut sim = GpuSim::new(ctx, variants[1].2.clone(), &plain)?;
-    sim.step(&plain, 1.0 / 60.0, 66)?;
+    let mut sim = GpuSim::new(ctx, variants[1].2.clone(), plain)?;
+    sim.step(plain, 1.0 / 60.0, 66)?;
     let mut bare_loaded = false;
     let mut order: Vec<usize> = (0..variants.len())
         .filter(|&i| !is_stateless(&variants[i].1))
@@ -148,18 +181,7 @@ pub(super) fn module_costs(
                     .map_err(SimError::Shader)?;
                 bare_loaded = i == 0;
             }
-            // Untimed steps for at least 100 ms: after a pause (a pipeline compile) the
-            // H100's SM clock takes tens of ms to climb back, and a fixed 10 steps (4 ms)
-            // left ALU-bound variants measured at a low clock (turbulence: 3.3 ms instead
-            // of 0.89) while memory-bound ones looked fine.
-            let warm = std::time::Instant::now();
-            loop {
-                sim.step(effect, 1.0 / 60.0, 10)?;
-                let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
-                if warm.elapsed().as_secs_f64() > 0.1 {
-                    break;
-                }
-            }
+            warm_up(ctx, &mut sim, effect)?;
             for _ in 0..per_round {
                 let ms = timer.time(ctx, |enc| {
                     let plans = sim.plan(effect, 1.0 / 60.0, 1);
@@ -169,15 +191,22 @@ pub(super) fn module_costs(
             }
         }
     }
-    let rows = variants
-        .iter()
-        .zip(samples.iter_mut())
-        .map(|((name, _, _), s)| {
-            let best = s.iter().copied().fold(f64::INFINITY, f64::min);
-            (name.clone(), median(s), best)
-        })
-        .collect();
-    Ok(rows)
+    Ok(samples)
+}
+
+/// Untimed steps for at least 100 ms: after a pause (a pipeline compile) the H100's SM
+/// clock takes tens of ms to climb back, and a fixed 10 steps (4 ms) left ALU-bound
+/// variants measured at a low clock (turbulence: 3.3 ms instead of 0.89) while
+/// memory-bound ones looked fine.
+fn warm_up(ctx: &GpuContext, sim: &mut GpuSim, effect: &Effect) -> Result<(), SimError> {
+    let warm = std::time::Instant::now();
+    loop {
+        sim.step(effect, 1.0 / 60.0, 10)?;
+        let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
+        if warm.elapsed().as_secs_f64() > 0.1 {
+            return Ok(());
+        }
+    }
 }
 
 /// One row of the sort table.

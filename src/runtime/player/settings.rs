@@ -79,7 +79,8 @@ pub enum PlayerError {
     NoInstance,
     /// The host's device lacks limits the player needs (each named with both values).
     #[error(
-        "the device's limits are too low for ignis: {}; request ignis::required_limits() when creating the device (docs/embedding.md: what the host provides)",
+        "the device's limits are too low for ignis: {}; request ignis::required_limits() when \
+            creating the device (docs/embedding.md: what the host provides)",
         list(.0)
     )]
     DeviceLimits(Vec<MissingLimit>),
