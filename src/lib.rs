@@ -84,6 +84,8 @@ pub mod sim;
 #[doc(hidden)]
 pub mod bench;
 #[cfg(feature = "editor")]
+pub mod cli;
+#[cfg(feature = "editor")]
 #[doc(hidden)]
 pub mod editor;
 #[cfg(feature = "editor")]

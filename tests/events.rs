@@ -440,13 +440,9 @@ fn frame_sequences() -> Vec<(String, Vec<f64>)> {
     out
 }
 
-/// A fixed-step effect with a chain of events (death → child, whose collisions feed a
-/// grandchild drawn as a ribbon per parent) played through a player at 30, 60, 144 and 240 fps and under jitter ends
-/// bit-identical, and seeking back to 1 s (from snapshots and from the start) gives the
-/// played state.
-#[test]
-fn events_are_frame_rate_independent_and_seekable() {
-    let ctx = strict_gpu();
+/// A fixed-step chain of events: death → child, whose ground collisions feed a
+/// grandchild drawn as a ribbon per parent.
+fn event_chain() -> Effect {
     let mut effect = parent_and_child(
         Event {
             count: CountRange { min: 1, max: 4 },
@@ -485,6 +481,17 @@ fn events_are_frame_rate_independent_and_seekable() {
     });
     effect.emitters.push(grandchild);
     effect.validate().expect("valid");
+    effect
+}
+
+/// A fixed-step effect with a chain of events (death → child, whose collisions feed a
+/// grandchild drawn as a ribbon per parent) played through a player at 30, 60, 144 and
+/// 240 fps and under jitter ends bit-identical, and seeking back to 1 s (from snapshots and from the start) gives the
+/// played state.
+#[test]
+fn events_are_frame_rate_independent_and_seekable() {
+    let ctx = strict_gpu();
+    let effect = event_chain();
     let state = |run: &ignis::headless::Headless| -> Vec<u8> {
         let links = run
             .player

@@ -14,7 +14,8 @@ fn layer(module: &str) -> Option<u32> {
         "sim" => 2,
         "render" => 3,
         "runtime" => 4,
-        "composite" | "headless" | "export" | "editor" | "bench" | "tune" | "hot_reload" => 5,
+        "composite" | "headless" | "export" | "editor" | "bench" | "tune" | "hot_reload"
+        | "cli" => 5,
         _ => return None,
     })
 }
@@ -148,4 +149,80 @@ fn no_source_file_is_over_800_lines() {
         })
         .collect();
     assert!(long.is_empty(), "files over 800 lines: {long:?}");
+}
+
+/// The functions of `text` longer than `max` lines, as "name (n lines)": a function runs
+/// from its `fn` line to the first line that closes at its indentation.
+fn long_functions(text: &str, max: usize) -> Vec<String> {
+    let lines: Vec<&str> = text.lines().collect();
+    let mut found = Vec::new();
+    for (i, line) in lines.iter().enumerate() {
+        let trimmed = line.trim_start();
+        let indent = &line[..line.len() - trimmed.len()];
+        let signature = [
+            "pub fn ",
+            "pub(crate) fn ",
+            "pub(super) fn ",
+            "fn ",
+            "const fn ",
+        ]
+        .iter()
+        .find_map(|p| trimmed.strip_prefix(p));
+        let Some(rest) = signature else {
+            continue;
+        };
+        if trimmed.ends_with(';') {
+            continue;
+        }
+        let close = format!("{indent}}}");
+        let end = lines[i + 1..]
+            .iter()
+            .position(|l| l.starts_with(&close))
+            .map_or(lines.len(), |p| i + 1 + p);
+        let n = end - i + 1;
+        if n > max {
+            let name: String = rest
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_')
+                .collect();
+            found.push(format!("{name} ({n} lines)"));
+        }
+    }
+    found
+}
+
+/// No function over 100 lines in the crate, its tests, examples and the Bevy plugin, but
+/// for tables of cases (a list of data, read as one).
+#[test]
+fn no_function_is_over_100_lines() {
+    let base = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut paths = Vec::new();
+    for dir in ["src", "tests", "examples", "crates/bevy_ignis"] {
+        sources(&base.join(dir), &mut paths);
+    }
+    let tables = ["malformed_cases"];
+    let long: Vec<String> = paths
+        .iter()
+        .filter(|p| !p.components().any(|c| c.as_os_str() == "target"))
+        .flat_map(|p| {
+            let text = std::fs::read_to_string(p).expect("read");
+            long_functions(&text, 100)
+                .into_iter()
+                .filter(|f| !tables.iter().any(|t| f.starts_with(&format!("{t} "))))
+                .map(move |f| format!("{}: {f}", p.display()))
+        })
+        .collect();
+    assert!(paths.len() > 150, "{} files read", paths.len());
+    assert!(long.is_empty(), "functions over 100 lines: {long:#?}");
+}
+
+/// The length check counts a function from `fn` to its closing brace, nested ones apart.
+#[test]
+fn the_length_check_counts_to_the_closing_brace() {
+    let body = "    let x = 1;\n".repeat(100);
+    let text = format!("fn long() {{\n{body}}}\n\nfn short() {{\n    inner();\n}}\n");
+    assert_eq!(long_functions(&text, 100), ["long (102 lines)"]);
+    assert!(long_functions(&text, 102).is_empty());
+    let nested = format!("impl A {{\n    pub fn f() {{\n{body}    }}\n}}\n");
+    assert_eq!(long_functions(&nested, 100), ["f (102 lines)"]);
 }

@@ -30,24 +30,7 @@ fn emitter_fields_ui(ui: &mut Ui, e: &mut Emitter) {
             ui.add(egui::TextEdit::singleline(&mut e.name).desired_width(180.0))
         });
         shape_ui(ui, &mut e.shape);
-        vec3_ui(
-            ui,
-            "Position",
-            "Emitter origin in the world, metres",
-            &mut e.transform.position_m,
-            -100.0..=100.0,
-            0.01,
-            " m",
-        );
-        vec3_ui(
-            ui,
-            "Rotation",
-            "Emitter rotation, degrees (applied X, then Y, then Z)",
-            &mut e.transform.rotation_deg,
-            -360.0..=360.0,
-            0.5,
-            "°",
-        );
+        placement_rows_ui(ui, e);
         param_row(
             ui,
             "Spawn rate",
@@ -92,42 +75,69 @@ fn emitter_fields_ui(ui: &mut Ui, e: &mut Emitter) {
             );
             ui.end_row();
         }
-        range_ui(
-            ui,
-            "Lifetime",
-            "Each particle draws its lifetime from this range, seconds",
-            &mut e.lifetime_secs,
-            0.001..=1000.0,
-            0.01,
-            " s",
-        );
-        vec3_ui(
-            ui,
-            "Direction",
-            "Initial direction in emitter space (normalised on use; must not be zero)",
-            &mut e.direction,
-            -1.0..=1.0,
-            0.01,
-            "",
-        );
-        row_ui(
-            ui,
-            "Spread",
-            "Half-angle of the cone of initial directions, degrees (a Cone shape uses its own \
-                angle)",
-            |ui| ui.add(drag(&mut e.spread_deg, 0.0..=180.0, 0.2, "°")),
-        );
-        range_ui(
-            ui,
-            "Speed",
-            "Initial speed range, metres per second",
-            &mut e.speed_m_per_s,
-            0.0..=1000.0,
-            0.01,
-            " m/s",
-        );
+        launch_rows_ui(ui, e);
     });
     bursts_ui(ui, &mut e.bursts);
+}
+
+/// Where the emitter is: position and rotation (rows of an open grid).
+fn placement_rows_ui(ui: &mut Ui, e: &mut Emitter) {
+    vec3_ui(
+        ui,
+        "Position",
+        "Emitter origin in the world, metres",
+        &mut e.transform.position_m,
+        -100.0..=100.0,
+        0.01,
+        " m",
+    );
+    vec3_ui(
+        ui,
+        "Rotation",
+        "Emitter rotation, degrees (applied X, then Y, then Z)",
+        &mut e.transform.rotation_deg,
+        -360.0..=360.0,
+        0.5,
+        "°",
+    );
+}
+
+/// How particles leave: lifetime, direction, spread and speed (rows of an open grid).
+fn launch_rows_ui(ui: &mut Ui, e: &mut Emitter) {
+    range_ui(
+        ui,
+        "Lifetime",
+        "Each particle draws its lifetime from this range, seconds",
+        &mut e.lifetime_secs,
+        0.001..=1000.0,
+        0.01,
+        " s",
+    );
+    vec3_ui(
+        ui,
+        "Direction",
+        "Initial direction in emitter space (normalised on use; must not be zero)",
+        &mut e.direction,
+        -1.0..=1.0,
+        0.01,
+        "",
+    );
+    row_ui(
+        ui,
+        "Spread",
+        "Half-angle of the cone of initial directions, degrees (a Cone shape uses its own \
+            angle)",
+        |ui| ui.add(drag(&mut e.spread_deg, 0.0..=180.0, 0.2, "°")),
+    );
+    range_ui(
+        ui,
+        "Speed",
+        "Initial speed range, metres per second",
+        &mut e.speed_m_per_s,
+        0.0..=1000.0,
+        0.01,
+        " m/s",
+    );
 }
 
 fn emitter_list_ui(ui: &mut Ui, effect: &mut Effect, selected: &mut usize) {

@@ -162,6 +162,64 @@ fn editor_player(
     Ok((player, instance))
 }
 
+/// What the window's surface can do besides being drawn to.
+struct SurfaceCaps {
+    /// Copied from (screenshots read the frame itself).
+    can_copy: bool,
+    /// Copied into (the retained window).
+    can_receive: bool,
+}
+
+/// The surface's configuration for `window`: egui's preferred format, copyable when the
+/// surface allows, no vsync under automation.
+fn surface_config(
+    surface: &wgpu::Surface,
+    adapter: &wgpu::Adapter,
+    window: &Window,
+    options: &EditOptions,
+) -> anyhow::Result<(wgpu::SurfaceConfiguration, SurfaceCaps)> {
+    let size = window.inner_size();
+    let caps = surface.get_capabilities(adapter);
+    let format = egui_wgpu::preferred_framebuffer_format(&caps.formats)
+        .map_err(|e| anyhow!("the window surface offers no usable format: {e:?}"))?;
+    let surface_can_copy = caps.usages.contains(wgpu::TextureUsages::COPY_SRC);
+    let surface_can_receive = caps.usages.contains(wgpu::TextureUsages::COPY_DST);
+    let mut config = surface
+        .get_default_config(adapter, size.width.max(1), size.height.max(1))
+        .ok_or_else(|| anyhow!("the adapter cannot present to this window"))?;
+    config.format = format;
+    config.usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+    if surface_can_copy {
+        // Screenshots copy the frame itself; no offscreen re-render needed.
+        config.usage |= wgpu::TextureUsages::COPY_SRC;
+    }
+    // Automation measures throughput, so it does not wait for vertical blanks.
+    config.present_mode = if options.frames.is_some() {
+        wgpu::PresentMode::AutoNoVsync
+    } else {
+        wgpu::PresentMode::AutoVsync
+    };
+
+    let caps = SurfaceCaps {
+        can_copy: surface_can_copy,
+        can_receive: surface_can_receive,
+    };
+    Ok((config, caps))
+}
+
+/// egui's window state, with the device's largest texture side.
+fn egui_state(egui_ctx: &egui::Context, window: &Window, ctx: &GpuContext) -> egui_winit::State {
+    let max_texture_side = ctx.device.limits().max_texture_dimension_2d as usize;
+    egui_winit::State::new(
+        egui_ctx.clone(),
+        egui::ViewportId::ROOT,
+        window,
+        Some(window.scale_factor() as f32),
+        window.theme(),
+        Some(max_texture_side),
+    )
+}
+
 impl Gfx {
     /// The GPU side of the editor in `window`: a device on an adapter that can draw to
     /// it, the surface, the player, the composite and egui's painter. Called at start and
@@ -187,27 +245,12 @@ impl Gfx {
             .ok_or_else(|| anyhow!("the GPU context lost its adapter"))?;
         let pass_timer = crate::gpu::timer::PassTimer::new(&ctx);
 
-        let size = window.inner_size();
-        let caps = surface.get_capabilities(&adapter);
-        let format = egui_wgpu::preferred_framebuffer_format(&caps.formats)
-            .map_err(|e| anyhow!("the window surface offers no usable format: {e:?}"))?;
-        let surface_can_copy = caps.usages.contains(wgpu::TextureUsages::COPY_SRC);
-        let surface_can_receive = caps.usages.contains(wgpu::TextureUsages::COPY_DST);
-        let mut config = surface
-            .get_default_config(&adapter, size.width.max(1), size.height.max(1))
-            .ok_or_else(|| anyhow!("the adapter cannot present to this window"))?;
-        config.format = format;
-        config.usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        if surface_can_copy {
-            // Screenshots copy the frame itself; no offscreen re-render needed.
-            config.usage |= wgpu::TextureUsages::COPY_SRC;
-        }
-        // Automation measures throughput, so it does not wait for vertical blanks.
-        config.present_mode = if options.frames.is_some() {
-            wgpu::PresentMode::AutoNoVsync
-        } else {
-            wgpu::PresentMode::AutoVsync
-        };
+        let (mut config, caps) = surface_config(&surface, &adapter, &window, options)?;
+        let SurfaceCaps {
+            can_copy: surface_can_copy,
+            can_receive: surface_can_receive,
+        } = caps;
+        let format = config.format;
 
         let lib = ShaderLibrary::discover(options.shader_dir.as_deref());
         let composite = Composite::new(&ctx, &lib)?;
@@ -216,15 +259,7 @@ impl Gfx {
 
         let egui_ctx = egui::Context::default();
         egui_ctx.set_visuals(egui::Visuals::dark());
-        let max_texture_side = ctx.device.limits().max_texture_dimension_2d as usize;
-        let egui_state = egui_winit::State::new(
-            egui_ctx.clone(),
-            egui::ViewportId::ROOT,
-            &window,
-            Some(window.scale_factor() as f32),
-            window.theme(),
-            Some(max_texture_side),
-        );
+        let egui_state = egui_state(&egui_ctx, &window, &ctx);
         let ui_painter = UiPainter::new(&ctx.device, format, ctx.profile.lean_painter);
         // Software adapters keep the window's image between frames (see retained.rs).
         let retained = (ctx.profile.retained_window && surface_can_receive).then(|| {

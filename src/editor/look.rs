@@ -154,40 +154,7 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
         .min_col_width(96.0)
         .show(ui, |ui| {
             sprite_rows_ui(ui, look);
-            let label_tip = "Additive: light adds up, order-independent (fire, sparks). Alpha: \
-                premultiplied over, darkens what is behind (smoke); alpha layers are drawn \
-                first, sorted back to front";
-            ui.label("Blend").on_hover_text(label_tip);
-            ui.horizontal(|ui| {
-                for b in [BlendMode::Additive, BlendMode::Alpha] {
-                    ui.radio_value(&mut look.blend, b, blend_label(b))
-                        .on_hover_text(label_tip);
-                }
-            });
-            ui.end_row();
-            let label = ui.label("Draw path").on_hover_text(format!(
-                "auto: compute splat when particles project below {SPLAT_BELOW_PX} px, blend \
-                    additively and have no streak; on GPUs the tile rasteriser from \
-                    {TILES_ABOVE_PX} px; billboards otherwise. billboard: instanced quads. \
-                    splat: compute splat (additive only; alpha falls back to billboards). \
-                    tiles: the compute tile rasteriser (alpha-blended emitters take it together \
-                    or not at all)"
-            ));
-            egui::ComboBox::from_id_salt("draw_path")
-                .selected_text(draw_path_label(look.draw_path))
-                .show_ui(ui, |ui| {
-                    for d in [
-                        DrawPath::Auto,
-                        DrawPath::Billboard,
-                        DrawPath::Splat,
-                        DrawPath::Tiles,
-                    ] {
-                        ui.selectable_value(&mut look.draw_path, d, draw_path_label(d));
-                    }
-                })
-                .response
-                .labelled_by(label.id);
-            ui.end_row();
+            blend_rows_ui(ui, look);
             param_row(
                 ui,
                 "Size",
@@ -223,59 +190,9 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
                 &mut look.spin_deg_per_s,
                 &SPIN,
             );
-            let label = ui.label("Streak").on_hover_text(
-                "Stretch each billboard from where the particle was (length \
-                    seconds ago) to where it is: spark trails",
-            );
-            ui.horizontal(|ui| {
-                let mut on = look.streak.is_some();
-                if ui.checkbox(&mut on, "stretch").changed() {
-                    look.streak = on.then(Streak::default);
-                }
-                if let Some(s) = &mut look.streak {
-                    ui.add(
-                        DragValue::new(&mut s.length_secs)
-                            .range(0.0..=1.0)
-                            .speed(0.001)
-                            .suffix(" s"),
-                    )
-                    .labelled_by(label.id);
-                    ui.add(
-                        DragValue::new(&mut s.max_length_m)
-                            .range(0.0..=100.0)
-                            .speed(0.01)
-                            .prefix("≤ ")
-                            .suffix(" m"),
-                    )
-                    .labelled_by(label.id);
-                }
-            });
-            ui.end_row();
+            streak_row_ui(ui, look);
             trail_rows_ui(ui, look);
-            let label = ui.label("Soft ground").on_hover_text(
-                "Fade sprites over this distance above the ground plane (the \
-                    emitter's ground collider, else y = 0) instead of cutting them: soft \
-                    particles. 0 = off",
-            );
-            ui.add(
-                DragValue::new(&mut look.soft_ground_m)
-                    .range(0.0..=10.0)
-                    .speed(0.002)
-                    .suffix(" m"),
-            )
-            .labelled_by(label.id);
-            ui.end_row();
-            let label = ui
-                .label("Intensity")
-                .on_hover_text("Multiplies the colour: HDR brightness before exposure and tonemap");
-            ui.add(
-                DragValue::new(&mut look.intensity)
-                    .range(0.0..=1000.0)
-                    .speed(0.01)
-                    .min_decimals(2),
-            )
-            .labelled_by(label.id);
-            ui.end_row();
+            brightness_rows_ui(ui, look);
         });
     ui.add_space(4.0);
     ui.label("Colour over life").on_hover_text(
@@ -284,6 +201,104 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
     );
     gradient_editor_ui(ui, &mut look.color_over_life);
     color_stops_ui(ui, &mut look.color_over_life);
+}
+
+/// Blend mode and draw path (rows of an open grid).
+fn blend_rows_ui(ui: &mut Ui, look: &mut Look) {
+    let label_tip = "Additive: light adds up, order-independent (fire, sparks). Alpha: \
+        premultiplied over, darkens what is behind (smoke); alpha layers are drawn \
+        first, sorted back to front";
+    ui.label("Blend").on_hover_text(label_tip);
+    ui.horizontal(|ui| {
+        for b in [BlendMode::Additive, BlendMode::Alpha] {
+            ui.radio_value(&mut look.blend, b, blend_label(b))
+                .on_hover_text(label_tip);
+        }
+    });
+    ui.end_row();
+    let label = ui.label("Draw path").on_hover_text(format!(
+        "auto: compute splat when particles project below {SPLAT_BELOW_PX} px, blend \
+            additively and have no streak; on GPUs the tile rasteriser from \
+            {TILES_ABOVE_PX} px; billboards otherwise. billboard: instanced quads. \
+            splat: compute splat (additive only; alpha falls back to billboards). \
+            tiles: the compute tile rasteriser (alpha-blended emitters take it together \
+            or not at all)"
+    ));
+    egui::ComboBox::from_id_salt("draw_path")
+        .selected_text(draw_path_label(look.draw_path))
+        .show_ui(ui, |ui| {
+            for d in [
+                DrawPath::Auto,
+                DrawPath::Billboard,
+                DrawPath::Splat,
+                DrawPath::Tiles,
+            ] {
+                ui.selectable_value(&mut look.draw_path, d, draw_path_label(d));
+            }
+        })
+        .response
+        .labelled_by(label.id);
+    ui.end_row();
+}
+
+/// The velocity streak: on/off, length in seconds and its cap (a row of an open grid).
+fn streak_row_ui(ui: &mut Ui, look: &mut Look) {
+    let label = ui.label("Streak").on_hover_text(
+        "Stretch each billboard from where the particle was (length \
+            seconds ago) to where it is: spark trails",
+    );
+    ui.horizontal(|ui| {
+        let mut on = look.streak.is_some();
+        if ui.checkbox(&mut on, "stretch").changed() {
+            look.streak = on.then(Streak::default);
+        }
+        if let Some(s) = &mut look.streak {
+            ui.add(
+                DragValue::new(&mut s.length_secs)
+                    .range(0.0..=1.0)
+                    .speed(0.001)
+                    .suffix(" s"),
+            )
+            .labelled_by(label.id);
+            ui.add(
+                DragValue::new(&mut s.max_length_m)
+                    .range(0.0..=100.0)
+                    .speed(0.01)
+                    .prefix("≤ ")
+                    .suffix(" m"),
+            )
+            .labelled_by(label.id);
+        }
+    });
+    ui.end_row();
+}
+
+/// Soft ground and intensity (rows of an open grid).
+fn brightness_rows_ui(ui: &mut Ui, look: &mut Look) {
+    let label = ui.label("Soft ground").on_hover_text(
+        "Fade sprites over this distance above the ground plane (the \
+            emitter's ground collider, else y = 0) instead of cutting them: soft \
+            particles. 0 = off",
+    );
+    ui.add(
+        DragValue::new(&mut look.soft_ground_m)
+            .range(0.0..=10.0)
+            .speed(0.002)
+            .suffix(" m"),
+    )
+    .labelled_by(label.id);
+    ui.end_row();
+    let label = ui
+        .label("Intensity")
+        .on_hover_text("Multiplies the colour: HDR brightness before exposure and tonemap");
+    ui.add(
+        DragValue::new(&mut look.intensity)
+            .range(0.0..=1000.0)
+            .speed(0.01)
+            .min_decimals(2),
+    )
+    .labelled_by(label.id);
+    ui.end_row();
 }
 
 /// The trail: on/off, points and spacing; width, tapers and the sprite when on (rows of an

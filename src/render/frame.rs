@@ -106,6 +106,53 @@ impl FrameResources {
     /// Creates the layouts and uniform buffers.
     pub fn new(ctx: &GpuContext) -> Self {
         let d = &ctx.device;
+        let (frame_layout, particle_layout) = Self::layouts(d);
+        let camera = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("FrameResources::camera"),
+            size: size_of::<CameraUniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let (looks, ramps, frame_group) = Self::look_buffer(ctx, &frame_layout, &camera, (4, 4));
+        Self {
+            frame_layout,
+            particle_layout,
+            camera,
+            looks,
+            look_slots: 4,
+            ramps,
+            ramp_rows: 4,
+            ramp_keys: vec![None; 4],
+            sprites: SpriteLibrary::new(ctx),
+            sprite_errors: Vec::new(),
+            frame_group,
+            particle_groups: HashMap::new(),
+            no_order: d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("FrameResources::no_order"),
+                size: 16,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            }),
+            no_trail: d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("FrameResources::no_trail"),
+                size: 64,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            }),
+            trim_sprites: true,
+            live_window_only: true,
+            trims: HashMap::new(),
+            allow_splat: true,
+            soft_depth: false,
+            allow_tiles: false,
+            look_bytes: Vec::new(),
+            lighting: None,
+            slot_origins: Vec::new(),
+        }
+    }
+
+    /// Group 0 (the camera, the looks, the ramps) and group 1 (the particles' state).
+    fn layouts(d: &wgpu::Device) -> (wgpu::BindGroupLayout, wgpu::BindGroupLayout) {
         let all = wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE;
         // Both draw paths read the looks as read-only *storage*: an array of a draw's
         // instances, and lavapipe (Mesa 22.3) inlines uniform-buffer values that steer
@@ -170,48 +217,7 @@ impl FrameResources {
                 },
             ],
         });
-        let camera = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("FrameResources::camera"),
-            size: size_of::<CameraUniform>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let (looks, ramps, frame_group) = Self::look_buffer(ctx, &frame_layout, &camera, (4, 4));
-        Self {
-            frame_layout,
-            particle_layout,
-            camera,
-            looks,
-            look_slots: 4,
-            ramps,
-            ramp_rows: 4,
-            ramp_keys: vec![None; 4],
-            sprites: SpriteLibrary::new(ctx),
-            sprite_errors: Vec::new(),
-            frame_group,
-            particle_groups: HashMap::new(),
-            no_order: d.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("FrameResources::no_order"),
-                size: 16,
-                usage: wgpu::BufferUsages::STORAGE,
-                mapped_at_creation: false,
-            }),
-            no_trail: d.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("FrameResources::no_trail"),
-                size: 64,
-                usage: wgpu::BufferUsages::STORAGE,
-                mapped_at_creation: false,
-            }),
-            trim_sprites: true,
-            live_window_only: true,
-            trims: HashMap::new(),
-            allow_splat: true,
-            soft_depth: false,
-            allow_tiles: false,
-            look_bytes: Vec::new(),
-            lighting: None,
-            slot_origins: Vec::new(),
-        }
+        (frame_layout, particle_layout)
     }
 
     /// The looks buffer (`slots.0` uniforms), the ramps (`slots.1` rows) and a group 0

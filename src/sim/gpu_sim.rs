@@ -247,6 +247,19 @@ impl GpuSim {
     /// dropped, a changed capacity keeps the particles that fit (a tiny-state pool, and
     /// any pool whose layout changes, restarts empty).
     pub fn sync(&mut self, effect: &Effect) -> Result<(), SimError> {
+        self.check_limits(effect)?;
+        self.sync_pools(effect);
+        self.sync_settings(effect);
+        let grown = self.grow_params(effect);
+        for key in used_keys(effect) {
+            lock(&self.update).ensure(&self.ctx, &self.library, key)?;
+        }
+        self.sync_events(effect, grown);
+        Ok(())
+    }
+
+    /// Refuses capacities and trail rings the device cannot hold, naming the emitter.
+    fn check_limits(&self, effect: &Effect) -> Result<(), SimError> {
         for e in &effect.emitters {
             self.ctx.check_capacity(&e.name, e.capacity)?;
             if let Some(t) = &e.look.trail {
@@ -256,6 +269,11 @@ impl GpuSim {
                     .check_trail(&e.name, (e.capacity.max(1), points), bytes)?;
             }
         }
+        Ok(())
+    }
+
+    /// One pool per emitter, of its capacity and state layout.
+    fn sync_pools(&mut self, effect: &Effect) {
         self.emitters.truncate(effect.emitters.len());
         for (i, e) in effect.emitters.iter().enumerate() {
             let capacity = e.capacity.max(1);
@@ -273,38 +291,42 @@ impl GpuSim {
                     }
                 }
                 _ => {
-                    let mut fresh = self.create_state(capacity, layout);
-                    if let Some(old) = self.emitters.get(i) {
-                        // The kept particles stay at their old slots, which the ring's
-                        // new modulus does not map their spawn counters to: visit the
-                        // whole pool until they have all died.
-                        let dead_by = self
-                            .planner
-                            .emitters
-                            .get(i)
-                            .map_or(f64::INFINITY, |p| p.all_dead_by(e.lifetime_secs.max));
-                        fresh.whole_pool_until = old.whole_pool_until.max(dead_by);
-                        // Keep the particles that fit (packed ones get the lifetimes of
-                        // their new ring positions).
-                        let keep = layout.bytes(old.capacity.min(capacity));
-                        let mut enc = self.ctx.device.create_command_encoder(&Default::default());
-                        for b in 0..2 {
-                            enc.copy_buffer_to_buffer(
-                                &old.buffers[old.current],
-                                0,
-                                &fresh.buffers[b],
-                                0,
-                                keep,
-                            );
-                        }
-                        self.ctx.queue.submit([enc.finish()]);
-                        self.emitters[i] = fresh;
-                    } else {
-                        self.emitters.push(fresh);
-                    }
+                    let fresh = self.create_state(capacity, layout);
+                    self.keep_particles(i, e, fresh);
                 }
             }
         }
+    }
+
+    /// Puts `fresh`, emitter `i`'s resized pool, in place of its old one, keeping the
+    /// particles that fit.
+    fn keep_particles(&mut self, i: usize, e: &crate::effect::Emitter, mut fresh: EmitterState) {
+        if let Some(old) = self.emitters.get(i) {
+            // The kept particles stay at their old slots, which the ring's
+            // new modulus does not map their spawn counters to: visit the
+            // whole pool until they have all died.
+            let dead_by = self
+                .planner
+                .emitters
+                .get(i)
+                .map_or(f64::INFINITY, |p| p.all_dead_by(e.lifetime_secs.max));
+            fresh.whole_pool_until = old.whole_pool_until.max(dead_by);
+            // Keep the particles that fit (packed ones get the lifetimes of
+            // their new ring positions).
+            let keep = fresh.layout.bytes(old.capacity.min(fresh.capacity));
+            let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+            for b in 0..2 {
+                enc.copy_buffer_to_buffer(&old.buffers[old.current], 0, &fresh.buffers[b], 0, keep);
+            }
+            self.ctx.queue.submit([enc.finish()]);
+            self.emitters[i] = fresh;
+        } else {
+            self.emitters.push(fresh);
+        }
+    }
+
+    /// Each pool's per-frame settings: lifetimes, seed, curves, stateless mode.
+    fn sync_settings(&mut self, effect: &Effect) {
         // Switching an emitter between stateless records and stateful particles restarts
         // its pool: the two layouts mean different things.
         // Created only when a pool must be cleared (this runs every frame).
@@ -333,6 +355,11 @@ impl GpuSim {
         if let Some(enc) = enc {
             self.ctx.queue.submit([enc.finish()]);
         }
+    }
+
+    /// Grows the parameter buffer to one slot per emitter and step of a submit; returns
+    /// whether it grew (every pool's groups rebound).
+    fn grow_params(&mut self, effect: &Effect) -> bool {
         let slots = STEPS_PER_SUBMIT * effect.emitters.len().max(1);
         let grown = slots > self.params_slots;
         if grown {
@@ -351,11 +378,7 @@ impl GpuSim {
                     self.bind_groups(&s.buffers, &s.counters, &s.births, &s.curves);
             }
         }
-        for key in used_keys(effect) {
-            lock(&self.update).ensure(&self.ctx, &self.library, key)?;
-        }
-        self.sync_events(effect, grown);
-        Ok(())
+        grown
     }
 
     /// Matches the event buffers to the effect's events (kept while they fit), and binds

@@ -161,6 +161,56 @@ pub struct Scan {
     pub written: Option<ScanConfig>,
 }
 
+/// The hooks group of one emitter: its records, its spawn list and its trail ring, each a
+/// placeholder when the emitter has none.
+fn hooks_group(
+    device: &wgpu::Device,
+    pipes: &HookPipes,
+    buffers: [&Option<wgpu::Buffer>; 3],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = buffers
+        .iter()
+        .zip(&pipes.placeholders)
+        .enumerate()
+        .map(|(binding, (buffer, placeholder))| wgpu::BindGroupEntry {
+            binding: binding as u32,
+            resource: buffer.as_ref().unwrap_or(placeholder).as_entire_binding(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("EmitterHooks::hooks"),
+        layout: &pipes.hooks_layout,
+        entries: &entries,
+    })
+}
+
+impl Scan {
+    /// The scan of one event rule into `child`'s list, for a parent of `capacity` slots.
+    fn new(device: &wgpu::Device, child: usize, linked: bool, capacity: u32) -> Self {
+        Scan {
+            child,
+            config: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("EmitterHooks::scan_config"),
+                size: size_of::<ScanConfig>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            // Where the list starts, a sum per block, the cap's bucket and this step's
+            // allowance, and for a ribbon per parent each parent slot's last child.
+            blocks: storage_buffer(
+                device,
+                "EmitterHooks::scan_blocks",
+                4 * (3
+                    + u64::from(capacity.div_ceil(EVENT_SCAN_BLOCK))
+                    + if linked { 2 * u64::from(capacity) } else { 0 }),
+            ),
+            group: None,
+            linked,
+            written: None,
+        }
+    }
+}
+
 impl EmitterHooks {
     /// Buffers for emitter `i` of `effect` with `capacity` slots (reusing `old`'s when
     /// they fit: same capacity, rules and list).
@@ -217,57 +267,11 @@ impl EmitterHooks {
         let trail = trail.map(|(points, every, mode)| {
             crate::sim::trails::ring_buffer(ctx, capacity, points, every, mode)
         });
-        let hooks = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("EmitterHooks::hooks"),
-            layout: &pipes.hooks_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: records
-                        .as_ref()
-                        .unwrap_or(&pipes.placeholders[0])
-                        .as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: list
-                        .as_ref()
-                        .unwrap_or(&pipes.placeholders[1])
-                        .as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: trail
-                        .as_ref()
-                        .unwrap_or(&pipes.placeholders[2])
-                        .as_entire_binding(),
-                },
-            ],
-        });
+        let hooks = hooks_group(device, pipes, [&records, &list, &trail]);
         let scans = children
             .into_iter()
             .zip(linked)
-            .map(|(child, linked)| Scan {
-                child,
-                config: device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("EmitterHooks::scan_config"),
-                    size: size_of::<ScanConfig>() as u64,
-                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                }),
-                // Where the list starts, a sum per block, the cap's bucket and this step's
-                // allowance, and for a ribbon per parent each parent slot's last child.
-                blocks: storage_buffer(
-                    device,
-                    "EmitterHooks::scan_blocks",
-                    4 * (3
-                        + u64::from(capacity.div_ceil(EVENT_SCAN_BLOCK))
-                        + if linked { 2 * u64::from(capacity) } else { 0 }),
-                ),
-                group: None,
-                linked,
-                written: None,
-            })
+            .map(|(child, linked)| Scan::new(device, child, linked, capacity))
             .collect();
         Some(EmitterHooks {
             records,
