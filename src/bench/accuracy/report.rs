@@ -26,8 +26,11 @@ struct Gathered {
     scenes: Vec<serde_json::Value>,
 }
 
+/// (dt, RMS error) at every dt of one run.
+type DtErrors = Vec<(f64, f64)>;
+
 /// One integrator's errors at every dt and its cost, for the frontier.
-type FrontierPoint = (Integrator, Vec<(f64, f64)>, f64);
+type FrontierPoint = (Integrator, DtErrors, f64);
 
 /// Runs the whole accuracy bench and returns its report (also writes CSV and SVG into
 /// `out_dir`).
@@ -161,7 +164,7 @@ fn integrator_row(
     (integrator, layout): (Integrator, StateLayout),
     cost: f64,
     g: &mut Gathered,
-) -> anyhow::Result<(Vec<String>, Vec<(f64, f64)>)> {
+) -> anyhow::Result<(Vec<String>, DtErrors)> {
     let mut errs = Vec::new();
     let mut row = vec![compact_label(integrator, layout)];
     for dt in DTS {

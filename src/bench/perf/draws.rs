@@ -125,7 +125,7 @@ fn tile_costs(
     let hdr = &targets.hdr_view;
     let tiles_ms = tiles.and_then(|t| {
         let mut enc = ctx.device.create_command_encoder(&Default::default());
-        let fits = t.record(ctx, &mut enc, frame, &all_tiles, size, None);
+        let fits = t.record(ctx, &mut enc, frame, all_tiles, size, None);
         ctx.queue.submit([enc.finish()]);
         let resolve = |t: &mut TilePass, enc: &mut wgpu::CommandEncoder| {
             if !t.resolve_into(ctx, enc, frame, hdr, size) {
@@ -135,7 +135,7 @@ fn tile_costs(
         let time = |t: &mut TilePass, stages| {
             t.set_stages(stages);
             time_median(timer, ctx, opts.repeats, |enc| {
-                t.record(ctx, enc, frame, &all_tiles, size, None);
+                t.record(ctx, enc, frame, all_tiles, size, None);
                 resolve(t, enc);
             })
         };
