@@ -13,9 +13,6 @@ use crate::runtime::{Layers, Player, PlayerSettings};
 use crate::shaders::{ShaderError, ShaderLibrary};
 use crate::sim::gpu_sim::{SimError, map_read};
 
-/// The composite's own WGSL entry files (the player's are [`crate::PLAYER_SHADERS`]).
-pub const COMPOSITE_SHADERS: &[&str] = &["tonemap.wgsl", "bloom.wgsl", "clear.wgsl"];
-
 /// HDR target, reduced-resolution layers, bloom and tonemap around a [`Player`].
 pub struct Composite {
     /// The tonemap pass.

@@ -6,7 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 
-mod curve;
+pub(crate) mod curve;
 mod events;
 mod forces;
 mod lit;
@@ -16,10 +16,8 @@ mod stability;
 mod trail;
 mod validate;
 
-pub use curve::{
-    CURVE_WIDTH, Curve, MAX_CURVE_KEYS, Param, ParamMode, SHAPES, bake_rows, lookup, lookup_blend,
-    rows_key,
-};
+pub(crate) use curve::{CURVE_WIDTH, bake_rows, lookup_blend, rows_key};
+pub use curve::{Curve, MAX_CURVE_KEYS, Param, ParamMode, SHAPES};
 pub use events::{CountRange, Event, MAX_CHILDREN_PER_EVENT, MAX_EVENTS_PER_EMITTER, Trigger};
 pub use forces::{
     Attractor, Collisions, Falloff, FlamePull, Forces, GroundPlane, Gusts, MAX_SPHERES,
@@ -30,7 +28,8 @@ pub use look::{
     BlendMode, ColorStop, DrawPath, Flipbook, FlipbookMode, Look, MAX_COLOR_STOPS, SPLAT_BELOW_PX,
     SPLAT_PX_PER_QUAD, Sprite, Streak, TILES_ABOVE_PX, TILES_MIN_FILL_PX,
 };
-pub use rate_cap::{CAP_BURST_SECS, RateCap, cap_burst};
+pub use rate_cap::RateCap;
+pub(crate) use rate_cap::cap_burst;
 pub use stability::{
     GROWTH_LIMIT, StabilityWarning, Stiffness, largest_stable_step, lifetime_growth,
 };

@@ -42,8 +42,8 @@
 //! ```
 //!
 //! `docs/embedding.md` describes the frame's order of calls, what the host provides,
-//! threading and costs. The modules marked hidden below are the editor's and the tests'
-//! internals, not part of the runtime's API.
+//! threading and costs. [`effect`] is the effect model a preset holds (what a tool built
+//! on ignis edits), [`preset`] reads and writes it as RON.
 #![deny(missing_docs)]
 
 pub(crate) mod runtime;
@@ -52,7 +52,7 @@ pub use effect::Effect;
 /// The math library of the API (`Mat4`, `Vec3`): hosts on another `glam` version use this one
 /// or pass plain `[[f32; 4]; 4]` arrays.
 pub use glam;
-pub use gpu::{AdapterProfile, ProfileKind, ProfileRequest, ProfileSetting};
+pub use gpu::{AdapterProfile, GpuError, ProfileKind, ProfileRequest, ProfileSetting};
 pub use runtime::{
     Camera, ClockStats, EffectLight, EmitterStats, EventCount, HostTargets, InstanceId, IntoMat4,
     Layers, MAX_POINT_LIGHTS, MissingLimit, PLAYER_SHADERS, ParticleCount, ParticleInfo, Player,
@@ -60,38 +60,32 @@ pub use runtime::{
     required_limits,
 };
 pub use shaders::ShaderError;
+pub use sim::SimError;
 pub use sim::planner::SpawnStats;
 
-#[doc(hidden)]
-pub mod composite;
-#[doc(hidden)]
 pub mod effect;
-#[doc(hidden)]
-pub mod gpu;
-#[doc(hidden)]
-pub mod headless;
 pub mod preset;
-#[doc(hidden)]
-pub mod render;
-#[doc(hidden)]
-pub mod rng;
-#[doc(hidden)]
-pub mod shaders;
-#[doc(hidden)]
-pub mod sim;
+
+pub(crate) mod composite;
+pub(crate) mod gpu;
+pub(crate) mod headless;
+pub(crate) mod render;
+pub(crate) mod rng;
+pub(crate) mod shaders;
+pub(crate) mod sim;
 
 #[cfg(feature = "editor")]
-#[doc(hidden)]
-pub mod bench;
+pub(crate) mod bench;
 #[cfg(feature = "editor")]
 pub mod cli;
 #[cfg(feature = "editor")]
-#[doc(hidden)]
-pub mod editor;
+pub(crate) mod editor;
 #[cfg(feature = "editor")]
 pub mod export;
 #[cfg(feature = "editor")]
-#[doc(hidden)]
-pub mod hot_reload;
+pub(crate) mod hot_reload;
 #[cfg(feature = "editor")]
 pub mod tune;
+
+#[doc(hidden)]
+pub mod testing;

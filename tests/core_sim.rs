@@ -6,9 +6,9 @@ mod common;
 use common::*;
 use glam::{Mat4, Vec3};
 use ignis::effect::{Burst, Effect, Emitter, Integrator, Range, Shape, TimeMode, Transform};
-use ignis::gpu::GpuError;
-use ignis::shaders::ShaderLibrary;
-use ignis::sim::{GpuSim, SimError, Stepper};
+use ignis::testing::gpu::GpuError;
+use ignis::testing::shaders::ShaderLibrary;
+use ignis::testing::sim::{GpuSim, SimError, Stepper};
 
 /// GPU and CPU agree after 240 steps for every integrator, with spawning, noise, drag,
 /// wind and a transformed disc emitter. Tolerance: 2e-5 absolute + 2e-5 relative on
@@ -294,7 +294,10 @@ fn capacity_beyond_device_limit_names_the_limit() {
     }
 }
 
-fn spawn_once(ctx: &ignis::gpu::GpuContext, e: Emitter) -> Vec<ignis::gpu::types::Particle> {
+fn spawn_once(
+    ctx: &ignis::testing::gpu::GpuContext,
+    e: Emitter,
+) -> Vec<ignis::testing::gpu::types::Particle> {
     let sim = run_gpu(ctx, &bare_effect(e), 1.0 / 120.0, 1);
     // Positions are stored relative to the emitter's simulation origin.
     let origin = sim.planner.emitters[0].origin().as_vec3();
@@ -525,7 +528,7 @@ fn point_emitter_spawns_at_its_transform() {
 #[test]
 fn pass_timer_reports_labelled_spans() {
     let ctx = gpu();
-    let Some(mut timer) = ignis::gpu::timer::PassTimer::new_even_on_cpu(&ctx) else {
+    let Some(mut timer) = ignis::testing::gpu::timer::PassTimer::new_even_on_cpu(&ctx) else {
         panic!("the adapter lacks timestamp queries inside encoders (lavapipe has them)");
     };
     let effect = Effect::default_campfire();
@@ -564,7 +567,7 @@ fn fountain() -> Emitter {
 /// Runs `e` on the full state and with `compact` applied (which must validate), `steps`
 /// steps of `dt` each: (full, compact).
 fn run_full_and_compact(
-    ctx: &ignis::gpu::GpuContext,
+    ctx: &ignis::testing::gpu::GpuContext,
     e: Emitter,
     compact: impl Fn(&mut Emitter),
     dt: f32,
@@ -808,8 +811,9 @@ fn compact_state_renders_like_the_full_state(set: impl Fn(&mut Emitter), max_mea
         set(e);
     }
     let render = |effect: ignis::effect::Effect| {
-        let mut run = ignis::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
-            .expect("headless");
+        let mut run =
+            ignis::testing::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
+                .expect("headless");
         for _ in 0..60 {
             run.advance(1.0 / 60.0);
         }
@@ -845,8 +849,8 @@ fn update_window_skips_only_dead_slots() {
     };
     let mut effect = bare_effect(e);
     let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
-    let mut planner = ignis::sim::EffectPlanner::default();
-    let mut cpu = ignis::sim::CpuSim::for_emitter(&effect.emitters[0]);
+    let mut planner = ignis::testing::sim::EffectPlanner::default();
+    let mut cpu = ignis::testing::sim::CpuSim::for_emitter(&effect.emitters[0]);
     let dt = 1.0 / 90.0;
     let mut longest = 0;
     for step in 0..400 {
@@ -892,8 +896,8 @@ fn update_window_skips_only_dead_slots() {
 fn revised_plans_equal_plans_built_anew() {
     let mut effect = ignis::Effect::default_campfire();
     let (mut cached, mut fresh) = (
-        ignis::sim::EffectPlanner::default(),
-        ignis::sim::EffectPlanner::default(),
+        ignis::testing::sim::EffectPlanner::default(),
+        ignis::testing::sim::EffectPlanner::default(),
     );
     let mut revision = 1;
     for step in 0..300 {
@@ -915,7 +919,7 @@ fn revised_plans_equal_plans_built_anew() {
         let mut got = vec![None; effect.emitters.len()];
         cached.plan_step_with(&effect, Some(revision), dt, |i, p| got[i] = p.copied());
         for (i, (g, e)) in got.iter().zip(&expected).enumerate() {
-            let bytes = |p: &Option<ignis::gpu::types::SimParams>| {
+            let bytes = |p: &Option<ignis::testing::gpu::types::SimParams>| {
                 p.map(|p| bytemuck::bytes_of(&p).to_vec())
             };
             assert_eq!(bytes(g), bytes(e), "step {step}, emitter {i}");

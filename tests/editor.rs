@@ -9,15 +9,15 @@ use egui::{Key, Modifiers, Role};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable as _;
 
-use ignis::editor::EditorState;
-use ignis::editor::panel::panel_ui;
-use ignis::editor::viewport::viewport_ui;
 use ignis::effect::Effect;
-use ignis::gpu::GpuContext;
-use ignis::gpu::types::Particle;
-use ignis::render::OrbitCamera;
-use ignis::shaders::ShaderLibrary;
-use ignis::sim::GpuSim;
+use ignis::testing::editor::EditorState;
+use ignis::testing::editor::panel::panel_ui;
+use ignis::testing::editor::panel::viewport::viewport_ui;
+use ignis::testing::gpu::GpuContext;
+use ignis::testing::gpu::types::Particle;
+use ignis::testing::render::OrbitCamera;
+use ignis::testing::shaders::ShaderLibrary;
+use ignis::testing::sim::GpuSim;
 use ignis::{Player, PlayerSettings};
 
 /// The side panel over an editor state, as the window runs it (UI, then end of frame).
@@ -696,10 +696,10 @@ fn inspect_follows_the_pointer_and_a_click_pins_the_particle_under_it() {
     }
     assert!(harness.state().editor.inspect.pin_requested, "a click pins");
     // The player's pick at that pointer, with the viewport's camera.
-    let ctx = ignis::gpu::GpuContext::headless().expect("an adapter");
+    let ctx = ignis::testing::gpu::GpuContext::headless().expect("an adapter");
     let effect = harness.state().editor.running.clone();
-    let mut run =
-        ignis::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    let mut run = ignis::testing::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
+        .expect("headless");
     for _ in 0..60 {
         run.advance(1.0 / 60.0);
     }
@@ -932,7 +932,7 @@ fn preset_workflow_dirty_revert_confirm_and_external_reload() {
     state.request_load();
     assert_eq!(
         state.pending,
-        Some(ignis::editor::state::PendingAction::Load)
+        Some(ignis::testing::editor::state::PendingAction::Load)
     );
     assert_eq!(state.effect.seed, 79);
     state.pending = None;
@@ -953,7 +953,7 @@ fn preset_workflow_dirty_revert_confirm_and_external_reload() {
     state.preset_changed_on_disk();
     assert_eq!(
         state.pending,
-        Some(ignis::editor::state::PendingAction::ExternalReload)
+        Some(ignis::testing::editor::state::PendingAction::ExternalReload)
     );
     assert_eq!(state.effect.seed, 5);
     state.confirm_pending();
@@ -993,7 +993,8 @@ fn mouse_collider_follows_the_pointer() {
     let right = harness.state().editor.mouse_point.expect("point");
     assert!(right.x > centre.x + 0.2, "{right} vs {centre}");
     let state = &harness.state().editor;
-    let simulated = ignis::editor::state::with_mouse_collider(&state.effect, state.mouse_point);
+    let simulated =
+        ignis::testing::editor::state::with_mouse_collider(&state.effect, state.mouse_point);
     for (e, s) in state.effect.emitters.iter().zip(&simulated.emitters) {
         assert_eq!(s.collisions.spheres.len(), e.collisions.spheres.len() + 1);
         assert_eq!(
@@ -1063,7 +1064,7 @@ fn look_controls_toggle_flipbook_streak_bloom_and_the_gradient_bar_adds_stops() 
         .find(|s| !stops.contains(s))
         .expect("a new stop");
     assert!((added.t - 0.5).abs() < 0.05, "added at {}", added.t);
-    let want = ignis::render::look::sample_gradient(&stops, added.t);
+    let want = ignis::testing::render::look::sample_gradient(&stops, added.t);
     for (got, want) in added.rgba.iter().zip(want) {
         assert!((got - want).abs() < 1e-5);
     }
@@ -1177,9 +1178,9 @@ fn retained_test_frame(
 /// (or the first frame) repaints in full.
 #[test]
 fn retained_ui_repaints_match_full_repaints() {
-    use ignis::editor::retained::{Repaint, RetainedUi};
-    use ignis::editor::screenshot::{Screenshot, read_back};
-    use ignis::editor::ui_painter::UiPainter;
+    use ignis::testing::editor::window::retained::{Repaint, RetainedUi};
+    use ignis::testing::editor::window::screenshot::{Screenshot, read_back};
+    use ignis::testing::editor::window::ui_painter::UiPainter;
 
     let ctx = GpuContext::headless().expect("a GPU adapter (lavapipe is fine)");
     let format = wgpu::TextureFormat::Rgba8Unorm;
@@ -1192,7 +1193,7 @@ fn retained_ui_repaints_match_full_repaints() {
         b: 11.0 / 255.0,
         a: 1.0,
     };
-    let full_target = ignis::gpu::texture_2d(
+    let full_target = ignis::testing::gpu::texture_2d(
         &ctx.device,
         "test::full",
         (480, 270),
@@ -1277,7 +1278,7 @@ fn run_export(harness: &mut Harness<'_, EditorState>, ctx: &GpuContext) -> (bool
         {
             let state = harness.state_mut();
             let effect = state.running.clone();
-            ignis::editor::export_ui::drive(
+            ignis::testing::editor::panel::export_ui::drive(
                 ctx,
                 &effect,
                 None,
@@ -1341,7 +1342,7 @@ fn the_export_section_exports_with_progress_and_cancels() {
     let state = harness.state_mut();
     let effect = state.running.clone();
     let step = |state: &mut EditorState, running: &mut Option<_>| {
-        ignis::editor::export_ui::drive(
+        ignis::testing::editor::panel::export_ui::drive(
             &ctx,
             &effect,
             None,
@@ -1375,7 +1376,7 @@ fn the_export_section_exports_with_progress_and_cancels() {
 /// effect's clock), the step back to one step before the current time; a restart clears.
 #[test]
 fn the_timeline_seeks_in_whole_steps() {
-    use ignis::editor::timeline::{span_secs, timeline_ui};
+    use ignis::testing::editor::panel::timeline::{span_secs, timeline_ui};
     let mut state = campfire_state();
     state.stats.sim_time_secs = 1.0;
     let mut harness = Harness::builder()
@@ -1417,8 +1418,8 @@ fn the_timeline_seeks_in_whole_steps() {
 /// follows), a click away from the keys adds one where it is, a right-click deletes one.
 #[test]
 fn the_curve_editor_drags_adds_and_deletes_keys() {
-    use ignis::editor::curve_editor::{View, plot_area};
     use ignis::effect::Param;
+    use ignis::testing::editor::panel::curve_editor::{View, plot_area};
     let mut harness = panel_harness(campfire_state());
     open_section(&mut harness, "Look");
     // Let the section's opening animation settle: the plot must stay where it is found.
@@ -1431,7 +1432,7 @@ fn the_curve_editor_drags_adds_and_deletes_keys() {
         panic!("the campfire smoke's size is two curves: {before:?}");
     };
     let rect = plot_area(harness.get_by_label("Size curve").rect());
-    let view = View::fit(&before, &ignis::editor::look::SIZE);
+    let view = View::fit(&before, &ignis::testing::editor::panel::look_ui::SIZE);
     // Row a's last key, (1.0, 0.91): drag it down by 20 points.
     let key = a.keys[1];
     let start = view.to_screen(rect, key);
@@ -1472,7 +1473,7 @@ fn the_curve_editor_drags_adds_and_deletes_keys() {
 
     // A click in the middle, away from the keys, adds a key to the nearer curve there.
     let rect = plot_area(harness.get_by_label("Size curve").rect());
-    let view = View::fit(&after, &ignis::editor::look::SIZE);
+    let view = View::fit(&after, &ignis::testing::editor::panel::look_ui::SIZE);
     let mid = view.to_screen(rect, (0.5, moved.eval(0.5) as f32));
     harness.hover_at(mid);
     harness.run();
@@ -1604,7 +1605,7 @@ fn run_measure(
         {
             let state = harness.state_mut();
             let effect = state.running.clone();
-            ignis::editor::measure_ui::drive(
+            ignis::testing::editor::panel::measure_ui::drive(
                 ctx,
                 &effect,
                 None,

@@ -7,15 +7,17 @@ mod common;
 
 use common::*;
 use ignis::effect::*;
-use ignis::gpu::types::{Particle, SimParams};
-use ignis::shaders::ShaderLibrary;
-use ignis::sim::GpuSim;
-use ignis::sim::events::{EventRecord, ScanConfig, child_key, event_of, rules_of, scan_events};
+use ignis::testing::gpu::types::{Particle, SimParams};
+use ignis::testing::shaders::ShaderLibrary;
+use ignis::testing::sim::GpuSim;
+use ignis::testing::sim::events::{
+    EventRecord, ScanConfig, child_key, event_of, rules_of, scan_events,
+};
 
 const DT: f32 = 1.0 / 60.0;
 
 /// The test's adapter, with any validation error a failure (the programs log them).
-fn strict_gpu() -> ignis::gpu::GpuContext {
+fn strict_gpu() -> ignis::testing::gpu::GpuContext {
     let ctx = gpu();
     ctx.device.on_uncaptured_error(std::sync::Arc::new(|e| {
         let mut msg = e.to_string();
@@ -74,7 +76,7 @@ fn expected_list(
     p: &SimParams,
     (before, after): (&[Particle], &[Particle]),
     bucket: &mut ignis::effect::RateCap,
-) -> (Vec<ignis::sim::events::EventSpawn>, u32) {
+) -> (Vec<ignis::testing::sim::events::EventSpawn>, u32) {
     let rule = rules_of(&effect.emitters[0])[0];
     let mut records = Vec::new();
     for i in 0..p.update_window[1] {
@@ -101,7 +103,7 @@ fn expected_list(
     }
     let delta = (sim.planner.emitters[0].origin() - sim.planner.emitters[1].origin()).as_vec3();
     let ev = &effect.emitters[0].events[0];
-    let room = ignis::sim::events::step_cap(effect, 0, 0);
+    let room = ignis::testing::sim::events::step_cap(effect, 0, 0);
     let cfg = ScanConfig {
         rule_capacity_cap: [
             0,
@@ -200,7 +202,7 @@ fn check_against_the_mirror(
                 s.pos_key[3].to_bits(),
                 bits & 0xFFFF,
             );
-            let want = ignis::sim::cpu_reference::spawn_particle(&cp, key).vel_life[3];
+            let want = ignis::testing::sim::cpu_reference::spawn_particle(&cp, key).vel_life[3];
             // Inheriting the colour, the lifetime's lowest 8 bits carry the parent's age.
             let want = if inherit_color {
                 f32::from_bits((want.to_bits() & !0xFF) | ((bits >> 16) & 0xFF))
@@ -492,7 +494,7 @@ fn event_chain() -> Effect {
 fn events_are_frame_rate_independent_and_seekable() {
     let ctx = strict_gpu();
     let effect = event_chain();
-    let state = |run: &ignis::headless::Headless| -> Vec<u8> {
+    let state = |run: &ignis::testing::headless::Headless| -> Vec<u8> {
         let links = run
             .player
             .trail(run.instance, 2)
@@ -508,9 +510,12 @@ fn events_are_frame_rate_independent_and_seekable() {
     };
     let mut reference = None;
     for (name, frames) in frame_sequences() {
-        let mut run =
-            ignis::headless::Headless::new(&ctx, effect.clone(), ShaderLibrary::embedded())
-                .expect("headless");
+        let mut run = ignis::testing::headless::Headless::new(
+            &ctx,
+            effect.clone(),
+            ShaderLibrary::embedded(),
+        )
+        .expect("headless");
         for dt in &frames {
             run.advance(*dt);
         }
@@ -528,11 +533,15 @@ fn events_are_frame_rate_independent_and_seekable() {
     // Seeking: played to 2 s at 60 fps with snapshots every 0.75 s, back to 1 s.
     let settings = ignis::PlayerSettings {
         batch_instances: false,
-        ..ignis::composite::Composite::player_settings()
+        ..ignis::testing::composite::Composite::player_settings()
     };
-    let mut run =
-        ignis::headless::Headless::with_settings(&ctx, effect, ShaderLibrary::embedded(), settings)
-            .expect("headless");
+    let mut run = ignis::testing::headless::Headless::with_settings(
+        &ctx,
+        effect,
+        ShaderLibrary::embedded(),
+        settings,
+    )
+    .expect("headless");
     run.player.keep_seek_snapshots(0.75, 64 << 20);
     let mut at_one = Vec::new();
     for frame in 1..=120 {
@@ -547,9 +556,12 @@ fn events_are_frame_rate_independent_and_seekable() {
         "seeking back to 1 s gives the played state"
     );
     // Without snapshots a seek replays from the start (a restart of every pool).
-    let mut fresh =
-        ignis::headless::Headless::new(&ctx, run.effect().clone(), ShaderLibrary::embedded())
-            .expect("headless");
+    let mut fresh = ignis::testing::headless::Headless::new(
+        &ctx,
+        run.effect().clone(),
+        ShaderLibrary::embedded(),
+    )
+    .expect("headless");
     fresh.seek(1.0, 1.0 / 60.0);
     assert!(
         state(&fresh) == at_one,
@@ -590,14 +602,18 @@ fn the_campfire_smoke_comes_from_its_flames() {
 fn adding_and_removing_events_live_moves_instances_between_batches_and_own_sims() {
     let ctx = strict_gpu();
     let torch = ignis::preset::load(std::path::Path::new("presets/torch.ron")).expect("load");
-    assert!(ignis::sim::batch::batchable(&torch));
+    assert!(ignis::testing::sim::batch::batchable(&torch));
     let settings = ignis::PlayerSettings {
         batch_instances: true,
-        ..ignis::composite::Composite::player_settings()
+        ..ignis::testing::composite::Composite::player_settings()
     };
-    let mut run =
-        ignis::headless::Headless::with_settings(&ctx, torch, ShaderLibrary::embedded(), settings)
-            .expect("headless");
+    let mut run = ignis::testing::headless::Headless::with_settings(
+        &ctx,
+        torch,
+        ShaderLibrary::embedded(),
+        settings,
+    )
+    .expect("headless");
     let second = run
         .player
         .add_instance(glam::Mat4::from_translation(glam::vec3(1.0, 0.0, 0.0)), 9)
@@ -688,8 +704,9 @@ fn inherited_colour_tints_the_children() {
         child.look.intensity = 0.5;
         child.look.draw_path = path;
         effect.validate().expect("valid");
-        let mut run = ignis::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
-            .expect("headless");
+        let mut run =
+            ignis::testing::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
+                .expect("headless");
         for _ in 0..30 {
             run.advance(1.0 / 60.0);
         }

@@ -9,10 +9,10 @@ mod common;
 use common::*;
 use glam::{DVec3, Vec3};
 use ignis::effect::*;
-use ignis::gpu::types::Particle;
-use ignis::shaders::ShaderLibrary;
-use ignis::sim::cpu_reference::{Forces as CpuForces, curl_noise};
-use ignis::sim::{GpuSim, Modules};
+use ignis::testing::gpu::types::Particle;
+use ignis::testing::shaders::ShaderLibrary;
+use ignis::testing::sim::cpu_reference::{Forces as CpuForces, curl_noise};
+use ignis::testing::sim::{GpuSim, Modules};
 
 fn particle(pos: Vec3, vel: Vec3) -> Particle {
     Particle {
@@ -101,7 +101,7 @@ fn gpu_turbulence_matches_cpu_field() {
     let out = run_from(&e, &initial, dt, 1);
     // The CPU field with the same parameter block.
     let effect = bare_effect(e.clone());
-    let mut planner = ignis::sim::EffectPlanner::default();
+    let mut planner = ignis::testing::sim::EffectPlanner::default();
     let params = planner.plan_step(&effect, dt)[0].expect("enabled");
     let forces = CpuForces {
         params: &params,
@@ -437,7 +437,8 @@ fn stateless_matches_stateful_and_is_refused_when_ineligible() {
     let mut compared = 0;
     let mut worst: f32 = 0.0;
     for (s, r) in full.iter().zip(&records) {
-        let e = ignis::sim::cpu_reference::evaluate_stateless(r, &stateless.emitters[0], now);
+        let e =
+            ignis::testing::sim::cpu_reference::evaluate_stateless(r, &stateless.emitters[0], now);
         assert_eq!(s.is_alive(), e.is_alive(), "{s:?} vs {e:?}");
         if s.is_alive() {
             worst = worst.max((s.position() - e.position()).length());
@@ -517,8 +518,8 @@ fn an_inspected_particle_reports_its_state_and_the_forces_on_it() {
     e.forces.wind_m_per_s = [0.5, 0.0, 0.0];
     e.transform.position_m = [3.0, 1.0, -2.0];
     let effect = bare_effect(e);
-    let mut run =
-        ignis::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    let mut run = ignis::testing::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
+        .expect("headless");
     for _ in 0..30 {
         run.advance(1.0 / 60.0);
     }

@@ -9,7 +9,7 @@
 
 use proptest::prelude::*;
 
-use ignis::shaders::ShaderLibrary;
+use ignis::testing::shaders::ShaderLibrary;
 
 /// A shipped preset with `edits` applied: (position fraction, byte) replacements,
 /// insertions and a truncation — text close to valid RON, where parsers break.

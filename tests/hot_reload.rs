@@ -10,12 +10,12 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use common::*;
-use ignis::composite::Composite;
 use ignis::effect::Effect;
-use ignis::gpu::GpuContext;
-use ignis::gpu::types::Particle;
-use ignis::hot_reload::{FileWatcher, ShaderReloader, wgsl_names};
-use ignis::shaders::{EMBEDDED, ShaderLibrary};
+use ignis::testing::composite::Composite;
+use ignis::testing::gpu::GpuContext;
+use ignis::testing::gpu::types::Particle;
+use ignis::testing::hot_reload::{FileWatcher, ShaderReloader, wgsl_names};
+use ignis::testing::shaders::{EMBEDDED, ShaderLibrary};
 use ignis::{InstanceId, Player, PlayerSettings};
 
 struct Rig {
@@ -85,11 +85,15 @@ impl Rig {
         std::fs::write(self.path(name), text.replacen(from, to, 1)).expect("write");
     }
 
-    fn reload(&mut self, changed: &[&str]) -> ignis::hot_reload::ReloadReport {
+    fn reload(&mut self, changed: &[&str]) -> ignis::testing::hot_reload::ReloadReport {
         self.reload_at(changed, Instant::now())
     }
 
-    fn reload_at(&mut self, changed: &[&str], noticed: Instant) -> ignis::hot_reload::ReloadReport {
+    fn reload_at(
+        &mut self,
+        changed: &[&str],
+        noticed: Instant,
+    ) -> ignis::testing::hot_reload::ReloadReport {
         let changed: Vec<String> = changed.iter().map(|s| (*s).to_owned()).collect();
         self.reloader.reload(
             &self.ctx,

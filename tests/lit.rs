@@ -11,7 +11,7 @@ use glam::{Mat4, Vec3, vec3};
 use host::Host;
 use ignis::Player;
 use ignis::effect::{BlendMode, DrawPath, Effect, Lighting, Param, Range, SixWayMaps};
-use ignis::render::sixway_maps::{EXTINCTION, PUFF_SEED, puff, puff_density};
+use ignis::testing::render::sixway_maps::{EXTINCTION, PUFF_SEED, puff, puff_density};
 
 /// Where the puff hangs, and the camera (looking down −Z: the sprite's back is −Z).
 const SMOKE: Vec3 = Vec3::from_array(common::SMOKE);

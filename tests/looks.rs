@@ -15,18 +15,19 @@ use std::path::Path;
 use common::*;
 use glam::Vec3;
 use ignis::effect::{
-    BlendMode, CURVE_WIDTH, ColorStop, Curve, DrawPath, Effect, Flipbook, FlipbookMode,
-    GroundPlane, Look, Param, Range, Sprite, Streak, lookup_blend,
+    BlendMode, ColorStop, Curve, DrawPath, Effect, Flipbook, FlipbookMode, GroundPlane, Look,
+    Param, Range, Sprite, Streak,
 };
-use ignis::gpu::GpuContext;
-use ignis::gpu::types::{CameraUniform, LookUniform};
-use ignis::headless::Headless;
-use ignis::render::frame::look_uniform;
-use ignis::render::look::{
+use ignis::testing::effect::{CURVE_WIDTH, lookup_blend};
+use ignis::testing::gpu::GpuContext;
+use ignis::testing::gpu::types::{CameraUniform, LookUniform};
+use ignis::testing::headless::Headless;
+use ignis::testing::render::frame::look_uniform;
+use ignis::testing::render::look::{
     RAMP_WIDTH, bake_look_curves, bake_ramp, flipbook_frame, sample_gradient,
 };
-use ignis::render::sprites::SpriteLibrary;
-use ignis::shaders::{EMBEDDED, ShaderLibrary};
+use ignis::testing::render::sprites::SpriteLibrary;
+use ignis::testing::shaders::{EMBEDDED, ShaderLibrary};
 use wgpu::util::DeviceExt;
 
 const PROBE: &str = r#"
@@ -187,7 +188,7 @@ fn probe_all(
     }
     enc.copy_buffer_to_buffer(&out, 0, &staging, 0, out_size);
     ctx.queue.submit([enc.finish()]);
-    let bytes = ignis::sim::gpu_sim::map_read(ctx, &staging).expect("readback");
+    let bytes = ignis::testing::sim::gpu_sim::map_read(ctx, &staging).expect("readback");
     let values: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
     values
         .chunks(3)
@@ -255,7 +256,7 @@ fn look_curves_on_the_gpu_match_the_cpu_reference_at_every_texel_and_between() {
     }
     let got = probe_all(&ctx, &look, &inputs);
     let rows = bake_look_curves(&look);
-    let params = ignis::render::look::look_curve_params(&look);
+    let params = ignis::testing::render::look::look_curve_params(&look);
     let mut worst = [0.0f32; 4];
     for (input, (frames, _, curves)) in inputs.iter().zip(&got) {
         let t = (input[0] / input[1]).clamp(0.0, 1.0);
@@ -852,7 +853,7 @@ fn a_png_changed_on_disk_is_seen_by_the_watcher_and_reloaded() {
     assert!(err.is_none());
     let dirs = lib.watched_dirs();
     let paths: Vec<&Path> = dirs.iter().map(|d| d.as_path()).collect();
-    let watcher = ignis::hot_reload::FileWatcher::new(&paths).expect("watch");
+    let watcher = ignis::testing::hot_reload::FileWatcher::new(&paths).expect("watch");
     // A save: write a new image next to it, then rename over (as editors do).
     let tmp = dir.path().join("glow.tmp.png");
     write_png(&tmp, 8, 8, |_, _| [255, 255, 255, 255]);
@@ -936,7 +937,7 @@ fn trimmed_billboards_draw_the_untrimmed_frame() {
     let ctx = gpu();
     let mut sprites = SpriteLibrary::new(&ctx);
     let (sheet, _) = sprites.resolve(&ctx, &Sprite::FlameSheet, None);
-    let t = ignis::render::sprites::TRIM_THRESHOLD;
+    let t = ignis::testing::render::sprites::TRIM_THRESHOLD;
     let [u0, v0, u1, v1] = sheet.trim_rect(4, 4, t);
     assert!(
         u1 - u0 < 0.6 && u0 > 0.2 && u1 < 0.8,

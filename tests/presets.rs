@@ -16,9 +16,9 @@ use ignis::effect::{
     Lighting, Lit, Look, MAX_CAPACITY, Param, Post, Range, Shape, SixWayMaps, SpawnNoise,
     SphereCollider, Sprite, Streak, TimeMode, TimeSettings, Transform, Turbulence, Vortex,
 };
-use ignis::headless::Headless;
 use ignis::preset::{self, PresetError};
-use ignis::shaders::ShaderLibrary;
+use ignis::testing::headless::Headless;
+use ignis::testing::shaders::ShaderLibrary;
 use proptest::prelude::*;
 
 fn presets_dir() -> PathBuf {
@@ -185,7 +185,11 @@ fn thesis_preset_replicates_the_2006_setup() {
 }
 
 /// Mean height of the alive particles of emitter 0 after one simulated second at `fps`.
-fn mean_height_after_1s(ctx: &ignis::gpu::GpuContext, effect: &Effect, fps: u32) -> (f32, Vec<u8>) {
+fn mean_height_after_1s(
+    ctx: &ignis::testing::gpu::GpuContext,
+    effect: &Effect,
+    fps: u32,
+) -> (f32, Vec<u8>) {
     let mut run = Headless::new(ctx, effect.clone(), ShaderLibrary::embedded()).expect("headless");
     for _ in 0..fps {
         run.advance(1.0 / fps as f64);

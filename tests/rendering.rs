@@ -8,13 +8,13 @@ mod common;
 use common::*;
 use glam::Vec3;
 use ignis::effect::Effect;
-use ignis::headless::Headless;
-use ignis::shaders::ShaderLibrary;
+use ignis::testing::headless::Headless;
+use ignis::testing::shaders::ShaderLibrary;
 
 const SIZE: (u32, u32) = (320, 240);
 
 fn campfire_after(
-    ctx: &ignis::gpu::GpuContext,
+    ctx: &ignis::testing::gpu::GpuContext,
     secs: f64,
     seed: u32,
 ) -> (Headless, image::RgbaImage) {
@@ -216,7 +216,7 @@ fn render_command_rejects_bad_input() {
 /// at 1920×1080 only under the software profile.
 #[test]
 fn a_gpu_profile_splats_only_dense_small_particles() {
-    use ignis::gpu::AdapterProfile;
+    use ignis::testing::gpu::AdapterProfile;
     let base = gpu();
     let splats = |profile: AdapterProfile, size: (u32, u32)| {
         let ctx = base.clone().with_profile(Some(profile));
@@ -341,8 +341,8 @@ fn stateless_emitter_renders_like_the_stateful_one() {
 #[test]
 fn gpu_sort_equals_cpu_sort() {
     let ctx = gpu();
-    let mut sort =
-        ignis::render::sort::SortPass::new(&ctx, &ShaderLibrary::embedded()).expect("sort");
+    let mut sort = ignis::testing::render::sort::SortPass::new(&ctx, &ShaderLibrary::embedded())
+        .expect("sort");
     let mut state = 0x9E37_79B9u32;
     let mut next = || {
         state ^= state << 13;
@@ -631,7 +631,7 @@ fn draft_glow_layer_renders_like_full_resolution() {
 /// `splat_dense_only`; `tests/tiles.rs` holds the tiles to the billboards' image.)
 #[test]
 fn both_adapter_profiles_render_the_same_frame() {
-    use ignis::gpu::AdapterProfile;
+    use ignis::testing::gpu::AdapterProfile;
     let render = |profile: AdapterProfile| {
         let ctx = gpu().with_profile(Some(profile));
         let mut effect = Effect::default_campfire();

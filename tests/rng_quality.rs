@@ -1,7 +1,7 @@
 //! Randomness quality of the counter-based hash (the same integer maths runs on the GPU;
 //! `core_sim::gpu_matches_cpu_reference_for_every_integrator` checks the two agree).
 
-use ignis::rng::{emitter_salt, rand_block, spawn_key, unorm, unorm4};
+use ignis::testing::rng::{emitter_salt, rand_block, spawn_key, unorm, unorm4};
 
 const N: u64 = 200_000;
 

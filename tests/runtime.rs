@@ -26,7 +26,7 @@ fn batchable_campfire() -> Effect {
         e.look.trail = None;
     }
     effect.emitters[0].spawn_rate_per_sec = ignis::effect::Param::Constant(90.0);
-    assert!(ignis::sim::batch::batchable(&effect));
+    assert!(ignis::testing::sim::batch::batchable(&effect));
     effect
 }
 
@@ -146,7 +146,7 @@ fn hides_the_fire_in(kind: HostKind, effect: &Effect, depth: bool) -> Frame {
         .emitters
         .iter()
         .any(|e| e.look.draw_path == ignis::effect::DrawPath::Tiles);
-    let tiles_fit = ignis::render::TilePass::supported(&host.device);
+    let tiles_fit = ignis::testing::render::TilePass::supported(&host.device);
     assert_eq!(tiled, wants_tiles && depth && tiles_fit, "the tiles ran");
     with_fire
 }
@@ -358,15 +358,18 @@ fn a_batched_instance_steps_exactly_as_a_simulation_of_its_own() {
     advance(&mut [&mut player], &host, 20);
     assert!(player.remove_instance(ids[1]));
     let late = player.add_instance(places[1], 77).expect("instance");
-    let ctx = ignis::gpu::GpuContext::from_device(&host.device, &host.queue);
+    let ctx = ignis::testing::gpu::GpuContext::from_device(&host.device, &host.queue);
     // The instance's own simulation, stepped as the player's clock stepped it from frame
     // `from` (a clock's steps per frame depend on its history: it is replayed).
     let own = |id, from: u32, frames: u32| {
         let placed = player.instance_effect(id).expect("instance").clone();
-        let mut sim =
-            ignis::sim::GpuSim::new(&ctx, ignis::shaders::ShaderLibrary::embedded(), &placed)
-                .expect("sim");
-        let mut stepper = ignis::sim::Stepper::default();
+        let mut sim = ignis::testing::sim::GpuSim::new(
+            &ctx,
+            ignis::testing::shaders::ShaderLibrary::embedded(),
+            &placed,
+        )
+        .expect("sim");
+        let mut stepper = ignis::testing::sim::Stepper::default();
         for frame in 0..from + frames {
             let plan = stepper.advance(1.0 / 60.0, &placed.time);
             if frame >= from {
@@ -616,7 +619,7 @@ fn an_instance_added_to_a_sorted_batch_shows_its_smoke() {
 #[test]
 fn a_frame_runs_every_step_it_needs_beyond_one_chunk() {
     let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
-    let ctx = ignis::gpu::GpuContext::from_device(&host.device, &host.queue);
+    let ctx = ignis::testing::gpu::GpuContext::from_device(&host.device, &host.queue);
     for (effect, label) in [
         (batchable_campfire(), "batched"),
         (preset("campfire"), "own"),
@@ -652,9 +655,12 @@ fn a_frame_runs_every_step_it_needs_beyond_one_chunk() {
                 "{label}, {steps_per_frame} steps a frame"
             );
             let placed = player.instance_effect(id).expect("instance").clone();
-            let mut sim =
-                ignis::sim::GpuSim::new(&ctx, ignis::shaders::ShaderLibrary::embedded(), &placed)
-                    .expect("sim");
+            let mut sim = ignis::testing::sim::GpuSim::new(
+                &ctx,
+                ignis::testing::shaders::ShaderLibrary::embedded(),
+                &placed,
+            )
+            .expect("sim");
             for _ in 0..frames {
                 sim.step(&placed, step, steps_per_frame).expect("step");
             }

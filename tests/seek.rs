@@ -8,17 +8,17 @@
 mod common;
 
 use common::gpu;
-use ignis::headless::Headless;
-use ignis::shaders::ShaderLibrary;
+use ignis::testing::headless::Headless;
+use ignis::testing::shaders::ShaderLibrary;
 
 const FPS: f64 = 60.0;
 
 /// A headless run whose instance has a simulation of its own (as the editor's): the
 /// player keeps seek snapshots for those.
-fn unbatched(ctx: &ignis::gpu::GpuContext, effect: ignis::Effect) -> Headless {
+fn unbatched(ctx: &ignis::testing::gpu::GpuContext, effect: ignis::Effect) -> Headless {
     let settings = ignis::PlayerSettings {
         batch_instances: false,
-        ..ignis::composite::Composite::player_settings()
+        ..ignis::testing::composite::Composite::player_settings()
     };
     Headless::with_settings(ctx, effect, ShaderLibrary::embedded(), settings).expect("headless")
 }
@@ -51,7 +51,7 @@ fn seeking_gives_the_played_state_bit_for_bit_for_every_shipped_preset() {
         let settings = ignis::PlayerSettings {
             asset_dir: path.parent().map(std::path::Path::to_path_buf),
             batch_instances: false,
-            ..ignis::composite::Composite::player_settings()
+            ..ignis::testing::composite::Composite::player_settings()
         };
         let mut run = Headless::with_settings(&ctx, effect, ShaderLibrary::embedded(), settings)
             .expect("headless");
@@ -257,8 +257,8 @@ fn an_edit_forgets_the_snapshots_and_seeks_land_on_steps() {
 /// start once the clock passes its end, and never runs past it by more than a frame.
 #[test]
 fn timeline_playback_speed_parked_steps_and_the_loop_region() {
-    use ignis::editor::state::Playback;
-    use ignis::editor::timeline::play;
+    use ignis::testing::editor::panel::timeline::play;
+    use ignis::testing::editor::state::Playback;
     let ctx = gpu();
     let effect = ignis::Effect::default_campfire();
     let step = f64::from(effect.time.step_secs);

@@ -1,8 +1,8 @@
 //! Shader composition and validation: every entry file validates, Rust and WGSL struct
 //! layouts agree, errors point at the right file, line and column.
 
-use ignis::gpu::types::{CameraUniform, LookUniform, Particle, SimParams, ToneUniform};
-use ignis::shaders::{EMBEDDED, ENTRY_FILES, ShaderError, ShaderLibrary};
+use ignis::testing::gpu::types::{CameraUniform, LookUniform, Particle, SimParams, ToneUniform};
+use ignis::testing::shaders::{EMBEDDED, ENTRY_FILES, ShaderError, ShaderLibrary};
 
 fn project_shaders() -> ShaderLibrary {
     ShaderLibrary::from_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/shaders"))
@@ -26,13 +26,13 @@ fn every_entry_validates() {
     }
     // The packed-state update: update.wgsl with state_packed.wgsl as its state I/O.
     let packed = project_shaders()
-        .compose_with("update.wgsl", &[ignis::shaders::PACKED_STATE_IO])
+        .compose_with("update.wgsl", &[ignis::testing::shaders::PACKED_STATE_IO])
         .unwrap_or_else(|e| panic!("packed update: {e}"));
     assert!(packed.files.iter().any(|f| f == "state_packed.wgsl"));
     assert!(!packed.files.iter().any(|f| f == "state_full.wgsl"));
     // The tiny-state update: state_tiny.wgsl (and the birth table) as its state I/O.
     let tiny = project_shaders()
-        .compose_with("update.wgsl", &[ignis::shaders::TINY_STATE_IO])
+        .compose_with("update.wgsl", &[ignis::testing::shaders::TINY_STATE_IO])
         .unwrap_or_else(|e| panic!("tiny update: {e}"));
     assert!(tiny.files.iter().any(|f| f == "state_tiny.wgsl"));
     assert!(!tiny.files.iter().any(|f| f == "state_full.wgsl"));
@@ -43,19 +43,19 @@ fn every_entry_validates() {
     assert!(deps.iter().any(|f| f == "params_instanced.wgsl"));
     // A runtime player's batched instances: an array of parameters (params_instanced.wgsl).
     let instanced = project_shaders()
-        .compose_with("update.wgsl", &[ignis::shaders::PARAMS_INSTANCED])
+        .compose_with("update.wgsl", &[ignis::testing::shaders::PARAMS_INSTANCED])
         .unwrap_or_else(|e| panic!("update with batched instances: {e}"));
     assert!(instanced.files.iter().any(|f| f == "params_instanced.wgsl"));
     assert!(!instanced.files.iter().any(|f| f == "params.wgsl"));
     // An emitter with events: events_on.wgsl (hooks and bindings) for events_off.wgsl.
     let events = project_shaders()
-        .compose_with("update.wgsl", &[ignis::shaders::EVENTS_IO])
+        .compose_with("update.wgsl", &[ignis::testing::shaders::EVENTS_IO])
         .unwrap_or_else(|e| panic!("update with events: {e}"));
     assert!(events.files.iter().any(|f| f == "events_on.wgsl"));
     assert!(!events.files.iter().any(|f| f == "events_off.wgsl"));
     // An emitter with a trail: trail_on.wgsl (the ring of positions) for trail_off.wgsl.
     let trail = project_shaders()
-        .compose_with("update.wgsl", &[ignis::shaders::TRAIL_IO])
+        .compose_with("update.wgsl", &[ignis::testing::shaders::TRAIL_IO])
         .unwrap_or_else(|e| panic!("update with a trail: {e}"));
     assert!(trail.files.iter().any(|f| f == "trail_on.wgsl"));
     assert!(!trail.files.iter().any(|f| f == "trail_off.wgsl"));
@@ -87,7 +87,7 @@ fn rust_and_wgsl_struct_sizes_agree() {
     let billboard = lib.compose("billboard.wgsl").expect("billboard");
     let tonemap = lib.compose("tonemap.wgsl").expect("tonemap");
     let scan = lib.compose("events.wgsl").expect("events");
-    use ignis::sim::events::{EventRule, EventSpawn, ScanConfig};
+    use ignis::testing::sim::events::{EventRule, EventSpawn, ScanConfig};
     let cases = [
         (&scan, "EventRule", size_of::<EventRule>()),
         (&scan, "EventSpawn", size_of::<EventSpawn>()),
@@ -97,9 +97,13 @@ fn rust_and_wgsl_struct_sizes_agree() {
         (
             &update,
             "PackedParticle",
-            size_of::<ignis::gpu::types::PackedParticle>(),
+            size_of::<ignis::testing::gpu::types::PackedParticle>(),
         ),
-        (&update, "Birth", size_of::<ignis::gpu::types::Birth>()),
+        (
+            &update,
+            "Birth",
+            size_of::<ignis::testing::gpu::types::Birth>(),
+        ),
         (&billboard, "CameraUniform", size_of::<CameraUniform>()),
         (&billboard, "LookUniform", size_of::<LookUniform>()),
         (&tonemap, "ToneUniform", size_of::<ToneUniform>()),

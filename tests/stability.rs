@@ -7,11 +7,11 @@ mod common;
 
 use common::*;
 use glam::Vec3;
-use ignis::bench::accuracy::{self, Scene};
 use ignis::effect::{Effect, Emitter, Integrator, Range, Transform};
-use ignis::gpu::types::Particle;
-use ignis::shaders::ShaderLibrary;
-use ignis::sim::{EffectPlanner, GpuSim};
+use ignis::testing::bench::accuracy::{self, Scene};
+use ignis::testing::gpu::types::Particle;
+use ignis::testing::shaders::ShaderLibrary;
+use ignis::testing::sim::{EffectPlanner, GpuSim};
 
 /// A pool of `n` particles at the origin with velocity `v0`, lifetime 1e4 s.
 fn moving(n: usize, v0: Vec3) -> Vec<Particle> {
@@ -26,7 +26,7 @@ fn moving(n: usize, v0: Vec3) -> Vec<Particle> {
 
 /// Pure linear drag, rate 0: runs `steps` steps from `initial` and returns the state.
 fn run_drag(
-    ctx: &ignis::gpu::GpuContext,
+    ctx: &ignis::testing::gpu::GpuContext,
     integrator: Integrator,
     k: f32,
     accel: f32,
@@ -233,8 +233,9 @@ fn far_from_the_origin_motion_still_resolves() {
     }
     shift(&mut far.camera.target_m);
     let run = |effect: Effect| {
-        let mut h = ignis::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
-            .expect("headless");
+        let mut h =
+            ignis::testing::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
+                .expect("headless");
         for _ in 0..60 {
             h.advance(1.0 / 60.0);
         }
@@ -286,7 +287,7 @@ fn a_million_steps_do_not_drift() {
         if s < 2000 || s >= steps - 2000 {
             let base = (p.spawn_base_hi as u64) << 32 | p.spawn_base_lo as u64;
             for i in 0..p.spawn_count as u64 {
-                let key = ignis::rng::spawn_key(
+                let key = ignis::testing::rng::spawn_key(
                     p.seed,
                     p.emitter_salt,
                     ((base + i) % 2048) as u32,

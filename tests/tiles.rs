@@ -12,9 +12,9 @@ use common::{gpu, image_diff, total_light};
 use ignis::effect::{
     BlendMode, DrawPath, Effect, Flipbook, FlipbookMode, Param, Range, Sprite, Streak,
 };
-use ignis::gpu::{AdapterProfile, GpuContext};
-use ignis::headless::Headless;
-use ignis::shaders::ShaderLibrary;
+use ignis::testing::gpu::{AdapterProfile, GpuContext};
+use ignis::testing::headless::Headless;
+use ignis::testing::shaders::ShaderLibrary;
 
 const SIZE: (u32, u32) = (192, 144);
 
@@ -325,7 +325,7 @@ fn tiles_are_deterministic_and_the_automatic_choice_follows_the_profile() {
     let ctx = base.clone().with_profile(Some(AdapterProfile::GPU));
     let settings = ignis::PlayerSettings {
         batch_instances: true,
-        ..ignis::composite::Composite::player_settings()
+        ..ignis::testing::composite::Composite::player_settings()
     };
     let torch = ignis::preset::load("presets/torch.ron".as_ref()).expect("torch");
     let mut run = Headless::with_settings(&ctx, torch, ShaderLibrary::embedded(), settings)

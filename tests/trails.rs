@@ -9,9 +9,9 @@ mod common;
 
 use common::*;
 use ignis::effect::*;
-use ignis::shaders::ShaderLibrary;
-use ignis::sim::GpuSim;
-use ignis::sim::trails::{Link, trail_indices};
+use ignis::testing::shaders::ShaderLibrary;
+use ignis::testing::sim::GpuSim;
+use ignis::testing::sim::trails::{Link, trail_indices};
 
 const DT: f32 = 1.0 / 60.0;
 
@@ -212,8 +212,8 @@ fn the_ribbon_lights_the_pixels_between_the_particle_and_its_tail() {
     e.look.intensity = 4.0;
     let mut effect = bare_effect(e);
     side_view(&mut effect);
-    let mut run =
-        ignis::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    let mut run = ignis::testing::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
+        .expect("headless");
     let frames = 60u32;
     for _ in 0..frames {
         run.advance(f64::from(DT));
@@ -397,7 +397,7 @@ fn joins_children_in_order(effect: Effect, capacity: usize) {
 /// of the ring (wrapping at `capacity`), from the run's first free slot on.
 fn spawn_order_within_steps(
     ray: &mut [usize],
-    children: &[ignis::gpu::types::Particle],
+    children: &[ignis::testing::gpu::types::Particle],
     capacity: usize,
 ) {
     let mut start = 0;
@@ -452,8 +452,8 @@ fn a_ribbon_per_parent_lights_the_pixels_between_the_children() {
     });
     side_view(&mut effect);
     effect.validate().expect("valid");
-    let mut run =
-        ignis::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    let mut run = ignis::testing::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
+        .expect("headless");
     for _ in 0..60 {
         run.advance(f64::from(DT));
     }

@@ -13,8 +13,8 @@ use std::path::{Path, PathBuf};
 
 use common::*;
 use ignis::effect::{Effect, Vortex};
-use ignis::headless::Headless;
-use ignis::shaders::ShaderLibrary;
+use ignis::testing::headless::Headless;
+use ignis::testing::shaders::ShaderLibrary;
 use ignis::tune::*;
 
 fn preset_path(name: &str) -> PathBuf {
@@ -43,7 +43,7 @@ fn frames_of(effect: &Effect, opts: &SweepOptions) -> Vec<Vec<u8>> {
     // The preset's sprite paths are relative to its folder.
     let settings = ignis::PlayerSettings {
         asset_dir: opts.asset_dir.clone(),
-        ..ignis::composite::Composite::player_settings()
+        ..ignis::testing::composite::Composite::player_settings()
     };
     let mut run =
         Headless::with_settings(&ctx, effect.clone(), ShaderLibrary::embedded(), settings)
@@ -254,7 +254,7 @@ fn check_zero_vortex(report: &TuneReport, flames: &str, budget: f64) {
 }
 
 fn check_tuned(
-    ctx: &ignis::gpu::GpuContext,
+    ctx: &ignis::testing::gpu::GpuContext,
     report: &TuneReport,
     effect: &Effect,
     opts: &SweepOptions,
@@ -298,7 +298,8 @@ fn the_same_seed_gives_the_same_particles_at_every_step() {
     let play = |step: f32| {
         let mut e = effect.clone();
         e.time.step_secs = step;
-        let mut sim = ignis::sim::GpuSim::new(&ctx, ShaderLibrary::embedded(), &e).expect("sim");
+        let mut sim =
+            ignis::testing::sim::GpuSim::new(&ctx, ShaderLibrary::embedded(), &e).expect("sim");
         let steps = (1.0 / step).round() as u32;
         sim.step(&e, step, steps).expect("step");
         let spawned = sim.planner.emitters[flames].stats.spawned;

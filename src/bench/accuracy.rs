@@ -364,21 +364,6 @@ pub fn measure_cost(
     Ok(median(&mut samples))
 }
 
-/// Frame-rate (in)dependence: final states after 2 s for several frame-time sequences.
-#[derive(Clone, Debug, Serialize)]
-pub struct FrameRateRow {
-    /// The frame sequence.
-    pub frames: String,
-    /// Time mode.
-    pub mode: &'static str,
-    /// FNV-1a hash of the final state bytes (fixed step) — equal means bit-identical.
-    pub state_hash: String,
-    /// RMS relative error against the exact solution (frame delta, scene 1).
-    pub rms_rel_error_vs_exact: Option<f64>,
-    /// RMS relative divergence from the 240 fps run (frame delta, scene 1).
-    pub rms_rel_divergence_vs_240fps: Option<f64>,
-}
-
 /// The frame sequences: constant 30, 60, 144, 240 fps and a jittered one, each 2 s long.
 pub fn frame_sequences() -> Vec<(String, Vec<f64>)> {
     let mut v: Vec<(String, Vec<f64>)> = [30.0, 60.0, 144.0, 240.0]

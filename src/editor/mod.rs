@@ -2,35 +2,15 @@
 //! effect.
 //!
 //! The UI is plain functions over [`EditorState`] (no GPU needed, so tests drive them
-//! with an `egui::Context`); [`app`] owns the window and the frame loop.
+//! with an `egui::Context`), in rooms: [`panel`] (one file per section of the side panel,
+//! the timeline and the viewport), [`window`] (the window, the frame loop and the GPU
+//! owner) and [`diagnostics`] (statistics, the inspector, costs and profiles).
 
-pub mod app;
-pub mod curve_editor;
-pub mod emitter_cost;
-mod emitter_ui;
-pub mod events_ui;
-pub mod export_ui;
-mod forces_ui;
-mod gfx;
-pub mod inspect;
-mod lighting_ui;
-pub mod look;
-pub mod measure_ui;
+pub mod diagnostics;
 pub mod panel;
-mod present;
-pub mod profile;
-pub mod report;
-pub mod retained;
-pub mod screenshot;
-mod scripted_edits;
 pub mod state;
-pub mod stats;
-mod time_ui;
-pub mod timeline;
-pub mod ui_painter;
 pub mod undo;
-pub mod viewport;
+pub mod window;
 
-pub use app::{EditOptions, RunReport, run};
-pub use state::{EditorState, Playback, ViewSettings};
-pub use undo::UndoHistory;
+pub use state::EditorState;
+pub use window::app::{EditOptions, run};

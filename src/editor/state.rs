@@ -3,8 +3,8 @@
 
 use crate::effect::{Effect, ValidationError};
 
-use super::stats::Stats;
-use super::undo::UndoHistory;
+use crate::editor::diagnostics::stats::Stats;
+use crate::editor::undo::UndoHistory;
 
 /// Viewing options that are not part of the effect (they do not change the fire, only
 /// how the editor shows it).
@@ -109,13 +109,13 @@ pub struct EditorState {
     /// The GPU device was lost and recreated (shown until dismissed).
     pub device_notice: Option<String>,
     /// View ▸ Inspect: the particle looked at.
-    pub inspect: super::inspect::Inspect,
+    pub inspect: crate::editor::diagnostics::inspector::Inspect,
     /// Stats ▸ cost per emitter: the measurement in progress.
-    pub cost_probe: Option<super::emitter_cost::CostProbe>,
+    pub cost_probe: Option<crate::editor::diagnostics::emitter_cost::CostProbe>,
     /// The effect the measurement plays now (instead of `running`).
     pub probe_effect: Option<crate::effect::Effect>,
     /// The last measurement's results.
-    pub emitter_costs: Vec<super::emitter_cost::EmitterCost>,
+    pub emitter_costs: Vec<crate::editor::diagnostics::emitter_cost::EmitterCost>,
     /// Index of the emitter shown in the emitter-specific sections.
     pub selected: usize,
     /// Undo/redo of `effect`.
@@ -144,9 +144,9 @@ pub struct EditorState {
     /// An action that would discard unsaved edits, waiting for the user's confirmation.
     pub pending: Option<PendingAction>,
     /// The Export section and the export it runs.
-    pub export: super::export_ui::ExportPanel,
+    pub export: crate::editor::panel::export_ui::ExportPanel,
     /// Time ▸ Measure this effect: its settings, progress and last result.
-    pub measure: super::measure_ui::MeasurePanel,
+    pub measure: crate::editor::panel::measure_ui::MeasurePanel,
 }
 
 /// Actions that discard unsaved edits, so they ask first.

@@ -370,7 +370,7 @@ pub fn lookup(row: &[[f32; 4]], t: f32) -> [f32; 4] {
     std::array::from_fn(|k| a[k] + (b[k] - a[k]) * f)
 }
 
-/// [`lookup`] of both rows, blended by the per-channel random numbers `u`.
+/// `lookup` of both rows, blended by the per-channel random numbers `u`.
 pub fn lookup_blend(rows: &[Vec<[f32; 4]>; 2], t: f32, u: [f32; 4]) -> [f32; 4] {
     let (a, b) = (lookup(&rows[0], t), lookup(&rows[1], t));
     std::array::from_fn(|k| a[k] + (b[k] - a[k]) * u[k])

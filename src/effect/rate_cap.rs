@@ -13,7 +13,7 @@ pub fn cap_burst(per_sec: f32) -> f32 {
 }
 
 /// A cap of so many per second of simulated time, as a bucket of tokens: it holds at most
-/// [`cap_burst`] tokens (full at the start), each step adds `per_sec · dt` before the step
+/// `cap_burst` tokens (full at the start), each step adds `per_sec · dt` before the step
 /// takes what it asks (up to the whole tokens there are), and what is left is kept. What it
 /// lets through does not depend on the step: a cap that binds throughout allows
 /// `⌊burst + per_sec · T⌋` over any span T at any step size, and one that never binds drops

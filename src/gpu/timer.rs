@@ -109,6 +109,7 @@ impl GpuTimer {
     }
 }
 
+#[cfg(feature = "editor")]
 /// The median of a list of samples (NaN when empty).
 pub fn median(samples: &mut [f64]) -> f64 {
     if samples.is_empty() {

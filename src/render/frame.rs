@@ -24,7 +24,7 @@ use crate::sim::Modules;
 
 mod looks;
 
-pub use super::draw_item::{DrawItem, GLOW_MIN_PX, LOOKS_PER_DRAW, Scene, SceneGroup};
+pub use super::draw_item::{DrawItem, LOOKS_PER_DRAW, Scene, SceneGroup};
 pub use super::variant::{LookVariant, StateVariant};
 pub use looks::look_uniform;
 use looks::{GroupLooks, write_looks};

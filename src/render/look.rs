@@ -68,16 +68,6 @@ pub fn bake_ramp(stops: &[ColorStop]) -> Vec<[f32; 4]> {
         .collect()
 }
 
-/// `particle_color` of look.wgsl on a baked row.
-pub fn ramp_lookup(ramp: &[[f32; 4]], t: f32) -> [f32; 4] {
-    let x = t.clamp(0.0, 1.0) * (RAMP_WIDTH - 1) as f32;
-    let i = (x as u32).min(RAMP_WIDTH - 1) as usize;
-    let j = (i + 1).min(RAMP_WIDTH as usize - 1);
-    let f = x - i as f32;
-    let (a, b) = (ramp[i], ramp[j]);
-    std::array::from_fn(|k| a[k] + (b[k] - a[k]) * f)
-}
-
 /// A flipbook frame choice: `frame`, the `next` frame and the weight of `next`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrameChoice {

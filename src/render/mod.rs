@@ -34,10 +34,8 @@ use crate::gpu::GpuContext;
 
 /// The HDR format particles accumulate into.
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-/// The display format of headless frames.
-pub const LDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 /// The format of the display image the tonemap writes (a compute pass: storage textures
-/// cannot be sRGB, so it holds sRGB-encoded values, the bytes an [`LDR_FORMAT`] image
+/// cannot be sRGB, so it holds sRGB-encoded values, the bytes an `Rgba8UnormSrgb` image
 /// would hold).
 pub const LDR_STORAGE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
@@ -111,52 +109,6 @@ pub fn scoped_variant<P>(
     }
 }
 
-/// A render pipeline without vertex buffers: `vs` and `fs` of one module, one colour
-/// target, override constants (given to both stages) and the primitive topology.
-#[allow(clippy::too_many_arguments)]
-pub fn simple_pipeline(
-    ctx: &GpuContext,
-    label: &str,
-    layout: &wgpu::PipelineLayout,
-    module: &wgpu::ShaderModule,
-    (vs, fs): (&str, &str),
-    target: wgpu::ColorTargetState,
-    constants: &[(&str, f64)],
-    topology: wgpu::PrimitiveTopology,
-) -> wgpu::RenderPipeline {
-    ctx.device
-        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(label),
-            layout: Some(layout),
-            vertex: wgpu::VertexState {
-                module,
-                entry_point: Some(vs),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants,
-                    zero_initialize_workgroup_memory: true,
-                },
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState {
-                topology,
-                ..Default::default()
-            },
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState::default(),
-            fragment: Some(wgpu::FragmentState {
-                module,
-                entry_point: Some(fs),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants,
-                    zero_initialize_workgroup_memory: true,
-                },
-                targets: &[Some(target)],
-            }),
-            multiview_mask: None,
-            cache: None,
-        })
-}
-
 /// The full-screen draw of a compute path's image into a host's pass (`vs_resolve`,
 /// `fs_resolve` of `module`): it passes any depth test, writes no depth, and blends with
 /// `blend` into `target`.
@@ -208,15 +160,6 @@ pub fn depth_test(target: billboard::DrawTarget) -> f64 {
     }
 }
 
-/// A colour target on the HDR format with `blend`.
-pub fn hdr_target(blend: wgpu::BlendState) -> wgpu::ColorTargetState {
-    wgpu::ColorTargetState {
-        format: HDR_FORMAT,
-        blend: Some(blend),
-        write_mask: wgpu::ColorWrites::ALL,
-    }
-}
-
 /// `size` divided by `factor`, rounded up.
 pub(crate) fn reduced(size: (u32, u32), factor: u32) -> (u32, u32) {
     (size.0.div_ceil(factor), size.1.div_ceil(factor))
@@ -238,6 +181,7 @@ pub(crate) fn ensure_layer(
     ));
 }
 
+#[cfg(feature = "editor")]
 /// Opens a render pass that clears the HDR target to transparent black.
 pub fn begin_hdr_pass<'a>(
     enc: &'a mut wgpu::CommandEncoder,

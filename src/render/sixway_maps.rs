@@ -177,6 +177,7 @@ pub fn combined(maps: &SixWayImages) -> Rgba32FImage {
     })
 }
 
+#[cfg(feature = "editor")]
 /// An image of the maps as 8-bit linear bytes (what [`load_pair`] reads back).
 pub fn to_png_linear(img: &Rgba32FImage) -> image::RgbaImage {
     image::RgbaImage::from_fn(img.width(), img.height(), |x, y| {

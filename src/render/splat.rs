@@ -10,10 +10,6 @@ use crate::render::frame::{DrawItem, FrameResources, StateVariant};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 use crate::sim::gpu_sim::dispatch_size;
 
-/// Fixed-point scale of the accumulation buffer (keep in sync with `FIXED_SCALE` in
-/// `shaders/splat.wgsl`): 1/4096 resolution, up to ~1e6 of HDR light per pixel.
-pub const SPLAT_FIXED_SCALE: f32 = 4096.0;
-
 /// Compute splat + resolve.
 pub struct SplatPass {
     target: DrawTarget,

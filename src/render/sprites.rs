@@ -402,6 +402,7 @@ pub fn load_png(path: &Path) -> Result<Rgba32FImage, SpriteError> {
     Ok(out)
 }
 
+#[cfg(feature = "editor")]
 /// A linear premultiplied image back to straight-alpha sRGB bytes (what `load_png` reads).
 pub fn to_png_rgba(img: &Rgba32FImage) -> image::RgbaImage {
     image::RgbaImage::from_fn(img.width(), img.height(), |x, y| {
@@ -419,6 +420,7 @@ pub fn to_png_rgba(img: &Rgba32FImage) -> image::RgbaImage {
     })
 }
 
+#[cfg(feature = "editor")]
 fn linear_to_srgb(c: f32) -> f32 {
     if c <= 0.003_130_8 {
         c * 12.92
@@ -646,6 +648,7 @@ fn value_noise(x: f32, y: f32) -> f32 {
     a + (b - a) * sx + (c - a) * sy + (a - b - c + d) * sx * sy
 }
 
+#[cfg(feature = "editor")]
 /// Writes the built-in sprites into `out` (created if missing) as straight-alpha sRGB
 /// PNGs, and the built-in six-way smoke maps (the puff and its sheet) as linear RGBA PNG
 /// pairs in Unity's packing: `*_sixway_rtba.png` (right, top, back, alpha) and

@@ -87,7 +87,7 @@ pub struct EventHeader {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ScanConfig {
     /// The rule's index, the child's capacity, the child list's room per step ([`step_cap`]),
-    /// flags ([`scan_flags`]).
+    /// flags (`scan_flags`).
     pub rule_capacity_cap: [u32; 4],
     /// The parent's simulation origin minus the child's, and the inherited fraction.
     pub delta_inherit: [f32; 4],

@@ -22,9 +22,7 @@ mod recording;
 pub use super::sim_state::{EmitterBuffers, SimState, TrailRing};
 pub(crate) use super::update_pass::lock;
 use super::update_pass::update_counts;
-pub use super::update_pass::{
-    PipelineKey, SharedUpdate, UpdateMode, UpdatePass, pipeline_key, used_keys,
-};
+pub use super::update_pass::{SharedUpdate, UpdateMode, UpdatePass, pipeline_key, used_keys};
 pub use readback::{map_read, read_buffer};
 
 /// Steps recorded per submission (the per-step params blocks live side by side).

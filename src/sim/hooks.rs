@@ -130,8 +130,6 @@ pub struct EmitterHooks {
     pub records: Option<wgpu::Buffer>,
     /// Header and list (a child).
     pub list: Option<wgpu::Buffer>,
-    /// The list's entries.
-    pub list_len: u32,
     /// The trail's ring of positions (an emitter with a trail).
     pub trail: Option<wgpu::Buffer>,
     /// Group 1 of the update.
@@ -276,7 +274,6 @@ impl EmitterHooks {
         Some(EmitterHooks {
             records,
             list,
-            list_len,
             trail,
             hooks,
             scans,

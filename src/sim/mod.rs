@@ -17,5 +17,5 @@ pub mod update_pass;
 pub use cpu_reference::CpuSim;
 pub use gpu_sim::{GpuSim, SimError};
 pub use modules::Modules;
-pub use planner::{EffectPlanner, EmitterPlanner, SpawnStats};
-pub use stepper::{StepPlan, Stepper};
+pub use planner::{EffectPlanner, EmitterPlanner};
+pub use stepper::Stepper;

@@ -3,10 +3,10 @@
 #![allow(dead_code)]
 
 use ignis::effect::{ColorStop, Effect, Emitter, Forces, Range, Shape, SpawnNoise};
-use ignis::gpu::GpuContext;
-use ignis::gpu::types::{Particle, SimParams};
-use ignis::shaders::ShaderLibrary;
-use ignis::sim::{CpuSim, EffectPlanner, GpuSim};
+use ignis::testing::gpu::GpuContext;
+use ignis::testing::gpu::types::{Particle, SimParams};
+use ignis::testing::shaders::ShaderLibrary;
+use ignis::testing::sim::{CpuSim, EffectPlanner, GpuSim};
 
 /// The GPU context for a test.
 pub fn gpu() -> GpuContext {

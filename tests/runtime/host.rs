@@ -105,7 +105,7 @@ pub fn host_device(limits: Option<wgpu::Limits>) -> (wgpu::Device, wgpu::Queue) 
     ))
     .expect("GPU tests need an adapter (CI installs mesa-vulkan-drivers)");
     let limits = limits.unwrap_or(wgpu::Limits {
-        max_storage_buffers_per_shader_stage: ignis::render::tiles::STORAGE_BUFFERS_NEEDED,
+        max_storage_buffers_per_shader_stage: ignis::testing::render::tiles::STORAGE_BUFFERS_NEEDED,
         ..Default::default()
     });
     pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {

@@ -113,7 +113,7 @@ fn torch_particles(
     despawned: &[u32],
     despawn_at: Option<u32>,
     frames: u32,
-) -> Vec<(u32, Vec<Vec<ignis::gpu::types::Particle>>)> {
+) -> Vec<(u32, Vec<Vec<ignis::testing::gpu::types::Particle>>)> {
     let mut app = common::app(&common::presets(), false);
     common::camera(&mut app, Vec3::new(0.0, 3.0, 12.0), Vec3::ZERO);
     let preset = common::load(&mut app, "torch.ron");

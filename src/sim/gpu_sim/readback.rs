@@ -199,7 +199,7 @@ pub fn read_buffer(
     map_read(ctx, &staging)
 }
 
-/// Maps a `MAP_READ` buffer and copies its bytes out (blocking): [`crate::gpu::readback::map_read`]
+/// Maps a `MAP_READ` buffer and copies its bytes out (blocking): `gpu::readback::map_read`
 /// with the simulation's error.
 pub fn map_read(ctx: &GpuContext, staging: &wgpu::Buffer) -> Result<Vec<u8>, SimError> {
     Ok(crate::gpu::readback::map_read(ctx, staging)?)

@@ -26,25 +26,6 @@ impl SimParams {
     }
 }
 
-/// Builds the uniform block for one emitter and one step. Every position in it is
-/// relative to `origin` (the emitter's simulation space).
-#[allow(clippy::too_many_arguments)]
-pub fn build_params(
-    e: &Emitter,
-    origin: glam::DVec3,
-    seed: u32,
-    salt: u32,
-    dt_secs: f32,
-    t0_secs: f64,
-    capacity: u32,
-    spawn_base: u64,
-    spawn_count: u32,
-) -> SimParams {
-    let mut params = static_params(e, origin, seed, salt, capacity);
-    params.set_step(dt_secs, t0_secs, spawn_base, spawn_count);
-    params
-}
-
 /// The part of an emitter's block that no step changes (its step fields are zero; see
 /// `SimParams::set_step`).
 pub(super) fn static_params(

@@ -9,19 +9,31 @@
 //! [`Effect::validate`](crate::effect::Effect::validate) is shown at the top and the last
 //! valid effect keeps running.
 
+pub mod curve_editor;
+pub mod emitter_ui;
+pub mod events_ui;
+pub mod export_ui;
+pub mod forces_ui;
+pub mod lighting_ui;
+pub mod look_ui;
+pub mod measure_ui;
+pub mod time_ui;
+pub mod timeline;
+pub mod viewport;
+
 use std::ops::RangeInclusive;
 
 use egui::{Color32, DragValue, Response, RichText, Ui};
 
 use crate::effect::Range;
 
-use super::curve_editor::ParamSpec;
-use super::emitter_ui::{emitter_ui, randomness_ui};
-use super::forces_ui::forces_ui;
-use super::look::look_ui;
-use super::state::{EditorState, ViewSettings};
-use super::stats::stats_ui;
-use super::time_ui::time_ui;
+use crate::editor::diagnostics::stats::stats_ui;
+use crate::editor::panel::curve_editor::ParamSpec;
+use crate::editor::panel::emitter_ui::{emitter_ui, randomness_ui};
+use crate::editor::panel::forces_ui::forces_ui;
+use crate::editor::panel::look_ui::look_ui;
+use crate::editor::panel::time_ui::time_ui;
+use crate::editor::state::{EditorState, ViewSettings};
 
 /// Default width of the side panel, points.
 pub const PANEL_WIDTH: f32 = 370.0;
@@ -82,7 +94,11 @@ pub fn panel_ui(ui: &mut Ui, state: &mut EditorState) {
                 &name,
                 (false, open("events")),
                 |ui| {
-                    super::events_ui::events_ui(ui, &mut state.effect, state.selected);
+                    crate::editor::panel::events_ui::events_ui(
+                        ui,
+                        &mut state.effect,
+                        state.selected,
+                    );
                 },
             );
             section_ui(ui, "time", "Time", "", (true, open("time")), |ui| {
@@ -112,11 +128,11 @@ pub fn panel_ui(ui: &mut Ui, state: &mut EditorState) {
                 view_ui(ui, &mut state.view, &mut state.frame_requested);
                 ui.separator();
                 ui.label("Scene light (lit smoke; saved with the preset)");
-                super::lighting_ui::lighting_ui(ui, &mut state.effect.lighting);
+                crate::editor::panel::lighting_ui::lighting_ui(ui, &mut state.effect.lighting);
             });
             section_ui(ui, "stats", "Stats", "", (true, open("stats")), |ui| {
                 stats_ui(ui, &state.stats, &state.running);
-                super::emitter_cost::emitter_cost_ui(
+                crate::editor::diagnostics::emitter_cost::emitter_cost_ui(
                     ui,
                     &mut state.cost_probe,
                     &state.emitter_costs,
@@ -125,7 +141,7 @@ pub fn panel_ui(ui: &mut Ui, state: &mut EditorState) {
                 );
             });
             section_ui(ui, "export", "Export", "", (false, open("export")), |ui| {
-                super::export_ui::export_ui(ui, &mut state.export);
+                crate::editor::panel::export_ui::export_ui(ui, &mut state.export);
             });
         });
 }
@@ -256,10 +272,10 @@ fn preset_file_ui(ui: &mut Ui, state: &mut EditorState) {
         error_box_ui(ui, |ui| {
             ui.label(
                 RichText::new(match pending {
-                    super::state::PendingAction::Load => {
+                    crate::editor::state::PendingAction::Load => {
                         "Discard the unsaved edits and load the preset?"
                     }
-                    super::state::PendingAction::ExternalReload => {
+                    crate::editor::state::PendingAction::ExternalReload => {
                         "The preset changed on disk. Reload it and discard the unsaved edits?"
                     }
                 })
@@ -376,7 +392,7 @@ fn preset_library_ui(ui: &mut Ui, state: &mut EditorState) {
     }
 }
 
-pub(super) fn error_box_ui(ui: &mut Ui, add: impl FnOnce(&mut Ui)) {
+pub(crate) fn error_box_ui(ui: &mut Ui, add: impl FnOnce(&mut Ui)) {
     egui::Frame::group(ui.style())
         .fill(Color32::from_rgb(70, 24, 24))
         .stroke(egui::Stroke::new(1.0, Color32::from_rgb(200, 80, 70)))
@@ -390,7 +406,7 @@ pub(super) fn error_box_ui(ui: &mut Ui, add: impl FnOnce(&mut Ui)) {
 // Small widget helpers.
 
 /// A job's progress bar (done of total), while it runs; frames keep coming meanwhile.
-pub(super) fn progress_ui(ui: &mut Ui, progress: Option<(usize, usize)>) {
+pub(crate) fn progress_ui(ui: &mut Ui, progress: Option<(usize, usize)>) {
     if let Some((done, total)) = progress {
         let f = done as f32 / total.max(1) as f32;
         ui.add(egui::ProgressBar::new(f).show_percentage());
@@ -399,7 +415,7 @@ pub(super) fn progress_ui(ui: &mut Ui, progress: Option<(usize, usize)>) {
 }
 
 /// A job's outcome: its message, or its error in the error colour.
-pub(super) fn outcome_ui(ui: &mut Ui, outcome: Option<&Result<String, String>>) {
+pub(crate) fn outcome_ui(ui: &mut Ui, outcome: Option<&Result<String, String>>) {
     match outcome {
         Some(Ok(m)) => {
             ui.label(m);
@@ -426,7 +442,7 @@ pub(crate) fn row_ui(
 }
 
 /// A multiplier over the particle's life.
-pub(super) fn multiplier(name: &'static str) -> ParamSpec {
+pub(crate) fn multiplier(name: &'static str) -> ParamSpec {
     ParamSpec {
         name,
         unit: "×",
@@ -438,7 +454,7 @@ pub(super) fn multiplier(name: &'static str) -> ParamSpec {
 }
 
 /// A float drag value clamped to `range`.
-pub(super) fn drag<'a>(
+pub(crate) fn drag<'a>(
     v: &'a mut f32,
     range: RangeInclusive<f32>,
     speed: f64,
@@ -453,7 +469,7 @@ pub(super) fn drag<'a>(
 
 /// Three drag values side by side (x, y, z) in one row; the returned response is their
 /// union (changed when any changed).
-pub(super) fn vec3_ui(
+pub(crate) fn vec3_ui(
     ui: &mut Ui,
     label: &str,
     tip: &str,
@@ -487,7 +503,7 @@ pub(super) fn vec3_ui(
 }
 
 /// A `[min, max]` pair whose widgets keep min ≤ max.
-pub(super) fn range_ui(
+pub(crate) fn range_ui(
     ui: &mut Ui,
     label: &str,
     tip: &str,
@@ -523,7 +539,7 @@ pub(super) fn range_ui(
     response
 }
 
-pub(super) fn grid(id: &str) -> egui::Grid {
+pub(crate) fn grid(id: &str) -> egui::Grid {
     egui::Grid::new(id)
         .num_columns(2)
         .spacing([10.0, 5.0])

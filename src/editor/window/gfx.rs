@@ -17,14 +17,14 @@ use crate::render::OrbitCamera;
 use crate::runtime::{InstanceId, Player, PlayerSettings};
 use crate::shaders::{ShaderLibrary, ShaderSourceDir};
 
-use super::app::EditOptions;
-use super::panel::{PANEL_WIDTH, panel_ui};
-use super::profile::StageProfiler;
-use super::report::{FrameLog, RunReport, Tick, WARMUP_FRAMES};
-use super::state::EditorState;
-use super::stats::{EmitterStats, ShaderReloadStats};
-use super::ui_painter::UiPainter;
-use super::viewport::{ViewportOutput, emitter_bounds, frame_bounds, viewport_ui};
+use crate::editor::diagnostics::stage_profiler::StageProfiler;
+use crate::editor::diagnostics::stats::{EmitterStats, ShaderReloadStats};
+use crate::editor::panel::viewport::{ViewportOutput, emitter_bounds, frame_bounds, viewport_ui};
+use crate::editor::panel::{PANEL_WIDTH, panel_ui};
+use crate::editor::state::EditorState;
+use crate::editor::window::app::EditOptions;
+use crate::editor::window::run_report::{FrameLog, RunReport, Tick, WARMUP_FRAMES};
+use crate::editor::window::ui_painter::UiPainter;
 
 /// Read the GPU's alive counters every this many frames (a blocking readback).
 const COUNTER_INTERVAL_FRAMES: u64 = 15;
@@ -49,7 +49,7 @@ fn total_slots(effect: &Effect) -> u64 {
 /// should move to a fresh device: the peak was a large pool and the effect is now a
 /// sixteenth of it or less. On the H100 small work on a device that held a large pool
 /// runs 2–5× slower; a new device is fast again.
-pub(super) fn wants_fresh_device(peak: u64, slots: u64) -> bool {
+pub(crate) fn wants_fresh_device(peak: u64, slots: u64) -> bool {
     peak >= LARGE_POOL_SLOTS && slots.saturating_mul(16) <= peak
 }
 
@@ -61,53 +61,53 @@ const EXPORT_BUDGET: Duration = Duration::from_millis(40);
 const MEASURE_BUDGET: Duration = Duration::from_millis(30);
 
 /// Everything that exists once the window does.
-pub(super) struct Gfx {
-    pub(super) window: Arc<Window>,
-    pub(super) surface: wgpu::Surface<'static>,
-    pub(super) config: wgpu::SurfaceConfiguration,
-    pub(super) surface_can_copy: bool,
-    pub(super) ctx: GpuContext,
+pub(crate) struct Gfx {
+    pub(crate) window: Arc<Window>,
+    pub(crate) surface: wgpu::Surface<'static>,
+    pub(crate) config: wgpu::SurfaceConfiguration,
+    pub(crate) surface_can_copy: bool,
+    pub(crate) ctx: GpuContext,
     /// Plays the running effect (one instance, at the origin).
-    pub(super) player: Player,
-    pub(super) instance: InstanceId,
+    pub(crate) player: Player,
+    pub(crate) instance: InstanceId,
     /// The viewport's HDR target, bloom and tonemap around the player.
-    pub(super) composite: Composite,
+    pub(crate) composite: Composite,
     /// The running effect the player last accepted (it plays this plus the mouse
     /// collider).
-    pub(super) gpu_effect: Effect,
-    pub(super) egui_ctx: egui::Context,
-    pub(super) egui_state: egui_winit::State,
-    pub(super) ui_painter: UiPainter,
-    pub(super) viewport_texture: Option<egui::TextureId>,
+    pub(crate) gpu_effect: Effect,
+    pub(crate) egui_ctx: egui::Context,
+    pub(crate) egui_state: egui_winit::State,
+    pub(crate) ui_painter: UiPainter,
+    pub(crate) viewport_texture: Option<egui::TextureId>,
     /// The viewport image egui shows (a gamma-encoded copy of the display image).
-    pub(super) viewport_image: Option<wgpu::Texture>,
+    pub(crate) viewport_image: Option<wgpu::Texture>,
     /// The frame clock and the run's timings.
-    pub(super) log: FrameLog,
-    pub(super) viewport_px: (u32, u32),
+    pub(crate) log: FrameLog,
+    pub(crate) viewport_px: (u32, u32),
     /// What changes every frame (points): the viewport and the timeline under it.
-    pub(super) live_rect: egui::Rect,
+    pub(crate) live_rect: egui::Rect,
     /// The retained window image (the adapter profile's choice, and a surface that can be
     /// copied to): the panel is repainted only when it changed.
-    pub(super) retained: Option<super::retained::RetainedUi>,
-    pub(super) profiler: StageProfiler,
+    pub(crate) retained: Option<crate::editor::window::retained::RetainedUi>,
+    pub(crate) profiler: StageProfiler,
     /// Per-pass GPU timestamps (None on CPU adapters: their timestamps are not trusted).
-    pub(super) pass_timer: Option<crate::gpu::timer::PassTimer>,
+    pub(crate) pass_timer: Option<crate::gpu::timer::PassTimer>,
     /// Hot reload of `shaders/` (absent with the embedded shaders).
     shader_watch: Option<ShaderWatch>,
     /// Watches the folders of the PNG sprites in use: a changed file is reloaded.
     /// (folders, their watcher).
-    pub(super) sprite_watch: Option<(Vec<PathBuf>, Option<FileWatcher>)>,
+    pub(crate) sprite_watch: Option<(Vec<PathBuf>, Option<FileWatcher>)>,
     /// The most particle slots the effect has had on this device (see
     /// [`wants_fresh_device`]).
-    pub(super) peak_slots: u64,
+    pub(crate) peak_slots: u64,
     /// The effect shrank far below that peak: the frame loop moves to a new device.
-    pub(super) wants_fresh_device: bool,
+    pub(crate) wants_fresh_device: bool,
     /// The state view's textures (View ▸ State view).
-    pub(super) state_textures: Option<([egui::TextureHandle; 3], u64)>,
+    pub(crate) state_textures: Option<([egui::TextureHandle; 3], u64)>,
     /// The export the Export section started, stepped a little every frame.
-    pub(super) export: Option<crate::export::Export>,
+    pub(crate) export: Option<crate::export::Export>,
     /// Time ▸ Measure this effect: the sweep in progress.
-    pub(super) sweep: Option<crate::tune::Sweep>,
+    pub(crate) sweep: Option<crate::tune::Sweep>,
 }
 
 /// The shader folder's watcher and the reloader that rebuilds affected pipelines.
@@ -224,7 +224,7 @@ impl Gfx {
     /// The GPU side of the editor in `window`: a device on an adapter that can draw to
     /// it, the surface, the player, the composite and egui's painter. Called at start and
     /// again after the device was lost.
-    pub(super) fn new(
+    pub(crate) fn new(
         window: Arc<Window>,
         instance: &wgpu::Instance,
         options: &EditOptions,
@@ -264,7 +264,7 @@ impl Gfx {
         // Software adapters keep the window's image between frames (see retained.rs).
         let retained = (ctx.profile.retained_window && surface_can_receive).then(|| {
             config.usage |= wgpu::TextureUsages::COPY_DST;
-            super::retained::RetainedUi::default()
+            crate::editor::window::retained::RetainedUi::default()
         });
         surface.configure(&ctx.device, &config);
         log::info!(
@@ -307,7 +307,7 @@ impl Gfx {
         })
     }
 
-    pub(super) fn resize(&mut self, width: u32, height: u32) {
+    pub(crate) fn resize(&mut self, width: u32, height: u32) {
         if width == 0 || height == 0 {
             return;
         }
@@ -318,7 +318,7 @@ impl Gfx {
 
     /// Step 1, the UI: the panel edits `state`, the viewport moves the camera and
     /// measures itself. Returns egui's output, painted in [`Self::paint_ui`].
-    pub(super) fn run_ui(
+    pub(crate) fn run_ui(
         &mut self,
         state: &mut EditorState,
         camera: &mut OrbitCamera,
@@ -337,14 +337,14 @@ impl Gfx {
                 .show(ui, |ui| panel_ui(ui, state));
             timeline = egui::Panel::bottom("timeline")
                 .show(ui, |ui| {
-                    super::timeline::timeline_ui(ui, state);
+                    crate::editor::panel::timeline::timeline_ui(ui, state);
                 })
                 .response
                 .rect;
             egui::CentralPanel::no_frame().show(ui, |ui| {
                 viewport = viewport_ui(ui, camera, state, texture);
             });
-            super::inspect::state_view_ui(ui.ctx(), state, state_textures);
+            crate::editor::diagnostics::inspector::state_view_ui(ui.ctx(), state, state_textures);
             state.end_frame(ui.ctx());
         });
         let platform = std::mem::take(&mut output.platform_output);
@@ -362,7 +362,7 @@ impl Gfx {
     /// Step 3, draw and composite: the player's compute and draws into the composite's
     /// HDR target, bloom and tonemap (the steps `ignis render` records too), then a copy
     /// egui shows; one submit. Returns the CPU time of the recording.
-    pub(super) fn draw_viewport(
+    pub(crate) fn draw_viewport(
         &mut self,
         state: &mut EditorState,
         camera: &OrbitCamera,
@@ -414,8 +414,10 @@ impl Gfx {
             state.stats.gpu_pass_ms = t.latest.clone();
             if let Some(probe) = state.cost_probe.as_mut() {
                 match probe.frame(&state.stats.gpu_pass_ms) {
-                    super::emitter_cost::ProbeStep::Play(e) => state.probe_effect = Some(e),
-                    super::emitter_cost::ProbeStep::Done(_, costs) => {
+                    crate::editor::diagnostics::emitter_cost::ProbeStep::Play(e) => {
+                        state.probe_effect = Some(e)
+                    }
+                    crate::editor::diagnostics::emitter_cost::ProbeStep::Done(_, costs) => {
                         state.emitter_costs = costs;
                         state.cost_probe = None;
                         state.probe_effect = None;
@@ -428,7 +430,7 @@ impl Gfx {
     }
 
     /// The Stats section's figures, and the camera framed when the panel asked.
-    pub(super) fn update_stats(
+    pub(crate) fn update_stats(
         &mut self,
         state: &mut EditorState,
         camera: &mut OrbitCamera,
@@ -440,13 +442,13 @@ impl Gfx {
             self.frame_camera(camera);
         }
         self.refresh_stats(state, false);
-        let inspected = super::inspect::Inspected {
+        let inspected = crate::editor::diagnostics::inspector::Inspected {
             player: &self.player,
             instance: self.instance,
             viewport_px: self.viewport_px,
             frame: self.log.index,
         };
-        super::inspect::update_inspect(&inspected, state, camera);
+        crate::editor::diagnostics::inspector::update_inspect(&inspected, state, camera);
         self.log.record(tick, cpu);
         if self.log.index > 1 {
             state
@@ -457,7 +459,7 @@ impl Gfx {
     }
 
     /// What a `--frames` run measured (after its last frame).
-    pub(super) fn run_report(
+    pub(crate) fn run_report(
         &mut self,
         state: &mut EditorState,
         devices_recreated: u32,
@@ -483,9 +485,9 @@ impl Gfx {
     }
     /// Makes the player follow `state.running` (plus the mouse collider); on a GPU
     /// refusal, goes back to the last effect that worked. Returns whether it changed.
-    pub(super) fn apply_running(&mut self, state: &mut EditorState) -> bool {
+    pub(crate) fn apply_running(&mut self, state: &mut EditorState) -> bool {
         let base = state.probe_effect.as_ref().unwrap_or(&state.running);
-        let wanted = super::state::with_mouse_collider(base, state.mouse_point);
+        let wanted = crate::editor::state::with_mouse_collider(base, state.mouse_point);
         if wanted == *self.player.effect() {
             return false;
         }
@@ -501,7 +503,8 @@ impl Gfx {
             Err(err) => {
                 log::warn!("effect refused by the GPU: {err}");
                 state.reject_running(&self.gpu_effect, err.to_string());
-                let back = super::state::with_mouse_collider(&self.gpu_effect, state.mouse_point);
+                let back =
+                    crate::editor::state::with_mouse_collider(&self.gpu_effect, state.mouse_point);
                 if let Err(err) = self.player.set_effect(&back) {
                     log::error!("the last effect that worked was refused too: {err}");
                 }
@@ -514,7 +517,7 @@ impl Gfx {
     /// Rebuilds the pipelines whose shaders changed on disk; a failure keeps the last
     /// good pipeline and shows the error (file, line, caret) in the panel.
     /// Returns whether a pipeline was rebuilt.
-    pub(super) fn reload_changed_shaders(&mut self, state: &mut EditorState) -> bool {
+    pub(crate) fn reload_changed_shaders(&mut self, state: &mut EditorState) -> bool {
         let Some(watch) = &mut self.shader_watch else {
             return false;
         };
@@ -560,17 +563,17 @@ impl Gfx {
     /// Step 2, simulate: the player follows the running effect (and changed shaders) and
     /// plans this frame's steps, recorded with the viewport; an export in progress takes
     /// its share of the frame.
-    pub(super) fn simulate(&mut self, state: &mut EditorState, frame_dt_secs: f64) {
+    pub(crate) fn simulate(&mut self, state: &mut EditorState, frame_dt_secs: f64) {
         let reloaded = self.reload_changed_shaders(state);
         let edited = self.apply_running(state) || reloaded;
-        super::timeline::play(
+        crate::editor::panel::timeline::play(
             &mut self.player,
             self.instance,
             &mut state.playback,
             edited,
             frame_dt_secs,
         );
-        super::export_ui::drive(
+        crate::editor::panel::export_ui::drive(
             &self.ctx,
             &state.running,
             state.asset_dir(),
@@ -578,7 +581,7 @@ impl Gfx {
             &mut self.export,
             EXPORT_BUDGET,
         );
-        super::measure_ui::drive(
+        crate::editor::panel::measure_ui::drive(
             &self.ctx,
             &state.running,
             state.asset_dir(),
@@ -591,7 +594,7 @@ impl Gfx {
 
     /// Copies the player's clock and per-emitter figures into the stats (the alive counts
     /// only every few frames: the readback waits for the GPU).
-    pub(super) fn refresh_stats(&mut self, state: &mut EditorState, force: bool) {
+    pub(crate) fn refresh_stats(&mut self, state: &mut EditorState, force: bool) {
         let stats = &mut state.stats;
         let clock = self.player.clock_stats();
         stats.steps_last_frame = clock.steps;
@@ -681,7 +684,7 @@ impl Gfx {
 
     /// Drops PNG sprites that changed on disk (they reload on the next frame) and
     /// keeps the watcher on the folders of the sprites in use.
-    pub(super) fn reload_changed_sprites(&mut self) {
+    pub(crate) fn reload_changed_sprites(&mut self) {
         let gfx = self;
         let dirs = gfx.player.sprite_folders();
         if gfx.sprite_watch.as_ref().is_none_or(|w| w.0 != dirs) {

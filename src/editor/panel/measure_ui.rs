@@ -217,9 +217,9 @@ fn controls_ui(ui: &mut Ui, panel: &mut MeasurePanel) {
         } else if ui.button("Measure").clicked() {
             panel.start_requested = true;
         }
-        super::panel::progress_ui(ui, panel.progress);
+        crate::editor::panel::progress_ui(ui, panel.progress);
     });
-    super::panel::outcome_ui(ui, panel.message.as_ref());
+    crate::editor::panel::outcome_ui(ui, panel.message.as_ref());
 }
 
 /// The chart: log10 of the frame time (x) and of the error (y); hovering a point names

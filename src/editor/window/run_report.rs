@@ -2,7 +2,7 @@
 
 use std::time::{Duration, Instant};
 
-use super::stats::median;
+use crate::editor::diagnostics::stats::median;
 
 /// Frames left out of the reported median (start-up: pipeline creation, first present).
 pub const WARMUP_FRAMES: usize = 3;

@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use crate::gpu::GpuContext;
 
-use super::stats::median;
+use crate::editor::diagnostics::stats::median;
 
 /// The stages of one editor frame, in order.
 pub const STAGES: [&str; 5] = [

@@ -5,7 +5,7 @@
 
 use crate::effect::Effect;
 
-use super::state::EditorState;
+use crate::editor::state::EditorState;
 
 /// The emitter whose intensity is edited.
 const EMITTER: &str = "flames";
@@ -15,7 +15,7 @@ const EDITS: [f32; 2] = [0.3, 0.6];
 
 /// Makes this frame's scripted edit, if any: before the UI runs, so that the frame's end
 /// records it as an undo step (or applies the undo).
-pub(super) fn apply(state: &mut EditorState, frame: u64, lose_at: u32) {
+pub(crate) fn apply(state: &mut EditorState, frame: u64, lose_at: u32) {
     let at = |offset: i64| frame as i64 == i64::from(lose_at) + offset;
     let value = if at(-6) {
         EDITS[0]
@@ -34,7 +34,7 @@ pub(super) fn apply(state: &mut EditorState, frame: u64, lose_at: u32) {
 
 /// What the run ended with: the undo steps left, and the edited intensity in the panel's
 /// effect and in the one the player plays.
-pub(super) fn summary(state: &EditorState, playing: &Effect) -> String {
+pub(crate) fn summary(state: &EditorState, playing: &Effect) -> String {
     let intensity = |e: &Effect| {
         e.emitters
             .iter()

@@ -8,7 +8,7 @@ use crate::effect::{Effect, Emitter, Shape};
 use crate::render::OrbitCamera;
 use crate::runtime::EffectLight;
 
-use super::state::EditorState;
+use crate::editor::state::EditorState;
 
 /// Radians of orbit per point dragged.
 const ORBIT_RAD_PER_POINT: f32 = 0.008;
@@ -95,7 +95,7 @@ pub fn viewport_ui(
             let (u, v) = basis(normal);
             projector.polyline(
                 &painter,
-                &circle(p, u, v, super::state::MOUSE_COLLIDER_RADIUS_M),
+                &circle(p, u, v, crate::editor::state::MOUSE_COLLIDER_RADIUS_M),
                 egui::Stroke::new(1.5, Color32::from_rgb(255, 120, 80)),
             );
         }
@@ -118,7 +118,7 @@ pub fn viewport_ui(
                 egui::Stroke::new(1.5, Color32::from_rgb(120, 220, 255)),
             );
         }
-        super::inspect::inspect_overlay(&painter, rect, state);
+        crate::editor::diagnostics::inspector::inspect_overlay(&painter, rect, state);
     }
 
     let ppp = ui.ctx().pixels_per_point();

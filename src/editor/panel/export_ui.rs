@@ -163,9 +163,12 @@ pub fn export_ui(ui: &mut Ui, panel: &mut ExportPanel) {
         {
             panel.start_requested = true;
         }
-        super::panel::progress_ui(ui, panel.progress.map(|(d, t)| (d as usize, t as usize)));
+        crate::editor::panel::progress_ui(
+            ui,
+            panel.progress.map(|(d, t)| (d as usize, t as usize)),
+        );
     });
-    super::panel::outcome_ui(ui, panel.message.as_ref());
+    crate::editor::panel::outcome_ui(ui, panel.message.as_ref());
     preview_ui(ui, panel);
 }
 
@@ -186,7 +189,7 @@ fn settings_ui(ui: &mut Ui, panel: &mut ExportPanel) {
 /// The export's layout and span (rows of an open grid): atlas or sequence, frames, size,
 /// start, rate, loop.
 fn layout_rows(ui: &mut Ui, panel: &mut ExportPanel) {
-    use super::panel::row_ui as row;
+    use crate::editor::panel::row_ui as row;
     let s = &mut panel.settings;
     row(
         ui,
@@ -245,7 +248,7 @@ fn layout_rows(ui: &mut Ui, panel: &mut ExportPanel) {
 
 /// The export's output (rows of an open grid): format, alpha, passes, camera, folder.
 fn output_rows(ui: &mut Ui, panel: &mut ExportPanel) {
-    use super::panel::row_ui as row;
+    use crate::editor::panel::row_ui as row;
     let s = &mut panel.settings;
     row(
         ui,

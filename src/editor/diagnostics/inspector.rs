@@ -11,7 +11,7 @@ use egui::{Align2, Color32, FontId, Painter, Rect, pos2};
 
 use crate::runtime::{InstanceId, ParticleInfo, Player};
 
-use super::state::EditorState;
+use crate::editor::state::EditorState;
 
 /// How far from the pointer a particle may be to be picked, in render pixels.
 const PICK_RADIUS_PX: f32 = 10.0;
@@ -92,7 +92,7 @@ pub struct Inspect {
 }
 
 /// The player's particles as the Inspect view asks them of the editor's one instance.
-pub(super) struct Inspected<'a> {
+pub(crate) struct Inspected<'a> {
     pub player: &'a Player,
     pub instance: InstanceId,
     /// The viewport's render size, pixels.
@@ -103,7 +103,7 @@ pub(super) struct Inspected<'a> {
 
 /// After the draw: picks or follows the inspected particle (a blocking readback, only
 /// while Inspect is on), and refreshes the state view.
-pub(super) fn update_inspect(
+pub(crate) fn update_inspect(
     gfx: &Inspected<'_>,
     state: &mut EditorState,
     camera: &crate::render::OrbitCamera,

@@ -4,8 +4,8 @@ use std::collections::VecDeque;
 
 use egui_plot::{Line, Plot};
 
+use crate::SpawnStats;
 use crate::effect::Effect;
-use crate::sim::SpawnStats;
 
 /// Frames kept for the plot and the averages.
 const HISTORY_FRAMES: usize = 300;

@@ -5,7 +5,7 @@ use egui::{DragValue, Ui};
 
 use crate::effect::{BlendMode, Lighting, Lit, Look, SixWayMaps};
 
-use super::panel::{grid, row_ui};
+use crate::editor::panel::{grid, row_ui};
 
 /// The preset's sun (a direction from its height and bearing, a colour and a strength)
 /// and its ambient light.

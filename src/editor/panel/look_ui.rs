@@ -9,8 +9,8 @@ use crate::effect::{
 };
 pub use crate::render::look::sample_gradient;
 
-use super::curve_editor::{ParamSpec, param_row};
-use super::state::ViewSettings;
+use crate::editor::panel::curve_editor::{ParamSpec, param_row};
+use crate::editor::state::ViewSettings;
 
 /// The size parameter's editor: metres over normalised age.
 pub const SIZE: ParamSpec = ParamSpec {
@@ -78,7 +78,9 @@ pub fn look_ui(
         return;
     };
     look_fields_ui(ui, &mut e.look);
-    super::panel::grid("lit_grid").show(ui, |ui| super::lighting_ui::lit_rows_ui(ui, &mut e.look));
+    crate::editor::panel::grid("lit_grid").show(ui, |ui| {
+        crate::editor::panel::lighting_ui::lit_rows_ui(ui, &mut e.look)
+    });
     if let Some(err) = sprite_error {
         ui.colored_label(Color32::from_rgb(255, 110, 90), err);
     }

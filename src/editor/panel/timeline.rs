@@ -11,7 +11,7 @@ use egui::{Color32, Sense, Stroke, Ui, vec2};
 use crate::effect::{Effect, TimeMode};
 use crate::runtime::{InstanceId, Player};
 
-use super::state::{EditorState, Playback};
+use crate::editor::state::{EditorState, Playback};
 
 /// The frame rate seeks replay at (the frame-delta mode's frame time).
 pub const SEEK_FRAME_DT_SECS: f64 = 1.0 / 60.0;
@@ -55,7 +55,7 @@ pub fn step_secs(effect: &Effect) -> f64 {
 }
 
 /// Play/Pause, Step and Restart (the timeline's and the Time section's).
-pub fn playback_buttons_ui(ui: &mut Ui, playback: &mut super::state::Playback) {
+pub fn playback_buttons_ui(ui: &mut Ui, playback: &mut crate::editor::state::Playback) {
     let pause_text = if playback.is_paused { "Play" } else { "Pause" };
     if ui
         .button(pause_text)

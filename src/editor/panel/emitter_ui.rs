@@ -5,8 +5,8 @@ use egui::{DragValue, RichText, Ui};
 
 use crate::effect::{Burst, Effect, Emitter, Shape};
 
-use super::curve_editor::{ParamSpec, param_row};
-use super::panel::{UI_MAX_CAPACITY, drag, grid, range_ui, row_ui, vec3_ui};
+use crate::editor::panel::curve_editor::{ParamSpec, param_row};
+use crate::editor::panel::{UI_MAX_CAPACITY, drag, grid, range_ui, row_ui, vec3_ui};
 
 /// The emitter list (select, mute, solo, add, duplicate, remove, reorder) and the
 /// selected emitter's spawning parameters.
@@ -20,7 +20,7 @@ pub fn emitter_ui(ui: &mut Ui, effect: &mut Effect, selected: &mut usize) {
     emitter_fields_ui(ui, &mut effect.emitters[*selected]);
     // Events name their children: a renamed emitter keeps its parents' events.
     let new_name = effect.emitters[*selected].name.clone();
-    super::events_ui::rename_references(effect, &old_name, &new_name);
+    crate::editor::panel::events_ui::rename_references(effect, &old_name, &new_name);
 }
 
 /// The selected emitter's own fields (name, shape, placement, spawning, bursts).

@@ -10,9 +10,9 @@ use std::path::PathBuf;
 use anyhow::Context as _;
 use egui::ClippedPrimitive;
 
-use super::gfx::Gfx;
-use super::retained::{Repaint, RetainedImage};
-use super::screenshot::Screenshot;
+use crate::editor::window::gfx::Gfx;
+use crate::editor::window::retained::{Repaint, RetainedImage};
+use crate::editor::window::screenshot::Screenshot;
 
 /// The viewport's background colour (gamma-encoded, as egui's colours are).
 const VIEWPORT_BACKGROUND: egui::Color32 = egui::Color32::from_rgb(9, 9, 11);
@@ -26,7 +26,7 @@ const VIEWPORT_CLEAR: wgpu::Color = wgpu::Color {
 };
 
 /// The UI ready to present: meshes uploaded, textures updated, what to paint over what.
-pub(super) struct PaintedUi {
+pub(crate) struct PaintedUi {
     encoder: wgpu::CommandEncoder,
     /// Command buffers the painter needs submitted before the frame's.
     callbacks: Vec<wgpu::CommandBuffer>,
@@ -43,7 +43,7 @@ pub(super) struct PaintedUi {
 impl Gfx {
     /// Step 4, paint: egui's texture updates, its meshes tessellated and uploaded (with a
     /// retained image: only those over the viewport while the panel is unchanged).
-    pub(super) fn paint_ui(&mut self, ui: egui::FullOutput) -> PaintedUi {
+    pub(crate) fn paint_ui(&mut self, ui: egui::FullOutput) -> PaintedUi {
         let mut encoder = self
             .ctx
             .device
@@ -106,7 +106,7 @@ impl Gfx {
     /// image, then copied to the frame), records the screenshot when `screenshot` names
     /// one, submits and presents. Returns the screenshot to read back, if one was taken
     /// (`None` also when the window had no frame to give: the caller tries again).
-    pub(super) fn present(
+    pub(crate) fn present(
         &mut self,
         mut ui: PaintedUi,
         instance: &wgpu::Instance,

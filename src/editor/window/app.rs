@@ -22,11 +22,11 @@ use crate::gpu::ProfileRequest;
 use crate::hot_reload::FileWatcher;
 use crate::render::OrbitCamera;
 
-use super::gfx::Gfx;
-pub use super::report::RunReport;
-use super::report::Tick;
-use super::screenshot::{Screenshot, read_back};
-use super::state::EditorState;
+use crate::editor::state::EditorState;
+use crate::editor::window::gfx::Gfx;
+pub use crate::editor::window::run_report::RunReport;
+use crate::editor::window::run_report::Tick;
+use crate::editor::window::screenshot::{Screenshot, read_back};
 
 /// Extra frames `--screenshot` waits for the window to hand out a frame.
 const MAX_EXTRA_FRAMES: u64 = 120;
@@ -213,7 +213,7 @@ impl App {
         };
         gfx.reload_changed_sprites();
         if let (true, Some(n)) = (self.options.edit_around_loss, self.options.lose_device_at) {
-            super::scripted_edits::apply(&mut self.state, gfx.log.index, n);
+            crate::editor::window::scripted_edits::apply(&mut self.state, gfx.log.index, n);
         }
         let tick = gfx.log.tick(self.options.frames);
         let ui = gfx.run_ui(&mut self.state, &mut self.camera);
@@ -312,7 +312,7 @@ impl App {
         }
         let mut report = gfx.run_report(&mut self.state, self.devices_recreated);
         if self.options.edit_around_loss {
-            report.edits = Some(super::scripted_edits::summary(
+            report.edits = Some(crate::editor::window::scripted_edits::summary(
                 &self.state,
                 gfx.player.effect(),
             ));

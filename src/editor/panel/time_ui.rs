@@ -5,8 +5,8 @@ use egui::{Color32, DragValue, Ui};
 
 use crate::effect::{Effect, Integrator, TimeMode};
 
-use super::panel::{drag, grid, row_ui};
-use super::state::Playback;
+use crate::editor::panel::{drag, grid, row_ui};
+use crate::editor::state::Playback;
 
 /// Time stepping, playback and the integrator of each emitter with its stability hint.
 pub fn time_ui(
@@ -14,10 +14,10 @@ pub fn time_ui(
     effect: &mut Effect,
     playback: &mut Playback,
     selected: usize,
-    measure: &mut super::measure_ui::MeasurePanel,
+    measure: &mut crate::editor::panel::measure_ui::MeasurePanel,
 ) {
     ui.horizontal(|ui| {
-        super::timeline::playback_buttons_ui(ui, playback);
+        crate::editor::panel::timeline::playback_buttons_ui(ui, playback);
         if playback.is_paused {
             ui.colored_label(Color32::from_rgb(240, 200, 90), "paused");
         }
@@ -85,7 +85,7 @@ pub fn time_ui(
         }
     });
     stability_ui(ui, effect);
-    super::measure_ui::measure_ui(ui, measure, effect);
+    crate::editor::panel::measure_ui::measure_ui(ui, measure, effect);
 }
 
 /// The selected emitter's rows (of an open grid): its integrator, closed form and state

@@ -8,8 +8,8 @@ use crate::effect::{
     Turbulence, Vortex,
 };
 
-use super::curve_editor::param_row;
-use super::panel::{drag, grid, multiplier, row_ui, vec3_ui};
+use crate::editor::panel::curve_editor::param_row;
+use crate::editor::panel::{drag, grid, multiplier, row_ui, vec3_ui};
 
 /// Gravity, buoyancy, drag and wind of the selected emitter.
 pub fn forces_ui(ui: &mut Ui, effect: &mut Effect, selected: usize) {
