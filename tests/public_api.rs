@@ -42,7 +42,13 @@ fn the_runtime_api_is_the_committed_list() {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let out = std::process::Command::new(cargo)
         .current_dir(root)
-        .args(["doc", "--offline", "--locked", "--no-deps", "--no-default-features"])
+        .args([
+            "doc",
+            "--offline",
+            "--locked",
+            "--no-deps",
+            "--no-default-features",
+        ])
         .env("CARGO_TARGET_DIR", &target)
         .env_remove("RUSTDOCFLAGS")
         .output()
@@ -62,8 +68,14 @@ fn the_runtime_api_is_the_committed_list() {
     }
     let committed = std::fs::read_to_string(&listed).expect("docs/public-api.txt");
     let want: Vec<&str> = committed.lines().collect();
-    let new: Vec<&String> = items.iter().filter(|i| !want.contains(&i.as_str())).collect();
-    let gone: Vec<&&str> = want.iter().filter(|w| !items.contains(&w.to_string())).collect();
+    let new: Vec<&String> = items
+        .iter()
+        .filter(|i| !want.contains(&i.as_str()))
+        .collect();
+    let gone: Vec<&&str> = want
+        .iter()
+        .filter(|w| !items.contains(&w.to_string()))
+        .collect();
     assert!(
         new.is_empty() && gone.is_empty(),
         "the public API changed: new {new:?}, gone {gone:?}; if intended, update \

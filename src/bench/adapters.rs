@@ -9,7 +9,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::gpu::{AdapterProfile, GpuContext, ProfileSetting};
+use crate::editor::window::editor_profile::AdaptSetting;
+use crate::gpu::{GpuContext, ProfileSetting};
 
 use super::Report;
 
@@ -32,7 +33,7 @@ pub struct AdaptersOptions {
 /// One variant: the software profile with these fields set.
 struct Variant {
     label: String,
-    settings: Vec<ProfileSetting>,
+    settings: Vec<AdaptSetting>,
     /// Median frame of each round's run, ms.
     frames_ms: Vec<f64>,
 }
@@ -40,17 +41,15 @@ struct Variant {
 /// Runs the interleaved rounds and builds the report.
 pub fn run(ctx: &GpuContext, opts: &AdaptersOptions) -> anyhow::Result<Report> {
     let exe = std::env::current_exe()?;
-    let (soft, gpu) = (AdapterProfile::SOFTWARE, AdapterProfile::GPU);
     let mut variants = vec![Variant {
         label: "software profile (all adaptations)".into(),
         settings: Vec::new(),
         frames_ms: Vec::new(),
     }];
     // Timestamps are a capability (trustworthy or not), not a speed choice.
-    for s in soft
-        .differences(&gpu)
+    for s in AdaptSetting::software_to_gpu()
         .into_iter()
-        .filter(|s| !matches!(s, ProfileSetting::Timestamps(_)))
+        .filter(|s| !matches!(s, AdaptSetting::Adapter(ProfileSetting::Timestamps(_))))
     {
         variants.push(Variant {
             label: format!("without {}", s.field()),
@@ -60,7 +59,7 @@ pub fn run(ctx: &GpuContext, opts: &AdaptersOptions) -> anyhow::Result<Report> {
     }
     variants.push(Variant {
         label: "GPU profile (none)".into(),
-        settings: soft.differences(&gpu),
+        settings: AdaptSetting::software_to_gpu(),
         frames_ms: Vec::new(),
     });
     for round in 0..opts.rounds {
@@ -80,7 +79,7 @@ pub fn run(ctx: &GpuContext, opts: &AdaptersOptions) -> anyhow::Result<Report> {
 fn editor_median_ms(
     exe: &Path,
     opts: &AdaptersOptions,
-    settings: &[ProfileSetting],
+    settings: &[AdaptSetting],
 ) -> anyhow::Result<f64> {
     let mut cmd = Command::new(exe);
     cmd.args(["--adapter-profile", "software", "edit", "--frames"])

@@ -11,8 +11,9 @@ mod bench;
 use bench::{BenchKind, bench};
 
 use crate::editor::EditOptions;
+use crate::editor::window::editor_profile::AdaptSetting;
 use crate::effect::Effect;
-use crate::gpu::{GpuContext, ProfileKind, ProfileRequest, ProfileSetting};
+use crate::gpu::{GpuContext, ProfileKind, ProfileRequest};
 use crate::headless::Headless;
 use crate::shaders::{ENTRY_FILES, ShaderLibrary};
 
@@ -21,16 +22,16 @@ use crate::shaders::{ENTRY_FILES, ShaderLibrary};
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
-    /// The choices that differ between GPUs and software adapters (render scale, draft
-    /// glow, UI painter, retained window, timestamps, tile rasteriser, splat density): gpu or
-    /// software (default: from the adapter's type).
+    /// The choices that differ between GPUs and software adapters (the runtime's:
+    /// timestamps, tile rasteriser, splat density; the editor's: render scale, draft glow,
+    /// UI painter, retained window): gpu or software (default: from the adapter's type).
     #[arg(long, global = true)]
     adapter_profile: Option<ProfileArg>,
     /// Set single fields of the adapter profile, comma-separated FIELD=VALUE (fields:
     /// timestamps, render_scale, draft, lean_painter, retained_window, tile_raster,
     /// splat_dense_only).
     #[arg(long, global = true, value_delimiter = ',')]
-    adapt: Vec<ProfileSetting>,
+    adapt: Vec<AdaptSetting>,
 }
 
 /// `--adapter-profile`'s values.
@@ -178,12 +179,14 @@ pub fn main() {
     let cli = Cli::parse();
     let adapter_profile = ProfileRequest {
         kind: cli.adapter_profile.map(ProfileKind::from),
-        settings: cli.adapt,
+        settings: AdaptSetting::adapter_settings(&cli.adapt),
     };
+    let editor_settings = cli.adapt;
     let result = match cli.command {
         None => edit(EditOptions {
             window_size: (1280, 720),
             adapter_profile,
+            editor_settings,
             ..Default::default()
         }),
         Some(Command::Edit {
@@ -215,6 +218,7 @@ pub fn main() {
             edit_around_loss,
             measure_span,
             adapter_profile,
+            editor_settings,
         }),
         Some(Command::Render {
             preset,

@@ -1,6 +1,7 @@
-//! [`AdapterProfile`]: every decision that differs between GPUs and software adapters
-//! (lavapipe: the CI machine's and GPU-less machines' "GPU"), made once from the adapter
-//! and overridable (`--adapter-profile`, one field at a time with `--adapt`). Code
+//! [`AdapterProfile`]: every decision of the runtime that differs between GPUs and
+//! software adapters (lavapipe: the CI machine's and GPU-less machines' "GPU"), made once
+//! from the adapter and overridable (`--adapter-profile`, one field at a time with
+//! `--adapt`). The editor's own choices live in its `EditorProfile`, of the same kind. Code
 //! elsewhere asks the profile; nothing else looks at the adapter's type. Each software
 //! choice is measured by `ignis bench adapters` (kept only where it takes ≥ 10 % off the
 //! editor's software frame); the reasons are in `docs/architecture.md` ("Software
@@ -24,15 +25,6 @@ pub struct AdapterProfile {
     pub kind: ProfileKind,
     /// GPU timestamps are trustworthy (per-pass timings in the editor and the benches).
     pub timestamps: bool,
-    /// The editor renders its viewport at this fraction of its size by default.
-    pub render_scale: f32,
-    /// The editor draws large glow at half resolution by default (draft quality).
-    pub draft: bool,
-    /// The editor paints its UI with its branch-free lean painter instead of egui-wgpu's.
-    pub lean_painter: bool,
-    /// The editor keeps the window's image and repaints only the viewport while the
-    /// panel is unchanged.
-    pub retained_window: bool,
     /// The automatic draw path sends large sprites to the compute tile rasteriser
     /// (`tiles.wgsl`) instead of the billboards.
     pub tile_raster: bool,
@@ -50,10 +42,6 @@ impl AdapterProfile {
     pub const GPU: Self = Self {
         kind: ProfileKind::Gpu,
         timestamps: true,
-        render_scale: 1.0,
-        draft: false,
-        lean_painter: false,
-        retained_window: false,
         tile_raster: true,
         splat_dense_only: true,
     };
@@ -62,10 +50,6 @@ impl AdapterProfile {
     pub const SOFTWARE: Self = Self {
         kind: ProfileKind::Software,
         timestamps: false,
-        render_scale: 0.5,
-        draft: true,
-        lean_painter: true,
-        retained_window: true,
         tile_raster: false,
         splat_dense_only: false,
     };
@@ -92,14 +76,10 @@ impl AdapterProfile {
     }
 
     /// Every field but the kind, as settings (in declaration order).
-    pub fn settings(&self) -> [ProfileSetting; 7] {
+    pub fn settings(&self) -> [ProfileSetting; 3] {
         use ProfileSetting as S;
         [
             S::Timestamps(self.timestamps),
-            S::RenderScale(self.render_scale),
-            S::Draft(self.draft),
-            S::LeanPainter(self.lean_painter),
-            S::RetainedWindow(self.retained_window),
             S::TileRaster(self.tile_raster),
             S::SplatDenseOnly(self.splat_dense_only),
         ]
@@ -144,39 +124,23 @@ impl ProfileRequest {
 }
 
 /// One field of an [`AdapterProfile`] set on its own: `--adapt FIELD=VALUE` (the field's
-/// name as in the struct, a bool or, for `render_scale`, a number in 0.1..=1).
+/// name as in the struct, and a bool).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[allow(missing_docs)] // each variant is the field of the same name
 pub enum ProfileSetting {
     Timestamps(bool),
-    RenderScale(f32),
-    Draft(bool),
-    LeanPainter(bool),
-    RetainedWindow(bool),
     TileRaster(bool),
     SplatDenseOnly(bool),
 }
 
 impl ProfileSetting {
     /// The field names `--adapt` accepts.
-    pub const FIELDS: [&'static str; 7] = [
-        "timestamps",
-        "render_scale",
-        "draft",
-        "lean_painter",
-        "retained_window",
-        "tile_raster",
-        "splat_dense_only",
-    ];
+    pub const FIELDS: [&'static str; 3] = ["timestamps", "tile_raster", "splat_dense_only"];
 
     /// Sets the field in `profile`.
     pub fn apply(&self, p: &mut AdapterProfile) {
         match *self {
             Self::Timestamps(v) => p.timestamps = v,
-            Self::RenderScale(v) => p.render_scale = v,
-            Self::Draft(v) => p.draft = v,
-            Self::LeanPainter(v) => p.lean_painter = v,
-            Self::RetainedWindow(v) => p.retained_window = v,
             Self::TileRaster(v) => p.tile_raster = v,
             Self::SplatDenseOnly(v) => p.splat_dense_only = v,
         }
@@ -195,16 +159,8 @@ impl ProfileSetting {
 
 impl std::fmt::Display for ProfileSetting {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let value = match *self {
-            Self::RenderScale(v) => v.to_string(),
-            Self::Timestamps(v)
-            | Self::Draft(v)
-            | Self::LeanPainter(v)
-            | Self::RetainedWindow(v)
-            | Self::TileRaster(v)
-            | Self::SplatDenseOnly(v) => v.to_string(),
-        };
-        write!(f, "{}={value}", self.field())
+        let (Self::Timestamps(v) | Self::TileRaster(v) | Self::SplatDenseOnly(v)) = *self;
+        write!(f, "{}={v}", self.field())
     }
 }
 
@@ -212,28 +168,10 @@ impl FromStr for ProfileSetting {
     type Err = String;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let (name, value) = s
-            .split_once('=')
-            .ok_or_else(|| format!("{s:?}: expected FIELD=VALUE, e.g. draft=false"))?;
-        let (name, value) = (name.trim(), value.trim());
-        let flag = || {
-            value
-                .parse::<bool>()
-                .map_err(|_| format!("{name}: {value:?} is not a bool (expected true or false)"))
-        };
+        let (name, value) = split_setting(s)?;
+        let flag = || parse_flag(name, value);
         Ok(match name {
             "timestamps" => Self::Timestamps(flag()?),
-            "render_scale" => match value.parse::<f32>() {
-                Ok(v) if (0.1..=1.0).contains(&v) => Self::RenderScale(v),
-                _ => {
-                    return Err(format!(
-                        "render_scale: {value:?} is not a number in 0.1..=1"
-                    ));
-                }
-            },
-            "draft" => Self::Draft(flag()?),
-            "lean_painter" => Self::LeanPainter(flag()?),
-            "retained_window" => Self::RetainedWindow(flag()?),
             "tile_raster" => Self::TileRaster(flag()?),
             "splat_dense_only" => Self::SplatDenseOnly(flag()?),
             other => {
@@ -244,6 +182,21 @@ impl FromStr for ProfileSetting {
             }
         })
     }
+}
+
+/// `FIELD=VALUE` split and trimmed, or an error that shows the form.
+pub fn split_setting(s: &str) -> Result<(&str, &str), String> {
+    let (name, value) = s
+        .split_once('=')
+        .ok_or_else(|| format!("{s:?}: expected FIELD=VALUE, e.g. tile_raster=false"))?;
+    Ok((name.trim(), value.trim()))
+}
+
+/// A setting's bool value, or an error naming the field.
+pub fn parse_flag(name: &str, value: &str) -> Result<bool, String> {
+    value
+        .parse::<bool>()
+        .map_err(|_| format!("{name}: {value:?} is not a bool (expected true or false)"))
 }
 
 #[cfg(test)]
@@ -274,18 +227,7 @@ mod tests {
     fn the_two_sets_differ_in_exactly_the_listed_fields() {
         let (gpu, soft) = (AdapterProfile::GPU, AdapterProfile::SOFTWARE);
         let differ: Vec<&str> = gpu.differences(&soft).iter().map(|s| s.field()).collect();
-        assert_eq!(
-            differ,
-            [
-                "timestamps",
-                "render_scale",
-                "draft",
-                "lean_painter",
-                "retained_window",
-                "tile_raster",
-                "splat_dense_only",
-            ]
-        );
+        assert_eq!(differ, ["timestamps", "tile_raster", "splat_dense_only"]);
         let mut turned = gpu.with(&gpu.differences(&soft));
         assert_ne!(turned, soft, "the kind is not a setting");
         turned.kind = ProfileKind::Software;
@@ -293,7 +235,12 @@ mod tests {
         for s in soft.settings().into_iter().chain(gpu.settings()) {
             assert_eq!(s.to_string().parse::<ProfileSetting>(), Ok(s));
         }
-        for bad in ["draft", "draft=maybe", "render_scale=2", "colour=true"] {
+        for bad in [
+            "tile_raster",
+            "tile_raster=maybe",
+            "draft=true",
+            "colour=true",
+        ] {
             assert!(bad.parse::<ProfileSetting>().is_err(), "{bad}");
         }
     }

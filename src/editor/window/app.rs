@@ -48,6 +48,9 @@ pub struct EditOptions {
     pub render_scale: Option<f32>,
     /// The adapter profile asked for instead of the adapter's own.
     pub adapter_profile: ProfileRequest,
+    /// Fields of the editor's profile set on top of the set of the adapter's kind (the
+    /// runtime's fields among them are ignored: they are in `adapter_profile`).
+    pub editor_settings: Vec<super::editor_profile::AdaptSetting>,
     /// Drain the GPU after each frame stage and report where the time goes.
     pub profile: bool,
     /// Open exactly these panel sections at start (ids: emitter, look, …).
@@ -146,9 +149,9 @@ impl ApplicationHandler for App {
                 self.state.view.render_scale = self
                     .options
                     .render_scale
-                    .unwrap_or(gfx.ctx.profile.render_scale)
+                    .unwrap_or(gfx.editor_profile.render_scale)
                     .clamp(0.1, 1.0);
-                self.state.view.draft = self.options.draft.unwrap_or(gfx.ctx.profile.draft);
+                self.state.view.draft = self.options.draft.unwrap_or(gfx.editor_profile.draft);
                 gfx.window.request_redraw();
                 self.gfx = Some(gfx);
             }

@@ -23,6 +23,7 @@ use crate::editor::panel::viewport::{ViewportOutput, emitter_bounds, frame_bound
 use crate::editor::panel::{PANEL_WIDTH, panel_ui};
 use crate::editor::state::EditorState;
 use crate::editor::window::app::EditOptions;
+use crate::editor::window::editor_profile::EditorProfile;
 use crate::editor::window::run_report::{FrameLog, RunReport, Tick, WARMUP_FRAMES};
 use crate::editor::window::ui_painter::UiPainter;
 
@@ -66,6 +67,8 @@ pub(crate) struct Gfx {
     pub(crate) surface: wgpu::Surface<'static>,
     pub(crate) config: wgpu::SurfaceConfiguration,
     pub(crate) surface_can_copy: bool,
+    /// The editor's choices for this adapter (render scale, draft, painter, retained).
+    pub(crate) editor_profile: EditorProfile,
     pub(crate) ctx: GpuContext,
     /// Plays the running effect (one instance, at the origin).
     pub(crate) player: Player,
@@ -260,9 +263,11 @@ impl Gfx {
         let egui_ctx = egui::Context::default();
         egui_ctx.set_visuals(egui::Visuals::dark());
         let egui_state = egui_state(&egui_ctx, &window, &ctx);
-        let ui_painter = UiPainter::new(&ctx.device, format, ctx.profile.lean_painter);
+        let editor_profile =
+            EditorProfile::of_kind(ctx.profile.kind).with(&options.editor_settings);
+        let ui_painter = UiPainter::new(&ctx.device, format, editor_profile.lean_painter);
         // Software adapters keep the window's image between frames (see retained.rs).
-        let retained = (ctx.profile.retained_window && surface_can_receive).then(|| {
+        let retained = (editor_profile.retained_window && surface_can_receive).then(|| {
             config.usage |= wgpu::TextureUsages::COPY_DST;
             crate::editor::window::retained::RetainedUi::default()
         });
@@ -280,6 +285,7 @@ impl Gfx {
             window,
             surface,
             config,
+            editor_profile,
             surface_can_copy,
             gpu_effect: state.running.clone(),
             ctx,

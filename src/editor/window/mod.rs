@@ -6,6 +6,7 @@
 //! ([`run_report`]).
 
 pub mod app;
+pub mod editor_profile;
 pub mod gfx;
 pub mod present;
 pub mod retained;

@@ -7,7 +7,7 @@
 //! `textureLoad`s and integer modulos, for every pixel; a full 1280×720 editor frame
 //! then takes ~170 ms in egui alone. [`LeanPainter`] draws the same meshes with a
 //! branch-free shader. Real GPUs keep egui-wgpu's renderer
-//! ([`crate::gpu::AdapterProfile::lean_painter`]).
+//! ([`crate::editor::window::editor_profile::EditorProfile::lean_painter`]).
 
 use std::collections::HashMap;
 
