@@ -15,7 +15,7 @@ fn layer(module: &str) -> Option<u32> {
         "render" => 3,
         "runtime" => 4,
         "composite" | "headless" | "export" | "editor" | "bench" | "tune" | "hot_reload"
-        | "cli" => 5,
+        | "cli" | "testing" => 5,
         _ => return None,
     })
 }
@@ -225,4 +225,37 @@ fn the_length_check_counts_to_the_closing_brace() {
     assert!(long_functions(&text, 102).is_empty());
     let nested = format!("impl A {{\n    pub fn f() {{\n{body}    }}\n}}\n");
     assert_eq!(long_functions(&nested, 100), ["f (102 lines)"]);
+}
+
+/// `docs/architecture.md` is a map of every file: each source file of the crate, its
+/// shaders, tests, examples and the Bevy plugin is named there (by its path).
+#[test]
+fn every_source_file_is_on_the_map() {
+    let base = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let map = std::fs::read_to_string(base.join("docs/architecture.md")).expect("read");
+    let mut paths = Vec::new();
+    for dir in ["src", "tests", "examples", "crates/bevy_ignis/src"] {
+        sources(&base.join(dir), &mut paths);
+    }
+    for entry in std::fs::read_dir(base.join("shaders"))
+        .expect("shaders")
+        .flatten()
+    {
+        paths.push(entry.path());
+    }
+    let missing: Vec<String> = paths
+        .iter()
+        .map(|p| {
+            p.strip_prefix(base)
+                .expect("under the crate")
+                .display()
+                .to_string()
+        })
+        .filter(|rel| !rel.starts_with("tests/fixtures") && !map.contains(&format!("`{rel}`")))
+        .collect();
+    assert!(paths.len() > 200, "{} files read", paths.len());
+    assert!(
+        missing.is_empty(),
+        "files docs/architecture.md does not name: {missing:?}"
+    );
 }

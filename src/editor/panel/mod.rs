@@ -51,99 +51,105 @@ pub fn panel_ui(ui: &mut Ui, state: &mut EditorState) {
     egui::ScrollArea::vertical()
         .auto_shrink([false, false])
         .show(ui, |ui| {
-            let name = state
-                .effect
-                .emitters
-                .get(state.selected)
-                .map(|e| e.name.clone())
-                .unwrap_or_default();
-            section_ui(
-                ui,
-                "emitter",
-                "Emitter",
-                "",
-                (true, open("emitter")),
-                |ui| {
-                    emitter_ui(ui, &mut state.effect, &mut state.selected);
-                },
-            );
-            section_ui(
-                ui,
-                "randomness",
-                "Randomness",
-                &name,
-                (false, open("randomness")),
-                |ui| {
-                    randomness_ui(ui, &mut state.effect, state.selected);
-                },
-            );
-            section_ui(
-                ui,
-                "forces",
-                "Forces",
-                &name,
-                (false, open("forces")),
-                |ui| {
-                    forces_ui(ui, &mut state.effect, state.selected);
-                },
-            );
-            section_ui(
-                ui,
-                "events",
-                "Events",
-                &name,
-                (false, open("events")),
-                |ui| {
-                    crate::editor::panel::events_ui::events_ui(
-                        ui,
-                        &mut state.effect,
-                        state.selected,
-                    );
-                },
-            );
-            section_ui(ui, "time", "Time", "", (true, open("time")), |ui| {
-                time_ui(
-                    ui,
-                    &mut state.effect,
-                    &mut state.playback,
-                    state.selected,
-                    &mut state.measure,
-                );
-            });
-            section_ui(ui, "look", "Look", &name, (false, open("look")), |ui| {
-                let sprite_error = state
-                    .sprite_errors
-                    .iter()
-                    .find(|(i, _)| *i == state.selected)
-                    .map(|(_, e)| e.as_str());
-                look_ui(
-                    ui,
-                    &mut state.effect,
-                    state.selected,
-                    &mut state.view,
-                    sprite_error,
-                );
-            });
-            section_ui(ui, "view", "View", "", (false, open("view")), |ui| {
-                view_ui(ui, &mut state.view, &mut state.frame_requested);
-                ui.separator();
-                ui.label("Scene light (lit smoke; saved with the preset)");
-                crate::editor::panel::lighting_ui::lighting_ui(ui, &mut state.effect.lighting);
-            });
-            section_ui(ui, "stats", "Stats", "", (true, open("stats")), |ui| {
-                stats_ui(ui, &state.stats, &state.running);
-                crate::editor::diagnostics::emitter_cost::emitter_cost_ui(
-                    ui,
-                    &mut state.cost_probe,
-                    &state.emitter_costs,
-                    &state.running,
-                    !state.stats.gpu_pass_ms.is_empty(),
-                );
-            });
-            section_ui(ui, "export", "Export", "", (false, open("export")), |ui| {
-                crate::editor::panel::export_ui::export_ui(ui, &mut state.export);
-            });
+            effect_sections_ui(ui, state, &open);
+            tool_sections_ui(ui, state, &open);
         });
+}
+
+/// The sections that edit the effect: emitter, randomness, forces, events, time, look.
+fn effect_sections_ui(ui: &mut Ui, state: &mut EditorState, open: &dyn Fn(&str) -> Option<bool>) {
+    let name = state
+        .effect
+        .emitters
+        .get(state.selected)
+        .map(|e| e.name.clone())
+        .unwrap_or_default();
+    section_ui(
+        ui,
+        "emitter",
+        "Emitter",
+        "",
+        (true, open("emitter")),
+        |ui| {
+            emitter_ui(ui, &mut state.effect, &mut state.selected);
+        },
+    );
+    section_ui(
+        ui,
+        "randomness",
+        "Randomness",
+        &name,
+        (false, open("randomness")),
+        |ui| {
+            randomness_ui(ui, &mut state.effect, state.selected);
+        },
+    );
+    section_ui(
+        ui,
+        "forces",
+        "Forces",
+        &name,
+        (false, open("forces")),
+        |ui| {
+            forces_ui(ui, &mut state.effect, state.selected);
+        },
+    );
+    section_ui(
+        ui,
+        "events",
+        "Events",
+        &name,
+        (false, open("events")),
+        |ui| {
+            crate::editor::panel::events_ui::events_ui(ui, &mut state.effect, state.selected);
+        },
+    );
+    section_ui(ui, "time", "Time", "", (true, open("time")), |ui| {
+        time_ui(
+            ui,
+            &mut state.effect,
+            &mut state.playback,
+            state.selected,
+            &mut state.measure,
+        );
+    });
+    section_ui(ui, "look", "Look", &name, (false, open("look")), |ui| {
+        let sprite_error = state
+            .sprite_errors
+            .iter()
+            .find(|(i, _)| *i == state.selected)
+            .map(|(_, e)| e.as_str());
+        look_ui(
+            ui,
+            &mut state.effect,
+            state.selected,
+            &mut state.view,
+            sprite_error,
+        );
+    });
+}
+
+/// The sections around the effect: view, stats, export.
+fn tool_sections_ui(ui: &mut Ui, state: &mut EditorState, open: &dyn Fn(&str) -> Option<bool>) {
+    section_ui(ui, "view", "View", "", (false, open("view")), |ui| {
+        view_ui(ui, &mut state.view, &mut state.frame_requested);
+        ui.separator();
+        ui.label("Scene light (lit smoke; saved with the preset)");
+        crate::editor::panel::lighting_ui::lighting_ui(ui, &mut state.effect.lighting);
+    });
+    section_ui(ui, "stats", "Stats", "", (true, open("stats")), |ui| {
+        stats_ui(ui, &state.stats, &state.running);
+        crate::editor::diagnostics::emitter_cost::emitter_cost_ui(
+            ui,
+            &mut state.cost_probe,
+            &state.emitter_costs,
+            &state.running,
+            !state.stats.gpu_pass_ms.is_empty(),
+        );
+    });
+    section_ui(ui, "export", "Export", "", (false, open("export")), |ui| {
+        crate::editor::panel::export_ui::export_ui(ui, &mut state.export);
+    });
 }
 
 /// A collapsible section with a stable id (its title may name the selected emitter).
