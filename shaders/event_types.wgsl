@@ -1,5 +1,5 @@
 // event_types.wgsl — the event buffers' structs, shared by the update's hooks
-// (events_on.wgsl) and the scan (events.wgsl). Keep in sync with src/sim/events.rs.
+// (events_on.wgsl) and the scan (events.wgsl). Keep in sync with src/sim/event_scan.rs.
 
 struct EventRule {
     trigger: u32,

@@ -25,7 +25,7 @@
 // the list position this scan starts at, one word per block of the parent's capacity, the
 // cap's bucket and this step's allowance, then two words per parent slot: its last child's
 // slot and stamp), 5 the child's trail ring (a placeholder unless RIBBON).
-// Mirrored by `scan_events` in src/sim/events.rs (the links are read by `Link` in
+// Mirrored by `scan_events` in src/sim/event_scan.rs (the links are read by `Link` in
 // src/sim/trails.rs).
 #import "common.wgsl"
 #import "params.wgsl"
@@ -50,7 +50,7 @@ struct ScanConfig {
 @group(0) @binding(4) var<storage, read_write> blocks: array<u32>;
 @group(0) @binding(5) var<storage, read_write> ribbon: TrailRing;
 
-// ScanConfig flags (keep in sync with src/sim/events.rs).
+// ScanConfig flags (keep in sync with src/sim/event_scan.rs).
 const INHERIT_COLOR: u32 = 1u;
 const RIBBON: u32 = 2u;
 // No previous child.
@@ -58,7 +58,7 @@ const NO_LINK: u32 = 0xFFFFFFFFu;
 
 const GROUP: u32 = 256u;
 // Slots per thread and per workgroup (keep in sync with EVENT_SCAN_BLOCK in
-// src/sim/events.rs).
+// src/sim/event_scan.rs).
 const PER_THREAD: u32 = 4u;
 const BLOCK: u32 = 1024u;
 

@@ -12,7 +12,7 @@
 //   header, written by the scan this step — `stamp` says which step) are born at the
 //   event's position plus the child's own shape offset, with the velocity of its own
 //   spawn settings plus the inherited part of the parent's.
-// Mirrored by `src/sim/events.rs` (the CPU reference of counts, keys and the scan).
+// Mirrored by `src/sim/event_scan.rs` (the CPU reference of counts, keys and the scan).
 #import "common.wgsl"
 #import "rng.wgsl"
 #import "event_types.wgsl"
@@ -29,7 +29,7 @@ const TRIGGER_NONE: u32 = 0xFFFFFFFFu;
 // Keep in sync with MAX_CHILDREN_PER_EVENT (src/effect/events.rs).
 const MAX_CHILDREN: u32 = 64u;
 // A collision's ordinal is the parent's age in these units (keep in sync with
-// COLLISION_ORDINALS_PER_SEC in src/sim/events.rs): the same bounce draws the same
+// COLLISION_ORDINALS_PER_SEC in src/sim/event_scan.rs): the same bounce draws the same
 // children at any step, where the age's own bits would differ with the step.
 const COLLISION_ORDINALS_PER_SEC: f32 = 16.0;
 

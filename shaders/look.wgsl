@@ -72,7 +72,7 @@ struct LookUniform {
     tiny_c: vec4<u32>,
 }
 
-// A lit layer's light (lit.wgsl; keep in sync with `LitUniform` in src/render/lit.rs),
+// A lit layer's light (lit.wgsl; keep in sync with `LitUniform` in src/render/scene_lighting.rs),
 // in the emitter's simulation space (the world's axes). Zero for unlit layers.
 struct LitUniform {
     // xyz: towards the sun, w: the effect light's gain (`self_light`).
@@ -107,7 +107,7 @@ override INTERPOLATE: bool = true;
 override STATE_LAYOUT: u32 = 0u;
 override STATELESS: bool = false;
 
-// Texels per colour ramp row (keep in sync with `RAMP_WIDTH` in src/render/look.rs).
+// Texels per colour ramp row (keep in sync with `RAMP_WIDTH` in src/render/look_bake.rs).
 const RAMP_WIDTH: u32 = 1024u;
 
 // Colour and alpha at normalised age t: the emitter's gradient baked into a ramp row

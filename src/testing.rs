@@ -56,8 +56,8 @@ pub mod sim {
     }
 
     /// Events: rules, records, the scan and its CPU mirror.
-    pub mod events {
-        pub use crate::sim::events::{
+    pub mod event_scan {
+        pub use crate::sim::event_scan::{
             EventRecord, EventRule, EventSpawn, ScanConfig, child_key, event_of, rules_of,
             scan_events, step_cap,
         };
@@ -84,8 +84,8 @@ pub mod render {
     }
 
     /// Colour ramps, curves and flipbooks baked for the GPU.
-    pub mod look {
-        pub use crate::render::look::{
+    pub mod look_bake {
+        pub use crate::render::look_bake::{
             RAMP_WIDTH, bake_look_curves, bake_ramp, flipbook_frame, look_curve_params,
             sample_gradient,
         };

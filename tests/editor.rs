@@ -1064,7 +1064,7 @@ fn look_controls_toggle_flipbook_streak_bloom_and_the_gradient_bar_adds_stops() 
         .find(|s| !stops.contains(s))
         .expect("a new stop");
     assert!((added.t - 0.5).abs() < 0.05, "added at {}", added.t);
-    let want = ignis::testing::render::look::sample_gradient(&stops, added.t);
+    let want = ignis::testing::render::look_bake::sample_gradient(&stops, added.t);
     for (got, want) in added.rgba.iter().zip(want) {
         assert!((got - want).abs() < 1e-5);
     }

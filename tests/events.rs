@@ -10,7 +10,7 @@ use ignis::effect::*;
 use ignis::testing::gpu::types::{Particle, SimParams};
 use ignis::testing::shaders::ShaderLibrary;
 use ignis::testing::sim::GpuSim;
-use ignis::testing::sim::events::{
+use ignis::testing::sim::event_scan::{
     EventRecord, ScanConfig, child_key, event_of, rules_of, scan_events,
 };
 
@@ -76,7 +76,7 @@ fn expected_list(
     p: &SimParams,
     (before, after): (&[Particle], &[Particle]),
     bucket: &mut ignis::effect::RateCap,
-) -> (Vec<ignis::testing::sim::events::EventSpawn>, u32) {
+) -> (Vec<ignis::testing::sim::event_scan::EventSpawn>, u32) {
     let rule = rules_of(&effect.emitters[0])[0];
     let mut records = Vec::new();
     for i in 0..p.update_window[1] {
@@ -103,7 +103,7 @@ fn expected_list(
     }
     let delta = (sim.planner.emitters[0].origin() - sim.planner.emitters[1].origin()).as_vec3();
     let ev = &effect.emitters[0].events[0];
-    let room = ignis::testing::sim::events::step_cap(effect, 0, 0);
+    let room = ignis::testing::sim::event_scan::step_cap(effect, 0, 0);
     let cfg = ScanConfig {
         rule_capacity_cap: [
             0,

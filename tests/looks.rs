@@ -23,7 +23,7 @@ use ignis::testing::gpu::GpuContext;
 use ignis::testing::gpu::types::{CameraUniform, LookUniform};
 use ignis::testing::headless::Headless;
 use ignis::testing::render::frame::look_uniform;
-use ignis::testing::render::look::{
+use ignis::testing::render::look_bake::{
     RAMP_WIDTH, bake_look_curves, bake_ramp, flipbook_frame, sample_gradient,
 };
 use ignis::testing::render::sprites::SpriteLibrary;
@@ -256,7 +256,7 @@ fn look_curves_on_the_gpu_match_the_cpu_reference_at_every_texel_and_between() {
     }
     let got = probe_all(&ctx, &look, &inputs);
     let rows = bake_look_curves(&look);
-    let params = ignis::testing::render::look::look_curve_params(&look);
+    let params = ignis::testing::render::look_bake::look_curve_params(&look);
     let mut worst = [0.0f32; 4];
     for (input, (frames, _, curves)) in inputs.iter().zip(&got) {
         let t = (input[0] / input[1]).clamp(0.0, 1.0);

@@ -87,7 +87,7 @@ fn rust_and_wgsl_struct_sizes_agree() {
     let billboard = lib.compose("billboard.wgsl").expect("billboard");
     let tonemap = lib.compose("tonemap.wgsl").expect("tonemap");
     let scan = lib.compose("events.wgsl").expect("events");
-    use ignis::testing::sim::events::{EventRule, EventSpawn, ScanConfig};
+    use ignis::testing::sim::event_scan::{EventRule, EventSpawn, ScanConfig};
     let cases = [
         (&scan, "EventRule", size_of::<EventRule>()),
         (&scan, "EventSpawn", size_of::<EventSpawn>()),

@@ -7,7 +7,7 @@
 use glam::Vec3;
 
 use crate::gpu::{GpuContext, TextureReadback};
-use crate::render::lit::SceneLighting;
+use crate::render::scene_lighting::SceneLighting;
 use crate::render::{Camera, begin_hdr_pass};
 use crate::runtime::{Layers, Player};
 

@@ -14,8 +14,8 @@ use crate::effect::{
 use crate::gpu::types::{CameraUniform, PARAMS_STRIDE};
 use crate::gpu::{AdapterProfile, GpuContext};
 use crate::render::camera::Camera;
-use crate::render::lit::SceneLighting;
-use crate::render::look::{
+use crate::render::scene_lighting::SceneLighting;
+use crate::render::look_bake::{
     RAMP_WIDTH, ROWS_PER_EMITTER, bake_look_curves, bake_ramp, gradient_key, look_curve_params,
 };
 use crate::render::sort::{SortJob, SortMember};

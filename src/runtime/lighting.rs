@@ -2,7 +2,7 @@
 //! lights, in the host's world, turned into the preset's.
 
 use super::Player;
-use crate::render::lit::SceneLighting;
+use crate::render::scene_lighting::SceneLighting;
 
 impl Player {
     /// Lights lit layers with the host's light instead of the preset's `lighting`: a

@@ -11,19 +11,19 @@ use crate::gpu::types::{
 };
 use crate::gpu::{GpuContext, GpuError};
 use crate::shaders::{ShaderError, ShaderLibrary};
-use crate::sim::events::{EventHeader, ScanConfig, scan_flags};
+use crate::sim::event_scan::{EventHeader, ScanConfig, scan_flags};
 use crate::sim::hooks::EmitterHooks;
 use crate::sim::modules::Modules;
 use crate::sim::planner::{EffectPlanner, LiveWindow};
 
-mod readback;
+mod state_readback;
 mod recording;
 
 pub use super::sim_state::{EmitterBuffers, SimState, TrailRing};
 pub(crate) use super::update_pass::lock;
 use super::update_pass::update_counts;
 pub use super::update_pass::{SharedUpdate, UpdateMode, UpdatePass, pipeline_key, used_keys};
-pub use readback::{map_read, read_buffer};
+pub use state_readback::{map_read, read_buffer};
 
 /// Steps recorded per submission (the per-step params blocks live side by side).
 const STEPS_PER_SUBMIT: usize = 32;

@@ -2,13 +2,13 @@
 //! emitter's hook buffers — its event counts and records (a parent), the spawn list its
 //! parents' events fill (a child), its trail's ring — with their bind groups, and the
 //! layouts and pipelines of the event scan that runs between a parent's update and its
-//! children's. What the buffers hold: `crate::sim::events` and `crate::sim::trails`.
+//! children's. What the buffers hold: `crate::sim::event_scan` and `crate::sim::trails`.
 
 use crate::effect::{Effect, MAX_EVENTS_PER_EMITTER, TrailMode};
 use crate::gpu::types::SimParams;
 use crate::gpu::{GpuContext, compute_storage_entry};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
-use crate::sim::events::{
+use crate::sim::event_scan::{
     EVENT_SCAN_BLOCK, EventHeader, EventRule, EventSpawn, RECORD_WORDS, RULES_BYTES, ScanConfig,
     rules_of, step_cap,
 };

@@ -3,7 +3,7 @@
 
 pub mod batch;
 pub mod cpu_reference;
-pub mod events;
+pub mod event_scan;
 pub mod gpu_sim;
 pub mod hooks;
 pub mod modules;

@@ -73,7 +73,7 @@ impl GpuSim {
             .map(|s| {
                 let buffers = s.buffers.each_ref().map(|b| copy_of(enc, b, b.size()));
                 let hooks = s.hooks.as_ref();
-                let header = size_of::<crate::sim::events::EventHeader>() as u64;
+                let header = size_of::<crate::sim::event_scan::EventHeader>() as u64;
                 let event_header = hooks
                     .and_then(|ev| ev.list.as_ref())
                     .map(|list| copy_of(enc, list, header));

@@ -7,7 +7,7 @@ use crate::effect::{
     MAX_TRAIL_POINTS, Param, Post, SPLAT_BELOW_PX, Sprite, Streak, TILES_ABOVE_PX, Trail,
     TrailMode,
 };
-pub use crate::render::look::sample_gradient;
+pub use crate::render::look_bake::sample_gradient;
 
 use crate::editor::panel::curve_editor::{ParamSpec, param_row};
 use crate::editor::state::ViewSettings;

@@ -271,7 +271,7 @@ impl GpuSim {
                     rule_capacity_cap: [
                         k as u32,
                         child_capacity,
-                        crate::sim::events::step_cap(effect, i, k),
+                        crate::sim::event_scan::step_cap(effect, i, k),
                         scan_flags(ev.inherit_color, scan.linked),
                     ],
                     delta_inherit: [delta.x, delta.y, delta.z, ev.inherit_velocity],
@@ -388,7 +388,7 @@ fn record_scans(
     offset: u32,
     slots: u32,
 ) {
-    let blocks = slots.div_ceil(crate::sim::events::EVENT_SCAN_BLOCK);
+    let blocks = slots.div_ceil(crate::sim::event_scan::EVENT_SCAN_BLOCK);
     for group in ev.scans.iter().filter_map(|sc| sc.group.as_ref()) {
         pass.set_bind_group(0, group, &[offset]);
         for (pipeline, groups) in scan.iter().zip([blocks, 1, blocks]) {
