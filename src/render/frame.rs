@@ -14,10 +14,10 @@ use crate::effect::{
 use crate::gpu::types::{CameraUniform, PARAMS_STRIDE};
 use crate::gpu::{AdapterProfile, GpuContext};
 use crate::render::camera::Camera;
-use crate::render::scene_lighting::SceneLighting;
 use crate::render::look_bake::{
     RAMP_WIDTH, ROWS_PER_EMITTER, bake_look_curves, bake_ramp, gradient_key, look_curve_params,
 };
+use crate::render::scene_lighting::SceneLighting;
 use crate::render::sort::{SortJob, SortMember};
 use crate::render::sprites::{SpriteError, SpriteLibrary, SpriteTexture};
 use crate::sim::Modules;

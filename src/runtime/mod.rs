@@ -17,8 +17,8 @@ mod remap;
 mod seeking;
 
 pub use crate::render::Camera;
-pub use crate::render::scene_lighting::{MAX_POINT_LIGHTS, PointLight, SceneLighting};
 pub use crate::render::matrix::IntoMat4;
+pub use crate::render::scene_lighting::{MAX_POINT_LIGHTS, PointLight, SceneLighting};
 pub use device_check::{MissingLimit, STORAGE_BUFFERS_REQUIRED, required_limits};
 pub use editing::PLAYER_SHADERS;
 pub use effect_light::EffectLight;

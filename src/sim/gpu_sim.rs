@@ -16,8 +16,8 @@ use crate::sim::hooks::EmitterHooks;
 use crate::sim::modules::Modules;
 use crate::sim::planner::{EffectPlanner, LiveWindow};
 
-mod state_readback;
 mod recording;
+mod state_readback;
 
 pub use super::sim_state::{EmitterBuffers, SimState, TrailRing};
 pub(crate) use super::update_pass::lock;

@@ -3,8 +3,8 @@
 
 use crate::effect::{BlendMode, Effect, FlipbookMode, Look, Streak};
 use crate::gpu::types::{LookUniform, PARAMS_STRIDE};
-use crate::render::scene_lighting::{LitUniform, SceneLighting, write_lit};
 use crate::render::look_bake::ROWS_PER_EMITTER;
+use crate::render::scene_lighting::{LitUniform, SceneLighting, write_lit};
 use crate::render::sort::SortMember;
 use crate::render::sprites::SpriteTexture;
 use crate::sim::Modules;
