@@ -152,23 +152,9 @@ pub struct PerfRow {
     pub lean_update_ms: f64,
     /// Compute copy of the same bytes, ms.
     pub copy_ms: f64,
-    /// Billboard draw, ms (None when skipped).
-    pub billboard_ms: Option<f64>,
-    /// Splat draw (clear + splat + resolve), ms.
-    pub splat_ms: f64,
-    /// Tile draw (project, bin, shade and the resolve), ms (None when the quads do not
-    /// fit the device's tile buffers, or the device has no tile rasteriser).
-    pub tiles_ms: Option<f64>,
-    /// The tile draw's project alone and project + bin, ms (the shade and resolve are the
-    /// rest of `tiles_ms`).
-    pub tiles_stages_ms: Option<[f64; 2]>,
-    /// The tiles' resolve alone, ms: by compute (None where the adapter cannot; the tile
-    /// draw uses it where it can, as the editor does) and by a draw.
-    pub tiles_resolve_ms: Option<(Option<f64>, f64)>,
-    /// Tonemap composite, ms.
-    pub composite_ms: f64,
-    /// The path Auto picks for this scene.
-    pub auto_path: &'static str,
+    /// The draw paths' times.
+    #[serde(flatten)]
+    pub draws: DrawCosts,
     /// update + auto draw + composite, ms.
     pub frame_ms: f64,
 }
@@ -379,14 +365,8 @@ fn measure_row(
         update_ms,
         lean_update_ms,
         copy_ms,
-        billboard_ms: d.billboard_ms,
-        splat_ms: d.splat_ms,
-        tiles_ms: d.tiles_ms,
-        tiles_stages_ms: d.tiles_stages_ms,
-        tiles_resolve_ms: d.tiles_resolve_ms,
-        composite_ms: d.composite_ms,
-        auto_path: d.auto_path,
         frame_ms: update_ms + draw + d.composite_ms,
+        draws: d,
     })
 }
 

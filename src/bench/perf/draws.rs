@@ -3,14 +3,25 @@
 
 use super::*;
 
-/// The draw paths' GPU times on one simulation (ms; `None` where a path was not timed).
-pub(super) struct DrawCosts {
+/// The draw paths' GPU times on one simulation.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct DrawCosts {
+    /// Billboard draw, ms (None when skipped).
     pub billboard_ms: Option<f64>,
+    /// Splat draw (clear + splat + resolve), ms.
     pub splat_ms: f64,
+    /// Tile draw (project, bin, shade and the resolve), ms (None when the quads do not
+    /// fit the device's tile buffers, or the device has no tile rasteriser).
     pub tiles_ms: Option<f64>,
+    /// The tile draw's project alone and project + bin, ms (the shade and resolve are the
+    /// rest of `tiles_ms`).
     pub tiles_stages_ms: Option<[f64; 2]>,
+    /// The tiles' resolve alone, ms: by compute (None where the adapter cannot; the tile
+    /// draw uses it where it can, as the editor does) and by a draw.
     pub tiles_resolve_ms: Option<(Option<f64>, f64)>,
+    /// Tonemap composite, ms.
     pub composite_ms: f64,
+    /// The path Auto picks for this scene.
     pub auto_path: &'static str,
 }
 

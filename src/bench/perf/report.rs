@@ -52,9 +52,11 @@ impl Tables {
 
     /// Row `side`² = `n` of the throughput and tile-stage tables and the JSON.
     pub(super) fn push_row(&mut self, side: u32, n: u64, row: &PerfRow) {
-        if let (Some(all), Some([project, bin]), Some((by_compute, by_draw))) =
-            (row.tiles_ms, row.tiles_stages_ms, row.tiles_resolve_ms)
-        {
+        if let (Some(all), Some([project, bin]), Some((by_compute, by_draw))) = (
+            row.draws.tiles_ms,
+            row.draws.tiles_stages_ms,
+            row.draws.tiles_resolve_ms,
+        ) {
             self.tile_table.push(vec![
                 format!("{side}² = {n}"),
                 format!("{project:.3}"),
@@ -78,12 +80,13 @@ impl Tables {
                 "{gbps:.3} GB/s ({:.0} % of the copy's {copy_gbps:.3})",
                 100.0 * row.copy_ms / row.lean_update_ms
             ),
-            row.billboard_ms
+            row.draws
+                .billboard_ms
                 .map_or("skipped".into(), |m| format!("{m:.3}")),
-            format!("{:.3}", row.splat_ms),
-            row.tiles_ms.map_or("—".into(), |m| format!("{m:.3}")),
-            format!("{:.3}", row.composite_ms),
-            format!("{:.3} ({})", row.frame_ms, row.auto_path),
+            format!("{:.3}", row.draws.splat_ms),
+            row.draws.tiles_ms.map_or("—".into(), |m| format!("{m:.3}")),
+            format!("{:.3}", row.draws.composite_ms),
+            format!("{:.3} ({})", row.frame_ms, row.draws.auto_path),
             format!("{fps:.0}"),
             thesis.map_or("—".into(), |t| format!("{t:.0} (ours: {:.2}×)", fps / t)),
             sci(n as f64 * fps),
