@@ -302,10 +302,7 @@ impl<'de> Visitor<'de> for Probe<'_, '_> {
 mod tests {
     use super::*;
 
-    const TEXT: &str = "// a preset\n(\n    version: 1,\n    name: \"x\",\n    emitters: [\n    \
-            (name: \"a\", rate: 5.0),\n        (\n            name: \"b\", // the second\n      \
-              shape: Disc(radius_m: -1e39, normal: (0.0, 1.0, 0.0)),\n            ramp: [(t: \
-        0.0), (t: 2.5)],\n            opt: Some(3),\n        ),\n    ],\n)\n";
+    const TEXT: &str = "// a preset\n(\n    version: 1,\n    name: \"x\",\n    emitters: [\n        (name: \"a\", rate: 5.0),\n        (\n            name: \"b\", // the second\n            shape: Disc(radius_m: -1e39, normal: (0.0, 1.0, 0.0)),\n            ramp: [(t: 0.0), (t: 2.5)],\n            opt: Some(3),\n        ),\n    ],\n)\n";
 
     fn at(path: &str) -> Option<(usize, usize, Option<String>)> {
         value_at(TEXT, path).map(|l| (l.pos.line, l.pos.column, l.literal))
