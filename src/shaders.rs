@@ -236,6 +236,10 @@ pub struct Composed {
 impl ShaderLibrary {
     /// The shaders compiled into the binary.
     pub fn embedded() -> Self {
+        #[cfg(feature = "mutants")]
+        if let Some(dir) = std::env::var_os("IGNIS_MUTANT_SHADERS") {
+            return Self::from_dir(PathBuf::from(dir));
+        }
         Self {
             source: ShaderSourceDir::Embedded,
             overrides: Vec::new(),

@@ -1,0 +1,215 @@
+#!/usr/bin/env python3
+"""Mutation testing of the WGSL in shaders/: which one-line shader mutations do the tests
+catch?
+
+Mutations are generated from the source, one per site, never picked by hand: arithmetic
+operators flipped (+ -, * /), comparisons inverted (< >=, > <=, == !=), logic swapped
+(&& ||), min/max swapped, and assignment statements dropped. Each mutant is a copy of
+shaders/ with one line changed; the test binaries (built once with the `mutants` feature,
+which makes `ShaderLibrary::embedded()` read IGNIS_MUTANT_SHADERS) run against it, no
+rebuild. A mutant is *caught* when a test fails or times out, *unviable* when the shader no
+longer validates (tests/shaders.rs's composition check fails), and *missed* otherwise.
+
+    cargo test --release --features mutants --no-run          # once
+    scripts/wgsl_mutants.py events.wgsl --jobs 4              # one shader
+    scripts/wgsl_mutants.py --all --jobs 12 --out bench/results/mutants
+
+The test binaries are found under target/release/deps (or --bins DIR). Which tests cover
+which shader is the table TESTS below.
+"""
+
+import argparse
+import concurrent.futures as futures
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+# Shader -> the tests that must catch its mutants: (test binary, name filter or None).
+TESTS = {
+    "events.wgsl": [("events", None), ("trails", "parent")],
+    "events_on.wgsl": [("events", None), ("trails", "parent")],
+    "trail.wgsl": [("trails", None)],
+    "trail_on.wgsl": [("trails", None)],
+    "tiles.wgsl": [("tiles", None)],
+    "tile_lists.wgsl": [("tiles", None)],
+    "splat.wgsl": [("rendering", "splat"), ("runtime", "splat"), ("tiles", "splat")],
+    "quad.wgsl": [("tiles", None), ("rendering", None)],
+    "integrators.wgsl": [("core_sim", None), ("stability", None)],
+    "tonemap.wgsl": [("rendering", None)],
+    "bloom.wgsl": [("rendering", None)],
+    "clear.wgsl": [("rendering", None)],
+}
+
+# The check that tells an unviable mutant (the shader no longer composes or validates).
+VALIDATE = ("shaders", "every_entry")
+
+SWAPS = [
+    (" + ", " - "), (" - ", " + "), (" * ", " / "), (" / ", " * "),
+    (" < ", " >= "), (" > ", " <= "), (" <= ", " > "), (" >= ", " < "),
+    (" == ", " != "), (" != ", " == "), (" && ", " || "), (" || ", " && "),
+    ("min(", "max("), ("max(", "min("),
+]
+
+ASSIGNMENT = re.compile(r"^\s*[A-Za-z_][\w.\[\]]*\s*(\+|-|\*|/)?=\s*[^=].*;\s*$")
+
+
+def code_part(line):
+    """The line without its trailing `//` comment."""
+    at = line.find("//")
+    return line if at < 0 else line[:at]
+
+
+def mutants_of(text):
+    """Every mutant of a shader's text: (line number, description, mutated text)."""
+    lines = text.split("\n")
+    out = []
+    for i, line in enumerate(lines):
+        code = code_part(line)
+        stripped = code.strip()
+        if not stripped or stripped.startswith(("#import", "@group", "@binding", "struct")):
+            continue
+        if re.match(r"^\s*(fn|@compute|@vertex|@fragment|override)\b", code):
+            continue
+        for old, new in SWAPS:
+            start = 0
+            while True:
+                at = code.find(old, start)
+                if at < 0:
+                    break
+                if old.strip() in "+-" and code[:at].rstrip().endswith(("(", ",", "=")):
+                    start = at + 1
+                    continue
+                mutated = line[:at] + new + line[at + len(old):]
+                out.append((i + 1, f"`{old.strip()}` → `{new.strip()}` at column {at + 1}",
+                            "\n".join(lines[:i] + [mutated] + lines[i + 1:])))
+                start = at + 1
+        if ASSIGNMENT.match(code) and not re.match(r"^\s*(let|var|const)\b", code):
+            out.append((i + 1, "statement dropped",
+                        "\n".join(lines[:i] + ["// (dropped)"] + lines[i + 1:])))
+    return out
+
+
+def find_bins(bins_dir):
+    """Test binary name -> path (the newest executable `name-<hash>`)."""
+    found = {}
+    for path in sorted(Path(bins_dir).glob("*-*"), key=lambda p: p.stat().st_mtime):
+        if path.suffix or not os.access(path, os.X_OK) or path.is_dir():
+            continue
+        found[path.name.rsplit("-", 1)[0]] = path
+    return found
+
+
+def run_tests(bins, tests, shader_dir, timeout):
+    """'failed', 'timeout' or 'passed' for the tests against the shaders in `shader_dir`."""
+    env = dict(os.environ, IGNIS_MUTANT_SHADERS=str(shader_dir))
+    for name, filt in tests:
+        cmd = [str(bins[name]), "--test-threads", "2"] + ([filt] if filt else [])
+        try:
+            r = subprocess.run(cmd, cwd=ROOT, env=env, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL, timeout=timeout)
+        except subprocess.TimeoutExpired:
+            return "timeout"
+        if r.returncode != 0:
+            return "failed"
+    return "passed"
+
+
+def judge(args, bins, shader, mutant):
+    line, what, text = mutant
+    with tempfile.TemporaryDirectory(prefix="wgsl-mutant-") as tmp:
+        copy = Path(tmp) / "shaders"
+        shutil.copytree(ROOT / "shaders", copy)
+        (copy / shader).write_text(text)
+        if run_tests(bins, [VALIDATE], copy, args.timeout) != "passed":
+            return (line, what, "unviable")
+        outcome = run_tests(bins, TESTS[shader], copy, args.timeout)
+    return (line, what, "missed" if outcome == "passed" else "caught")
+
+
+def baseline(args, bins, shaders):
+    """The tests must pass on the unmutated copy, or no mutant's outcome means anything."""
+    with tempfile.TemporaryDirectory(prefix="wgsl-baseline-") as tmp:
+        copy = Path(tmp) / "shaders"
+        shutil.copytree(ROOT / "shaders", copy)
+        tests = [VALIDATE] + sorted({t for s in shaders for t in TESTS[s]}, key=str)
+        for test in tests:
+            if run_tests(bins, [test], copy, args.timeout) != "passed":
+                sys.exit(f"the tests {test} fail on the unmutated shaders: fix them first")
+
+
+def report(shader, results, seconds):
+    viable = [r for r in results if r[2] != "unviable"]
+    caught = [r for r in viable if r[2] == "caught"]
+    missed = [r for r in viable if r[2] == "missed"]
+    score = 100.0 * len(caught) / max(1, len(viable))
+    lines = [
+        f"# WGSL mutants: `shaders/{shader}`",
+        "",
+        f"`scripts/wgsl_mutants.py {shader}` — tests: "
+        + ", ".join(f"`{b}`" + (f" ({f})" if f else "") for b, f in TESTS[shader])
+        + f"; {seconds:.0f} s.",
+        "",
+        "| mutants | unviable | caught | missed | score |",
+        "|---|---|---|---|---|",
+        f"| {len(results)} | {len(results) - len(viable)} | {len(caught)} | {len(missed)} "
+        f"| {score:.1f} % |",
+        "",
+    ]
+    if missed:
+        lines += ["## Missed", "", "| line | mutation |", "|---|---|"]
+        lines += [f"| {l} | {w} |" for l, w, _ in sorted(missed)]
+        lines.append("")
+    return "\n".join(lines), (len(results), len(viable), len(caught), score)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("shaders", nargs="*", help="shader file names (see TESTS)")
+    ap.add_argument("--all", action="store_true", help="every shader in TESTS")
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--timeout", type=float, default=300.0, help="seconds per test binary")
+    ap.add_argument("--bins", default=str(ROOT / "target/release/deps"))
+    ap.add_argument("--out", help="folder for one results file per shader")
+    ap.add_argument("--list", action="store_true", help="print the mutants and stop")
+    args = ap.parse_args()
+    shaders = list(TESTS) if args.all else args.shaders
+    unknown = [s for s in shaders if s not in TESTS]
+    if not shaders or unknown:
+        sys.exit(f"name shaders from: {', '.join(TESTS)} (unknown: {unknown})")
+    bins = find_bins(args.bins)
+    needed = {b for s in shaders for b, _ in TESTS[s]} | {VALIDATE[0]}
+    if not args.list and needed - set(bins):
+        sys.exit(f"test binaries missing in {args.bins}: {sorted(needed - set(bins))}; "
+                 "build them: cargo test --release --features mutants --no-run")
+    summary = []
+    if not args.list:
+        baseline(args, bins, shaders)
+    for shader in shaders:
+        mutants = mutants_of((ROOT / "shaders" / shader).read_text())
+        if args.list:
+            for line, what, _ in mutants:
+                print(f"{shader}:{line}: {what}")
+            continue
+        start = time.time()
+        with futures.ThreadPoolExecutor(args.jobs) as pool:
+            results = list(pool.map(lambda m: judge(args, bins, shader, m), mutants))
+        text, row = report(shader, results, time.time() - start)
+        print(text)
+        summary.append((shader, row))
+        if args.out:
+            out = Path(args.out)
+            out.mkdir(parents=True, exist_ok=True)
+            (out / f"wgsl-{shader.replace('.wgsl', '')}.md").write_text(text)
+    for shader, (n, viable, caught, score) in summary:
+        print(f"{shader}: {caught}/{viable} viable caught ({score:.1f} %), {n - viable} unviable")
+
+
+if __name__ == "__main__":
+    main()
