@@ -6,8 +6,8 @@
 use std::path::{Path, PathBuf};
 
 use super::ExportError;
+use super::export_settings::{AlphaMode, ExportSettings, Format};
 use super::frames::RawFrame;
-use super::settings::{AlphaMode, ExportSettings, Format};
 
 /// What turns a rendered frame into stored pixels and file names (shared by the
 /// writer's threads).

@@ -8,7 +8,7 @@ use crate::runtime::{Layers, Player};
 use crate::sim::gpu_sim::map_read;
 
 use super::ExportError;
-use super::settings::ExportSettings;
+use super::export_settings::ExportSettings;
 
 /// One rendered frame, linear and premultiplied, exposure applied.
 #[derive(Clone, Debug, Default)]

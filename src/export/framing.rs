@@ -6,7 +6,7 @@ use glam::{Mat4, Vec3};
 use crate::effect::Effect;
 use crate::render::{Camera, OrbitCamera};
 
-use super::settings::CameraMode;
+use super::export_settings::CameraMode;
 
 /// Particles kept per frame at most (every k-th one beyond).
 const PER_FRAME: usize = 20_000;

@@ -18,9 +18,9 @@
 
 pub mod cli;
 mod encode;
+mod export_settings;
 mod frames;
 mod framing;
-mod settings;
 mod sidecar;
 mod sixway_pass;
 mod writer;
@@ -32,7 +32,9 @@ use crate::gpu::GpuContext;
 use crate::runtime::{InstanceId, Player, PlayerError, PlayerSettings};
 
 pub use encode::{decode_motion, linear_to_srgb, srgb_to_linear};
-pub use settings::{AlphaMode, CameraMode, ExportSettings, Format, Layout, Passes, SIXWAY_PACKING};
+pub use export_settings::{
+    AlphaMode, CameraMode, ExportSettings, Format, Layout, Passes, SIXWAY_PACKING,
+};
 pub use sidecar::Sidecar;
 
 use frames::{FrameRenderer, RawFrame};

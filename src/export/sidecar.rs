@@ -4,7 +4,7 @@ use serde::Serialize;
 
 use crate::effect::Effect;
 
-use super::settings::{ExportSettings, Layout};
+use super::export_settings::{ExportSettings, Layout};
 
 /// How well a loop closes: mean colour difference (8-bit steps) of the last frame to the
 /// first, next to the median of consecutive frames.
@@ -115,7 +115,7 @@ impl Sidecar {
             sixway_packing: settings
                 .passes
                 .sixway
-                .then_some(super::settings::SIXWAY_PACKING),
+                .then_some(super::export_settings::SIXWAY_PACKING),
             motion_vector_scale,
             camera: settings.camera.name(),
             preset: effect.name.clone(),

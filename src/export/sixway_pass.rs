@@ -1,7 +1,7 @@
 //! The export's six-way passes: the alpha-blended (smoke) layers rendered seven more
 //! times — lit by a unit white light from each axis of the camera's frame (right, up,
 //! behind, left, down, front) with nothing else, then by their own glow alone — and
-//! packed as Unity's Six Way shader reads them (RTBA, LBFE: `settings::SIXWAY_PACKING`),
+//! packed as Unity's Six Way shader reads them (RTBA, LBFE: `export_settings::SIXWAY_PACKING`),
 //! so an engine relights the exported flipbook with its own lights.
 
 use glam::Vec3;

@@ -8,8 +8,8 @@ use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 
 use super::encode::{self, Encoder};
+use super::export_settings::{ExportSettings, Layout};
 use super::frames::RawFrame;
-use super::settings::{ExportSettings, Layout};
 use super::{ExportError, Sidecar};
 
 /// One output frame, converted.
