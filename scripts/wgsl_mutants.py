@@ -202,15 +202,24 @@ def main():
                 print(f"{shader}:{line}: {what}")
             continue
         start = time.time()
+        results = []
+        out = Path(args.out) if args.out else None
+        if out:
+            out.mkdir(parents=True, exist_ok=True)
+        path = out / f"wgsl-{shader.replace('.wgsl', '')}.md" if out else None
         with futures.ThreadPoolExecutor(args.jobs) as pool:
-            results = list(pool.map(lambda m: judge(args, bins, shader, m), mutants))
+            jobs = [pool.submit(judge, args, bins, shader, m) for m in mutants]
+            for job in futures.as_completed(jobs):
+                results.append(job.result())
+                if path and len(results) < len(mutants):
+                    # Progress on disk: a run cut short keeps what it judged.
+                    text, _ = report(shader, results, time.time() - start)
+                    path.write_text(f"{text}\n(partial: {len(results)} of {len(mutants)})\n")
         text, row = report(shader, results, time.time() - start)
         print(text)
         summary.append((shader, row))
-        if args.out:
-            out = Path(args.out)
-            out.mkdir(parents=True, exist_ok=True)
-            (out / f"wgsl-{shader.replace('.wgsl', '')}.md").write_text(text)
+        if path:
+            path.write_text(text)
     for shader, (n, viable, caught, score) in summary:
         print(f"{shader}: {caught}/{viable} viable caught ({score:.1f} %), {n - viable} unviable")
 
