@@ -71,12 +71,18 @@ fn gpu_matches_cpu_reference_for_every_integrator() {
 fn gpu_matches_cpu_reference_with_every_module() {
     use ignis::effect::*;
     let ctx = gpu();
-    // Each integrator, then two with every over-life multiplier on, one in each mode.
+    // Each integrator, then with every over-life multiplier on: the two-stage integrators
+    // (Verlet, Heun) evaluate their second acceleration at the predicted position,
+    // velocity, age and time, which the position-, velocity-, age- and time-dependent
+    // modules here all see.
     for (integrator, curves) in [
+        (Integrator::ExplicitEuler, false),
         (Integrator::SemiImplicitEuler, false),
         (Integrator::Rk4, false),
         (Integrator::Exponential, false),
         (Integrator::SemiImplicitEuler, true),
+        (Integrator::VelocityVerlet, true),
+        (Integrator::Heun, true),
         (Integrator::Exponential, true),
     ] {
         let mut e = Emitter {
