@@ -44,7 +44,7 @@ TESTS = {
     "splat.wgsl": [("rendering", "splat"), ("runtime", "splat"), ("tiles", "splat")],
     "quad.wgsl": [("tiles", None), ("rendering", "--skip render_command")],
     "integrators.wgsl": [("core_sim", None), ("stability", "--skip ignis_check")],
-    "tonemap.wgsl": [("rendering", "--skip render_command")],
+    "tonemap.wgsl": [("tonemap", None), ("rendering", "--skip render_command")],
     "bloom.wgsl": [("rendering", "--skip render_command")],
     "clear.wgsl": [("rendering", "--skip render_command")],
 }

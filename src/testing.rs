@@ -106,6 +106,11 @@ pub mod render {
         pub use crate::render::sprites::{SpriteLibrary, TRIM_THRESHOLD};
     }
 
+    /// The composite's tonemap.
+    pub mod tonemap {
+        pub use crate::render::tonemap::TonemapPass;
+    }
+
     /// The tile rasteriser's limits.
     pub mod tiles {
         pub use crate::render::tiles::STORAGE_BUFFERS_NEEDED;
