@@ -267,6 +267,45 @@ fn a_burst_that_dies_leaves_exactly_count_children() {
     }
 }
 
+/// A parent with two rules feeds two children, each exactly: every rule has its own
+/// records (a birth rule's two children and a death rule's three, per parent).
+#[test]
+fn two_rules_of_one_parent_keep_their_own_counts() {
+    let ctx = strict_gpu();
+    let mut effect = parent_and_child(
+        Event {
+            trigger: Trigger::Birth,
+            count: CountRange { min: 2, max: 2 },
+            ..Event::default()
+        },
+        0.0,
+    );
+    let mut second = effect.emitters[1].clone();
+    second.name = "second child".into();
+    effect.emitters.push(second);
+    let parent = &mut effect.emitters[0];
+    parent.events.push(Event {
+        emitter: "second child".into(),
+        count: CountRange { min: 3, max: 3 },
+        ..Event::default()
+    });
+    parent.bursts = vec![Burst {
+        time_secs: 0.0,
+        count: 40,
+    }];
+    parent.lifetime_secs = Range::new(0.5, 0.5);
+    effect.validate().expect("valid");
+    let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
+    sim.step(&effect, DT, 10).expect("step");
+    let alive = |sim: &GpuSim, e| alive_of(&sim.read_particles(e).expect("read"));
+    assert_eq!(alive(&sim, 1), 80, "born: two each");
+    assert_eq!(alive(&sim, 2), 0, "none dead yet");
+    sim.step(&effect, DT, 50).expect("step");
+    assert_eq!(alive(&sim, 0), 0);
+    assert_eq!(alive(&sim, 1), 80, "the birth rule fired once");
+    assert_eq!(alive(&sim, 2), 120, "died: three each");
+}
+
 /// Each trigger fires when it should: births (one child per parent born), over life
 /// (rate × life children per parent), collisions (an impact on the ground).
 #[test]
