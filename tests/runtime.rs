@@ -10,6 +10,8 @@ mod host;
 use glam::{DVec3, Mat4, Vec3, vec3};
 use host::{Frame, Host, HostKind, Quad, SIZE};
 use ignis::effect::{BlendMode, ColorStop, Effect, Sprite};
+use ignis::testing::shaders::ShaderLibrary;
+use ignis::testing::sim::{GpuSim, Stepper};
 use ignis::{Player, PlayerSettings};
 
 fn preset(name: &str) -> Effect {
@@ -363,13 +365,8 @@ fn a_batched_instance_steps_exactly_as_a_simulation_of_its_own() {
     // `from` (a clock's steps per frame depend on its history: it is replayed).
     let own = |id, from: u32, frames: u32| {
         let placed = player.instance_effect(id).expect("instance").clone();
-        let mut sim = ignis::testing::sim::GpuSim::new(
-            &ctx,
-            ignis::testing::shaders::ShaderLibrary::embedded(),
-            &placed,
-        )
-        .expect("sim");
-        let mut stepper = ignis::testing::sim::Stepper::default();
+        let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &placed).expect("sim");
+        let mut stepper = Stepper::default();
         for frame in 0..from + frames {
             let plan = stepper.advance(1.0 / 60.0, &placed.time);
             if frame >= from {
@@ -655,12 +652,7 @@ fn a_frame_runs_every_step_it_needs_beyond_one_chunk() {
                 "{label}, {steps_per_frame} steps a frame"
             );
             let placed = player.instance_effect(id).expect("instance").clone();
-            let mut sim = ignis::testing::sim::GpuSim::new(
-                &ctx,
-                ignis::testing::shaders::ShaderLibrary::embedded(),
-                &placed,
-            )
-            .expect("sim");
+            let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &placed).expect("sim");
             for _ in 0..frames {
                 sim.step(&placed, step, steps_per_frame).expect("step");
             }

@@ -8,6 +8,12 @@ use super::{
     MAX_CAPACITY, MAX_COLOR_STOPS, MAX_CURVE_KEYS, MAX_SPHERES, Param, Range, Shape, Sprite,
 };
 
+/// A state layout set together with `stateless` (which stores spawn records, not state).
+const STATELESS_CONFLICT: &str = concat!(
+    "cannot be combined with `stateless` (stateless emitters store spawn records, ",
+    "not state); turn one off"
+);
+
 /// A validation failure: the field path and what is wrong with its value.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error("{path} = {value}: {problem}")]
@@ -300,20 +306,10 @@ impl Emitter {
             );
         }
         if self.packed_state && self.stateless {
-            c.push(
-                p("packed_state"),
-                true,
-                "cannot be combined with `stateless` (stateless emitters store spawn records, \
-                    not state); turn one off",
-            );
+            c.push(p("packed_state"), true, STATELESS_CONFLICT);
         }
         if self.tiny_state && self.stateless {
-            c.push(
-                p("tiny_state"),
-                true,
-                "cannot be combined with `stateless` (stateless emitters store spawn records, \
-                    not state); turn one off",
-            );
+            c.push(p("tiny_state"), true, STATELESS_CONFLICT);
         }
         if self.tiny_state && self.packed_state {
             c.push(
