@@ -100,6 +100,28 @@ impl UndoHistory {
 mod tests {
     use super::*;
 
+    /// The history keeps the last `MAX_UNDO_STEPS` steps, the oldest dropped first, and
+    /// `reset` forgets every step.
+    #[test]
+    fn the_history_keeps_the_last_steps_and_reset_forgets_them() {
+        let mut effect = Effect::default_campfire();
+        let mut history = UndoHistory::new(&effect);
+        for k in 0..MAX_UNDO_STEPS + 10 {
+            effect.seed = 1000 + k as u32;
+            assert!(history.observe(&effect, false));
+            assert_eq!(history.undo_len(), (k + 1).min(MAX_UNDO_STEPS));
+        }
+        let mut undone = 0;
+        while history.undo(&mut effect) {
+            undone += 1;
+        }
+        assert_eq!(undone, MAX_UNDO_STEPS);
+        assert_eq!(effect.seed, 1009, "the ten oldest steps were dropped");
+        assert_eq!(history.redo_len(), MAX_UNDO_STEPS);
+        history.reset(&effect);
+        assert_eq!((history.undo_len(), history.redo_len()), (0, 0));
+    }
+
     #[test]
     fn one_gesture_is_one_step() {
         let mut effect = Effect::default_campfire();
