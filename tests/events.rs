@@ -743,13 +743,9 @@ fn inherited_colour_tints_the_children() {
         child.look.intensity = 0.5;
         child.look.draw_path = path;
         effect.validate().expect("valid");
-        let mut run =
-            ignis::testing::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
-                .expect("headless");
-        for _ in 0..30 {
-            run.advance(1.0 / 60.0);
-        }
-        let image = run.render((160, 120)).expect("render");
+        let image = headless_after(&ctx, effect, 30)
+            .render((160, 120))
+            .expect("render");
         let mut sum = [0.0f64; 3];
         for p in image.pixels() {
             for c in 0..3 {

@@ -6,7 +6,7 @@ mod common;
 
 use std::path::Path;
 
-use common::gpu;
+use common::{gpu, run_ok};
 use ignis::effect::Effect;
 use ignis::export::{AlphaMode, CameraMode, ExportSettings, Format, Layout, Passes};
 
@@ -485,23 +485,11 @@ fn exports_are_byte_identical() {
 #[test]
 fn the_export_command_writes_a_flipbook_and_refuses_bad_settings() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_ignis"))
-        .args([
-            "export",
-            "presets/torch.ron",
-            "--flipbook",
-            "4x2",
-            "--frame-size",
-            "32x32",
-        ])
-        .args(["--passes", "color,motion", "--out"])
-        .arg(dir.path())
-        .output()
-        .expect("run ignis");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    run_ok(
+        std::process::Command::new(env!("CARGO_BIN_EXE_ignis"))
+            .args(["export", "presets/torch.ron", "--flipbook", "4x2"])
+            .args(["--frame-size", "32x32", "--passes", "color,motion", "--out"])
+            .arg(dir.path()),
     );
     let json = std::fs::read_to_string(dir.path().join("torch.json")).expect("sidecar");
     let v: serde_json::Value = serde_json::from_str(&json).expect("json");

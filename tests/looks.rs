@@ -70,28 +70,14 @@ fn probe(ctx: &GpuContext, look: &Look, inputs: &[[f32; 4]]) -> Vec<([f32; 3], [
 
 /// The look's colour ramp and its two curve rows, as the frame's ramp texture holds them.
 fn ramp_texture(ctx: &GpuContext, look: &Look) -> wgpu::Texture {
-    let d = &ctx.device;
     let mut ramp = bake_ramp(&look.color_over_life);
     let [a, b] = bake_look_curves(look);
     ramp.extend(a);
     ramp.extend(b);
-    d.create_texture_with_data(
-        &ctx.queue,
-        &wgpu::TextureDescriptor {
-            label: None,
-            size: wgpu::Extent3d {
-                width: RAMP_WIDTH,
-                height: 3,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        },
-        wgpu::util::TextureDataOrder::LayerMajor,
+    common::texture_with(
+        ctx,
+        (RAMP_WIDTH, 3),
+        wgpu::TextureFormat::Rgba32Float,
         bytemuck::cast_slice(&ramp),
     )
 }

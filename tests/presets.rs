@@ -1061,16 +1061,10 @@ fn saved_text_is_readable() {
 /// and field of a broken preset.
 #[test]
 fn check_command_validates_the_library_and_reports_located_errors() {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_ignis"))
-        .arg("check")
-        .arg(presets_dir())
-        .output()
-        .expect("run ignis");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
+    let stdout = run_ok(
+        std::process::Command::new(env!("CARGO_BIN_EXE_ignis"))
+            .arg("check")
+            .arg(presets_dir()),
     );
     let count = preset::list(&presets_dir()).len();
     assert!(

@@ -3,6 +3,8 @@
 //! item, or one that went missing, fails here; after deciding it belongs, update the file
 //! with `IGNIS_UPDATE_API=1 cargo test --release --test public_api`.
 
+mod common;
+
 use std::path::Path;
 
 /// The documented items of `all.html` (rustdoc's list of every public item), one
@@ -40,23 +42,13 @@ fn the_runtime_api_is_the_committed_list() {
     // A target of its own: the tests' own build holds the usual one.
     let target = root.join("target").join("api-doc");
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let out = std::process::Command::new(cargo)
-        .current_dir(root)
-        .args([
-            "doc",
-            "--offline",
-            "--locked",
-            "--no-deps",
-            "--no-default-features",
-        ])
-        .env("CARGO_TARGET_DIR", &target)
-        .env_remove("RUSTDOCFLAGS")
-        .output()
-        .expect("cargo runs");
-    assert!(
-        out.status.success(),
-        "cargo doc failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
+    common::run_ok(
+        std::process::Command::new(cargo)
+            .current_dir(root)
+            .args(["doc", "--offline", "--locked", "--no-deps"])
+            .arg("--no-default-features")
+            .env("CARGO_TARGET_DIR", &target)
+            .env_remove("RUSTDOCFLAGS"),
     );
     let html = std::fs::read_to_string(target.join("doc/ignis/all.html")).expect("all.html");
     let items = items_of(&html);

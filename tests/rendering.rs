@@ -160,18 +160,11 @@ fn deterministic_frames_for_a_seed() {
 #[test]
 fn render_command_writes_pngs() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_ignis"))
-        .args([
-            "render", "--frames", "5", "--size", "160x120", "--fps", "30", "--out",
-        ])
-        .arg(dir.path())
-        .output()
-        .expect("run ignis");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "ignis render failed: {}",
-        String::from_utf8_lossy(&out.stderr)
+    let stdout = run_ok(
+        std::process::Command::new(env!("CARGO_BIN_EXE_ignis"))
+            .args(["render", "--frames", "5", "--size", "160x120"])
+            .args(["--fps", "30", "--out"])
+            .arg(dir.path()),
     );
     assert!(stdout.contains("rendered 5 frames"), "{stdout}");
     for f in 0..5 {

@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::gpu;
+use common::{gpu, run_ok};
 use ignis::testing::headless::Headless;
 use ignis::testing::shaders::ShaderLibrary;
 
@@ -86,16 +86,11 @@ fn seeking_gives_the_played_state_bit_for_bit_for_every_shipped_preset() {
 fn render_start_writes_the_frame_a_full_render_writes_then() {
     let dir = tempfile::tempdir().expect("temp dir");
     let run = |out: &str, extra: &[&str]| {
-        let status = std::process::Command::new(env!("CARGO_BIN_EXE_ignis"))
-            .args(["render", "--size", "160x120", "--out"])
-            .arg(dir.path().join(out))
-            .args(extra)
-            .output()
-            .expect("running ignis render");
-        assert!(
-            status.status.success(),
-            "ignis render {extra:?}: {}",
-            String::from_utf8_lossy(&status.stderr)
+        run_ok(
+            std::process::Command::new(env!("CARGO_BIN_EXE_ignis"))
+                .args(["render", "--size", "160x120", "--out"])
+                .arg(dir.path().join(out))
+                .args(extra),
         );
     };
     run("full", &["--frames", "121"]);

@@ -233,12 +233,7 @@ fn far_from_the_origin_motion_still_resolves() {
     }
     shift(&mut far.camera.target_m);
     let run = |effect: Effect| {
-        let mut h =
-            ignis::testing::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
-                .expect("headless");
-        for _ in 0..60 {
-            h.advance(1.0 / 60.0);
-        }
+        let mut h = headless_after(&ctx, effect, 60);
         let img = h.render((160, 120)).expect("render");
         let state: Vec<Vec<Particle>> = (0..3)
             .map(|i| h.player.particles(h.instance, i).expect("read"))

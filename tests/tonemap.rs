@@ -29,7 +29,6 @@ fn srgb(x: f32) -> f32 {
 
 /// A W×H Rgba16Float texture whose pixel (x, y) holds `f(x, y)` in RGB, alpha 1.
 fn hdr_texture(ctx: &GpuContext, f: impl Fn(u32, u32) -> [f32; 3]) -> wgpu::TextureView {
-    use wgpu::util::DeviceExt;
     let mut data = Vec::new();
     for y in 0..H {
         for x in 0..W {
@@ -37,23 +36,10 @@ fn hdr_texture(ctx: &GpuContext, f: impl Fn(u32, u32) -> [f32; 3]) -> wgpu::Text
             data.extend([r, g, b, 1.0].map(f16::from_f32));
         }
     }
-    let texture = ctx.device.create_texture_with_data(
-        &ctx.queue,
-        &wgpu::TextureDescriptor {
-            label: Some("tonemap test layer"),
-            size: wgpu::Extent3d {
-                width: W,
-                height: H,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba16Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        },
-        wgpu::util::TextureDataOrder::LayerMajor,
+    let texture = common::texture_with(
+        ctx,
+        (W, H),
+        wgpu::TextureFormat::Rgba16Float,
         bytemuck::cast_slice(&data),
     );
     texture.create_view(&Default::default())

@@ -200,24 +200,9 @@ fn begin_clear_pass<'a>(
     view: &'a wgpu::TextureView,
     b: [f32; 3],
 ) -> wgpu::RenderPass<'a> {
-    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some("Export::background"),
-        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-            view,
-            depth_slice: None,
-            resolve_target: None,
-            ops: wgpu::Operations {
-                load: wgpu::LoadOp::Clear(wgpu::Color {
-                    r: f64::from(b[0]),
-                    g: f64::from(b[1]),
-                    b: f64::from(b[2]),
-                    a: 1.0,
-                }),
-                store: wgpu::StoreOp::Store,
-            },
-        })],
-        ..Default::default()
-    })
+    let [r, g, b] = b.map(f64::from);
+    let clear = wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 });
+    crate::gpu::color_pass(enc, view, clear, "Export::background")
 }
 
 /// An `Rgba16Float` or `Rgba32Float` readback's texels as f32.

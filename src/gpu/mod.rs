@@ -28,6 +28,29 @@ pub fn compute_pass<'p>(
     })
 }
 
+/// A render pass (labelled `label`) over one colour target that starts with `load` (a
+/// clear, or what the target holds) and stores what it draws; no depth.
+pub fn color_pass<'a>(
+    enc: &'a mut wgpu::CommandEncoder,
+    view: &'a wgpu::TextureView,
+    load: wgpu::LoadOp<wgpu::Color>,
+    label: &str,
+) -> wgpu::RenderPass<'a> {
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load,
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        ..Default::default()
+    })
+}
+
 /// A 2-D depth texture binding (a host's depth, sampled with `textureLoad`).
 pub fn depth_texture_entry(
     binding: u32,

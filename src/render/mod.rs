@@ -187,7 +187,8 @@ pub fn begin_hdr_pass<'a>(
     enc: &'a mut wgpu::CommandEncoder,
     hdr: &'a wgpu::TextureView,
 ) -> wgpu::RenderPass<'a> {
-    hdr_pass(enc, hdr, wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT))
+    let clear = wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT);
+    crate::gpu::color_pass(enc, hdr, clear, "Renderer::hdr_pass")
 }
 
 /// A render pass into an HDR target that keeps what it holds (cleared by
@@ -196,28 +197,5 @@ pub fn load_hdr_pass<'a>(
     enc: &'a mut wgpu::CommandEncoder,
     hdr: &'a wgpu::TextureView,
 ) -> wgpu::RenderPass<'a> {
-    hdr_pass(enc, hdr, wgpu::LoadOp::Load)
-}
-
-fn hdr_pass<'a>(
-    enc: &'a mut wgpu::CommandEncoder,
-    hdr: &'a wgpu::TextureView,
-    load: wgpu::LoadOp<wgpu::Color>,
-) -> wgpu::RenderPass<'a> {
-    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some("Renderer::hdr_pass"),
-        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-            view: hdr,
-            depth_slice: None,
-            resolve_target: None,
-            ops: wgpu::Operations {
-                load,
-                store: wgpu::StoreOp::Store,
-            },
-        })],
-        depth_stencil_attachment: None,
-        timestamp_writes: None,
-        occlusion_query_set: None,
-        multiview_mask: None,
-    })
+    crate::gpu::color_pass(enc, hdr, wgpu::LoadOp::Load, "Renderer::hdr_pass")
 }

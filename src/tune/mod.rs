@@ -14,7 +14,7 @@ pub mod cli;
 mod frontier;
 mod image_error;
 mod report;
-mod svg;
+pub(crate) mod svg;
 mod sweep;
 
 pub use candidate::{

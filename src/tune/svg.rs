@@ -76,11 +76,23 @@ fn draw<'a>(r: &TuneReport, out: &'a mut String) -> Result<(), Box<dyn std::erro
             .label(name)
             .legend(move |(x, y)| Circle::new((x + 8, y), 6, color.stroke_width(2)));
     }
+    legend_and_present(&mut chart, &root)?;
+    Ok(())
+}
+
+/// The charts' log-log axes.
+pub(crate) type LogLog = Cartesian2d<LogCoord<f64>, LogCoord<f64>>;
+
+/// Draws the legend (white box, black border) of a log-log SVG chart and finishes the
+/// image.
+pub(crate) fn legend_and_present<'a, 'b: 'a>(
+    chart: &mut ChartContext<'a, SVGBackend<'b>, LogLog>,
+    root: &DrawingArea<SVGBackend<'b>, plotters::coord::Shift>,
+) -> Result<(), DrawingAreaErrorKind<std::io::Error>> {
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .draw()?;
-    root.present()?;
-    Ok(())
+    root.present()
 }

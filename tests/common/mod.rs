@@ -181,3 +181,60 @@ pub fn flat_maps(dir: &std::path::Path) -> ignis::effect::SixWayMaps {
         lbfe: write("flat_lbfe.png", FLAT_LBFE),
     }
 }
+
+/// Runs `cmd` to completion and fails the test, with its stderr, unless it succeeded.
+/// Returns its stdout.
+pub fn run_ok(cmd: &mut std::process::Command) -> String {
+    let out = cmd
+        .output()
+        .unwrap_or_else(|e| panic!("running {cmd:?}: {e}"));
+    assert!(
+        out.status.success(),
+        "{cmd:?} failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// A headless run of `effect` advanced `steps` fixed 60 Hz steps.
+pub fn headless_after(
+    ctx: &GpuContext,
+    effect: Effect,
+    steps: u32,
+) -> ignis::testing::headless::Headless {
+    let mut run = ignis::testing::headless::Headless::new(ctx, effect, ShaderLibrary::embedded())
+        .expect("headless");
+    for _ in 0..steps {
+        run.advance(1.0 / 60.0);
+    }
+    run
+}
+
+/// A 2D sampled texture of `format` holding `bytes` (one mip, tightly packed rows).
+pub fn texture_with(
+    ctx: &GpuContext,
+    (width, height): (u32, u32),
+    format: wgpu::TextureFormat,
+    bytes: &[u8],
+) -> wgpu::Texture {
+    use wgpu::util::DeviceExt;
+    ctx.device.create_texture_with_data(
+        &ctx.queue,
+        &wgpu::TextureDescriptor {
+            label: Some("test texture"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        bytes,
+    )
+}

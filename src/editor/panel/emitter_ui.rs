@@ -44,27 +44,14 @@ fn emitter_fields_ui(ui: &mut Ui, e: &mut Emitter) {
             "Max spawn / s",
             "At most this many continuous spawns per second of simulated time, at any step size \
                 (clips a rate curve's peaks; bursts are not capped). 0 = no cap",
-            |ui| {
-                ui.add(
-                    DragValue::new(&mut e.max_spawn_per_sec)
-                        .range(0.0..=1e9)
-                        .speed(10.0),
-                )
-            },
+            |ui| ui.add(drag(&mut e.max_spawn_per_sec, 0.0..=1e9, 10.0, "")),
         );
         row_ui(
             ui,
             "Capacity",
             "Particle slots in this emitter's ring. Keep it above rate × max lifetime, or \
                 living particles are recycled. Changing it keeps the particles that fit",
-            |ui| {
-                ui.add(
-                    DragValue::new(&mut e.capacity)
-                        .range(1..=UI_MAX_CAPACITY)
-                        .speed(16.0)
-                        .suffix(" slots"),
-                )
-            },
+            |ui| ui.add(drag(&mut e.capacity, 1..=UI_MAX_CAPACITY, 16.0, " slots")),
         );
         let needed = e.spawn_rate_per_sec.bounds().1 * e.lifetime_secs.max;
         if needed > e.capacity as f32 * 1.02 {
@@ -370,12 +357,7 @@ fn bursts_ui(ui: &mut Ui, bursts: &mut Vec<Burst>) {
                     .prefix("at ")
                     .min_decimals(2),
             );
-            ui.add(
-                DragValue::new(&mut b.count)
-                    .range(0..=UI_MAX_CAPACITY)
-                    .speed(1.0)
-                    .suffix(" particles"),
-            );
+            ui.add(drag(&mut b.count, 0..=UI_MAX_CAPACITY, 1.0, " particles"));
             if ui
                 .small_button("x")
                 .on_hover_text("Remove this burst")

@@ -9,6 +9,8 @@ use crate::effect::{
     CountRange, Effect, Event, MAX_CHILDREN_PER_EVENT, MAX_EVENTS_PER_EMITTER, Trigger,
 };
 
+use crate::editor::panel::drag;
+
 /// The Events section of emitter `selected`.
 pub fn events_ui(ui: &mut Ui, effect: &mut Effect, selected: usize) {
     let others: Vec<String> = effect
@@ -102,13 +104,8 @@ fn event_grid_ui(ui: &mut Ui, ev: &mut Event, others: &[String]) {
                 let label = ui
                     .label("Rate")
                     .on_hover_text("Children per second per living particle");
-                ui.add(
-                    DragValue::new(&mut ev.rate_per_sec)
-                        .range(0.0..=1000.0)
-                        .speed(0.1)
-                        .suffix(" /s"),
-                )
-                .labelled_by(label.id);
+                ui.add(drag(&mut ev.rate_per_sec, 0.0..=1000.0, 0.1, " /s"))
+                    .labelled_by(label.id);
             } else {
                 let label = ui
                     .label("Count")
@@ -122,25 +119,16 @@ fn event_grid_ui(ui: &mut Ui, ev: &mut Event, others: &[String]) {
                 let label = ui
                     .label("Chance")
                     .on_hover_text("The chance that an event spawns at all (1 = every event)");
-                ui.add(
-                    DragValue::new(&mut ev.probability)
-                        .range(0.0..=1.0)
-                        .speed(0.002)
-                        .max_decimals(3),
-                )
-                .labelled_by(label.id);
+                ui.add(drag(&mut ev.probability, 0.0..=1.0, 0.002, "").max_decimals(3))
+                    .labelled_by(label.id);
             }
             ui.end_row();
             let label = ui.label("Inherit velocity").on_hover_text(
                 "The fraction of the \
                 parent's velocity a child starts with, on top of its own spawn speed",
             );
-            ui.add(
-                DragValue::new(&mut ev.inherit_velocity)
-                    .range(-10.0..=10.0)
-                    .speed(0.01),
-            )
-            .labelled_by(label.id);
+            ui.add(drag(&mut ev.inherit_velocity, -10.0..=10.0, 0.01, ""))
+                .labelled_by(label.id);
             ui.end_row();
             ui.label("Inherit colour").on_hover_text(
                 "Multiply the child's colour by the \
@@ -153,12 +141,8 @@ fn event_grid_ui(ui: &mut Ui, ev: &mut Event, others: &[String]) {
                 second of simulated time, at any step size; the rest are dropped and counted in \
                 Stats",
             );
-            ui.add(
-                DragValue::new(&mut ev.max_per_sec)
-                    .range(1.0..=1e8)
-                    .speed(10.0),
-            )
-            .labelled_by(label.id);
+            ui.add(drag(&mut ev.max_per_sec, 1.0..=1e8, 10.0, ""))
+                .labelled_by(label.id);
             ui.end_row();
         });
 }

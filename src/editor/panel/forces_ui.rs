@@ -1,7 +1,7 @@
 //! The panel's Forces section: gravity, buoyancy, drag and wind, the optional force
 //! modules and the collisions.
 
-use egui::{DragValue, RichText, Ui};
+use egui::{RichText, Ui};
 
 use crate::effect::{
     Attractor, Collisions, Effect, Falloff, FlamePull, Gusts, MAX_SPHERES, SphereCollider,
@@ -185,7 +185,7 @@ fn turbulence_ui(ui: &mut Ui, t: &mut Turbulence) {
         ui,
         "Octaves",
         "Each octave doubles the frequency and halves the amplitude",
-        |ui| ui.add(DragValue::new(&mut t.octaves).range(1..=4).speed(0.05)),
+        |ui| ui.add(drag(&mut t.octaves, 1..=4, 0.05, "")),
     );
     row_ui(
         ui,

@@ -5,7 +5,7 @@ use egui::{DragValue, Ui};
 
 use crate::effect::{BlendMode, Lighting, Lit, Look, SixWayMaps};
 
-use crate::editor::panel::{grid, row_ui};
+use crate::editor::panel::{drag, grid, row_ui};
 
 /// The preset's sun (a direction from its height and bearing, a colour and a strength)
 /// and its ambient light.
@@ -157,25 +157,13 @@ pub fn lit_rows_ui(ui: &mut Ui, look: &mut Look) {
         "Glow",
         "How much of the colour over life the smoke emits itself, where the maps' emissive mask \
             says (embers in the smoke)",
-        |ui| {
-            ui.add(
-                DragValue::new(&mut lit.emission)
-                    .range(0.0..=100.0)
-                    .speed(0.01),
-            )
-        },
+        |ui| ui.add(drag(&mut lit.emission, 0.0..=100.0, 0.01, "")),
     );
     row_ui(
         ui,
         "Fire light",
         "How strongly the effect's own light (its additive layers, measured each frame) lights \
             this layer: 1 = its power over the squared distance",
-        |ui| {
-            ui.add(
-                DragValue::new(&mut lit.self_light)
-                    .range(0.0..=100.0)
-                    .speed(0.01),
-            )
-        },
+        |ui| ui.add(drag(&mut lit.self_light, 0.0..=100.0, 0.01, "")),
     );
 }

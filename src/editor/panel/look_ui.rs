@@ -10,6 +10,7 @@ use crate::effect::{
 pub use crate::render::look_bake::sample_gradient;
 
 use crate::editor::panel::curve_editor::{ParamSpec, param_row};
+use crate::editor::panel::drag;
 use crate::editor::state::ViewSettings;
 
 /// The size parameter's editor: metres over normalised age.
@@ -121,22 +122,14 @@ fn post_ui(ui: &mut Ui, post: &mut Post) {
         let label = ui
             .label("Bloom threshold")
             .on_hover_text("HDR brightness where the glow starts");
-        ui.add(
-            DragValue::new(&mut b.threshold)
-                .range(0.0..=100.0)
-                .speed(0.01),
-        )
-        .labelled_by(label.id);
+        ui.add(drag(&mut b.threshold, 0.0..=100.0, 0.01, ""))
+            .labelled_by(label.id);
         ui.end_row();
         let label = ui
             .label("Bloom intensity")
             .on_hover_text("How much blurred light is added");
-        ui.add(
-            DragValue::new(&mut b.intensity)
-                .range(0.0..=10.0)
-                .speed(0.01),
-        )
-        .labelled_by(label.id);
+        ui.add(drag(&mut b.intensity, 0.0..=10.0, 0.01, ""))
+            .labelled_by(label.id);
         ui.end_row();
         let label = ui
             .label("Bloom levels")
@@ -175,14 +168,8 @@ pub fn look_fields_ui(ui: &mut Ui, look: &mut Look) {
             let label = ui
                 .label("Rotation")
                 .on_hover_text("Random initial rotation spread, degrees");
-            ui.add(
-                DragValue::new(&mut look.rotation_random_deg)
-                    .range(0.0..=360.0)
-                    .speed(1.0)
-                    .prefix("random ")
-                    .suffix("°"),
-            )
-            .labelled_by(label.id);
+            ui.add(drag(&mut look.rotation_random_deg, 0.0..=360.0, 1.0, "°").prefix("random "))
+                .labelled_by(label.id);
             ui.end_row();
             param_row(
                 ui,
@@ -255,21 +242,10 @@ fn streak_row_ui(ui: &mut Ui, look: &mut Look) {
             look.streak = on.then(Streak::default);
         }
         if let Some(s) = &mut look.streak {
-            ui.add(
-                DragValue::new(&mut s.length_secs)
-                    .range(0.0..=1.0)
-                    .speed(0.001)
-                    .suffix(" s"),
-            )
-            .labelled_by(label.id);
-            ui.add(
-                DragValue::new(&mut s.max_length_m)
-                    .range(0.0..=100.0)
-                    .speed(0.01)
-                    .prefix("≤ ")
-                    .suffix(" m"),
-            )
-            .labelled_by(label.id);
+            ui.add(drag(&mut s.length_secs, 0.0..=1.0, 0.001, " s"))
+                .labelled_by(label.id);
+            ui.add(drag(&mut s.max_length_m, 0.0..=100.0, 0.01, " m").prefix("≤ "))
+                .labelled_by(label.id);
         }
     });
     ui.end_row();
@@ -282,24 +258,14 @@ fn brightness_rows_ui(ui: &mut Ui, look: &mut Look) {
             emitter's ground collider, else y = 0) instead of cutting them: soft \
             particles. 0 = off",
     );
-    ui.add(
-        DragValue::new(&mut look.soft_ground_m)
-            .range(0.0..=10.0)
-            .speed(0.002)
-            .suffix(" m"),
-    )
-    .labelled_by(label.id);
+    ui.add(drag(&mut look.soft_ground_m, 0.0..=10.0, 0.002, " m"))
+        .labelled_by(label.id);
     ui.end_row();
     let label = ui
         .label("Intensity")
         .on_hover_text("Multiplies the colour: HDR brightness before exposure and tonemap");
-    ui.add(
-        DragValue::new(&mut look.intensity)
-            .range(0.0..=1000.0)
-            .speed(0.01)
-            .min_decimals(2),
-    )
-    .labelled_by(label.id);
+    ui.add(drag(&mut look.intensity, 0.0..=1000.0, 0.01, "").min_decimals(2))
+        .labelled_by(label.id);
     ui.end_row();
 }
 
@@ -349,14 +315,8 @@ fn trail_points_row_ui(ui: &mut Ui, t: &mut Trail) {
                 .prefix("points "),
         )
         .labelled_by(label.id);
-        ui.add(
-            DragValue::new(&mut t.length_secs)
-                .range(1e-3..=60.0)
-                .speed(0.005)
-                .prefix("over ")
-                .suffix(" s"),
-        )
-        .labelled_by(label.id);
+        ui.add(drag(&mut t.length_secs, 1e-3..=60.0, 0.005, " s").prefix("over "))
+            .labelled_by(label.id);
     });
     ui.end_row();
 }
@@ -371,27 +331,12 @@ fn trail_width_rows_ui(ui: &mut Ui, look: &mut Look) {
             fractions of it; sprite: draw the particle's sprite too",
     );
     ui.horizontal(|ui| {
-        ui.add(
-            DragValue::new(&mut t.width)
-                .range(0.0..=100.0)
-                .speed(0.01)
-                .suffix("×"),
-        )
-        .labelled_by(label.id);
-        ui.add(
-            DragValue::new(&mut t.tail_width)
-                .range(0.0..=1.0)
-                .speed(0.01)
-                .prefix("tail "),
-        )
-        .labelled_by(label.id);
-        ui.add(
-            DragValue::new(&mut t.tail_opacity)
-                .range(0.0..=1.0)
-                .speed(0.01)
-                .prefix("fade "),
-        )
-        .labelled_by(label.id);
+        ui.add(drag(&mut t.width, 0.0..=100.0, 0.01, "×"))
+            .labelled_by(label.id);
+        ui.add(drag(&mut t.tail_width, 0.0..=1.0, 0.01, "").prefix("tail "))
+            .labelled_by(label.id);
+        ui.add(drag(&mut t.tail_opacity, 0.0..=1.0, 0.01, "").prefix("fade "))
+            .labelled_by(label.id);
         ui.checkbox(&mut t.draw_sprite, "sprite");
     });
     ui.end_row();
@@ -758,15 +703,10 @@ mod tests {
 
     #[test]
     fn add_stop_keeps_the_list_sorted_and_the_colour() {
+        let stop = |t, rgba| ColorStop { t, rgba };
         let mut stops = vec![
-            ColorStop {
-                t: 0.0,
-                rgba: [1.0, 0.0, 0.0, 1.0],
-            },
-            ColorStop {
-                t: 1.0,
-                rgba: [0.0, 0.0, 1.0, 0.0],
-            },
+            stop(0.0, [1.0, 0.0, 0.0, 1.0]),
+            stop(1.0, [0.0, 0.0, 1.0, 0.0]),
         ];
         add_stop(&mut stops);
         assert_eq!(stops.len(), 3);

@@ -459,10 +459,10 @@ pub(crate) fn multiplier(name: &'static str) -> ParamSpec {
     }
 }
 
-/// A float drag value clamped to `range`.
-pub(crate) fn drag<'a>(
-    v: &'a mut f32,
-    range: RangeInclusive<f32>,
+/// A drag value clamped to `range`, shown with at most four decimals.
+pub(crate) fn drag<'a, N: egui::emath::Numeric>(
+    v: &'a mut N,
+    range: RangeInclusive<N>,
     speed: f64,
     suffix: &str,
 ) -> DragValue<'a> {

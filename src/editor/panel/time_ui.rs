@@ -1,7 +1,7 @@
 //! The panel's Time section: the step mode, the integrator, each emitter's stability at
 //! its step, and "Measure this effect" (`measure_ui.rs`).
 
-use egui::{Color32, DragValue, Ui};
+use egui::{Color32, Ui};
 
 use crate::effect::{Effect, Integrator, TimeMode};
 
@@ -54,14 +54,7 @@ pub fn time_ui(
             "Max substeps",
             "At most this many fixed steps per frame; the rest of the time is dropped and \
                 counted (Stats)",
-            |ui| {
-                ui.add_enabled(
-                    is_fixed,
-                    DragValue::new(&mut t.max_substeps)
-                        .range(1..=256)
-                        .speed(0.1),
-                )
-            },
+            |ui| ui.add_enabled(is_fixed, drag(&mut t.max_substeps, 1..=256, 0.1, "")),
         );
         row_ui(
             ui,

@@ -115,24 +115,8 @@ impl UiPainter {
         screen: &egui_wgpu::ScreenDescriptor,
         load: wgpu::LoadOp<wgpu::Color>,
     ) {
-        let mut pass = encoder
-            .begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("UiPainter::paint"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: target,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load,
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            })
-            .forget_lifetime();
+        let mut pass =
+            crate::gpu::color_pass(encoder, target, load, "UiPainter::paint").forget_lifetime();
         self.render(&mut pass, paint_jobs, screen);
     }
 
