@@ -67,7 +67,8 @@ struct SimParams {
     collide_b: vec4<f32>,
     // Sphere colliders: xyz centre (m), w radius (m).
     spheres: array<vec4<f32>, 4>,
-    // x: stick on contact (0/1): the particle stops where it touches, yzw: unused.
+    // x: stick on contact (0/1): the particle stops where it touches, y: depth
+    // collision's surface thickness (m), z: kill on depth contact (0/1), w: unused.
     collide_c: vec4<f32>,
     // x: first slot this step updates, y: how many (wrapping at the capacity): the ring's
     // live window plus this step's spawns; every other slot is dead in both buffers.

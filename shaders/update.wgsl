@@ -39,6 +39,9 @@
 #import "spawn.wgsl"
 #import "integrators.wgsl"
 #import "collide.wgsl"
+// Depth collision: depth_off.wgsl (nothing) unless the emitter collides with the host's
+// depth buffer (depth_on.wgsl, group 2).
+#import "depth_off.wgsl"
 #import "alive_count.wgsl"
 #import "curves.wgsl"
 // The event hooks: events_off.wgsl (no code, no bindings) unless the emitter has events or
@@ -54,6 +57,7 @@
 override MOD_STATELESS: bool = false;
 override COUNT_ALIVE: bool = true;
 override MOD_CURVES: bool = false;
+override MOD_DEPTH_COLLISION: bool = false;
 
 // This particle's multipliers for the step: x displacement (speed), y drag (linear and
 // quadratic), z turbulence, w flame pull. All 1 unless MOD_CURVES.
@@ -232,6 +236,14 @@ fn update_at(slot: u32) -> bool {
             hit = c.hit;
             if c.killed {
                 // Killed on contact: dead, and its age says so.
+                age = life;
+            }
+        }
+        if MOD_DEPTH_COLLISION && age < life {
+            let c = depth_collide(p.pos_age.xyz, s.pos, s.vel);
+            s = State(c.pos, c.vel);
+            hit = hit || c.hit;
+            if c.killed {
                 age = life;
             }
         }

@@ -20,8 +20,8 @@ pub(crate) use curve::{CURVE_WIDTH, bake_rows, lookup_blend, rows_key};
 pub use curve::{Curve, MAX_CURVE_KEYS, Param, ParamMode, SHAPES};
 pub use events::{CountRange, Event, MAX_CHILDREN_PER_EVENT, MAX_EVENTS_PER_EMITTER, Trigger};
 pub use forces::{
-    Attractor, Collisions, Falloff, FlamePull, Forces, GroundPlane, Gusts, MAX_SPHERES,
-    SphereCollider, Turbulence, Vortex,
+    Attractor, Collisions, DepthCollision, Falloff, FlamePull, Forces, GroundPlane, Gusts,
+    MAX_SPHERES, SphereCollider, Turbulence, Vortex,
 };
 pub use lit::{Lighting, Lit, SixWayMaps};
 pub use look::{
@@ -603,6 +603,9 @@ impl Emitter {
         }
         if self.collisions.any() {
             v.push("collisions");
+        }
+        if self.collisions.depth_collision.is_some() {
+            v.push("depth collision");
         }
         if !f.drag_over_life.is_constant(1.0) {
             v.push("drag over life");

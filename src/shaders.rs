@@ -22,6 +22,8 @@ pub const EMBEDDED: &[(&str, &str)] = &[
         include_str!("../shaders/integrators.wgsl"),
     ),
     ("collide.wgsl", include_str!("../shaders/collide.wgsl")),
+    ("depth_off.wgsl", include_str!("../shaders/depth_off.wgsl")),
+    ("depth_on.wgsl", include_str!("../shaders/depth_on.wgsl")),
     (
         "events_off.wgsl",
         include_str!("../shaders/events_off.wgsl"),
@@ -114,6 +116,10 @@ pub const EVENTS_IO: (&str, &str) = ("events_off.wgsl", "events_on.wgsl");
 /// The update of an emitter with a trail: trail_on.wgsl (the ring of positions) in
 /// place of trail_off.wgsl (nothing).
 pub const TRAIL_IO: (&str, &str) = ("trail_off.wgsl", "trail_on.wgsl");
+
+/// The update of an emitter that collides with the host's depth buffer: depth_on.wgsl
+/// (the march and its group 2) in place of depth_off.wgsl (nothing).
+pub const DEPTH_IO: (&str, &str) = ("depth_off.wgsl", "depth_on.wgsl");
 
 /// Imports that some pipelines replace by another file (see
 /// [`ShaderLibrary::compose_with`]).

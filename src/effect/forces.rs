@@ -131,6 +131,33 @@ pub struct Collisions {
     /// ground). Forces still act afterwards: on the ground a stuck particle stays; on a
     /// sphere's side, gravity can pull it off again.
     pub stick_on_contact: bool,
+    /// Collide with the host's depth buffer (screen-space collision): the geometry the
+    /// camera sees stops the particles, with the response above. Needs a depth view handed
+    /// to the runtime; without one (or off screen) particles fly on.
+    pub depth_collision: Option<DepthCollision>,
+}
+
+/// Collision with what the host's depth buffer shows: each step's path of a particle is
+/// marched across the screen against the depth, the crossing refined, the surface's
+/// normal rebuilt from the depth around it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DepthCollision {
+    /// How thick the surfaces the depth buffer shows are taken to be, metres: a particle
+    /// that crosses behind a surface within this distance of it hits it; one further
+    /// behind (a silhouette it passes behind, a wall seen edge-on) flies on.
+    pub thickness_m: f32,
+    /// Kill particles that touch the host's geometry (sparks that go out).
+    pub kill_on_contact: bool,
+}
+
+impl Default for DepthCollision {
+    fn default() -> Self {
+        Self {
+            thickness_m: 0.25,
+            kill_on_contact: false,
+        }
+    }
 }
 
 /// A horizontal plane y = height.
@@ -219,12 +246,13 @@ impl Default for Collisions {
             rest_speed_m_per_s: 0.05,
             kill_on_sphere_contact: false,
             stick_on_contact: false,
+            depth_collision: None,
         }
     }
 }
 
 impl Collisions {
-    /// True when any collider is present.
+    /// True when the ground or a sphere is present (the analytic colliders).
     pub fn any(&self) -> bool {
         self.ground.is_some() || !self.spheres.is_empty()
     }

@@ -482,6 +482,14 @@ impl Collisions {
                 &format!("at most {MAX_SPHERES}"),
             );
         }
+        if let Some(d) = &self.depth_collision {
+            c.num(
+                || p("collisions.depth_collision.thickness_m"),
+                d.thickness_m,
+                0.0,
+                1e3,
+            );
+        }
         for (k, sp) in self.spheres.iter().enumerate() {
             c.vec3(
                 || p(&format!("collisions.spheres[{k}].center_m")),

@@ -225,7 +225,8 @@ pub struct SimParams {
     pub collide_b: [f32; 4],
     /// Sphere colliders: centre, radius.
     pub spheres: [[f32; 4]; 4],
-    /// x: stick on contact.
+    /// x: stick on contact, y: depth collision's thickness (m), z: kill on depth contact,
+    /// w: unused.
     pub collide_c: [f32; 4],
     /// The slots this step updates: first slot, count (wrapping at the capacity) — the
     /// ring's live window plus this step's spawns; every other slot is dead in both
@@ -238,6 +239,20 @@ pub struct SimParams {
     /// counters from it to the newest spawn; the step's number (the event scan's stamp);
     /// unused.
     pub tiny_b: [u32; 4],
+}
+
+/// How an emitter's simulation space is seen by the host's depth (keep in sync with
+/// `DepthView` in `shaders/depth_on.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct DepthViewUniform {
+    /// Simulation space → clip (composed in f64, rounded once).
+    pub clip_from_sim: [[f32; 4]; 4],
+    /// Its inverse.
+    pub sim_from_clip: [[f32; 4]; 4],
+    /// xy: the target's size (px), z: +1 when depth grows away from the camera, −1 for
+    /// reversed Z, w: 1 when a depth is bound (0: nothing collides).
+    pub viewport: [f32; 4],
 }
 
 /// Camera data for the billboard pass (keep in sync with `CameraUniform` in

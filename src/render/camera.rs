@@ -283,6 +283,17 @@ impl Camera {
         self.clip_from_world
     }
 
+    /// Whether depth shrinks away from the camera (reversed Z; the clear value is 0): the
+    /// projection's depth 2 m ahead against 1 m ahead (the projection is monotonic along
+    /// the view, so this holds wherever the near plane is).
+    pub(crate) fn reversed_z(&self) -> bool {
+        let depth = |z: f64| {
+            let c = self.clip_from_view * glam::DVec4::new(0.0, 0.0, z, 1.0);
+            c.z / c.w
+        };
+        depth(-2.0) < depth(-1.0)
+    }
+
     /// Simulation space with origin `origin` → clip, composed in f64 and rounded once.
     pub(crate) fn clip_from_sim(&self, origin: glam::DVec3) -> Mat4 {
         (self.clip_from_world() * DMat4::from_translation(origin)).as_mat4()

@@ -17,6 +17,7 @@ use crate::runtime::host_depth::HostDepth;
 use crate::runtime::instances::{Backing, Instance, InstanceId, Slab};
 use crate::shaders::{ShaderError, ShaderLibrary};
 use crate::sim::batch::{BatchMember, InstanceBatch, batchable};
+use crate::sim::depth_collision::HostDepthView;
 use crate::sim::gpu_sim::{SharedUpdate, SimError, UpdateMode};
 use crate::sim::{GpuSim, Stepper};
 
@@ -392,6 +393,7 @@ impl Player {
     ) {
         let camera = &self.preset_camera(camera);
         if !std::mem::take(&mut self.simulated) {
+            self.point_depth_collision(camera, depth);
             self.record_steps(encoder);
         }
         self.billboard.set_scene_depth(&self.ctx, depth);
@@ -466,6 +468,22 @@ impl Player {
         drop(groups);
         drop(members);
         self.uploads.finish(encoder);
+    }
+
+    /// Hands this frame's depth (and `camera`, in the presets' world) to every simulation
+    /// with depth collision: the steps recorded next collide with it.
+    fn point_depth_collision(&mut self, camera: &Camera, depth: Option<&wgpu::TextureView>) {
+        let host = depth.map(|view| HostDepthView {
+            view: view.clone(),
+            clip_from_world: camera.clip_from_world(),
+            reversed_z: camera.reversed_z(),
+            size: camera.size_px(),
+        });
+        for instance in self.instances.iter_mut() {
+            if let (Backing::Own(sim), _) = instance.state_mut() {
+                sim.set_host_depth(host.clone());
+            }
+        }
     }
 
     /// The view of the host's depth the passes sample (see [`HostDepth`]), or why the

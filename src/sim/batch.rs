@@ -51,12 +51,16 @@ pub const BATCH_STATE_BYTES: u64 = 64 << 20;
 const MAX_STEPS: usize = 32;
 
 /// Whether `effect`'s emitters can be batched (full or packed state, not stateless, no
-/// events or trails: a batch runs one dispatch per emitter and step, the events need a scan
-/// between, and neither keeps per-instance hook buffers).
+/// events, trails or depth collision: a batch runs one dispatch per emitter and step, the
+/// events need a scan between, and none keeps per-instance hook buffers or the camera
+/// each instance's simulation space is seen through).
 pub fn batchable(effect: &Effect) -> bool {
     (0..effect.emitters.len()).all(|i| {
         let m = Modules::in_effect(effect, i);
-        !m.contains(Modules::TINY) && !m.contains(Modules::STATELESS) && !m.has_hooks()
+        !m.contains(Modules::TINY)
+            && !m.contains(Modules::STATELESS)
+            && !m.has_hooks()
+            && !m.contains(Modules::DEPTH_COLLISION)
     })
 }
 

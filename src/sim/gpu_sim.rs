@@ -11,6 +11,7 @@ use crate::gpu::types::{
 };
 use crate::gpu::{GpuContext, GpuError};
 use crate::shaders::{ShaderError, ShaderLibrary};
+use crate::sim::depth_collision::{DepthCollider, HostDepthView};
 use crate::sim::event_scan::{EventHeader, ScanConfig, scan_flags};
 use crate::sim::hooks::EmitterHooks;
 use crate::sim::modules::Modules;
@@ -82,6 +83,8 @@ pub(super) struct EmitterState {
     /// Spawns from other emitters' events: the GPU fills the ring, so the planner cannot
     /// know its live window and every slot is visited.
     pub(super) gpu_fed: bool,
+    /// Group 2 of an emitter with depth collision.
+    pub(super) depth: Option<DepthCollider>,
 }
 
 /// A buffer for an emitter's baked over-life curves (rows A and B, [`CURVE_WIDTH`]
@@ -154,6 +157,9 @@ pub struct GpuSim {
     pub(super) emitters: Vec<EmitterState>,
     /// CPU planning (time, spawn counts).
     pub planner: EffectPlanner,
+    /// The host's depth the next record's steps collide with (emitters with depth
+    /// collision; none: they fly on).
+    host_depth: Option<HostDepthView>,
 }
 
 impl SimState for GpuSim {
@@ -214,9 +220,16 @@ impl GpuSim {
             later_chunks: None,
             emitters: Vec::new(),
             planner: EffectPlanner::default(),
+            host_depth: None,
         };
         sim.sync(effect)?;
         Ok(sim)
+    }
+
+    /// The host's depth (and the camera that drew it) the next record's steps collide
+    /// with, for emitters with depth collision; `None`: they fly on.
+    pub fn set_host_depth(&mut self, host: Option<HostDepthView>) {
+        self.host_depth = host;
     }
 
     /// The shader library in use.
@@ -335,6 +348,11 @@ impl GpuSim {
             s.salt = crate::rng::emitter_salt(i as u32, e.seed_offset);
             let modules = Modules::in_effect(effect, i);
             s.gpu_fed = modules.contains(Modules::EVENT_SPAWN);
+            if modules.contains(Modules::DEPTH_COLLISION) != s.depth.is_some() {
+                s.depth = modules
+                    .contains(Modules::DEPTH_COLLISION)
+                    .then(|| DepthCollider::new(&self.ctx, &lock(&self.update).depth_layout));
+            }
             if modules.contains(Modules::CURVES) {
                 upload_over_life(&self.ctx.queue, &s.curves, &mut s.curves_key, e);
             }
@@ -473,6 +491,7 @@ impl GpuSim {
             spawned_end: 0,
             hooks: None,
             gpu_fed: false,
+            depth: None,
         }
     }
 

@@ -3,6 +3,7 @@
 
 pub mod batch;
 pub mod cpu_reference;
+pub mod depth_collision;
 pub mod event_scan;
 pub mod gpu_sim;
 pub mod hooks;

@@ -39,9 +39,11 @@ impl Modules {
     pub const EVENT_SPAWN: Modules = Modules(8192);
     /// Trails: the update records each particle's positions in a ring (trail_on.wgsl).
     pub const TRAIL: Modules = Modules(16384);
+    /// Collision with the host's depth buffer (depth_on.wgsl, group 2).
+    pub const DEPTH_COLLISION: Modules = Modules(32768);
 
     /// Every module with its override-constant name.
-    pub const ALL: [(Modules, &'static str); 15] = [
+    pub const ALL: [(Modules, &'static str); 16] = [
         (Self::DRAG, "MOD_DRAG"),
         (Self::GUSTS, "MOD_GUSTS"),
         (Self::QUADRATIC_DRAG, "MOD_QUADRATIC_DRAG"),
@@ -57,6 +59,7 @@ impl Modules {
         (Self::EVENTS, "MOD_EVENTS"),
         (Self::EVENT_SPAWN, "MOD_EVENT_SPAWN"),
         (Self::TRAIL, "MOD_TRAIL"),
+        (Self::DEPTH_COLLISION, "MOD_DEPTH_COLLISION"),
     ];
 
     /// The modules an emitter's settings need.
@@ -105,9 +108,12 @@ impl Modules {
         if !e.events.is_empty() {
             m.0 |= Self::EVENTS.0;
         }
-        if m.has_hooks() {
-            // Events and trails read the particles' whole state every step: the full
-            // layout, stateful.
+        if e.collisions.depth_collision.is_some() {
+            m.0 |= Self::DEPTH_COLLISION.0;
+        }
+        if m.has_hooks() || m.contains(Self::DEPTH_COLLISION) {
+            // Events and trails read the particles' whole state every step, and depth
+            // collision is composed for it only: the full layout, stateful.
         } else if e.stateless && e.stateless_blockers().is_empty() {
             m.0 |= Self::STATELESS.0;
         } else if e.tiny_state {

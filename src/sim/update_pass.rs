@@ -8,8 +8,8 @@ use crate::effect::{Effect, Integrator};
 use crate::gpu::GpuContext;
 use crate::gpu::types::SimParams;
 use crate::shaders::{
-    EVENTS_IO, PACKED_STATE_IO, PARAMS_INSTANCED, ShaderError, ShaderLibrary, TINY_STATE_IO,
-    TRAIL_IO, create_checked,
+    DEPTH_IO, EVENTS_IO, PACKED_STATE_IO, PARAMS_INSTANCED, ShaderError, ShaderLibrary,
+    TINY_STATE_IO, TRAIL_IO, create_checked,
 };
 use crate::sim::hooks::HookPipes;
 use crate::sim::modules::Modules;
@@ -43,6 +43,12 @@ pub struct UpdatePass {
     pub(crate) hooks: HookPipes,
     /// Groups 0 and 1: the update of an emitter with hooks (none when batched).
     pub(crate) hooks_pipeline_layout: Option<wgpu::PipelineLayout>,
+    /// Group 2 of an update with depth collision: the host's depth and how the emitter's
+    /// simulation space is seen (`crate::sim::depth_collision`).
+    pub(crate) depth_layout: wgpu::BindGroupLayout,
+    /// Groups 0 and 2, and 0, 1 and 2: the update of an emitter with depth collision,
+    /// without and with hooks (none when batched).
+    depth_pipeline_layouts: Option<[wgpu::PipelineLayout; 2]>,
 }
 
 /// How an update pass's pipelines are specialised.
@@ -109,6 +115,17 @@ impl UpdatePass {
                     immediate_size: 0,
                 })
         });
+        let depth_layout = crate::sim::depth_collision::layout(ctx);
+        let depth_pipeline_layouts = (!batched).then(|| {
+            [None, Some(&hooks.hooks_layout)].map(|hooks| {
+                ctx.device
+                    .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                        label: Some("UpdatePass::depth_pipeline_layout"),
+                        bind_group_layouts: &[Some(&layout), hooks, Some(&depth_layout)],
+                        immediate_size: 0,
+                    })
+            })
+        });
         let count_layout = ctx
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -134,6 +151,18 @@ impl UpdatePass {
             batched,
             hooks,
             hooks_pipeline_layout,
+            depth_layout,
+            depth_pipeline_layouts,
+        }
+    }
+
+    /// The layout of an update with hooks or depth collision, if it can have them.
+    fn hooked_layout(&self, modules: Modules) -> Option<&wgpu::PipelineLayout> {
+        if modules.contains(Modules::DEPTH_COLLISION) {
+            let layouts = self.depth_pipeline_layouts.as_ref()?;
+            Some(&layouts[usize::from(modules.has_hooks())])
+        } else {
+            self.hooks_pipeline_layout.as_ref()
         }
     }
 
@@ -164,12 +193,17 @@ impl UpdatePass {
         let packed = compose(Some(PACKED_STATE_IO))?;
         // Tiny-state pipelines: state_tiny.wgsl as the state I/O.
         let tiny = compose(Some(TINY_STATE_IO))?;
-        // Emitters with events (or fed by them) or trails: their hooks, full state only.
+        // Emitters with events (or fed by them), trails or depth collision: their hooks,
+        // full state only.
         let mut hooked = HashMap::new();
-        for &(_, modules) in keys.iter().filter(|(_, m)| m.has_hooks()) {
-            let key = (modules.has_events(), modules.contains(Modules::TRAIL));
+        for &(_, modules) in keys.iter().filter(|(_, m)| is_hooked(*m)) {
+            let key = hooked_key(modules);
             if let std::collections::hash_map::Entry::Vacant(v) = hooked.entry(key) {
-                let hooks = [key.0.then_some(EVENTS_IO), key.1.then_some(TRAIL_IO)];
+                let hooks = [
+                    key.0.then_some(EVENTS_IO),
+                    key.1.then_some(TRAIL_IO),
+                    key.2.then_some(DEPTH_IO),
+                ];
                 let aliases: Vec<(&str, &str)> =
                     hooks.into_iter().flatten().chain(params).collect();
                 v.insert(lib.compose_with("update.wgsl", &aliases)?);
@@ -177,8 +211,9 @@ impl UpdatePass {
         }
         let mut fresh = HashMap::new();
         for &(integrator, modules) in keys {
-            let hooks = (modules.has_events(), modules.contains(Modules::TRAIL));
-            let with_hooks = hooked.get(&hooks).zip(self.hooks_pipeline_layout.as_ref());
+            let with_hooks = hooked
+                .get(&hooked_key(modules))
+                .zip(self.hooked_layout(modules));
             let (composed, layout) = if let Some((c, l)) = with_hooks {
                 (c, l)
             } else if modules.contains(Modules::TINY) {
@@ -262,6 +297,20 @@ impl UpdatePass {
         wanted.push(key);
         self.rebuild(ctx, lib, &wanted)
     }
+}
+
+/// Whether an update with `modules` composes hooks or depth collision.
+fn is_hooked(modules: Modules) -> bool {
+    modules.has_hooks() || modules.contains(Modules::DEPTH_COLLISION)
+}
+
+/// Which of events, the trail and depth collision an update composes.
+fn hooked_key(modules: Modules) -> (bool, bool, bool) {
+    (
+        modules.has_events(),
+        modules.contains(Modules::TRAIL),
+        modules.contains(Modules::DEPTH_COLLISION),
+    )
 }
 
 /// The update pipelines, shared by the simulations of one effect's instances.

@@ -78,6 +78,7 @@ impl GpuSim {
             }
         }
         self.write_scan_configs(effect);
+        self.point_depth_colliders();
         let chunks: Vec<(Vec<u8>, Vec<u32>)> = plans
             .chunks(STEPS_PER_SUBMIT)
             .map(|chunk| self.param_blocks(chunk))
@@ -108,6 +109,24 @@ impl GpuSim {
                 at += len;
             }
             self.dispatch_steps(enc, pass, effect, chunk, windows, c + 1 == chunks.len());
+        }
+    }
+
+    /// Points each emitter's depth collider at the host's depth, seen from its
+    /// simulation space.
+    fn point_depth_colliders(&mut self) {
+        let update = Arc::clone(&self.update);
+        let layout = &lock(&update).depth_layout;
+        for (e, em) in self.emitters.iter_mut().enumerate() {
+            if let Some(depth) = &mut em.depth {
+                let origin = self
+                    .planner
+                    .emitters
+                    .get(e)
+                    .map(|p| p.origin())
+                    .unwrap_or_default();
+                depth.update(&self.ctx, layout, self.host_depth.as_ref(), origin);
+            }
         }
     }
 
@@ -231,6 +250,9 @@ impl GpuSim {
                     pass.set_bind_group(0, group, &[offset]);
                     if let Some(ev) = &em.hooks {
                         pass.set_bind_group(1, &ev.hooks, &[]);
+                    }
+                    if let Some(depth) = &em.depth {
+                        pass.set_bind_group(2, depth.group(), &[]);
                     }
                     let (x, y) = dispatch_size(invocations);
                     pass.dispatch_workgroups(x, y, 1);

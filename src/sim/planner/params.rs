@@ -165,5 +165,11 @@ pub(super) fn set_collisions(p: &mut SimParams, col: &Collisions, origin: glam::
         flag(col.kill_on_sphere_contact),
         flag(ground.is_some()),
     ];
-    p.collide_c = [flag(col.stick_on_contact), 0.0, 0.0, 0.0];
+    let depth = col.depth_collision.as_ref();
+    p.collide_c = [
+        flag(col.stick_on_contact),
+        depth.map_or(0.0, |d| d.thickness_m),
+        flag(depth.is_some_and(|d| d.kill_on_contact)),
+        0.0,
+    ];
 }
