@@ -255,7 +255,7 @@ fn off_screen_and_behind_geometry_sparks_fly_on() {
 }
 
 /// Sparks at 60 m/s travel 1 m a step; the wall in the depth is a single surface (thinner
-/// than any step), and none gets through it.
+/// than any step), and none gets through it, nor through a post it crosses obliquely.
 #[test]
 fn fast_sparks_do_not_tunnel_through_a_thin_wall() {
     let host = Host::new(EYE, TARGET);
@@ -276,6 +276,23 @@ fn fast_sparks_do_not_tunnel_through_a_thin_wall() {
     assert!(
         last.iter().all(|p| vel(p).z > 11.9),
         "every spark rebounded"
+    );
+    // A post 0.2 m wide crossed at 45°: a step starts in front of it and ends beside it,
+    // over the background; only the march along the step finds the post between.
+    let post = quad(Vec3::ZERO, Vec3::X * 0.1, Vec3::Y * 2.0);
+    let effect = sparks(
+        100,
+        vec3(0.6, 0.5, 0.6),
+        [0.02, 0.3, 0.0],
+        vec3(-30.0, 0.0, -30.0),
+        0.2,
+    );
+    let mut player = host.player(&effect);
+    let (_, last) = run(&host, &[post], &mut player, 4, true, |_| {});
+    assert_eq!(last.len(), 100);
+    assert!(
+        last.iter().all(|p| vel(p).z > 5.9 && pos(p).z > 0.0),
+        "every spark rebounded off the post"
     );
 }
 

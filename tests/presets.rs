@@ -11,10 +11,11 @@ use std::path::{Path, PathBuf};
 
 use common::*;
 use ignis::effect::{
-    Attractor, BlendMode, Bloom, CURRENT_VERSION, CameraHint, Collisions, ColorStop, Effect,
-    Emitter, Falloff, FlamePull, Flipbook, FlipbookMode, Forces, GroundPlane, Gusts, Integrator,
-    Lighting, Lit, Look, MAX_CAPACITY, Param, Post, Range, Shape, SixWayMaps, SpawnNoise,
-    SphereCollider, Sprite, Streak, TimeMode, TimeSettings, Transform, Turbulence, Vortex,
+    Attractor, BlendMode, Bloom, CURRENT_VERSION, CameraHint, Collisions, ColorStop,
+    DepthCollision, Effect, Emitter, Falloff, FlamePull, Flipbook, FlipbookMode, Forces,
+    GroundPlane, Gusts, Integrator, Lighting, Lit, Look, MAX_CAPACITY, Param, Post, Range, Shape,
+    SixWayMaps, SpawnNoise, SphereCollider, Sprite, Streak, TimeMode, TimeSettings, Transform,
+    Turbulence, Vortex,
 };
 use ignis::preset::{self, PresetError};
 use ignis::testing::headless::Headless;
@@ -1305,6 +1306,11 @@ fn collisions() -> BoxedStrategy<Collisions> {
         });
     let sphere = (v3(1e7), fl(1e-3, 1e4))
         .prop_map(|(center_m, radius_m)| SphereCollider { center_m, radius_m });
+    let depth =
+        (fl(0.0, 1e3), any::<bool>()).prop_map(|(thickness_m, kill_on_contact)| DepthCollision {
+            thickness_m,
+            kill_on_contact,
+        });
     (
         proptest::option::of(ground),
         proptest::collection::vec(sphere, 0..=4),
@@ -1313,9 +1319,10 @@ fn collisions() -> BoxedStrategy<Collisions> {
         fl(0.0, 1e3),
         any::<bool>(),
         any::<bool>(),
+        proptest::option::of(depth),
     )
         .prop_map(
-            |(ground, spheres, elasticity, friction, rest, kill, stick)| Collisions {
+            |(ground, spheres, elasticity, friction, rest, kill, stick, depth)| Collisions {
                 ground,
                 spheres,
                 elasticity,
@@ -1323,6 +1330,7 @@ fn collisions() -> BoxedStrategy<Collisions> {
                 rest_speed_m_per_s: rest,
                 kill_on_sphere_contact: kill,
                 stick_on_contact: stick,
+                depth_collision: depth,
             },
         )
         .boxed()
