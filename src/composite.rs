@@ -6,6 +6,7 @@
 
 use crate::gpu::{GpuContext, TextureReadback};
 use crate::render::bloom::BloomPass;
+use crate::render::test_scene::TestScene;
 use crate::render::{
     Camera, HDR_FORMAT, Targets, TonemapPass, ensure_layer, load_hdr_pass, reduced,
 };
@@ -33,6 +34,13 @@ pub struct Composite {
     alpha_layer: Option<((u32, u32), wgpu::TextureView)>,
     /// The half-resolution target of the glow layer (draft).
     glow_layer: Option<((u32, u32), wgpu::TextureView)>,
+    /// Draw the test scene's props before the particles and hand the player their depth
+    /// (the editor's View setting): the layers are then all drawn at full resolution,
+    /// where their soft edges read the depth.
+    pub test_scene: bool,
+    scene: TestScene,
+    /// The scene was drawn into the HDR target this frame (it is not cleared again).
+    scene_drawn: bool,
 }
 
 impl Composite {
@@ -47,6 +55,9 @@ impl Composite {
             draft: false,
             alpha_layer: None,
             glow_layer: None,
+            test_scene: false,
+            scene: TestScene::new(ctx, lib)?,
+            scene_drawn: false,
         })
     }
 
@@ -67,6 +78,7 @@ impl Composite {
             "tonemap.wgsl" => self.tonemap.rebuild(ctx, lib),
             "bloom.wgsl" => self.bloom.rebuild(ctx, lib),
             "clear.wgsl" => self.clear.rebuild(ctx, lib),
+            "test_scene.wgsl" => TestScene::new(ctx, lib).map(|s| self.scene = s),
             _ => Ok(()),
         }
     }
@@ -93,8 +105,27 @@ impl Composite {
         player: &mut Player,
         camera: &Camera,
     ) {
-        player.record_sampling(enc, camera, None);
+        let depth = self.draw_scene(ctx, enc, camera);
+        player.record_sampling(enc, camera, depth.as_ref());
         self.draw(ctx, enc, player, camera);
+    }
+
+    /// With [`Composite::test_scene`] on, clears the HDR target and draws the props into
+    /// it and into their depth, which it returns for the player; otherwise nothing.
+    pub fn draw_scene(
+        &mut self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        camera: &Camera,
+    ) -> Option<wgpu::TextureView> {
+        if !self.test_scene {
+            return None;
+        }
+        let targets = self.targets(ctx, camera.size_px());
+        let (hdr, size) = (targets.hdr_view.clone(), targets.size);
+        self.clear.record(ctx, enc, &hdr, size);
+        self.scene_drawn = true;
+        Some(self.scene.record(ctx, enc, &hdr, camera))
     }
 
     /// [`Composite::record`] after the player's `record` for `camera` (timed apart by
@@ -126,7 +157,8 @@ impl Composite {
         // The blended layer at reduced resolution (draft halves it again: soft smoke
         // hides it), added in the tonemap.
         let downscale = post.alpha_downscale.clamp(1, 4) << u32::from(self.draft);
-        if downscale > 1 && drawn.contains(Layers::BLENDED) {
+        let reduce = !self.test_scene;
+        if reduce && downscale > 1 && drawn.contains(Layers::BLENDED) {
             let low = reduced(size, downscale);
             ensure_layer(ctx, &mut self.alpha_layer, "Composite::alpha_layer", low);
             if let Some((_, view)) = &self.alpha_layer {
@@ -135,7 +167,7 @@ impl Composite {
                 layered |= Layers::BLENDED;
             }
         }
-        if self.draft && drawn.contains(Layers::GLOW) {
+        if reduce && self.draft && drawn.contains(Layers::GLOW) {
             let half = reduced(size, 2);
             ensure_layer(ctx, &mut self.glow_layer, "Composite::glow_layer", half);
             if let Some((_, view)) = &self.glow_layer {
@@ -146,7 +178,9 @@ impl Composite {
         }
         if let Some(targets) = self.targets.as_ref() {
             let (view, size) = (&targets.hdr_view, targets.size);
-            self.clear.record(ctx, enc, view, size);
+            if !std::mem::take(&mut self.scene_drawn) {
+                self.clear.record(ctx, enc, view, size);
+            }
             // The tiles are resolved by compute where the adapter can (between the
             // blended billboards under them and the light over them), else drawn.
             let main = Layers::ALL.without(layered);

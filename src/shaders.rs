@@ -80,6 +80,10 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ("bloom.wgsl", include_str!("../shaders/bloom.wgsl")),
     ("clear.wgsl", include_str!("../shaders/clear.wgsl")),
     (
+        "test_scene.wgsl",
+        include_str!("../shaders/test_scene.wgsl"),
+    ),
+    (
         "depth_resolve.wgsl",
         include_str!("../shaders/depth_resolve.wgsl"),
     ),
@@ -146,6 +150,7 @@ pub const ENTRY_FILES: &[&str] = &[
     "depth_resolve.wgsl",
     "light.wgsl",
     "light_apply.wgsl",
+    "test_scene.wgsl",
 ];
 
 /// A shader problem, located in the file the user edits.

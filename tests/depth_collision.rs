@@ -358,3 +358,49 @@ fn the_same_depth_and_seed_give_the_same_particles() {
     assert_eq!(runs[0].len(), 200);
     assert!(runs[0] == runs[1], "two runs differ");
 }
+
+/// The editor's test scene: its props are drawn into the composite's image and their
+/// depth is handed to the player, so sparks fired at the box bounce off it (and fly on
+/// with the scene off).
+#[test]
+fn the_test_scene_gives_the_viewport_a_depth_to_collide_with() {
+    let ctx = gpu();
+    let effect = sparks(
+        50,
+        vec3(-0.8, 0.3, 0.0),
+        [0.0, 0.1, 0.1],
+        vec3(-3.0, 0.0, 0.0),
+        0.5,
+    );
+    let run = |scene: bool| {
+        let mut h = ignis::testing::headless::Headless::new(
+            &ctx,
+            effect.clone(),
+            ignis::testing::shaders::ShaderLibrary::embedded(),
+        )
+        .expect("headless");
+        h.composite.test_scene = scene;
+        let mut image = None;
+        for _ in 0..40 {
+            h.advance(1.0 / 60.0);
+            image = Some(h.render((160, 120)).expect("render"));
+        }
+        let p = alive(h.player.particles(h.instance, 0).expect("read"));
+        (p, image.expect("an image"))
+    };
+    let (bounced, shown) = run(true);
+    assert_eq!(bounced.len(), 50);
+    assert!(
+        bounced.iter().all(|p| vel(p).x > 1.4),
+        "bounced off the box"
+    );
+    let (through, bare) = run(false);
+    assert!(through.iter().all(|p| vel(p).x < -2.9), "no scene: flew on");
+    let lit = |img: &image::RgbaImage| img.pixels().filter(|p| p[0] > 20).count();
+    assert!(
+        lit(&shown) > lit(&bare) + 2000,
+        "the props are drawn: {} lit pixels against {}",
+        lit(&shown),
+        lit(&bare)
+    );
+}

@@ -93,6 +93,10 @@ enum Command {
         /// layers at half theirs (default: on for software adapters, off elsewhere).
         #[arg(long)]
         draft: Option<bool>,
+        /// Start with View → Test scene on: a ground, a box and a step in the viewport's
+        /// depth (depth collision, soft edges and occlusion against them).
+        #[arg(long)]
+        test_scene: bool,
         /// Destroy the GPU device after this frame, to test the recovery (the editor
         /// recreates it and keeps the effect).
         #[arg(long, hide = true)]
@@ -200,6 +204,7 @@ pub fn main() {
             sections,
             select,
             draft,
+            test_scene,
             lose_device_at,
             edit_around_loss,
             measure_span,
@@ -214,6 +219,7 @@ pub fn main() {
             sections,
             select,
             draft,
+            test_scene,
             lose_device_at,
             edit_around_loss,
             measure_span,

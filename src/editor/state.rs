@@ -23,6 +23,8 @@ pub struct ViewSettings {
     /// Draft quality: large additive sprites (flame tongues) at half the render
     /// resolution, alpha-blended layers at half their own (`Renderer::draft`).
     pub draft: bool,
+    /// Draw the test scene's props into the viewport and its depth (`Composite::test_scene`).
+    pub test_scene: bool,
     /// A sphere collider follows the pointer over the viewport: push the fire around.
     pub mouse_collider: bool,
     /// Show the particle under the pointer (or the one clicked) and the forces on it.
@@ -40,6 +42,7 @@ impl Default for ViewSettings {
             show_gizmos: true,
             render_scale: 1.0,
             draft: false,
+            test_scene: false,
             mouse_collider: false,
             inspect: false,
             state_view: false,

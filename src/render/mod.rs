@@ -17,6 +17,7 @@ pub mod sixway_maps;
 pub mod sort;
 pub mod splat;
 pub mod sprites;
+pub mod test_scene;
 pub mod tiles;
 pub mod tonemap;
 pub mod variant;

@@ -392,8 +392,10 @@ impl Player {
         depth: Option<&wgpu::TextureView>,
     ) {
         let camera = &self.preset_camera(camera);
+        // This frame's depth for the steps recorded now, or (after `simulate`) for the
+        // next frame's.
+        self.point_depth_collision(camera, depth);
         if !std::mem::take(&mut self.simulated) {
-            self.point_depth_collision(camera, depth);
             self.record_steps(encoder);
         }
         self.billboard.set_scene_depth(&self.ctx, depth);
@@ -468,6 +470,13 @@ impl Player {
         drop(groups);
         drop(members);
         self.uploads.finish(encoder);
+    }
+
+    /// The depth (seen by `camera`) the steps of a following [`Player::simulate`] collide
+    /// with: the editor's test scene, drawn before its timed update.
+    pub(crate) fn collide_with(&mut self, camera: &Camera, depth: Option<&wgpu::TextureView>) {
+        let camera = self.preset_camera(camera);
+        self.point_depth_collision(&camera, depth);
     }
 
     /// Hands this frame's depth (and `camera`, in the presets' world) to every simulation

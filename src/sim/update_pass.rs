@@ -193,22 +193,7 @@ impl UpdatePass {
         let packed = compose(Some(PACKED_STATE_IO))?;
         // Tiny-state pipelines: state_tiny.wgsl as the state I/O.
         let tiny = compose(Some(TINY_STATE_IO))?;
-        // Emitters with events (or fed by them), trails or depth collision: their hooks,
-        // full state only.
-        let mut hooked = HashMap::new();
-        for &(_, modules) in keys.iter().filter(|(_, m)| is_hooked(*m)) {
-            let key = hooked_key(modules);
-            if let std::collections::hash_map::Entry::Vacant(v) = hooked.entry(key) {
-                let hooks = [
-                    key.0.then_some(EVENTS_IO),
-                    key.1.then_some(TRAIL_IO),
-                    key.2.then_some(DEPTH_IO),
-                ];
-                let aliases: Vec<(&str, &str)> =
-                    hooks.into_iter().flatten().chain(params).collect();
-                v.insert(lib.compose_with("update.wgsl", &aliases)?);
-            }
-        }
+        let hooked = compose_hooked(lib, keys, params)?;
         let mut fresh = HashMap::new();
         for &(integrator, modules) in keys {
             let with_hooks = hooked
@@ -297,6 +282,29 @@ impl UpdatePass {
         wanted.push(key);
         self.rebuild(ctx, lib, &wanted)
     }
+}
+
+/// The update composed for each combination of events (or being fed by them), trails and
+/// depth collision among `keys` (their hooks; full state only).
+fn compose_hooked(
+    lib: &ShaderLibrary,
+    keys: &[PipelineKey],
+    params: Option<(&'static str, &'static str)>,
+) -> Result<HashMap<(bool, bool, bool), crate::shaders::Composed>, ShaderError> {
+    let mut hooked = HashMap::new();
+    for &(_, modules) in keys.iter().filter(|(_, m)| is_hooked(*m)) {
+        let key = hooked_key(modules);
+        if let std::collections::hash_map::Entry::Vacant(v) = hooked.entry(key) {
+            let hooks = [
+                key.0.then_some(EVENTS_IO),
+                key.1.then_some(TRAIL_IO),
+                key.2.then_some(DEPTH_IO),
+            ];
+            let aliases: Vec<(&str, &str)> = hooks.into_iter().flatten().chain(params).collect();
+            v.insert(lib.compose_with("update.wgsl", &aliases)?);
+        }
+    }
+    Ok(hooked)
 }
 
 /// Whether an update with `modules` composes hooks or depth collision.

@@ -573,6 +573,14 @@ pub fn view_ui(ui: &mut Ui, view: &mut ViewSettings, frame_requested: &mut bool)
         );
         row_ui(
             ui,
+            "Test scene",
+            "Draw a ground, a box and a step into the viewport's depth, as a game's world: \
+                emitters with depth collision bounce off them, soft edges and occlusion \
+                show against them (the props are the viewport's, not the preset's)",
+            |ui| ui.checkbox(&mut view.test_scene, ""),
+        );
+        row_ui(
+            ui,
             "Mouse collider",
             "A sphere collider follows the pointer over the viewport: push the fire around",
             |ui| ui.checkbox(&mut view.mouse_collider, ""),

@@ -54,7 +54,9 @@ pub fn viewport_ui(
         let uv = Rect::from_min_max(Pos2::ZERO, egui::pos2(1.0, 1.0));
         painter.image(id, rect, uv, additive);
     }
-    if state.view.show_grid {
+    // The test scene's ground has its own checker (and the grid, drawn over the image,
+    // would cross its props).
+    if state.view.show_grid && !state.view.test_scene {
         // After the image and additive too, so the sum is the same in either order and
         // an opaque image cannot hide the grid.
         let light = state.fire_light.filter(|_| state.view.fire_lights_grid);

@@ -59,6 +59,8 @@ pub struct EditOptions {
     pub select: Option<String>,
     /// Draft viewport (default: on for software adapters).
     pub draft: Option<bool>,
+    /// Start with the test scene shown (View → Test scene).
+    pub test_scene: bool,
     /// Destroy the GPU device after this frame (tests the recovery from a lost device).
     pub lose_device_at: Option<u32>,
     /// With `lose_device_at`: edit the effect twice before the loss and undo once after
@@ -152,6 +154,7 @@ impl ApplicationHandler for App {
                     .unwrap_or(gfx.editor_profile.render_scale)
                     .clamp(0.1, 1.0);
                 self.state.view.draft = self.options.draft.unwrap_or(gfx.editor_profile.draft);
+                self.state.view.test_scene |= self.options.test_scene;
                 gfx.window.request_redraw();
                 self.gfx = Some(gfx);
             }

@@ -376,6 +376,7 @@ impl Gfx {
         let start = Instant::now();
         self.composite.exposure = state.view.exposure;
         self.composite.draft = state.view.draft;
+        self.composite.test_scene = state.view.test_scene;
         self.player.set_asset_dir(state.asset_dir());
         let lights_grid = state.view.show_grid && state.view.fire_lights_grid;
         self.player.set_light_estimate(lights_grid);
@@ -397,9 +398,11 @@ impl Gfx {
         } = self;
         match pass_timer.as_mut().filter(|_| timing) {
             Some(t) => {
+                let depth = composite.draw_scene(ctx, &mut encoder, &camera);
+                player.collide_with(&camera, depth.as_ref());
                 t.scope(&mut encoder, "update", |enc| player.simulate(enc));
                 t.scope(&mut encoder, "sort + splat", |enc| {
-                    player.record_sampling(enc, &camera, None)
+                    player.record_sampling(enc, &camera, depth.as_ref())
                 });
                 t.scope(&mut encoder, "draw + composite", |enc| {
                     composite.draw(ctx, enc, player, &camera)
