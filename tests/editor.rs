@@ -570,6 +570,18 @@ fn force_modules_and_colliders_are_switched_and_edited_in_the_panel() {
         0.9
     );
 
+    // The host's depth: on with its defaults, its thickness edited, then off.
+    harness.get_by_label("Host's depth").click_accesskit();
+    harness.run();
+    harness.get_by_label("Thickness").set_value_accesskit(0.05);
+    harness.run();
+    let depth = &harness.state().running.emitters[0].collisions.depth_collision;
+    assert_eq!(depth.as_ref().map(|d| d.thickness_m), Some(0.05));
+    harness.get_by_label("Host's depth").click_accesskit();
+    harness.run();
+    let col = &harness.state().running.emitters[0].collisions;
+    assert!(col.depth_collision.is_none());
+
     harness.get_by_label("Turbulence").click_accesskit();
     harness.run();
     assert!(

@@ -320,6 +320,60 @@ fn collisions_ui(ui: &mut Ui, col: &mut Collisions) {
             );
         },
     );
+    module_ui(
+        ui,
+        "depth_collision",
+        "Host's depth",
+        "Collide with what the host's depth buffer shows (a game's world; here View → \
+            Test scene): the response below applies",
+        &mut col.depth_collision,
+        |ui, d| {
+            row_ui(
+                ui,
+                "Thickness",
+                "How thick surfaces are taken to be: a particle further behind one than this \
+                    is hidden by it and flies on, metres",
+                |ui| ui.add(drag(&mut d.thickness_m, 0.0..=100.0, 0.005, " m")),
+            );
+            row_ui(
+                ui,
+                "Kill on contact",
+                "Particles that touch the host's geometry die",
+                |ui| ui.checkbox(&mut d.kill_on_contact, ""),
+            );
+        },
+    );
+    spheres_ui(ui, col);
+    if col.any() || col.depth_collision.is_some() {
+        grid("collision_grid").show(ui, |ui| {
+            row_ui(
+                ui,
+                "Elasticity",
+                "Normal restitution: 0 stops, 1 bounces perfectly",
+                |ui| ui.add(drag(&mut col.elasticity, 0.0..=1.0, 0.005, "")),
+            );
+            row_ui(ui, "Friction", "Tangential loss per contact, 0..1", |ui| {
+                ui.add(drag(&mut col.friction, 0.0..=1.0, 0.005, ""))
+            });
+            row_ui(
+                ui,
+                "Rest speed",
+                "Below this normal speed after a bounce the particle rests, m/s",
+                |ui| {
+                    ui.add(drag(
+                        &mut col.rest_speed_m_per_s,
+                        0.0..=100.0,
+                        0.001,
+                        " m/s",
+                    ))
+                },
+            );
+        });
+    }
+}
+
+/// The sphere colliders: one row each (centre, radius, remove), then add, kill, stick.
+fn spheres_ui(ui: &mut Ui, col: &mut Collisions) {
     let mut remove = None;
     for (k, sphere) in col.spheres.iter_mut().enumerate() {
         ui.horizontal(|ui| {
@@ -360,30 +414,4 @@ fn collisions_ui(ui: &mut Ui, col: &mut Collisions) {
         ui.checkbox(&mut col.stick_on_contact, "stick")
             .on_hover_text("Particles stop where they touch a collider and stay there");
     });
-    if col.any() {
-        grid("collision_grid").show(ui, |ui| {
-            row_ui(
-                ui,
-                "Elasticity",
-                "Normal restitution: 0 stops, 1 bounces perfectly",
-                |ui| ui.add(drag(&mut col.elasticity, 0.0..=1.0, 0.005, "")),
-            );
-            row_ui(ui, "Friction", "Tangential loss per contact, 0..1", |ui| {
-                ui.add(drag(&mut col.friction, 0.0..=1.0, 0.005, ""))
-            });
-            row_ui(
-                ui,
-                "Rest speed",
-                "Below this normal speed after a bounce the particle rests, m/s",
-                |ui| {
-                    ui.add(drag(
-                        &mut col.rest_speed_m_per_s,
-                        0.0..=100.0,
-                        0.001,
-                        " m/s",
-                    ))
-                },
-            );
-        });
-    }
 }
