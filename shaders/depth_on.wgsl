@@ -7,7 +7,7 @@
 //   back, composed in f64 on the CPU, and the target's size).
 // - depth_collide(old, pos, vel): the step's path old → pos is marched across the screen
 //   (a sample every 2 px, at most 16) and the first sample behind the depth refined by
-//   bisection (12 halvings). The crossing is a hit when the particle is then at most the
+//   bisection (10 halvings). The crossing is a hit when the particle is then at most the
 //   thickness (params.collide_c.y) behind the surface — across a continuous surface the
 //   gap closes to 0, behind a silhouette it stays — so a wall thinner than a step's travel
 //   still stops a fast particle. A path that starts behind a surface within the thickness
@@ -33,8 +33,8 @@ struct DepthView {
 @group(2) @binding(0) var host_depth: texture_depth_2d;
 @group(2) @binding(1) var<uniform> depth_view: DepthView;
 
-// Bisection steps refining a crossing (2^-12 of a march sample).
-const DEPTH_REFINE: u32 = 12u;
+// Bisection steps refining a crossing (2^-10 of a march sample).
+const DEPTH_REFINE: u32 = 10u;
 // The most march samples along one step's path.
 const DEPTH_MARCH_MAX: u32 = 16u;
 
@@ -83,8 +83,11 @@ fn behind(p: vec3<f32>) -> vec2<f32> {
     if d == 1.0 - near_depth() {
         return vec2<f32>(-1.0, 0.0);
     }
-    let gap = distance(p, unproject(s.xy, d));
-    return vec2<f32>(select(-gap, gap, (s.z - d) * depth_view.viewport.z > 0.0), 1.0);
+    if (s.z - d) * depth_view.viewport.z < 0.0 {
+        // In front: how far is not needed.
+        return vec2<f32>(-1.0, 1.0);
+    }
+    return vec2<f32>(distance(p, unproject(s.xy, d)), 1.0);
 }
 
 fn is_behind(q: vec2<f32>) -> bool {

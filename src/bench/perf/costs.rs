@@ -89,6 +89,12 @@ fn module_variants(plain: &Effect) -> Result<Vec<Variant>, SimError> {
             }),
         ),
         (
+            "depth collision on (a 1080p host depth: a plane through the flames' axis)",
+            Box::new(|e: &mut Emitter| {
+                e.collisions.depth_collision = Some(Default::default());
+            }),
+        ),
+        (
             "trail on (4 points, every 2 steps)",
             Box::new(|e: &mut Emitter| {
                 e.look.trail = Some(crate::effect::Trail {
@@ -162,6 +168,7 @@ fn time_variants(
     let mut samples = vec![Vec::new(); variants.len()];
     let is_stateless = |e: &Effect| e.emitters.iter().any(|e| e.stateless);
     let mut sim = GpuSim::new(ctx, variants[1].2.clone(), plain)?;
+    sim.set_host_depth(Some(bench_depth(ctx)));
     sim.step(plain, 1.0 / 60.0, 66)?;
     let mut bare_loaded = false;
     let mut order: Vec<usize> = (0..variants.len())
@@ -192,6 +199,50 @@ fn time_variants(
         }
     }
     Ok(samples)
+}
+
+/// The depth-collision row's host depth: 1920×1080, the campfire seen from 3 m, holding a
+/// plane facing the camera through the flames' axis (the half of the flames behind it
+/// cross it and bounce; every particle on screen marches its step).
+fn bench_depth(ctx: &GpuContext) -> crate::sim::depth_collision::HostDepthView {
+    use glam::Vec3;
+    let size = (1920, 1080);
+    let view = glam::camera::rh::view::look_at_mat4(
+        Vec3::new(0.0, 0.8, 3.0),
+        Vec3::new(0.0, 0.6, 0.0),
+        Vec3::Y,
+    );
+    let proj = glam::camera::rh::proj::directx::perspective(0.8, 16.0 / 9.0, 0.05, 100.0);
+    let clip_from_world = (proj * view).as_dmat4();
+    let c = clip_from_world * glam::DVec4::new(0.0, 0.6, 0.0, 1.0);
+    let texture = crate::gpu::texture_2d(
+        &ctx.device,
+        "bench depth",
+        size,
+        1,
+        wgpu::TextureFormat::Depth32Float,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+    );
+    let view = texture.create_view(&Default::default());
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    drop(enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: &view,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear((c.z / c.w) as f32),
+                store: wgpu::StoreOp::Store,
+            }),
+            stencil_ops: None,
+        }),
+        ..Default::default()
+    }));
+    ctx.queue.submit([enc.finish()]);
+    crate::sim::depth_collision::HostDepthView {
+        view,
+        clip_from_world,
+        reversed_z: false,
+        size,
+    }
 }
 
 /// Untimed steps for at least 100 ms: after a pause (a pipeline compile) the H100's SM
