@@ -34,6 +34,14 @@
 // weighted mean motion of the particles seen at a pixel.
 override MOTION: bool = false;
 
+// The heat-haze pass (an emitter with `heat_haze`, never drawn in colour): each fragment
+// adds its screen-space offset (uv units; rg) and its weight (a) into the distortion
+// target: a ripple across the sprite (look.extra.y ripples), of amplitude
+// look.size_intensity.w × the particle's size on screen, weighted by the sprite's
+// coverage, the opacity over life and the soft edges. haze_apply.wgsl refracts the frame
+// by the sum.
+override HAZE: bool = false;
+
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
     // Atlas coordinates of this frame and of the next (flipbook blending).
@@ -111,7 +119,29 @@ fn quad_vertex(qd: Quad, vi: u32) -> VsOut {
         let w = select(max(max(out.color.r, out.color.g), out.color.b), out.color.a, SORTED);
         out.color = vec4<f32>(px, 0.0, w);
     }
+    if HAZE {
+        // For the fragment (which has no look): the ripple's phase (cycles: random per
+        // particle, moving with its age), its amplitude (the strength × the particle's
+        // size on screen, px), the ripples per sprite and its weight.
+        let d = qd.d;
+        let w = dot(transpose(look.clip_from_sim)[3], vec4<f32>(d.pos, 1.0));
+        let size_px = qd.lc.x * camera.viewport.z / max(w, 1e-4);
+        let weight = select(max(max(out.color.r, out.color.g), out.color.b), out.color.a, SORTED);
+        let phase = qd.rnd.x + d.age * look.spin_streak.y;
+        out.color = vec4<f32>(phase, size_px * look.size_intensity.w, look.extra.y, weight);
+    }
     return out;
+}
+
+// The heat-haze pass's output at sprite coordinates `uv` (0..1) with coverage `a`.
+fn haze_offset(in: VsOut, uv: vec2<f32>, a: f32) -> vec4<f32> {
+    let p = uv * 2.0 - 1.0;
+    let k = 6.2831853 * in.color.z;
+    let phase = 6.2831853 * in.color.x;
+    // A procedural normal: two crossed ripples, sideways stronger than vertical.
+    let n = vec2<f32>(sin(k * p.y + phase), 0.5 * cos(k * p.x * 0.8 + 1.7 * phase));
+    let offset_px = n * in.color.y * a;
+    return vec4<f32>(offset_px / camera.viewport.xy, 0.0, a);
 }
 
 // A ribbon's corner: quad q is segment q mod S of particle quad q / S (S segments each).
@@ -162,6 +192,9 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     let fade = edge_fade(in.clip, in.blend_height.y);
     a *= fade;
     rgb *= fade;
+    if HAZE {
+        return haze_offset(in, in.uv0, in.color.a * tex.a * fade);
+    }
     if MOTION {
         // Weighted by the cube of the visible weight: where sparks cross, the brightest
         // one's motion wins rather than a mean that fits neither.

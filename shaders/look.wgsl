@@ -30,7 +30,7 @@ struct LookUniform {
     // The emitter's simulation space → clip, composed in f64 on the CPU so effects far
     // from the world origin render without f32 jitter.
     clip_from_sim: mat4x4<f32>,
-    // x, y, w: unused, z: intensity.
+    // x, y: the trail's tail width and opacity, z: intensity, w: heat haze's strength.
     size_intensity: vec4<f32>,
     // x: colour ramp row (the curve rows A and B follow it), y: blend (0 additive,
     // 1 alpha), z: flipbook rows, w: columns.
@@ -39,10 +39,11 @@ struct LookUniform {
     // z: per-emitter random salt, w: the first slot of the pool's segment in the state
     // buffers (a batched instance's; else 0).
     flags: vec4<u32>,
-    // x: ∫ sprite brightness over the quad (the splat's energy), y: unused (STATELESS
-    // below), z: random rotation spread (rad), w: flipbook frames per second.
+    // x: ∫ sprite brightness over the quad (the splat's energy), y: heat haze's ripples
+    // per sprite, z: random rotation spread (rad), w: flipbook frames per second.
     extra: vec4<f32>,
-    // x, y: unused (the spin is a curve), z: streak length (s), w: longest streak (m).
+    // x: the trail's width, y: heat haze's speed (cycles/s), z: streak length (s), w:
+    // longest streak (m).
     spin_streak: vec4<f32>,
     // x: ground height in simulation space (m), y: 1 / soft-edge distance (1/m),
     // z, w: lifetime range (s; packed state re-derives lifetimes from it).

@@ -41,6 +41,8 @@ pub struct Composite {
     scene: TestScene,
     /// The scene was drawn into the HDR target this frame (it is not cleared again).
     scene_drawn: bool,
+    /// The copy of the HDR target heat haze refracts (made on first need).
+    haze_copy: Option<((u32, u32), wgpu::TextureView)>,
 }
 
 impl Composite {
@@ -58,6 +60,7 @@ impl Composite {
             test_scene: false,
             scene: TestScene::new(ctx, lib)?,
             scene_drawn: false,
+            haze_copy: None,
         })
     }
 
@@ -138,7 +141,34 @@ impl Composite {
         camera: &Camera,
     ) {
         let layered = self.draw_particles(ctx, enc, player, camera);
+        self.apply_haze(ctx, enc, player);
         self.post(ctx, enc, player, layered);
+    }
+
+    /// Heat haze over the HDR target (the scene and the particles at full resolution):
+    /// a copy of it refracted back into it by the player's haze layers.
+    pub fn apply_haze(
+        &mut self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        player: &mut Player,
+    ) {
+        let Some(targets) = self.targets.as_ref().filter(|_| player.has_haze()) else {
+            return;
+        };
+        let (hdr, size) = (targets.hdr_view.clone(), targets.size);
+        ensure_layer(ctx, &mut self.haze_copy, "Composite::haze_copy", size);
+        let Some((_, copy)) = &self.haze_copy else {
+            return;
+        };
+        enc.copy_texture_to_texture(
+            hdr.texture().as_image_copy(),
+            copy.texture().as_image_copy(),
+            hdr.texture().size(),
+        );
+        if let Err(e) = player.apply_haze(enc, copy, &hdr) {
+            log::warn!("heat haze: {e}");
+        }
     }
 
     /// The particle draws of [`Composite::draw`] (into the HDR target and the reduced

@@ -80,6 +80,10 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ("bloom.wgsl", include_str!("../shaders/bloom.wgsl")),
     ("clear.wgsl", include_str!("../shaders/clear.wgsl")),
     (
+        "haze_apply.wgsl",
+        include_str!("../shaders/haze_apply.wgsl"),
+    ),
+    (
         "test_scene.wgsl",
         include_str!("../shaders/test_scene.wgsl"),
     ),
@@ -151,6 +155,7 @@ pub const ENTRY_FILES: &[&str] = &[
     "light.wgsl",
     "light_apply.wgsl",
     "test_scene.wgsl",
+    "haze_apply.wgsl",
 ];
 
 /// A shader problem, located in the file the user edits.

@@ -78,6 +78,16 @@ pub mod sim {
 pub mod render {
     pub use crate::render::{OrbitCamera, TilePass};
 
+    /// Heat haze's distortion target and refraction.
+    pub mod haze {
+        pub use crate::render::haze::HazePass;
+    }
+
+    /// The billboards' pipeline variants.
+    pub mod variant {
+        pub use crate::render::variant::{LookVariant, StateVariant};
+    }
+
     /// The looks' uniform.
     pub mod frame {
         pub use crate::render::frame::look_uniform;

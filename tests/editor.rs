@@ -575,7 +575,9 @@ fn force_modules_and_colliders_are_switched_and_edited_in_the_panel() {
     harness.run();
     harness.get_by_label("Thickness").set_value_accesskit(0.05);
     harness.run();
-    let depth = &harness.state().running.emitters[0].collisions.depth_collision;
+    let depth = &harness.state().running.emitters[0]
+        .collisions
+        .depth_collision;
     assert_eq!(depth.as_ref().map(|d| d.thickness_m), Some(0.05));
     harness.get_by_label("Host's depth").click_accesskit();
     harness.run();

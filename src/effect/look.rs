@@ -43,6 +43,35 @@ pub struct Look {
     /// replace `sprite`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lit: Option<Lit>,
+    /// Heat haze: the emitter is not drawn; its particles bend what is behind them (see
+    /// [`HeatHaze`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub heat_haze: Option<HeatHaze>,
+}
+
+/// A distortion layer: each particle of the emitter writes a screen-space offset — a
+/// procedural ripple across its sprite, scaled by its size on screen and weighted by its
+/// sprite's coverage and its opacity over life — and the frame's colour is refracted by
+/// the sum. The emitter itself is invisible (its colour is not drawn).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct HeatHaze {
+    /// The largest offset, as a fraction of the particle's size on screen.
+    pub strength: f32,
+    /// Ripples across a sprite.
+    pub frequency: f32,
+    /// How fast the ripples move, cycles per second of each particle's age.
+    pub speed_hz: f32,
+}
+
+impl Default for HeatHaze {
+    fn default() -> Self {
+        Self {
+            strength: 0.03,
+            frequency: 1.5,
+            speed_hz: 1.2,
+        }
+    }
 }
 
 /// The two draw paths; both render the same look.
@@ -260,6 +289,7 @@ impl Default for Look {
             blend: BlendMode::Additive,
             draw_path: DrawPath::Auto,
             lit: None,
+            heat_haze: None,
         }
     }
 }

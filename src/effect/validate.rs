@@ -570,6 +570,19 @@ impl Look {
                 );
             }
         }
+        if let Some(h) = &self.heat_haze {
+            c.num(|| p("look.heat_haze.strength"), h.strength, 0.0, 10.0);
+            c.num(|| p("look.heat_haze.frequency"), h.frequency, 0.0, 100.0);
+            c.num(|| p("look.heat_haze.speed_hz"), h.speed_hz, -100.0, 100.0);
+            for (on, what) in [
+                (self.trail.is_some(), "draws sprites only: remove the trail"),
+                (self.lit.is_some(), "is not drawn in colour: remove `lit`"),
+            ] {
+                if on {
+                    c.push(p("look.heat_haze"), "Some(..)", what);
+                }
+            }
+        }
         if let Some(s) = &self.streak {
             c.num(|| p("look.streak.length_secs"), s.length_secs, 0.0, 10.0);
             c.num(|| p("look.streak.max_length_m"), s.max_length_m, 0.0, 1e3);

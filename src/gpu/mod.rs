@@ -32,7 +32,7 @@ pub fn compute_pass<'p>(
 /// clear, or what the target holds) and stores what it draws; no depth.
 pub fn color_pass<'a>(
     enc: &'a mut wgpu::CommandEncoder,
-    view: &'a wgpu::TextureView,
+    view: &wgpu::TextureView,
     load: wgpu::LoadOp<wgpu::Color>,
     label: &str,
 ) -> wgpu::RenderPass<'a> {

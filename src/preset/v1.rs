@@ -283,6 +283,7 @@ impl From<Look> for crate::effect::Look {
             blend: l.blend,
             draw_path: l.draw_path,
             lit: None,
+            heat_haze: None,
         }
     }
 }

@@ -294,6 +294,7 @@ impl Look {
             blend: l.blend,
             draw_path: l.draw_path,
             lit: None,
+            heat_haze: None,
         }
     }
 }

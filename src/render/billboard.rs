@@ -149,7 +149,17 @@ impl BillboardPass {
         v: LookVariant,
         target: DrawTarget,
     ) -> wgpu::RenderPipeline {
-        let blend = if v.motion {
+        // Heat haze adds offsets into the distortion target (no depth attachment: the soft
+        // edges against the host's depth hide it behind geometry).
+        let target = match v.haze {
+            true => DrawTarget {
+                color_format: HAZE_FORMAT,
+                depth: None,
+                sample_count: 1,
+            },
+            false => target,
+        };
+        let blend = if v.motion || v.haze {
             SUMMED
         } else if v.alpha {
             wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING
@@ -312,12 +322,24 @@ impl BillboardPass {
         frame: &FrameResources,
         items: &[DrawItem],
     ) {
-        self.draw_as(pass, frame, items, |_| true, LookVariant::with_motion);
+        let visible = |d: &DrawItem| !d.variant.haze;
+        self.draw_as(pass, frame, items, visible, LookVariant::with_motion);
+    }
+
+    /// Draws the heat-haze items into an open pass over the distortion target
+    /// ([`HAZE_FORMAT`], cleared to zero): per pixel the summed offsets (rg) and weights.
+    pub fn draw_haze(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        frame: &FrameResources,
+        items: &[DrawItem],
+    ) {
+        self.draw_as(pass, frame, items, |d| d.variant.haze, |v| v);
     }
 
     /// Draws the billboard items that `wanted` accepts into an open render pass
-    /// (alpha-blended layers first, then additive ones on top). Items whose pipeline or
-    /// sprite was not prepared are skipped.
+    /// (alpha-blended layers first, then additive ones on top); heat haze is never drawn
+    /// here. Items whose pipeline or sprite was not prepared are skipped.
     pub fn draw(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
@@ -325,6 +347,7 @@ impl BillboardPass {
         items: &[DrawItem],
         wanted: impl Fn(&DrawItem) -> bool,
     ) {
+        let wanted = |d: &DrawItem| !d.variant.haze && wanted(d);
         self.draw_as(pass, frame, items, wanted, |v| v);
     }
 
@@ -383,6 +406,9 @@ impl BillboardPass {
         }
     }
 }
+
+/// The distortion target's format: screen offsets (rg, uv units) and weights (a), summed.
+pub const HAZE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 /// Everything adds up, alpha too (the motion pass's weighted sums).
 const SUMMED: wgpu::BlendState = wgpu::BlendState {

@@ -582,6 +582,10 @@ impl FrameResources {
     /// `Auto` chooses from the projected size, the count and the adapter `profile`
     /// (`tile_raster`, `splat_dense_only`).
     fn choose_path(&self, profile: &AdapterProfile, look: &Look, scene: PathScene) -> (bool, bool) {
+        if look.heat_haze.is_some() {
+            // Haze is drawn by the billboards only, into the distortion target.
+            return (false, false);
+        }
         let PathScene {
             size_px,
             quads,

@@ -439,7 +439,7 @@ impl Buffers {
 fn plan(items: &[DrawItem]) -> (Vec<Job>, u32, u32) {
     let (mut jobs, mut partials, mut totals) = (Vec::new(), 0, 0);
     for (item, d) in items.iter().enumerate() {
-        if d.blend != BlendMode::Additive || d.width == 0 {
+        if d.blend != BlendMode::Additive || d.variant.haze || d.width == 0 {
             continue;
         }
         let (x, y) = dispatch_size(d.width);

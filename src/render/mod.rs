@@ -7,6 +7,7 @@ pub mod clear;
 pub mod depth_resolve;
 pub mod draw_item;
 pub mod frame;
+pub mod haze;
 pub(crate) mod image_groups;
 pub mod light;
 pub mod light_apply;
@@ -86,7 +87,9 @@ pub fn hdr_texture(ctx: &GpuContext, label: &str, size: (u32, u32)) -> wgpu::Tex
         HDR_FORMAT,
         wgpu::TextureUsages::RENDER_ATTACHMENT
             | wgpu::TextureUsages::TEXTURE_BINDING
-            | wgpu::TextureUsages::STORAGE_BINDING,
+            | wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::COPY_SRC
+            | wgpu::TextureUsages::COPY_DST,
     )
 }
 

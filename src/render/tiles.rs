@@ -400,7 +400,7 @@ impl TilePass {
         let mut constants: Vec<(&str, f64)> = v
             .constants()
             .into_iter()
-            .filter(|(name, _)| *name != "MOTION" && *name != "TRAIL")
+            .filter(|(name, _)| !["MOTION", "TRAIL", "HAZE"].contains(name))
             .collect();
         constants.push(("DEPTH_TEST", crate::render::depth_test(target)));
         // Software blending (lavapipe) rounds f16 toward zero; the tiles round as it does.

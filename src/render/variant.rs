@@ -50,6 +50,8 @@ pub struct LookVariant {
     pub state: StateVariant,
     /// Lit smoke: six-way maps under the slot's `LitUniform` (`lit.wgsl`).
     pub lit: bool,
+    /// Heat haze: drawn only into the distortion target, as summed screen offsets.
+    pub haze: bool,
 }
 
 impl LookVariant {
@@ -66,6 +68,7 @@ impl LookVariant {
             trail: false,
             state,
             lit: look.lit.is_some() && look.blend == BlendMode::Alpha,
+            haze: look.heat_haze.is_some(),
         }
     }
 
@@ -103,11 +106,12 @@ impl LookVariant {
             trail: false,
             state: StateVariant::default(),
             lit: false,
+            haze: false,
         }
     }
 
     /// The override constants of this variant's billboard pipeline.
-    pub fn constants(self) -> [(&'static str, f64); 11] {
+    pub fn constants(self) -> [(&'static str, f64); 12] {
         let b = |v: bool| if v { 1.0 } else { 0.0 };
         let [layout, stateless] = self.state.constants();
         [
@@ -120,6 +124,7 @@ impl LookVariant {
             ("MOTION", b(self.motion)),
             ("TRAIL", b(self.trail)),
             ("LIT", b(self.lit)),
+            ("HAZE", b(self.haze)),
             layout,
             stateless,
         ]

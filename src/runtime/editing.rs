@@ -8,6 +8,7 @@ use glam::Mat4;
 
 use crate::effect::Effect;
 use crate::gpu::types::StateLayout;
+use crate::render::haze::HazePass;
 use crate::runtime::instances::{Backing, Instance};
 use crate::runtime::player::update_mode;
 use crate::runtime::remap::emitter_sources;
@@ -31,6 +32,7 @@ pub const PLAYER_SHADERS: &[&str] = &[
     "depth_resolve.wgsl",
     "light.wgsl",
     "light_apply.wgsl",
+    "haze_apply.wgsl",
 ];
 
 impl Player {
@@ -192,6 +194,12 @@ impl Player {
             "light_apply.wgsl" => {
                 if let Some(pass) = &mut self.light.apply {
                     pass.rebuild(&self.ctx, &lib)?;
+                }
+            }
+            "haze_apply.wgsl" => {
+                if self.haze.is_some() {
+                    let format = self.settings.color_format;
+                    self.haze = Some(HazePass::new(&self.ctx, &lib, format)?);
                 }
             }
             _ => return Ok(()),

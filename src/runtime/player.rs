@@ -72,6 +72,8 @@ pub struct Player {
     pub(super) simulated: bool,
     /// Snapshots a seek can start from (`Player::keep_seek_snapshots`).
     pub(super) snapshots: super::seeking::SeekSnapshots,
+    /// Heat haze's distortion target and refraction (built on first use).
+    pub(super) haze: Option<crate::render::haze::HazePass>,
 }
 
 /// Steps one chunk of a `record` runs (the simulation's parameter ring holds this many
@@ -158,6 +160,7 @@ impl Player {
             light: Default::default(),
             simulated: false,
             snapshots: Default::default(),
+            haze: None,
         })
     }
 
@@ -763,7 +766,11 @@ impl Player {
     /// The layers that hold particles to draw, as last recorded.
     pub fn drawn_layers(&self) -> Layers {
         let mut layers = Layers::NONE;
-        for d in self.items.iter().filter(|d| d.is_billboard()) {
+        for d in self
+            .items
+            .iter()
+            .filter(|d| d.is_billboard() && !d.variant.haze)
+        {
             layers |= Layers::of(d);
         }
         if self.splatted || self.tiles.as_ref().is_some_and(TilePass::drawn) {

@@ -84,20 +84,22 @@ pub fn look_uniform(look: &Look, ramp_row: u32, salt: u32, sprite_integral: f32)
             look.trail.as_ref().map_or(1.0, |t| t.tail_width),
             look.trail.as_ref().map_or(1.0, |t| t.tail_opacity),
             look.intensity,
-            0.0,
+            // w: heat haze's strength (billboard.wgsl HAZE).
+            look.heat_haze.map_or(0.0, |h| h.strength),
         ],
         ids: [ramp_row, blend, rows, cols],
         flags: [mode, random_start, salt, 0],
         extra: [
             sprite_integral,
-            0.0,
+            // y: heat haze's ripples per sprite.
+            look.heat_haze.map_or(0.0, |h| h.frequency),
             look.rotation_random_deg.to_radians(),
             fps,
         ],
-        // x: the trail's width (× the particle's size; trail.wgsl).
+        // x: the trail's width (× the particle's size; trail.wgsl), y: heat haze's speed.
         spin_streak: [
             look.trail.as_ref().map_or(0.0, |t| t.width),
-            0.0,
+            look.heat_haze.map_or(0.0, |h| h.speed_hz),
             streak.length_secs,
             streak.max_length_m,
         ],

@@ -1,0 +1,160 @@
+//! Heat haze: the distortion target the haze layers add their screen offsets into
+//! (`billboard.wgsl` HAZE) and the refraction of the frame's colour by it
+//! (`shaders/haze_apply.wgsl`).
+
+use crate::gpu::GpuContext;
+use crate::render::billboard::HAZE_FORMAT;
+use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
+
+/// The distortion target (kept while its size holds) and the refraction's pipeline.
+pub struct HazePass {
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::RenderPipeline,
+    sampler: wgpu::Sampler,
+    target: Option<((u32, u32), wgpu::Texture, wgpu::TextureView)>,
+}
+
+impl HazePass {
+    /// Builds the refraction into targets of `format` from `lib`.
+    pub fn new(
+        ctx: &GpuContext,
+        lib: &ShaderLibrary,
+        format: wgpu::TextureFormat,
+    ) -> Result<Self, ShaderError> {
+        let layout = ctx
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("HazePass::layout"),
+                entries: &[
+                    crate::gpu::fragment_texture_entry(0, true),
+                    crate::gpu::fragment_texture_entry(1, false),
+                    crate::gpu::fragment_sampler_entry(2),
+                ],
+            });
+        let pipeline = pipeline(ctx, lib, &layout, format)?;
+        let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("HazePass::sampler"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        Ok(Self {
+            layout,
+            pipeline,
+            sampler,
+            target: None,
+        })
+    }
+
+    /// The distortion target of `size` pixels (made on first need), cleared to `clear`
+    /// (no offset: transparent) and open in a pass for the haze layers' draws.
+    pub fn begin<'e>(
+        &mut self,
+        ctx: &GpuContext,
+        enc: &'e mut wgpu::CommandEncoder,
+        size: (u32, u32),
+        clear: wgpu::Color,
+    ) -> wgpu::RenderPass<'e> {
+        if self.target.as_ref().is_some_and(|(s, _, _)| *s != size) {
+            self.target = None;
+        }
+        let (_, _, view) = self.target.get_or_insert_with(|| {
+            let texture = crate::gpu::texture_2d(
+                &ctx.device,
+                "HazePass::distortion",
+                size,
+                1,
+                HAZE_FORMAT,
+                wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC,
+            );
+            let view = texture.create_view(&Default::default());
+            (size, texture, view)
+        });
+        let clear = wgpu::LoadOp::Clear(clear);
+        crate::gpu::color_pass(enc, view, clear, "HazePass::distortion")
+    }
+
+    /// The distortion target as last drawn (rg: offsets in uv units, a: weights).
+    pub fn distortion(&self) -> Option<&wgpu::Texture> {
+        self.target.as_ref().map(|t| &t.1)
+    }
+
+    /// Refracts `scene` (a copy of the frame's colour, the distortion's size) into
+    /// `target` by the distortion target.
+    pub fn refract(
+        &self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        scene: &wgpu::TextureView,
+        target: &wgpu::TextureView,
+    ) {
+        let Some((_, _, distortion)) = &self.target else {
+            return;
+        };
+        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("HazePass::group"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(scene),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(distortion),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::Sampler(&self.sampler),
+                },
+            ],
+        });
+        let load = wgpu::LoadOp::Load;
+        let mut pass = crate::gpu::color_pass(enc, target, load, "HazePass::refract");
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}
+
+fn pipeline(
+    ctx: &GpuContext,
+    lib: &ShaderLibrary,
+    layout: &wgpu::BindGroupLayout,
+    format: wgpu::TextureFormat,
+) -> Result<wgpu::RenderPipeline, ShaderError> {
+    let pipeline_layout = ctx
+        .device
+        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("HazePass::pipeline_layout"),
+            bind_group_layouts: &[Some(layout)],
+            immediate_size: 0,
+        });
+    let composed = lib.compose("haze_apply.wgsl")?;
+    create_checked(&ctx.device, &composed, lib, |module| {
+        ctx.device
+            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("HazePass"),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: Default::default(),
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module,
+                    entry_point: Some("fs_main"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(format.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+    })
+}

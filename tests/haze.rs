@@ -1,0 +1,281 @@
+//! Heat haze on a real adapter: the refraction shifts a host image by a known constant
+//! offset exactly; an effect without haze leaves the host's image untouched bit for bit and
+//! compiles the haze out of its pipelines; a haze layer bends the image only around its
+//! particles and is never drawn in colour.
+
+mod common;
+
+use common::*;
+use ignis::effect::{Burst, ColorStop, Effect, Emitter, HeatHaze, Range, Shape};
+use ignis::testing::gpu::GpuContext;
+use ignis::testing::render::haze::HazePass;
+use ignis::testing::render::variant::{LookVariant, StateVariant};
+use ignis::testing::shaders::ShaderLibrary;
+use ignis::{Camera, Player, PlayerSettings};
+
+const W: u32 = 96;
+const H: u32 = 64;
+const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+/// A pattern no shift maps onto itself: every texel differs from its neighbours.
+fn pattern(x: u32, y: u32) -> [u8; 4] {
+    [
+        (x * 37 + y * 11) as u8,
+        (x * 5 + y * 53) as u8,
+        ((x ^ y) * 29) as u8,
+        255,
+    ]
+}
+
+fn pattern_bytes() -> Vec<u8> {
+    (0..H)
+        .flat_map(|y| (0..W).flat_map(move |x| pattern(x, y)))
+        .collect()
+}
+
+/// A target the size of the test's frame: sampled, drawn into, copied and read back.
+fn target(ctx: &GpuContext, bytes: &[u8]) -> wgpu::Texture {
+    let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("haze test target"),
+        size: wgpu::Extent3d {
+            width: W,
+            height: H,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC
+            | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    ctx.queue.write_texture(
+        texture.as_image_copy(),
+        bytes,
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(W * 4),
+            rows_per_image: None,
+        },
+        texture.size(),
+    );
+    texture
+}
+
+/// `texture`'s texels after `enc` runs.
+fn read(ctx: &GpuContext, mut enc: wgpu::CommandEncoder, texture: &wgpu::Texture) -> Vec<u8> {
+    let row = (W * 4).next_multiple_of(256);
+    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: u64::from(row * H),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    enc.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row),
+                rows_per_image: None,
+            },
+        },
+        texture.size(),
+    );
+    ctx.queue.submit([enc.finish()]);
+    let slice = buffer.slice(..);
+    slice.map_async(wgpu::MapMode::Read, |r| r.expect("map"));
+    let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
+    let data = slice.get_mapped_range().expect("mapped");
+    (0..H as usize)
+        .flat_map(|y| data[y * row as usize..][..W as usize * 4].to_vec())
+        .collect()
+}
+
+/// A distortion of a constant (3, −2) pixels: every pixel whose source is inside the
+/// image shows the pattern's texel there, to the 8-bit level.
+#[test]
+fn the_refraction_shifts_the_image_by_the_distortion() {
+    let ctx = gpu();
+    let (dx, dy) = (3i32, -2i32);
+    let mut haze = HazePass::new(&ctx, &ShaderLibrary::embedded(), FORMAT).expect("haze pass");
+    let scene = target(&ctx, &pattern_bytes());
+    let out = target(&ctx, &vec![0; (W * H * 4) as usize]);
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    let offset = wgpu::Color {
+        r: f64::from(dx) / f64::from(W),
+        g: f64::from(dy) / f64::from(H),
+        b: 0.0,
+        a: 0.0,
+    };
+    drop(haze.begin(&ctx, &mut enc, (W, H), offset));
+    let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+    haze.refract(&ctx, &mut enc, &view(&scene), &view(&out));
+    let got = read(&ctx, enc, &out);
+    let mut checked = 0;
+    for y in 0..H as i32 {
+        for x in 0..W as i32 {
+            let (sx, sy) = (x + dx, y + dy);
+            if sx < 0 || sy < 0 || sx >= W as i32 || sy >= H as i32 {
+                continue;
+            }
+            let at = ((y as u32 * W + x as u32) * 4) as usize;
+            let want = pattern(sx as u32, sy as u32);
+            for c in 0..4 {
+                let d = (i32::from(got[at + c]) - i32::from(want[c])).abs();
+                assert!(
+                    d <= 1,
+                    "({x}, {y}) channel {c}: {} for {}",
+                    got[at + c],
+                    want[c]
+                );
+            }
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, (W as usize - 3) * (H as usize - 2));
+}
+
+/// A torch player (no haze): nothing to apply, nothing recorded, the host's image kept
+/// bit for bit; its pipelines compile the haze out (`HAZE` = 0), a haze look's in.
+#[test]
+fn without_haze_the_host_image_is_untouched_and_haze_is_compiled_out() {
+    let ctx = gpu();
+    let torch = ignis::preset::load("presets/torch.ron".as_ref()).expect("torch");
+    // The flames about a metre up, brought down into the view.
+    let frame = frame_with(&ctx, &torch, glam::Vec3::new(0.0, -0.9, 0.0));
+    assert!(!frame.applied, "no haze to apply");
+    assert!(frame.drawn != pattern_bytes(), "the torch was drawn");
+    assert!(frame.hazed == frame.drawn, "the host image changed");
+    let haze_of = |e: &Emitter| {
+        let v = LookVariant::of(&e.look, StateVariant::default());
+        v.constants()
+            .iter()
+            .find(|(n, _)| *n == "HAZE")
+            .map(|c| c.1)
+    };
+    assert!(torch.emitters.iter().all(|e| haze_of(e) == Some(0.0)));
+    assert_eq!(haze_of(&haze_emitter()), Some(1.0));
+}
+
+/// A haze layer (a burst of large particles in the middle of the frame): the refracted
+/// image differs from the host's around them and is the host's bit for bit far from them;
+/// the layer adds no colour of its own.
+#[test]
+fn a_haze_layer_bends_the_image_only_around_its_particles() {
+    let ctx = gpu();
+    let mut effect = bare_effect(haze_emitter());
+    effect.post.bloom = None;
+    let frame = frame_with(&ctx, &effect, glam::Vec3::ZERO);
+    assert!(frame.applied);
+    assert!(frame.drawn == pattern_bytes(), "the haze layer drew colour");
+    let changed = |x: u32, y: u32| {
+        let at = ((y * W + x) * 4) as usize;
+        frame.hazed[at..at + 4] != frame.drawn[at..at + 4]
+    };
+    let near: usize = (W / 2 - 8..W / 2 + 8)
+        .flat_map(|x| (H / 2 - 8..H / 2 + 8).map(move |y| (x, y)))
+        .filter(|&(x, y)| changed(x, y))
+        .count();
+    assert!(near > 64, "only {near} of 256 pixels bent near the haze");
+    for (x, y) in [(2, 2), (W - 3, 2), (2, H - 3), (W - 3, H - 3)] {
+        assert!(!changed(x, y), "({x}, {y}) bent, far from the haze");
+    }
+}
+
+/// An invisible emitter of 40 particles 0.6 m wide at the origin, haze on.
+fn haze_emitter() -> Emitter {
+    let mut e = Emitter {
+        name: "haze".into(),
+        capacity: 64,
+        spawn_rate_per_sec: ignis::effect::Param::Constant(0.0),
+        bursts: vec![Burst {
+            time_secs: 0.0,
+            count: 40,
+        }],
+        lifetime_secs: Range::new(5.0, 5.0),
+        shape: Shape::Sphere {
+            radius_m: 0.05,
+            surface_only: false,
+        },
+        ..plain_emitter()
+    };
+    e.look.size_m = ignis::effect::Param::Constant(0.6);
+    e.look.soft_ground_m = 0.0;
+    e.look.color_over_life = vec![ColorStop {
+        t: 0.0,
+        rgba: [1.0, 1.0, 1.0, 1.0],
+    }];
+    e.look.heat_haze = Some(HeatHaze {
+        strength: 0.2,
+        ..HeatHaze::default()
+    });
+    e
+}
+
+/// What a host frame held: after the particles' pass, after the haze, and whether haze
+/// was applied.
+struct Framed {
+    drawn: Vec<u8>,
+    hazed: Vec<u8>,
+    applied: bool,
+}
+
+/// `effect` played 10 frames at `at`, seen from 1.5 m in front of the origin, each frame
+/// drawn over a host image holding the pattern and its haze applied.
+fn frame_with(ctx: &GpuContext, effect: &Effect, at: glam::Vec3) -> Framed {
+    let settings = PlayerSettings::new(FORMAT);
+    let mut player = Player::new(&ctx.device, &ctx.queue, effect, settings).expect("player");
+    player
+        .add_instance(glam::Mat4::from_translation(at), 1)
+        .expect("instance");
+    let view = glam::camera::rh::view::look_at_mat4(
+        glam::Vec3::new(0.0, 0.0, 1.5),
+        glam::Vec3::ZERO,
+        glam::Vec3::Y,
+    );
+    let proj = glam::camera::rh::proj::directx::perspective(0.9, W as f32 / H as f32, 0.05, 50.0);
+    let camera = Camera::new(view, proj, (W, H));
+    let host = target(ctx, &pattern_bytes());
+    let copy = target(ctx, &pattern_bytes());
+    let mut applied = false;
+    for _ in 0..10 {
+        let layout = wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(W * 4),
+            rows_per_image: None,
+        };
+        let bytes = pattern_bytes();
+        ctx.queue
+            .write_texture(host.as_image_copy(), &bytes, layout, host.size());
+        player.advance(1.0 / 60.0);
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        player.record(&mut enc, &camera, None).expect("record");
+        let host_view = host.create_view(&Default::default());
+        {
+            let mut pass = ignis::HostTargets {
+                color: &host_view,
+                resolve_target: None,
+                depth: None,
+            }
+            .begin_pass(&mut enc);
+            player.draw(&mut pass);
+        }
+        enc.copy_texture_to_texture(host.as_image_copy(), copy.as_image_copy(), host.size());
+        let copy_view = copy.create_view(&Default::default());
+        applied = player
+            .apply_haze(&mut enc, &copy_view, &host_view)
+            .expect("haze");
+        ctx.queue.submit([enc.finish()]);
+    }
+    let enc = || ctx.device.create_command_encoder(&Default::default());
+    Framed {
+        drawn: read(ctx, enc(), &copy),
+        hazed: read(ctx, enc(), &host),
+        applied,
+    }
+}
