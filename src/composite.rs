@@ -41,6 +41,8 @@ pub struct Composite {
     scene: TestScene,
     /// The scene was drawn into the HDR target this frame (it is not cleared again).
     scene_drawn: bool,
+    /// Apply the effect's heat haze (on by default; the editor's View setting).
+    pub heat_haze: bool,
     /// The copy of the HDR target heat haze refracts (made on first need).
     haze_copy: Option<((u32, u32), wgpu::TextureView)>,
 }
@@ -60,6 +62,7 @@ impl Composite {
             test_scene: false,
             scene: TestScene::new(ctx, lib)?,
             scene_drawn: false,
+            heat_haze: true,
             haze_copy: None,
         })
     }
@@ -153,7 +156,8 @@ impl Composite {
         enc: &mut wgpu::CommandEncoder,
         player: &mut Player,
     ) {
-        let Some(targets) = self.targets.as_ref().filter(|_| player.has_haze()) else {
+        let on = self.heat_haze && player.has_haze();
+        let Some(targets) = self.targets.as_ref().filter(|_| on) else {
             return;
         };
         let (hdr, size) = (targets.hdr_view.clone(), targets.size);

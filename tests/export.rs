@@ -212,6 +212,7 @@ fn the_emissive_pass_is_the_colour_passs_additive_light() {
         emissive: true,
         motion: false,
         sixway: false,
+        distortion: false,
     };
     for (e, out) in [(&effect, &lit), (&dark, &smoke)] {
         // The preset's own camera: a fitted one would frame the dark flames differently.
@@ -369,6 +370,7 @@ fn motion_vectors_predict_the_next_frame() {
         emissive: false,
         motion: true,
         sixway: false,
+        distortion: false,
     };
     let summary = export(&effect, s);
     let scale = summary.sidecar.motion_vector_scale;
@@ -568,6 +570,7 @@ fn the_sixway_passes_hold_each_axis_in_unitys_packing() {
             emissive: false,
             motion: false,
             sixway: true,
+            distortion: false,
         },
         format: Format::Exr,
         start_secs: 0.1,
@@ -619,4 +622,54 @@ fn the_sixway_passes_hold_each_axis_in_unitys_packing() {
             "LBFE {lbfe:?}, want {want_lbfe:?}"
         );
     }
+}
+
+/// `--passes distortion`: the campfire's heat haze as RG offsets around 0.5, its scale in
+/// the sidecar; where there is no haze (the frame's corners, and every pixel of an effect
+/// without haze) exactly 0.5; the colour pass is not refracted (the same as without it).
+#[test]
+fn the_distortion_pass_holds_the_heat_haze_offsets() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let passes = |distortion| Passes {
+        color: true,
+        emissive: false,
+        motion: false,
+        sixway: false,
+        distortion,
+    };
+    let run = |effect: &Effect, name: &str, distortion: bool| {
+        let out = dir.path().join(name);
+        let settings = ExportSettings {
+            passes: passes(distortion),
+            format: Format::Exr,
+            ..sequence(&out, 1, 0.1)
+        };
+        export(effect, settings);
+        out
+    };
+    let campfire = preset("campfire");
+    let out = run(&campfire, "hazed", true);
+    let sidecar = std::fs::read_to_string(out.join("campfire.json")).expect("sidecar");
+    let json: serde_json::Value = serde_json::from_str(&sidecar).expect("json");
+    assert_eq!(json["passes"], serde_json::json!(["color", "distortion"]));
+    assert_eq!(json["distortion_scale"], serde_json::json!(0.1));
+    let d = exr(&out, "distortion", 0);
+    let largest = d
+        .iter()
+        .map(|p| (p[0] - 0.5).abs().max((p[1] - 0.5).abs()))
+        .fold(0.0f32, f32::max);
+    assert!(largest > 1e-3, "the haze wrote no offset ({largest})");
+    for corner in [0, 63, 64 * 63, 64 * 64 - 1] {
+        assert_eq!(&d[corner][..2], &[0.5, 0.5], "pixel {corner}");
+    }
+    let plain = run(&campfire, "plain", false);
+    assert!(
+        exr(&out, "color", 0) == exr(&plain, "color", 0),
+        "the colour pass was refracted"
+    );
+    let mut torch = preset("torch");
+    torch.name = "campfire".into();
+    let none = run(&torch, "none", true);
+    let d = exr(&none, "distortion", 0);
+    assert!(d.iter().all(|p| p[0] == 0.5 && p[1] == 0.5));
 }

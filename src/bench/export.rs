@@ -29,6 +29,7 @@ pub fn run(
         emissive: true,
         motion: true,
         sixway: false,
+        distortion: false,
     };
     let mut configs = Vec::new();
     for passes in [
@@ -37,6 +38,7 @@ pub fn run(
             emissive: false,
             motion: false,
             sixway: false,
+            distortion: false,
         },
         all,
     ] {

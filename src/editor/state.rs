@@ -25,6 +25,8 @@ pub struct ViewSettings {
     pub draft: bool,
     /// Draw the test scene's props into the viewport and its depth (`Composite::test_scene`).
     pub test_scene: bool,
+    /// Apply the effect's heat haze (`Composite::heat_haze`).
+    pub heat_haze: bool,
     /// A sphere collider follows the pointer over the viewport: push the fire around.
     pub mouse_collider: bool,
     /// Show the particle under the pointer (or the one clicked) and the forces on it.
@@ -43,6 +45,7 @@ impl Default for ViewSettings {
             render_scale: 1.0,
             draft: false,
             test_scene: false,
+            heat_haze: true,
             mouse_collider: false,
             inspect: false,
             state_view: false,

@@ -39,7 +39,8 @@ pub struct ExportArgs {
     /// straight or premultiplied.
     #[arg(long, value_enum, default_value = "premultiplied")]
     pub alpha: AlphaMode,
-    /// Passes, comma-separated: color, emissive, motion, sixway (the smoke's six-way
+    /// Passes, comma-separated: color, emissive, motion, distortion (the heat haze's
+    /// screen offsets), sixway (the smoke's six-way
     /// lightmaps, two files, for an engine to relight).
     #[arg(long, default_value = "color", value_delimiter = ',')]
     pub passes: Vec<String>,
@@ -93,6 +94,7 @@ impl ExportArgs {
             emissive: false,
             motion: false,
             sixway: false,
+            distortion: false,
         };
         for p in &self.passes {
             match p.trim() {
@@ -100,9 +102,11 @@ impl ExportArgs {
                 "emissive" => passes.emissive = true,
                 "motion" => passes.motion = true,
                 "sixway" => passes.sixway = true,
+                "distortion" => passes.distortion = true,
                 other => {
                     return Err(format!(
-                        "--passes: unknown pass {other:?} (color, emissive, motion, sixway)"
+                        "--passes: unknown pass {other:?} (color, emissive, motion, sixway, \
+                         distortion)"
                     ));
                 }
             }

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use super::ExportError;
-use super::export_settings::{AlphaMode, ExportSettings, Format};
+use super::export_settings::{AlphaMode, DISTORTION_SCALE, ExportSettings, Format};
 use super::frames::RawFrame;
 
 /// What turns a rendered frame into stored pixels and file names (shared by the
@@ -40,6 +40,14 @@ impl Encoder {
                 .emissive
                 .iter()
                 .map(|&[r, g, b, _]| store_light([r, g, b], format))
+                .collect(),
+            "distortion" => frame
+                .distortion
+                .iter()
+                .map(|d| {
+                    let e = |k: usize| (0.5 + d[k] / DISTORTION_SCALE).clamp(0.0, 1.0);
+                    [e(0), e(1), 0.5, 1.0]
+                })
                 .collect(),
             // Lightmaps: linear and straight, as they were packed.
             "sixway_rtba" => frame.sixway[0].clone(),

@@ -102,7 +102,14 @@ pub struct Passes {
     /// The alpha-blended (smoke) layers' six-way lightmaps, for an engine to relight:
     /// two files, `sixway_rtba` and `sixway_lbfe` (see [`SIXWAY_PACKING`]).
     pub sixway: bool,
+    /// The heat-haze layers' screen offsets in RG, centred at 0.5, for an engine's
+    /// distortion material (offset in frame UV = (value − 0.5) × [`DISTORTION_SCALE`]).
+    pub distortion: bool,
 }
+
+/// The distortion pass's encoding: a stored value v means an offset of
+/// (v − 0.5) × this, in frame UV (x right, y down).
+pub const DISTORTION_SCALE: f32 = 0.1;
 
 /// The packing of the six-way passes, as the sidecar states it (Unity's Six Way
 /// shader's): lit by a unit white light from each axis of the camera's frame.
@@ -120,6 +127,7 @@ impl Passes {
             (self.motion, "motion"),
             (self.sixway, "sixway_rtba"),
             (self.sixway, "sixway_lbfe"),
+            (self.distortion, "distortion"),
         ]
         .into_iter()
         .filter_map(|(on, n)| on.then_some(n))
@@ -180,6 +188,7 @@ impl ExportSettings {
                 emissive: false,
                 motion: false,
                 sixway: false,
+                distortion: false,
             },
             seed: None,
             camera: CameraMode::Fit,
@@ -262,8 +271,10 @@ impl ExportSettings {
             ));
         }
         let p = self.passes;
-        if !(p.color || p.emissive || p.motion || p.sixway) {
-            return bad("--passes: name at least one of color, emissive, motion, sixway".into());
+        if !(p.color || p.emissive || p.motion || p.sixway || p.distortion) {
+            return bad(
+                "--passes: name at least one of color, emissive, motion, sixway, distortion".into(),
+            );
         }
         Ok(())
     }

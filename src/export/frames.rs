@@ -22,6 +22,8 @@ pub(super) struct RawFrame {
     /// The six-way lightmaps of the alpha-blended layers, straight: RTBA and LBFE
     /// (empty when off; `sixway_pass.rs`).
     pub sixway: [Vec<[f32; 4]>; 2],
+    /// The heat haze's summed screen offsets in frame UV (empty when off).
+    pub distortion: Vec<[f32; 2]>,
 }
 
 impl RawFrame {
@@ -34,7 +36,9 @@ impl RawFrame {
         for (a, b) in self.emissive.iter_mut().zip(&other.emissive) {
             (0..4).for_each(|k| mix(&mut a[k], b[k]));
         }
-        for (a, b) in self.motion.iter_mut().zip(&other.motion) {
+        for (a, b) in (self.motion.iter_mut().chain(&mut self.distortion))
+            .zip(other.motion.iter().chain(&other.distortion))
+        {
             (0..2).for_each(|k| mix(&mut a[k], b[k]));
         }
         for (mine, theirs) in self.sixway.iter_mut().zip(&other.sixway) {
@@ -55,6 +59,8 @@ pub(super) struct FrameRenderer {
     motion: Option<wgpu::Texture>,
     /// The six-way passes' target (each of its renders read back in turn).
     sixway: Option<wgpu::Texture>,
+    /// The distortion pass is on (the player's own target is read back).
+    distortion: bool,
 }
 
 impl FrameRenderer {
@@ -80,7 +86,25 @@ impl FrameRenderer {
             emissive: target(settings.passes.emissive, "Export::emissive"),
             motion: target(settings.passes.motion, "Export::motion"),
             sixway: target(settings.passes.sixway, "Export::sixway"),
+            distortion: settings.passes.distortion,
         }
+    }
+
+    /// Draws the haze layers into the player's distortion target at the frame size and
+    /// records its readback (`None`: the effect has no haze this frame).
+    fn record_distortion(
+        &self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        player: &mut Player,
+    ) -> Result<Option<TextureReadback>, ExportError> {
+        let drawn = player
+            .draw_distortion(enc, self.size)
+            .map_err(|e| ExportError::Invalid(format!("the distortion pass: {e}")))?;
+        Ok(drawn
+            .then(|| player.distortion())
+            .flatten()
+            .map(|t| TextureReadback::record(&ctx.device, enc, t, "Export::distortion")))
     }
 
     /// The frame size.
@@ -139,6 +163,9 @@ impl FrameRenderer {
         let motion = self.motion.as_ref().map(|t| read(&mut enc, t));
         let sixway = (self.sixway.as_ref())
             .map(|t| super::sixway_pass::record(ctx, &mut enc, player, &self.camera, t));
+        let distortion = self
+            .distortion
+            .then(|| self.record_distortion(ctx, &mut enc, player));
         ctx.queue.submit([enc.finish()]);
         let exposure = player.effect().post.exposure;
         let lit = |p: [f32; 4]| [p[0] * exposure, p[1] * exposure, p[2] * exposure, p[3]];
@@ -164,6 +191,12 @@ impl FrameRenderer {
                 .map(|r| texels(ctx, r))
                 .collect::<Result<Vec<_>, _>>()?;
             frame.sixway = super::sixway_pass::pack(&renders);
+        }
+        if let Some(d) = distortion.transpose()?.flatten() {
+            frame.distortion = texels(ctx, &d)?.into_iter().map(|p| [p[0], p[1]]).collect();
+        } else if self.distortion {
+            // No haze: no offset anywhere.
+            frame.distortion = vec![[0.0; 2]; (self.size.0 * self.size.1) as usize];
         }
         if let Some(m) = &motion {
             frame.motion = texels(ctx, m)?

@@ -276,6 +276,7 @@ impl Export {
                 emissive: false,
                 motion: false,
                 sixway: false,
+                distortion: false,
             },
             background: None,
             ..self.settings.clone()

@@ -58,6 +58,10 @@ pub struct Sidecar {
     /// Motion pass: motion in frame UV (x right, y down) to the next frame =
     /// (value − 0.5) × this.
     pub motion_vector_scale: f32,
+    /// Distortion pass (with `--passes distortion`): the heat haze's offset in frame UV
+    /// (x right, y down) = (value − 0.5) × this, in R and G.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub distortion_scale: Option<f32>,
     /// The camera mode.
     pub camera: &'static str,
     /// The preset's name.
@@ -117,6 +121,8 @@ impl Sidecar {
                 .sixway
                 .then_some(super::export_settings::SIXWAY_PACKING),
             motion_vector_scale,
+            distortion_scale: (settings.passes.distortion)
+                .then_some(super::export_settings::DISTORTION_SCALE),
             camera: settings.camera.name(),
             preset: effect.name.clone(),
             seed,

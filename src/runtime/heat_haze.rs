@@ -26,10 +26,27 @@ impl Player {
         scene: &wgpu::TextureView,
         target: &wgpu::TextureView,
     ) -> Result<bool, PlayerError> {
+        let size = target.texture().size();
+        if !self.draw_distortion(encoder, (size.width, size.height))? {
+            return Ok(false);
+        }
+        if let Some(haze) = &self.haze {
+            haze.refract(&self.ctx, encoder, scene, target);
+        }
+        Ok(true)
+    }
+
+    /// Draws the haze layers into the distortion target, made `size` pixels, without
+    /// refracting anything (the export's distortion pass); false, and nothing recorded,
+    /// without haze.
+    pub(crate) fn draw_distortion(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        size: (u32, u32),
+    ) -> Result<bool, PlayerError> {
         if !self.has_haze() {
             return Ok(false);
         }
-        let size = target.texture().size();
         let haze = match &mut self.haze {
             Some(h) => h,
             None => {
@@ -39,18 +56,15 @@ impl Player {
                 self.haze.insert(pass)
             }
         };
-        {
-            let size = (size.width, size.height);
-            let mut pass = haze.begin(&self.ctx, encoder, size, wgpu::Color::TRANSPARENT);
-            self.billboard
-                .draw_haze(&mut pass, &self.frame, &self.items);
-        }
-        haze.refract(&self.ctx, encoder, scene, target);
+        let mut pass = haze.begin(&self.ctx, encoder, size, wgpu::Color::TRANSPARENT);
+        self.billboard
+            .draw_haze(&mut pass, &self.frame, &self.items);
         Ok(true)
     }
 
     /// The distortion target as last drawn by [`Player::apply_haze`] (rg: summed offsets
     /// in uv units; the export's distortion pass).
+    #[cfg(feature = "editor")]
     pub(crate) fn distortion(&self) -> Option<&wgpu::Texture> {
         self.haze.as_ref().and_then(HazePass::distortion)
     }

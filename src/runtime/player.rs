@@ -477,6 +477,7 @@ impl Player {
 
     /// The depth (seen by `camera`) the steps of a following [`Player::simulate`] collide
     /// with: the editor's test scene, drawn before its timed update.
+    #[cfg(feature = "editor")]
     pub(crate) fn collide_with(&mut self, camera: &Camera, depth: Option<&wgpu::TextureView>) {
         let camera = self.preset_camera(camera);
         self.point_depth_collision(&camera, depth);

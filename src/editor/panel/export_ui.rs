@@ -299,6 +299,13 @@ fn output_rows(ui: &mut Ui, panel: &mut ExportPanel) {
     );
     row(
         ui,
+        "Distortion pass",
+        "The heat haze's screen offsets in RG, centred at 0.5, for an engine's distortion \
+            material (the scale is in the sidecar)",
+        |ui| ui.checkbox(&mut s.passes.distortion, ""),
+    );
+    row(
+        ui,
         "Camera",
         "Fitted to the whole span, orthographic, or the preset's",
         |ui| {

@@ -581,6 +581,13 @@ pub fn view_ui(ui: &mut Ui, view: &mut ViewSettings, frame_requested: &mut bool)
         );
         row_ui(
             ui,
+            "Heat haze",
+            "Refract the viewport by the effect's heat-haze layers (best seen over the test \
+                scene)",
+            |ui| ui.checkbox(&mut view.heat_haze, ""),
+        );
+        row_ui(
+            ui,
             "Mouse collider",
             "A sphere collider follows the pointer over the viewport: push the fire around",
             |ui| ui.checkbox(&mut view.mouse_collider, ""),

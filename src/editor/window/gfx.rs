@@ -377,6 +377,7 @@ impl Gfx {
         self.composite.exposure = state.view.exposure;
         self.composite.draft = state.view.draft;
         self.composite.test_scene = state.view.test_scene;
+        self.composite.heat_haze = state.view.heat_haze;
         self.player.set_asset_dir(state.asset_dir());
         let lights_grid = state.view.show_grid && state.view.fire_lights_grid;
         self.player.set_light_estimate(lights_grid);
