@@ -97,7 +97,7 @@ impl Headless {
     /// Simulates and draws one frame of `frame_dt_secs` for `camera` with each part timed
     /// apart by `timer` (GPU timestamps where the adapter has them, else the wall clock
     /// around a drained queue), in milliseconds: update, record (sort, splat, the tiles'
-    /// passes), particle draws, composite (bloom and tonemap).
+    /// passes), particle draws, composite (heat haze, bloom and tonemap).
     pub fn timed_frame(
         &mut self,
         timer: &GpuTimer,
@@ -117,7 +117,10 @@ impl Headless {
         let draw = timer.time(ctx, |enc| {
             layered = composite.draw_particles(ctx, enc, player, camera);
         });
-        let post = timer.time(ctx, |enc| composite.post(ctx, enc, player, layered));
+        let post = timer.time(ctx, |enc| {
+            composite.apply_haze(ctx, enc, player);
+            composite.post(ctx, enc, player, layered)
+        });
         [update, record, draw, post]
     }
 

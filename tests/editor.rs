@@ -235,7 +235,10 @@ fn emitters_can_be_added_duplicated_reordered_and_removed() {
         .iter()
         .map(|e| e.name.clone())
         .collect();
-    assert_eq!(names, ["smoke", "smoke copy", "flames", "embers"]);
+    assert_eq!(
+        names,
+        ["smoke", "smoke copy", "flames", "embers", "heat haze"]
+    );
     assert_eq!(harness.state().selected, 1);
     assert!(harness.state().validation_errors.is_empty());
 
@@ -515,7 +518,10 @@ fn reordering_emitters_moves_their_particles_along() {
         .iter()
         .map(|e| e.name.as_str())
         .collect();
-    assert_eq!(names, ["flames", "smoke", "smoke copy", "embers"]);
+    assert_eq!(
+        names,
+        ["flames", "smoke", "smoke copy", "embers", "heat haze"]
+    );
 
     player.set_effect(&state.running).expect("the edit");
     assert_eq!(player.particles(id, 0).expect("read"), flames);

@@ -827,11 +827,14 @@ fn version_1_fixture_keeps_loading() {
 /// features (events, trails), its first version-2 form (`tests/fixtures/v2/`, frozen).
 /// (The committed reference images, rendered from the version-1 presets, still match the
 /// version-2 frames: `looks.rs`.)
-/// `effect` without lit smoke, which shipped presets took after their migration to
-/// version 3 (a look change, not a format change: older files have none).
+/// `effect` without what shipped presets took after their migration to version 3 — lit
+/// smoke, heat-haze layers, collision with the host's depth (look and behaviour changes,
+/// not format changes: older files have none).
 fn unlit(mut effect: Effect) -> Effect {
+    effect.emitters.retain(|e| e.look.heat_haze.is_none());
     for e in &mut effect.emitters {
         e.look.lit = None;
+        e.collisions.depth_collision = None;
     }
     effect
 }

@@ -55,23 +55,60 @@ struct Row {
 /// Frames run before the timed ones of each row.
 const UNTIMED_FRAMES: usize = 10;
 
-/// The path choices measured: a label, the path forced on every emitter, and whether
-/// lit layers are drawn unlit (`lit: None`; measured only for presets with lit smoke:
-/// the lit rows' cost is theirs minus these, in one run). The billboards first: the
-/// other paths' images are compared with theirs.
-const PATHS: [(&str, Option<DrawPath>, bool); 6] = [
-    ("billboard", Some(DrawPath::Billboard), false),
-    ("auto", None, false),
-    ("splat", Some(DrawPath::Splat), false),
-    ("tiles", Some(DrawPath::Tiles), false),
-    ("billboard unlit", Some(DrawPath::Billboard), true),
-    ("tiles unlit", Some(DrawPath::Tiles), true),
-];
-
-/// Whether any emitter of `effect` is lit smoke.
-fn has_lit(effect: &Effect) -> bool {
-    effect.emitters.iter().any(|e| e.look.lit.is_some())
+/// What a row takes away from the preset, to measure what it costs in the same run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Without {
+    /// Nothing: the preset as it is.
+    Nothing,
+    /// Lit layers drawn unlit (`lit: None`).
+    Lighting,
+    /// The heat-haze layers removed (no distortion target, no refraction).
+    Haze,
 }
+
+impl Without {
+    /// Whether `effect` has what this takes away (the row is measured only then).
+    fn applies_to(self, effect: &Effect) -> bool {
+        let any = |f: fn(&crate::effect::Emitter) -> bool| effect.emitters.iter().any(f);
+        match self {
+            Self::Nothing => true,
+            Self::Lighting => any(|e| e.look.lit.is_some()),
+            Self::Haze => any(|e| e.look.heat_haze.is_some()),
+        }
+    }
+
+    /// `effect` without it.
+    fn strip(self, effect: &mut Effect) {
+        match self {
+            Self::Nothing => {}
+            Self::Lighting => effect.emitters.iter_mut().for_each(|e| e.look.lit = None),
+            Self::Haze => effect.emitters.retain(|e| e.look.heat_haze.is_none()),
+        }
+    }
+}
+
+/// The path choices measured: a label, the path forced on every emitter, and what is
+/// taken away (measured only for presets that have it: its cost is the full rows' minus
+/// these, in one run). The billboards first: the other paths' images are compared with
+/// theirs.
+const PATHS: [(&str, Option<DrawPath>, Without); 8] = [
+    ("billboard", Some(DrawPath::Billboard), Without::Nothing),
+    ("auto", None, Without::Nothing),
+    ("splat", Some(DrawPath::Splat), Without::Nothing),
+    ("tiles", Some(DrawPath::Tiles), Without::Nothing),
+    (
+        "billboard unlit",
+        Some(DrawPath::Billboard),
+        Without::Lighting,
+    ),
+    ("tiles unlit", Some(DrawPath::Tiles), Without::Lighting),
+    (
+        "billboard no haze",
+        Some(DrawPath::Billboard),
+        Without::Haze,
+    ),
+    ("auto no haze", None, Without::Haze),
+];
 
 /// Runs every preset, size and path, `opts.passes` times over.
 pub fn run(ctx: &GpuContext, opts: &PresetsOptions) -> Result<Report, PlayerError> {
@@ -91,7 +128,7 @@ pub fn run(ctx: &GpuContext, opts: &PresetsOptions) -> Result<Report, PlayerErro
     // were up to twice as slow on the H100 (first use of each path's pipelines and
     // memory, the GPU's clocks).
     if let (Some((path, effect)), Some(&size)) = (effects.first(), opts.sizes.first()) {
-        for choice in PATHS.into_iter().filter(|c| !c.2 || has_lit(effect)) {
+        for choice in PATHS.into_iter().filter(|c| c.2.applies_to(effect)) {
             measure(ctx, &timer, path, effect, size, choice, opts)?;
         }
     }
@@ -103,8 +140,8 @@ pub fn run(ctx: &GpuContext, opts: &PresetsOptions) -> Result<Report, PlayerErro
         for (path, effect) in &effects {
             for &size in &opts.sizes {
                 let mut reference = None;
-                for (label, forced, unlit) in PATHS {
-                    if unlit && !has_lit(effect) {
+                for (label, forced, without) in PATHS {
+                    if !without.applies_to(effect) {
                         continue;
                     }
                     let (mut row, mut run) = measure(
@@ -113,7 +150,7 @@ pub fn run(ctx: &GpuContext, opts: &PresetsOptions) -> Result<Report, PlayerErro
                         path,
                         effect,
                         size,
-                        (label, forced, unlit),
+                        (label, forced, without),
                         opts,
                     )?;
                     println!(
@@ -125,7 +162,7 @@ pub fn run(ctx: &GpuContext, opts: &PresetsOptions) -> Result<Report, PlayerErro
                         let image = run.render(size)?;
                         let reference = reference.get_or_insert(image.clone());
                         (row.diff_mean, row.diff_max) = image_diff(reference, &image);
-                        if row.diff_max > 8 && !unlit {
+                        if row.diff_max > 8 && without == Without::Nothing {
                             report_difference(reference, &image, &row, opts);
                         }
                         row.pass_frame_ms = vec![row.frame_ms];
@@ -249,16 +286,14 @@ fn measure(
     path: &Path,
     effect: &Effect,
     size: (u32, u32),
-    (label, forced, unlit): (&'static str, Option<DrawPath>, bool),
+    (label, forced, without): (&'static str, Option<DrawPath>, Without),
     opts: &PresetsOptions,
 ) -> Result<(Row, Headless), PlayerError> {
     let mut effect = effect.clone();
+    without.strip(&mut effect);
     for e in &mut effect.emitters {
         if let Some(p) = forced {
             e.look.draw_path = p;
-        }
-        if unlit {
-            e.look.lit = None;
         }
     }
     let settings = crate::PlayerSettings {
@@ -309,11 +344,13 @@ fn report(ctx: &GpuContext, timer: &GpuTimer, opts: &PresetsOptions, rows: &[Row
          burst), then 10 untimed frames, then {} frames; medians of each part, timed apart ({:?}): update, sort + \
          splat + the tiles' project, bin and shade (the player's record), particle draws \
          (billboards, the splat's and the tiles' composite into the target), composite \
-         (bloom + tonemap). `frame` is their sum. `auto` is the preset's own draw-path \
+         (heat haze + bloom + tonemap). `frame` is their sum. `auto` is the preset's own draw-path \
          choice; `billboard`, `splat` and `tiles` force every emitter onto one path (same \
          process, same run); for presets with lit smoke, `billboard unlit` and `tiles \
          unlit` draw it unlit (no six-way shading, no light pass): the lit layers' cost is \
-         the difference. Every row is measured in {} passes over the whole run (the \
+         the difference; for presets with heat haze, `billboard no haze` and `auto no haze` \
+         remove its layers (no distortion target, no refraction): the haze costs the \
+         difference. Every row is measured in {} passes over the whole run (the \
          lent H100 has slow states that double every part of a frame for seconds at a time): \
          the parts shown are the row's fastest pass's, and every pass's frame is listed. The \
          last column compares the next frame's image with the billboards' (8-bit levels; the \

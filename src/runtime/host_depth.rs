@@ -3,8 +3,13 @@
 //! multisampled one copied to a single sample first.
 
 use crate::gpu::GpuContext;
+use crate::render::Camera;
 use crate::render::depth_resolve::DepthResolvePass;
 use crate::shaders::{ShaderError, ShaderLibrary};
+use crate::sim::depth_collision::HostDepthView;
+
+use super::Player;
+use super::instances::Backing;
 
 /// What the player keeps of the host's depth between frames.
 pub(super) struct HostDepth {
@@ -130,4 +135,58 @@ fn depth_aspect(host: &wgpu::TextureView) -> wgpu::TextureView {
 
 fn shader_error(e: &ShaderError) -> String {
     format!("the depth copy's shader failed: {e}")
+}
+
+impl Player {
+    /// The depth (seen by `camera`) the steps of a following [`Player::simulate`] collide
+    /// with: the editor's test scene, drawn before its timed update.
+    #[cfg(feature = "editor")]
+    pub(crate) fn collide_with(&mut self, camera: &Camera, depth: Option<&wgpu::TextureView>) {
+        let camera = self.preset_camera(camera);
+        self.point_depth_collision(&camera, depth);
+    }
+
+    /// Hands this frame's depth (and `camera`, in the presets' world) to every simulation
+    /// with depth collision: the steps recorded next collide with it.
+    pub(super) fn point_depth_collision(
+        &mut self,
+        camera: &Camera,
+        depth: Option<&wgpu::TextureView>,
+    ) {
+        let host = depth.map(|view| HostDepthView {
+            view: view.clone(),
+            clip_from_world: camera.clip_from_world(),
+            reversed_z: camera.reversed_z(),
+            size: camera.size_px(),
+        });
+        for instance in self.instances.iter_mut() {
+            if let (Backing::Own(sim), _) = instance.state_mut() {
+                sim.set_host_depth(host.clone());
+            }
+        }
+    }
+
+    /// The view of the host's depth the passes sample (see [`HostDepth`]), or why the
+    /// one handed over cannot be.
+    pub(super) fn host_depth_view(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        camera: &Camera,
+        scene_depth: Option<&wgpu::TextureView>,
+    ) -> (Option<wgpu::TextureView>, Option<String>) {
+        let Some(view) = scene_depth else {
+            return (None, None);
+        };
+        let Some(format) = self.settings.depth_format else {
+            let why = "the player was created without a depth format \
+                       (PlayerSettings::depth_format)";
+            return (None, Some(why.into()));
+        };
+        let expected = (format, self.settings.sample_count.max(1));
+        let size = camera.size_px();
+        match (self.host_depth).sampled(&self.ctx, &self.library, encoder, view, size, expected) {
+            Ok(v) => (Some(v), None),
+            Err(why) => (None, Some(why)),
+        }
+    }
 }

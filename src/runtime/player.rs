@@ -17,7 +17,6 @@ use crate::runtime::host_depth::HostDepth;
 use crate::runtime::instances::{Backing, Instance, InstanceId, Slab};
 use crate::shaders::{ShaderError, ShaderLibrary};
 use crate::sim::batch::{BatchMember, InstanceBatch, batchable};
-use crate::sim::depth_collision::HostDepthView;
 use crate::sim::gpu_sim::{SharedUpdate, SimError, UpdateMode};
 use crate::sim::{GpuSim, Stepper};
 
@@ -473,54 +472,6 @@ impl Player {
         drop(groups);
         drop(members);
         self.uploads.finish(encoder);
-    }
-
-    /// The depth (seen by `camera`) the steps of a following [`Player::simulate`] collide
-    /// with: the editor's test scene, drawn before its timed update.
-    #[cfg(feature = "editor")]
-    pub(crate) fn collide_with(&mut self, camera: &Camera, depth: Option<&wgpu::TextureView>) {
-        let camera = self.preset_camera(camera);
-        self.point_depth_collision(&camera, depth);
-    }
-
-    /// Hands this frame's depth (and `camera`, in the presets' world) to every simulation
-    /// with depth collision: the steps recorded next collide with it.
-    fn point_depth_collision(&mut self, camera: &Camera, depth: Option<&wgpu::TextureView>) {
-        let host = depth.map(|view| HostDepthView {
-            view: view.clone(),
-            clip_from_world: camera.clip_from_world(),
-            reversed_z: camera.reversed_z(),
-            size: camera.size_px(),
-        });
-        for instance in self.instances.iter_mut() {
-            if let (Backing::Own(sim), _) = instance.state_mut() {
-                sim.set_host_depth(host.clone());
-            }
-        }
-    }
-
-    /// The view of the host's depth the passes sample (see [`HostDepth`]), or why the
-    /// one handed over cannot be.
-    fn host_depth_view(
-        &mut self,
-        encoder: &mut wgpu::CommandEncoder,
-        camera: &Camera,
-        scene_depth: Option<&wgpu::TextureView>,
-    ) -> (Option<wgpu::TextureView>, Option<String>) {
-        let Some(view) = scene_depth else {
-            return (None, None);
-        };
-        let Some(format) = self.settings.depth_format else {
-            let why = "the player was created without a depth format \
-                       (PlayerSettings::depth_format)";
-            return (None, Some(why.into()));
-        };
-        let expected = (format, self.settings.sample_count.max(1));
-        let size = camera.size_px();
-        match (self.host_depth).sampled(&self.ctx, &self.library, encoder, view, size, expected) {
-            Ok(v) => (Some(v), None),
-            Err(why) => (None, Some(why)),
-        }
     }
 
     /// The groups of instances drawn together, far to near by their mean depth along
