@@ -29,7 +29,7 @@ pub mod gpu {
 /// The shader library and its composed sources (`shaders`).
 pub mod shaders {
     pub use crate::shaders::{
-        EMBEDDED, ENTRY_FILES, EVENTS_IO, PACKED_STATE_IO, PARAMS_INSTANCED, ShaderError,
+        DEPTH_IO, EMBEDDED, ENTRY_FILES, EVENTS_IO, PACKED_STATE_IO, PARAMS_INSTANCED, ShaderError,
         ShaderLibrary, TINY_STATE_IO, TRAIL_IO,
     };
 }

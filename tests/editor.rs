@@ -256,11 +256,11 @@ fn emitters_can_be_added_duplicated_reordered_and_removed() {
         .iter()
         .map(|e| e.enabled)
         .collect();
-    assert_eq!(enabled, [false, false, true, false]);
+    assert_eq!(enabled, [false, false, true, false, false]);
 
     harness.get_by_label("Remove").click_accesskit();
     harness.run();
-    assert_eq!(harness.state().effect.emitters.len(), 3);
+    assert_eq!(harness.state().effect.emitters.len(), 4);
     harness.get_by_label("All on").click_accesskit();
     harness.run();
     assert!(harness.state().effect.emitters.iter().all(|e| e.enabled));

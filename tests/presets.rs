@@ -1629,6 +1629,7 @@ fn documented_examples_and_defaults_match_the_code() {
     e.forces.flame_pull = Some(FlamePull::default());
     e.collisions.ground = Some(GroundPlane::default());
     e.collisions.spheres = vec![SphereCollider::default()];
+    e.collisions.depth_collision = Some(DepthCollision::default());
     e.look.flipbook = Some(Flipbook::default());
     e.look.streak = Some(Streak::default());
     expected.post.bloom = Some(Bloom::default());

@@ -60,6 +60,13 @@ fn every_entry_validates() {
     assert!(trail.files.iter().any(|f| f == "trail_on.wgsl"));
     assert!(!trail.files.iter().any(|f| f == "trail_off.wgsl"));
     reached.extend(trail.files);
+    // An emitter colliding with the host's depth: depth_on.wgsl for depth_off.wgsl.
+    let depth = project_shaders()
+        .compose_with("update.wgsl", &[ignis::testing::shaders::DEPTH_IO])
+        .unwrap_or_else(|e| panic!("update with depth collision: {e}"));
+    assert!(depth.files.iter().any(|f| f == "depth_on.wgsl"));
+    assert!(!depth.files.iter().any(|f| f == "depth_off.wgsl"));
+    reached.extend(depth.files);
     reached.extend(packed.files);
     reached.extend(tiny.files);
     reached.extend(instanced.files);

@@ -402,11 +402,11 @@ impl FrameResources {
         self.look_bytes = blocks;
         // Alpha-blended layers are drawn in one order by one path: all by the tiles or
         // none — but ribbons, which only the billboards draw: those are drawn first
-        // (behind the tiles' blended layers) and leave the others their path.
-        if items
-            .iter()
-            .any(|d| d.blend == BlendMode::Alpha && !d.tiles && d.trail.is_none())
-        {
+        // (behind the tiles' blended layers) and leave the others their path; and heat
+        // haze, which is not drawn in colour at all.
+        if items.iter().any(|d| {
+            d.blend == BlendMode::Alpha && !d.tiles && d.trail.is_none() && !d.variant.haze
+        }) {
             for d in items.iter_mut().filter(|d| d.blend == BlendMode::Alpha) {
                 d.tiles = false;
             }
