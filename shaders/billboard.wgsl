@@ -39,8 +39,11 @@ override MOTION: bool = false;
 // target: a ripple across the sprite (look.extra.y ripples), of amplitude
 // look.size_intensity.w × the particle's size on screen, weighted by the sprite's
 // coverage, the opacity over life and the soft edges. haze_apply.wgsl refracts the frame
-// by the sum.
+// by the sum. The distortion target is HAZE_DOWNSCALE times smaller than the frame
+// (keep in sync with `HAZE_DOWNSCALE` in src/render/haze.rs): the ripples are smooth, and
+// large hot-air sprites cost a quarter of their fill.
 override HAZE: bool = false;
+const HAZE_DOWNSCALE: f32 = 2.0;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -215,7 +218,9 @@ fn edge_fade(clip: vec4<f32>, height: f32) -> f32 {
     if SOFT_DEPTH {
         // Soft particles against the host's scene: fade over the soft-edge distance
         // between this fragment and what the host drew behind it (view-space distances).
-        let scene = textureLoad(scene_depth, vec2<i32>(clip.xy), 0);
+        // The host's depth is the frame's size; the distortion target is smaller.
+        let px = clip.xy * select(1.0, HAZE_DOWNSCALE, HAZE);
+        let scene = textureLoad(scene_depth, vec2<i32>(px), 0);
         fade = clamp((view_distance(scene) - view_distance(clip.z)) * height, 0.0, 1.0);
     }
     return fade;

@@ -2,8 +2,9 @@
 // distortion target says, into the frame's colour. One full-screen triangle.
 //
 // Contract: group 0: binding 0 `scene_color` (the copy, the target's size), 1
-// `distortion` (the summed offsets in uv units, rg; billboard.wgsl HAZE), 2 a linear
-// clamped sampler. A pixel with no offset samples its own texel's centre: unchanged.
+// `distortion` (the summed offsets in uv units, rg; billboard.wgsl HAZE; smaller than the
+// target, sampled bilinearly), 2 a linear clamped sampler. A pixel with no offset samples
+// its own texel's centre: unchanged.
 
 @group(0) @binding(0) var scene_color: texture_2d<f32>;
 @group(0) @binding(1) var distortion: texture_2d<f32>;
@@ -17,7 +18,7 @@ fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
 
 @fragment
 fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let size = vec2<f32>(textureDimensions(scene_color));
-    let offset = textureLoad(distortion, vec2<i32>(frag.xy), 0).xy;
-    return textureSampleLevel(scene_color, scene_sampler, frag.xy / size + offset, 0.0);
+    let uv = frag.xy / vec2<f32>(textureDimensions(scene_color));
+    let offset = textureSampleLevel(distortion, scene_sampler, uv, 0.0).xy;
+    return textureSampleLevel(scene_color, scene_sampler, uv + offset, 0.0);
 }

@@ -112,7 +112,7 @@ fn the_refraction_shifts_the_image_by_the_distortion() {
         b: 0.0,
         a: 0.0,
     };
-    drop(haze.begin(&ctx, &mut enc, (W, H), offset));
+    drop(haze.begin(&ctx, &mut enc, ((W, H), 2), offset));
     let view = |t: &wgpu::Texture| t.create_view(&Default::default());
     haze.refract(&ctx, &mut enc, &view(&scene), &view(&out));
     let got = read(&ctx, enc, &out);

@@ -99,7 +99,7 @@ impl FrameRenderer {
         player: &mut Player,
     ) -> Result<Option<TextureReadback>, ExportError> {
         let drawn = player
-            .draw_distortion(enc, self.size)
+            .draw_distortion(enc, (self.size, 1))
             .map_err(|e| ExportError::Invalid(format!("the distortion pass: {e}")))?;
         Ok(drawn
             .then(|| player.distortion())

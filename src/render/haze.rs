@@ -6,6 +6,10 @@ use crate::gpu::GpuContext;
 use crate::render::billboard::HAZE_FORMAT;
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 
+/// How many times smaller than the frame the distortion target is (keep in sync with
+/// `HAZE_DOWNSCALE` in `shaders/billboard.wgsl`).
+pub const HAZE_DOWNSCALE: u32 = 2;
+
 /// The distortion target (kept while its size holds) and the refraction's pipeline.
 pub struct HazePass {
     layout: wgpu::BindGroupLayout,
@@ -27,7 +31,7 @@ impl HazePass {
                 label: Some("HazePass::layout"),
                 entries: &[
                     crate::gpu::fragment_texture_entry(0, true),
-                    crate::gpu::fragment_texture_entry(1, false),
+                    crate::gpu::fragment_texture_entry(1, true),
                     crate::gpu::fragment_sampler_entry(2),
                 ],
             });
@@ -46,15 +50,18 @@ impl HazePass {
         })
     }
 
-    /// The distortion target of `size` pixels (made on first need), cleared to `clear`
-    /// (no offset: transparent) and open in a pass for the haze layers' draws.
+    /// The distortion target for a frame of `frame` pixels, `downscale` times smaller
+    /// ([`HAZE_DOWNSCALE`] for a frame's refraction, 1 for the export's pass; made on
+    /// first need), cleared to `clear` (no offset: transparent) and open in a pass for
+    /// the haze layers' draws.
     pub fn begin<'e>(
         &mut self,
         ctx: &GpuContext,
         enc: &'e mut wgpu::CommandEncoder,
-        size: (u32, u32),
+        (frame, downscale): ((u32, u32), u32),
         clear: wgpu::Color,
     ) -> wgpu::RenderPass<'e> {
+        let size = crate::render::reduced(frame, downscale.max(1));
         if self.target.as_ref().is_some_and(|(s, _, _)| *s != size) {
             self.target = None;
         }

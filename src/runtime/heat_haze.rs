@@ -1,7 +1,7 @@
 //! Heat haze in the runtime: the effect's haze layers drawn into the player's distortion
 //! target and the frame refracted by it, after the particles' pass.
 
-use crate::render::haze::HazePass;
+use crate::render::haze::{HAZE_DOWNSCALE, HazePass};
 use crate::sim::SimError;
 
 use super::{Player, PlayerError};
@@ -27,7 +27,8 @@ impl Player {
         target: &wgpu::TextureView,
     ) -> Result<bool, PlayerError> {
         let size = target.texture().size();
-        if !self.draw_distortion(encoder, (size.width, size.height))? {
+        let frame = (size.width, size.height);
+        if !self.draw_distortion(encoder, (frame, HAZE_DOWNSCALE))? {
             return Ok(false);
         }
         if let Some(haze) = &self.haze {
@@ -36,13 +37,13 @@ impl Player {
         Ok(true)
     }
 
-    /// Draws the haze layers into the distortion target, made `size` pixels, without
-    /// refracting anything (the export's distortion pass); false, and nothing recorded,
-    /// without haze.
+    /// Draws the haze layers into the distortion target of a frame of `size.0` pixels,
+    /// `size.1` times smaller, without refracting anything (the export's distortion pass
+    /// at full size); false, and nothing recorded, without haze.
     pub(crate) fn draw_distortion(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
-        size: (u32, u32),
+        size: ((u32, u32), u32),
     ) -> Result<bool, PlayerError> {
         if !self.has_haze() {
             return Ok(false);
