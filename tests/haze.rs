@@ -65,9 +65,19 @@ fn target(ctx: &GpuContext, bytes: &[u8]) -> wgpu::Texture {
     texture
 }
 
-/// `texture`'s texels after `enc` runs.
-fn read(ctx: &GpuContext, mut enc: wgpu::CommandEncoder, texture: &wgpu::Texture) -> Vec<u8> {
-    let row = (W * 4).next_multiple_of(256);
+/// `texture`'s texels (8-bit RGBA) after `enc` runs.
+fn read(ctx: &GpuContext, enc: wgpu::CommandEncoder, texture: &wgpu::Texture) -> Vec<u8> {
+    read_texels(ctx, enc, texture, 4)
+}
+
+/// `texture`'s texels of `texel` bytes after `enc` runs.
+fn read_texels(
+    ctx: &GpuContext,
+    mut enc: wgpu::CommandEncoder,
+    texture: &wgpu::Texture,
+    texel: u32,
+) -> Vec<u8> {
+    let row = (W * texel).next_multiple_of(256);
     let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
         label: None,
         size: u64::from(row * H),
@@ -92,7 +102,7 @@ fn read(ctx: &GpuContext, mut enc: wgpu::CommandEncoder, texture: &wgpu::Texture
     let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
     let data = slice.get_mapped_range().expect("mapped");
     (0..H as usize)
-        .flat_map(|y| data[y * row as usize..][..W as usize * 4].to_vec())
+        .flat_map(|y| data[y * row as usize..][..(W * texel) as usize].to_vec())
         .collect()
 }
 
@@ -138,6 +148,82 @@ fn the_refraction_shifts_the_image_by_the_distortion() {
         }
     }
     assert_eq!(checked, (W as usize - 3) * (H as usize - 2));
+}
+
+/// The compute refraction (an `Rgba16Float` storage target, as the editor's HDR image):
+/// the same shift of (−4, 3) pixels, to 1/255; pixels outside the distortion's reach are
+/// not rewritten.
+#[test]
+fn the_compute_refraction_shifts_an_hdr_image_by_the_distortion() {
+    let ctx = gpu();
+    let (dx, dy) = (-4i32, 3i32);
+    let format = wgpu::TextureFormat::Rgba16Float;
+    let mut haze = HazePass::new(&ctx, &ShaderLibrary::embedded(), format).expect("haze pass");
+    let halves: Vec<u8> = pattern_bytes()
+        .iter()
+        .flat_map(|&b| half::f16::from_f32(f32::from(b) / 255.0).to_le_bytes())
+        .collect();
+    let hdr = |bytes: &[u8]| {
+        let t = ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("haze test hdr"),
+            size: wgpu::Extent3d {
+                width: W,
+                height: H,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let layout = wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(W * 8),
+            rows_per_image: None,
+        };
+        ctx.queue
+            .write_texture(t.as_image_copy(), bytes, layout, t.size());
+        t
+    };
+    let (scene, out) = (hdr(&halves), hdr(&halves));
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    let offset = wgpu::Color {
+        r: f64::from(dx) / f64::from(W),
+        g: f64::from(dy) / f64::from(H),
+        b: 0.0,
+        a: 0.0,
+    };
+    drop(haze.begin(&ctx, &mut enc, ((W, H), 2), offset));
+    let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+    haze.refract(&ctx, &mut enc, &view(&scene), &view(&out));
+    let got = read_texels(&ctx, enc, &out, 8);
+    let mut checked = 0;
+    for y in 0..H as i32 {
+        for x in 0..W as i32 {
+            let (sx, sy) = (x + dx, y + dy);
+            if sx < 0 || sy < 0 || sx >= W as i32 || sy >= H as i32 {
+                continue;
+            }
+            let at = ((y as u32 * W + x as u32) * 8) as usize;
+            let want = pattern(sx as u32, sy as u32);
+            for c in 0..4 {
+                let v = half::f16::from_le_bytes([got[at + 2 * c], got[at + 2 * c + 1]]);
+                let d = (v.to_f32() - f32::from(want[c]) / 255.0).abs();
+                assert!(
+                    d <= 1.0 / 255.0,
+                    "({x}, {y}) channel {c}: {v} for {}",
+                    want[c]
+                );
+            }
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, (W as usize - 4) * (H as usize - 3));
 }
 
 /// A torch player (no haze): nothing to apply, nothing recorded, the host's image kept

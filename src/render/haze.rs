@@ -14,6 +14,9 @@ pub const HAZE_DOWNSCALE: u32 = 2;
 pub struct HazePass {
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::RenderPipeline,
+    /// The refraction by compute into an `Rgba16Float` storage target.
+    compute_layout: wgpu::BindGroupLayout,
+    compute: wgpu::ComputePipeline,
     sampler: wgpu::Sampler,
     target: Option<((u32, u32), wgpu::Texture, wgpu::TextureView)>,
 }
@@ -36,6 +39,28 @@ impl HazePass {
                 ],
             });
         let pipeline = pipeline(ctx, lib, &layout, format)?;
+        let compute_layout =
+            ctx.device
+                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some("HazePass::compute_layout"),
+                    entries: &[
+                        compute_entry(0, texture_entry()),
+                        compute_entry(1, texture_entry()),
+                        compute_entry(
+                            2,
+                            wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                        ),
+                        compute_entry(
+                            3,
+                            wgpu::BindingType::StorageTexture {
+                                access: wgpu::StorageTextureAccess::WriteOnly,
+                                format: COMPUTE_FORMAT,
+                                view_dimension: wgpu::TextureViewDimension::D2,
+                            },
+                        ),
+                    ],
+                });
+        let compute = compute_pipeline(ctx, lib, &compute_layout)?;
         let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("HazePass::sampler"),
             mag_filter: wgpu::FilterMode::Linear,
@@ -45,6 +70,8 @@ impl HazePass {
         Ok(Self {
             layout,
             pipeline,
+            compute_layout,
+            compute,
             sampler,
             target: None,
         })
@@ -88,8 +115,9 @@ impl HazePass {
         self.target.as_ref().map(|t| &t.1)
     }
 
-    /// Refracts `scene` (a copy of the frame's colour, the distortion's size) into
-    /// `target` by the distortion target.
+    /// Refracts `scene` (a copy of the frame's colour, the frame's size) into `target`
+    /// (holding the same image) by the distortion target: by compute where `target` is
+    /// an `Rgba16Float` storage texture, else by a full-screen draw.
     pub fn refract(
         &self,
         ctx: &GpuContext,
@@ -100,23 +128,31 @@ impl HazePass {
         let Some((_, _, distortion)) = &self.target else {
             return;
         };
+        let texture = target.texture();
+        let entries = |extra| group_entries([scene, distortion], &self.sampler, extra);
+        if texture.format() == COMPUTE_FORMAT
+            && texture
+                .usage()
+                .contains(wgpu::TextureUsages::STORAGE_BINDING)
+        {
+            let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("HazePass::compute_group"),
+                layout: &self.compute_layout,
+                entries: &entries(Some(target)),
+            });
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("HazePass::refract"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.compute);
+            pass.set_bind_group(0, &group, &[]);
+            pass.dispatch_workgroups(texture.width().div_ceil(8), texture.height().div_ceil(8), 1);
+            return;
+        }
         let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("HazePass::group"),
             layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(scene),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(distortion),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::Sampler(&self.sampler),
-                },
-            ],
+            entries: &entries(None),
         });
         let load = wgpu::LoadOp::Load;
         let mut pass = crate::gpu::color_pass(enc, target, load, "HazePass::refract");
@@ -124,6 +160,77 @@ impl HazePass {
         pass.set_bind_group(0, &group, &[]);
         pass.draw(0..3, 0..1);
     }
+}
+
+/// The refraction's bindings: the scene copy and the distortion, the sampler, and (the
+/// compute path) the target.
+fn group_entries<'a>(
+    views: [&'a wgpu::TextureView; 2],
+    sampler: &'a wgpu::Sampler,
+    target: Option<&'a wgpu::TextureView>,
+) -> Vec<wgpu::BindGroupEntry<'a>> {
+    let view = |binding, view| wgpu::BindGroupEntry {
+        binding,
+        resource: wgpu::BindingResource::TextureView(view),
+    };
+    let mut entries = vec![
+        view(0, views[0]),
+        view(1, views[1]),
+        wgpu::BindGroupEntry {
+            binding: 2,
+            resource: wgpu::BindingResource::Sampler(sampler),
+        },
+    ];
+    entries.extend(target.map(|t| view(3, t)));
+    entries
+}
+
+/// The storage format the compute refraction writes.
+const COMPUTE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// A filterable float texture binding.
+fn texture_entry() -> wgpu::BindingType {
+    wgpu::BindingType::Texture {
+        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+        view_dimension: wgpu::TextureViewDimension::D2,
+        multisampled: false,
+    }
+}
+
+/// A compute-stage binding.
+fn compute_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty,
+        count: None,
+    }
+}
+
+/// The compute refraction (`cs_main`).
+fn compute_pipeline(
+    ctx: &GpuContext,
+    lib: &ShaderLibrary,
+    layout: &wgpu::BindGroupLayout,
+) -> Result<wgpu::ComputePipeline, ShaderError> {
+    let pipeline_layout = ctx
+        .device
+        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("HazePass::compute_pipeline_layout"),
+            bind_group_layouts: &[Some(layout)],
+            immediate_size: 0,
+        });
+    let composed = lib.compose("haze_apply.wgsl")?;
+    create_checked(&ctx.device, &composed, lib, |module| {
+        crate::gpu::compute_pipeline(
+            ctx,
+            "HazePass::compute",
+            &pipeline_layout,
+            module,
+            "cs_main",
+            &[],
+        )
+    })
 }
 
 fn pipeline(
