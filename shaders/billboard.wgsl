@@ -43,7 +43,7 @@ override MOTION: bool = false;
 // (keep in sync with `HAZE_DOWNSCALE` in src/render/haze.rs): the ripples are smooth, and
 // large hot-air sprites cost a quarter of their fill.
 override HAZE: bool = false;
-const HAZE_DOWNSCALE: f32 = 2.0;
+const HAZE_DOWNSCALE: f32 = 4.0;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,

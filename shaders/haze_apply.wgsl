@@ -25,8 +25,8 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
 
 // The same refraction by compute, for a target with storage usage in `rgba16float` (the
 // editor's and `ignis render`'s HDR target): GPUs run compute on every SM, while a
-// full-screen draw runs on the few that rasterise (on the H100 the draw took ~3 ms at 4K).
-// Only pixels with an offset are written: the others already hold their colour.
+// full-screen draw runs on the few that rasterise. Every pixel is written (the target
+// need not hold the image: the editor refracts into a second HDR image).
 @group(0) @binding(3) var target_image: texture_storage_2d<rgba16float, write>;
 
 @compute @workgroup_size(8, 8)
@@ -37,8 +37,5 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let uv = (vec2<f32>(id.xy) + 0.5) / vec2<f32>(size);
     let offset = textureSampleLevel(distortion, scene_sampler, uv, 0.0).xy;
-    if all(offset == vec2<f32>(0.0)) {
-        return;
-    }
     textureStore(target_image, id.xy, textureSampleLevel(scene_color, scene_sampler, uv + offset, 0.0));
 }

@@ -151,8 +151,7 @@ fn the_refraction_shifts_the_image_by_the_distortion() {
 }
 
 /// The compute refraction (an `Rgba16Float` storage target, as the editor's HDR image):
-/// the same shift of (−4, 3) pixels, to 1/255; pixels outside the distortion's reach are
-/// not rewritten.
+/// the same shift of (−4, 3) pixels, to 1/255.
 #[test]
 fn the_compute_refraction_shifts_an_hdr_image_by_the_distortion() {
     let ctx = gpu();

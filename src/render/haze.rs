@@ -8,7 +8,7 @@ use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 
 /// How many times smaller than the frame the distortion target is (keep in sync with
 /// `HAZE_DOWNSCALE` in `shaders/billboard.wgsl`).
-pub const HAZE_DOWNSCALE: u32 = 2;
+pub const HAZE_DOWNSCALE: u32 = 4;
 
 /// The distortion target (kept while its size holds) and the refraction's pipeline.
 pub struct HazePass {
@@ -115,9 +115,9 @@ impl HazePass {
         self.target.as_ref().map(|t| &t.1)
     }
 
-    /// Refracts `scene` (a copy of the frame's colour, the frame's size) into `target`
-    /// (holding the same image) by the distortion target: by compute where `target` is
-    /// an `Rgba16Float` storage texture, else by a full-screen draw.
+    /// Refracts `scene` (a copy of the frame's colour, the frame's size) into `target`,
+    /// every pixel written, by the distortion target: by compute where `target` is an
+    /// `Rgba16Float` storage texture, else by a full-screen draw.
     pub fn refract(
         &self,
         ctx: &GpuContext,
