@@ -128,6 +128,23 @@ fn vel(p: &Particle) -> Vec3 {
     Vec3::from_slice(&p.vel_life[..3])
 }
 
+/// `effect` played `frames` frames against the wall: the particles at the end, and the
+/// lowest z any particle reached in any frame (how far behind the wall it got).
+fn at_the_wall(host: &Host, effect: &Effect, frames: u32) -> (Vec<Particle>, f32) {
+    let mut deepest = f32::MAX;
+    let (_, last) = run(
+        host,
+        &[wall()],
+        &mut host.player(effect),
+        frames,
+        true,
+        |p| {
+            deepest = p.iter().map(|p| pos(p).z).fold(deepest, f32::min);
+        },
+    );
+    (last, deepest)
+}
+
 /// The wall the sparks are fired at: the plane z = 0 facing the camera.
 fn wall() -> Quad {
     quad(Vec3::ZERO, Vec3::X * 3.0, Vec3::Y * 3.0)
@@ -146,11 +163,7 @@ fn sparks_stop_at_the_host_depth_and_rebound_with_the_restitution() {
         vec3(0.0, 0.0, -3.0),
         0.5,
     );
-    let mut player = host.player(&effect);
-    let mut deepest = f32::MAX;
-    let (_, last) = run(&host, &[wall()], &mut player, 60, true, |p| {
-        deepest = p.iter().map(|p| pos(p).z).fold(deepest, f32::min);
-    });
+    let (last, deepest) = at_the_wall(&host, &effect, 60);
     assert_eq!(last.len(), 200);
     assert!(deepest >= -THICKNESS, "a spark reached z = {deepest}");
     for p in &last {
@@ -170,6 +183,45 @@ fn sparks_stop_at_the_host_depth_and_rebound_with_the_restitution() {
         through.iter().all(|p| pos(p).z < -1.4),
         "without the depth they fly on"
     );
+}
+
+/// The host's depth as hosts hand it over: multisampled (4×: the runtime's single-sample
+/// copy is what the sparks collide with) and a depth-stencil format (its depth aspect):
+/// the sparks stop at the wall and come back at the restitution as with a plain host.
+#[test]
+fn msaa_and_depth_stencil_hosts_stop_sparks_alike() {
+    let kinds = [
+        HostKind {
+            color: wgpu::TextureFormat::Rgba16Float,
+            samples: 4,
+            ..HostKind::default()
+        },
+        HostKind {
+            depth: wgpu::TextureFormat::Depth24PlusStencil8,
+            ..HostKind::default()
+        },
+    ];
+    let effect = sparks(
+        100,
+        vec3(0.0, 0.5, 1.5),
+        [0.6, 0.4, 0.0],
+        vec3(0.0, 0.0, -3.0),
+        0.5,
+    );
+    for kind in kinds {
+        let what = format!("{kind:?}");
+        let host = Host::of(kind, EYE, TARGET);
+        let (last, deepest) = at_the_wall(&host, &effect, 60);
+        assert_eq!(last.len(), 100, "{what}");
+        assert!(
+            deepest >= -THICKNESS,
+            "{what}: a spark reached z = {deepest}"
+        );
+        for p in &last {
+            let v = vel(p);
+            assert!(v.abs_diff_eq(vec3(0.0, 0.0, 1.5), 2e-2), "{what}: {v}");
+        }
+    }
 }
 
 /// A plane tilted towards the camera: a perfectly elastic bounce reflects each spark
@@ -266,11 +318,7 @@ fn fast_sparks_do_not_tunnel_through_a_thin_wall() {
         vec3(0.0, 0.0, -60.0),
         0.2,
     );
-    let mut player = host.player(&effect);
-    let mut deepest = f32::MAX;
-    let (_, last) = run(&host, &[wall()], &mut player, 6, true, |p| {
-        deepest = p.iter().map(|p| pos(p).z).fold(deepest, f32::min);
-    });
+    let (last, deepest) = at_the_wall(&host, &effect, 6);
     assert_eq!(last.len(), 200);
     assert!(deepest >= -THICKNESS, "a spark reached z = {deepest}");
     assert!(

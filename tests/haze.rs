@@ -35,6 +35,18 @@ fn pattern_bytes() -> Vec<u8> {
 
 /// A target the size of the test's frame: sampled, drawn into, copied and read back.
 fn target(ctx: &GpuContext, bytes: &[u8]) -> wgpu::Texture {
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+    texture_of(ctx, FORMAT, usage, bytes)
+}
+
+/// A texture of the test's frame size in `format` holding `bytes` (tight rows), sampled,
+/// copied both ways, and with `usage` too.
+fn texture_of(
+    ctx: &GpuContext,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+    bytes: &[u8],
+) -> wgpu::Texture {
     let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
         label: Some("haze test target"),
         size: wgpu::Extent3d {
@@ -45,19 +57,20 @@ fn target(ctx: &GpuContext, bytes: &[u8]) -> wgpu::Texture {
         mip_level_count: 1,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
-        format: FORMAT,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+        format,
+        usage: usage
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC
             | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
     });
+    let texel = format.block_copy_size(None).unwrap_or(4);
     ctx.queue.write_texture(
         texture.as_image_copy(),
         bytes,
         wgpu::TexelCopyBufferLayout {
             offset: 0,
-            bytes_per_row: Some(W * 4),
+            bytes_per_row: Some(W * texel),
             rows_per_image: None,
         },
         texture.size(),
@@ -106,90 +119,43 @@ fn read_texels(
         .collect()
 }
 
-/// A distortion of a constant (3, −2) pixels: every pixel whose source is inside the
-/// image shows the pattern's texel there, to the 8-bit level.
+/// A distortion of a constant (3, −2) pixels by the full-screen draw (an 8-bit target):
+/// every pixel whose source is inside the image shows the pattern's texel there, to the
+/// 8-bit level.
 #[test]
 fn the_refraction_shifts_the_image_by_the_distortion() {
-    let ctx = gpu();
-    let (dx, dy) = (3i32, -2i32);
-    let mut haze = HazePass::new(&ctx, &ShaderLibrary::embedded(), FORMAT).expect("haze pass");
-    let scene = target(&ctx, &pattern_bytes());
-    let out = target(&ctx, &vec![0; (W * H * 4) as usize]);
-    let mut enc = ctx.device.create_command_encoder(&Default::default());
-    let offset = wgpu::Color {
-        r: f64::from(dx) / f64::from(W),
-        g: f64::from(dy) / f64::from(H),
-        b: 0.0,
-        a: 0.0,
-    };
-    drop(haze.begin(&ctx, &mut enc, ((W, H), 2), offset));
-    let view = |t: &wgpu::Texture| t.create_view(&Default::default());
-    haze.refract(&ctx, &mut enc, &view(&scene), &view(&out));
-    let got = read(&ctx, enc, &out);
-    let mut checked = 0;
-    for y in 0..H as i32 {
-        for x in 0..W as i32 {
-            let (sx, sy) = (x + dx, y + dy);
-            if sx < 0 || sy < 0 || sx >= W as i32 || sy >= H as i32 {
-                continue;
-            }
-            let at = ((y as u32 * W + x as u32) * 4) as usize;
-            let want = pattern(sx as u32, sy as u32);
-            for c in 0..4 {
-                let d = (i32::from(got[at + c]) - i32::from(want[c])).abs();
-                assert!(
-                    d <= 1,
-                    "({x}, {y}) channel {c}: {} for {}",
-                    got[at + c],
-                    want[c]
-                );
-            }
-            checked += 1;
-        }
-    }
-    assert_eq!(checked, (W as usize - 3) * (H as usize - 2));
+    let got = refracted(FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT, (3, -2));
+    assert_shifted((3, -2), |at, c| f32::from(got[at * 4 + c]) / 255.0);
 }
 
 /// The compute refraction (an `Rgba16Float` storage target, as the editor's HDR image):
-/// the same shift of (−4, 3) pixels, to 1/255.
+/// a shift of (−4, 3) pixels, to 1/255.
 #[test]
 fn the_compute_refraction_shifts_an_hdr_image_by_the_distortion() {
-    let ctx = gpu();
-    let (dx, dy) = (-4i32, 3i32);
     let format = wgpu::TextureFormat::Rgba16Float;
+    let got = refracted(format, wgpu::TextureUsages::STORAGE_BINDING, (-4, 3));
+    assert_shifted((-4, 3), |at, c| {
+        half::f16::from_le_bytes([got[at * 8 + 2 * c], got[at * 8 + 2 * c + 1]]).to_f32()
+    });
+}
+
+/// The pattern in a `format` texture (with `usage`) refracted by a constant distortion of
+/// `shift` pixels into another: its bytes.
+fn refracted(
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+    (dx, dy): (i32, i32),
+) -> Vec<u8> {
+    let ctx = gpu();
     let mut haze = HazePass::new(&ctx, &ShaderLibrary::embedded(), format).expect("haze pass");
-    let halves: Vec<u8> = pattern_bytes()
-        .iter()
-        .flat_map(|&b| half::f16::from_f32(f32::from(b) / 255.0).to_le_bytes())
-        .collect();
-    let hdr = |bytes: &[u8]| {
-        let t = ctx.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("haze test hdr"),
-            size: wgpu::Extent3d {
-                width: W,
-                height: H,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::STORAGE_BINDING
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC
-                | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
-        let layout = wgpu::TexelCopyBufferLayout {
-            offset: 0,
-            bytes_per_row: Some(W * 8),
-            rows_per_image: None,
-        };
-        ctx.queue
-            .write_texture(t.as_image_copy(), bytes, layout, t.size());
-        t
+    let bytes: Vec<u8> = match format {
+        FORMAT => pattern_bytes(),
+        _ => (pattern_bytes().iter())
+            .flat_map(|&b| half::f16::from_f32(f32::from(b) / 255.0).to_le_bytes())
+            .collect(),
     };
-    let (scene, out) = (hdr(&halves), hdr(&halves));
+    let scene = texture_of(&ctx, format, usage, &bytes);
+    let out = texture_of(&ctx, format, usage, &vec![0; bytes.len()]);
     let mut enc = ctx.device.create_command_encoder(&Default::default());
     let offset = wgpu::Color {
         r: f64::from(dx) / f64::from(W),
@@ -200,7 +166,13 @@ fn the_compute_refraction_shifts_an_hdr_image_by_the_distortion() {
     drop(haze.begin(&ctx, &mut enc, ((W, H), 2), offset));
     let view = |t: &wgpu::Texture| t.create_view(&Default::default());
     haze.refract(&ctx, &mut enc, &view(&scene), &view(&out));
-    let got = read_texels(&ctx, enc, &out, 8);
+    let texel = format.block_copy_size(None).unwrap_or(4);
+    read_texels(&ctx, enc, &out, texel)
+}
+
+/// Every pixel whose source, `shift` pixels away, is inside the frame holds the pattern's
+/// texel there to 1/255 (`value(pixel, channel)`: what the image holds, 0..1).
+fn assert_shifted((dx, dy): (i32, i32), value: impl Fn(usize, usize) -> f32) {
     let mut checked = 0;
     for y in 0..H as i32 {
         for x in 0..W as i32 {
@@ -208,21 +180,22 @@ fn the_compute_refraction_shifts_an_hdr_image_by_the_distortion() {
             if sx < 0 || sy < 0 || sx >= W as i32 || sy >= H as i32 {
                 continue;
             }
-            let at = ((y as u32 * W + x as u32) * 8) as usize;
             let want = pattern(sx as u32, sy as u32);
-            for c in 0..4 {
-                let v = half::f16::from_le_bytes([got[at + 2 * c], got[at + 2 * c + 1]]);
-                let d = (v.to_f32() - f32::from(want[c]) / 255.0).abs();
+            let at = (y as u32 * W + x as u32) as usize;
+            for (c, w) in want.iter().enumerate() {
+                let v = value(at, c);
+                let d = (v - f32::from(*w) / 255.0).abs();
                 assert!(
-                    d <= 1.0 / 255.0,
-                    "({x}, {y}) channel {c}: {v} for {}",
-                    want[c]
+                    d <= 1.0 / 255.0 + 1e-6,
+                    "({x}, {y}) channel {c}: {v} for {w}"
                 );
             }
             checked += 1;
         }
     }
-    assert_eq!(checked, (W as usize - 4) * (H as usize - 3));
+    let expected =
+        (W as usize - dx.unsigned_abs() as usize) * (H as usize - dy.unsigned_abs() as usize);
+    assert_eq!(checked, expected);
 }
 
 /// A torch player (no haze): nothing to apply, nothing recorded, the host's image kept

@@ -38,7 +38,7 @@ impl HazePass {
                     crate::gpu::fragment_sampler_entry(2),
                 ],
             });
-        let pipeline = pipeline(ctx, lib, &layout, format)?;
+
         let compute_layout =
             ctx.device
                 .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -60,7 +60,7 @@ impl HazePass {
                         ),
                     ],
                 });
-        let compute = compute_pipeline(ctx, lib, &compute_layout)?;
+        let (pipeline, compute) = pipelines(ctx, lib, [&layout, &compute_layout], format)?;
         let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("HazePass::sampler"),
             mag_filter: wgpu::FilterMode::Linear,
@@ -207,68 +207,66 @@ fn compute_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEn
     }
 }
 
-/// The compute refraction (`cs_main`).
-fn compute_pipeline(
-    ctx: &GpuContext,
-    lib: &ShaderLibrary,
-    layout: &wgpu::BindGroupLayout,
-) -> Result<wgpu::ComputePipeline, ShaderError> {
-    let pipeline_layout = ctx
-        .device
-        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("HazePass::compute_pipeline_layout"),
-            bind_group_layouts: &[Some(layout)],
-            immediate_size: 0,
-        });
-    let composed = lib.compose("haze_apply.wgsl")?;
-    create_checked(&ctx.device, &composed, lib, |module| {
-        crate::gpu::compute_pipeline(
-            ctx,
-            "HazePass::compute",
-            &pipeline_layout,
-            module,
-            "cs_main",
-            &[],
-        )
-    })
-}
-
-fn pipeline(
-    ctx: &GpuContext,
-    lib: &ShaderLibrary,
-    layout: &wgpu::BindGroupLayout,
-    format: wgpu::TextureFormat,
-) -> Result<wgpu::RenderPipeline, ShaderError> {
-    let pipeline_layout = ctx
-        .device
+/// A pipeline layout of one group.
+fn one_group(ctx: &GpuContext, layout: &wgpu::BindGroupLayout) -> wgpu::PipelineLayout {
+    ctx.device
         .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("HazePass::pipeline_layout"),
             bind_group_layouts: &[Some(layout)],
             immediate_size: 0,
-        });
+        })
+}
+
+/// The refraction's pipelines from one module: the full-screen draw into `format`
+/// (`layouts[0]`) and the compute (`layouts[1]`).
+fn pipelines(
+    ctx: &GpuContext,
+    lib: &ShaderLibrary,
+    layouts: [&wgpu::BindGroupLayout; 2],
+    format: wgpu::TextureFormat,
+) -> Result<(wgpu::RenderPipeline, wgpu::ComputePipeline), ShaderError> {
+    let [draw_layout, compute_layout] = layouts.map(|l| one_group(ctx, l));
     let composed = lib.compose("haze_apply.wgsl")?;
     create_checked(&ctx.device, &composed, lib, |module| {
-        ctx.device
-            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("HazePass"),
-                layout: Some(&pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: Default::default(),
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module,
-                    entry_point: Some("fs_main"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(format.into())],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+        let compute = crate::gpu::compute_pipeline(
+            ctx,
+            "HazePass::compute",
+            &compute_layout,
+            module,
+            "cs_main",
+            &[],
+        );
+        (draw(ctx, module, &draw_layout, format), compute)
     })
+}
+
+/// The full-screen draw (`vs_main`, `fs_main`) into `format`.
+fn draw(
+    ctx: &GpuContext,
+    module: &wgpu::ShaderModule,
+    pipeline_layout: &wgpu::PipelineLayout,
+    format: wgpu::TextureFormat,
+) -> wgpu::RenderPipeline {
+    ctx.device
+        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("HazePass"),
+            layout: Some(pipeline_layout),
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(format.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
 }
