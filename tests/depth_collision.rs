@@ -38,7 +38,8 @@ fn quad(center: Vec3, u: Vec3, v: Vec3) -> Quad {
 
 /// `count` sparks in a box of half extents `half` at `at`, all at `velocity`, no forces,
 /// colliding with the host's depth (restitution `elasticity`, no friction).
-fn sparks(count: u32, at: Vec3, half: [f32; 3], velocity: Vec3, elasticity: f32) -> Effect {
+fn sparks(count: u32, at: [f32; 3], half: [f32; 3], velocity: [f32; 3], elasticity: f32) -> Effect {
+    let (at, velocity) = (Vec3::from(at), Vec3::from(velocity));
     let speed = velocity.length();
     let e = Emitter {
         name: "sparks".into(),
@@ -156,13 +157,7 @@ fn wall() -> Quad {
 #[test]
 fn sparks_stop_at_the_host_depth_and_rebound_with_the_restitution() {
     let host = Host::new(EYE, TARGET);
-    let effect = sparks(
-        200,
-        vec3(0.0, 0.5, 1.5),
-        [0.6, 0.4, 0.0],
-        vec3(0.0, 0.0, -3.0),
-        0.5,
-    );
+    let effect = sparks(200, [0.0, 0.5, 1.5], [0.6, 0.4, 0.0], [0.0, 0.0, -3.0], 0.5);
     let (last, deepest) = at_the_wall(&host, &effect, 60);
     assert_eq!(last.len(), 200);
     assert!(deepest >= -THICKNESS, "a spark reached z = {deepest}");
@@ -201,13 +196,7 @@ fn msaa_and_depth_stencil_hosts_stop_sparks_alike() {
             ..HostKind::default()
         },
     ];
-    let effect = sparks(
-        100,
-        vec3(0.0, 0.5, 1.5),
-        [0.6, 0.4, 0.0],
-        vec3(0.0, 0.0, -3.0),
-        0.5,
-    );
+    let effect = sparks(100, [0.0, 0.5, 1.5], [0.6, 0.4, 0.0], [0.0, 0.0, -3.0], 0.5);
     for kind in kinds {
         let what = format!("{kind:?}");
         let host = Host::of(kind, EYE, TARGET);
@@ -231,13 +220,7 @@ fn tilted_run(kind: HostKind) -> Vec<Particle> {
     let n = vec3(0.0, 0.5, 1.0).normalize();
     let along = vec3(0.0, n.z, -n.y);
     let plane = quad(vec3(0.0, 0.5, 0.0), Vec3::X * 3.0, along * 3.0);
-    let effect = sparks(
-        100,
-        vec3(0.0, 0.6, 1.5),
-        [0.5, 0.2, 0.0],
-        vec3(0.0, 0.0, -3.0),
-        1.0,
-    );
+    let effect = sparks(100, [0.0, 0.6, 1.5], [0.5, 0.2, 0.0], [0.0, 0.0, -3.0], 1.0);
     let mut player = host.player(&effect);
     let (_, last) = run(&host, &[plane], &mut player, 45, true, |_| {});
     assert_eq!(last.len(), 100);
@@ -272,19 +255,13 @@ fn off_screen_and_behind_geometry_sparks_fly_on() {
     let wide = quad(Vec3::ZERO, Vec3::X * 40.0, Vec3::Y * 3.0);
     let off = sparks(
         50,
-        vec3(-1.0, 0.5, 1.0),
+        [-1.0, 0.5, 1.0],
         [0.1, 0.1, 0.0],
-        vec3(-6.0, 0.0, -1.5),
+        [-6.0, 0.0, -1.5],
         0.5,
     );
     let panel = quad(vec3(0.0, 0.5, 2.0), Vec3::X * 0.4, Vec3::Y * 0.5);
-    let behind = sparks(
-        50,
-        vec3(-1.5, 0.5, 1.0),
-        [0.05, 0.2, 0.0],
-        Vec3::X * 3.0,
-        0.5,
-    );
+    let behind = sparks(50, [-1.5, 0.5, 1.0], [0.05, 0.2, 0.0], [3.0, 0.0, 0.0], 0.5);
     let mut ends = Vec::new();
     for (effect, quad, frames) in [(&off, &wide, 72), (&behind, &panel, 60)] {
         let quads = std::slice::from_ref(quad);
@@ -313,9 +290,9 @@ fn fast_sparks_do_not_tunnel_through_a_thin_wall() {
     let host = Host::new(EYE, TARGET);
     let effect = sparks(
         200,
-        vec3(0.0, 0.5, 1.7),
+        [0.0, 0.5, 1.7],
         [0.6, 0.4, 0.0],
-        vec3(0.0, 0.0, -60.0),
+        [0.0, 0.0, -60.0],
         0.2,
     );
     let (last, deepest) = at_the_wall(&host, &effect, 6);
@@ -330,9 +307,9 @@ fn fast_sparks_do_not_tunnel_through_a_thin_wall() {
     let post = quad(Vec3::ZERO, Vec3::X * 0.1, Vec3::Y * 2.0);
     let effect = sparks(
         100,
-        vec3(0.6, 0.5, 0.6),
+        [0.6, 0.5, 0.6],
         [0.02, 0.3, 0.0],
-        vec3(-30.0, 0.0, -30.0),
+        [-30.0, 0.0, -30.0],
         0.2,
     );
     let mut player = host.player(&effect);
@@ -349,7 +326,7 @@ fn fast_sparks_do_not_tunnel_through_a_thin_wall() {
 #[test]
 fn depth_hits_fire_collision_events_once_per_impact() {
     let host = Host::new(EYE, TARGET);
-    let mut effect = sparks(50, vec3(0.0, 0.3, 0.0), [0.0; 3], Vec3::NEG_Y * 1e-6, 0.0);
+    let mut effect = sparks(50, [0.0, 0.3, 0.0], [0.0; 3], [0.0, -1e-6, 0.0], 0.0);
     let parent = &mut effect.emitters[0];
     parent.lifetime_secs = Range::new(3.0, 3.0);
     parent.forces.gravity_m_per_s2 = [0.0, -9.81, 0.0];
@@ -385,9 +362,9 @@ fn the_same_depth_and_seed_give_the_same_particles() {
     let host = Host::new(EYE, TARGET);
     let effect = sparks(
         200,
-        vec3(0.0, 0.5, 1.5),
+        [0.0, 0.5, 1.5],
         [0.6, 0.4, 0.2],
-        vec3(0.3, -0.5, -3.0),
+        [0.3, -0.5, -3.0],
         0.5,
     );
     let runs: Vec<Vec<Particle>> = (0..2)
@@ -413,13 +390,7 @@ fn the_same_depth_and_seed_give_the_same_particles() {
 #[test]
 fn the_test_scene_gives_the_viewport_a_depth_to_collide_with() {
     let ctx = gpu();
-    let effect = sparks(
-        50,
-        vec3(-0.8, 0.3, 0.0),
-        [0.0, 0.1, 0.1],
-        vec3(-3.0, 0.0, 0.0),
-        0.5,
-    );
+    let effect = sparks(50, [-0.8, 0.3, 0.0], [0.0, 0.1, 0.1], [-3.0, 0.0, 0.0], 0.5);
     let run = |scene: bool| {
         let mut h = ignis::testing::headless::Headless::new(
             &ctx,

@@ -210,9 +210,7 @@ fn the_emissive_pass_is_the_colour_passs_additive_light() {
     let passes = Passes {
         color: true,
         emissive: true,
-        motion: false,
-        sixway: false,
-        distortion: false,
+        ..Passes::NONE
     };
     for (e, out) in [(&effect, &lit), (&dark, &smoke)] {
         // The preset's own camera: a fitted one would frame the dark flames differently.
@@ -367,10 +365,8 @@ fn motion_vectors_predict_the_next_frame() {
     s.frame_size = (SIZE, SIZE);
     s.passes = Passes {
         color: true,
-        emissive: false,
         motion: true,
-        sixway: false,
-        distortion: false,
+        ..Passes::NONE
     };
     let summary = export(&effect, s);
     let scale = summary.sidecar.motion_vector_scale;
@@ -567,10 +563,8 @@ fn the_sixway_passes_hold_each_axis_in_unitys_packing() {
     let settings = ExportSettings {
         passes: Passes {
             color: true,
-            emissive: false,
-            motion: false,
             sixway: true,
-            distortion: false,
+            ..Passes::NONE
         },
         format: Format::Exr,
         start_secs: 0.1,
@@ -631,11 +625,8 @@ fn the_sixway_passes_hold_each_axis_in_unitys_packing() {
 fn the_distortion_pass_holds_the_heat_haze_offsets() {
     let dir = tempfile::tempdir().expect("tempdir");
     let passes = |distortion| Passes {
-        color: true,
-        emissive: false,
-        motion: false,
-        sixway: false,
         distortion,
+        ..Passes::COLOR
     };
     let run = |effect: &Effect, name: &str, distortion: bool| {
         let out = dir.path().join(name);

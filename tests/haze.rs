@@ -7,10 +7,11 @@ mod common;
 
 use common::*;
 use ignis::effect::{Burst, ColorStop, Effect, Emitter, HeatHaze, Range, Shape};
-use ignis::testing::gpu::GpuContext;
+use ignis::testing::gpu::{GpuContext, TextureReadback};
 use ignis::testing::render::haze::HazePass;
 use ignis::testing::render::variant::{LookVariant, StateVariant};
 use ignis::testing::shaders::ShaderLibrary;
+use ignis::testing::sim::gpu_sim::map_read;
 use ignis::{Camera, Player, PlayerSettings};
 
 const W: u32 = 96;
@@ -78,45 +79,12 @@ fn texture_of(
     texture
 }
 
-/// `texture`'s texels (8-bit RGBA) after `enc` runs.
-fn read(ctx: &GpuContext, enc: wgpu::CommandEncoder, texture: &wgpu::Texture) -> Vec<u8> {
-    read_texels(ctx, enc, texture, 4)
-}
-
-/// `texture`'s texels of `texel` bytes after `enc` runs.
-fn read_texels(
-    ctx: &GpuContext,
-    mut enc: wgpu::CommandEncoder,
-    texture: &wgpu::Texture,
-    texel: u32,
-) -> Vec<u8> {
-    let row = (W * texel).next_multiple_of(256);
-    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: None,
-        size: u64::from(row * H),
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    enc.copy_texture_to_buffer(
-        texture.as_image_copy(),
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(row),
-                rows_per_image: None,
-            },
-        },
-        texture.size(),
-    );
+/// `texture`'s texels (tight rows) after `enc` runs.
+fn read(ctx: &GpuContext, mut enc: wgpu::CommandEncoder, texture: &wgpu::Texture) -> Vec<u8> {
+    let readback = TextureReadback::record(&ctx.device, &mut enc, texture, "haze test");
     ctx.queue.submit([enc.finish()]);
-    let slice = buffer.slice(..);
-    slice.map_async(wgpu::MapMode::Read, |r| r.expect("map"));
-    let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
-    let data = slice.get_mapped_range().expect("mapped");
-    (0..H as usize)
-        .flat_map(|y| data[y * row as usize..][..(W * texel) as usize].to_vec())
-        .collect()
+    let bytes = map_read(ctx, &readback.buffer).expect("read back");
+    readback.rows(&bytes).expect("rows").concat()
 }
 
 /// A distortion of a constant (3, −2) pixels by the full-screen draw (an 8-bit target):
@@ -166,8 +134,7 @@ fn refracted(
     drop(haze.begin(&ctx, &mut enc, ((W, H), 2), offset));
     let view = |t: &wgpu::Texture| t.create_view(&Default::default());
     haze.refract(&ctx, &mut enc, &view(&scene), &view(&out));
-    let texel = format.block_copy_size(None).unwrap_or(4);
-    read_texels(&ctx, enc, &out, texel)
+    read(&ctx, enc, &out)
 }
 
 /// Every pixel whose source, `shift` pixels away, is inside the frame holds the pattern's

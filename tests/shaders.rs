@@ -47,30 +47,20 @@ fn every_entry_validates() {
         .unwrap_or_else(|e| panic!("update with batched instances: {e}"));
     assert!(instanced.files.iter().any(|f| f == "params_instanced.wgsl"));
     assert!(!instanced.files.iter().any(|f| f == "params.wgsl"));
-    // An emitter with events: events_on.wgsl (hooks and bindings) for events_off.wgsl.
-    let events = project_shaders()
-        .compose_with("update.wgsl", &[ignis::testing::shaders::EVENTS_IO])
-        .unwrap_or_else(|e| panic!("update with events: {e}"));
-    assert!(events.files.iter().any(|f| f == "events_on.wgsl"));
-    assert!(!events.files.iter().any(|f| f == "events_off.wgsl"));
-    // An emitter with a trail: trail_on.wgsl (the ring of positions) for trail_off.wgsl.
-    let trail = project_shaders()
-        .compose_with("update.wgsl", &[ignis::testing::shaders::TRAIL_IO])
-        .unwrap_or_else(|e| panic!("update with a trail: {e}"));
-    assert!(trail.files.iter().any(|f| f == "trail_on.wgsl"));
-    assert!(!trail.files.iter().any(|f| f == "trail_off.wgsl"));
-    reached.extend(trail.files);
-    // An emitter colliding with the host's depth: depth_on.wgsl for depth_off.wgsl.
-    let depth = project_shaders()
-        .compose_with("update.wgsl", &[ignis::testing::shaders::DEPTH_IO])
-        .unwrap_or_else(|e| panic!("update with depth collision: {e}"));
-    assert!(depth.files.iter().any(|f| f == "depth_on.wgsl"));
-    assert!(!depth.files.iter().any(|f| f == "depth_off.wgsl"));
-    reached.extend(depth.files);
+    // The update's hooks, each composed in place of its empty twin: events (records and
+    // bindings), a trail (the ring of positions), collision with the host's depth.
+    use ignis::testing::shaders::{DEPTH_IO, EVENTS_IO, TRAIL_IO};
+    for (off, on) in [EVENTS_IO, TRAIL_IO, DEPTH_IO] {
+        let hooked = project_shaders()
+            .compose_with("update.wgsl", &[(off, on)])
+            .unwrap_or_else(|e| panic!("update with {on}: {e}"));
+        assert!(hooked.files.iter().any(|f| f == on));
+        assert!(!hooked.files.iter().any(|f| f == off));
+        reached.extend(hooked.files);
+    }
     reached.extend(packed.files);
     reached.extend(tiny.files);
     reached.extend(instanced.files);
-    reached.extend(events.files);
     for f in std::fs::read_dir(dir).expect("shaders/") {
         let name = f.expect("entry").file_name().to_string_lossy().into_owned();
         if name.ends_with(".wgsl") {

@@ -32,16 +32,7 @@ pub fn run(
         distortion: false,
     };
     let mut configs = Vec::new();
-    for passes in [
-        Passes {
-            color: true,
-            emissive: false,
-            motion: false,
-            sixway: false,
-            distortion: false,
-        },
-        all,
-    ] {
+    for passes in [Passes::COLOR, all] {
         let names = passes.names().join(" + ");
         let mut book = ExportSettings::new(dir.join("book"));
         book.passes = passes;

@@ -89,13 +89,7 @@ impl ExportArgs {
         s.looped = self.looped;
         s.format = self.format;
         s.alpha = self.alpha;
-        let mut passes = Passes {
-            color: false,
-            emissive: false,
-            motion: false,
-            sixway: false,
-            distortion: false,
-        };
+        let mut passes = Passes::NONE;
         for p in &self.passes {
             match p.trim() {
                 "color" => passes.color = true,

@@ -119,6 +119,21 @@ pub const SIXWAY_PACKING: &str = "sixway_rtba: R lit from the camera's right, G 
     glow); linear, straight alpha, the alpha-blended layers only";
 
 impl Passes {
+    /// No pass (the start of a list of passes).
+    pub const NONE: Passes = Passes {
+        color: false,
+        emissive: false,
+        motion: false,
+        sixway: false,
+        distortion: false,
+    };
+
+    /// The colour pass alone (the default).
+    pub const COLOR: Passes = Passes {
+        color: true,
+        ..Passes::NONE
+    };
+
     /// The names of the passes that are on.
     pub fn names(self) -> Vec<&'static str> {
         [
@@ -183,13 +198,7 @@ impl ExportSettings {
             looped: false,
             format: Format::Png8,
             alpha: AlphaMode::Premultiplied,
-            passes: Passes {
-                color: true,
-                emissive: false,
-                motion: false,
-                sixway: false,
-                distortion: false,
-            },
+            passes: Passes::COLOR,
             seed: None,
             camera: CameraMode::Fit,
             background: None,

@@ -271,13 +271,7 @@ impl Export {
         let wide = framing::enclosing(self.player.effect(), &samples, self.settings.camera);
         let probe = ExportSettings {
             frame_size: framing::probe_size(self.settings.frame_size),
-            passes: Passes {
-                color: true,
-                emissive: false,
-                motion: false,
-                sixway: false,
-                distortion: false,
-            },
+            passes: Passes::COLOR,
             background: None,
             ..self.settings.clone()
         };

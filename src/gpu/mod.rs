@@ -51,6 +51,64 @@ pub fn color_pass<'a>(
     })
 }
 
+/// What a plain render pipeline is made of: one vertex and one fragment entry of
+/// `module` (no override constants), its vertex buffers, depth state and colour targets,
+/// with the default primitive state.
+pub struct PipelineParts<'a> {
+    /// Debug label.
+    pub label: &'a str,
+    /// The layout (`None`: derived from the module).
+    pub layout: Option<&'a wgpu::PipelineLayout>,
+    /// The shader module.
+    pub module: &'a wgpu::ShaderModule,
+    /// The vertex and fragment entry points.
+    pub entries: (&'a str, &'a str),
+    /// Vertex buffers.
+    pub buffers: &'a [Option<wgpu::VertexBufferLayout<'a>>],
+    /// Depth test and write.
+    pub depth_stencil: Option<wgpu::DepthStencilState>,
+    /// Samples per pixel.
+    pub multisample: wgpu::MultisampleState,
+    /// The colour targets.
+    pub targets: &'a [Option<wgpu::ColorTargetState>],
+}
+
+/// The render pipeline of `parts`.
+pub fn render_pipeline(ctx: &GpuContext, parts: PipelineParts<'_>) -> wgpu::RenderPipeline {
+    let PipelineParts {
+        label,
+        layout,
+        module,
+        entries: (vs, fs),
+        buffers,
+        depth_stencil,
+        multisample,
+        targets,
+    } = parts;
+    ctx.device
+        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout,
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some(vs),
+                compilation_options: Default::default(),
+                buffers,
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil,
+            multisample,
+            fragment: Some(wgpu::FragmentState {
+                module,
+                entry_point: Some(fs),
+                compilation_options: Default::default(),
+                targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+}
+
 /// A 2-D depth texture binding (a host's depth, sampled with `textureLoad`).
 pub fn depth_texture_entry(
     binding: u32,

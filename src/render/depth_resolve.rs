@@ -51,17 +51,14 @@ impl DepthResolvePass {
             });
         let composed = lib.compose("depth_resolve.wgsl")?;
         let pipeline = create_checked(&ctx.device, &composed, lib, |module| {
-            ctx.device
-                .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some("DepthResolvePass"),
+            crate::gpu::render_pipeline(
+                ctx,
+                crate::gpu::PipelineParts {
+                    label: "DepthResolvePass",
                     layout: Some(&pipeline_layout),
-                    vertex: wgpu::VertexState {
-                        module,
-                        entry_point: Some("vs"),
-                        compilation_options: Default::default(),
-                        buffers: &[],
-                    },
-                    primitive: Default::default(),
+                    module,
+                    entries: ("vs", "fs"),
+                    buffers: &[],
                     depth_stencil: Some(wgpu::DepthStencilState {
                         format: RESOLVED_FORMAT,
                         depth_write_enabled: Some(true),
@@ -70,15 +67,9 @@ impl DepthResolvePass {
                         bias: Default::default(),
                     }),
                     multisample: Default::default(),
-                    fragment: Some(wgpu::FragmentState {
-                        module,
-                        entry_point: Some("fs"),
-                        compilation_options: Default::default(),
-                        targets: &[],
-                    }),
-                    multiview_mask: None,
-                    cache: None,
-                })
+                    targets: &[],
+                },
+            )
         })?;
         Ok(Self {
             layout,

@@ -247,26 +247,17 @@ fn draw(
     pipeline_layout: &wgpu::PipelineLayout,
     format: wgpu::TextureFormat,
 ) -> wgpu::RenderPipeline {
-    ctx.device
-        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("HazePass"),
+    crate::gpu::render_pipeline(
+        ctx,
+        crate::gpu::PipelineParts {
+            label: "HazePass",
             layout: Some(pipeline_layout),
-            vertex: wgpu::VertexState {
-                module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
+            module,
+            entries: ("vs_main", "fs_main"),
+            buffers: &[],
             depth_stencil: None,
             multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(format.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        })
+            targets: &[Some(format.into())],
+        },
+    )
 }

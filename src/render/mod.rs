@@ -129,28 +129,19 @@ pub fn resolve_pipeline(
         blend: Some(blend),
         write_mask: wgpu::ColorWrites::ALL,
     };
-    ctx.device
-        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(label),
+    crate::gpu::render_pipeline(
+        ctx,
+        crate::gpu::PipelineParts {
+            label,
             layout: Some(layout),
-            vertex: wgpu::VertexState {
-                module,
-                entry_point: Some("vs_resolve"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState::default(),
+            module,
+            entries: ("vs_resolve", "fs_resolve"),
+            buffers: &[],
             depth_stencil: target.read_only_depth(Some(wgpu::CompareFunction::Always)),
             multisample: target.multisample(),
-            fragment: Some(wgpu::FragmentState {
-                module,
-                entry_point: Some("fs_resolve"),
-                compilation_options: Default::default(),
-                targets: &[Some(color)],
-            }),
-            multiview_mask: None,
-            cache: None,
-        })
+            targets: &[Some(color)],
+        },
+    )
 }
 
 /// The compute paths' `DEPTH_TEST` constant for a target: 0 none, 1 a particle nearer

@@ -143,21 +143,18 @@ impl TestScene {
 fn pipeline(ctx: &GpuContext, lib: &ShaderLibrary) -> Result<wgpu::RenderPipeline, ShaderError> {
     let composed = lib.compose("test_scene.wgsl")?;
     create_checked(&ctx.device, &composed, lib, |module| {
-        ctx.device
-            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("TestScene"),
+        crate::gpu::render_pipeline(
+            ctx,
+            crate::gpu::PipelineParts {
+                label: "TestScene",
                 layout: None,
-                vertex: wgpu::VertexState {
-                    module,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[Some(wgpu::VertexBufferLayout {
-                        array_stride: 24,
-                        step_mode: wgpu::VertexStepMode::Vertex,
-                        attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
-                    })],
-                },
-                primitive: Default::default(),
+                module,
+                entries: ("vs_main", "fs_main"),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: 24,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
+                })],
                 depth_stencil: Some(wgpu::DepthStencilState {
                     format: SCENE_DEPTH_FORMAT,
                     depth_write_enabled: Some(true),
@@ -166,15 +163,9 @@ fn pipeline(ctx: &GpuContext, lib: &ShaderLibrary) -> Result<wgpu::RenderPipelin
                     bias: Default::default(),
                 }),
                 multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module,
-                    entry_point: Some("fs_main"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(HDR_FORMAT.into())],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+                targets: &[Some(HDR_FORMAT.into())],
+            },
+        )
     })
 }
 
