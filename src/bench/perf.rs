@@ -166,15 +166,14 @@ fn copy_pipeline(ctx: &GpuContext, wgsl: &str) -> (wgpu::ComputePipeline, wgpu::
             label: Some("bench copy"),
             source: wgpu::ShaderSource::Wgsl(wgsl.into()),
         });
-    let layout = ctx
-        .device
-        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("bench copy layout"),
-            entries: &[
-                crate::gpu::compute_storage_entry(0, true),
-                crate::gpu::compute_storage_entry(1, false),
-            ],
-        });
+    let layout = crate::gpu::bind_group_layout(
+        ctx,
+        "bench copy layout",
+        &[
+            crate::gpu::compute_storage_entry(0, true),
+            crate::gpu::compute_storage_entry(1, false),
+        ],
+    );
     let pl = ctx
         .device
         .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

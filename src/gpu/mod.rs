@@ -109,6 +109,19 @@ pub fn render_pipeline(ctx: &GpuContext, parts: PipelineParts<'_>) -> wgpu::Rend
         })
 }
 
+/// A bind group layout of `entries`.
+pub fn bind_group_layout(
+    ctx: &GpuContext,
+    label: &str,
+    entries: &[wgpu::BindGroupLayoutEntry],
+) -> wgpu::BindGroupLayout {
+    ctx.device
+        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(label),
+            entries,
+        })
+}
+
 /// A 2-D depth texture binding (a host's depth, sampled with `textureLoad`).
 pub fn depth_texture_entry(
     binding: u32,

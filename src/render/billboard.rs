@@ -85,26 +85,24 @@ impl BillboardPass {
         frame: &FrameResources,
         target: DrawTarget,
     ) -> Result<Self, ShaderError> {
-        let depth_layout = ctx
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("BillboardPass::depth_layout"),
-                entries: &[crate::gpu::depth_texture_entry(
-                    0,
-                    wgpu::ShaderStages::FRAGMENT,
-                )],
-            });
+        let depth_layout = crate::gpu::bind_group_layout(
+            ctx,
+            "BillboardPass::depth_layout",
+            &[crate::gpu::depth_texture_entry(
+                0,
+                wgpu::ShaderStages::FRAGMENT,
+            )],
+        );
         let no_depth = crate::gpu::placeholder_depth(&ctx.device, "BillboardPass::no_depth");
         let depth_group = Self::depth_group(ctx, &depth_layout, &no_depth);
-        let sprite_layout = ctx
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("BillboardPass::sprite_layout"),
-                entries: &[
-                    crate::gpu::fragment_texture_entry(0, true),
-                    crate::gpu::fragment_sampler_entry(1),
-                ],
-            });
+        let sprite_layout = crate::gpu::bind_group_layout(
+            ctx,
+            "BillboardPass::sprite_layout",
+            &[
+                crate::gpu::fragment_texture_entry(0, true),
+                crate::gpu::fragment_sampler_entry(1),
+            ],
+        );
         let pipeline_layout = ctx
             .device
             .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

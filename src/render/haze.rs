@@ -28,38 +28,36 @@ impl HazePass {
         lib: &ShaderLibrary,
         format: wgpu::TextureFormat,
     ) -> Result<Self, ShaderError> {
-        let layout = ctx
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("HazePass::layout"),
-                entries: &[
-                    crate::gpu::fragment_texture_entry(0, true),
-                    crate::gpu::fragment_texture_entry(1, true),
-                    crate::gpu::fragment_sampler_entry(2),
-                ],
-            });
+        let layout = crate::gpu::bind_group_layout(
+            ctx,
+            "HazePass::layout",
+            &[
+                crate::gpu::fragment_texture_entry(0, true),
+                crate::gpu::fragment_texture_entry(1, true),
+                crate::gpu::fragment_sampler_entry(2),
+            ],
+        );
 
-        let compute_layout =
-            ctx.device
-                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                    label: Some("HazePass::compute_layout"),
-                    entries: &[
-                        compute_entry(0, texture_entry()),
-                        compute_entry(1, texture_entry()),
-                        compute_entry(
-                            2,
-                            wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                        ),
-                        compute_entry(
-                            3,
-                            wgpu::BindingType::StorageTexture {
-                                access: wgpu::StorageTextureAccess::WriteOnly,
-                                format: COMPUTE_FORMAT,
-                                view_dimension: wgpu::TextureViewDimension::D2,
-                            },
-                        ),
-                    ],
-                });
+        let compute_layout = crate::gpu::bind_group_layout(
+            ctx,
+            "HazePass::compute_layout",
+            &[
+                compute_entry(0, texture_entry()),
+                compute_entry(1, texture_entry()),
+                compute_entry(
+                    2,
+                    wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                ),
+                compute_entry(
+                    3,
+                    wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: COMPUTE_FORMAT,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
+                ),
+            ],
+        );
         let (pipeline, compute) = pipelines(ctx, lib, [&layout, &compute_layout], format)?;
         let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("HazePass::sampler"),

@@ -26,12 +26,11 @@ impl SelfLightPass {
     /// Builds the pipeline from `lib`.
     pub fn new(ctx: &GpuContext, lib: &ShaderLibrary) -> Result<Self, ShaderError> {
         let entry = crate::gpu::compute_storage_entry;
-        let layout = ctx
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("SelfLightPass::layout"),
-                entries: &[entry(0, true), entry(1, false), entry(2, true)],
-            });
+        let layout = crate::gpu::bind_group_layout(
+            ctx,
+            "SelfLightPass::layout",
+            &[entry(0, true), entry(1, false), entry(2, true)],
+        );
         let pipeline_layout = ctx
             .device
             .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

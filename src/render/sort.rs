@@ -211,30 +211,28 @@ impl SortPass {
             has_dynamic_offset: false,
             min_binding_size: None,
         };
-        let layout = ctx
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("SortPass::layout"),
-                entries: &[
-                    entry(
-                        0,
-                        wgpu::BindingType::Buffer {
-                            ty: wgpu::BufferBindingType::Storage { read_only: true },
-                            has_dynamic_offset: true,
-                            min_binding_size: wgpu::BufferSize::new(size_of::<SortStep>() as u64),
-                        },
-                    ),
-                    entry(1, storage(false)),
-                    entry(2, storage(false)),
-                    entry(3, storage(true)),
-                ],
-            });
-        let state_layout = ctx
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("SortPass::state_layout"),
-                entries: &[entry(0, storage(true)), entry(1, storage(true))],
-            });
+        let layout = crate::gpu::bind_group_layout(
+            ctx,
+            "SortPass::layout",
+            &[
+                entry(
+                    0,
+                    wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: true,
+                        min_binding_size: wgpu::BufferSize::new(size_of::<SortStep>() as u64),
+                    },
+                ),
+                entry(1, storage(false)),
+                entry(2, storage(false)),
+                entry(3, storage(true)),
+            ],
+        );
+        let state_layout = crate::gpu::bind_group_layout(
+            ctx,
+            "SortPass::state_layout",
+            &[entry(0, storage(true)), entry(1, storage(true))],
+        );
         let pipeline_layout = ctx
             .device
             .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

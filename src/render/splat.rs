@@ -43,24 +43,23 @@ impl SplatPass {
         frame: &FrameResources,
         target: DrawTarget,
     ) -> Result<Self, ShaderError> {
-        let accum_layout = ctx
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("SplatPass::accum_layout"),
-                entries: &[
-                    wgpu::BindGroupLayoutEntry {
-                        binding: 0,
-                        visibility: wgpu::ShaderStages::COMPUTE | wgpu::ShaderStages::FRAGMENT,
-                        ty: wgpu::BindingType::Buffer {
-                            ty: wgpu::BufferBindingType::Storage { read_only: false },
-                            has_dynamic_offset: false,
-                            min_binding_size: None,
-                        },
-                        count: None,
+        let accum_layout = crate::gpu::bind_group_layout(
+            ctx,
+            "SplatPass::accum_layout",
+            &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::COMPUTE | wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: false },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
                     },
-                    crate::gpu::depth_texture_entry(1, wgpu::ShaderStages::COMPUTE),
-                ],
-            });
+                    count: None,
+                },
+                crate::gpu::depth_texture_entry(1, wgpu::ShaderStages::COMPUTE),
+            ],
+        );
         let no_depth = crate::gpu::placeholder_depth(&ctx.device, "SplatPass::no_depth");
         let pipeline_layout = ctx
             .device
@@ -74,12 +73,7 @@ impl SplatPass {
                 immediate_size: 0,
             });
         // The resolve reads no particles: group 1 is an empty placeholder.
-        let empty_layout = ctx
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("SplatPass::empty_layout"),
-                entries: &[],
-            });
+        let empty_layout = crate::gpu::bind_group_layout(ctx, "SplatPass::empty_layout", &[]);
         let empty_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("SplatPass::empty_group"),
             layout: &empty_layout,

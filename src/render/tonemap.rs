@@ -27,32 +27,31 @@ fn compute(mut e: wgpu::BindGroupLayoutEntry) -> wgpu::BindGroupLayoutEntry {
 impl TonemapPass {
     /// Builds the pass (its output: a [`crate::render::LDR_STORAGE_FORMAT`] storage view).
     pub fn new(ctx: &GpuContext, lib: &ShaderLibrary) -> Result<Self, ShaderError> {
-        let layout = ctx
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("TonemapPass::layout"),
-                entries: &[
-                    compute(crate::gpu::fragment_texture_entry(0, false)),
-                    compute(crate::gpu::fragment_buffer_entry(
-                        1,
-                        wgpu::BufferBindingType::Uniform,
-                    )),
-                    compute(crate::gpu::fragment_texture_entry(3, true)),
-                    compute(crate::gpu::fragment_sampler_entry(4)),
-                    compute(crate::gpu::fragment_texture_entry(5, true)),
-                    compute(crate::gpu::fragment_texture_entry(6, true)),
-                    wgpu::BindGroupLayoutEntry {
-                        binding: 7,
-                        visibility: wgpu::ShaderStages::COMPUTE,
-                        ty: wgpu::BindingType::StorageTexture {
-                            access: wgpu::StorageTextureAccess::WriteOnly,
-                            format: crate::render::LDR_STORAGE_FORMAT,
-                            view_dimension: wgpu::TextureViewDimension::D2,
-                        },
-                        count: None,
+        let layout = crate::gpu::bind_group_layout(
+            ctx,
+            "TonemapPass::layout",
+            &[
+                compute(crate::gpu::fragment_texture_entry(0, false)),
+                compute(crate::gpu::fragment_buffer_entry(
+                    1,
+                    wgpu::BufferBindingType::Uniform,
+                )),
+                compute(crate::gpu::fragment_texture_entry(3, true)),
+                compute(crate::gpu::fragment_sampler_entry(4)),
+                compute(crate::gpu::fragment_texture_entry(5, true)),
+                compute(crate::gpu::fragment_texture_entry(6, true)),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 7,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: crate::render::LDR_STORAGE_FORMAT,
+                        view_dimension: wgpu::TextureViewDimension::D2,
                     },
-                ],
-            });
+                    count: None,
+                },
+            ],
+        );
         let pipeline_layout = ctx
             .device
             .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

@@ -41,23 +41,23 @@ impl HostDepthView {
 
 /// The layout of group 2: the depth (binding 0) and the view (binding 1).
 pub(crate) fn layout(ctx: &GpuContext) -> wgpu::BindGroupLayout {
-    ctx.device
-        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("depth_collision::layout"),
-            entries: &[
-                crate::gpu::depth_texture_entry(0, wgpu::ShaderStages::COMPUTE),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
+    crate::gpu::bind_group_layout(
+        ctx,
+        "depth_collision::layout",
+        &[
+            crate::gpu::depth_texture_entry(0, wgpu::ShaderStages::COMPUTE),
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
                 },
-            ],
-        })
+                count: None,
+            },
+        ],
+    )
 }
 
 /// One emitter's group 2: its view uniform and the depth it is bound to.

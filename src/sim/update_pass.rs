@@ -82,21 +82,20 @@ impl UpdatePass {
             },
             count: None,
         };
-        let layout = ctx
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("UpdatePass::layout"),
-                entries: &[
-                    params_entry,
-                    storage(1, true),
-                    storage(2, false),
-                    storage(3, false),
-                    // The birth table (tiny state; a placeholder for the others).
-                    storage(4, true),
-                    // The over-life curves (read with MOD_CURVES).
-                    storage(5, true),
-                ],
-            });
+        let layout = crate::gpu::bind_group_layout(
+            ctx,
+            "UpdatePass::layout",
+            &[
+                params_entry,
+                storage(1, true),
+                storage(2, false),
+                storage(3, false),
+                // The birth table (tiny state; a placeholder for the others).
+                storage(4, true),
+                // The over-life curves (read with MOD_CURVES).
+                storage(5, true),
+            ],
+        );
         let pipeline_layout = ctx
             .device
             .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -126,12 +125,11 @@ impl UpdatePass {
                     })
             })
         });
-        let count_layout = ctx
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("UpdatePass::count_layout"),
-                entries: &[storage(0, true), storage(1, false), storage(2, true)],
-            });
+        let count_layout = crate::gpu::bind_group_layout(
+            ctx,
+            "UpdatePass::count_layout",
+            &[storage(0, true), storage(1, false), storage(2, true)],
+        );
         let count_pipeline_layout =
             ctx.device
                 .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
