@@ -47,6 +47,8 @@ TESTS = {
     "tonemap.wgsl": [("tonemap", None), ("rendering", "--skip render_command")],
     "bloom.wgsl": [("rendering", "--skip render_command")],
     "clear.wgsl": [("rendering", "--skip render_command")],
+    "depth_on.wgsl": [("depth_collision", None)],
+    "haze_apply.wgsl": [("haze", None)],
 }
 
 # The check that tells an unviable mutant (the shader no longer composes or validates).
