@@ -33,7 +33,7 @@ use crate::runtime::{InstanceId, Player, PlayerError, PlayerSettings};
 
 pub use encode::{decode_motion, linear_to_srgb, srgb_to_linear};
 pub use export_settings::{
-    AlphaMode, CameraMode, ExportSettings, Format, Layout, Passes, SIXWAY_PACKING,
+    AlphaMode, CameraMode, DISTORTION_SCALE, ExportSettings, Format, Layout, Passes, SIXWAY_PACKING,
 };
 pub use sidecar::Sidecar;
 
