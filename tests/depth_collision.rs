@@ -245,6 +245,33 @@ fn sparks_starting_just_behind_a_surface_are_put_back_on_it() {
     }
 }
 
+/// A step seen from above: its top (y = 0.25) left of x = 0, the floor (y = 0) right of
+/// it. Sparks dropped on both sides of the edge bounce straight up: at the pixels beside
+/// the edge the normal is built from the neighbour on the same surface (the nearer depth),
+/// not across the jump.
+#[test]
+fn beside_an_edge_the_normal_comes_from_the_same_surface() {
+    let host = Host::new(vec3(0.0, 3.0, 0.3), Vec3::ZERO);
+    let top = quad(vec3(-1.0, 0.25, 0.0), Vec3::X, Vec3::Z * 2.0);
+    let floor = quad(vec3(1.0, 0.0, 0.0), Vec3::X, Vec3::Z * 2.0);
+    let face = quad(vec3(0.0, 0.125, 0.0), Vec3::Z * 2.0, Vec3::Y * 0.125);
+    let effect = sparks(400, [0.0, 0.6, 0.0], [0.1, 0.0, 0.3], [0.0, -3.0, 0.0], 1.0);
+    let (_, last) = run(
+        &host,
+        &[top, floor, face],
+        &mut host.player(&effect),
+        16,
+        true,
+        |_| {},
+    );
+    assert_eq!(last.len(), 400);
+    for p in &last {
+        let v = vel(p);
+        assert!(v.y > 2.9, "{} did not bounce: {v}", pos(p));
+        assert!(v.x.abs() < 0.02 && v.z.abs() < 0.02, "{}: {v}", pos(p));
+    }
+}
+
 /// A plane tilted towards the camera: a perfectly elastic bounce reflects each spark
 /// about the plane's normal, which the depth around the contact gives to 1e-3.
 fn tilted_run(kind: HostKind) -> Vec<Particle> {
