@@ -17,8 +17,9 @@ impl Player {
     /// player's distortion target (the target's size; the host's depth handed to
     /// [`Player::record`] hides them behind geometry) and refracts `scene` — a copy of the
     /// frame's colour so far (`copy_texture_to_texture` of your colour after the
-    /// particles' pass) — into `target`, the frame's colour (the player's colour format,
-    /// `RENDER_ATTACHMENT` usage), every pixel written. Without haze nothing is recorded
+    /// particles' pass) — into `target`, the frame's colour (single-sample: a multisampled
+    /// host's resolved colour; the player's colour format, `RENDER_ATTACHMENT` usage),
+    /// every pixel written. Without haze nothing is recorded
     /// and `target` keeps its image; returns whether the haze was applied.
     pub fn apply_haze(
         &mut self,
