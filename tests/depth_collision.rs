@@ -342,8 +342,9 @@ fn off_screen_and_behind_geometry_sparks_fly_on() {
     assert!(ends[1].iter().all(|p| pos(p).x > 1.3));
 }
 
-/// Sparks at 60 m/s travel 1 m a step; the wall in the depth is a single surface (thinner
-/// than any step), and none gets through it, nor through a post it crosses obliquely.
+/// Sparks at 60 m/s travel 0.5 m a step (1/120 s); the wall in the depth is a single
+/// surface (thinner than any step), and none gets through it, nor through a post it crosses
+/// obliquely.
 #[test]
 fn fast_sparks_do_not_tunnel_through_a_thin_wall() {
     let host = Host::new(EYE, TARGET);
