@@ -74,36 +74,22 @@ fn effect_sections_ui(ui: &mut Ui, state: &mut EditorState, open: &dyn Fn(&str) 
             emitter_ui(ui, &mut state.effect, &mut state.selected);
         },
     );
-    section_ui(
-        ui,
-        "randomness",
-        "Randomness",
-        &name,
-        (false, open("randomness")),
-        |ui| {
-            randomness_ui(ui, &mut state.effect, state.selected);
-        },
-    );
-    section_ui(
-        ui,
-        "forces",
-        "Forces",
-        &name,
-        (false, open("forces")),
-        |ui| {
-            forces_ui(ui, &mut state.effect, state.selected);
-        },
-    );
-    section_ui(
-        ui,
-        "events",
-        "Events",
-        &name,
-        (false, open("events")),
-        |ui| {
-            crate::editor::panel::events_ui::events_ui(ui, &mut state.effect, state.selected);
-        },
-    );
+    // The selected emitter's randomness, forces and events: the same section each.
+    type EmitterSection = fn(&mut Ui, &mut crate::effect::Effect, usize);
+    let sections: [(&str, &str, EmitterSection); 3] = [
+        ("randomness", "Randomness", randomness_ui),
+        ("forces", "Forces", forces_ui),
+        (
+            "events",
+            "Events",
+            crate::editor::panel::events_ui::events_ui,
+        ),
+    ];
+    for (id, title, body) in sections {
+        section_ui(ui, id, title, &name, (false, open(id)), |ui| {
+            body(ui, &mut state.effect, state.selected);
+        });
+    }
     section_ui(ui, "time", "Time", "", (true, open("time")), |ui| {
         time_ui(
             ui,
