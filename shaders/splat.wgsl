@@ -1,9 +1,12 @@
-// splat.wgsl — pass 2, small particles: a compute splat. Each alive slot projects its
-// particle and adds its light, as the billboard would have integrated it
-// (colour · alpha · intensity · ∫coverage · (size in px / 2)²), into a fixed-point
-// accumulation buffer, spread bilinearly over the 2×2 nearest pixels (one pixel below 2 px); `resolve` turns the
-// buffer into HDR light. Order-independent, so additive fire needs no sort; alpha-blended
-// emitters always use billboards.
+// splat.wgsl — pass 2, small particles: a compute splat. Each quad of the draw (as the
+// billboards would draw it: quad.wgsl, projected by sprite_project.wgsl) adds its light
+// into a fixed-point accumulation buffer with atomics, order-independent, so additive
+// fire needs no sort. A sprite whose pixel box is at most FOOTPRINT pixels a side adds,
+// at every pixel centre it covers, the texel the billboard's fragment would add there
+// (its footprint: the billboards' image); a larger one (the path forced on large
+// sprites) adds its integrated light (colour · intensity · ∫coverage · (size in px / 2)²)
+// bilinearly over the 2×2 pixels nearest its centre. `resolve` turns the buffer into HDR
+// light. Alpha-blended emitters always use billboards.
 //
 // Contract:
 // - groups 0 and 1: particle_bindings.wgsl (camera, looks with a dynamic offset per
@@ -11,17 +14,24 @@
 // - group 2: 0 `accum` (3 × u32 per pixel: R, G, B in units of 1/FIXED_SCALE), 1
 //   `scene_depth` (the host's depth, tested at every pixel a particle adds light to
 //   when it is the viewport's size).
+// - group 3: the emitter's sprite and sampler.
 // - DEPTH_TEST: 0 none, 1 a particle nearer than or level with the host's depth passes
 //   (depth 0 = near), 2 the reverse (reversed Z). Particles never write depth.
 #import "common.wgsl"
 #import "rng.wgsl"
-#import "look.wgsl"
+#import "sprite_project.wgsl"
 #import "particle_bindings.wgsl"
 
 @group(2) @binding(0) var<storage, read_write> accum: array<atomic<u32>>;
 @group(2) @binding(1) var scene_depth: texture_depth_2d;
+@group(3) @binding(0) var sprite_tex: texture_2d<f32>;
+@group(3) @binding(1) var sprite_sampler: sampler;
 
 override DEPTH_TEST: u32 = 0u;
+
+// Sprites whose pixel box is at most this many pixels a side add their footprint;
+// larger ones their integrated light (`FOOTPRINT_PX` in src/render/splat.rs sets it).
+override FOOTPRINT: i32 = 8;
 
 // Whether a particle at NDC depth `z` is in front of the host's geometry at pixel `p`.
 fn visible(p: vec2<i32>, z: f32) -> bool {
@@ -36,14 +46,10 @@ fn visible(p: vec2<i32>, z: f32) -> bool {
 // Keep in sync with `SPLAT_FIXED_SCALE` in src/render/splat.rs.
 const FIXED_SCALE: f32 = 4096.0;
 
-fn add_light(x: i32, y: i32, z: f32, rgb: vec3<f32>, dither: f32) {
-    let w = i32(camera.viewport.x);
-    let h = i32(camera.viewport.y);
-    if x < 0 || y < 0 || x >= w || y >= h || !visible(vec2<i32>(x, y), z) {
-        return;
-    }
-    let base = u32(y * w + x) * 3u;
-    // Dithered rounding keeps the expected energy of faint contributions.
+// Adds `rgb` at pixel `p` (inside the target), rounded with `dither` (in [0, 1)): the
+// expected energy of faint contributions is kept.
+fn add_fixed(p: vec2<i32>, rgb: vec3<f32>, dither: vec3<f32>) {
+    let base = u32(p.y * i32(camera.viewport.x) + p.x) * 3u;
     let q = vec3<u32>(rgb * FIXED_SCALE + dither);
     if q.r > 0u {
         atomicAdd(&accum[base], q.r);
@@ -62,54 +68,85 @@ fn splat(
     @builtin(num_workgroups) nwg: vec3<u32>,
     @builtin(local_invocation_index) lid: u32,
 ) {
-    // One invocation per slot of the live window: the last ring_b.w slots before the
-    // ring's head (ring.x), wrapping at the capacity (ring_b.z).
-    look = looks[wg.z].look;
+    // One invocation per quad of instance wg.z's live window (the draw's widest window
+    // per instance: quad.wgsl's `quad_slot`).
     let i = (wg.y * nwg.x + wg.x) * 256u + lid;
-    if i >= look.ring_b.w {
+    let width = max(looks[0].look.ring.w, 1u);
+    if i >= width {
         return;
     }
-    var slot = look.ring.x + look.ring_b.z - look.ring_b.w + i;
-    if slot >= look.ring_b.z {
-        slot -= look.ring_b.z;
-    }
-    let pair = load_pair(slot);
-    let d = drawn(pair[0], pair[1]);
-    if !d.alive {
+    let qd = load_quad(wg.z * width + i);
+    if !qd.d.alive {
         return;
     }
-    let clip = look.clip_from_sim * vec4<f32>(d.pos, 1.0);
-    if clip.w <= 1e-4 || any(abs(clip.xy) > vec2<f32>(clip.w * 1.01)) || clip.z < 0.0 || clip.z > clip.w {
+    let s = project_quad(qd);
+    if s.bounds.x > s.bounds.z || s.bounds.y > s.bounds.w {
         return;
     }
-    let t = age_fraction(d.age, d.life);
-    let color = particle_color(t) * vec4<f32>(inherited_rgb(d.life), 1.0);
-    let rnd = particle_random(slot, d.life);
-    let lc = look_curves(t, curve_random(slot, d.life, rnd));
-    let size_px = lc.x * camera.viewport.z / clip.w;
+    let seed = vec2<u32>(qd.slot, bitcast<u32>(qd.d.age));
+    if all(s.bounds.zw - s.bounds.xy < vec2<i32>(FOOTPRINT)) {
+        for (var y = s.bounds.y; y <= s.bounds.w; y++) {
+            for (var x = s.bounds.x; x <= s.bounds.z; x++) {
+                footprint_pixel(s, vec2<i32>(x, y), seed);
+            }
+        }
+    } else {
+        integrated_light(qd, seed);
+    }
+}
+
+// Sprite `s`'s light at pixel `p`, as the billboard's fragment adds it there.
+fn footprint_pixel(s: TileSprite, p: vec2<i32>, seed: vec2<u32>) {
+    let pc = vec2<f32>(p) + 0.5;
+    var sp: SpritePoint;
+    if s.offset.z != 0.0 {
+        sp = affine_point(s.map, s.offset, pc);
+    } else {
+        sp = projective_point(s.map, s.offset, s.map_z, s.z_row, s.w_row, pc);
+    }
+    if sprite_misses(sp, pc, p, s.offset, s.uv_box) {
+        return;
+    }
+    let tex = sprite_texel(sp.uv * s.grad.xy, s.frames, s.grad.z, sp.ddx * s.grad.xy, sp.ddy * s.grad.xy);
+    var rgb = s.color.rgb * tex.rgb;
+    if SOFT || SOFT_DEPTH {
+        rgb *= soft_fade(p, sp.uv, sp.z, s.ground, s.grad.w);
+    }
+    let dither = unorm4(pcg4d(vec4<u32>(seed, u32(p.x) | (u32(p.y) << 16u), 0x5EEDu)));
+    add_fixed(p, rgb, dither.xyz);
+}
+
+// A large quad's integrated light, bilinearly over the 2×2 pixels nearest its centre
+// (one pixel below 2 px), each tested against the host's depth at the centre's depth.
+fn integrated_light(qd: Quad, seed: vec2<u32>) {
+    let clip = look.clip_from_sim * vec4<f32>(qd.d.pos, 1.0);
+    if clip.w <= 1e-4 || clip.z < 0.0 || clip.z > clip.w {
+        return;
+    }
+    let size_px = qd.lc.x * camera.viewport.z / clip.w;
     let half = 0.5 * size_px;
-    var energy = color.rgb * (color.a * lc.y * look.size_intensity.z * look.extra.x * half * half);
+    // qd.color: premultiplied, × the intensity.
+    var energy = qd.color.rgb * (look.extra.x * half * half);
     if look.soft.y > 0.0 {
         // The billboard's ground fade, taken at the particle's centre.
-        energy *= clamp((d.pos.y - look.soft.x) * look.soft.y, 0.0, 1.0);
+        energy *= clamp((qd.d.pos.y - look.soft.x) * look.soft.y, 0.0, 1.0);
     }
     let ndc = clip.xy / clip.w;
     let px = vec2<f32>((ndc.x * 0.5 + 0.5) * camera.viewport.x, (0.5 - ndc.y * 0.5) * camera.viewport.y) - 0.5;
-    let dither = unorm4(pcg4d(vec4<u32>(slot, bitcast<u32>(d.age), 0x5EEDu, 0u)));
-    // Bilinear over the 2×2 nearest pixels; below two pixels one tap (3 atomics)
-    // suffices: the footprint is sub-pixel anyway, and atomics are the splat's cost. One
-    // loop for both, so a CPU adapter (which runs every branch for a SIMD batch of
-    // particles, masked) pays for the taps the batch needs, not for both paths.
+    let dither = unorm4(pcg4d(vec4<u32>(seed, 0u, 0x5EEDu)));
     let small = size_px < 2.0;
-    let near = floor(px + 0.5);
-    let b = vec2<i32>(select(floor(px), near, small));
+    let b = vec2<i32>(select(floor(px), floor(px + 0.5), small));
     let f = select(px - floor(px), vec2<f32>(0.0), small);
     let taps = select(4u, 1u, small);
+    let size = vec2<i32>(camera.viewport.xy);
     for (var k = 0u; k < taps; k++) {
         let o = vec2<u32>(k & 1u, k >> 1u);
+        let p = b + vec2<i32>(o);
         let wx = select(1.0 - f.x, f.x, o.x == 1u);
         let wy = select(1.0 - f.y, f.y, o.y == 1u);
-        add_light(b.x + i32(o.x), b.y + i32(o.y), clip.z / clip.w, energy * (wx * wy), dither[k]);
+        if all(p >= vec2<i32>(0)) && all(p < size) && visible(p, clip.z / clip.w) {
+            add_fixed(p, energy * (wx * wy), vec3<f32>(dither[k]));
+        }
     }
 }
 

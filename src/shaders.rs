@@ -71,6 +71,10 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ("billboard.wgsl", include_str!("../shaders/billboard.wgsl")),
     ("tiles.wgsl", include_str!("../shaders/tiles.wgsl")),
     (
+        "sprite_project.wgsl",
+        include_str!("../shaders/sprite_project.wgsl"),
+    ),
+    (
         "tile_lists.wgsl",
         include_str!("../shaders/tile_lists.wgsl"),
     ),

@@ -234,67 +234,6 @@ fn a_gpu_profile_splats_only_dense_small_particles() {
     assert!(!splats(AdapterProfile::GPU, full), "sparse points splatted");
 }
 
-/// Both draw paths render the same look: flames of 3-px particles drawn as billboards and
-/// as compute splats agree in total light (within 10 %) and, block-averaged over 8×8
-/// pixels, in where the light is.
-#[test]
-fn billboard_and_splat_paths_agree() {
-    use ignis::effect::DrawPath;
-    let ctx = gpu();
-    let render = |path: DrawPath| {
-        let mut effect = Effect::default_campfire();
-        effect.emitters.retain(|e| e.name == "flames");
-        effect.drop_dangling_events();
-        let e = &mut effect.emitters[0];
-        e.look.size_m = ignis::effect::Param::Curve {
-            keys: vec![(0.0, 0.03), (1.0, 0.02)],
-            smooth: false,
-        };
-        e.look.intensity = 0.6;
-        e.look.draw_path = path;
-        let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
-        run.composite.exposure = 0.5;
-        for _ in 0..60 {
-            run.advance(1.0 / 60.0);
-        }
-        run.render(SIZE).expect("render")
-    };
-    let a = render(DrawPath::Billboard);
-    let b = render(DrawPath::Splat);
-    let (la, lb) = (total_light(&a), total_light(&b));
-    assert!(la > 1e5, "billboards drew almost nothing: {la}");
-    assert!(
-        (la - lb).abs() / la < 0.10,
-        "total light differs: billboard {la}, splat {lb}"
-    );
-    let blocks = |img: &image::RgbaImage| -> Vec<f64> {
-        let mut v = Vec::new();
-        for by in 0..SIZE.1 / 8 {
-            for bx in 0..SIZE.0 / 8 {
-                v.push(
-                    mean_rgb(img, bx * 8, by * 8, bx * 8 + 8, by * 8 + 8)
-                        .iter()
-                        .map(|c| *c as f64)
-                        .sum::<f64>(),
-                );
-            }
-        }
-        v
-    };
-    let (ba, bb) = (blocks(&a), blocks(&b));
-    let diff: f64 = ba.iter().zip(&bb).map(|(x, y)| (x - y).abs()).sum::<f64>();
-    let total: f64 = ba.iter().sum();
-    assert!(
-        diff / total < 0.15,
-        "block-averaged images differ by {:.1} %",
-        100.0 * diff / total
-    );
-    a.save(std::env::temp_dir().join("ignis_path_billboard.png"))
-        .expect("save");
-    b.save(std::env::temp_dir().join("ignis_path_splat.png"))
-        .expect("save");
-}
-
 /// A stateless emitter draws the same fire as the stateful exponential integrator (exact
 /// for the same forces): the draw passes evaluate its spawn records in closed form.
 #[test]

@@ -1,14 +1,21 @@
-//! The compute splat draw path for small particles: project, accumulate fixed-point
-//! light with atomics, resolve into the HDR target. ~90× cheaper than tiny instanced
-//! quads on GPUs whose rasteriser runs on a few SMs (see the perf bench).
+//! The compute splat draw path for small particles: each quad projected as the billboards
+//! draw it, its light at every pixel centre it covers (its footprint; a sprite larger than
+//! [`FOOTPRINT_PX`] its integrated light near its centre) accumulated in fixed point with
+//! atomics, resolved into the HDR target. Far cheaper than tiny instanced quads on GPUs
+//! whose rasteriser runs on a few SMs (see the perf bench).
 
 use std::collections::HashMap;
 
 use crate::gpu::GpuContext;
 use crate::render::billboard::{ADDITIVE, DrawTarget};
-use crate::render::frame::{DrawItem, FrameResources, StateVariant};
+use crate::render::frame::{DrawItem, FrameResources, LookVariant};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 use crate::sim::gpu_sim::dispatch_size;
+
+/// Sprites whose pixel box is at most this many pixels a side add their footprint (the
+/// billboards' pixels); larger ones (a forced splat of large sprites) their integrated
+/// light over the 2×2 pixels nearest their centre (splat.wgsl's `FOOTPRINT`).
+pub const FOOTPRINT_PX: u32 = 8;
 
 /// Compute splat + resolve.
 pub struct SplatPass {
@@ -20,10 +27,12 @@ pub struct SplatPass {
     resolve_layout: wgpu::PipelineLayout,
     empty_group: wgpu::BindGroup,
     module: wgpu::ShaderModule,
-    /// Splat pipelines per state variant, built on first use (`None`: failed, logged).
-    splats: HashMap<StateVariant, Option<wgpu::ComputePipeline>>,
+    /// Splat pipelines per look variant, built on first use (`None`: failed, logged).
+    splats: HashMap<LookVariant, Option<wgpu::ComputePipeline>>,
     resolve: wgpu::RenderPipeline,
     accum: Option<Accum>,
+    /// The splat items' sprites (group 3).
+    sprites: crate::render::sprites::SpriteGroups,
 }
 
 /// The accumulation buffer of one size and its bind group (with the depth it tests).
@@ -61,6 +70,8 @@ impl SplatPass {
             ],
         );
         let no_depth = crate::gpu::placeholder_depth(&ctx.device, "SplatPass::no_depth");
+        let sprite_layout =
+            crate::render::sprites::compute_sprite_layout(ctx, "SplatPass::sprite_layout");
         let pipeline_layout = ctx
             .device
             .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -69,6 +80,7 @@ impl SplatPass {
                     Some(&frame.frame_layout),
                     Some(&frame.particle_layout),
                     Some(&accum_layout),
+                    Some(&sprite_layout),
                 ],
                 immediate_size: 0,
             });
@@ -103,6 +115,10 @@ impl SplatPass {
             splats,
             resolve,
             accum: None,
+            sprites: crate::render::sprites::SpriteGroups::new(
+                "SplatPass::sprite_group",
+                sprite_layout,
+            ),
         })
     }
 
@@ -110,26 +126,28 @@ impl SplatPass {
         ctx: &GpuContext,
         layout: &wgpu::PipelineLayout,
         module: &wgpu::ShaderModule,
-        state: StateVariant,
+        v: LookVariant,
         target: DrawTarget,
     ) -> wgpu::ComputePipeline {
-        let [a, b] = state.constants();
-        let constants = [a, b, ("DEPTH_TEST", crate::render::depth_test(target))];
-        ctx.device
-            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(&format!("SplatPass::splat {state:?}")),
-                layout: Some(layout),
-                module,
-                entry_point: Some("splat"),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &constants,
-                    ..Default::default()
-                },
-                cache: None,
-            })
+        // splat.wgsl draws sprites only: no motion pass, ribbons or haze.
+        let mut constants: Vec<(&str, f64)> = v
+            .constants()
+            .into_iter()
+            .filter(|(name, _)| !["MOTION", "TRAIL", "HAZE"].contains(name))
+            .collect();
+        constants.push(("DEPTH_TEST", crate::render::depth_test(target)));
+        constants.push(("FOOTPRINT", f64::from(FOOTPRINT_PX)));
+        crate::render::compute_pipeline(
+            ctx,
+            &format!("SplatPass::splat {v:?}"),
+            layout,
+            module,
+            "splat",
+            &constants,
+        )
     }
 
-    /// The module, the full-state splat (validated with it) and the resolve.
+    /// The module, the basic variant's splat (validated with it) and the resolve.
     #[allow(clippy::type_complexity)]
     fn build(
         ctx: &GpuContext,
@@ -140,17 +158,17 @@ impl SplatPass {
     ) -> Result<
         (
             wgpu::ShaderModule,
-            HashMap<StateVariant, Option<wgpu::ComputePipeline>>,
+            HashMap<LookVariant, Option<wgpu::ComputePipeline>>,
             wgpu::RenderPipeline,
         ),
         ShaderError,
     > {
         let composed = lib.compose("splat.wgsl")?;
         create_checked(&ctx.device, &composed, lib, |module| {
-            let full = StateVariant::default();
+            let basic = LookVariant::basic(false);
             let splats = HashMap::from([(
-                full,
-                Some(Self::splat_pipeline(ctx, layout, module, full, target)),
+                basic,
+                Some(Self::splat_pipeline(ctx, layout, module, basic, target)),
             )]);
             let resolve = crate::render::resolve_pipeline(
                 ctx,
@@ -164,7 +182,7 @@ impl SplatPass {
         })
     }
 
-    /// Rebuilds the pipelines; keeps the old ones on error. Other state variants are
+    /// Rebuilds the pipelines; keeps the old ones on error. Other look variants are
     /// rebuilt on first use.
     pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
         let (module, splats, resolve) = Self::build(
@@ -218,28 +236,10 @@ impl SplatPass {
                 self.accum = Some(self.accum_over(ctx, size, buffer, depth));
             }
         }
+        self.prepare(ctx, items, &frame.sprites.sampler);
         let Some(Accum { buffer, group, .. }) = self.accum.as_ref() else {
             return false;
         };
-        for d in items.iter().filter(|d| d.splat) {
-            let state = d.variant.state;
-            if !self.splats.contains_key(&state) {
-                let p = crate::render::scoped_variant(
-                    ctx,
-                    format_args!("splat variant {state:?}"),
-                    || {
-                        Self::splat_pipeline(
-                            ctx,
-                            &self.pipeline_layout,
-                            &self.module,
-                            state,
-                            self.target,
-                        )
-                    },
-                );
-                self.splats.insert(state, p);
-            }
-        }
         enc.clear_buffer(buffer, 0, None);
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("SplatPass::splat"),
@@ -247,10 +247,11 @@ impl SplatPass {
         });
         pass.set_bind_group(2, group, &[]);
         for d in items.iter().filter(|d| d.splat) {
-            let Some(particles) = frame.particle_group(d.key) else {
-                continue;
-            };
-            let Some(Some(pipeline)) = self.splats.get(&d.variant.state) else {
+            let (Some(particles), Some(Some(pipeline)), Some(sprite)) = (
+                frame.particle_group(d.key),
+                self.splats.get(&d.variant),
+                self.sprites.get(d.sprite.id),
+            ) else {
                 continue;
             };
             pass.set_pipeline(pipeline);
@@ -260,11 +261,29 @@ impl SplatPass {
                 &[FrameResources::look_offset(d.look_slot)],
             );
             pass.set_bind_group(1, particles, &[]);
+            pass.set_bind_group(3, sprite, &[]);
             // Workgroup z is the instance.
             let (x, y) = dispatch_size(d.width);
             pass.dispatch_workgroups(x, y, d.members);
         }
         true
+    }
+
+    /// Builds what the frame's splat items need: pipelines of their variants and sprite
+    /// bind groups.
+    fn prepare(&mut self, ctx: &GpuContext, items: &[DrawItem], sampler: &wgpu::Sampler) {
+        for d in items.iter().filter(|d| d.splat) {
+            let v = d.variant;
+            if !self.splats.contains_key(&v) {
+                let p = crate::render::scoped_variant(ctx, format_args!("splat variant {v:?}"), || {
+                    Self::splat_pipeline(ctx, &self.pipeline_layout, &self.module, v, self.target)
+                });
+                self.splats.insert(v, p);
+            }
+            self.sprites.ensure(ctx, &d.sprite, sampler);
+        }
+        let splats = items.iter().filter(|d| d.splat);
+        self.sprites.keep_drawn(splats.map(|d| d.sprite.id));
     }
 
     /// The accumulation `buffer` (cleared on use) of `size` and its bind group over `depth`

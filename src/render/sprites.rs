@@ -47,6 +47,23 @@ pub struct SpriteTexture {
 /// quads are trimmed to the texels above it (divided by the emitter's intensity).
 pub const TRIM_THRESHOLD: f32 = 1.0 / 1024.0;
 
+/// The layout of a compute draw path's sprite group: the texture (filterable) at binding
+/// 0, its sampler at 1.
+pub fn compute_sprite_layout(ctx: &GpuContext, label: &str) -> wgpu::BindGroupLayout {
+    let compute = |entry: wgpu::BindGroupLayoutEntry| wgpu::BindGroupLayoutEntry {
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ..entry
+    };
+    crate::gpu::bind_group_layout(
+        ctx,
+        label,
+        &[
+            compute(crate::gpu::fragment_texture_entry(0, true)),
+            compute(crate::gpu::fragment_sampler_entry(1)),
+        ],
+    )
+}
+
 /// A draw path's bind groups of sprites (texture at binding 0, sampler at 1 of its
 /// layout), cached by sprite id.
 pub struct SpriteGroups {

@@ -140,23 +140,13 @@ struct TileLayouts {
 impl TileLayouts {
     /// Group 0 is the frame's everywhere; the compute passes add the particles, the sprites
     /// and the tile group; the bin and list passes bind one group of their own at 3.
-    fn new(d: &wgpu::Device, frame: &FrameResources) -> Self {
+    fn new(ctx: &GpuContext, frame: &FrameResources) -> Self {
+        let d = &ctx.device;
+        let sprite_layout =
+            crate::render::sprites::compute_sprite_layout(ctx, "TilePass::sprite_layout");
         let tile_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("TilePass::tile_layout"),
             entries: &TilePass::tile_entries(),
-        });
-        let sprite_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("TilePass::sprite_layout"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ..crate::gpu::fragment_texture_entry(0, true)
-                },
-                wgpu::BindGroupLayoutEntry {
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ..crate::gpu::fragment_sampler_entry(1)
-                },
-            ],
         });
         let read = |binding, visibility| wgpu::BindGroupLayoutEntry {
             binding,
@@ -252,7 +242,7 @@ impl TilePass {
         target: DrawTarget,
     ) -> Result<Self, ShaderError> {
         let d = &ctx.device;
-        let l = TileLayouts::new(d, frame);
+        let l = TileLayouts::new(ctx, frame);
         let compute_resolve =
             ComputeResolve::new(ctx, target, &frame.frame_layout, &l.resolve_group);
         let built = Self::build(
