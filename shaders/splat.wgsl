@@ -14,7 +14,8 @@
 // - group 2: 0 `accum` (3 × u32 per pixel: R, G, B in units of 1/FIXED_SCALE), 1
 //   `scene_depth` (the host's depth, tested at every pixel a particle adds light to
 //   when it is the viewport's size).
-// - group 3: the emitter's sprite and sampler.
+// - group 3: the emitter's sprite and sampler; the compute resolve (`resolve_add`, where
+//   the adapter can): binding 2 `resolve_image`, the target, and no group 1.
 // - DEPTH_TEST: 0 none, 1 a particle nearer than or level with the host's depth passes
 //   (depth 0 = near), 2 the reverse (reversed Z). Particles never write depth.
 #import "common.wgsl"
@@ -26,6 +27,8 @@
 @group(2) @binding(1) var scene_depth: texture_depth_2d;
 @group(3) @binding(0) var sprite_tex: texture_2d<f32>;
 @group(3) @binding(1) var sprite_sampler: sampler;
+// The compute resolve's target (the HDR image, read and written in place).
+@group(3) @binding(2) var resolve_image: texture_storage_2d<rgba16float, read_write>;
 
 override DEPTH_TEST: u32 = 0u;
 
@@ -164,4 +167,22 @@ fn fs_resolve(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let i = (u32(frag.y) * w + u32(frag.x)) * 3u;
     let rgb = vec3<f32>(f32(atomicLoad(&accum[i])), f32(atomicLoad(&accum[i + 1u])), f32(atomicLoad(&accum[i + 2u])));
     return vec4<f32>(rgb / FIXED_SCALE, 0.0);
+}
+
+// The resolve by compute (where the adapter can read and write the target in place):
+// the accumulated light added to the HDR image, as the draw's additive blending does, on
+// every compute unit rather than the raster.
+@compute @workgroup_size(16, 16)
+fn resolve_add(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = vec2<u32>(camera.viewport.xy);
+    if any(id.xy >= size) {
+        return;
+    }
+    let i = (id.y * size.x + id.x) * 3u;
+    let rgb = vec3<u32>(atomicLoad(&accum[i]), atomicLoad(&accum[i + 1u]), atomicLoad(&accum[i + 2u]));
+    if all(rgb == vec3<u32>(0u)) {
+        return;
+    }
+    let dst = textureLoad(resolve_image, vec2<i32>(id.xy));
+    textureStore(resolve_image, vec2<i32>(id.xy), vec4<f32>(dst.rgb + vec3<f32>(rgb) / FIXED_SCALE, dst.a));
 }

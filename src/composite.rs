@@ -10,7 +10,7 @@ use crate::render::test_scene::TestScene;
 use crate::render::{
     Camera, HDR_FORMAT, Targets, TonemapPass, ensure_layer, load_hdr_pass, reduced,
 };
-use crate::runtime::{Layers, Player, PlayerSettings};
+use crate::runtime::{Layers, Player, PlayerSettings, Resolves};
 use crate::shaders::{ShaderError, ShaderLibrary};
 use crate::sim::gpu_sim::{SimError, map_read};
 
@@ -226,16 +226,25 @@ impl Composite {
                 self.clear.record(ctx, enc, view, size);
             }
             // The tiles are resolved by compute where the adapter can (between the
-            // blended billboards under them and the light over them), else drawn.
+            // blended billboards under them and the light over them), else drawn; so is
+            // the splat's light (after the rest: it is added).
             let main = Layers::ALL.without(layered);
-            if main.contains(Layers::LIGHT) && player.tiles_resolvable_into(size) {
+            let light = main.contains(Layers::LIGHT);
+            let mut drawn = Resolves::DRAWN;
+            drawn.splat = !(light && player.splat_resolvable_into(size));
+            if light && player.tiles_resolvable_into(size) {
                 if player.draws_under_tiles(main) {
                     player.draw_under_tiles(&mut load_hdr_pass(enc, view), main);
                 }
-                let resolved = player.resolve_tiles_into(enc, view, size);
-                player.draw_over_tiles(&mut load_hdr_pass(enc, view), main, !resolved);
+                drawn.tiles = !player.resolve_tiles_into(enc, view, size);
+                player.draw_over_tiles(&mut load_hdr_pass(enc, view), main, drawn);
             } else {
-                player.draw_layers(&mut load_hdr_pass(enc, view), main);
+                let mut pass = load_hdr_pass(enc, view);
+                player.draw_under_tiles(&mut pass, main);
+                player.draw_over_tiles(&mut pass, main, drawn);
+            }
+            if !drawn.splat {
+                player.resolve_splat_into(enc, view, size);
             }
         }
         layered

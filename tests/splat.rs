@@ -69,7 +69,11 @@ fn small_additive(ctx: &GpuContext, effect: &Effect, frames: u32, size: (u32, u3
 
 /// The share of `a`'s channels that differ from `b`'s by more than 8/255.
 fn share_off(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
-    let off = a.as_raw().iter().zip(b.as_raw()).filter(|(x, y)| x.abs_diff(**y) > 8);
+    let off = a
+        .as_raw()
+        .iter()
+        .zip(b.as_raw())
+        .filter(|(x, y)| x.abs_diff(**y) > 8);
     off.count() as f64 / a.as_raw().len() as f64
 }
 
@@ -81,7 +85,10 @@ fn splat_agrees(what: &str, effect: &Effect, splat: &[usize], size: (u32, u32)) 
     let ctx = gpu();
     let a = render(&ctx, effect, &[], 60, size);
     let b = render(&ctx, effect, splat, 60, size);
-    assert!(total_light(&a) > 1e3, "{what}: the billboards drew almost nothing");
+    assert!(
+        total_light(&a) > 1e3,
+        "{what}: the billboards drew almost nothing"
+    );
     let (mean, max) = image_diff(&a, &b);
     let off = share_off(&a, &b);
     if std::env::var_os("IGNIS_SAVE_SPLAT_IMAGES").is_some() {
@@ -139,7 +146,10 @@ fn every_shipped_preset_splats_its_small_sprites_as_the_billboards_draw_them() {
     assert!(failed.is_empty(), "{failed:?}");
     // The thesis's points at both sizes, the bonfire's and the torch's small light at the
     // half size.
-    assert!(splatted >= 4, "only {splatted} small additive emitters splatted");
+    assert!(
+        splatted >= 4,
+        "only {splatted} small additive emitters splatted"
+    );
 }
 
 /// The campfire's flames at about 3 px: a blended flipbook with a ground fade.
@@ -193,6 +203,44 @@ fn a_dense_sphere_of_three_pixel_sparks_splats_as_the_billboards_draw_it() {
     splat_agrees("dense 3-px sphere", &effect, &[0], SIZE);
 }
 
+/// The editor's and renders' own HDR image takes the splat's light by compute
+/// (`resolve_add`) where the adapter can read and write it in place: the image the
+/// resolve's draw gives (the thesis's points; the spark fountain's sparks and glow).
+#[test]
+fn the_compute_resolve_adds_what_the_resolve_draw_does() {
+    let ctx = gpu();
+    for name in ["thesis_2006", "spark_fountain"] {
+        let path = format!("presets/{name}.ron");
+        let mut effect = ignis::preset::load(path.as_ref()).expect("shipped preset");
+        for e in &mut effect.emitters {
+            if e.look.blend == BlendMode::Additive && e.look.heat_haze.is_none() {
+                e.look.draw_path = DrawPath::Splat;
+            }
+        }
+        let image = |compute: bool| {
+            let mut run =
+                Headless::new(&ctx, effect.clone(), ShaderLibrary::embedded()).expect("headless");
+            run.player.splat_pass().set_compute_resolve(compute);
+            for _ in 0..60 {
+                run.advance(1.0 / 60.0);
+            }
+            let image = run.render(SIZE).expect("render");
+            let used = run.player.splat_pass().can_resolve_into(SIZE);
+            assert_eq!(used, compute, "{name}: compute resolve used: {used}");
+            assert!(run.player.draw_items().iter().any(|d| d.splat), "{name}");
+            image
+        };
+        let (drawn, computed) = (image(false), image(true));
+        assert!(total_light(&drawn) > 1e3, "{name}: almost nothing drawn");
+        let (mean, max) = image_diff(&drawn, &computed);
+        eprintln!("{name}: compute resolve vs draw: mean {mean:.4}/255, max {max}/255");
+        assert!(
+            mean <= 0.01 && max <= 1,
+            "{name}: the compute resolve differs by {mean:.4}/255 mean, {max}/255 max"
+        );
+    }
+}
+
 /// The light-weighted centre of `img` in pixels.
 fn centroid(img: &image::RgbaImage) -> (f64, f64) {
     let (mut sx, mut sy, mut total) = (0.0, 0.0, 0.0);
@@ -220,10 +268,16 @@ fn large_sprites_forced_onto_the_splat_keep_their_light_at_their_centres() {
     let b = render(&ctx, &effect, &[0], 60, SIZE);
     let (la, lb) = (total_light(&a), total_light(&b));
     assert!(la > 1e5, "billboards drew almost nothing: {la}");
-    assert!(lb > la / 3.0 && lb < la, "light: billboard {la}, splat {lb}");
+    assert!(
+        lb > la / 3.0 && lb < la,
+        "light: billboard {la}, splat {lb}"
+    );
     let (ca, cb) = (centroid(&a), centroid(&b));
     let d = ((ca.0 - cb.0).powi(2) + (ca.1 - cb.1).powi(2)).sqrt();
     assert!(d < 3.0, "centroids {ca:?} and {cb:?}");
     let (mean, _) = image_diff(&a, &b);
-    assert!(mean > 1.0, "large sprites took their footprint: {mean:.3}/255");
+    assert!(
+        mean > 1.0,
+        "large sprites took their footprint: {mean:.3}/255"
+    );
 }

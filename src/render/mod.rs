@@ -4,6 +4,7 @@ pub mod billboard;
 pub mod bloom;
 pub mod camera;
 pub mod clear;
+pub(crate) mod compute_resolve;
 pub mod depth_resolve;
 pub mod draw_item;
 pub mod frame;

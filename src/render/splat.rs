@@ -8,6 +8,7 @@ use std::collections::HashMap;
 
 use crate::gpu::GpuContext;
 use crate::render::billboard::{ADDITIVE, DrawTarget};
+use crate::render::compute_resolve::ComputeResolve;
 use crate::render::frame::{DrawItem, FrameResources, LookVariant};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 use crate::sim::gpu_sim::dispatch_size;
@@ -30,9 +31,25 @@ pub struct SplatPass {
     /// Splat pipelines per look variant, built on first use (`None`: failed, logged).
     splats: HashMap<LookVariant, Option<wgpu::ComputePipeline>>,
     resolve: wgpu::RenderPipeline,
+    /// The resolve by compute's layouts and groups over the targets it wrote last, and its
+    /// pipeline (`None`: the adapter cannot, or the host's target is not an HDR image).
+    compute_resolve: Option<(ComputeResolve, wgpu::ComputePipeline)>,
+    /// Whether [`SplatPass::resolve_into`] may resolve by compute (tests compare it with
+    /// the draw).
+    compute_resolve_on: bool,
     accum: Option<Accum>,
     /// The splat items' sprites (group 3).
     sprites: crate::render::sprites::SpriteGroups,
+}
+
+/// What a build of `splat.wgsl` makes.
+struct Built {
+    module: wgpu::ShaderModule,
+    /// The basic variant's splat (built to validate the module).
+    splats: HashMap<LookVariant, Option<wgpu::ComputePipeline>>,
+    resolve: wgpu::RenderPipeline,
+    /// The resolve by compute, where the adapter can read and write the target.
+    resolve_add: Option<wgpu::ComputePipeline>,
 }
 
 /// The accumulation buffer of one size and its bind group (with the depth it tests).
@@ -102,8 +119,19 @@ impl SplatPass {
                 ],
                 immediate_size: 0,
             });
-        let (module, splats, resolve) =
-            Self::build(ctx, lib, &pipeline_layout, &resolve_layout, target)?;
+        let over = ComputeResolve::new(
+            ctx,
+            "SplatPass::resolve_add",
+            target,
+            &[&frame.frame_layout, &empty_layout, &accum_layout],
+        );
+        let built = Self::build(
+            ctx,
+            lib,
+            [&pipeline_layout, &resolve_layout],
+            over.as_ref().map(|c| &c.layout),
+            target,
+        )?;
         Ok(Self {
             target,
             accum_layout,
@@ -111,9 +139,11 @@ impl SplatPass {
             pipeline_layout,
             resolve_layout,
             empty_group,
-            module,
-            splats,
-            resolve,
+            module: built.module,
+            splats: built.splats,
+            resolve: built.resolve,
+            compute_resolve: over.zip(built.resolve_add),
+            compute_resolve_on: true,
             accum: None,
             sprites: crate::render::sprites::SpriteGroups::new(
                 "SplatPass::sprite_group",
@@ -147,22 +177,14 @@ impl SplatPass {
         )
     }
 
-    /// The module, the basic variant's splat (validated with it) and the resolve.
-    #[allow(clippy::type_complexity)]
+    /// The module, the basic variant's splat (validated with it) and the resolves.
     fn build(
         ctx: &GpuContext,
         lib: &ShaderLibrary,
-        layout: &wgpu::PipelineLayout,
-        resolve_layout: &wgpu::PipelineLayout,
+        [layout, resolve_layout]: [&wgpu::PipelineLayout; 2],
+        over_layout: Option<&wgpu::PipelineLayout>,
         target: DrawTarget,
-    ) -> Result<
-        (
-            wgpu::ShaderModule,
-            HashMap<LookVariant, Option<wgpu::ComputePipeline>>,
-            wgpu::RenderPipeline,
-        ),
-        ShaderError,
-    > {
+    ) -> Result<Built, ShaderError> {
         let composed = lib.compose("splat.wgsl")?;
         create_checked(&ctx.device, &composed, lib, |module| {
             let basic = LookVariant::basic(false);
@@ -178,23 +200,37 @@ impl SplatPass {
                 target,
                 ADDITIVE,
             );
-            (module.clone(), splats, resolve)
+            let resolve_add = over_layout.map(|l| {
+                crate::render::compute_pipeline(
+                    ctx,
+                    "SplatPass::resolve_add",
+                    l,
+                    module,
+                    "resolve_add",
+                    &[],
+                )
+            });
+            Built {
+                module: module.clone(),
+                splats,
+                resolve,
+                resolve_add,
+            }
         })
     }
 
     /// Rebuilds the pipelines; keeps the old ones on error. Other look variants are
     /// rebuilt on first use.
     pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
-        let (module, splats, resolve) = Self::build(
-            ctx,
-            lib,
-            &self.pipeline_layout,
-            &self.resolve_layout,
-            self.target,
-        )?;
-        self.module = module;
-        self.splats = splats;
-        self.resolve = resolve;
+        let over = self.compute_resolve.as_ref().map(|(c, _)| &c.layout);
+        let layouts = [&self.pipeline_layout, &self.resolve_layout];
+        let built = Self::build(ctx, lib, layouts, over, self.target)?;
+        self.module = built.module;
+        self.splats = built.splats;
+        self.resolve = built.resolve;
+        if let (Some((_, p)), Some(new)) = (self.compute_resolve.as_mut(), built.resolve_add) {
+            *p = new;
+        }
         Ok(())
     }
 
@@ -275,9 +311,16 @@ impl SplatPass {
         for d in items.iter().filter(|d| d.splat) {
             let v = d.variant;
             if !self.splats.contains_key(&v) {
-                let p = crate::render::scoped_variant(ctx, format_args!("splat variant {v:?}"), || {
-                    Self::splat_pipeline(ctx, &self.pipeline_layout, &self.module, v, self.target)
-                });
+                let p =
+                    crate::render::scoped_variant(ctx, format_args!("splat variant {v:?}"), || {
+                        Self::splat_pipeline(
+                            ctx,
+                            &self.pipeline_layout,
+                            &self.module,
+                            v,
+                            self.target,
+                        )
+                    });
                 self.splats.insert(v, p);
             }
             self.sprites.ensure(ctx, &d.sprite, sampler);
@@ -328,5 +371,53 @@ impl SplatPass {
         pass.set_bind_group(1, &self.empty_group, &[]);
         pass.set_bind_group(2, group, &[]);
         pass.draw(0..3, 0..1);
+    }
+
+    /// Whether [`SplatPass::resolve_into`] adds the last splat's light into a target of
+    /// `size` pixels.
+    pub fn can_resolve_into(&self, size: (u32, u32)) -> bool {
+        self.compute_resolve_on
+            && self.compute_resolve.is_some()
+            && self.accum.as_ref().is_some_and(|a| a.size == size)
+    }
+
+    /// Lets [`SplatPass::resolve_into`] resolve by compute (the default) or not (tests
+    /// compare the two).
+    #[doc(hidden)]
+    pub fn set_compute_resolve(&mut self, on: bool) {
+        self.compute_resolve_on = on;
+    }
+
+    /// Adds the last splat's light into `target` (the HDR image of `size` pixels the
+    /// resolve would draw into, with storage usage) by compute instead of a draw. Returns
+    /// false, recording nothing, where it cannot (then [`SplatPass::resolve`] draws it).
+    pub fn resolve_into(
+        &mut self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        frame: &FrameResources,
+        target: &wgpu::TextureView,
+        size: (u32, u32),
+    ) -> bool {
+        if !self.can_resolve_into(size) {
+            return false;
+        }
+        let (Some((c, pipeline)), Some(Accum { group, .. })) =
+            (self.compute_resolve.as_mut(), self.accum.as_ref())
+        else {
+            return false;
+        };
+        let image = c.images.group(ctx, target);
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("SplatPass::resolve_add"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &frame.frame_group, &[0]);
+        pass.set_bind_group(1, &self.empty_group, &[]);
+        pass.set_bind_group(2, group, &[]);
+        pass.set_bind_group(3, image, &[]);
+        pass.dispatch_workgroups(size.0.div_ceil(16), size.1.div_ceil(16), 1);
+        true
     }
 }

@@ -14,16 +14,14 @@ use std::collections::HashMap;
 use crate::gpu::GpuContext;
 use crate::render::billboard::DrawTarget;
 use crate::render::frame::{DrawItem, FrameResources, LookVariant};
-use crate::render::image_groups::ImageGroups;
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 use crate::sim::gpu_sim::dispatch_size;
 
 mod buffers;
-mod compute_resolve;
 mod sizing;
 
+use crate::render::compute_resolve::ComputeResolve;
 use buffers::TileBuffers;
-use compute_resolve::ComputeResolve;
 use sizing::*;
 
 /// Pixels per tile side (one workgroup each; keep in sync with `TILE` in tiles.wgsl).
@@ -243,8 +241,12 @@ impl TilePass {
     ) -> Result<Self, ShaderError> {
         let d = &ctx.device;
         let l = TileLayouts::new(ctx, frame);
-        let compute_resolve =
-            ComputeResolve::new(ctx, target, &frame.frame_layout, &l.resolve_group);
+        let compute_resolve = ComputeResolve::new(
+            ctx,
+            "TilePass::resolve_over",
+            target,
+            &[&frame.frame_layout, &l.resolve_group],
+        );
         let built = Self::build(
             ctx,
             lib,

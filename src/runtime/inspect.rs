@@ -223,6 +223,12 @@ impl Player {
         self.tiles.as_mut()
     }
 
+    /// The compute splat (tests compare its resolves).
+    #[doc(hidden)]
+    pub fn splat_pass(&mut self) -> &mut crate::render::SplatPass {
+        &mut self.splat
+    }
+
     /// The draws prepared by the last record (tests look at the paths and layers chosen).
     #[doc(hidden)]
     pub fn draw_items(&self) -> &[DrawItem] {

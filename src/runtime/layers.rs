@@ -50,6 +50,24 @@ impl Layers {
     }
 }
 
+/// Which of the compute draw paths' resolves a draw of the layers draws in its render
+/// pass (the others are resolved by compute into the image).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Resolves {
+    /// The tiles' shaded pixels.
+    pub tiles: bool,
+    /// The splat's light.
+    pub splat: bool,
+}
+
+impl Resolves {
+    /// Both drawn in the pass.
+    pub const DRAWN: Self = Self {
+        tiles: true,
+        splat: true,
+    };
+}
+
 impl std::ops::BitOr for Layers {
     type Output = Self;
 

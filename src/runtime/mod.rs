@@ -27,5 +27,6 @@ pub use host_targets::HostTargets;
 pub use inspect::{ClockStats, EmitterStats, EventCount, ParticleCount};
 pub use instances::InstanceId;
 pub use layers::Layers;
+pub(crate) use layers::Resolves;
 pub use particle_info::ParticleInfo;
 pub use player::{Player, PlayerError, PlayerSettings};

@@ -11,10 +11,10 @@ use crate::render::billboard::{BillboardPass, DrawTarget};
 use crate::render::matrix::IntoMat4;
 use crate::render::sort::SortPass;
 use crate::render::{Camera, DrawItem, FrameResources, Scene, SplatPass, TilePass};
-use crate::runtime::Layers;
 use crate::runtime::device_check::{MissingLimit, missing_limits};
 use crate::runtime::host_depth::HostDepth;
 use crate::runtime::instances::{Backing, Instance, InstanceId, Slab};
+use crate::runtime::{Layers, Resolves};
 use crate::shaders::{ShaderError, ShaderLibrary};
 use crate::sim::batch::{BatchMember, InstanceBatch, batchable};
 use crate::sim::gpu_sim::{SharedUpdate, SimError, UpdateMode};
@@ -635,7 +635,7 @@ impl Player {
         // Alpha-blended billboards, then the tiles (alpha-blended layers are drawn by
         // one path or the other, never both), then the light.
         self.draw_under_tiles(pass, layers);
-        self.draw_over_tiles(pass, layers, true);
+        self.draw_over_tiles(pass, layers, Resolves::DRAWN);
     }
 
     /// What [`Player::draw_layers`] draws before the tiles: the alpha-blended billboards
@@ -652,27 +652,48 @@ impl Player {
             .any(|d| d.is_billboard() && under_tiles(d, layers))
     }
 
-    /// The rest of [`Player::draw_layers`]: the tiles (unless `tiles` is false: resolved
-    /// by compute already), the additive billboards and the splat's light.
+    /// The rest of [`Player::draw_layers`]: the tiles, the additive billboards and the
+    /// splat's light (the resolves `drawn` says are drawn; the others are resolved by
+    /// compute).
     pub(crate) fn draw_over_tiles(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
         layers: Layers,
-        tiles: bool,
+        drawn: Resolves,
     ) {
         if let Some(t) = self
             .tiles
             .as_ref()
-            .filter(|_| tiles && layers.contains(Layers::LIGHT))
+            .filter(|_| drawn.tiles && layers.contains(Layers::LIGHT))
         {
             t.resolve(pass, &self.frame);
         }
         self.billboard.draw(pass, &self.frame, &self.items, |d| {
             d.blend == BlendMode::Additive && layers.contains(Layers::of(d))
         });
-        if self.splatted && layers.contains(Layers::LIGHT) {
+        if self.splatted && drawn.splat && layers.contains(Layers::LIGHT) {
             self.splat.resolve(pass, &self.frame);
         }
+    }
+
+    /// Whether [`Player::resolve_splat_into`] resolves into a target of `size` pixels.
+    pub(crate) fn splat_resolvable_into(&self, size: (u32, u32)) -> bool {
+        self.splatted && self.splat.can_resolve_into(size)
+    }
+
+    /// Adds the last record's splatted light into `target` (an HDR image of `size` pixels
+    /// with storage usage) by compute, after [`Player::draw_over_tiles`] drew the rest;
+    /// false where it cannot (nothing recorded).
+    pub(crate) fn resolve_splat_into(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        size: (u32, u32),
+    ) -> bool {
+        self.splatted
+            && self
+                .splat
+                .resolve_into(&self.ctx, enc, &self.frame, target, size)
     }
 
     /// Whether [`Player::resolve_tiles_into`] resolves into a target of `size` pixels.

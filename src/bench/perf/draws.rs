@@ -80,13 +80,16 @@ pub(super) fn draw_costs(
             billboard.draw(&mut pass, &frame, &all_billboard, |_| true);
         })
     });
-    // Splat: clear + compute splat + its resolve into the HDR target.
+    // Splat: clear + compute splat + its resolve into the HDR target (by compute where
+    // the adapter can, as the editor does).
     let splat_ms = {
         let mut samples = Vec::new();
         for _ in 0..opts.repeats {
             samples.push(timer.time(ctx, |enc| {
                 splat.splat(ctx, enc, &frame, &all_splat, size, None);
-                splat.resolve(&mut load_hdr_pass(enc, &targets.hdr_view), &frame);
+                if !splat.resolve_into(ctx, enc, &frame, &targets.hdr_view, size) {
+                    splat.resolve(&mut load_hdr_pass(enc, &targets.hdr_view), &frame);
+                }
             }));
         }
         median(&mut samples)
