@@ -11,9 +11,9 @@
 // Contract:
 // - groups 0 and 1: particle_bindings.wgsl (camera, looks with a dynamic offset per
 //   emitter, ramps; the state buffers).
-// - group 2: 0 `accum` (3 × u32 per pixel: R, G, B in units of 1/FIXED_SCALE), 1
-//   `scene_depth` (the host's depth, tested at every pixel a particle adds light to
-//   when it is the viewport's size).
+// - group 2: 0 `accum` (splat_accum.wgsl: three u32 per pixel, or one u64 where the
+//   device has 64-bit atomics, splat_accum64.wgsl), 1 `scene_depth` (the host's depth,
+//   tested at every pixel a particle adds light to when it is the viewport's size).
 // - group 3: the emitter's sprite and sampler; the compute resolve (`resolve_add`, where
 //   the adapter can): binding 2 `resolve_image`, the target, and no group 1.
 // - DEPTH_TEST: 0 none, 1 a particle nearer than or level with the host's depth passes
@@ -22,8 +22,8 @@
 #import "rng.wgsl"
 #import "sprite_project.wgsl"
 #import "particle_bindings.wgsl"
+#import "splat_accum.wgsl"
 
-@group(2) @binding(0) var<storage, read_write> accum: array<atomic<u32>>;
 @group(2) @binding(1) var scene_depth: texture_depth_2d;
 @group(3) @binding(0) var sprite_tex: texture_2d<f32>;
 @group(3) @binding(1) var sprite_sampler: sampler;
@@ -44,25 +44,6 @@ fn visible(p: vec2<i32>, z: f32) -> bool {
     }
     let d = textureLoad(scene_depth, p, 0);
     return select(z >= d, z <= d, DEPTH_TEST == 1u);
-}
-
-// Keep in sync with `SPLAT_FIXED_SCALE` in src/render/splat.rs.
-const FIXED_SCALE: f32 = 4096.0;
-
-// Adds `rgb` at pixel `p` (inside the target), rounded with `dither` (in [0, 1)): the
-// expected energy of faint contributions is kept.
-fn add_fixed(p: vec2<i32>, rgb: vec3<f32>, dither: vec3<f32>) {
-    let base = u32(p.y * i32(camera.viewport.x) + p.x) * 3u;
-    let q = vec3<u32>(rgb * FIXED_SCALE + dither);
-    if q.r > 0u {
-        atomicAdd(&accum[base], q.r);
-    }
-    if q.g > 0u {
-        atomicAdd(&accum[base + 1u], q.g);
-    }
-    if q.b > 0u {
-        atomicAdd(&accum[base + 2u], q.b);
-    }
 }
 
 @compute @workgroup_size(256)
@@ -164,9 +145,7 @@ fn vs_resolve(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
 @fragment
 fn fs_resolve(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let w = u32(camera.viewport.x);
-    let i = (u32(frag.y) * w + u32(frag.x)) * 3u;
-    let rgb = vec3<f32>(f32(atomicLoad(&accum[i])), f32(atomicLoad(&accum[i + 1u])), f32(atomicLoad(&accum[i + 2u])));
-    return vec4<f32>(rgb / FIXED_SCALE, 0.0);
+    return vec4<f32>(accum_rgb(u32(frag.y) * w + u32(frag.x)), 0.0);
 }
 
 // The resolve by compute (where the adapter can read and write the target in place):
@@ -178,11 +157,10 @@ fn resolve_add(@builtin(global_invocation_id) id: vec3<u32>) {
     if any(id.xy >= size) {
         return;
     }
-    let i = (id.y * size.x + id.x) * 3u;
-    let rgb = vec3<u32>(atomicLoad(&accum[i]), atomicLoad(&accum[i + 1u]), atomicLoad(&accum[i + 2u]));
-    if all(rgb == vec3<u32>(0u)) {
+    let rgb = accum_rgb(id.y * size.x + id.x);
+    if all(rgb == vec3<f32>(0.0)) {
         return;
     }
     let dst = textureLoad(resolve_image, vec2<i32>(id.xy));
-    textureStore(resolve_image, vec2<i32>(id.xy), vec4<f32>(dst.rgb + vec3<f32>(rgb) / FIXED_SCALE, dst.a));
+    textureStore(resolve_image, vec2<i32>(id.xy), vec4<f32>(dst.rgb + rgb, dst.a));
 }

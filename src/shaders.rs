@@ -79,6 +79,14 @@ pub const EMBEDDED: &[(&str, &str)] = &[
         include_str!("../shaders/tile_lists.wgsl"),
     ),
     ("splat.wgsl", include_str!("../shaders/splat.wgsl")),
+    (
+        "splat_accum.wgsl",
+        include_str!("../shaders/splat_accum.wgsl"),
+    ),
+    (
+        "splat_accum64.wgsl",
+        include_str!("../shaders/splat_accum64.wgsl"),
+    ),
     ("sort.wgsl", include_str!("../shaders/sort.wgsl")),
     ("tonemap.wgsl", include_str!("../shaders/tonemap.wgsl")),
     ("bloom.wgsl", include_str!("../shaders/bloom.wgsl")),
@@ -129,6 +137,10 @@ pub const EVENTS_IO: (&str, &str) = ("events_off.wgsl", "events_on.wgsl");
 /// place of trail_off.wgsl (nothing).
 pub const TRAIL_IO: (&str, &str) = ("trail_off.wgsl", "trail_on.wgsl");
 
+/// The splat's accumulation where the device has 64-bit atomics: one u64 per pixel
+/// (splat_accum64.wgsl) in place of three u32 (splat_accum.wgsl).
+pub const SPLAT_ACCUM64: (&str, &str) = ("splat_accum.wgsl", "splat_accum64.wgsl");
+
 /// The update of an emitter that collides with the host's depth buffer: depth_on.wgsl
 /// (the march and its group 2) in place of depth_off.wgsl (nothing).
 pub const DEPTH_IO: (&str, &str) = ("depth_off.wgsl", "depth_on.wgsl");
@@ -141,6 +153,7 @@ pub const IMPORT_VARIANTS: &[(&str, &str)] = &[
     PARAMS_INSTANCED,
     EVENTS_IO,
     TRAIL_IO,
+    SPLAT_ACCUM64,
 ];
 
 /// The entry files, one per pipeline family; the others are imported by them.

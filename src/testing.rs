@@ -11,7 +11,9 @@ pub mod effect {
 
 /// GPU helpers and the state's records (`gpu`).
 pub mod gpu {
-    pub use crate::gpu::{AdapterProfile, GpuContext, GpuError, TextureReadback, texture_2d};
+    pub use crate::gpu::{
+        AdapterProfile, GpuContext, GpuError, INT64_ATOMICS, TextureReadback, texture_2d,
+    };
 
     /// The GPU records: particle state, parameters, uniforms.
     pub mod types {

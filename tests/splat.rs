@@ -9,7 +9,7 @@ mod common;
 
 use common::{gpu, image_diff, total_light};
 use ignis::effect::{BlendMode, DrawPath, Effect, Param, Range, Shape, Sprite};
-use ignis::testing::gpu::GpuContext;
+use ignis::testing::gpu::{GpuContext, INT64_ATOMICS};
 use ignis::testing::headless::Headless;
 use ignis::testing::shaders::ShaderLibrary;
 
@@ -82,9 +82,19 @@ fn share_off(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
 /// than 8/255 (a tilted sprite's edge through a pixel centre: the rasteriser's
 /// snapping); returns the mean.
 fn splat_agrees(what: &str, effect: &Effect, splat: &[usize], size: (u32, u32)) -> f64 {
-    let ctx = gpu();
-    let a = render(&ctx, effect, &[], 60, size);
-    let b = render(&ctx, effect, splat, 60, size);
+    splat_agrees_on(&gpu(), what, effect, splat, size)
+}
+
+/// [`splat_agrees`] on the device of `ctx`.
+fn splat_agrees_on(
+    ctx: &GpuContext,
+    what: &str,
+    effect: &Effect,
+    splat: &[usize],
+    size: (u32, u32),
+) -> f64 {
+    let a = render(ctx, effect, &[], 60, size);
+    let b = render(ctx, effect, splat, 60, size);
     assert!(
         total_light(&a) > 1e3,
         "{what}: the billboards drew almost nothing"
@@ -169,10 +179,17 @@ fn three_pixel_flames_splat_as_the_billboards_draw_them() {
 }
 
 /// A dense sphere of 3-px sparks (the peers' workload, scaled to the test's target): a
-/// 1 m sphere, 2 s lives, gravity and drag, a soft disc.
+/// 1 m sphere, 2 s lives, gravity and drag, a soft disc. On a device with 64-bit atomics
+/// (one per lit pixel: lavapipe has them) and on one without (three u32 per pixel).
 #[test]
 fn a_dense_sphere_of_three_pixel_sparks_splats_as_the_billboards_draw_it() {
     let ctx = gpu();
+    let narrow = GpuContext::headless_without(INT64_ATOMICS).expect("a device");
+    assert!(
+        ctx.device.features().contains(INT64_ATOMICS),
+        "lavapipe has 64-bit atomics"
+    );
+    assert!(!narrow.device.features().contains(INT64_ATOMICS));
     let mut effect = Effect::default_campfire();
     effect.emitters.retain(|e| e.name == "embers");
     effect.drop_dangling_events();
@@ -200,7 +217,8 @@ fn a_dense_sphere_of_three_pixel_sparks_splats_as_the_billboards_draw_it() {
     let px = run.player.draw_items()[0].size_px;
     effect.emitters[0].look.size_m = Param::Constant(0.02 * 3.0 / px);
     assert_eq!(small_additive(&ctx, &effect, 1, SIZE), [0], "{px} px");
-    splat_agrees("dense 3-px sphere", &effect, &[0], SIZE);
+    splat_agrees_on(&ctx, "dense 3-px sphere, u64", &effect, &[0], SIZE);
+    splat_agrees_on(&narrow, "dense 3-px sphere, 3 × u32", &effect, &[0], SIZE);
 }
 
 /// The editor's and renders' own HDR image takes the splat's light by compute

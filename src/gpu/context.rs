@@ -61,6 +61,11 @@ pub enum GpuError {
     },
 }
 
+/// 64-bit integers and every atomic operation on them: the splat adds a pixel's light
+/// with one atomic (`render::splat::packed`). Asked for where the adapter has them.
+pub const INT64_ATOMICS: wgpu::Features =
+    wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS);
+
 /// An adapter, device and queue, shared by the simulation and the renderers.
 #[derive(Clone)]
 pub struct GpuContext {
@@ -84,17 +89,32 @@ impl GpuContext {
     /// A headless context (tests, `ignis render`, `ignis bench`). The adapter may be forced
     /// with `WGPU_BACKEND` / `WGPU_ADAPTER_NAME`.
     pub fn headless() -> Result<Self, GpuError> {
+        Self::headless_without(wgpu::Features::empty())
+    }
+
+    /// Creates the device on `adapter`, asking for the largest buffers it offers.
+    pub fn from_adapter(adapter: wgpu::Adapter) -> Result<Self, GpuError> {
+        Self::from_adapter_without(adapter, wgpu::Features::empty())
+    }
+
+    /// A headless context whose device lacks `features` even where the adapter has them
+    /// (tests take the paths of devices without them).
+    #[doc(hidden)]
+    pub fn headless_without(features: wgpu::Features) -> Result<Self, GpuError> {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(
             &instance, None,
         ))
         .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
-        Self::from_adapter(adapter)
+        Self::from_adapter_without(adapter, features)
     }
 
-    /// Creates the device on `adapter`, asking for the largest buffers it offers.
-    pub fn from_adapter(adapter: wgpu::Adapter) -> Result<Self, GpuError> {
+    /// [`GpuContext::from_adapter`], leaving out `without` of the features it asks for.
+    fn from_adapter_without(
+        adapter: wgpu::Adapter,
+        without: wgpu::Features,
+    ) -> Result<Self, GpuError> {
         let info = adapter.get_info();
         let supported = adapter.limits();
         let mut limits = wgpu::Limits::default().using_resolution(supported.clone());
@@ -110,10 +130,12 @@ impl GpuContext {
         // accumulation of bright additive light; f16 rounds it by a few percent); the
         // adapter's own format features (the tiles' compute resolve reads and writes the
         // HDR image in place).
-        let features = crate::gpu::timer::timing_features(&adapter)
-            | (adapter.features()
-                & (wgpu::Features::FLOAT32_BLENDABLE
-                    | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES));
+        // And 64-bit atomics (the splat adds a pixel's light with one).
+        let wanted = wgpu::Features::FLOAT32_BLENDABLE
+            | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES
+            | INT64_ATOMICS;
+        let features =
+            crate::gpu::timer::timing_features(&adapter) | (adapter.features() & wanted & !without);
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("ignis device"),
             required_features: features,

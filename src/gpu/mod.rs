@@ -7,7 +7,7 @@ pub mod timer;
 pub mod types;
 pub mod upload;
 
-pub use context::{GpuContext, GpuError};
+pub use context::{GpuContext, GpuError, INT64_ATOMICS};
 pub use profile::{AdapterProfile, ProfileKind, ProfileRequest, ProfileSetting};
 pub use readback::TextureReadback;
 pub use upload::Uploads;

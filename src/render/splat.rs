@@ -42,6 +42,17 @@ pub struct SplatPass {
     sprites: crate::render::sprites::SpriteGroups,
 }
 
+/// Whether the splat accumulates into one u64 per pixel (one atomic add per lit pixel;
+/// splat_accum64.wgsl): where the device has 64-bit atomics. Else three u32.
+pub fn packed(ctx: &GpuContext) -> bool {
+    ctx.device.features().contains(crate::gpu::INT64_ATOMICS)
+}
+
+/// Bytes of the accumulation per pixel.
+fn pixel_bytes(ctx: &GpuContext) -> u64 {
+    if packed(ctx) { 8 } else { 12 }
+}
+
 /// What a build of `splat.wgsl` makes.
 struct Built {
     module: wgpu::ShaderModule,
@@ -185,7 +196,12 @@ impl SplatPass {
         over_layout: Option<&wgpu::PipelineLayout>,
         target: DrawTarget,
     ) -> Result<Built, ShaderError> {
-        let composed = lib.compose("splat.wgsl")?;
+        let aliases: &[(&str, &str)] = if packed(ctx) {
+            &[crate::shaders::SPLAT_ACCUM64]
+        } else {
+            &[]
+        };
+        let composed = lib.compose_with("splat.wgsl", aliases)?;
         create_checked(&ctx.device, &composed, lib, |module| {
             let basic = LookVariant::basic(false);
             let splats = HashMap::from([(
@@ -265,7 +281,7 @@ impl SplatPass {
             _ => {
                 let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("SplatPass::accum"),
-                    size: (size.0 as u64 * size.1 as u64 * 12).max(12),
+                    size: (size.0 as u64 * size.1 as u64 * pixel_bytes(ctx)).max(12),
                     usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                     mapped_at_creation: false,
                 });
