@@ -103,7 +103,8 @@ pub const SPLAT_BELOW_PX: f32 = 4.0;
 /// splat only when the draw has a quad (its widest live window × its instances) for every
 /// this many pixels of the target or more. The splat clears and resolves the whole target:
 /// on the H100 at 1920×1080 the thesis preset's 16384 points (one per 127 pixels) took
-/// 0.42 ms a frame splatted and 0.20 ms as billboards (`ignis bench presets`).
+/// 0.42 ms a frame splatted and 0.20 ms as billboards (`ignis bench presets`) with the
+/// splat's resolve drawn, as in a host's pass (resolved by compute: 0.145 against 0.227).
 pub const SPLAT_PX_PER_QUAD: f32 = 64.0;
 
 /// Auto draw path on adapters whose profile allows the tile rasteriser: particles that
