@@ -396,7 +396,9 @@ impl TilePass {
             .collect();
         constants.push(("DEPTH_TEST", crate::render::depth_test(target)));
         // Software blending (lavapipe) rounds f16 toward zero; the tiles round as it does.
-        let round_down = ctx.profile.is_software();
+        // The adapter's, whatever profile it runs (a software adapter may take the GPU
+        // profile's choices).
+        let round_down = ctx.info.device_type == wgpu::DeviceType::Cpu;
         constants.push(("F16_ROUND_DOWN", if round_down { 1.0 } else { 0.0 }));
         [
             Self::compute(ctx, layout, module, "project", &constants),
