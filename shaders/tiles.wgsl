@@ -71,14 +71,16 @@ const BLOCK: u32 = 1024u;
 // Bins a target holds at most (keep in sync with src/render/tiles.rs).
 const MAX_BINS: u32 = 2048u;
 
-// One dispatch's work: x the item's first sprite, y its quads, z sprites this frame
-// (each item's rounded up to whole blocks), w the capacity of the bin lists (entries);
-// `counts2`: the item's index, the items, the blocks of BLOCK sprites, the chunks the tile
-// lists' passes read at most; `firsts`: every item's first sprite, then the frame's
-// sprites.
+// One dispatch's work, an item of the chunk (an emitter's quads, or a piece of them where
+// a frame's sprites are drawn in chunks): x the item's first sprite, y its quads, z
+// sprites this chunk (each item's rounded up to whole blocks), w the capacity of the bin
+// lists (entries); `counts2`: the item's index, the items, the blocks of BLOCK sprites,
+// the chunks the tile lists' passes read at most; `base.x`: the item's first quad of its
+// emitter's; `firsts`: every item's first sprite, then the chunk's sprites.
 struct TileJob {
     counts: vec4<u32>,
     counts2: vec4<u32>,
+    base: vec4<u32>,
     firsts: array<vec4<u32>, 14>,
 }
 
@@ -104,7 +106,7 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
         return;
     }
     // The particle is loaded once for both records.
-    let qd = load_quad(q);
+    let qd = load_quad(job.base.x + q);
     if LIT {
         lit_record(qd, index + job.counts.y);
     }

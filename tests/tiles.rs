@@ -486,3 +486,84 @@ fn sprites_smaller_than_a_pixel_cover_the_rasterisers_pixels() {
         "sub-pixel points differ by {mean:.4}/255 mean, {max}/255 max"
     );
 }
+
+/// A frame whose sprites exceed a chunk of the tile buffers is drawn chunk after chunk,
+/// each shaded over what the ones before it left, an emitter larger than a chunk in
+/// pieces: the bonfire (lit smoke, flames, embers) and the fireball drawn in chunks of 2048
+/// sprites give the image of one chunk bit for bit (every sprite is blended in the same
+/// order, rounded to f16 after each as before).
+#[test]
+fn a_frame_drawn_in_chunks_is_the_frame_drawn_at_once() {
+    let ctx = gpu();
+    for name in ["bonfire", "fireball"] {
+        let mut effect = shipped(name);
+        effect.post.alpha_downscale = 1;
+        for e in &mut effect.emitters {
+            e.look.draw_path = DrawPath::Tiles;
+        }
+        let image = |chunk: Option<u32>| {
+            let mut run =
+                Headless::new(&ctx, effect.clone(), ShaderLibrary::embedded()).expect("headless");
+            run.player
+                .tile_pass()
+                .expect("the tiles")
+                .set_chunk_sprites(chunk);
+            for _ in 0..60 {
+                run.advance(1.0 / 60.0);
+            }
+            let img = run.render(SIZE).expect("render");
+            let items = run.player.draw_items().iter().filter(|d| d.tiles);
+            let quads: u32 = items.map(|d| d.width * d.members).sum();
+            (img, quads)
+        };
+        let (whole, quads) = image(None);
+        assert!(quads > 2 * 2048, "{name}: {quads} quads fit two chunks");
+        assert!(total_light(&whole) > 1e3, "{name}: almost nothing drawn");
+        let (chunked, _) = image(Some(2048));
+        let (mean, max) = image_diff(&whole, &chunked);
+        assert!(
+            whole == chunked,
+            "{name}: in chunks the image differs by {mean:.4}/255 mean, {max}/255 max"
+        );
+    }
+}
+
+/// Tiny sprites above one chunk's count — the peers' dense sphere of 3-px sparks, drawn in
+/// chunks of 4096 sprites at a small target — keep the billboards' image (1/255 mean,
+/// 8/255 max), every light kept.
+#[test]
+fn tiny_sprites_beyond_a_chunk_draw_the_billboards_image() {
+    let ctx = gpu();
+    let mut effect =
+        ignis::preset::load("bench/scenes/sphere_1m.ron".as_ref()).expect("the bench scene");
+    let e = &mut effect.emitters[0];
+    e.capacity = 40_000;
+    e.spawn_rate_per_sec = Param::Constant(20_000.0);
+    e.look.intensity = 0.1;
+    e.look.size_m = Param::Constant(0.0092 * 3.0 * 1080.0 / f32::from(SIZE.1 as u16) / 3.0);
+    let billboards = render(&ctx, &effect, DrawPath::Billboard, 90);
+    effect.emitters[0].look.draw_path = DrawPath::Tiles;
+    let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    run.player
+        .tile_pass()
+        .expect("the tiles")
+        .set_chunk_sprites(Some(4096));
+    for _ in 0..90 {
+        run.advance(1.0 / 60.0);
+    }
+    let tiles = run.render(SIZE).expect("render");
+    let d = &run.player.draw_items()[0];
+    assert!(
+        d.tiles && d.width * d.members > 6 * 4096,
+        "{} quads",
+        d.width
+    );
+    assert!(d.size_px > 2.0 && d.size_px < 4.0, "{} px", d.size_px);
+    let (mean, max) = image_diff(&billboards, &tiles);
+    eprintln!("sphere in chunks: mean {mean:.3}/255, max {max}/255");
+    assert!(total_light(&billboards) > 1e4);
+    assert!(
+        mean <= 1.0 && max <= 8,
+        "tiles in chunks differ by {mean:.3}/255 mean, {max}/255 max"
+    );
+}

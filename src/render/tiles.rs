@@ -18,10 +18,12 @@ use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 use crate::sim::gpu_sim::dispatch_size;
 
 mod buffers;
+mod chunks;
 mod sizing;
 
 use crate::render::compute_resolve::ComputeResolve;
 use buffers::TileBuffers;
+use chunks::Chunk;
 use sizing::*;
 
 /// Pixels per tile side (one workgroup each; keep in sync with `TILE` in tiles.wgsl).
@@ -30,9 +32,16 @@ pub const TILE_PX: u32 = 16;
 pub const BIN_PX: u32 = 128;
 /// Bytes of one projected sprite (`TileSprite` in tiles.wgsl).
 const SPRITE_BYTES: u64 = 192;
-/// Tile items (emitters of a group of instances) a frame draws with the tiles at most
-/// (`MAX_ITEMS` in tiles.wgsl); beyond, the frame's tile items are billboards.
+/// Tile items (emitters of a group of instances, or pieces of one) a chunk of the tile
+/// passes draws at most (`MAX_ITEMS` in tiles.wgsl); more take further chunks.
 pub const MAX_ITEMS: usize = 55;
+/// Sprites a chunk of the tile passes holds at most (768 MB of projected sprites): a
+/// frame with more is drawn chunk after chunk, each shaded over what the ones before it
+/// left, an item larger than a chunk in pieces.
+const CHUNK_SPRITES: u32 = 1 << 22;
+/// Stride of each chunk's dispatch arguments (each piece's shade, then the tile lists'
+/// chunk passes: `MAX_ITEMS + 1` of 16 bytes; the storage offset alignment).
+const ARGS_STRIDE: u64 = 1024;
 /// The `touched` buffer's header: the resolve's indirect draw arguments.
 const TOUCHED_FLAGS: u64 = 4;
 /// Entries per chunk of the tile lists' passes (`CHUNK` in tile_lists.wgsl).
@@ -43,8 +52,9 @@ const BLOCK: u32 = 1024;
 /// Bins a target may hold (`MAX_BINS` in tiles.wgsl): 7680×4320 at most, beyond it the
 /// frame's tile items are billboards.
 const MAX_BINS: u64 = 2048;
-/// Stride of the per-dispatch jobs (the storage offset alignment).
-const JOB_STRIDE: u64 = 256;
+/// Stride of the per-dispatch jobs (`TileJob` in tiles.wgsl, to the storage offset
+/// alignment).
+const JOB_STRIDE: u64 = 512;
 /// The bins' lists take at most this many bytes: a frame whose lists need more shades its
 /// overflowing bins from the sprites directly.
 const MAX_LIST_BYTES: u64 = 128 << 20;
@@ -105,6 +115,8 @@ pub struct TilePass {
     list_capacity: Option<u32>,
     /// The tiles' lists' capacity in entries, when set (tests force an overflow with it).
     tile_list_capacity: Option<u32>,
+    /// Sprites per chunk, when set (tests draw a frame in many chunks).
+    chunk_sprites: Option<u32>,
     /// The stages a record runs (the bench times them apart).
     stages: TileStages,
 }
@@ -277,6 +289,7 @@ impl TilePass {
             drawn: false,
             list_capacity: None,
             tile_list_capacity: None,
+            chunk_sprites: None,
             stages: TileStages::All,
         })
     }
@@ -306,7 +319,8 @@ impl TilePass {
         ]
     }
 
-    /// The bin's group 3: the tile group and binding 7, the shades' dispatch arguments.
+    /// The bin's group 3: the tile group and binding 7, the chunk's shades' dispatch
+    /// arguments (a dynamic offset per chunk).
     fn bin_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         let mut entries = Self::tile_entries();
         entries.push(wgpu::BindGroupLayoutEntry {
@@ -314,7 +328,7 @@ impl TilePass {
             visibility: wgpu::ShaderStages::COMPUTE,
             ty: wgpu::BindingType::Buffer {
                 ty: wgpu::BufferBindingType::Storage { read_only: false },
-                has_dynamic_offset: false,
+                has_dynamic_offset: true,
                 min_binding_size: None,
             },
             count: None,
@@ -449,8 +463,9 @@ impl TilePass {
     }
 
     /// Projects, bins and shades every tile item of `items` (compute), testing against
-    /// `depth` (the host's, single-sample and `size`) when given. Returns false when
-    /// there was nothing to draw (then `resolve` draws nothing).
+    /// `depth` (the host's, single-sample and `size`) when given: chunk after chunk where
+    /// the frame's sprites exceed one (`CHUNK_SPRITES`, or the device's binding limit).
+    /// Returns false when there was nothing to draw (then `resolve` draws nothing).
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
@@ -462,44 +477,69 @@ impl TilePass {
         depth: Option<&wgpu::TextureView>,
     ) -> bool {
         let order = draw_order(items);
-        let firsts = item_firsts(&order);
-        let total = u64::from(firsts[firsts.len() - 1]);
         self.drawn = false;
-        if total == 0 {
+        let limit = ctx.device.limits().max_storage_buffer_binding_size;
+        let capacity = self.chunk_sprites.unwrap_or_else(|| chunk_sprites(limit));
+        let chunks = chunks::plan(&chunks::shapes(&order), capacity);
+        if chunks.is_empty() {
             return false;
         }
-        let limit = ctx.device.limits().max_storage_buffer_binding_size;
-        if !fits(size, total, limit) || order.len() > MAX_ITEMS {
-            // The buffers would be too large: their memory goes back.
+        if grid_bins(size) > MAX_BINS {
+            // A target larger than the bins: the buffers' memory goes back.
             self.buffers = None;
             return false;
         }
-        let lists = self
-            .list_capacity
-            .unwrap_or_else(|| list_entries(&order, size, total as u32, limit));
+        let sprites = chunks.iter().map(Chunk::sprites).max().unwrap_or(0);
+        let lists = self.list_capacity.unwrap_or_else(|| {
+            let entries = |c: &Chunk| list_entries(&order, c, size, limit);
+            chunks.iter().map(entries).max().unwrap_or(1)
+        });
         self.prepare(ctx, &order, &frame.sprites.sampler);
-        self.ensure_buffers(ctx, size, (total as u32, lists), order.len() as u32, depth);
+        self.ensure_buffers(ctx, size, (sprites, lists), chunks.len() as u32, depth);
         let Some(b) = self.buffers.as_ref() else {
             return false;
         };
-        self.upload_jobs(ctx, &order, &firsts);
+        self.upload_jobs(ctx, &chunks);
         enc.clear_buffer(&b.touched, TOUCHED_FLAGS * 4, Some(grid_tiles(size) * 4));
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("TilePass::tiles"),
             timestamp_writes: None,
         });
-        // Project every item, bin once, then shade each item in draw order.
+        for (c, chunk) in chunks.iter().enumerate() {
+            if !self.record_chunk(&mut pass, frame, b, (&order, c, chunk), size) {
+                return false;
+            }
+        }
+        drop(pass);
+        self.drawn = true;
+        true
+    }
+
+    /// Chunk `c` of the frame: its pieces projected, binned once, then each shaded in
+    /// draw order over what the chunks before it left. False when the bench's stages stop
+    /// before the shade.
+    fn record_chunk(
+        &self,
+        pass: &mut wgpu::ComputePass<'_>,
+        frame: &FrameResources,
+        b: &TileBuffers,
+        (order, c, chunk): (&[&DrawItem], usize, &Chunk),
+        size: (u32, u32),
+    ) -> bool {
+        let jobs = (c * MAX_ITEMS) as u64 * JOB_STRIDE;
+        let args = c as u64 * ARGS_STRIDE;
         for stage in 0..2 {
             if stage == 1 {
                 if self.stages == TileStages::Project {
                     return false;
                 }
-                self.record_bins(&mut pass, frame, b, size, total as u32 / BLOCK);
+                self.record_bins(pass, frame, b, size, (chunk.sprites() / BLOCK, jobs, args));
                 if self.stages == TileStages::Bin {
                     return false;
                 }
             }
-            for (k, d) in order.iter().enumerate() {
+            for (k, p) in chunk.pieces.iter().enumerate() {
+                let d = order[p.item];
                 let (Some(particles), Some(Some(pipes)), Some(sprite)) = (
                     frame.particle_group(d.key),
                     self.variants.get(&d.variant),
@@ -512,37 +552,37 @@ impl TilePass {
                 pass.set_bind_group(0, &frame.frame_group, &[look]);
                 pass.set_bind_group(1, particles, &[]);
                 pass.set_bind_group(2, sprite, &[]);
-                pass.set_bind_group(3, &b.group, &[(k as u64 * JOB_STRIDE) as u32]);
+                let job = jobs + k as u64 * JOB_STRIDE;
+                pass.set_bind_group(3, &b.group, &[job as u32]);
                 if stage == 0 {
-                    // The item's last block is filled up with empty sprites.
-                    let (x, y) = dispatch_size(item_sprites(d).next_multiple_of(BLOCK));
+                    // The piece's last block is filled up with empty sprites.
+                    let (x, y) = dispatch_size(p.sprites());
                     pass.dispatch_workgroups(x, y, 1);
                 } else {
-                    // Only the bins holding some of the item's sprites (the bin scan lists
-                    // them).
-                    pass.dispatch_workgroups_indirect(&b.dispatch_args, k as u64 * 16);
+                    // Only the bins holding some of the piece's sprites (the bin scan
+                    // lists them).
+                    pass.dispatch_workgroups_indirect(&b.dispatch_args, args + k as u64 * 16);
                 }
             }
         }
-        drop(pass);
-        self.drawn = true;
         true
     }
 
-    /// The binning's passes over the frame's `blocks` blocks of sprites: count per block,
-    /// scan per bin, the bins' starts, the lists; then the tiles' lists.
+    /// The binning's passes over a chunk's `blocks` blocks of sprites (its jobs and
+    /// dispatch arguments at byte offsets `jobs` and `args`): count per block, scan per
+    /// bin, the bins' starts, the lists; then the tiles' lists.
     fn record_bins(
         &self,
         pass: &mut wgpu::ComputePass<'_>,
         frame: &FrameResources,
         b: &TileBuffers,
         size: (u32, u32),
-        blocks: u32,
+        (blocks, jobs, args): (u32, u64, u64),
     ) {
         pass.set_bind_group(0, &frame.frame_group, &[0]);
         pass.set_bind_group(1, &self.empty_group, &[]);
         pass.set_bind_group(2, &self.empty_group, &[]);
-        pass.set_bind_group(3, &b.bin_group, &[0]);
+        pass.set_bind_group(3, &b.bin_group, &[jobs as u32, args as u32]);
         let bins = grid(size, BIN_PX);
         let [
             count,
@@ -563,8 +603,8 @@ impl TilePass {
         pass.set_pipeline(list);
         pass.dispatch_workgroups(bins.0, bins.1, blocks);
         // The tiles' lists: over the chunks of the bins' lists (counted by `bin_starts`).
-        let chunk_args = MAX_ITEMS as u64 * 16;
-        pass.set_bind_group(3, &b.group, &[0]);
+        let chunk_args = args + MAX_ITEMS as u64 * 16;
+        pass.set_bind_group(3, &b.group, &[jobs as u32]);
         pass.set_pipeline(tile_count);
         pass.dispatch_workgroups_indirect(&b.dispatch_args, chunk_args);
         pass.set_pipeline(tile_scan);
@@ -587,6 +627,13 @@ impl TilePass {
     #[doc(hidden)]
     pub fn set_list_capacity(&mut self, entries: Option<u32>) {
         self.list_capacity = entries;
+    }
+
+    /// Sets the sprites a chunk holds (`None`: `CHUNK_SPRITES`, within the device's
+    /// binding limit). Tests draw a frame in many chunks with it.
+    #[doc(hidden)]
+    pub fn set_chunk_sprites(&mut self, sprites: Option<u32>) {
+        self.chunk_sprites = sprites;
     }
 
     /// Sets the tiles' lists' capacity in entries (`None`: twice the bins' lists'). Tests

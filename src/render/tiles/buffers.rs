@@ -10,12 +10,13 @@ pub(super) struct TileBuffers {
     pub(super) capacity: u32,
     /// Entries the bins' lists hold in all.
     pub(super) list_capacity: u32,
-    /// Jobs the job buffer holds.
-    pub(super) jobs: u32,
+    /// Chunks the job buffer and the dispatch arguments hold.
+    pub(super) chunks: u32,
     pub(super) job_buffer: wgpu::Buffer,
     /// The resolve's draw arguments, a flag per tile and the shaded tiles' list.
     pub(super) touched: wgpu::Buffer,
-    /// Each item's shade dispatch arguments, written by the bin.
+    /// Each chunk's shade dispatch arguments per piece, written by the bin (`ARGS_STRIDE`
+    /// apart).
     pub(super) dispatch_args: wgpu::Buffer,
     pub(super) group: wgpu::BindGroup,
     pub(super) bin_group: wgpu::BindGroup,
@@ -26,56 +27,58 @@ pub(super) struct TileBuffers {
 }
 
 impl TilePass {
-    /// Uploads one job per item (`TileJob`: its first sprite and quads, the frame's
-    /// sprites, the lists' capacity; its index, the item count, the blocks and the chunks'
-    /// capacity; every item's first sprite), the resolve's draw arguments (six vertices per shaded tile, counted
-    /// by the shade) and the shades' dispatch arguments (bins counted by the bin scan, 64
-    /// tiles each).
-    pub(super) fn upload_jobs(&self, ctx: &GpuContext, order: &[&DrawItem], firsts: &[u32]) {
+    /// Uploads one job per piece of each chunk (`TileJob`: its first sprite and quads,
+    /// the chunk's sprites, the lists' capacity; its index, the pieces, the blocks and the
+    /// tile lists' chunk capacity; its first quad of its item; every piece's first sprite),
+    /// `MAX_ITEMS` jobs a chunk; the resolve's draw arguments (six vertices per shaded tile,
+    /// counted by the shades) and the shades' dispatch arguments (bins counted by the bin
+    /// scan, 64 tiles each), `ARGS_STRIDE` bytes a chunk.
+    pub(super) fn upload_jobs(&self, ctx: &GpuContext, chunks: &[Chunk]) {
         let Some(b) = self.buffers.as_ref() else {
             return;
         };
-        let mut jobs = vec![0u32; order.len() * JOB_STRIDE as usize / 4];
-        let items = order.len() as u32;
-        let total = firsts[firsts.len() - 1];
-        let blocks = total / BLOCK;
-        for (k, (job, d)) in jobs
-            .chunks_mut(JOB_STRIDE as usize / 4)
-            .zip(order)
-            .enumerate()
-        {
-            let n = d.width * d.members;
-            let head = [
-                firsts[k],
-                n,
-                total,
-                b.list_capacity,
-                k as u32,
-                items,
-                blocks,
-                chunk_capacity(b.list_capacity, b.size),
-            ];
-            job[..8].copy_from_slice(&head);
-            job[8..8 + firsts.len()].copy_from_slice(firsts);
+        let words = JOB_STRIDE as usize / 4;
+        let mut jobs = vec![0u32; chunks.len() * MAX_ITEMS * words];
+        let mut args = vec![0u32; chunks.len() * ARGS_STRIDE as usize / 4];
+        for (c, chunk) in chunks.iter().enumerate() {
+            let firsts = chunk.firsts();
+            let total = firsts[firsts.len() - 1];
+            for (k, p) in chunk.pieces.iter().enumerate() {
+                let job = &mut jobs[(c * MAX_ITEMS + k) * words..][..words];
+                let head = [
+                    firsts[k],
+                    p.quads,
+                    total,
+                    b.list_capacity,
+                    k as u32,
+                    chunk.pieces.len() as u32,
+                    total / BLOCK,
+                    chunk_capacity(b.list_capacity, b.size),
+                    p.base,
+                ];
+                job[..head.len()].copy_from_slice(&head);
+                job[12..12 + firsts.len()].copy_from_slice(&firsts);
+                let a = c * ARGS_STRIDE as usize / 4 + 4 * k;
+                args[a..a + 4].copy_from_slice(&[0, 64, 1, 0]);
+            }
         }
         ctx.queue
             .write_buffer(&b.job_buffer, 0, bytemuck::cast_slice(&jobs));
         ctx.queue
             .write_buffer(&b.touched, 0, bytemuck::cast_slice(&[6u32, 0, 0, 0]));
-        let args: Vec<u32> = order.iter().flat_map(|_| [0u32, 64, 1, 0]).collect();
         ctx.queue
             .write_buffer(&b.dispatch_args, 0, bytemuck::cast_slice(&args));
     }
 
-    /// Creates the buffers for `size`, `sprites` quads (capacity in powers of two),
-    /// `lists` list entries and `jobs` dispatches unless the current ones hold them;
-    /// rebinds a new depth view.
+    /// Creates the buffers for `size`, `sprites` quads a chunk (capacity in powers of
+    /// two), `lists` list entries and `chunks` chunks of jobs unless the current ones hold
+    /// them; rebinds a new depth view.
     pub(super) fn ensure_buffers(
         &mut self,
         ctx: &GpuContext,
         size: (u32, u32),
         (sprites, list_capacity): (u32, u32),
-        jobs: u32,
+        chunks: u32,
         depth: Option<&wgpu::TextureView>,
     ) {
         if let Some(b) = &self.buffers
@@ -83,13 +86,13 @@ impl TilePass {
             && b.capacity >= sprites
             && b.list_capacity >= list_capacity
             && (self.list_capacity.is_none() || b.list_capacity == list_capacity)
-            && b.jobs >= jobs
+            && b.chunks >= chunks
             && b.depth.as_ref() == depth
         {
             return;
         }
         let capacity = sprites.next_power_of_two().max(BLOCK);
-        let jobs = jobs.next_power_of_two().max(4);
+        let chunks = chunks.next_power_of_two();
         let (bx, by) = grid(size, BIN_PX);
         let bins = u64::from(bx * by);
         let buffer = |label: &str, bytes: u64, usage: wgpu::BufferUsages| {
@@ -132,13 +135,11 @@ impl TilePass {
                 none,
             ),
         ];
-        let job_buffer = buffer("TilePass::jobs", u64::from(jobs) * JOB_STRIDE, none);
-        // Each item's shade, then the tile lists' chunk passes.
-        let dispatch_args = buffer(
-            "TilePass::dispatch_args",
-            (MAX_ITEMS as u64 + 1) * 16,
-            indirect,
-        );
+        let job_bytes = u64::from(chunks) * MAX_ITEMS as u64 * JOB_STRIDE;
+        let job_buffer = buffer("TilePass::jobs", job_bytes, none);
+        // Per chunk: each piece's shade, then the tile lists' chunk passes.
+        let args_bytes = u64::from(chunks) * ARGS_STRIDE;
+        let dispatch_args = buffer("TilePass::dispatch_args", args_bytes, indirect);
         let depth_view = depth.unwrap_or(&self.no_depth);
         let [tile_group, bin_group, resolve_group] =
             self.bind_groups(ctx, &lists, (&job_buffer, &dispatch_args), depth_view);
@@ -147,7 +148,7 @@ impl TilePass {
             size,
             capacity,
             list_capacity,
-            jobs,
+            chunks,
             job_buffer,
             touched,
             dispatch_args,
@@ -192,7 +193,11 @@ impl TilePass {
             });
             entries.extend(args.map(|a| wgpu::BindGroupEntry {
                 binding: 7,
-                resource: a.as_entire_binding(),
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: a,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(ARGS_STRIDE),
+                }),
             }));
             ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("TilePass::group"),

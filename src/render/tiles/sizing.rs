@@ -20,41 +20,29 @@ pub(super) fn grid_bins(size: (u32, u32)) -> u64 {
     u64::from(bx) * u64::from(by)
 }
 
-/// The sprites an item takes: one per quad, and a lit item's six-way light after them
-/// (`tiles.wgsl` `lit_record`).
-pub(super) fn item_sprites(d: &DrawItem) -> u32 {
-    let quads = d.width * d.members;
-    if d.variant.lit { 2 * quads } else { quads }
+/// Sprites a chunk holds on a device whose storage bindings take `limit` bytes: at most
+/// `CHUNK_SPRITES`, a power of two.
+pub(super) fn chunk_sprites(limit: u64) -> u32 {
+    let fit = (limit / SPRITE_BYTES).clamp(u64::from(2 * BLOCK), u64::from(CHUNK_SPRITES));
+    1 << fit.ilog2()
 }
 
-/// Whether `sprites` quads (whole blocks) fit the tile path's buffers at `size` on a
-/// device whose storage bindings take `limit` bytes.
-pub(super) fn fits(size: (u32, u32), sprites: u64, limit: u64) -> bool {
-    grid_bins(size) <= MAX_BINS && sprites.next_power_of_two() * SPRITE_BYTES <= limit
-}
-
-/// The sprites of the frame's items in whole blocks: each item's first sprite (then the
-/// frame's), its quads rounded up to blocks.
-pub(super) fn item_firsts(order: &[&DrawItem]) -> Vec<u32> {
-    let mut firsts = Vec::with_capacity(order.len() + 1);
-    firsts.push(0u32);
-    for d in order {
-        let n = item_sprites(d).next_multiple_of(BLOCK);
-        firsts.push(firsts[firsts.len() - 1] + n);
-    }
-    firsts
-}
-
-/// Entries for the bins' lists of `order`'s sprites (`sprites`, whole blocks) at `size`:
+/// Entries for the bins' lists of `chunk`'s sprites (pieces of `order`'s items) at `size`:
 /// every bin for each when that is small, else about twice what their projected sizes
 /// cover (a bin whose list does not fit is shaded from the sprites directly).
-pub(super) fn list_entries(order: &[&DrawItem], size: (u32, u32), sprites: u32, limit: u64) -> u32 {
-    let every = grid_bins(size) * u64::from(sprites);
-    let covered: f64 = order
+pub(super) fn list_entries(
+    order: &[&DrawItem],
+    chunk: &Chunk,
+    size: (u32, u32),
+    limit: u64,
+) -> u32 {
+    let every = grid_bins(size) * u64::from(chunk.sprites());
+    let covered: f64 = chunk
+        .pieces
         .iter()
-        .map(|d| {
-            let side = (f64::from(d.size_px) * 1.5 / f64::from(BIN_PX)).ceil() + 1.0;
-            f64::from(d.width * d.members) * side * side
+        .map(|p| {
+            let side = (f64::from(order[p.item].size_px) * 1.5 / f64::from(BIN_PX)).ceil() + 1.0;
+            f64::from(p.quads) * side * side
         })
         .sum();
     let estimate = (2.0 * covered) as u64;
