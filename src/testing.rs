@@ -31,8 +31,8 @@ pub mod gpu {
 /// The shader library and its composed sources (`shaders`).
 pub mod shaders {
     pub use crate::shaders::{
-        DEPTH_IO, EMBEDDED, ENTRY_FILES, EVENTS_IO, PACKED_STATE_IO, PARAMS_INSTANCED, ShaderError,
-        ShaderLibrary, TINY_STATE_IO, TRAIL_IO,
+        DEPTH_IO, EMBEDDED, ENTRY_FILES, EVENTS_IO, PACKED_STATE_IO, PARAMS_INSTANCED,
+        SPLAT_ACCUM64, ShaderError, ShaderLibrary, TINY_STATE_IO, TRAIL_IO,
     };
 }
 

@@ -58,6 +58,13 @@ fn every_entry_validates() {
         assert!(!hooked.files.iter().any(|f| f == off));
         reached.extend(hooked.files);
     }
+    // The splat's accumulation in one u64 per pixel (devices with 64-bit atomics).
+    let splat64 = project_shaders()
+        .compose_with("splat.wgsl", &[ignis::testing::shaders::SPLAT_ACCUM64])
+        .unwrap_or_else(|e| panic!("splat with 64-bit atomics: {e}"));
+    assert!(splat64.files.iter().any(|f| f == "splat_accum64.wgsl"));
+    assert!(!splat64.files.iter().any(|f| f == "splat_accum.wgsl"));
+    reached.extend(splat64.files);
     reached.extend(packed.files);
     reached.extend(tiny.files);
     reached.extend(instanced.files);
