@@ -52,7 +52,9 @@ pub use effect::Effect;
 /// The math library of the API (`Mat4`, `Vec3`): hosts on another `glam` version use this one
 /// or pass plain `[[f32; 4]; 4]` arrays.
 pub use glam;
-pub use gpu::{AdapterProfile, GpuError, ProfileKind, ProfileRequest, ProfileSetting};
+pub use gpu::{
+    AdapterProfile, GpuError, INT64_ATOMICS, ProfileKind, ProfileRequest, ProfileSetting,
+};
 pub use runtime::{
     Camera, ClockStats, EffectLight, EmitterStats, EventCount, HostTargets, InstanceId, IntoMat4,
     Layers, MAX_POINT_LIGHTS, MissingLimit, PLAYER_SHADERS, ParticleCount, ParticleInfo, Player,

@@ -42,12 +42,7 @@ fn render(ctx: &GpuContext, effect: &Effect, auto: bool) -> (image::RgbaImage, u
 /// The shipped presets and the dense sphere (`bench/scenes/sphere_1m.ron` at a twentieth
 /// of its count, so that its sprites stay dense at the test's size).
 fn effects() -> Vec<(String, Effect)> {
-    let mut paths: Vec<_> = std::fs::read_dir("presets")
-        .expect("presets/")
-        .map(|e| e.expect("entry").path())
-        .filter(|p| p.extension().is_some_and(|x| x == "ron"))
-        .collect();
-    paths.sort();
+    let paths = common::shipped_preset_paths();
     let mut out: Vec<(String, Effect)> = paths
         .iter()
         .map(|p| {

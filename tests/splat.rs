@@ -130,13 +130,7 @@ fn splat_agrees_on(
 #[test]
 fn every_shipped_preset_splats_its_small_sprites_as_the_billboards_draw_them() {
     let ctx = gpu();
-    let mut paths: Vec<_> = std::fs::read_dir("presets")
-        .expect("presets/")
-        .map(|e| e.expect("entry").path())
-        .filter(|p| p.extension().is_some_and(|x| x == "ron"))
-        .collect();
-    paths.sort();
-    assert!(paths.len() >= 7, "shipped presets: {paths:?}");
+    let paths = common::shipped_preset_paths();
     let (mut splatted, mut failed) = (0, Vec::new());
     for path in paths {
         let effect = ignis::preset::load(&path).expect("shipped preset loads");
@@ -280,14 +274,7 @@ fn the_compute_resolve_adds_what_the_resolve_draw_does() {
             assert!(run.player.draw_items().iter().any(|d| d.splat), "{name}");
             image
         };
-        let (drawn, computed) = (image(false), image(true));
-        assert!(total_light(&drawn) > 1e3, "{name}: almost nothing drawn");
-        let (mean, max) = image_diff(&drawn, &computed);
-        eprintln!("{name}: compute resolve vs draw: mean {mean:.4}/255, max {max}/255");
-        assert!(
-            mean <= 0.01 && max <= 1,
-            "{name}: the compute resolve differs by {mean:.4}/255 mean, {max}/255 max"
-        );
+        common::resolves_agree(name, &image(false), &image(true));
     }
 }
 

@@ -93,16 +93,7 @@ fn paths_agree(ctx: &GpuContext, what: &str, effect: &Effect, frames: u32) -> (f
 #[test]
 fn every_shipped_preset_draws_alike_with_tiles_and_billboards() {
     let ctx = gpu();
-    let mut names = Vec::new();
-    for entry in std::fs::read_dir("presets").expect("presets/") {
-        let path = entry.expect("entry").path();
-        if path.extension().is_some_and(|x| x == "ron") {
-            names.push(path);
-        }
-    }
-    names.sort();
-    assert!(names.len() >= 7, "shipped presets: {names:?}");
-    for path in names {
+    for path in common::shipped_preset_paths() {
         let mut effect = ignis::preset::load(&path).expect("shipped preset loads");
         // Particles smaller than a few pixels are the splat's (a sub-pixel quad covers a
         // pixel centre or not by the rasteriser's snapping): they keep their own path.
@@ -454,14 +445,7 @@ fn the_compute_resolve_composites_what_the_resolve_draw_does() {
             );
             image
         };
-        let (drawn, computed) = (image(false), image(true));
-        assert!(total_light(&drawn) > 1e3, "{name}: almost nothing drawn");
-        let (mean, max) = image_diff(&drawn, &computed);
-        eprintln!("{name}: compute resolve vs draw: mean {mean:.4}/255, max {max}/255");
-        assert!(
-            mean <= 0.01 && max <= 1,
-            "{name}: the compute resolve differs by {mean:.4}/255 mean, {max}/255 max"
-        );
+        common::resolves_agree(name, &image(false), &image(true));
     }
 }
 

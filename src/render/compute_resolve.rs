@@ -3,6 +3,7 @@
 //! compute unit rather than the raster, which the H100 keeps only a sliver of its chip for.
 
 use crate::gpu::GpuContext;
+use crate::render::FrameResources;
 use crate::render::billboard::DrawTarget;
 use crate::render::image_groups::ImageGroups;
 
@@ -49,5 +50,30 @@ impl ComputeResolve {
             immediate_size: 0,
         });
         Some(Self { images, layout })
+    }
+
+    /// Records `pipeline` over `target` in a compute pass of its own: the frame's group 0,
+    /// `groups` after it, the target's group last, `workgroups` dispatched.
+    pub(crate) fn dispatch(
+        &mut self,
+        ctx: &GpuContext,
+        enc: &mut wgpu::CommandEncoder,
+        (label, pipeline): (&str, &wgpu::ComputePipeline),
+        (frame, groups): (&FrameResources, &[&wgpu::BindGroup]),
+        target: &wgpu::TextureView,
+        workgroups: (u32, u32),
+    ) {
+        let image = self.images.group(ctx, target);
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(label),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &frame.frame_group, &[0]);
+        for (i, g) in groups.iter().enumerate() {
+            pass.set_bind_group(i as u32 + 1, *g, &[]);
+        }
+        pass.set_bind_group(groups.len() as u32 + 1, image, &[]);
+        pass.dispatch_workgroups(workgroups.0, workgroups.1, 1);
     }
 }

@@ -170,13 +170,7 @@ impl SplatPass {
         v: LookVariant,
         target: DrawTarget,
     ) -> wgpu::ComputePipeline {
-        // splat.wgsl draws sprites only: no motion pass, ribbons or haze.
-        let mut constants: Vec<(&str, f64)> = v
-            .constants()
-            .into_iter()
-            .filter(|(name, _)| !["MOTION", "TRAIL", "HAZE"].contains(name))
-            .collect();
-        constants.push(("DEPTH_TEST", crate::render::depth_test(target)));
+        let mut constants = crate::render::variant::compute_constants(v, target);
         constants.push(("FOOTPRINT", f64::from(FOOTPRINT_PX)));
         crate::render::compute_pipeline(
             ctx,
@@ -324,25 +318,14 @@ impl SplatPass {
     /// Builds what the frame's splat items need: pipelines of their variants and sprite
     /// bind groups.
     fn prepare(&mut self, ctx: &GpuContext, items: &[DrawItem], sampler: &wgpu::Sampler) {
-        for d in items.iter().filter(|d| d.splat) {
-            let v = d.variant;
-            if !self.splats.contains_key(&v) {
-                let p =
-                    crate::render::scoped_variant(ctx, format_args!("splat variant {v:?}"), || {
-                        Self::splat_pipeline(
-                            ctx,
-                            &self.pipeline_layout,
-                            &self.module,
-                            v,
-                            self.target,
-                        )
-                    });
-                self.splats.insert(v, p);
-            }
-            self.sprites.ensure(ctx, &d.sprite, sampler);
-        }
-        let splats = items.iter().filter(|d| d.splat);
-        self.sprites.keep_drawn(splats.map(|d| d.sprite.id));
+        let (layout, module, target) = (&self.pipeline_layout, &self.module, self.target);
+        self.sprites.prepare(
+            ctx,
+            ("splat", sampler),
+            &mut self.splats,
+            items.iter().filter(|d| d.splat),
+            |v| Self::splat_pipeline(ctx, layout, module, v, target),
+        );
     }
 
     /// The accumulation `buffer` (cleared on use) of `size` and its bind group over `depth`
@@ -423,17 +406,10 @@ impl SplatPass {
         else {
             return false;
         };
-        let image = c.images.group(ctx, target);
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("SplatPass::resolve_add"),
-            timestamp_writes: None,
-        });
-        pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, &frame.frame_group, &[0]);
-        pass.set_bind_group(1, &self.empty_group, &[]);
-        pass.set_bind_group(2, group, &[]);
-        pass.set_bind_group(3, image, &[]);
-        pass.dispatch_workgroups(size.0.div_ceil(16), size.1.div_ceil(16), 1);
+        let groups = [&self.empty_group, group];
+        let workgroups = (size.0.div_ceil(16), size.1.div_ceil(16));
+        let label = ("SplatPass::resolve_add", &*pipeline);
+        c.dispatch(ctx, enc, label, (frame, &groups), target, workgroups);
         true
     }
 }

@@ -111,6 +111,27 @@ impl SpriteGroups {
         }
     }
 
+    /// Builds what a compute draw path's `items` need this frame: each look variant's
+    /// pipelines in `pipelines` (made by `make` on first use; `None` where they fail,
+    /// logged as `what`'s) and each sprite's group with `sampler`.
+    pub(crate) fn prepare<'a, P>(
+        &mut self,
+        ctx: &GpuContext,
+        (what, sampler): (&str, &wgpu::Sampler),
+        pipelines: &mut std::collections::HashMap<crate::render::variant::LookVariant, Option<P>>,
+        items: impl Iterator<Item = &'a crate::render::DrawItem> + Clone,
+        make: impl Fn(crate::render::variant::LookVariant) -> P,
+    ) {
+        for d in items.clone() {
+            let v = d.variant;
+            pipelines.entry(v).or_insert_with(|| {
+                crate::render::scoped_variant(ctx, format_args!("{what} variant {v:?}"), || make(v))
+            });
+            self.ensure(ctx, &d.sprite, sampler);
+        }
+        self.keep_drawn(items.map(|d| d.sprite.id));
+    }
+
     /// The group of sprite `id`, if made.
     pub fn get(&self, id: u64) -> Option<&wgpu::BindGroup> {
         self.groups.get(&id)

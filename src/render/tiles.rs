@@ -403,12 +403,7 @@ impl TilePass {
         target: DrawTarget,
     ) -> [wgpu::ComputePipeline; 2] {
         // tiles.wgsl has no motion pass and no ribbons (trails stay billboards).
-        let mut constants: Vec<(&str, f64)> = v
-            .constants()
-            .into_iter()
-            .filter(|(name, _)| !["MOTION", "TRAIL", "HAZE"].contains(name))
-            .collect();
-        constants.push(("DEPTH_TEST", crate::render::depth_test(target)));
+        let mut constants = crate::render::variant::compute_constants(v, target);
         // Software blending (lavapipe) rounds f16 toward zero; the tiles round as it does.
         // The adapter's, whatever profile it runs (a software adapter may take the GPU
         // profile's choices).
@@ -442,24 +437,14 @@ impl TilePass {
     /// Builds what the frame's tile items need: pipelines of their variants and sprite
     /// bind groups.
     fn prepare(&mut self, ctx: &GpuContext, items: &[&DrawItem], sampler: &wgpu::Sampler) {
-        for d in items {
-            let v = d.variant;
-            if !self.variants.contains_key(&v) {
-                let p =
-                    crate::render::scoped_variant(ctx, format_args!("tile variant {v:?}"), || {
-                        Self::variant_pipelines(
-                            ctx,
-                            &self.compute_layout,
-                            &self.module,
-                            v,
-                            self.target,
-                        )
-                    });
-                self.variants.insert(v, p);
-            }
-            self.sprites.ensure(ctx, &d.sprite, sampler);
-        }
-        self.sprites.keep_drawn(items.iter().map(|d| d.sprite.id));
+        let (layout, module, target) = (&self.compute_layout, &self.module, self.target);
+        self.sprites.prepare(
+            ctx,
+            ("tile", sampler),
+            &mut self.variants,
+            items.iter().copied(),
+            |v| Self::variant_pipelines(ctx, layout, module, v, target),
+        );
     }
 
     /// Projects, bins and shades every tile item of `items` (compute), testing against
@@ -679,17 +664,16 @@ impl TilePass {
         ) else {
             return false;
         };
-        let group = c.images.group(ctx, target);
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("TilePass::resolve_over"),
-            timestamp_writes: None,
-        });
-        pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, &frame.frame_group, &[0]);
-        pass.set_bind_group(1, &b.resolve_group, &[]);
-        pass.set_bind_group(2, group, &[]);
-        let (tx, ty) = grid(size, TILE_PX);
-        pass.dispatch_workgroups(tx, ty, 1);
+        let label = ("TilePass::resolve_over", pipeline);
+        let groups = [&b.resolve_group];
+        c.dispatch(
+            ctx,
+            enc,
+            label,
+            (frame, &groups),
+            target,
+            grid(size, TILE_PX),
+        );
         true
     }
 

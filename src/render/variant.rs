@@ -130,3 +130,19 @@ impl LookVariant {
         ]
     }
 }
+
+/// The pipeline constants of look variant `v` for the compute draw paths (tiles.wgsl,
+/// splat.wgsl: sprites only — no motion pass, ribbons or haze), with the host depth test
+/// of `target`.
+pub(crate) fn compute_constants(
+    v: LookVariant,
+    target: crate::render::billboard::DrawTarget,
+) -> Vec<(&'static str, f64)> {
+    let mut constants: Vec<(&str, f64)> = v
+        .constants()
+        .into_iter()
+        .filter(|(name, _)| !["MOTION", "TRAIL", "HAZE"].contains(name))
+        .collect();
+    constants.push(("DEPTH_TEST", crate::render::depth_test(target)));
+    constants
+}

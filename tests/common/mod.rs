@@ -238,3 +238,27 @@ pub fn texture_with(
         bytes,
     )
 }
+
+/// The shipped presets' files (`presets/*.ron`), sorted; at least seven.
+pub fn shipped_preset_paths() -> Vec<std::path::PathBuf> {
+    let mut paths: Vec<_> = std::fs::read_dir("presets")
+        .expect("presets/")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.extension().is_some_and(|x| x == "ron"))
+        .collect();
+    paths.sort();
+    assert!(paths.len() >= 7, "shipped presets: {paths:?}");
+    paths
+}
+
+/// A compute resolve's image (`computed`) is the one its draw gives (`drawn`): within
+/// 0.01/255 mean and 1/255 max, with something drawn.
+pub fn resolves_agree(what: &str, drawn: &image::RgbaImage, computed: &image::RgbaImage) {
+    assert!(total_light(drawn) > 1e3, "{what}: almost nothing drawn");
+    let (mean, max) = image_diff(drawn, computed);
+    eprintln!("{what}: compute resolve vs draw: mean {mean:.4}/255, max {max}/255");
+    assert!(
+        mean <= 0.01 && max <= 1,
+        "{what}: the compute resolve differs by {mean:.4}/255 mean, {max}/255 max"
+    );
+}
