@@ -458,7 +458,7 @@ impl Player {
             )
         });
         if !tiled {
-            // Too many quads for the tiles' lists this frame: billboards draw them.
+            // A target larger than the tiles' bins (7680×4320): billboards draw them.
             for d in &mut self.items {
                 d.tiles = false;
             }

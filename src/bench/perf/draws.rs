@@ -10,8 +10,8 @@ pub struct DrawCosts {
     pub billboard_ms: Option<f64>,
     /// Splat draw (clear + splat + resolve), ms.
     pub splat_ms: f64,
-    /// Tile draw (project, bin, shade and the resolve), ms (None when the quads do not
-    /// fit the device's tile buffers, or the device has no tile rasteriser).
+    /// Tile draw (project, bin, shade and the resolve), ms (None when the target is larger
+    /// than the tiles' bins, or the device has no tile rasteriser).
     pub tiles_ms: Option<f64>,
     /// The tile draw's project alone and project + bin, ms (the shade and resolve are the
     /// rest of `tiles_ms`).
