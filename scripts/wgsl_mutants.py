@@ -41,7 +41,7 @@ TESTS = {
     "trail_on.wgsl": [("trails", None)],
     "tiles.wgsl": [("tiles", None)],
     "tile_lists.wgsl": [("tiles", None)],
-    "splat.wgsl": [("splat", None), ("runtime", "splat")],
+    "splat.wgsl": [("splat", None), ("runtime", "splat reversed_z msaa")],
     "splat_accum.wgsl": [("splat", None)],
     "splat_accum64.wgsl": [("splat", None)],
     "sprite_project.wgsl": [("splat", None), ("tiles", None)],
