@@ -475,7 +475,7 @@ fn sprites_smaller_than_a_pixel_cover_the_rasterisers_pixels() {
 /// each shaded over what the ones before it left, an emitter larger than a chunk in
 /// pieces: the bonfire (lit smoke, flames, embers) and the fireball drawn in chunks of 2048
 /// sprites give the image of one chunk bit for bit (every sprite is blended in the same
-/// order, rounded to f16 after each as before).
+/// order, rounded to f16 after each as before), also when every bin's list overflows.
 #[test]
 fn a_frame_drawn_in_chunks_is_the_frame_drawn_at_once() {
     let ctx = gpu();
@@ -485,13 +485,12 @@ fn a_frame_drawn_in_chunks_is_the_frame_drawn_at_once() {
         for e in &mut effect.emitters {
             e.look.draw_path = DrawPath::Tiles;
         }
-        let image = |chunk: Option<u32>| {
+        let image = |chunk: Option<u32>, lists: Option<u32>| {
             let mut run =
                 Headless::new(&ctx, effect.clone(), ShaderLibrary::embedded()).expect("headless");
-            run.player
-                .tile_pass()
-                .expect("the tiles")
-                .set_chunk_sprites(chunk);
+            let tiles = run.player.tile_pass().expect("the tiles");
+            tiles.set_chunk_sprites(chunk);
+            tiles.set_list_capacity(lists);
             for _ in 0..60 {
                 run.advance(1.0 / 60.0);
             }
@@ -500,15 +499,20 @@ fn a_frame_drawn_in_chunks_is_the_frame_drawn_at_once() {
             let quads: u32 = items.map(|d| d.width * d.members).sum();
             (img, quads)
         };
-        let (whole, quads) = image(None);
+        let (whole, quads) = image(None, None);
         assert!(quads > 2 * 2048, "{name}: {quads} quads fit two chunks");
         assert!(total_light(&whole) > 1e3, "{name}: almost nothing drawn");
-        let (chunked, _) = image(Some(2048));
-        let (mean, max) = image_diff(&whole, &chunked);
-        assert!(
-            whole == chunked,
-            "{name}: in chunks the image differs by {mean:.4}/255 mean, {max}/255 max"
-        );
+        // In chunks, and in chunks whose every bin list overflows (shaded from the
+        // chunk's sprites directly).
+        for lists in [None, Some(1)] {
+            let (chunked, _) = image(Some(2048), lists);
+            let (mean, max) = image_diff(&whole, &chunked);
+            assert!(
+                whole == chunked,
+                "{name}, lists {lists:?}: in chunks the image differs by {mean:.4}/255 mean, \
+                 {max}/255 max"
+            );
+        }
     }
 }
 
