@@ -341,6 +341,57 @@ fn the_compute_resolve_adds_what_the_resolve_draw_does() {
     }
 }
 
+/// One large sprite forced onto the splat adds its integrated light at the four pixels
+/// nearest its centre, bilinearly: a single 0.3 m disc at the orbit's target (tens of
+/// pixels: past the footprint's 8) lights a 2×2 block around the billboard's centre of
+/// light, its own centre within 0.35 px of it (8-bit sRGB shifts a centre of
+/// four bilinear weights by a fraction of a pixel; a tap a pixel off moves it by one).
+#[test]
+fn one_large_sprite_forced_onto_the_splat_lights_the_four_pixels_at_its_centre() {
+    let ctx = gpu();
+    let mut e = common::plain_emitter();
+    e.capacity = 1;
+    e.spawn_rate_per_sec = Param::Constant(1.0);
+    e.lifetime_secs = Range::new(10.0, 10.0);
+    e.look.sprite = Sprite::SoftDisc;
+    e.look.flipbook = None;
+    e.look.streak = None;
+    e.look.trail = None;
+    e.look.soft_ground_m = 0.0;
+    e.look.size_m = Param::Constant(0.3);
+    e.look.intensity = 0.05;
+    e.look.blend = BlendMode::Additive;
+    let mut effect = common::bare_effect(e);
+    // The disc a fraction of a pixel off the target's pixel corner: unequal weights.
+    effect.camera.target_m = [0.011, 0.007, 0.0];
+    effect.camera.pitch_deg = 0.0;
+    effect.post.bloom = None;
+    let a = render(&ctx, &effect, &[], 90, SIZE);
+    let b = render(&ctx, &effect, &[0], 90, SIZE);
+    let lit: Vec<(u32, u32)> = b
+        .enumerate_pixels()
+        .filter(|(_, _, p)| p[0] > 0 || p[1] > 0 || p[2] > 0)
+        .map(|(x, y, _)| (x, y))
+        .collect();
+    assert!(!lit.is_empty() && lit.len() <= 4, "lit pixels {lit:?}");
+    let (x0, y0) = (lit.iter().map(|p| p.0).min(), lit.iter().map(|p| p.1).min());
+    let (x0, y0) = (x0.unwrap_or(0), y0.unwrap_or(0));
+    assert!(
+        lit.iter().all(|&(x, y)| x <= x0 + 1 && y <= y0 + 1),
+        "not a 2×2 block: {lit:?}"
+    );
+    let ca = centroid(&a);
+    let inside = |c: f64, lo: u32| c >= f64::from(lo) && c <= f64::from(lo) + 1.0;
+    assert!(
+        inside(ca.0, x0) && inside(ca.1, y0),
+        "the billboard's centre {ca:?} is not among the lit pixels {lit:?}"
+    );
+    let cb = centroid(&b);
+    let d = ((ca.0 - cb.0).powi(2) + (ca.1 - cb.1).powi(2)).sqrt();
+    eprintln!("one large sprite: centres {ca:?} and {cb:?} ({d:.3} px), lit {lit:?}");
+    assert!(d < 0.35, "centres {ca:?} and {cb:?}");
+}
+
 /// The light-weighted centre of `img` in pixels.
 fn centroid(img: &image::RgbaImage) -> (f64, f64) {
     let (mut sx, mut sy, mut total) = (0.0, 0.0, 0.0);
