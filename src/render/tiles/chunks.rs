@@ -112,6 +112,7 @@ mod tests {
         );
         assert_eq!(chunks[0].firsts(), [0, 2048, 4096]);
         assert_eq!(chunks[1].firsts(), [0, 3072, 4096]);
+        assert_eq!([chunks[0].sprites(), chunks[1].sprites()], [4096, 4096]);
         // Every quad once.
         let per_item = |i: usize| -> u32 {
             pieces
