@@ -172,6 +172,14 @@ fn three_pixel_flames_splat_as_the_billboards_draw_them() {
     splat_agrees("3-px flames", &effect, &[0], SIZE);
 }
 
+/// `look` as a plain soft disc: no flipbook, streak or trail.
+fn plain_disc(look: &mut ignis::effect::Look) {
+    look.sprite = Sprite::SoftDisc;
+    look.flipbook = None;
+    look.streak = None;
+    look.trail = None;
+}
+
 /// A dense sphere of 3-px sparks at the test's size: 24000 in a 1 m sphere, 2 s lives,
 /// gravity and drag, a soft disc.
 fn dense_sphere(ctx: &GpuContext) -> Effect {
@@ -189,10 +197,7 @@ fn dense_sphere(ctx: &GpuContext) -> Effect {
     e.speed_m_per_s = Range::new(0.0, 0.3);
     e.forces.gravity_m_per_s2 = [0.0, -0.5, 0.0];
     e.forces.drag_per_sec = 0.5;
-    e.look.sprite = Sprite::SoftDisc;
-    e.look.flipbook = None;
-    e.look.streak = None;
-    e.look.trail = None;
+    plain_disc(&mut e.look);
     e.look.intensity = 0.05;
     e.look.size_m = Param::Constant(0.02);
     // Scaled so that the sprites project at 3 px.
@@ -353,10 +358,7 @@ fn one_large_sprite_forced_onto_the_splat_lights_the_four_pixels_at_its_centre()
     e.capacity = 1;
     e.spawn_rate_per_sec = Param::Constant(1.0);
     e.lifetime_secs = Range::new(10.0, 10.0);
-    e.look.sprite = Sprite::SoftDisc;
-    e.look.flipbook = None;
-    e.look.streak = None;
-    e.look.trail = None;
+    plain_disc(&mut e.look);
     e.look.soft_ground_m = 0.0;
     e.look.size_m = Param::Constant(0.3);
     e.look.intensity = 0.05;

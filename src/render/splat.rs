@@ -85,14 +85,11 @@ impl SplatPass {
             "SplatPass::accum_layout",
             &[
                 wgpu::BindGroupLayoutEntry {
-                    binding: 0,
                     visibility: wgpu::ShaderStages::COMPUTE | wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: false },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
+                    ..crate::gpu::fragment_buffer_entry(
+                        0,
+                        wgpu::BufferBindingType::Storage { read_only: false },
+                    )
                 },
                 crate::gpu::depth_texture_entry(1, wgpu::ShaderStages::COMPUTE),
             ],

@@ -47,14 +47,8 @@ pub(crate) fn layout(ctx: &GpuContext) -> wgpu::BindGroupLayout {
         &[
             crate::gpu::depth_texture_entry(0, wgpu::ShaderStages::COMPUTE),
             wgpu::BindGroupLayoutEntry {
-                binding: 1,
                 visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
+                ..crate::gpu::fragment_buffer_entry(1, wgpu::BufferBindingType::Uniform)
             },
         ],
     )

@@ -49,14 +49,8 @@ impl HookPipes {
                 compute_storage_entry(4, false),
                 compute_storage_entry(5, false),
                 wgpu::BindGroupLayoutEntry {
-                    binding: 3,
                     visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
+                    ..crate::gpu::fragment_buffer_entry(3, wgpu::BufferBindingType::Uniform)
                 },
             ],
         });

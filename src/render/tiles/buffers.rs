@@ -62,6 +62,9 @@ impl TilePass {
                 args[a..a + 4].copy_from_slice(&[0, 64, 1, 0]);
             }
         }
+        // Up to the last chunk's last job (a frame of one chunk writes its items' only).
+        let last = chunks.last().map_or(0, |c| c.pieces.len());
+        jobs.truncate(((chunks.len().max(1) - 1) * MAX_ITEMS + last) * words);
         ctx.queue
             .write_buffer(&b.job_buffer, 0, bytemuck::cast_slice(&jobs));
         ctx.queue
