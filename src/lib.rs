@@ -52,6 +52,7 @@ pub use effect::Effect;
 /// The math library of the API (`Mat4`, `Vec3`): hosts on another `glam` version use this one
 /// or pass plain `[[f32; 4]; 4]` arrays.
 pub use glam;
+pub use gpu::commands::CommandCounts;
 pub use gpu::{
     AdapterProfile, GpuError, INT64_ATOMICS, ProfileKind, ProfileRequest, ProfileSetting,
 };

@@ -1,5 +1,6 @@
 //! GPU plumbing: the device context and the structs shared with WGSL.
 
+pub mod commands;
 pub mod context;
 pub mod profile;
 pub mod readback;

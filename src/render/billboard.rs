@@ -3,6 +3,7 @@
 //! (two triangles on four shared vertices; the shader reads quad = vertex / 4 +
 //! instance).
 
+use crate::gpu::commands::CountedRender;
 use std::collections::HashMap;
 
 use wgpu::util::DeviceExt;
@@ -399,7 +400,7 @@ impl BillboardPass {
                 // One quad per slot of each instance's live window (`width` per
                 // instance), or sorted, through the sort's order; a ribbon has
                 // `segments` quads per particle.
-                pass.draw_indexed(0..6, 0, 0..d.width * d.members * segments);
+                pass.counted_draw_indexed(0..6, 0..d.width * d.members * segments);
             }
         }
     }

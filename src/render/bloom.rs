@@ -4,6 +4,7 @@
 
 use crate::effect::Bloom;
 use crate::gpu::GpuContext;
+use crate::gpu::commands::CountedCompute;
 use crate::render::HDR_FORMAT;
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 
@@ -324,7 +325,7 @@ impl BloomPass {
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, group, &[]);
             let (x, y) = chain.groups_of[level];
-            pass.dispatch_workgroups(x, y, 1);
+            pass.dispatch(x, y, 1);
         };
         run(&p.prefilter[variant], &prefilter_group, 0);
         for (m, group) in chain.down_groups.iter().enumerate() {

@@ -2,6 +2,7 @@
 //! load them instead of clearing, which the H100's small raster slice does slowly.
 
 use crate::gpu::GpuContext;
+use crate::gpu::commands::CountedCompute;
 use crate::render::image_groups::ImageGroups;
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 
@@ -70,6 +71,6 @@ impl ClearPass {
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, group, &[]);
-        pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+        pass.dispatch(size.0.div_ceil(8), size.1.div_ceil(8), 1);
     }
 }

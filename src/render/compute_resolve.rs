@@ -3,6 +3,7 @@
 //! compute unit rather than the raster, which the H100 keeps only a sliver of its chip for.
 
 use crate::gpu::GpuContext;
+use crate::gpu::commands::CountedCompute;
 use crate::render::FrameResources;
 use crate::render::billboard::DrawTarget;
 use crate::render::image_groups::ImageGroups;
@@ -74,6 +75,6 @@ impl ComputeResolve {
             pass.set_bind_group(i as u32 + 1, *g, &[]);
         }
         pass.set_bind_group(groups.len() as u32 + 1, image, &[]);
-        pass.dispatch_workgroups(workgroups.0, workgroups.1, 1);
+        pass.dispatch(workgroups.0, workgroups.1, 1);
     }
 }

@@ -3,6 +3,7 @@
 //! `texture_depth_2d`, which a multisampled texture cannot be bound as.
 
 use crate::gpu::GpuContext;
+use crate::gpu::commands::CountedRender;
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 
 /// The resolve's pipeline and its target (kept while the size holds).
@@ -106,7 +107,7 @@ impl DepthResolvePass {
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &t.group, &[]);
-        pass.draw(0..3, 0..1);
+        pass.counted_draw(0..3, 0..1);
         drop(pass);
         t.view.clone()
     }

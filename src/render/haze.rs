@@ -3,6 +3,7 @@
 //! (`shaders/haze_apply.wgsl`).
 
 use crate::gpu::GpuContext;
+use crate::gpu::commands::{CountedCompute, CountedRender};
 use crate::render::billboard::HAZE_FORMAT;
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 
@@ -144,7 +145,7 @@ impl HazePass {
             });
             pass.set_pipeline(&self.compute);
             pass.set_bind_group(0, &group, &[]);
-            pass.dispatch_workgroups(texture.width().div_ceil(8), texture.height().div_ceil(8), 1);
+            pass.dispatch(texture.width().div_ceil(8), texture.height().div_ceil(8), 1);
             return;
         }
         let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -156,7 +157,7 @@ impl HazePass {
         let mut pass = crate::gpu::color_pass(enc, target, load, "HazePass::refract");
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &group, &[]);
-        pass.draw(0..3, 0..1);
+        pass.counted_draw(0..3, 0..1);
     }
 }
 

@@ -3,6 +3,7 @@
 //! ring of readback buffers, each mapped when the GPU is done with it, so results arrive a
 //! frame or two after the frame they measure.
 
+use crate::gpu::commands::CountedCompute;
 use std::collections::HashMap;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -292,9 +293,9 @@ impl<T: Clone> LightPass<T> {
             pass.set_bind_group(2, &b.group, &[(k as u64 * JOB_STRIDE) as u32]);
             pass.set_pipeline(sum);
             let (x, y) = dispatch_size(d.width);
-            pass.dispatch_workgroups(x, y, d.members);
+            pass.dispatch(x, y, d.members);
             pass.set_pipeline(&self.total);
-            pass.dispatch_workgroups(d.members.div_ceil(64), 1, 1);
+            pass.dispatch(d.members.div_ceil(64), 1, 1);
         }
     }
 

@@ -5,6 +5,7 @@
 //! with no readback.
 
 use crate::gpu::GpuContext;
+use crate::gpu::commands::CountedCompute;
 use crate::render::DrawItem;
 use crate::render::frame::FrameResources;
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
@@ -110,7 +111,7 @@ impl SelfLightPass {
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, group, &[]);
-        pass.dispatch_workgroups(targets.div_ceil(64), 1, 1);
+        pass.dispatch(targets.div_ceil(64), 1, 1);
     }
 }
 

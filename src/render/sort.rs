@@ -7,6 +7,7 @@
 //! sorted, and merges finished, in one dispatch each ([`sort_dispatches`]), so a 2048-slot
 //! sort is 6 dispatches instead of 66.
 
+use crate::gpu::commands::CountedCompute;
 use std::collections::HashMap;
 
 use bytemuck::{Pod, Zeroable};
@@ -430,7 +431,7 @@ impl SortPass {
             };
             pass.set_pipeline(pipeline);
             let (x, y) = dispatch_size(threads);
-            pass.dispatch_workgroups(x, y, 1);
+            pass.dispatch(x, y, 1);
         }
     }
 
@@ -515,7 +516,7 @@ impl SortPass {
         pass.set_bind_group(0, &b.group, &[0]);
         pass.set_bind_group(1, state_group, &[]);
         let (x, y) = dispatch_size(b.count);
-        pass.dispatch_workgroups(x, y, 1);
+        pass.dispatch(x, y, 1);
         self.record_stages(pass, b);
     }
 

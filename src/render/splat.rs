@@ -4,6 +4,7 @@
 //! atomics, resolved into the HDR target. Far cheaper than tiny instanced quads on GPUs
 //! whose rasteriser runs on a few SMs (see the perf bench).
 
+use crate::gpu::commands::{CountedCompute, CountedRender};
 use std::collections::HashMap;
 
 use crate::gpu::GpuContext;
@@ -307,7 +308,7 @@ impl SplatPass {
             pass.set_bind_group(3, sprite, &[]);
             // Workgroup z is the instance.
             let (x, y) = dispatch_size(d.width);
-            pass.dispatch_workgroups(x, y, d.members);
+            pass.dispatch(x, y, d.members);
         }
         true
     }
@@ -366,7 +367,7 @@ impl SplatPass {
         pass.set_bind_group(0, &frame.frame_group, &[0]);
         pass.set_bind_group(1, &self.empty_group, &[]);
         pass.set_bind_group(2, group, &[]);
-        pass.draw(0..3, 0..1);
+        pass.counted_draw(0..3, 0..1);
     }
 
     /// Whether [`SplatPass::resolve_into`] adds the last splat's light into a target of

@@ -3,6 +3,7 @@
 //! which the player is then handed as a host's depth (depth collision, soft edges,
 //! occlusion). The props are the viewport's, not the preset's.
 
+use crate::gpu::commands::CountedRender;
 use wgpu::util::DeviceExt;
 
 use crate::gpu::GpuContext;
@@ -132,7 +133,7 @@ impl TestScene {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.group, &[]);
         pass.set_vertex_buffer(0, self.vertices.slice(..));
-        pass.draw(0..self.count, 0..1);
+        pass.counted_draw(0..self.count, 0..1);
         drop(pass);
         self.depth = Some((size, depth.clone()));
         depth

@@ -9,6 +9,7 @@
 //! GPUs that keep only a sliver of their chip for rasterisation (the H100) fill large
 //! sprites far faster this way.
 
+use crate::gpu::commands::{CountedCompute, CountedRender};
 use std::collections::HashMap;
 
 use crate::gpu::GpuContext;
@@ -542,11 +543,11 @@ impl TilePass {
                 if stage == 0 {
                     // The piece's last block is filled up with empty sprites.
                     let (x, y) = dispatch_size(p.sprites());
-                    pass.dispatch_workgroups(x, y, 1);
+                    pass.dispatch(x, y, 1);
                 } else {
                     // Only the bins holding some of the piece's sprites (the bin scan
                     // lists them).
-                    pass.dispatch_workgroups_indirect(&b.dispatch_args, args + k as u64 * 16);
+                    pass.dispatch_indirect(&b.dispatch_args, args + k as u64 * 16);
                 }
             }
         }
@@ -580,24 +581,24 @@ impl TilePass {
             tile_scatter,
         ] = &self.bin;
         pass.set_pipeline(count);
-        pass.dispatch_workgroups(blocks, 1, 1);
+        pass.dispatch(blocks, 1, 1);
         pass.set_pipeline(scan);
-        pass.dispatch_workgroups(bins.0 * bins.1, 1, 1);
+        pass.dispatch(bins.0 * bins.1, 1, 1);
         pass.set_pipeline(starts);
-        pass.dispatch_workgroups(1, 1, 1);
+        pass.dispatch(1, 1, 1);
         pass.set_pipeline(list);
-        pass.dispatch_workgroups(bins.0, bins.1, blocks);
+        pass.dispatch(bins.0, bins.1, blocks);
         // The tiles' lists: over the chunks of the bins' lists (counted by `bin_starts`).
         let chunk_args = args + MAX_ITEMS as u64 * 16;
         pass.set_bind_group(3, &b.group, &[jobs as u32]);
         pass.set_pipeline(tile_count);
-        pass.dispatch_workgroups_indirect(&b.dispatch_args, chunk_args);
+        pass.dispatch_indirect(&b.dispatch_args, chunk_args);
         pass.set_pipeline(tile_scan);
-        pass.dispatch_workgroups(bins.0 * bins.1, 1, 1);
+        pass.dispatch(bins.0 * bins.1, 1, 1);
         pass.set_pipeline(tile_starts);
-        pass.dispatch_workgroups(1, 1, 1);
+        pass.dispatch(1, 1, 1);
         pass.set_pipeline(tile_scatter);
-        pass.dispatch_workgroups_indirect(&b.dispatch_args, chunk_args);
+        pass.dispatch_indirect(&b.dispatch_args, chunk_args);
     }
 
     /// Sets how far the next records go (the bench times the stages apart; a record that
@@ -638,7 +639,7 @@ impl TilePass {
         pass.set_pipeline(&self.resolve);
         pass.set_bind_group(0, &frame.frame_group, &[0]);
         pass.set_bind_group(1, &b.resolve_group, &[]);
-        pass.draw_indirect(&b.touched, 0);
+        pass.counted_draw_indirect(&b.touched, 0);
     }
 
     /// Composites the last record's tiles over `target` (the HDR image of `size` pixels

@@ -2,6 +2,7 @@
 //! fit → sRGB display target.
 
 use crate::gpu::GpuContext;
+use crate::gpu::commands::CountedCompute;
 use crate::gpu::types::ToneUniform;
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 
@@ -188,6 +189,6 @@ impl TonemapPass {
             + 4 * usize::from(glow.is_some());
         pass.set_pipeline(&self.pipelines[variant]);
         pass.set_bind_group(0, &bind_group, &[]);
-        pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+        pass.dispatch(size.0.div_ceil(8), size.1.div_ceil(8), 1);
     }
 }

@@ -5,6 +5,7 @@
 mod device_check;
 mod editing;
 mod effect_light;
+mod frame_commands;
 mod heat_haze;
 mod host_depth;
 mod host_targets;

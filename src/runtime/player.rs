@@ -73,6 +73,8 @@ pub struct Player {
     pub(super) snapshots: super::seeking::SeekSnapshots,
     /// Heat haze's distortion target and refraction (built on first use).
     pub(super) haze: Option<crate::render::haze::HazePass>,
+    /// The frame's dispatches and draws (`Player::recorded_commands`).
+    pub(super) commands: super::frame_commands::FrameCommands,
 }
 
 /// Steps one chunk of a `record` runs (the simulation's parameter ring holds this many
@@ -160,6 +162,7 @@ impl Player {
             simulated: false,
             snapshots: Default::default(),
             haze: None,
+            commands: Default::default(),
         })
     }
 
@@ -393,6 +396,7 @@ impl Player {
         camera: &Camera,
         depth: Option<&wgpu::TextureView>,
     ) {
+        let start = self.commands.begin(self.simulated);
         let camera = &self.preset_camera(camera);
         // This frame's depth for the steps recorded now, or (after `simulate`) for the
         // next frame's.
@@ -472,6 +476,7 @@ impl Player {
         drop(groups);
         drop(members);
         self.uploads.finish(encoder);
+        self.commands.add_since(start);
     }
 
     /// The groups of instances drawn together, far to near by their mean depth along
@@ -543,8 +548,10 @@ impl Player {
     /// warm-up), or to time the update on its own. [`Player::record`] does this first
     /// unless it was called since the last record.
     pub fn simulate(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        let start = self.commands.begin(self.simulated);
         self.record_steps(encoder);
         self.uploads.finish(encoder);
+        self.commands.add_since(start);
         self.simulated = true;
     }
 
@@ -641,8 +648,10 @@ impl Player {
     /// What [`Player::draw_layers`] draws before the tiles: the alpha-blended billboards
     /// of `layers`.
     pub(crate) fn draw_under_tiles(&self, pass: &mut wgpu::RenderPass<'_>, layers: Layers) {
+        let start = crate::gpu::commands::recorded();
         self.billboard
             .draw(pass, &self.frame, &self.items, |d| under_tiles(d, layers));
+        self.commands.add_draws_since(start);
     }
 
     /// Whether [`Player::draw_under_tiles`] draws anything for `layers`.
@@ -661,6 +670,7 @@ impl Player {
         layers: Layers,
         drawn: Resolves,
     ) {
+        let start = crate::gpu::commands::recorded();
         if let Some(t) = self
             .tiles
             .as_ref()
@@ -674,6 +684,7 @@ impl Player {
         if self.splatted && drawn.splat && layers.contains(Layers::LIGHT) {
             self.splat.resolve(pass, &self.frame);
         }
+        self.commands.add_draws_since(start);
     }
 
     /// Whether [`Player::resolve_splat_into`] resolves into a target of `size` pixels.
@@ -690,10 +701,13 @@ impl Player {
         target: &wgpu::TextureView,
         size: (u32, u32),
     ) -> bool {
-        self.splatted
+        let start = crate::gpu::commands::recorded();
+        let resolved = self.splatted
             && self
                 .splat
-                .resolve_into(&self.ctx, enc, &self.frame, target, size)
+                .resolve_into(&self.ctx, enc, &self.frame, target, size);
+        self.commands.add_since(start);
+        resolved
     }
 
     /// Whether [`Player::resolve_tiles_into`] resolves into a target of `size` pixels.
@@ -715,7 +729,10 @@ impl Player {
         let Some(tiles) = self.tiles.as_mut() else {
             return false;
         };
-        tiles.resolve_into(&self.ctx, enc, &self.frame, target, size)
+        let start = crate::gpu::commands::recorded();
+        let resolved = tiles.resolve_into(&self.ctx, enc, &self.frame, target, size);
+        self.commands.add_since(start);
+        resolved
     }
 
     /// Prepares the motion pass from the next [`Player::record`] on (the export's

@@ -10,6 +10,7 @@
 //! simulation (a player with such an emitter runs one simulation per instance).
 
 use crate::effect::Effect;
+use crate::gpu::commands::CountedCompute;
 use crate::gpu::types::{PackedParticle, Particle, SimParams, StateLayout};
 use crate::gpu::{GpuContext, Uploads};
 use crate::sim::gpu_sim::{
@@ -422,7 +423,7 @@ impl InstanceBatch {
                 let offset = ((s * n + e) as u64 * self.block_bytes) as u32;
                 pass.set_bind_group(0, group, &[offset]);
                 let (x, y) = dispatch_size(invocations);
-                pass.dispatch_workgroups(x, y, active);
+                pass.dispatch(x, y, active);
             }
         }
         self.planned.clear();

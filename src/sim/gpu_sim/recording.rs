@@ -2,6 +2,7 @@
 //! dispatches (the update, the event scans and the hooks), a tiny state's births.
 
 use super::*;
+use crate::gpu::commands::CountedCompute;
 
 impl GpuSim {
     /// Runs `steps` steps of `dt_secs` (spawning, integrating, ageing) on the GPU.
@@ -255,7 +256,7 @@ impl GpuSim {
                         pass.set_bind_group(2, depth.group(), &[]);
                     }
                     let (x, y) = dispatch_size(invocations);
-                    pass.dispatch_workgroups(x, y, 1);
+                    pass.dispatch(x, y, 1);
                 }
                 // The parent's events become its children's spawn lists, the same step.
                 if let (Some(ev), Some(scan)) = (&em.hooks, &update.hooks.scan) {
@@ -417,7 +418,7 @@ fn record_scans(
             if groups > 0 {
                 pass.set_pipeline(pipeline);
                 let (x, y) = dispatch_groups(groups);
-                pass.dispatch_workgroups(x, y, 1);
+                pass.dispatch(x, y, 1);
             }
         }
     }

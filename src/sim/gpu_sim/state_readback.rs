@@ -2,6 +2,7 @@
 //! trail ring and event header, and the blocking buffer readbacks under them.
 
 use super::*;
+use crate::gpu::commands::CountedCompute;
 
 impl GpuSim {
     /// Emitter `index`'s trail ring (a blocking readback): points per slot, steps between
@@ -171,7 +172,7 @@ impl GpuSim {
                 pass.set_pipeline(&count[usize::from(s.layout == StateLayout::Packed)]);
                 pass.set_bind_group(0, &group, &[]);
                 let (x, y) = dispatch_size(s.capacity);
-                pass.dispatch_workgroups(x, y, 1);
+                pass.dispatch(x, y, 1);
             }
             self.ctx.queue.submit([enc.finish()]);
         }

@@ -1,0 +1,99 @@
+//! The runtime's batches as a host sees them: instances of one preset share their
+//! batch's dispatches and draws. The commands a frame records (`Player::recorded_commands`)
+//! for 1, 16, 17 and 100 torches on every draw path: the same for 1 and 16 (one batch),
+//! and the same step from each further batch (17: two, 100: three: batches of 16, 32 and
+//! 64). The smoke's sort is one per batch, but its bitonic network grows with the log² of
+//! the batch's particles: with smoke, the draws are checked exactly and the dispatches
+//! within that growth; the additive torch's commands are checked exactly.
+
+// The runtime tests' host (this file uses part of it).
+#[allow(dead_code)]
+#[path = "runtime/host.rs"]
+mod host;
+
+use glam::{Mat4, vec3};
+use host::Host;
+use ignis::effect::{BlendMode, DrawPath, Effect};
+use ignis::{CommandCounts, Player};
+
+fn torch_on(path: DrawPath, smoke: bool) -> Effect {
+    let path_ = format!("{}/presets/torch.ron", env!("CARGO_MANIFEST_DIR"));
+    let mut effect = ignis::preset::load(path_.as_ref()).expect("shipped preset");
+    if !smoke {
+        effect
+            .emitters
+            .retain(|e| e.look.blend == BlendMode::Additive);
+    }
+    for e in &mut effect.emitters {
+        // The splat takes additive layers only; the smoke stays on the billboards.
+        if path != DrawPath::Splat || e.look.blend == BlendMode::Additive {
+            e.look.draw_path = path;
+        }
+    }
+    assert!(ignis::testing::sim::batch::batchable(&effect));
+    effect
+}
+
+/// A frame's commands with `n` torches on a grid 0.3 m apart, after the same 30 frames
+/// of warm-up whatever `n` (the same steps), and whether the frame shows fire.
+fn frame_commands(host: &Host, effect: &Effect, n: u32) -> (CommandCounts, bool) {
+    let mut player: Player = host.player(effect);
+    for i in 0..n {
+        let (x, z) = ((i % 10) as f32 * 0.3 - 1.35, -((i / 10) as f32) * 0.3);
+        player
+            .add_instance(Mat4::from_translation(vec3(x, 0.0, z)), i + 1)
+            .expect("instance");
+    }
+    for _ in 0..30 {
+        let mut enc = host.device.create_command_encoder(&Default::default());
+        player.advance(1.0 / 60.0);
+        player.record(&mut enc, &host.camera, None).expect("record");
+        host.queue.submit([enc.finish()]);
+    }
+    player.advance(1.0 / 60.0);
+    let frame = host.frame([0.0; 3], &[], &mut [&mut player], true);
+    let lit = frame.rgba.iter().any(|p| p[0] > 0.05);
+    (player.recorded_commands(), lit)
+}
+
+#[test]
+fn instances_of_one_preset_share_their_batch_dispatches_and_draws() {
+    let host = Host::new(vec3(0.0, 1.5, 3.5), vec3(0.0, 0.8, -1.0));
+    for path in [DrawPath::Billboard, DrawPath::Tiles, DrawPath::Splat] {
+        for smoke in [false, true] {
+            let [one, sixteen, two, hundred] = batch_commands(&host, path, smoke);
+            let what = format!("{path:?}, smoke {smoke}");
+            assert!(one.dispatches > 0 && one.draws > 0, "{what}: {one:?}");
+            assert_eq!(one, sixteen, "{what}: 16 instances in one batch");
+            let per_batch = two - one;
+            assert!(
+                per_batch.dispatches > 0,
+                "{what}: a second batch steps nowhere"
+            );
+            let third = hundred - two;
+            if smoke {
+                // The third batch's sort (64 members, not 32) may run a longer network.
+                assert_eq!(third.draws, per_batch.draws, "{what}: draws per batch");
+                let growth = third.dispatches - per_batch.dispatches;
+                assert!(
+                    growth <= 8,
+                    "{what}: the third batch {third:?}, the second {per_batch:?}"
+                );
+            } else {
+                assert_eq!(third, per_batch, "{what}: commands per batch");
+            }
+        }
+    }
+}
+
+/// The commands of 1, 16, 17 and 100 torches on `path`.
+fn batch_commands(host: &Host, path: DrawPath, smoke: bool) -> [CommandCounts; 4] {
+    let effect = torch_on(path, smoke);
+    let counts = [1, 16, 17, 100].map(|n| {
+        let (c, lit) = frame_commands(host, &effect, n);
+        assert!(lit, "{path:?}, {n} torches: no fire drawn");
+        c
+    });
+    eprintln!("{path:?}, smoke {smoke}: 1, 16, 17, 100 torches record {counts:?}");
+    counts
+}
