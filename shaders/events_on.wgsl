@@ -133,7 +133,12 @@ fn emit_events(slot: u32, p: Particle, born: bool, was_alive: bool, alive: bool,
                 }
             }
         }
-        let key = event_key(slot, counter, e, ordinal);
+        // The key only where it is used: most slots fire nothing in a step, and the hash is
+        // most of this hook's arithmetic.
+        var key = 0u;
+        if fired || n > 0u {
+            key = event_key(slot, counter, e, ordinal);
+        }
         if fired {
             let h = pcg4d(vec4<u32>(key, params.seed, e, 0xC0u));
             let span = rule.count_max - rule.count_min + 1u;

@@ -31,7 +31,8 @@ fn trail_point(slot: u32, j: u32) -> vec4<f32> {
     let before = look.tiny_c.y - 1u;
     let k = before - before % every;
     let r = (k / every + n - (j - 1u) % n) % n;
-    return trail_ring.history[(look.flags.w + slot) * n + r];
+    let slots = arrayLength(&trail_ring.history) / n;
+    return trail_ring.history[ring_entry(look.flags.w + slot, r, slots)];
 }
 
 struct TrailCorner {

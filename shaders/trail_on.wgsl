@@ -1,6 +1,7 @@
 // trail_on.wgsl — the update's trail hook: each particle's last positions in a ring of
 // `points` entries (xyz: position in the emitter's simulation space, w: the particle's
-// age then), group 1 binding 2.
+// age then), group 1 binding 2. Point-major (trail_ring.wgsl `ring_entry`): neighbouring
+// invocations write neighbouring entries, whole memory sectors.
 //
 // Contract (read by trail.wgsl when the billboards draw the ribbon):
 // - A particle born this step fills its whole ring with its birth point, so a ribbon never
@@ -19,16 +20,17 @@ fn record_trail(slot: u32, p: Particle, born: bool, alive: bool) {
         return;
     }
     let n = trail.points;
-    let base = (slot_base + slot) * n;
+    let slots = arrayLength(&trail.history) / max(n, 1u);
+    let at = slot_base + slot;
     let point = p.pos_age;
     if born {
         for (var i = 0u; i < n; i++) {
-            trail.history[base + i] = point;
+            trail.history[ring_entry(at, i, slots)] = point;
         }
         return;
     }
     let step = params.tiny_b.z;
     if step % trail.every == 0u {
-        trail.history[base + (step / trail.every) % n] = point;
+        trail.history[ring_entry(at, (step / trail.every) % n, slots)] = point;
     }
 }

@@ -105,7 +105,7 @@ fn ribbon_points_are_the_recorded_positions_of_one_life() {
             let (birth, birth_point) = life[0];
             let now_age = life.last().map_or(0.0, |(_, q)| q[3]);
             for (&r, &k) in indices.iter().zip(&steps) {
-                let got = ring.entries[slot * points as usize + r as usize];
+                let got = ring.entry(slot, r as usize);
                 // Before the birth: the birth point (the ring is refilled at birth).
                 let want = if k <= birth {
                     birth_point
@@ -162,12 +162,9 @@ fn the_trail_spans_the_same_seconds_at_any_step() {
         let ring = sim.read_trail(0).expect("read").expect("a trail");
         assert_eq!(ring.points, kept);
         let slot = (0..4)
-            .find(|&s| ring.entries[s * kept as usize][3] > 0.0)
+            .find(|&s| ring.entry(s, 0)[3] > 0.0)
             .expect("the particle's ring");
-        let ages: Vec<f32> = ring.entries[slot * kept as usize..][..kept as usize]
-            .iter()
-            .map(|p| p[3])
-            .collect();
+        let ages: Vec<f32> = (0..kept as usize).map(|r| ring.entry(slot, r)[3]).collect();
         let newest = ages.iter().copied().fold(f32::MIN, f32::max);
         let oldest = ages.iter().copied().fold(f32::MAX, f32::min);
         // The entries are `every` steps apart: the span minus one spacing.

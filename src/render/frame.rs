@@ -93,11 +93,10 @@ pub struct FrameResources {
 
 /// What the automatic draw path looks at: the particles' largest projected size (pixels),
 /// the quads of the draw (the widest live window × the instances: at least the live
-/// particles), the instances, whether a trail's ribbon is drawn, and the target's size.
+/// particles), whether a trail's ribbon is drawn, and the target's size.
 struct PathScene {
     size_px: f32,
     quads: u32,
-    instances: u32,
     trail: bool,
     target_px: (u32, u32),
 }
@@ -515,7 +514,6 @@ impl FrameResources {
             PathScene {
                 size_px,
                 quads: width * n,
-                instances: n,
                 trail: trail.is_some(),
                 target_px: view.camera.size_px(),
             },
@@ -589,7 +587,6 @@ impl FrameResources {
         let PathScene {
             size_px,
             quads,
-            instances,
             trail,
             target_px: (tw, th),
         } = scene;
@@ -615,14 +612,13 @@ impl FrameResources {
             && !trail
             && match look.draw_path {
                 DrawPath::Auto => {
-                    // Billboard fill at most (every quad at the largest size). A group of
-                    // several instances (a runtime host's batch) keeps billboards: a grid
-                    // of 100 torches measured 6.5 ms a frame with the tiles, 2.8 without.
+                    // Billboard fill at most (every quad at the largest size), of every
+                    // instance of a group (a runtime host's batch is one group): on an
+                    // H100 at 1080p, 100 torches on a grid took 2.2 ms a frame on the
+                    // tiles against 3.2 on billboards, and 100 at one spot 15.7 ms against
+                    // 31.2 (`bench/results/runtime-nvidia-h100-80gb.md`).
                     let fill = quads as f32 * size_px * size_px;
-                    profile.tile_raster
-                        && instances == 1
-                        && size_px >= TILES_ABOVE_PX
-                        && fill >= TILES_MIN_FILL_PX
+                    profile.tile_raster && size_px >= TILES_ABOVE_PX && fill >= TILES_MIN_FILL_PX
                 }
                 DrawPath::Tiles => true,
                 DrawPath::Billboard | DrawPath::Splat => false,

@@ -11,8 +11,17 @@ pub struct TrailRing {
     pub points: u32,
     /// Steps between recorded points.
     pub every_steps: u32,
-    /// `points` entries per slot, slot after slot: position (simulation space) and age.
+    /// `points` entries per slot, point-major (every slot's point 0, then every slot's
+    /// point 1, …: `shaders/trail_ring.wgsl`): position (simulation space) and age.
     pub entries: Vec<[f32; 4]>,
+}
+
+impl TrailRing {
+    /// Point `r` of `slot` (see [`TrailRing::entries`]).
+    pub fn entry(&self, slot: usize, r: usize) -> [f32; 4] {
+        let slots = self.entries.len() / self.points.max(1) as usize;
+        self.entries[r * slots + slot]
+    }
 }
 
 /// Read-only views of an emitter's state buffers, for the draw passes.

@@ -17,6 +17,8 @@ use bevy::render::diagnostic::RenderDiagnosticsPlugin;
 use bevy::render::render_resource::TextureFormat;
 use bevy_ignis::IgnisEffect;
 
+// The shared headless app (this example adds a plugin: `headless_app_with`).
+#[allow(dead_code)]
 #[path = "common/headless.rs"]
 mod headless;
 
@@ -76,8 +78,9 @@ fn measure(
     (size, msaa): ((u32, u32), u32),
     frames: usize,
 ) -> Result<(Row, String), String> {
-    let mut app = headless::headless_app(presets, false);
-    app.add_plugins(RenderDiagnosticsPlugin);
+    let mut app = headless::headless_app_with(presets, false, |app| {
+        app.add_plugins(RenderDiagnosticsPlugin);
+    });
     let image = Image::new_target_texture(size.0, size.1, TextureFormat::Rgba8UnormSrgb, None);
     let target = app.world_mut().resource_mut::<Assets<Image>>().add(image);
     let side = (torches as f32).sqrt().ceil().max(1.0) as u32;

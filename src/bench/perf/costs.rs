@@ -31,6 +31,9 @@ pub(super) fn module_costs(
     Ok(rows)
 }
 
+/// Rounds over the module table's variants (see `time_variants`).
+pub(super) const MODULE_ROUNDS: usize = 8;
+
 /// A row of the module table: its name, the effect and the shader library it runs on.
 type Variant = (String, Effect, ShaderLibrary);
 
@@ -162,8 +165,10 @@ fn time_variants(
     // swaps the pipelines (the bare one is built from another library), never the pool.
     // Stateless mode clears the pool (its records mean something else), so it is measured
     // last. Rounds over the variants keep slow drifts of a shared machine hitting all
-    // alike.
-    let rounds = 3;
+    // alike; the H100 spends seconds at a time in a state where the same step takes twice
+    // as long, so a variant needs several rounds to be seen in the fast one too (with three
+    // rounds some variants never were, and read +100 %).
+    let rounds = MODULE_ROUNDS;
     let per_round = opts.repeats.max(1);
     let mut samples = vec![Vec::new(); variants.len()];
     let is_stateless = |e: &Effect| e.emitters.iter().any(|e| e.stateless);

@@ -228,13 +228,14 @@ pub(super) fn report_modules(
     let bare = costs.first().map_or(f64::NAN, |c| c.2);
     let mcap = opts.module_capacity.min(ctx.max_capacity() as u32);
     report.para(&format!(
-        "Update pass at {mcap} particles, ms per step: the median and the best of {} one-step submissions in 3 rounds \
+        "Update pass at {mcap} particles, ms per step: the median and the best of {} one-step submissions in {} rounds \
          over the variants, all on one full pool (several large pools alive at once slow every one of them on the \
          H100), each after 100 ms of untimed steps; stateless mode, which clears the pool, last. The comparison uses \
          the best: on the H100 a share of samples runs in a slow state (0.42 → 0.75 ms for the same step, bimodal), which moves medians by tens of percent while the best repeats to 1 %. \
          The first two rows are the \"off costs nothing\" check: the pipeline with every module compiled out \
          by its override constant against one built from source with the module code deleted.",
-        opts.repeats.max(1) * 3
+        opts.repeats.max(1) * super::costs::MODULE_ROUNDS,
+        super::costs::MODULE_ROUNDS
     ));
     let mrows: Vec<Vec<String>> = costs
         .iter()

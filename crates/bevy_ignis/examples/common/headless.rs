@@ -16,6 +16,12 @@ use bevy_ignis::IgnisPlugin;
 /// The app, its plugins built and finished, ready to spawn into (`watch`: Bevy's file
 /// watcher on the asset folder).
 pub fn headless_app(assets: &Path, watch: bool) -> App {
+    headless_app_with(assets, watch, |_| {})
+}
+
+/// [`headless_app`] with `more` plugins added before they are built and finished (Bevy
+/// refuses plugins after that).
+pub fn headless_app_with(assets: &Path, watch: bool, more: impl FnOnce(&mut App)) -> App {
     let mut app = App::new();
     app.add_plugins(
         DefaultPlugins
@@ -42,6 +48,7 @@ pub fn headless_app(assets: &Path, watch: bool) -> App {
     .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(
         1.0 / 60.0,
     )));
+    more(&mut app);
     while app.plugins_state() == PluginsState::Adding {
         bevy::tasks::tick_global_task_pools_on_main_thread();
     }
