@@ -141,17 +141,22 @@ fn count_blocks(
 @compute @workgroup_size(256)
 fn scan_blocks(@builtin(local_invocation_index) lid: u32) {
     let n_blocks = (params.update_window.y + BLOCK - 1u) / BLOCK;
+    // Each invocation sums a run of consecutive blocks, one workgroup scan places the runs,
+    // and each invocation writes its run's offsets: one scan, however many blocks (a scan
+    // per 256 blocks was 64 in a row, each with its barriers, at 16.8M slots).
+    let per = (n_blocks + GROUP - 1u) / GROUP;
+    let first = lid * per;
+    let last = min(first + per, n_blocks);
+    var sum = 0u;
+    for (var i = first; i < last; i++) {
+        sum += blocks[1u + i];
+    }
     var running = 0u;
-    for (var base = 0u; base < n_blocks; base += GROUP) {
-        let i = base + lid;
-        var v = 0u;
-        if i < n_blocks {
-            v = blocks[1u + i];
-        }
-        let at = running_exclusive(lid, v, &running);
-        if i < n_blocks {
-            blocks[1u + i] = at;
-        }
+    var at = running_exclusive(lid, sum, &running);
+    for (var i = first; i < last; i++) {
+        let v = blocks[1u + i];
+        blocks[1u + i] = at;
+        at += v;
     }
     if lid == 0u {
         if event_in.stamp != params.tiny_b.z {

@@ -137,6 +137,9 @@ fn death_children_match_the_cpu_mirror_including_the_cap() {
     check_against_the_mirror(1024, 900.0, 750.0, false);
     // Children that inherit the parent's colour carry its age at the event.
     check_against_the_mirror(4096, 9_000.0, 6030.0, true);
+    // A window of more blocks than the scan's workgroup has invocations (about 350 blocks
+    // of 1024 slots): each invocation places a run of consecutive blocks.
+    check_against_the_mirror(1 << 19, 900_000.0, 12_000.0, false);
 }
 
 fn check_against_the_mirror(
