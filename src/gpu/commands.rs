@@ -29,7 +29,7 @@ impl std::ops::Add for CommandCounts {
 impl std::ops::Sub for CommandCounts {
     type Output = Self;
 
-    /// What was recorded between two readings of [`recorded`] (saturating).
+    /// What was recorded between two readings of the count (saturating).
     fn sub(self, o: Self) -> Self {
         Self {
             dispatches: self.dispatches.saturating_sub(o.dispatches),
