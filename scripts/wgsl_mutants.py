@@ -37,7 +37,7 @@ ROOT = Path(__file__).resolve().parent.parent
 TESTS = {
     "events.wgsl": [("events", None), ("trails", "parent")],
     "events_on.wgsl": [("events", None), ("trails", "parent")],
-    "trail.wgsl": [("trails", None)],
+    "trail.wgsl": [("trails", None), ("looks", "reference_images"), ("tiles", "ribbons")],
     "trail_on.wgsl": [("trails", None)],
     "tiles.wgsl": [("tiles", None)],
     "tile_lists.wgsl": [("tiles", None)],

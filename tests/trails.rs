@@ -1,7 +1,8 @@
 //! Trails on a real adapter: the points a ribbon is drawn through are the particle's own
 //! positions after the steps that recorded them (the ring read back, its entries chosen as
 //! the vertex shader chooses them), a reused slot's ribbon holds only its new particle's
-//! points, and the drawn ribbon lights the pixels between the particle and its tail. A
+//! points, and the drawn ribbon lights the pixels between the particle and its tail,
+//! narrowing from its width at the particle to its tail width. A
 //! ribbon per parent joins each parent's children in the order it spawned them, never two
 //! parents' lives, and lights the pixels between them.
 
@@ -179,10 +180,15 @@ fn the_trail_spans_the_same_seconds_at_any_step() {
 
 /// One particle flying straight across the view with a ribbon and no sprite: the lit
 /// pixels run from the particle back to its oldest point, not beyond.
-#[test]
-fn the_ribbon_lights_the_pixels_between_the_particle_and_its_tail() {
-    let ctx = gpu();
-    let (points, every) = (9u32, 2u32);
+/// One particle born at x = −1, 1 m up, flying along +x at 1.2 m/s for 60 steps of
+/// [`side_view`], drawn as a ribbon of `points` points `every` steps apart (no sprite),
+/// `width` times its `size_m` wide at the particle and `tail_width` times that at its tail;
+/// rendered at `size`.
+fn straight_ribbon(
+    (points, every): (u32, u32),
+    (size_m, width, tail_width): (f32, f32, f32),
+    size: (u32, u32),
+) -> image::RgbaImage {
     let mut e = plain_emitter();
     e.capacity = 4;
     e.spawn_rate_per_sec = Param::Constant(0.0);
@@ -194,13 +200,13 @@ fn the_ribbon_lights_the_pixels_between_the_particle_and_its_tail() {
     e.transform.position_m = [-1.0, 1.0, 0.0];
     e.direction = [1.0, 0.0, 0.0];
     e.speed_m_per_s = Range::new(1.2, 1.2);
-    e.look.size_m = Param::Constant(0.05);
+    e.look.size_m = Param::Constant(size_m);
     e.look.trail = Some(Trail {
         points,
         // `every` steps of side_view's 1/60 s step between points.
         length_secs: (points * every) as f32 * DT,
-        width: 1.0,
-        tail_width: 1.0,
+        width,
+        tail_width,
         tail_opacity: 1.0,
         draw_sprite: false,
         ..Trail::default()
@@ -209,19 +215,29 @@ fn the_ribbon_lights_the_pixels_between_the_particle_and_its_tail() {
     e.look.intensity = 4.0;
     let mut effect = bare_effect(e);
     side_view(&mut effect);
+    let ctx = gpu();
     let mut run = ignis::testing::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
         .expect("headless");
-    let frames = 60u32;
-    for _ in 0..frames {
+    for _ in 0..RIBBON_FRAMES {
         run.advance(f64::from(DT));
     }
+    run.render(size).expect("render")
+}
+
+/// The frames [`straight_ribbon`] plays.
+const RIBBON_FRAMES: u32 = 60;
+
+#[test]
+fn the_ribbon_lights_the_pixels_between_the_particle_and_its_tail() {
+    let (points, every) = (9u32, 2u32);
     let (w, h) = (320u32, 240u32);
-    let image = run.render((w, h)).expect("render");
+    let image = straight_ribbon((points, every), (0.05, 1.0, 1.0), (w, h));
     // Born half way through the first step at x = −1, at 1.2 m/s: after step k it is at
     // −1 + 1.2 (k + ½) dt. The particle is drawn between its states after the last two
     // steps; the oldest point is the state after the oldest recording step shown.
     let to_px = |x: f32| side_view_px(x, (w, h));
     let after = |k: i64| -1.0 + 1.2 * (k as f32 + 0.5) * DT;
+    let frames = RIBBON_FRAMES;
     let last_step = i64::from(frames) - 1;
     let (head_lo, head_hi) = (to_px(after(last_step - 1)), to_px(after(last_step)));
     let oldest_step = point_steps(points, every, u64::from(frames))
@@ -238,6 +254,39 @@ fn the_ribbon_lights_the_pixels_between_the_particle_and_its_tail() {
         "lit {first}..={last}, ribbon from {tail:.1} to {head_lo:.1}..{head_hi:.1}"
     );
     assert_eq!(lit.len() as u32, last - first + 1, "one unbroken ribbon");
+}
+
+/// The ribbon is `width` × the particle's size wide at the particle and narrows linearly
+/// along its points to `tail_width` of that at its tail: its lit height near the head is
+/// that width (within what the sprite's soft edge leaves under the threshold), and near
+/// the tail a quarter of it.
+#[test]
+fn the_ribbon_narrows_from_its_width_at_the_particle_to_its_tail_width() {
+    let (w, h) = (640u32, 480u32);
+    let (size_m, width, tail_width) = (0.2f32, 0.5f32, 0.25f32);
+    let image = straight_ribbon((9, 2), (size_m, width, tail_width), (w, h));
+    let lit = lit_pixels(&image, h / 2);
+    let (first, last) = (*lit.first().expect("lit pixels"), *lit.last().expect("lit"));
+    let height = |x: u32| (0..h).filter(|&y| image.get_pixel(x, y)[0] > 40).count() as f32;
+    let px_per_m = side_view_px(1.0, (w, h)) - side_view_px(0.0, (w, h));
+    let head_px = size_m * width * px_per_m;
+    let span = (last - first) as f32;
+    // A tenth of the ribbon in from each end: the width there, linear along the ribbon's
+    // evenly spaced points (the first segment, to the particle, is shorter: a little slack).
+    let near_head = height(last - (span * 0.1) as u32);
+    let near_tail = height(first + (span * 0.1) as u32);
+    let want_head = head_px * (1.0 - 0.1 * (1.0 - tail_width));
+    let want_tail = head_px * (tail_width + 0.1 * (1.0 - tail_width));
+    assert!(
+        (0.6 * want_head..=want_head + 2.0).contains(&near_head),
+        "near the particle {near_head} px high, the ribbon {want_head:.1}"
+    );
+    let ratio = near_tail / near_head;
+    let want = want_tail / want_head;
+    assert!(
+        (ratio - want).abs() < 0.12,
+        "tail over head {ratio:.2} ({near_tail} / {near_head} px), want {want:.2}"
+    );
 }
 
 /// A trail whose ring cannot fit one storage binding is refused with a message that names
