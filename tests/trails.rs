@@ -2,7 +2,8 @@
 //! positions after the steps that recorded them (the ring read back, its entries chosen as
 //! the vertex shader chooses them), a reused slot's ribbon holds only its new particle's
 //! points, and the drawn ribbon lights the pixels between the particle and its tail,
-//! narrowing from its width at the particle to its tail width. A
+//! narrowing from its width at the particle to its tail width, and along a curve passes
+//! through its recorded points. A
 //! ribbon per parent joins each parent's children in the order it spawned them, never two
 //! parents' lives, and lights the pixels between them.
 
@@ -189,6 +190,16 @@ fn straight_ribbon(
     (size_m, width, tail_width): (f32, f32, f32),
     size: (u32, u32),
 ) -> image::RgbaImage {
+    let mut run = ribbon_run((points, every), (size_m, width, tail_width), |_| {});
+    run.render(size).expect("render")
+}
+
+/// The played run of [`straight_ribbon`], its emitter changed by `edit` first.
+fn ribbon_run(
+    (points, every): (u32, u32),
+    (size_m, width, tail_width): (f32, f32, f32),
+    edit: impl FnOnce(&mut Emitter),
+) -> ignis::testing::headless::Headless {
     let mut e = plain_emitter();
     e.capacity = 4;
     e.spawn_rate_per_sec = Param::Constant(0.0);
@@ -213,6 +224,7 @@ fn straight_ribbon(
     });
     e.look.color_over_life = flat_color([1.0, 1.0, 1.0, 1.0]);
     e.look.intensity = 4.0;
+    edit(&mut e);
     let mut effect = bare_effect(e);
     side_view(&mut effect);
     let ctx = gpu();
@@ -221,7 +233,7 @@ fn straight_ribbon(
     for _ in 0..RIBBON_FRAMES {
         run.advance(f64::from(DT));
     }
-    run.render(size).expect("render")
+    run
 }
 
 /// The frames [`straight_ribbon`] plays.
@@ -286,6 +298,78 @@ fn the_ribbon_narrows_from_its_width_at_the_particle_to_its_tail_width() {
     assert!(
         (ratio - want).abs() < 0.12,
         "tail over head {ratio:.2} ({near_tail} / {near_head} px), want {want:.2}"
+    );
+}
+
+/// A ribbon along a curve is drawn through the points its ring recorded, each read where
+/// the vertex shader reads it, and not across the curve: every shown point's pixel is lit,
+/// the point one recording before the oldest shown is not, and neither is the middle of
+/// the chord from the particle to its oldest point.
+#[test]
+fn a_curved_ribbon_passes_through_its_recorded_points() {
+    let (points, every) = (9u32, 2u32);
+    let mut run = ribbon_run((points, every), (0.05, 1.0, 1.0), |e| {
+        // Thrown up and to the right, back at 1 m up after the run's 1 s: the ribbon's
+        // 16 steps arc about 0.09 m off its chord.
+        e.direction = [0.4, 0.917, 0.0];
+        e.speed_m_per_s = Range::new(5.45, 5.45);
+        e.forces.gravity_m_per_s2 = [0.0, -10.0, 0.0];
+    });
+    let (w, h) = (640u32, 480u32);
+    let image = run.render((w, h)).expect("render");
+    let ring = run
+        .player
+        .trail(run.instance, 0)
+        .expect("read")
+        .expect("a trail");
+    let particles = run.player.particles(run.instance, 0).expect("read");
+    let slot = particles
+        .iter()
+        .position(|p| p.is_alive())
+        .expect("the particle");
+    let world = run.player.particle_motion(run.instance).expect("read")[0].0;
+    // The ring holds simulation-space positions: the particle's own gives the offset.
+    let offset = world - glam::Vec3::from_slice(&particles[slot].pos_age[..3]);
+    let px_per_m = side_view_px(1.0, (w, h)) - side_view_px(0.0, (w, h));
+    let to_px = |p: glam::Vec3| {
+        let q = p + offset;
+        (
+            side_view_px(q.x, (w, h)),
+            h as f32 / 2.0 - (q.y - 1.0) * px_per_m,
+        )
+    };
+    let lit_near = |(x, y): (f32, f32)| {
+        (-1..=1).any(|dy: i32| {
+            (-1..=1).any(|dx: i32| {
+                let (px, py) = (x.round() as i32 + dx, y.round() as i32 + dy);
+                px >= 0
+                    && py >= 0
+                    && (px as u32) < w
+                    && (py as u32) < h
+                    && image.get_pixel(px as u32, py as u32)[0] > 40
+            })
+        })
+    };
+    let entry = |r: u32| glam::Vec3::from_slice(&ring.entry(slot, r as usize)[..3]);
+    let shown = trail_indices(points, every, u64::from(RIBBON_FRAMES));
+    for (j, &r) in shown.iter().enumerate() {
+        let at = to_px(entry(r));
+        assert!(
+            lit_near(at),
+            "point {} (entry {r}) at {at:?} is dark",
+            j + 1
+        );
+    }
+    let oldest = to_px(entry(*shown.last().expect("points")));
+    let head = to_px(world - offset);
+    let chord = ((head.0 + oldest.0) / 2.0, (head.1 + oldest.1) / 2.0);
+    assert!(!lit_near(chord), "the chord's middle {chord:?} is lit");
+    // The entry before the oldest shown (the ring's next one back) lies beyond the tail.
+    let before = (shown.last().copied().expect("points") + points - 1) % points;
+    let beyond = to_px(entry(before));
+    assert!(
+        !lit_near(beyond),
+        "the entry before the oldest, at {beyond:?}, is lit"
     );
 }
 
