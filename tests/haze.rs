@@ -292,9 +292,16 @@ fn frame_with(ctx: &GpuContext, effect: &Effect, at: glam::Vec3) -> Framed {
         }
         enc.copy_texture_to_texture(host.as_image_copy(), copy.as_image_copy(), host.size());
         let copy_view = copy.create_view(&Default::default());
+        let before = player.recorded_commands();
         applied = player
             .apply_haze(&mut enc, &copy_view, &host_view)
             .expect("haze");
+        // The frame's commands include the haze's: its distortion draw and refraction.
+        let haze = player.recorded_commands() - before;
+        assert!(
+            !applied || haze.draws + haze.dispatches >= 2,
+            "the haze's commands are not counted: {haze:?}"
+        );
         ctx.queue.submit([enc.finish()]);
     }
     let enc = || ctx.device.create_command_encoder(&Default::default());

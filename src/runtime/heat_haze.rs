@@ -29,12 +29,15 @@ impl Player {
     ) -> Result<bool, PlayerError> {
         let size = target.texture().size();
         let frame = (size.width, size.height);
+        let start = crate::gpu::commands::recorded();
         if !self.draw_distortion(encoder, (frame, HAZE_DOWNSCALE))? {
             return Ok(false);
         }
         if let Some(haze) = &self.haze {
             haze.refract(&self.ctx, encoder, scene, target);
         }
+        // The frame's commands (`Player::recorded_commands`) include the haze's.
+        self.commands.add_since(start);
         Ok(true)
     }
 
