@@ -10,6 +10,9 @@
 //! `cargo run --release -p bench_hanabi -- --counts 1048576,4194304 --out DIR`
 //! (`scripts/peers.sh` runs it beside `ignis bench presets` on the same scenes).
 
+// The headless Bevy app the plugin's examples and tests run on (no ignis in it).
+#[path = "../../bevy_ignis/examples/common/bevy_headless.rs"]
+mod bevy_headless;
 mod capture;
 mod stamps;
 mod workload;

@@ -3,22 +3,18 @@
 //! (`RoundModifier`): the cost is the same shape of quad.
 
 use std::path::Path;
-use std::time::Duration;
 
-use bevy::app::PluginsState;
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
 use bevy::diagnostic::DiagnosticsStore;
 use bevy::prelude::*;
-use bevy::render::RenderPlugin;
 use bevy::render::diagnostic::RenderDiagnosticsPlugin;
 use bevy::render::render_resource::TextureFormat;
 use bevy::render::renderer::RenderAdapterInfo;
-use bevy::time::TimeUpdateStrategy;
-use bevy::window::ExitCondition;
 use bevy_hanabi::prelude::*;
 
 use crate::Options;
+use crate::bevy_headless;
 use crate::stamps::{Stamps, StampsPlugin};
 
 /// One N's medians.
@@ -32,37 +28,18 @@ pub struct Run {
     pub frames: usize,
 }
 
-/// A headless app (no window, frames of exactly 1/60 s, the render world on the main
-/// thread, pipelines compiled before the first frame) with hanabi and the timers.
+/// A headless app (`bevy_headless`: no window, frames of exactly 1/60 s, the render world
+/// on the main thread, pipelines compiled before the first frame) with hanabi and the
+/// timers.
 fn app() -> App {
     let mut app = App::new();
+    // One app per N: Bevy's logger can be set only once in a process.
     app.add_plugins(
-        DefaultPlugins
-            .set(WindowPlugin {
-                primary_window: None,
-                exit_condition: ExitCondition::DontExit,
-                ..default()
-            })
-            .set(RenderPlugin {
-                synchronous_pipeline_compilation: true,
-                ..default()
-            })
-            // One app per N: Bevy's logger can be set only once in a process.
-            .disable::<bevy::log::LogPlugin>()
-            .disable::<bevy::winit::WinitPlugin>()
-            .disable::<bevy::render::pipelined_rendering::PipelinedRenderingPlugin>(),
+        bevy_headless::plugins(AssetPlugin::default()).disable::<bevy::log::LogPlugin>(),
     )
     .add_plugins((HanabiPlugin, RenderDiagnosticsPlugin, StampsPlugin))
-    .insert_resource(ClearColor(Color::BLACK))
-    .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(
-        1.0 / 60.0,
-    )));
-    while app.plugins_state() == PluginsState::Adding {
-        bevy::tasks::tick_global_task_pools_on_main_thread();
-    }
-    app.finish();
-    app.cleanup();
-    app
+    .insert_resource(ClearColor(Color::BLACK));
+    bevy_headless::finish(app)
 }
 
 /// ignis's `bench/scenes/sphere_*.ron` of `n` particles as a hanabi effect.

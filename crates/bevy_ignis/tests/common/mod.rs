@@ -7,14 +7,12 @@
 mod headless;
 
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
 use bevy::prelude::*;
 use bevy::render::render_resource::TextureFormat;
-use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 use bevy_ignis::{IgnisPlayers, IgnisPreset};
 
 /// The test image's size.
@@ -76,27 +74,12 @@ pub fn run(app: &mut App, frames: u32) {
 
 /// The next frame's image as RGBA8 (sRGB), read back through a screenshot.
 pub fn capture(app: &mut App, target: &Handle<Image>) -> Vec<[u8; 4]> {
-    let slot: Arc<Mutex<Option<Image>>> = Arc::default();
-    let out = slot.clone();
-    app.world_mut()
-        .spawn(Screenshot::image(target.clone()))
-        .observe(move |shot: On<ScreenshotCaptured>| {
-            if let Ok(mut s) = out.lock() {
-                *s = Some(shot.image.clone());
-            }
-        });
-    for _ in 0..30 {
-        app.update();
-        let taken = slot.lock().ok().and_then(|mut s| s.take());
-        if let Some(image) = taken {
-            let bytes = image.data.expect("screenshot bytes");
-            return bytes
-                .chunks_exact(4)
-                .map(|c| [c[0], c[1], c[2], c[3]])
-                .collect();
-        }
-    }
-    panic!("no screenshot");
+    let image = headless::bevy_headless::screenshot(app, target, 30).expect("a screenshot");
+    let bytes = image.data.expect("screenshot bytes");
+    bytes
+        .chunks_exact(4)
+        .map(|c| [c[0], c[1], c[2], c[3]])
+        .collect()
 }
 
 /// The render world's players.
