@@ -1,4 +1,4 @@
-// noise.wgsl — smooth value noise, seeded, for spawn flicker (and later turbulence).
+// noise.wgsl — smooth value noise, seeded: spawn flicker, gusts, and curl-noise turbulence.
 //
 // Contract: `value_noise3(p, seed)` returns a value in [0, 1] that varies smoothly with p
 // (quintic fade); mirrored in `src/sim/cpu_reference.rs`.
@@ -58,20 +58,59 @@ fn value_noise3_grad(p: vec3<f32>, seed: u32) -> vec4<f32> {
     return vec4<f32>(grad, n);
 }
 
-// Curl noise (Bridson et al. 2007): the curl of a vector potential of three decorrelated
-// value-noise channels, summed over octaves. Divergence-free by construction. The result
-// is in units of the potential per unit length (frequency is applied by the caller).
+// Three lattice values in [0, 1) for the three channels of a vector potential: ten bits
+// each of one lowbias32 hash (the cell folded as `hash_cell` does), set as the mantissa of
+// a float in [1, 2) — exact multiples of 1/1024, no integer-to-float conversion.
+fn hash_cell3(c: vec3<i32>, seed_mix: u32) -> vec3<f32> {
+    let u = bitcast<vec3<u32>>(c);
+    let h = lowbias32((u.x * 0x8DA6B343u) ^ (u.y * 0xD8163841u) ^ (u.z * 0xCB1AB31Fu) ^ seed_mix);
+    let m = ((vec3<u32>(h) >> vec3<u32>(22u, 12u, 2u)) & vec3<u32>(0x3FFu)) << vec3<u32>(13u);
+    return bitcast<vec3<f32>>(m | vec3<u32>(0x3F800000u)) - 1.0;
+}
+
+// One octave of curl noise: the curl of a vector potential ψ whose three channels are
+// value noise on one lattice (one hash per corner for all three), so the fade weights and
+// their derivatives are shared. Trilinear form with quintic fade, as `value_noise3_grad`.
+fn curl_octave(p: vec3<f32>, seed: u32) -> vec3<f32> {
+    let cell = floor(p);
+    let f = p - cell;
+    let c = vec3<i32>(cell);
+    let u = fade3(f);
+    let du = fade3_deriv(f);
+    let s = seed * 0x9E3779B9u;
+    let a = hash_cell3(c + vec3<i32>(0, 0, 0), s);
+    let b = hash_cell3(c + vec3<i32>(1, 0, 0), s);
+    let cc = hash_cell3(c + vec3<i32>(0, 1, 0), s);
+    let d = hash_cell3(c + vec3<i32>(1, 1, 0), s);
+    let e = hash_cell3(c + vec3<i32>(0, 0, 1), s);
+    let ff = hash_cell3(c + vec3<i32>(1, 0, 1), s);
+    let g = hash_cell3(c + vec3<i32>(0, 1, 1), s);
+    let h = hash_cell3(c + vec3<i32>(1, 1, 1), s);
+    let k1 = b - a;
+    let k2 = cc - a;
+    let k3 = e - a;
+    let k4 = a - b - cc + d;
+    let k5 = a - cc - e + g;
+    let k6 = a - b - e + ff;
+    let k7 = -a + b + cc - d + e - ff - g + h;
+    // ∂ψ/∂x, ∂ψ/∂y, ∂ψ/∂z, each over the three channels.
+    let dx = du.x * (k1 + k4 * u.y + k6 * u.z + k7 * u.y * u.z);
+    let dy = du.y * (k2 + k4 * u.x + k5 * u.z + k7 * u.x * u.z);
+    let dz = du.z * (k3 + k5 * u.y + k6 * u.x + k7 * u.x * u.y);
+    // curl ψ = (∂ψz/∂y − ∂ψy/∂z, ∂ψx/∂z − ∂ψz/∂x, ∂ψy/∂x − ∂ψx/∂y).
+    return vec3<f32>(dy.z - dz.y, dz.x - dx.z, dx.y - dy.x);
+}
+
+// Curl noise (Bridson et al. 2007), summed over octaves: divergence-free by construction.
+// The result is in units of the potential per unit length (frequency is applied by the
+// caller); octave o uses seed + o.
 fn curl_noise(p: vec3<f32>, seed: u32, octaves: u32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     var freq = 1.0;
     var amp = 1.0;
     for (var o = 0u; o < octaves; o++) {
-        let q = p * freq;
-        let gx = value_noise3_grad(q, seed + o * 3u).xyz;
-        let gy = value_noise3_grad(q + vec3<f32>(31.416, 47.853, 12.793), seed + o * 3u + 1u).xyz;
-        let gz = value_noise3_grad(q + vec3<f32>(-17.231, 5.117, 63.941), seed + o * 3u + 2u).xyz;
-        // curl ψ = (∂ψz/∂y − ∂ψy/∂z, ∂ψx/∂z − ∂ψz/∂x, ∂ψy/∂x − ∂ψx/∂y), chain rule × freq.
-        sum += amp * freq * vec3<f32>(gz.y - gy.z, gx.z - gz.x, gy.x - gx.y);
+        // Chain rule: the octave's gradient × its frequency.
+        sum += amp * freq * curl_octave(p * freq, seed + o);
         freq *= 2.0;
         amp *= 0.5;
     }

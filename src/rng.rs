@@ -55,8 +55,9 @@ pub fn emitter_salt(emitter_index: u32, seed_offset: u32) -> u32 {
     pcg4d([emitter_index, seed_offset, 0x1DE5_F1E5, 0])[0]
 }
 
-/// A lattice hash for value noise (see `hash_cell` in `shaders/rng.wgsl`).
-pub fn hash_cell(c: [i32; 3], seed: u32) -> f32 {
+/// The lattice hash's word (see `hash_cell` in `shaders/rng.wgsl`): the cell folded by
+/// large odd multipliers, then Wellons' "lowbias32" avalanche.
+fn hash_cell_word(c: [i32; 3], seed: u32) -> u32 {
     let mut h = (c[0] as u32).wrapping_mul(0x8DA6_B343)
         ^ (c[1] as u32).wrapping_mul(0xD816_3841)
         ^ (c[2] as u32).wrapping_mul(0xCB1A_B31F)
@@ -66,5 +67,17 @@ pub fn hash_cell(c: [i32; 3], seed: u32) -> f32 {
     h ^= h >> 15;
     h = h.wrapping_mul(0x846C_A68B);
     h ^= h >> 16;
-    unorm(h)
+    h
+}
+
+/// A lattice hash for value noise (see `hash_cell` in `shaders/rng.wgsl`).
+pub fn hash_cell(c: [i32; 3], seed: u32) -> f32 {
+    unorm(hash_cell_word(c, seed))
+}
+
+/// Three lattice values in [0, 1) from one hash, ten bits each (multiples of 1/1024): the
+/// vector potential of curl noise (see `hash_cell3` in `shaders/noise.wgsl`).
+pub fn hash_cell3(c: [i32; 3], seed: u32) -> [f32; 3] {
+    let h = hash_cell_word(c, seed);
+    [22, 12, 2].map(|shift| ((h >> shift) & 0x3FF) as f32 / 1024.0)
 }

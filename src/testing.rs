@@ -38,7 +38,7 @@ pub mod shaders {
 
 /// The random streams (`rng`).
 pub mod rng {
-    pub use crate::rng::{emitter_salt, rand_block, spawn_key, unorm, unorm4};
+    pub use crate::rng::{emitter_salt, hash_cell3, rand_block, spawn_key, unorm, unorm4};
 }
 
 /// The simulation, its planner and its CPU reference (`sim`).

@@ -137,9 +137,33 @@ fn death_children_match_the_cpu_mirror_including_the_cap() {
     check_against_the_mirror(1024, 900.0, 750.0, false);
     // Children that inherit the parent's colour carry its age at the event.
     check_against_the_mirror(4096, 9_000.0, 6030.0, true);
-    // A window of more blocks than the scan's workgroup has invocations (about 350 blocks
-    // of 1024 slots): each invocation places a run of consecutive blocks.
-    check_against_the_mirror(1 << 19, 900_000.0, 12_000.0, false);
+    // A window of more blocks than the scan's workgroup has invocations (about 290 blocks
+    // of 4096 slots): each invocation places a run of consecutive blocks. (The records of
+    // 1.8M slots, 130 MB, fit the 128 MiB binding every adapter gives.)
+    check_against_the_mirror(1_800_000, 2_000_000.0, 12_000.0, false);
+}
+
+/// A parent whose event records cannot fit one storage binding is refused with a message
+/// that names the emitter, the limit and the capacity that fits (nothing half-built).
+#[test]
+fn events_too_large_for_the_device_are_a_clear_error() {
+    let ctx = gpu();
+    let limit = ctx.device.limits().max_storage_buffer_binding_size;
+    let mut effect = parent_and_child(Event::default(), 0.0);
+    effect.emitters[0].name = "crowded parent".into();
+    // The state (32 bytes a slot) fits; the records (72 bytes a slot) do not.
+    effect.emitters[0].capacity = (limit / 64).min(u64::from(u32::MAX)) as u32;
+    let err = match GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect) {
+        Ok(_) => panic!("event records over the binding limit were accepted"),
+        Err(err) => err.to_string(),
+    };
+    let fits = (limit - 64) / 72;
+    assert!(
+        err.contains("crowded parent")
+            && err.contains("max_storage_buffer_binding_size")
+            && err.contains(&format!("capacity to {fits} or less")),
+        "{err}"
+    );
 }
 
 fn check_against_the_mirror(

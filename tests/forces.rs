@@ -73,6 +73,47 @@ fn curl_noise_is_divergence_free() {
     );
 }
 
+/// Curl noise equals the curl of its potential taken independently: ψ's three channels
+/// interpolated from `hash_cell3`'s lattice values (quintic fade, written here as nested
+/// lerps), differentiated by central differences, summed over octaves (seed + octave,
+/// amplitude ½ and frequency 2 per octave).
+#[test]
+fn curl_noise_is_the_curl_of_its_potential() {
+    let fade = |t: f64| t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
+    let potential = |p: DVec3, seed: u32| -> DVec3 {
+        let cell = p.floor();
+        let f = p - cell;
+        let lattice = |dx: i32, dy: i32, dz: i32| {
+            let c = [cell.x as i32 + dx, cell.y as i32 + dy, cell.z as i32 + dz];
+            DVec3::from(ignis::testing::rng::hash_cell3(c, seed).map(f64::from))
+        };
+        let (u, v, w) = (fade(f.x), fade(f.y), fade(f.z));
+        let x0 = |dy, dz| lattice(0, dy, dz).lerp(lattice(1, dy, dz), u);
+        let y0 = |dz| x0(0, dz).lerp(x0(1, dz), v);
+        y0(0).lerp(y0(1), w)
+    };
+    let curl = |p: DVec3, seed: u32| -> DVec3 {
+        let h = 1e-5;
+        let d = |axis: DVec3| {
+            (potential(p + axis * h, seed) - potential(p - axis * h, seed)) / (2.0 * h)
+        };
+        let (dx, dy, dz) = (d(DVec3::X), d(DVec3::Y), d(DVec3::Z));
+        DVec3::new(dy.z - dz.y, dz.x - dx.z, dx.y - dy.x)
+    };
+    let mut worst: f64 = 0.0;
+    for i in 0..500 {
+        let p = DVec3::new(
+            (i as f64 * 0.37).sin() * 5.0,
+            (i as f64 * 0.11).cos() * 5.0 - 0.5,
+            i as f64 * 0.021 - 4.0,
+        );
+        let expected = curl(p, 11) + 0.5 * 2.0 * curl(p * 2.0, 12);
+        let got = curl_noise(p, 11, 2);
+        worst = worst.max((got - expected).length() / expected.length().max(0.1));
+    }
+    assert!(worst < 1e-5, "curl noise vs the potential's curl: {worst}");
+}
+
 /// The GPU's turbulence acceleration (read from one explicit Euler step: Δv/dt) equals the
 /// CPU field at the same points.
 #[test]

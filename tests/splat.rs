@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{gpu, image_diff, total_light};
+use common::{gpu, image_diff, share_off, total_light};
 use ignis::effect::{BlendMode, DrawPath, Effect, Param, Range, Shape, Sprite};
 use ignis::testing::gpu::{GpuContext, INT64_ATOMICS};
 use ignis::testing::headless::Headless;
@@ -65,16 +65,6 @@ fn small_additive(ctx: &GpuContext, effect: &Effect, frames: u32, size: (u32, u3
     small.sort_unstable();
     small.dedup();
     small
-}
-
-/// The share of `a`'s channels that differ from `b`'s by more than 8/255.
-fn share_off(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
-    let off = a
-        .as_raw()
-        .iter()
-        .zip(b.as_raw())
-        .filter(|(x, y)| x.abs_diff(**y) > 8);
-    off.count() as f64 / a.as_raw().len() as f64
 }
 
 /// The splat's and the billboards' images of `effect` (the `splat` emitters on the

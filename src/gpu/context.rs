@@ -59,6 +59,25 @@ pub enum GpuError {
         /// The limit's value.
         limit_bytes: u64,
     },
+    /// An emitter's event records (a count and a record per rule and slot) need more
+    /// than one storage binding holds.
+    #[error(
+        "emitter \"{emitter}\": its events over {capacity} slots need {needed_bytes} bytes \
+            of records, but this adapter's max_storage_buffer_binding_size is {limit_bytes} \
+            bytes; lower the emitter's capacity to {max_capacity} or less"
+    )]
+    EventsTooLarge {
+        /// Emitter name.
+        emitter: String,
+        /// Slots.
+        capacity: u32,
+        /// Bytes it needs.
+        needed_bytes: u64,
+        /// The limit's value.
+        limit_bytes: u64,
+        /// Largest capacity that fits.
+        max_capacity: u64,
+    },
 }
 
 /// 64-bit integers and every atomic operation on them: the splat adds a pixel's light
@@ -239,6 +258,28 @@ impl GpuContext {
                 capacity,
                 needed_bytes,
                 limit_bytes,
+            });
+        }
+        Ok(())
+    }
+
+    /// Fails with a clear message when emitter `emitter`'s event records over `capacity`
+    /// slots, `bytes_per_slot` each after `fixed_bytes`, do not fit one storage binding.
+    pub fn check_events(
+        &self,
+        emitter: &str,
+        capacity: u32,
+        (fixed_bytes, bytes_per_slot): (u64, u64),
+    ) -> Result<(), GpuError> {
+        let limit_bytes = self.device.limits().max_storage_buffer_binding_size;
+        let needed_bytes = fixed_bytes + bytes_per_slot * u64::from(capacity);
+        if needed_bytes > limit_bytes {
+            return Err(GpuError::EventsTooLarge {
+                emitter: emitter.to_owned(),
+                capacity,
+                needed_bytes,
+                limit_bytes,
+                max_capacity: limit_bytes.saturating_sub(fixed_bytes) / bytes_per_slot.max(1),
             });
         }
         Ok(())

@@ -422,18 +422,36 @@ pub fn value_noise3_grad(p: DVec3, seed: u32) -> (DVec3, f64) {
     (grad, n)
 }
 
+/// `curl_octave` in noise.wgsl, in f64: the curl of a vector potential whose three
+/// channels are value noise on one lattice (`rng::hash_cell3`).
+fn curl_octave(p: DVec3, seed: u32) -> DVec3 {
+    let cell = p.floor();
+    let f = p - cell;
+    let c = [cell.x as i32, cell.y as i32, cell.z as i32];
+    let h = |dx: i32, dy: i32, dz: i32| {
+        DVec3::from(rng::hash_cell3([c[0] + dx, c[1] + dy, c[2] + dz], seed).map(f64::from))
+    };
+    let u = DVec3::new(fade64(f.x), fade64(f.y), fade64(f.z));
+    let du = DVec3::new(fade64_deriv(f.x), fade64_deriv(f.y), fade64_deriv(f.z));
+    let (a, b, cc, d) = (h(0, 0, 0), h(1, 0, 0), h(0, 1, 0), h(1, 1, 0));
+    let (e, ff, g, hh) = (h(0, 0, 1), h(1, 0, 1), h(0, 1, 1), h(1, 1, 1));
+    let k4 = a - b - cc + d;
+    let k5 = a - cc - e + g;
+    let k6 = a - b - e + ff;
+    let k7 = -a + b + cc - d + e - ff - g + hh;
+    let dx = du.x * ((b - a) + k4 * u.y + k6 * u.z + k7 * u.y * u.z);
+    let dy = du.y * ((cc - a) + k4 * u.x + k5 * u.z + k7 * u.x * u.z);
+    let dz = du.z * ((e - a) + k5 * u.y + k6 * u.x + k7 * u.x * u.y);
+    DVec3::new(dy.z - dz.y, dz.x - dx.z, dx.y - dy.x)
+}
+
 /// `curl_noise` in noise.wgsl, in f64.
 pub fn curl_noise(p: DVec3, seed: u32, octaves: u32) -> DVec3 {
     let mut sum = DVec3::ZERO;
     let mut freq = 1.0;
     let mut amp = 1.0;
     for o in 0..octaves {
-        let q = p * freq;
-        let s = seed.wrapping_add(o * 3);
-        let gx = value_noise3_grad(q, s).0;
-        let gy = value_noise3_grad(q + DVec3::new(31.416, 47.853, 12.793), s.wrapping_add(1)).0;
-        let gz = value_noise3_grad(q + DVec3::new(-17.231, 5.117, 63.941), s.wrapping_add(2)).0;
-        sum += amp * freq * DVec3::new(gz.y - gy.z, gx.z - gz.x, gy.x - gx.y);
+        sum += amp * freq * curl_octave(p * freq, seed.wrapping_add(o));
         freq *= 2.0;
         amp *= 0.5;
     }

@@ -269,10 +269,15 @@ impl GpuSim {
         Ok(())
     }
 
-    /// Refuses capacities and trail rings the device cannot hold, naming the emitter.
+    /// Refuses capacities, event records and trail rings the device cannot hold, naming
+    /// the emitter.
     fn check_limits(&self, effect: &Effect) -> Result<(), SimError> {
         for e in &effect.emitters {
             self.ctx.check_capacity(&e.name, e.capacity)?;
+            if !e.events.is_empty() {
+                let bytes = super::hooks::record_bytes();
+                self.ctx.check_events(&e.name, e.capacity.max(1), bytes)?;
+            }
             if let Some(t) = &e.look.trail {
                 let points = t.layout(effect.time.nominal_step_secs()).points;
                 let bytes = super::trails::ring_bytes(e.capacity.max(1), points);

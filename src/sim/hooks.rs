@@ -243,9 +243,8 @@ impl EmitterHooks {
         }
         let device = &ctx.device;
         let records = (!e.events.is_empty()).then(|| {
-            // A count (one word) and a record (RECORD_WORDS words) per rule and slot.
-            let words = (1 + RECORD_WORDS) * MAX_EVENTS_PER_EMITTER as u64 * u64::from(capacity);
-            let size = RULES_BYTES + 4 * words;
+            let (fixed, per_slot) = record_bytes();
+            let size = fixed + per_slot * u64::from(capacity);
             let b = storage_buffer(device, "EmitterHooks::records", size);
             ctx.queue.write_buffer(&b, 0, bytemuck::cast_slice(&rules));
             b
@@ -336,4 +335,13 @@ impl EmitterHooks {
             );
         }
     }
+}
+
+/// The bytes of a parent's event records: (the rules, then per slot) — a count (one word)
+/// and a record (`RECORD_WORDS` words) per rule and slot.
+pub fn record_bytes() -> (u64, u64) {
+    (
+        RULES_BYTES,
+        4 * (1 + RECORD_WORDS) * MAX_EVENTS_PER_EMITTER as u64,
+    )
 }

@@ -101,6 +101,16 @@ pub fn image_diff(a: &image::RgbaImage, b: &image::RgbaImage) -> (f64, u8) {
     (sum as f64 / a.as_raw().len().max(1) as f64, max)
 }
 
+/// The share of channels (of all) that differ by more than 8/255 between `a` and `b`.
+pub fn share_off(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
+    let off = a
+        .as_raw()
+        .iter()
+        .zip(b.as_raw())
+        .filter(|(x, y)| x.abs_diff(**y) > 8);
+    off.count() as f64 / a.as_raw().len() as f64
+}
+
 /// The sum of every pixel's R + G + B.
 pub fn total_light(img: &image::RgbaImage) -> f64 {
     img.pixels()
