@@ -59,8 +59,8 @@ const NO_LINK: u32 = 0xFFFFFFFFu;
 const GROUP: u32 = 256u;
 // Slots per thread and per workgroup (keep in sync with EVENT_SCAN_BLOCK in
 // src/sim/event_scan.rs).
-const PER_THREAD: u32 = 16u;
-const BLOCK: u32 = 4096u;
+const PER_THREAD: u32 = 4u;
+const BLOCK: u32 = 1024u;
 
 
 // Where the scratch keeps the cap's bucket (tokens short of full, f32 bits; zero: full)

@@ -185,8 +185,12 @@ fn check_reference_converges(report: &TuneReport) {
         .map(|m| m.error.mean)
         .fold(f64::INFINITY, f64::min);
     assert!(smallest > 0.0, "every candidate differs from its reference");
+    // Converged: far below the best candidate's error, or below a twentieth of an 8-bit
+    // level on average, where the finest candidates' errors (~0.1/255 for the torch) are
+    // the f32 round-off that the flames' turbulence amplifies, as is the reference's
+    // difference from itself at half its step (the torch: 0.011–0.021/255).
     assert!(
-        check.mean < 0.1 * smallest,
+        check.mean < 0.1 * smallest || check.mean < 0.05,
         "reference vs half its step {} against the smallest candidate error {smallest}",
         check.mean
     );

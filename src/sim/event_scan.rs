@@ -109,7 +109,7 @@ pub(super) const RULES_BYTES: u64 = (MAX_EVENTS_PER_EMITTER * size_of::<EventRul
 pub(super) const RECORD_WORDS: u64 = 8;
 
 /// Slots per workgroup of the scan's passes (`BLOCK` in `shaders/events.wgsl`).
-pub const EVENT_SCAN_BLOCK: u32 = 4096;
+pub const EVENT_SCAN_BLOCK: u32 = 1024;
 
 /// The update's rules of emitter `e` (unused slots say none).
 pub fn rules_of(e: &Emitter) -> [EventRule; MAX_EVENTS_PER_EMITTER] {
