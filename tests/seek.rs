@@ -149,6 +149,13 @@ fn seeks_from_snapshots_give_the_played_state() {
                 "{layout}: the state after seeking to {t:.2} s differs from the played one"
             );
         }
+        // Every seek restored a snapshot (a refused restore forgets them all and replays
+        // from time 0, which reaches the same state).
+        assert_eq!(
+            run.player.seek_snapshot_bytes(),
+            (bytes, count),
+            "{layout}: the seeks kept the snapshots"
+        );
         // Seeking forward past the last snapshot takes more as it goes, and agrees too.
         run.seek(0.0, 1.0 / FPS);
         for _ in 0..30 {
@@ -179,6 +186,19 @@ fn seek_snapshots_stay_within_their_memory_bound() {
     assert!(
         bytes <= bound && count >= 2,
         "{count} snapshots, {bytes} bytes"
+    );
+    // Each snapshot holds both state buffers of every pool, and the events' scratch (a
+    // word per parent slot and block, the spawn list's header): the bound counts them all.
+    let states: u64 = run
+        .player
+        .effect()
+        .emitters
+        .iter()
+        .map(|e| 2 * 32 * u64::from(e.capacity))
+        .sum();
+    assert!(
+        bytes >= count as u64 * states && bytes < count as u64 * 2 * states,
+        "{count} snapshots, {bytes} bytes: {states} bytes of state each"
     );
 }
 

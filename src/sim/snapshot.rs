@@ -39,11 +39,6 @@ struct EmitterSnapshot {
 }
 
 impl SimSnapshot {
-    /// Steps simulated when it was taken.
-    pub fn step_index(&self) -> u64 {
-        self.planner.step_index
-    }
-
     /// GPU memory it holds.
     pub fn bytes(&self) -> u64 {
         self.bytes
