@@ -1755,3 +1755,98 @@ fn the_export_section_asks_for_the_sixway_passes() {
         "{names:?}"
     );
 }
+
+/// The timeline bar paints where the state says: the played part and the playhead at
+/// now / span of the bar's width, each burst's marker at its time, the loop region over
+/// its span; the bar fills its row but for 8 px; Pause and Play toggle the playback.
+#[test]
+fn the_timeline_bar_paints_the_playhead_bursts_and_loop_where_they_are() {
+    use egui::epaint::Shape;
+    use ignis::testing::editor::panel::timeline::{span_secs, timeline_ui};
+    let mut state = campfire_state();
+    state.running.emitters[0].bursts.push(ignis::effect::Burst {
+        time_secs: 0.75,
+        count: 10,
+    });
+    state.stats.sim_time_secs = 1.0;
+    state.playback.loop_region = Some((0.5, 1.5));
+    // Where the row the bar is in ends.
+    let row_end = std::rc::Rc::new(std::cell::Cell::new(0.0f32));
+    let row = row_end.clone();
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(900.0, 40.0))
+        .build_ui_state(
+            move |ui, state: &mut EditorState| {
+                row.set(ui.max_rect().right());
+                timeline_ui(ui, state);
+            },
+            state,
+        );
+    harness.run();
+    let bar = harness.get_by_label("Timeline").rect();
+    let span = span_secs(&harness.state().running).max(1.0);
+    let x_of = |t: f64| bar.left() + (t / span) as f32 * bar.width();
+    let shapes: Vec<Shape> = harness
+        .output()
+        .shapes
+        .iter()
+        .map(|c| c.shape.clone())
+        .collect();
+    let lines = |color: egui::Color32| -> Vec<f32> {
+        let at = |s: &Shape| match s {
+            Shape::LineSegment { points, stroke } if stroke.color == color => Some(points[0].x),
+            _ => None,
+        };
+        shapes.iter().filter_map(at).collect()
+    };
+    let rects = |fill: egui::Color32| -> Vec<egui::Rect> {
+        let at = |s: &Shape| match s {
+            Shape::Rect(r) if r.fill == fill => Some(r.rect),
+            _ => None,
+        };
+        shapes.iter().filter_map(at).collect()
+    };
+    let near = |a: f32, b: f32| (a - b).abs() < 0.01;
+    let playhead = lines(egui::Color32::WHITE);
+    assert!(
+        playhead.len() == 1 && near(playhead[0], x_of(1.0)),
+        "playhead at {playhead:?}, want {}",
+        x_of(1.0)
+    );
+    let bursts = lines(egui::Color32::from_rgb(240, 150, 60));
+    assert!(
+        bursts.iter().any(|&x| near(x, x_of(0.75))),
+        "burst markers at {bursts:?}, want one at {}",
+        x_of(0.75)
+    );
+    let played = rects(egui::Color32::from_rgb(120, 70, 30));
+    assert!(
+        played.len() == 1
+            && near(played[0].left(), bar.left())
+            && near(played[0].right(), x_of(1.0)),
+        "played part {played:?}"
+    );
+    let region = rects(egui::Color32::from_rgb(45, 60, 80));
+    assert!(
+        region.len() == 1
+            && near(region[0].left(), x_of(0.5))
+            && near(region[0].right(), x_of(1.5)),
+        "loop region {region:?}, want {} – {}",
+        x_of(0.5),
+        x_of(1.5)
+    );
+    // The bar ends 8 px before its row.
+    assert!(
+        near(row_end.get() - 8.0, bar.right()),
+        "the bar ends at {}, its row at {}",
+        bar.right(),
+        row_end.get()
+    );
+    assert!(!harness.state().playback.is_paused);
+    harness.get_by_label("Pause").click();
+    harness.run();
+    assert!(harness.state().playback.is_paused, "Pause pauses");
+    harness.get_by_label("Play").click();
+    harness.run();
+    assert!(!harness.state().playback.is_paused, "Play plays");
+}

@@ -301,10 +301,20 @@ fn timeline_playback_speed_parked_steps_and_the_loop_region() {
     frames(&mut run, &mut playback, 60);
     assert!((now(&run) - 2.25).abs() <= step, "2×: {}", now(&run));
 
-    // Parked at 1 s by a seek, a step is one step.
+    // A fixed-step effect keeps no frame times (only a frame-delta one replays them).
+    assert!(
+        playback.frame_times.is_empty(),
+        "{:?}",
+        playback.frame_times.len()
+    );
+
+    // Parked at 1 s by a seek, a step is one step; the view stays parked at that time
+    // frame after frame (an edit then re-simulates to it).
     playback.seek_to = Some(1.0);
     frames(&mut run, &mut playback, 1);
     assert!(playback.is_paused && (now(&run) - 1.0).abs() <= 0.5 * step);
+    frames(&mut run, &mut playback, 2);
+    assert_eq!(playback.parked_at, Some(1.0), "still parked");
     let parked = now(&run);
     playback.step_requested = true;
     frames(&mut run, &mut playback, 1);
@@ -335,5 +345,21 @@ fn timeline_playback_speed_parked_steps_and_the_loop_region() {
             .iter()
             .all(|t| *t >= 0.5 - step && *t < 1.0 + 1.0 / FPS + step),
         "{times:?}"
+    );
+
+    // An effect played at half speed: a seek to 1 s of its time lands there.
+    let mut slow = ignis::Effect::default_campfire();
+    slow.time.speed = 0.5;
+    let mut run = unbatched(&ctx, slow);
+    assert_eq!(run.instance, id, "the first instance of a player");
+    let mut playback = Playback {
+        seek_to: Some(1.0),
+        ..Playback::default()
+    };
+    frames(&mut run, &mut playback, 1);
+    assert!(
+        (now(&run) - 1.0).abs() <= 0.5 * step,
+        "a seek at half speed: {}",
+        now(&run)
     );
 }
