@@ -363,3 +363,44 @@ fn timeline_playback_speed_parked_steps_and_the_loop_region() {
         now(&run)
     );
 }
+
+/// A snapshot is restored only into the pools it was taken from: after a pool is rebuilt
+/// (a new capacity) it is refused and nothing changes; into the same pools it puts the
+/// state back.
+#[test]
+fn a_snapshot_of_a_rebuilt_pool_is_refused() {
+    use ignis::testing::sim::GpuSim;
+    let ctx = gpu();
+    let effect = ignis::Effect::default_campfire();
+    let dt = effect.time.step_secs;
+    let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
+    sim.step(&effect, dt, 30).expect("step");
+    let snapshot = |sim: &GpuSim| {
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        let s = sim.snapshot(&mut enc);
+        ctx.queue.submit([enc.finish()]);
+        s
+    };
+    let restore = |sim: &mut GpuSim, s| {
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        let done = sim.restore(&mut enc, s);
+        ctx.queue.submit([enc.finish()]);
+        done
+    };
+    let taken = snapshot(&sim);
+    let at_snapshot = sim.read_particles(0).expect("read");
+    sim.step(&effect, dt, 10).expect("step");
+    assert!(restore(&mut sim, &taken), "the same pools");
+    assert!(sim.read_particles(0).expect("read") == at_snapshot);
+
+    let mut bigger = effect.clone();
+    bigger.emitters[0].capacity *= 2;
+    sim.sync(&bigger).expect("sync");
+    sim.step(&bigger, dt, 5).expect("step");
+    let before = sim.read_particles(0).expect("read");
+    assert!(!restore(&mut sim, &taken), "restored into a rebuilt pool");
+    assert!(
+        sim.read_particles(0).expect("read") == before,
+        "a refused restore changed the pool"
+    );
+}
