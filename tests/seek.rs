@@ -350,7 +350,11 @@ fn timeline_playback_speed_parked_steps_and_the_loop_region() {
     // A loop region of no length loops nothing: the clock runs on past it.
     playback.loop_region = Some((1.0, 1.0));
     frames(&mut run, &mut playback, 90);
-    assert!(now(&run) > 1.2, "held at an empty loop region: {}", now(&run));
+    assert!(
+        now(&run) > 1.2,
+        "held at an empty loop region: {}",
+        now(&run)
+    );
 
     // An effect played at half speed: a seek to 1 s of its time lands there.
     let mut slow = ignis::Effect::default_campfire();
