@@ -266,13 +266,32 @@ fn an_edit_forgets_the_snapshots_and_seeks_land_on_steps() {
     }
 }
 
+/// Plays `n` frames of 1/60 s through the editor's timeline (`editor::timeline::play`,
+/// then the simulation) and returns the instance's clock after each.
+fn timeline_frames(
+    ctx: &ignis::testing::gpu::GpuContext,
+    run: &mut Headless,
+    playback: &mut ignis::testing::editor::state::Playback,
+    n: u32,
+) -> Vec<f64> {
+    use ignis::testing::editor::panel::timeline::play;
+    let mut times = Vec::new();
+    for _ in 0..n {
+        play(&mut run.player, run.instance, playback, false, 1.0 / FPS);
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        run.player.simulate(&mut enc);
+        ctx.queue.submit([enc.finish()]);
+        times.push(run.player.time_secs(run.instance).expect("time"));
+    }
+    times
+}
+
 /// The editor's timeline playback (`editor::timeline::play`, what its frame loop calls):
 /// at 0.25× and 2× the effect's clock advances by a quarter and twice the frames' time; a
 /// step while parked after a seek moves exactly one step; a loop region wraps back to its
 /// start once the clock passes its end, and never runs past it by more than a frame.
 #[test]
 fn timeline_playback_speed_parked_steps_and_the_loop_region() {
-    use ignis::testing::editor::panel::timeline::play;
     use ignis::testing::editor::state::Playback;
     let ctx = gpu();
     let effect = ignis::Effect::default_campfire();
@@ -280,15 +299,7 @@ fn timeline_playback_speed_parked_steps_and_the_loop_region() {
     let mut run = unbatched(&ctx, effect);
     let id = run.instance;
     let frames = |run: &mut Headless, playback: &mut Playback, n: u32| {
-        let mut times = Vec::new();
-        for _ in 0..n {
-            play(&mut run.player, id, playback, false, 1.0 / FPS);
-            let mut enc = ctx.device.create_command_encoder(&Default::default());
-            run.player.simulate(&mut enc);
-            ctx.queue.submit([enc.finish()]);
-            times.push(run.player.time_secs(id).expect("time"));
-        }
-        times
+        timeline_frames(&ctx, run, playback, n)
     };
     let now = |run: &Headless| run.player.time_secs(id).expect("time");
     let mut playback = Playback {

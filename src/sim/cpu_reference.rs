@@ -207,6 +207,27 @@ pub fn sample_shape(params: &SimParams, r: [f32; 4]) -> Vec3 {
     }
 }
 
+/// The trilinear form's coefficients from a cell's eight corner values `h(dx, dy, dz)`:
+/// `[k0, …, k7]` with value = k0 + k1·u + k2·v + k3·w + k4·uv + k5·vw + k6·wu + k7·uvw, in
+/// the operations and order `value_noise3_grad` and `curl_octave` (noise.wgsl) use.
+fn trilinear<T>(h: impl Fn(i32, i32, i32) -> T) -> [T; 8]
+where
+    T: Copy + std::ops::Add<Output = T> + std::ops::Sub<Output = T> + std::ops::Neg<Output = T>,
+{
+    let (a, b, cc, d) = (h(0, 0, 0), h(1, 0, 0), h(0, 1, 0), h(1, 1, 0));
+    let (e, ff, g, hh) = (h(0, 0, 1), h(1, 0, 1), h(0, 1, 1), h(1, 1, 1));
+    [
+        a,
+        b - a,
+        cc - a,
+        e - a,
+        a - b - cc + d,
+        a - cc - e + g,
+        a - b - e + ff,
+        -a + b + cc - d + e - ff - g + hh,
+    ]
+}
+
 fn fade(t: f32) -> f32 {
     t * t * t * (t * (t * 6.0 - 15.0) + 10.0)
 }
@@ -219,19 +240,8 @@ pub fn value_noise3(p: Vec3, seed: u32) -> f32 {
     let h = |dx: i32, dy: i32, dz: i32| rng::hash_cell([c[0] + dx, c[1] + dy, c[2] + dz], seed);
     let (ux, uy, uz) = (fade(f.x), fade(f.y), fade(f.z));
     // The same polynomial form as `value_noise3_grad` in noise.wgsl, in f32.
-    let (a, b, cc, d) = (h(0, 0, 0), h(1, 0, 0), h(0, 1, 0), h(1, 1, 0));
-    let (e, ff, g, hh) = (h(0, 0, 1), h(1, 0, 1), h(0, 1, 1), h(1, 1, 1));
-    let k4 = a - b - cc + d;
-    let k5 = a - cc - e + g;
-    let k6 = a - b - e + ff;
-    let k7 = -a + b + cc - d + e - ff - g + hh;
-    a + (b - a) * ux
-        + (cc - a) * uy
-        + (e - a) * uz
-        + k4 * ux * uy
-        + k5 * uy * uz
-        + k6 * uz * ux
-        + k7 * ux * uy * uz
+    let [a, k1, k2, k3, k4, k5, k6, k7] = trilinear(h);
+    a + k1 * ux + k2 * uy + k3 * uz + k4 * ux * uy + k5 * uy * uz + k6 * uz * ux + k7 * ux * uy * uz
 }
 
 /// `value_noise3_vec` in noise.wgsl.
@@ -396,15 +406,7 @@ pub fn value_noise3_grad(p: DVec3, seed: u32) -> (DVec3, f64) {
         |dx: i32, dy: i32, dz: i32| rng::hash_cell([c[0] + dx, c[1] + dy, c[2] + dz], seed) as f64;
     let u = DVec3::new(fade64(f.x), fade64(f.y), fade64(f.z));
     let du = DVec3::new(fade64_deriv(f.x), fade64_deriv(f.y), fade64_deriv(f.z));
-    let (a, b, cc, d) = (h(0, 0, 0), h(1, 0, 0), h(0, 1, 0), h(1, 1, 0));
-    let (e, ff, g, hh) = (h(0, 0, 1), h(1, 0, 1), h(0, 1, 1), h(1, 1, 1));
-    let k1 = b - a;
-    let k2 = cc - a;
-    let k3 = e - a;
-    let k4 = a - b - cc + d;
-    let k5 = a - cc - e + g;
-    let k6 = a - b - e + ff;
-    let k7 = -a + b + cc - d + e - ff - g + hh;
+    let [a, k1, k2, k3, k4, k5, k6, k7] = trilinear(h);
     let n = a
         + k1 * u.x
         + k2 * u.y
@@ -433,15 +435,10 @@ fn curl_octave(p: DVec3, seed: u32) -> DVec3 {
     };
     let u = DVec3::new(fade64(f.x), fade64(f.y), fade64(f.z));
     let du = DVec3::new(fade64_deriv(f.x), fade64_deriv(f.y), fade64_deriv(f.z));
-    let (a, b, cc, d) = (h(0, 0, 0), h(1, 0, 0), h(0, 1, 0), h(1, 1, 0));
-    let (e, ff, g, hh) = (h(0, 0, 1), h(1, 0, 1), h(0, 1, 1), h(1, 1, 1));
-    let k4 = a - b - cc + d;
-    let k5 = a - cc - e + g;
-    let k6 = a - b - e + ff;
-    let k7 = -a + b + cc - d + e - ff - g + hh;
-    let dx = du.x * ((b - a) + k4 * u.y + k6 * u.z + k7 * u.y * u.z);
-    let dy = du.y * ((cc - a) + k4 * u.x + k5 * u.z + k7 * u.x * u.z);
-    let dz = du.z * ((e - a) + k5 * u.y + k6 * u.x + k7 * u.x * u.y);
+    let [_, k1, k2, k3, k4, k5, k6, k7] = trilinear(h);
+    let dx = du.x * (k1 + k4 * u.y + k6 * u.z + k7 * u.y * u.z);
+    let dy = du.y * (k2 + k4 * u.x + k5 * u.z + k7 * u.x * u.z);
+    let dz = du.z * (k3 + k5 * u.y + k6 * u.x + k7 * u.x * u.y);
     DVec3::new(dy.z - dz.y, dz.x - dx.z, dx.y - dy.x)
 }
 
