@@ -97,3 +97,32 @@ fn batch_commands(host: &Host, path: DrawPath, smoke: bool) -> [CommandCounts; 4
     eprintln!("{path:?}, smoke {smoke}: 1, 16, 17, 100 torches record {counts:?}");
     counts
 }
+
+/// The draws a frame reports are the record's plus the host's draw: more than a frame
+/// recorded without drawing, and by no more than a handful (a count that wraps or
+/// subtracts fails).
+#[test]
+fn a_frames_draws_are_counted_on_top_of_its_record() {
+    let host = Host::new(vec3(0.0, 1.5, 3.5), vec3(0.0, 0.8, -1.0));
+    let effect = torch_on(DrawPath::Billboard, false);
+    let mut player: Player = host.player(&effect);
+    player.add_instance(Mat4::IDENTITY, 1).expect("instance");
+    let mut record_only = || {
+        let mut enc = host.device.create_command_encoder(&Default::default());
+        player.advance(1.0 / 60.0);
+        player.record(&mut enc, &host.camera, None).expect("record");
+        host.queue.submit([enc.finish()]);
+        player.recorded_commands()
+    };
+    for _ in 0..30 {
+        record_only();
+    }
+    let recorded = record_only();
+    player.advance(1.0 / 60.0);
+    host.frame([0.0; 3], &[], &mut [&mut player], true);
+    let drawn = player.recorded_commands();
+    assert!(
+        drawn.draws > recorded.draws && drawn.draws <= recorded.draws + 16,
+        "a record alone {recorded:?}, with the draw {drawn:?}"
+    );
+}
