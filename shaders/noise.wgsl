@@ -9,8 +9,25 @@ fn fade3(t: vec3<f32>) -> vec3<f32> {
 }
 
 fn value_noise3(p: vec3<f32>, seed: u32) -> f32 {
-    // The gradient is dead code here and is eliminated after inlining.
-    return value_noise3_grad(p, seed).w;
+    let cell = floor(p);
+    let f = p - cell;
+    let c = vec3<i32>(cell);
+    let u = fade3(f);
+    let a = hash_cell(c + vec3<i32>(0, 0, 0), seed);
+    let b = hash_cell(c + vec3<i32>(1, 0, 0), seed);
+    let cc = hash_cell(c + vec3<i32>(0, 1, 0), seed);
+    let d = hash_cell(c + vec3<i32>(1, 1, 0), seed);
+    let e = hash_cell(c + vec3<i32>(0, 0, 1), seed);
+    let ff = hash_cell(c + vec3<i32>(1, 0, 1), seed);
+    let g = hash_cell(c + vec3<i32>(0, 1, 1), seed);
+    let h = hash_cell(c + vec3<i32>(1, 1, 1), seed);
+    // The trilinear form (as `curl_octave`'s, one channel).
+    let k4 = a - b - cc + d;
+    let k5 = a - cc - e + g;
+    let k6 = a - b - e + ff;
+    let k7 = -a + b + cc - d + e - ff - g + h;
+    return a + (b - a) * u.x + (cc - a) * u.y + (e - a) * u.z + k4 * u.x * u.y + k5 * u.y * u.z
+        + k6 * u.z * u.x + k7 * u.x * u.y * u.z;
 }
 
 // Three decorrelated noise channels centred on zero, in [-1, 1].
@@ -26,66 +43,32 @@ fn fade3_deriv(t: vec3<f32>) -> vec3<f32> {
     return 30.0 * t * t * (t * (t - 2.0) + 1.0);
 }
 
-// Value noise and its analytic gradient: xyz = ∇n, w = n.
-fn value_noise3_grad(p: vec3<f32>, seed: u32) -> vec4<f32> {
-    let cell = floor(p);
-    let f = p - cell;
-    let c = vec3<i32>(cell);
-    let u = fade3(f);
-    let du = fade3_deriv(f);
-    let a = hash_cell(c + vec3<i32>(0, 0, 0), seed);
-    let b = hash_cell(c + vec3<i32>(1, 0, 0), seed);
-    let cc = hash_cell(c + vec3<i32>(0, 1, 0), seed);
-    let d = hash_cell(c + vec3<i32>(1, 1, 0), seed);
-    let e = hash_cell(c + vec3<i32>(0, 0, 1), seed);
-    let ff = hash_cell(c + vec3<i32>(1, 0, 1), seed);
-    let g = hash_cell(c + vec3<i32>(0, 1, 1), seed);
-    let h = hash_cell(c + vec3<i32>(1, 1, 1), seed);
-    let k1 = b - a;
-    let k2 = cc - a;
-    let k3 = e - a;
-    let k4 = a - b - cc + d;
-    let k5 = a - cc - e + g;
-    let k6 = a - b - e + ff;
-    let k7 = -a + b + cc - d + e - ff - g + h;
-    let n = a + k1 * u.x + k2 * u.y + k3 * u.z + k4 * u.x * u.y + k5 * u.y * u.z + k6 * u.z * u.x
-        + k7 * u.x * u.y * u.z;
-    let grad = du * vec3<f32>(
-        k1 + k4 * u.y + k6 * u.z + k7 * u.y * u.z,
-        k2 + k4 * u.x + k5 * u.z + k7 * u.x * u.z,
-        k3 + k5 * u.y + k6 * u.x + k7 * u.x * u.y,
-    );
-    return vec4<f32>(grad, n);
-}
-
 // Three lattice values in [0, 1) for the three channels of a vector potential: ten bits
-// each of one lowbias32 hash (the cell folded as `hash_cell` does), set as the mantissa of
-// a float in [1, 2) — exact multiples of 1/1024, no integer-to-float conversion.
-fn hash_cell3(c: vec3<i32>, seed_mix: u32) -> vec3<f32> {
-    let u = bitcast<vec3<u32>>(c);
-    let h = lowbias32((u.x * 0x8DA6B343u) ^ (u.y * 0xD8163841u) ^ (u.z * 0xCB1AB31Fu) ^ seed_mix);
+// each of `hash_cell_word`, set as the mantissa of a float in [1, 2) — exact multiples of
+// 1/1024, no integer-to-float conversion.
+fn hash_cell3(c: vec3<i32>, seed: u32) -> vec3<f32> {
+    let h = hash_cell_word(c, seed);
     let m = ((vec3<u32>(h) >> vec3<u32>(22u, 12u, 2u)) & vec3<u32>(0x3FFu)) << vec3<u32>(13u);
     return bitcast<vec3<f32>>(m | vec3<u32>(0x3F800000u)) - 1.0;
 }
 
 // One octave of curl noise: the curl of a vector potential ψ whose three channels are
 // value noise on one lattice (one hash per corner for all three), so the fade weights and
-// their derivatives are shared. Trilinear form with quintic fade, as `value_noise3_grad`.
+// their derivatives are shared. Trilinear form with quintic fade, as `value_noise3`.
 fn curl_octave(p: vec3<f32>, seed: u32) -> vec3<f32> {
     let cell = floor(p);
     let f = p - cell;
     let c = vec3<i32>(cell);
     let u = fade3(f);
     let du = fade3_deriv(f);
-    let s = seed * 0x9E3779B9u;
-    let a = hash_cell3(c + vec3<i32>(0, 0, 0), s);
-    let b = hash_cell3(c + vec3<i32>(1, 0, 0), s);
-    let cc = hash_cell3(c + vec3<i32>(0, 1, 0), s);
-    let d = hash_cell3(c + vec3<i32>(1, 1, 0), s);
-    let e = hash_cell3(c + vec3<i32>(0, 0, 1), s);
-    let ff = hash_cell3(c + vec3<i32>(1, 0, 1), s);
-    let g = hash_cell3(c + vec3<i32>(0, 1, 1), s);
-    let h = hash_cell3(c + vec3<i32>(1, 1, 1), s);
+    let a = hash_cell3(c + vec3<i32>(0, 0, 0), seed);
+    let b = hash_cell3(c + vec3<i32>(1, 0, 0), seed);
+    let cc = hash_cell3(c + vec3<i32>(0, 1, 0), seed);
+    let d = hash_cell3(c + vec3<i32>(1, 1, 0), seed);
+    let e = hash_cell3(c + vec3<i32>(0, 0, 1), seed);
+    let ff = hash_cell3(c + vec3<i32>(1, 0, 1), seed);
+    let g = hash_cell3(c + vec3<i32>(0, 1, 1), seed);
+    let h = hash_cell3(c + vec3<i32>(1, 1, 1), seed);
     let k1 = b - a;
     let k2 = cc - a;
     let k3 = e - a;

@@ -56,7 +56,11 @@ fn lowbias32(x: u32) -> u32 {
 // cell folded into one word by large odd multipliers, then Wellons' "lowbias32"
 // avalanche (two multiplies, three xor-shifts) — a third of pcg4d's work.
 fn hash_cell(c: vec3<i32>, seed: u32) -> f32 {
+    return f32(hash_cell_word(c, seed) >> 8u) * (1.0 / 16777216.0);
+}
+
+// `hash_cell`'s word: the cell and seed folded by large odd multipliers, then avalanched.
+fn hash_cell_word(c: vec3<i32>, seed: u32) -> u32 {
     let u = bitcast<vec3<u32>>(c);
-    let h = lowbias32((u.x * 0x8DA6B343u) ^ (u.y * 0xD8163841u) ^ (u.z * 0xCB1AB31Fu) ^ (seed * 0x9E3779B9u));
-    return f32(h >> 8u) * (1.0 / 16777216.0);
+    return lowbias32((u.x * 0x8DA6B343u) ^ (u.y * 0xD8163841u) ^ (u.z * 0xCB1AB31Fu) ^ (seed * 0x9E3779B9u));
 }

@@ -43,8 +43,9 @@ impl FrameCommands {
 impl Player {
     /// The dispatches and draw calls this player recorded for its frame: the last
     /// [`Player::record`] (and a [`Player::simulate`] of the same frame), every draw since
-    /// and the heat haze applied ([`Player::apply_haze`]). Instances of one preset share them: a batch of instances records the same
-    /// commands as one instance (a host's profiler can show them as its "draw calls").
+    /// and the heat haze applied ([`Player::apply_haze`]). Instances of one preset share
+    /// them: a batch of instances records the same commands as one instance (a host's
+    /// profiler can show them as its "draw calls").
     pub fn recorded_commands(&self) -> CommandCounts {
         let mut counts = self.commands.recorded;
         counts.draws += self.commands.drawn.load(Ordering::Relaxed);

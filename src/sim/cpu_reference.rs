@@ -209,7 +209,7 @@ pub fn sample_shape(params: &SimParams, r: [f32; 4]) -> Vec3 {
 
 /// The trilinear form's coefficients from a cell's eight corner values `h(dx, dy, dz)`:
 /// `[k0, …, k7]` with value = k0 + k1·u + k2·v + k3·w + k4·uv + k5·vw + k6·wu + k7·uvw, in
-/// the operations and order `value_noise3_grad` and `curl_octave` (noise.wgsl) use.
+/// the operations and order `value_noise3` and `curl_octave` (noise.wgsl) use.
 fn trilinear<T>(h: impl Fn(i32, i32, i32) -> T) -> [T; 8]
 where
     T: Copy + std::ops::Add<Output = T> + std::ops::Sub<Output = T> + std::ops::Neg<Output = T>,
@@ -239,7 +239,7 @@ pub fn value_noise3(p: Vec3, seed: u32) -> f32 {
     let c = [cell.x as i32, cell.y as i32, cell.z as i32];
     let h = |dx: i32, dy: i32, dz: i32| rng::hash_cell([c[0] + dx, c[1] + dy, c[2] + dz], seed);
     let (ux, uy, uz) = (fade(f.x), fade(f.y), fade(f.z));
-    // The same polynomial form as `value_noise3_grad` in noise.wgsl, in f32.
+    // The same polynomial form as `value_noise3` in noise.wgsl, in f32.
     let [a, k1, k2, k3, k4, k5, k6, k7] = trilinear(h);
     a + k1 * ux + k2 * uy + k3 * uz + k4 * ux * uy + k5 * uy * uz + k6 * uz * ux + k7 * ux * uy * uz
 }
@@ -386,7 +386,20 @@ impl Forces<'_> {
 
 /// `value_noise3` in noise.wgsl, in f64.
 pub fn value_noise3_f64(p: DVec3, seed: u32) -> f64 {
-    value_noise3_grad(p, seed).1
+    let cell = p.floor();
+    let f = p - cell;
+    let c = [cell.x as i32, cell.y as i32, cell.z as i32];
+    let h =
+        |dx: i32, dy: i32, dz: i32| rng::hash_cell([c[0] + dx, c[1] + dy, c[2] + dz], seed) as f64;
+    let u = DVec3::new(fade64(f.x), fade64(f.y), fade64(f.z));
+    let [a, k1, k2, k3, k4, k5, k6, k7] = trilinear(h);
+    a + k1 * u.x
+        + k2 * u.y
+        + k3 * u.z
+        + k4 * u.x * u.y
+        + k5 * u.y * u.z
+        + k6 * u.z * u.x
+        + k7 * u.x * u.y * u.z
 }
 
 fn fade64(t: f64) -> f64 {
@@ -395,33 +408,6 @@ fn fade64(t: f64) -> f64 {
 
 fn fade64_deriv(t: f64) -> f64 {
     30.0 * t * t * (t * (t - 2.0) + 1.0)
-}
-
-/// `value_noise3_grad` in noise.wgsl: (∇n, n), in f64.
-pub fn value_noise3_grad(p: DVec3, seed: u32) -> (DVec3, f64) {
-    let cell = p.floor();
-    let f = p - cell;
-    let c = [cell.x as i32, cell.y as i32, cell.z as i32];
-    let h =
-        |dx: i32, dy: i32, dz: i32| rng::hash_cell([c[0] + dx, c[1] + dy, c[2] + dz], seed) as f64;
-    let u = DVec3::new(fade64(f.x), fade64(f.y), fade64(f.z));
-    let du = DVec3::new(fade64_deriv(f.x), fade64_deriv(f.y), fade64_deriv(f.z));
-    let [a, k1, k2, k3, k4, k5, k6, k7] = trilinear(h);
-    let n = a
-        + k1 * u.x
-        + k2 * u.y
-        + k3 * u.z
-        + k4 * u.x * u.y
-        + k5 * u.y * u.z
-        + k6 * u.z * u.x
-        + k7 * u.x * u.y * u.z;
-    let grad = du
-        * DVec3::new(
-            k1 + k4 * u.y + k6 * u.z + k7 * u.y * u.z,
-            k2 + k4 * u.x + k5 * u.z + k7 * u.x * u.z,
-            k3 + k5 * u.y + k6 * u.x + k7 * u.x * u.y,
-        );
-    (grad, n)
 }
 
 /// `curl_octave` in noise.wgsl, in f64: the curl of a vector potential whose three
