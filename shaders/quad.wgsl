@@ -114,11 +114,13 @@ fn quad_corner(qd: Quad, vi: u32) -> Corner {
     var corner = vec2<f32>(f32(vi & 1u), f32(vi >> 1u)) * 2.0 - 1.0;
     if !STREAK {
         // Cut the quad to the sprite's occupied rectangle (look.trim, frame texture
-        // coordinates), grown by 3 screen pixels: the mip the sampler picks blurs the
-        // edge by about two of its texels, which are about one pixel each.
+        // coordinates), grown by 6 screen pixels: trilinear filtering also reads the mip
+        // above the one the derivatives ask for, whose texels are up to two pixels each,
+        // and the mip chain's triangle filter has spread each level's edge by about
+        // one and a half of its texels (3 pixels left a lit puff's sphere edge cut).
         let w = dot(transpose(look.clip_from_sim)[3], vec4<f32>(d.pos, 1.0));
         let px = size * camera.viewport.z / max(w, 1e-4);
-        let m = 3.0 / max(px, 1e-3);
+        let m = 6.0 / max(px, 1e-3);
         let lo = max(look.trim.xy - m, vec2<f32>(0.0));
         let hi = min(look.trim.zw + m, vec2<f32>(1.0));
         let u = mix(lo.x, hi.x, corner.x * 0.5 + 0.5);

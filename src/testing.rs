@@ -105,7 +105,14 @@ pub mod render {
 
     /// The six-way maps ignis makes.
     pub mod sixway_maps {
-        pub use crate::render::sixway_maps::{EXTINCTION, PUFF_SEED, puff, puff_density};
+        pub use crate::render::sixway_maps::{
+            EXTINCTION, PUFF_SEED, combined, puff, puff_density, puff_sheet,
+        };
+    }
+
+    /// The billboards' cut to their sprite's visible part.
+    pub mod sprite_trim {
+        pub use crate::render::sprite_trim::{Trim, trim};
     }
 
     /// The GPU sort.
@@ -115,7 +122,7 @@ pub mod render {
 
     /// Sprite images.
     pub mod sprites {
-        pub use crate::render::sprites::{SpriteLibrary, TRIM_THRESHOLD};
+        pub use crate::render::sprites::{SpriteLibrary, TRIM_THRESHOLD, coverage, generate};
     }
 
     /// The composite's tonemap.

@@ -18,6 +18,7 @@ pub mod scene_lighting;
 pub mod sixway_maps;
 pub mod sort;
 pub mod splat;
+pub mod sprite_trim;
 pub mod sprites;
 pub mod test_scene;
 pub mod tiles;

@@ -14,6 +14,7 @@ use image::{Rgba, Rgba32FImage};
 use crate::effect::{SixWayMaps, Sprite};
 use crate::gpu::GpuContext;
 use crate::render::sixway_maps;
+use crate::render::sprite_trim::{self, Trim};
 
 /// Side of a built-in sprite (one frame), pixels.
 pub const BUILT_IN_SIZE: u32 = 128;
@@ -35,7 +36,7 @@ pub struct SpriteTexture {
     /// splat's energy per unit of colour.
     pub integral: f32,
     /// The largest premultiplied channel of mip 0 over cells of `cell` × `cell` texels
-    /// (row-major, at most 256 cells a side): what [`SpriteTexture::trim_rect`] fits the
+    /// (row-major, at most 256 cells a side): what [`SpriteTexture::trim`] fits the
     /// drawn quads to.
     coverage: Vec<f32>,
     /// Texels per coverage cell side (a power of two).
@@ -140,49 +141,31 @@ impl SpriteGroups {
 
 impl SpriteTexture {
     /// The part of every frame that holds something above `threshold`, as a `rows ×
-    /// cols` flipbook (1 × 1 without one): `[u0, v0, u1, v1]` in frame-local texture
-    /// coordinates (v down), the union over all frames, grown by one texel for bilinear
-    /// filtering (and rounded out to the coverage cells). Billboards are cut to it (plus a
+    /// cols` flipbook (1 × 1 without one): the union over all frames, grown by one texel
+    /// for bilinear filtering ([`sprite_trim::trim`]). Billboards are cut to it (plus a
     /// mip margin, in the shader): a flame-tongue sheet covers half its square, so half of
-    /// its fill was spent on nothing. The whole frame when the sprite is empty.
-    pub fn trim_rect(&self, rows: u32, cols: u32, threshold: f32) -> [f32; 4] {
-        let (w, h) = self.size;
-        let (rows, cols) = (rows.max(1) as f32, cols.max(1) as f32);
-        let (sx, sy) = (cols / w as f32, rows / h as f32);
-        let cells_x = w.div_ceil(self.cell);
-        let mut rect = [f32::MAX, f32::MAX, f32::MIN, f32::MIN];
-        for (i, _) in self
-            .coverage
-            .iter()
-            .enumerate()
-            .filter(|(_, c)| **c > threshold)
-        {
-            let (gx, gy) = (i as u32 % cells_x, i as u32 / cells_x);
-            // The cell's texels, frame-local (frame of the cell's centre).
-            let (x0, y0) = ((gx * self.cell) as f32, (gy * self.cell) as f32);
-            let (x1, y1) = (
-                ((gx + 1) * self.cell).min(w) as f32,
-                ((gy + 1) * self.cell).min(h) as f32,
-            );
-            let (cx, cy) = (
-                ((x0 + x1) * 0.5 * sx).floor(),
-                ((y0 + y1) * 0.5 * sy).floor(),
-            );
-            rect[0] = rect[0].min((x0 * sx - cx).max(0.0));
-            rect[1] = rect[1].min((y0 * sy - cy).max(0.0));
-            rect[2] = rect[2].max((x1 * sx - cx).min(1.0));
-            rect[3] = rect[3].max((y1 * sy - cy).min(1.0));
-        }
-        if rect[0] > rect[2] {
-            return [0.0, 0.0, 1.0, 1.0];
-        }
-        [
-            (rect[0] - sx).max(0.0),
-            (rect[1] - sy).max(0.0),
-            (rect[2] + sx).min(1.0),
-            (rect[3] + sy).min(1.0),
-        ]
+    /// its fill was spent on nothing.
+    pub fn trim(&self, rows: u32, cols: u32, threshold: f32) -> Trim {
+        sprite_trim::trim(&self.coverage, self.cell, self.size, rows, cols, threshold)
     }
+}
+
+/// The largest premultiplied channel of `img` over cells of `cell` × `cell` texels
+/// (row-major), with `cell` the power of two that makes at most 256 cells a side (so
+/// that cells do not straddle the frames of power-of-two flipbooks).
+pub fn coverage(img: &Rgba32FImage) -> (Vec<f32>, u32) {
+    let (w, h) = img.dimensions();
+    let cell = (w.max(h) / 256).max(1).next_power_of_two();
+    let cells_x = w.div_ceil(cell);
+    let mut coverage = vec![0.0f32; (cells_x * h.div_ceil(cell)) as usize];
+    for (x, y, p) in img.enumerate_pixels() {
+        let i = ((y / cell) * cells_x + x / cell) as usize;
+        let m = p.0.iter().fold(0.0f32, |a, &c| a.max(c));
+        if let Some(c) = coverage.get_mut(i) {
+            *c = c.max(m);
+        }
+    }
+    (coverage, cell)
 }
 
 /// A sprite that could not be loaded.
@@ -507,18 +490,7 @@ pub fn brightness_integral(img: &Rgba32FImage) -> f32 {
 fn upload(ctx: &GpuContext, img: &Rgba32FImage, id: u64, label: &str) -> SpriteTexture {
     let levels = mip_chain(img);
     let (w, h) = img.dimensions();
-    // Max-pooled coverage, at most 256 cells a side (power-of-two cells, so they do not
-    // straddle the frames of power-of-two flipbooks).
-    let cell = (w.max(h) / 256).max(1).next_power_of_two();
-    let cells_x = w.div_ceil(cell);
-    let mut coverage = vec![0.0f32; (cells_x * h.div_ceil(cell)) as usize];
-    for (x, y, p) in img.enumerate_pixels() {
-        let i = ((y / cell) * cells_x + x / cell) as usize;
-        let m = p.0.iter().fold(0.0f32, |a, &c| a.max(c));
-        if let Some(c) = coverage.get_mut(i) {
-            *c = c.max(m);
-        }
-    }
+    let (coverage, cell) = coverage(img);
     let texture = crate::gpu::texture_2d(
         &ctx.device,
         &format!("sprite {label}"),

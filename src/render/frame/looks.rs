@@ -10,6 +10,11 @@ use crate::render::sprites::SpriteTexture;
 use crate::sim::Modules;
 
 use super::{FrameResources, GroupView};
+
+/// A lit layer's quads keep texels down to the trim threshold over this gain: its light
+/// (sun, flames, host lights) has no bound known when the look is built. The built-in
+/// puff ends at its sphere, so the cut does not depend on it.
+const LIT_TRIM_GAIN: f32 = 256.0;
 use crate::render::draw_item::Scene;
 
 /// Emitter `i` across a group's instances (`FrameResources::group_looks`).
@@ -120,21 +125,26 @@ impl FrameResources {
     ) -> LookUniform {
         let e = &effect.emitters[i];
         let mut u = look_uniform(&e.look, ROWS_PER_EMITTER * i as u32, 0, sprite.integral);
-        // Six-way maps hold two images side by side: their quads are not trimmed.
+        // Six-way maps hold two images side by side (RTBA | LBFE): every frame of either
+        // counts, as frames of a sheet twice as wide.
         let lit = e.look.lit.is_some() && e.look.blend == BlendMode::Alpha;
-        if self.trim_sprites && e.look.streak.is_none() && !lit {
+        if self.trim_sprites && e.look.streak.is_none() {
             let (rows, cols) = e
                 .look
                 .flipbook
                 .as_ref()
                 .map_or((1, 1), |f| (f.rows, f.cols));
-            // What is invisible at intensity 1 shows when the light is multiplied.
+            let cols = if lit { 2 * cols } else { cols };
+            // What is invisible at intensity 1 shows when the light is multiplied; a lit
+            // layer's light has no bound known here, so it keeps what is nearly black.
             let gain = (e.look.intensity * effect.post.exposure).max(1.0);
+            let gain = if lit { gain * LIT_TRIM_GAIN } else { gain };
             let threshold = crate::render::sprites::TRIM_THRESHOLD / gain;
-            u.trim = *self
+            u.trim = self
                 .trims
                 .entry((sprite.id, rows, cols, threshold.to_bits()))
-                .or_insert_with(|| sprite.trim_rect(rows, cols, threshold));
+                .or_insert_with(|| sprite.trim(rows, cols, threshold).rect)
+                .to_owned();
         }
         u
     }
