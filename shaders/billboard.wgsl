@@ -66,13 +66,19 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u3
     }
     // Quad q (one instance each), corner `vi` (two triangles: 0 1 2, 2 1 3) of four
     // shared vertices over the corners (-1,-1) (1,-1) (-1,1) (1,1): a third fewer vertex
-    // invocations than two separate triangles.
-    let qd = load_quad((vertex >> 2u) + inst);
+    // invocations than two separate triangles. OCTAGON: eight vertices, six triangles.
+    let qd = load_quad(inst);
     if !qd.d.alive {
         out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
         return out;
     }
-    return quad_vertex(qd, vertex & 3u);
+    return quad_vertex(qd, corner_index(vertex));
+}
+
+// The corner a vertex of the index buffer is (src/render/billboard.rs: the quad's six
+// indices over 0..3, the octagon's eighteen over 0..7).
+fn corner_index(vertex: u32) -> u32 {
+    return select(vertex & 3u, vertex & 7u, OCTAGON);
 }
 
 // Corner `vi` of the living quad `qd`.
@@ -244,12 +250,12 @@ struct VsLit {
 @vertex
 fn vs_lit(@builtin(vertex_index) vertex: u32, @builtin(instance_index) inst: u32) -> VsLit {
     var out: VsLit;
-    let qd = load_quad((vertex >> 2u) + inst);
+    let qd = load_quad(inst);
     if !qd.d.alive {
         out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
         return out;
     }
-    let v = quad_vertex(qd, vertex & 3u);
+    let v = quad_vertex(qd, corner_index(vertex));
     let l = quad_sixway(qd);
     return VsLit(v.clip, v.uv0, v.uv1, vec4<f32>(v.color.rgb * lit.ambient.w, v.color.a), v.blend_height, l[0], l[1], l[2], l[3], l[4]);
 }

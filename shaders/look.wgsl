@@ -69,7 +69,9 @@ struct LookUniform {
     // z: the oldest entry's first spawn counter, w: the counters from it to the newest.
     tiny_b: vec4<u32>,
     // Tiny state: x: the counters from the oldest entry's first to the last step's first
-    // spawn (a slot's previous state holds its particle only below it), yzw: unused.
+    // spawn (a slot's previous state holds its particle only below it); y: the trail's
+    // last step; z: the colour parent's ramp row + 1 (0: none); w: the octagon's corner
+    // cuts (pack4x8unorm; sprite_trim.wgsl, billboards).
     tiny_c: vec4<u32>,
 }
 

@@ -6,6 +6,7 @@
 // array<u32>` (the sort's back-to-front buffer indices), and the look modules below.
 #import "look.wgsl"
 #import "lit.wgsl"
+#import "sprite_trim.wgsl"
 
 // Pipeline variants: each look module is compiled in only when an emitter uses it.
 override SORTED: bool = false;
@@ -17,6 +18,9 @@ override SOFT: bool = false;
 override SOFT_DEPTH: bool = false;
 // Lit smoke (lit.wgsl): six-way maps shaded by the instance's `LitUniform`.
 override LIT: bool = false;
+// Billboards cut to an octagon (sprite_trim.wgsl): `quad_corner`'s corner index runs over
+// its eight corners instead of the rectangle's four. Never set for the compute paths.
+override OCTAGON: bool = false;
 
 // Which instance of the draw and which slot of its pool quad `q` is, or none.
 // Unsorted, quad q is slot q mod W of instance q / W's live window (W: the widest window
@@ -106,7 +110,8 @@ struct Corner {
     world: vec3<f32>,
 }
 
-// Corner `vi` (0 (-1,-1), 1 (1,-1), 2 (-1,1), 3 (1,1)) of quad `qd`.
+// Corner `vi` (0 (-1,-1), 1 (1,-1), 2 (-1,1), 3 (1,1)) of quad `qd`; OCTAGON: corner
+// `vi` (0..7) of its octagon.
 fn quad_corner(qd: Quad, vi: u32) -> Corner {
     var out: Corner;
     let d = qd.d;
@@ -123,9 +128,11 @@ fn quad_corner(qd: Quad, vi: u32) -> Corner {
         let m = 6.0 / max(px, 1e-3);
         let lo = max(look.trim.xy - m, vec2<f32>(0.0));
         let hi = min(look.trim.zw + m, vec2<f32>(1.0));
-        let u = mix(lo.x, hi.x, corner.x * 0.5 + 0.5);
-        let v = mix(lo.y, hi.y, 0.5 - corner.y * 0.5);
-        corner = vec2<f32>(2.0 * u - 1.0, 1.0 - 2.0 * v);
+        var uv = vec2<f32>(mix(lo.x, hi.x, corner.x * 0.5 + 0.5), mix(lo.y, hi.y, 0.5 - corner.y * 0.5));
+        if OCTAGON {
+            uv = octagon_corner(lo, hi, look.trim, look.tiny_c.w, m, vi);
+        }
+        corner = vec2<f32>(2.0 * uv.x - 1.0, 1.0 - 2.0 * uv.y);
     }
     out.uv = corner;
     if STREAK {

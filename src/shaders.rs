@@ -67,6 +67,10 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ("count.wgsl", include_str!("../shaders/count.wgsl")),
     ("look.wgsl", include_str!("../shaders/look.wgsl")),
     ("lit.wgsl", include_str!("../shaders/lit.wgsl")),
+    (
+        "sprite_trim.wgsl",
+        include_str!("../shaders/sprite_trim.wgsl"),
+    ),
     ("quad.wgsl", include_str!("../shaders/quad.wgsl")),
     ("billboard.wgsl", include_str!("../shaders/billboard.wgsl")),
     ("tiles.wgsl", include_str!("../shaders/tiles.wgsl")),

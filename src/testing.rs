@@ -112,7 +112,7 @@ pub mod render {
 
     /// The billboards' cut to their sprite's visible part.
     pub mod sprite_trim {
-        pub use crate::render::sprite_trim::{Trim, trim};
+        pub use crate::render::sprite_trim::{OCTAGON_SHARE, Trim, trim};
     }
 
     /// The GPU sort.

@@ -314,7 +314,9 @@ pub struct LookUniform {
     /// oldest entry's first spawn counter, the counters from it to the newest spawn.
     pub tiny_b: [u32; 4],
     /// Tiny state: the counters from the oldest entry's first to the last step's first
-    /// spawn (a slot's previous state is its particle's only below it); unused × 3.
+    /// spawn (a slot's previous state is its particle's only below it); the trail's last
+    /// step; the colour parent's ramp row + 1 (0: none); the octagon's corner cuts
+    /// (`Trim::packed_cuts`, billboards).
     pub tiny_c: [u32; 4],
 }
 

@@ -1,7 +1,7 @@
 //! The billboard pass: camera-facing quads, four vertices each, pulled from the state
 //! buffer the update pass just wrote: one instance per quad over a six-index buffer
-//! (two triangles on four shared vertices; the shader reads quad = vertex / 4 +
-//! instance).
+//! (two triangles on four shared vertices; the shader reads quad = instance), or cut to
+//! an octagon where the sprite leaves its corners empty (eighteen indices over eight).
 
 use crate::gpu::commands::CountedRender;
 use std::collections::HashMap;
@@ -121,7 +121,7 @@ impl BillboardPass {
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("BillboardPass::quad_indices"),
-                contents: bytemuck::cast_slice(&[0u32, 1, 2, 2, 1, 3]),
+                contents: bytemuck::cast_slice(&QUAD_AND_OCTAGON),
                 usage: wgpu::BufferUsages::INDEX,
             });
         Ok(Self {
@@ -400,11 +400,19 @@ impl BillboardPass {
                 // One quad per slot of each instance's live window (`width` per
                 // instance), or sorted, through the sort's order; a ribbon has
                 // `segments` quads per particle.
-                pass.counted_draw_indexed(0..6, 0..d.width * d.members * segments);
+                let indices = if v.octagon { 6..24 } else { 0..6 };
+                pass.counted_draw_indexed(indices, 0..d.width * d.members * segments);
             }
         }
     }
 }
+
+/// The index buffer: a quad's two triangles over its four corners, then an octagon's six
+/// over its eight (corners in order around it; `shaders/sprite_trim.wgsl`).
+const QUAD_AND_OCTAGON: [u32; 24] = [
+    0, 1, 2, 2, 1, 3, //
+    0, 1, 7, 1, 2, 7, 7, 2, 6, 2, 3, 6, 6, 3, 5, 3, 4, 5,
+];
 
 /// The distortion target's format: screen offsets (rg, uv units) and weights (a), summed.
 pub const HAZE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;

@@ -69,11 +69,14 @@ pub struct FrameResources {
     /// Cut billboards to the occupied part of their sprite (on by default; off draws the
     /// whole square, for comparisons).
     pub trim_sprites: bool,
+    /// Cut billboards to an octagon where their sprite leaves the rectangle's corners
+    /// empty (on by default; off draws rectangles, for comparisons).
+    pub octagons: bool,
     /// Draw and sort only each emitter's live window of the ring (on by default; off
     /// visits every slot, for comparisons).
     pub live_window_only: bool,
-    /// Trim rectangles by (sprite id, flipbook rows, columns, threshold bits).
-    trims: HashMap<(u64, u32, u32, u32), [f32; 4]>,
+    /// Sprite trims by (sprite id, flipbook rows, columns, threshold bits).
+    trims: HashMap<(u64, u32, u32, u32), crate::render::sprite_trim::Trim>,
     /// Let small additive particles take the compute splat (off in the runtime player,
     /// which draws everything inside the host's pass).
     pub allow_splat: bool,
@@ -139,6 +142,7 @@ impl FrameResources {
                 mapped_at_creation: false,
             }),
             trim_sprites: true,
+            octagons: true,
             live_window_only: true,
             trims: HashMap::new(),
             allow_splat: true,
@@ -467,7 +471,7 @@ impl FrameResources {
             // Emitter i of every instance shares ramp row i: the first group's look bakes it.
             self.upload_ramp(ctx, i, &e.look);
         }
-        let base = self.base_look(first.effect, i, &sprite);
+        let (base, trim) = self.base_look(first.effect, i, &sprite);
         let GroupLooks {
             looks,
             members,
@@ -526,6 +530,12 @@ impl FrameResources {
             },
         );
         variant.soft_depth = self.soft_depth;
+        // Billboards alone (the compute paths cut by the rectangle): the octagon where
+        // it spares enough of the rectangle's fill to pay for twice the vertices.
+        variant.octagon = self.octagons
+            && !splat
+            && !tiles
+            && trim.is_some_and(|t| t.octagon_share() <= crate::render::sprite_trim::OCTAGON_SHARE);
         Some(DrawItem {
             index: i,
             look_slot: 0,

@@ -9,6 +9,11 @@
 //! bilinear filtering, lies inside; the shader grows them further by the mip margin
 //! (`shaders/quad.wgsl`, `quad_corner`).
 
+/// Billboards take the octagon where it draws at most this share of the rectangle's
+/// fill: a round puff's (0.84) pays for its eight vertices, the flame sheet's tongues
+/// (0.92, their tips sway across the frames) do not.
+pub const OCTAGON_SHARE: f32 = 0.9;
+
 /// A sprite's visible part within one flipbook frame, in frame-local texture coordinates
 /// (u right, v down, 0..1): the union over every frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -26,44 +31,69 @@ impl Trim {
         diag: [0.0, 2.0, -1.0, 1.0],
     };
 
+    /// The corners' cuts before any margin, as the shader reads them: the legs of the cut
+    /// triangles at (u0, v0), (u1, v0), (u1, v1), (u0, v1), in frame units, rounded down
+    /// to 8 bits (cutting less stays conservative).
+    pub fn cuts(&self) -> [f32; 4] {
+        let [u0, v0, u1, v1] = self.rect;
+        [
+            self.diag[0] - (u0 + v0),
+            (u1 - v0) - self.diag[3],
+            (u1 + v1) - self.diag[1],
+            self.diag[2] - (u0 - v1),
+        ]
+        .map(|t| (t.clamp(0.0, 1.0) * 255.0).floor() / 255.0)
+    }
+
+    /// [`Trim::cuts`] packed as WGSL's `pack4x8unorm` packs them (the first in the lowest
+    /// byte).
+    pub fn packed_cuts(&self) -> u32 {
+        self.cuts()
+            .iter()
+            .enumerate()
+            .map(|(i, t)| ((t * 255.0).round() as u32) << (8 * i))
+            .sum()
+    }
+
     /// The octagon's eight corners in order around it (some may coincide), with its
     /// bounds grown by `margin` in u and v (the mip margin) and cut to the frame: the
-    /// same construction as the shader's.
+    /// shader's construction (`shaders/sprite_trim.wgsl`, `octagon_corner`).
     pub fn octagon(&self, margin: f32) -> [[f32; 2]; 8] {
-        let [lo_u, lo_v, hi_u, hi_v] = [
+        let lo = [
             (self.rect[0] - margin).max(0.0),
             (self.rect[1] - margin).max(0.0),
+        ];
+        let hi = [
             (self.rect[2] + margin).min(1.0),
             (self.rect[3] + margin).min(1.0),
         ];
-        let m2 = 2.0 * margin;
-        // Each corner's cut, as the length of its legs along the two edges it meets.
+        // Where the frame clipped the margin, the corner moved less and its cut shrinks.
+        let glo = [self.rect[0] - margin - lo[0], self.rect[1] - margin - lo[1]];
+        let ghi = [hi[0] - self.rect[2] - margin, hi[1] - self.rect[3] - margin];
+        let c = self.cuts();
         let mut t = [
-            self.diag[0] - m2 - (lo_u + lo_v),   // (lo, lo): u + v ≥ min
-            (hi_u - lo_v) - (self.diag[3] + m2), // (hi, lo): u − v ≤ max
-            (hi_u + hi_v) - (self.diag[1] + m2), // (hi, hi): u + v ≤ max
-            self.diag[2] - m2 - (lo_u - hi_v),   // (lo, hi): u − v ≥ min
+            c[0] + glo[0] + glo[1],
+            c[1] + ghi[0] + glo[1],
+            c[2] + ghi[0] + ghi[1],
+            c[3] + glo[0] + ghi[1],
         ]
         .map(|x| x.max(0.0));
-        let (w, h) = (hi_u - lo_u, hi_v - lo_v);
+        let (w, h) = (hi[0] - lo[0], hi[1] - lo[1]);
         // Two cuts along one edge never overlap (cutting less stays conservative).
         for (a, b, len) in [(0, 1, w), (1, 2, h), (3, 2, w), (0, 3, h)] {
-            let sum = t[a] + t[b];
-            if sum > len {
-                let k = len / sum;
-                t[a] *= k;
-                t[b] *= k;
-            }
+            let k = (len / (t[a] + t[b]).max(1e-12)).min(1.0);
+            t[a] *= k;
+            t[b] *= k;
         }
         [
-            [lo_u + t[0], lo_v],
-            [hi_u - t[1], lo_v],
-            [hi_u, lo_v + t[1]],
-            [hi_u, hi_v - t[2]],
-            [hi_u - t[2], hi_v],
-            [lo_u + t[3], hi_v],
-            [lo_u, hi_v - t[3]],
-            [lo_u, lo_v + t[0]],
+            [lo[0] + t[0], lo[1]],
+            [hi[0] - t[1], lo[1]],
+            [hi[0], lo[1] + t[1]],
+            [hi[0], hi[1] - t[2]],
+            [hi[0] - t[2], hi[1]],
+            [lo[0] + t[3], hi[1]],
+            [lo[0], hi[1] - t[3]],
+            [lo[0], lo[1] + t[0]],
         ]
     }
 

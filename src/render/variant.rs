@@ -52,6 +52,9 @@ pub struct LookVariant {
     pub lit: bool,
     /// Heat haze: drawn only into the distortion target, as summed screen offsets.
     pub haze: bool,
+    /// Billboards cut to an octagon (eight vertices) instead of a rectangle: for sprites
+    /// that leave their rectangle's corners empty (`sprite_trim.rs`).
+    pub octagon: bool,
 }
 
 impl LookVariant {
@@ -69,6 +72,7 @@ impl LookVariant {
             state,
             lit: look.lit.is_some() && look.blend == BlendMode::Alpha,
             haze: look.heat_haze.is_some(),
+            octagon: false,
         }
     }
 
@@ -81,6 +85,7 @@ impl LookVariant {
             flip_blend: false,
             streak: false,
             lit: false,
+            octagon: false,
             ..self
         }
     }
@@ -107,11 +112,12 @@ impl LookVariant {
             state: StateVariant::default(),
             lit: false,
             haze: false,
+            octagon: false,
         }
     }
 
     /// The override constants of this variant's billboard pipeline.
-    pub fn constants(self) -> [(&'static str, f64); 12] {
+    pub fn constants(self) -> [(&'static str, f64); 13] {
         let b = |v: bool| if v { 1.0 } else { 0.0 };
         let [layout, stateless] = self.state.constants();
         [
@@ -125,6 +131,7 @@ impl LookVariant {
             ("TRAIL", b(self.trail)),
             ("LIT", b(self.lit)),
             ("HAZE", b(self.haze)),
+            ("OCTAGON", b(self.octagon)),
             layout,
             stateless,
         ]
@@ -141,7 +148,7 @@ pub(crate) fn compute_constants(
     let mut constants: Vec<(&str, f64)> = v
         .constants()
         .into_iter()
-        .filter(|(name, _)| !["MOTION", "TRAIL", "HAZE"].contains(name))
+        .filter(|(name, _)| !["MOTION", "TRAIL", "HAZE", "OCTAGON"].contains(name))
         .collect();
     constants.push(("DEPTH_TEST", crate::render::depth_test(target)));
     constants

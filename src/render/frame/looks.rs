@@ -6,6 +6,7 @@ use crate::gpu::types::{LookUniform, PARAMS_STRIDE};
 use crate::render::look_bake::ROWS_PER_EMITTER;
 use crate::render::scene_lighting::{LitUniform, SceneLighting, write_lit};
 use crate::render::sort::SortMember;
+use crate::render::sprite_trim::Trim;
 use crate::render::sprites::SpriteTexture;
 use crate::sim::Modules;
 
@@ -116,37 +117,40 @@ pub fn look_uniform(look: &Look, ramp_row: u32, salt: u32, sprite_integral: f32)
 
 impl FrameResources {
     /// Emitter `i`'s look of every instance (its salt, place and ring are set per
-    /// instance by `member_look`): the look's settings and the sprite's trim.
+    /// instance by `member_look`): the look's settings and the sprite's trim (also
+    /// returned; none for a streak, or with trimming off).
     pub(super) fn base_look(
         &mut self,
         effect: &Effect,
         i: usize,
         sprite: &SpriteTexture,
-    ) -> LookUniform {
+    ) -> (LookUniform, Option<Trim>) {
         let e = &effect.emitters[i];
         let mut u = look_uniform(&e.look, ROWS_PER_EMITTER * i as u32, 0, sprite.integral);
+        if !self.trim_sprites || e.look.streak.is_some() {
+            return (u, None);
+        }
         // Six-way maps hold two images side by side (RTBA | LBFE): every frame of either
         // counts, as frames of a sheet twice as wide.
         let lit = e.look.lit.is_some() && e.look.blend == BlendMode::Alpha;
-        if self.trim_sprites && e.look.streak.is_none() {
-            let (rows, cols) = e
-                .look
-                .flipbook
-                .as_ref()
-                .map_or((1, 1), |f| (f.rows, f.cols));
-            let cols = if lit { 2 * cols } else { cols };
-            // What is invisible at intensity 1 shows when the light is multiplied; a lit
-            // layer's light has no bound known here, so it keeps what is nearly black.
-            let gain = (e.look.intensity * effect.post.exposure).max(1.0);
-            let gain = if lit { gain * LIT_TRIM_GAIN } else { gain };
-            let threshold = crate::render::sprites::TRIM_THRESHOLD / gain;
-            u.trim = self
-                .trims
-                .entry((sprite.id, rows, cols, threshold.to_bits()))
-                .or_insert_with(|| sprite.trim(rows, cols, threshold).rect)
-                .to_owned();
-        }
-        u
+        let (rows, cols) = e
+            .look
+            .flipbook
+            .as_ref()
+            .map_or((1, 1), |f| (f.rows, f.cols));
+        let cols = if lit { 2 * cols } else { cols };
+        // What is invisible at intensity 1 shows when the light is multiplied; a lit
+        // layer's light has no bound known here, so it keeps what is nearly black.
+        let gain = (e.look.intensity * effect.post.exposure).max(1.0);
+        let gain = if lit { gain * LIT_TRIM_GAIN } else { gain };
+        let threshold = crate::render::sprites::TRIM_THRESHOLD / gain;
+        let trim = *self
+            .trims
+            .entry((sprite.id, rows, cols, threshold.to_bits()))
+            .or_insert_with(|| sprite.trim(rows, cols, threshold));
+        u.trim = trim.rect;
+        u.tiny_c[3] = trim.packed_cuts();
+        (u, Some(trim))
     }
 
     /// Writes lit emitter `i`'s `LitUniform` of every instance of the group into `block`
@@ -231,7 +235,10 @@ impl FrameResources {
         ];
         // w: the live window's length (it ends at the ring's head, ring.x).
         u.ring_b = [b.seed_salt.0, b.seed_salt.1, b.capacity, b.window.len];
+        // The octagon's cuts (tiny_c.w) are the sprite's, set in the base look.
+        let cuts = u.tiny_c[3];
         [u.tiny, u.tiny_b, u.tiny_c] = b.tiny;
+        u.tiny_c[3] = cuts;
         // The trail's newest entries are from before the last step (trail.wgsl).
         u.tiny_c[1] = b.last_step;
         // An emitter that inherits its parent's colour: the parent's ramp row + 1.
