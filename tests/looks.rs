@@ -27,7 +27,7 @@ use ignis::testing::render::look_bake::{
     RAMP_WIDTH, bake_look_curves, bake_ramp, flipbook_frame, sample_gradient,
 };
 use ignis::testing::render::sprites::SpriteLibrary;
-use ignis::testing::shaders::{EMBEDDED, ShaderLibrary};
+use ignis::testing::shaders::ShaderLibrary;
 use wgpu::util::DeviceExt;
 
 const PROBE: &str = r#"
@@ -88,26 +88,8 @@ fn probe_all(
     look: &Look,
     inputs: &[[f32; 4]],
 ) -> Vec<([f32; 3], [f32; 4], [f32; 4])> {
-    let dir = tempfile::tempdir().expect("tempdir");
-    for (name, text) in EMBEDDED {
-        std::fs::write(dir.path().join(name), text).expect("write shader");
-    }
-    std::fs::write(dir.path().join("probe.wgsl"), PROBE).expect("write probe");
-    let lib = ShaderLibrary::from_dir(dir.path());
-    let composed = lib.compose("probe.wgsl").expect("probe composes");
+    let pipeline = probe_pipeline(ctx, PROBE);
     let d = &ctx.device;
-    let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("probe"),
-        source: wgpu::ShaderSource::Wgsl(composed.source.as_str().into()),
-    });
-    let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("probe"),
-        layout: None,
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
     let uniform = look_uniform(look, 0, 1234, 1.0);
     let camera = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: None,

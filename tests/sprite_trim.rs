@@ -12,7 +12,7 @@ use ignis::testing::headless::Headless;
 use ignis::testing::render::sixway_maps::{PUFF_SEED, combined, puff, puff_sheet};
 use ignis::testing::render::sprite_trim::{OCTAGON_SHARE, Trim, trim};
 use ignis::testing::render::sprites::{TRIM_THRESHOLD, coverage, generate};
-use ignis::testing::shaders::{EMBEDDED, ShaderLibrary};
+use ignis::testing::shaders::ShaderLibrary;
 use ignis::testing::sim::gpu_sim::map_read;
 use wgpu::util::DeviceExt;
 
@@ -147,27 +147,8 @@ fn the_shader_builds_the_cpus_octagon() {
 }
 
 fn run_probe(ctx: &GpuContext, cases: &[[f32; 4]], corners: usize) -> Vec<[f32; 2]> {
-    let dir = tempfile::tempdir().expect("tempdir");
-    for (name, text) in EMBEDDED {
-        std::fs::write(dir.path().join(name), text).expect("write shader");
-    }
-    std::fs::write(dir.path().join("probe.wgsl"), PROBE).expect("write probe");
-    let composed = ShaderLibrary::from_dir(dir.path())
-        .compose("probe.wgsl")
-        .expect("probe composes");
+    let pipeline = probe_pipeline(ctx, PROBE);
     let d = &ctx.device;
-    let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("octagon probe"),
-        source: wgpu::ShaderSource::Wgsl(composed.source.as_str().into()),
-    });
-    let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("octagon probe"),
-        layout: None,
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
     let input = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: None,
         contents: bytemuck::cast_slice(cases),

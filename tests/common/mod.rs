@@ -272,3 +272,32 @@ pub fn resolves_agree(what: &str, drawn: &image::RgbaImage, computed: &image::Rg
         "{what}: the compute resolve differs by {mean:.4}/255 mean, {max}/255 max"
     );
 }
+
+/// A compute pipeline of `probe` (WGSL whose entry point is `main`; it may `#import` any
+/// embedded shader), composed as the shader library composes the shipped shaders, with
+/// its bind group layouts taken from the shader.
+pub fn probe_pipeline(ctx: &GpuContext, probe: &str) -> wgpu::ComputePipeline {
+    let dir = tempfile::tempdir().expect("tempdir");
+    for (name, text) in ignis::testing::shaders::EMBEDDED {
+        std::fs::write(dir.path().join(name), text).expect("write shader");
+    }
+    std::fs::write(dir.path().join("probe.wgsl"), probe).expect("write probe");
+    let composed = ShaderLibrary::from_dir(dir.path())
+        .compose("probe.wgsl")
+        .expect("probe composes");
+    let module = ctx
+        .device
+        .create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("probe"),
+            source: wgpu::ShaderSource::Wgsl(composed.source.as_str().into()),
+        });
+    ctx.device
+        .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("probe"),
+            layout: None,
+            module: &module,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+}
