@@ -6,12 +6,14 @@
 // Contract: as quad.wgsl, plus the importer's `sprite_tex` and `sprite_sampler` (the
 // emitter's sprite), `scene_depth` (the host's depth) and `visible(p, z)` (its depth test).
 #import "quad.wgsl"
+#import "raster_edges.wgsl"
 
 // A projected quad. Its coordinates in the sprite's frame at a pixel p (pixel units, the
 // origin at the target's top-left corner): h = (map.xy·p.x + map.zw·p.y + offset.xy,
 // map_z·(p, 1)), uv = h.xy / h.z (a projective map: the perspective-correct interpolation
 // of the billboard's corners). A camera-facing quad's map is affine (offset.z = 1): uv =
-// h.xy; the fields after `ground` are then never written or read. The shade reads the
+// h.xy; the fields after `ground` then hold the snapped corners (map_z: p0, p1; z_row:
+// p2, p3; pixels × 256), read only near a turned sprite's edges. The shade reads the
 // first eight fields of every sprite it meets: they fill four whole 32-byte sectors.
 // The corners are placed on the rasteriser's sub-pixel grid. An upright rectangle there
 // (an unrotated camera-facing sprite) covers exactly the rasteriser's pixels: the centres
@@ -143,6 +145,10 @@ fn project_quad(qd: Quad) -> TileSprite {
         let inv = mat2x2<f32>(vec2<f32>(j[1].y, -j[0].y), vec2<f32>(-j[1].x, j[0].x)) * (1.0 / det);
         s.map = vec4<f32>(inv[0], inv[1]);
         s.offset = vec4<f32>(c0.uv - inv * p0, s.offset.zw);
+        // The snapped corners (pixels × 256, integers), for `quad_covers` near the edges
+        // of a turned sprite (an affine map leaves these fields unused).
+        s.map_z = vec4<f32>(p0, p1) * 256.0;
+        s.z_row = vec4<f32>(p2, p3) * 256.0;
         if p0.x == p2.x && p1.x == p3.x && p0.y == p1.y && p2.y == p3.y {
             // An upright rectangle on the grid (an unrotated camera-facing sprite): the
             // rasteriser's pixels are exactly the centres in [x0, x1) × [y0, y1) (the
@@ -195,14 +201,34 @@ fn projective_point(map: vec4<f32>, offset: vec4<f32>, map_z: vec4<f32>, z_row: 
     return SpritePoint(uv, ddx, ddy, dot(z_row.xyz, uv1) / dot(w_row.xyz, uv1));
 }
 
-// Whether the point misses the sprite: outside its box — pixels, half-open, for an
-// upright rectangle (`offset.z` = 2), else frame coordinates — or outside the depth range
-// (clipped as the rasteriser clips the billboard), or behind the host's geometry.
+// Whether the point misses the sprite: outside its box (`box_outside`), or outside the
+// depth range (clipped as the rasteriser clips the billboard), or behind the host's
+// geometry.
 fn sprite_misses(sp: SpritePoint, pc: vec2<f32>, p: vec2<i32>, offset: vec4<f32>, uv_box: vec4<f32>) -> bool {
+    return box_outside(sp, pc, offset, uv_box) || depth_misses(sp, p);
+}
+
+// Whether the point lies outside the sprite's box: pixels, half-open, for an upright
+// rectangle (`offset.z` = 2), else frame coordinates.
+fn box_outside(sp: SpritePoint, pc: vec2<f32>, offset: vec4<f32>, uv_box: vec4<f32>) -> bool {
     let upright = offset.z == 2.0;
     let q = select(sp.uv, pc, upright);
-    let outside = any(q < uv_box.xy) || any(q > uv_box.zw) || (upright && any(q == uv_box.zw));
-    return outside || sp.z < 0.0 || sp.z > 1.0 || !visible(p, sp.z);
+    return any(q < uv_box.xy) || any(q > uv_box.zw) || (upright && any(q == uv_box.zw));
+}
+
+// Whether the point is outside the depth range or behind the host's geometry.
+fn depth_misses(sp: SpritePoint, p: vec2<i32>) -> bool {
+    return sp.z < 0.0 || sp.z > 1.0 || !visible(p, sp.z);
+}
+
+// Whether a turned camera-facing sprite's (`offset.z` = 1) box edge passes within 1/64
+// pixel of the point: there the uv test and the rasteriser may disagree (a tie on its
+// grid, or the fourth corner snapped off the parallelogram), and `quad_covers` decides.
+fn near_box_edge(sp: SpritePoint, offset: vec4<f32>, uv_box: vec4<f32>) -> bool {
+    let tol = (abs(sp.ddx) + abs(sp.ddy)) * (1.0 / 64.0);
+    let near = (abs(sp.uv - uv_box.xy) <= tol) | (abs(sp.uv - uv_box.zw) <= tol);
+    let within = all(sp.uv >= uv_box.xy - tol) && all(sp.uv <= uv_box.zw + tol);
+    return offset.z == 1.0 && within && any(near);
 }
 
 // The sprite's texel at frame coordinates `uv` (the atlas scale applied): the frame at

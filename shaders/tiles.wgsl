@@ -124,9 +124,12 @@ fn project(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: v
     if SOFT {
         sprites[index].ground = s.ground;
     }
-    if s.offset.z == 0.0 {
+    // A projective map's rows; a turned camera-facing sprite's snapped corners.
+    if s.offset.z != 2.0 {
         sprites[index].map_z = s.map_z;
         sprites[index].z_row = s.z_row;
+    }
+    if s.offset.z == 0.0 {
         sprites[index].w_row = s.w_row;
     }
 }
@@ -464,7 +467,13 @@ fn sprite_light(i: u32, k: u32, p: vec2<i32>) -> vec4<f32> {
     } else {
         sp = projective_point(ca, cb, sprites[i].map_z, sprites[i].z_row, sprites[i].w_row, pc);
     }
-    if sprite_misses(sp, pc, p, cb, cache_box[k]) {
+    var outside = box_outside(sp, pc, cb, cache_box[k]);
+    if near_box_edge(sp, cb, cache_box[k]) {
+        // Near a turned sprite's edge: the rasteriser's own decision, in integers.
+        let covers = quad_covers(sprites[i].map_z, sprites[i].z_row, pc);
+        outside = select(outside, covers == 0, covers >= 0);
+    }
+    if outside || depth_misses(sp, p) {
         return vec4<f32>(0.0);
     }
     let grad = cache_grad[k];

@@ -71,6 +71,10 @@ pub const EMBEDDED: &[(&str, &str)] = &[
         "sprite_trim.wgsl",
         include_str!("../shaders/sprite_trim.wgsl"),
     ),
+    (
+        "raster_edges.wgsl",
+        include_str!("../shaders/raster_edges.wgsl"),
+    ),
     ("quad.wgsl", include_str!("../shaders/quad.wgsl")),
     ("billboard.wgsl", include_str!("../shaders/billboard.wgsl")),
     ("tiles.wgsl", include_str!("../shaders/tiles.wgsl")),

@@ -102,9 +102,8 @@ fn compare_paths(ctx: &GpuContext, what: &str, effect: &Effect, frames: u32) -> 
     (mean, max, off)
 }
 
-/// Every shipped preset draws alike on both paths: within 1/255 mean, and no more than
-/// 0.01 % of the channels over 8/255 (the issue's 8/255 maximum is not met where a
-/// rotated sprite's edge passes exactly through a pixel centre; see below).
+/// Every shipped preset draws alike on both paths: within 1/255 mean and 8/255 max, at
+/// two frames (the torch's turned flames over 25 frames: below).
 #[test]
 fn every_shipped_preset_draws_alike_with_tiles_and_billboards() {
     let ctx = gpu();
@@ -120,21 +119,62 @@ fn every_shipped_preset_draws_alike_with_tiles_and_billboards() {
                 effect.emitters[d.index].look.draw_path = DrawPath::Splat;
             }
         }
-        // Several frames: a rotated sprite's edge through a pixel centre (an exact tie,
-        // which the rasteriser settles by its top-left rule and the tiles' uv test in
-        // floating point may not) shows in a few pixels of some frames: the torch's
-        // flames, about half of them, up to 25/255 in a channel.
         for frames in [60, 69] {
             let what = format!("{} after {frames} frames", path.display());
-            let (mean, _, off) = compare_paths(&ctx, &what, &effect, frames);
-            assert!(
-                mean <= 1.0 && off <= 1e-4,
-                "{what}: tiles differ from billboards by {mean:.3}/255 mean, {:.4} % of \
-                 channels over 8/255",
-                100.0 * off
-            );
+            paths_agree(&ctx, &what, &effect, frames);
         }
     }
+}
+
+/// The torch's flames, turned at random, over 25 frames: every frame within 1/255 mean
+/// and 8/255 max. A rotated sprite's edge through a pixel centre (to the rasteriser's
+/// 1/256-pixel grid) is an exact tie the rasteriser settles by its top-left rule over two
+/// triangles; the tiles settle it with the same edge functions, exactly, wherever the uv
+/// test cannot tell (with the uv test alone, about half these frames had a pixel up to
+/// 25/255 off).
+#[test]
+fn rotated_sprites_edges_match_the_rasteriser_in_every_frame() {
+    let ctx = gpu();
+    let mut effect = shipped("torch");
+    effect.post.alpha_downscale = 1;
+    let frames = 50..75;
+    let draw = |path: DrawPath| {
+        let mut effect = effect.clone();
+        for e in &mut effect.emitters {
+            e.look.draw_path = path;
+        }
+        let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+        let mut images = Vec::new();
+        for frame in 0..frames.end {
+            run.advance(1.0 / 60.0);
+            if frames.contains(&frame) {
+                images.push(run.render(SIZE).expect("render"));
+            }
+        }
+        images
+    };
+    let (billboards, tiles) = (draw(DrawPath::Billboard), draw(DrawPath::Tiles));
+    let mut worst = (0.0, 0u8);
+    for (frame, (a, b)) in frames.zip(billboards.iter().zip(&tiles)) {
+        let (mean, max) = image_diff(a, b);
+        eprintln!("torch frame {frame}: mean {mean:.4}/255, max {max}/255");
+        // Within the issue's 8/255, and as close as measured (1/255: the fourth
+        // corner's texel filtering): a tie settled by the wrong rule reads 4/255.
+        assert!(
+            mean <= 1.0 && max <= 2,
+            "torch frame {frame}: tiles differ from billboards by {mean:.3}/255 mean, \
+             {max}/255 max"
+        );
+        worst = (f64::max(worst.0, mean), worst.1.max(max));
+    }
+    assert!(
+        total_light(&billboards[0]) > 1e3,
+        "the torch drew almost nothing"
+    );
+    eprintln!(
+        "torch, frames 50..75: worst mean {:.4}/255, worst max {}/255",
+        worst.0, worst.1
+    );
 }
 
 /// The campfire's flames with one look module on at a time.
