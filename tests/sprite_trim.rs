@@ -124,8 +124,21 @@ fn the_shader_builds_the_cpus_octagon() {
     let ctx = gpu();
     let mut cases: Vec<[f32; 4]> = Vec::new();
     let mut want: Vec<[f32; 2]> = Vec::new();
-    for (_, img, rows, cols) in sprites() {
-        let t = trim_of(&img, rows, cols);
+    let mut trims: Vec<Trim> = sprites()
+        .into_iter()
+        .map(|(_, img, rows, cols)| trim_of(&img, rows, cols))
+        .collect();
+    // Shapes whose cuts overlap along an edge (scaled back to meet): a diamond around one
+    // point, and a sliver along a diagonal with one corner of the frame clipped.
+    trims.push(Trim {
+        rect: [0.4, 0.4, 0.6, 0.6],
+        diag: [1.0, 1.0, 0.0, 0.0],
+    });
+    trims.push(Trim {
+        rect: [0.0, 0.1, 0.9, 1.0],
+        diag: [0.3, 1.7, -0.2, 0.1],
+    });
+    for t in trims {
         for m in [0.0, 0.01, 0.05, 0.2, 0.6] {
             let lo = [(t.rect[0] - m).max(0.0), (t.rect[1] - m).max(0.0)];
             let hi = [(t.rect[2] + m).min(1.0), (t.rect[3] + m).min(1.0)];

@@ -274,11 +274,17 @@ pub fn resolves_agree(what: &str, drawn: &image::RgbaImage, computed: &image::Rg
 }
 
 /// A compute pipeline of `probe` (WGSL whose entry point is `main`; it may `#import` any
-/// embedded shader), composed as the shader library composes the shipped shaders, with
-/// its bind group layouts taken from the shader.
+/// embedded shader, or a mutant's under `IGNIS_MUTANT_SHADERS`), composed as the shader
+/// library composes the shipped shaders, with its bind group layouts taken from the shader.
 pub fn probe_pipeline(ctx: &GpuContext, probe: &str) -> wgpu::ComputePipeline {
     let dir = tempfile::tempdir().expect("tempdir");
+    // The shaders under test: a mutant's copy when scripts/wgsl_mutants.py runs the tests.
+    let mutant = std::env::var_os("IGNIS_MUTANT_SHADERS").map(std::path::PathBuf::from);
     for (name, text) in ignis::testing::shaders::EMBEDDED {
+        let text = match &mutant {
+            Some(m) => std::fs::read_to_string(m.join(name)).expect("read mutant shader"),
+            None => text.to_string(),
+        };
         std::fs::write(dir.path().join(name), text).expect("write shader");
     }
     std::fs::write(dir.path().join("probe.wgsl"), probe).expect("write probe");
