@@ -35,7 +35,7 @@ ROOT = Path(__file__).resolve().parent.parent
 # a name filter, `--skip NAME`). The tests that run the `ignis` command are skipped: they
 # check the command line, and need the binary beside the tests.
 TESTS = {
-    "raster_edges.wgsl": [("tiles", "rotated_sprites")],
+    "raster_edges.wgsl": [("raster_edges", None), ("tiles", "rotated_sprites")],
     "sprite_trim.wgsl": [("sprite_trim", None), ("looks", "trimmed")],
     "events.wgsl": [("events", None), ("trails", "parent")],
     "events_on.wgsl": [("events", None), ("trails", "parent")],
