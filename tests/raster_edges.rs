@@ -148,7 +148,7 @@ fn the_tiles_exact_edges_are_the_64_bit_rule() {
     }
     assert!(ties > 50, "{ties} pixel centres on an edge");
     assert_eq!(got.iter().filter(|&&g| g < 0).count(), 3, "refused cases");
-    assert!(got.iter().any(|&g| g == 1) && got.iter().any(|&g| g == 0));
+    assert!(got.contains(&1) && got.contains(&0));
 }
 
 fn run_probe(ctx: &GpuContext, input: &[[f32; 4]], n: usize) -> Vec<i32> {
