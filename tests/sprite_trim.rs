@@ -117,6 +117,28 @@ fn the_octagon_holds_every_visible_texel() {
     }
 }
 
+/// The bounds are exactly the visible cells' texels grown by one texel, in their own
+/// frame's coordinates (here a cell of 2 × 2 texels in the lower frame of a 2-row
+/// flipbook): nothing looser, and a cell at the threshold or an empty sprite cuts nothing.
+#[test]
+fn the_trim_is_the_visible_cells_grown_by_a_texel() {
+    // 16 × 16 texels in cells of 2: 8 × 8 cells, one lit at (3, 6) — texels x 6..8,
+    // y 12..14, in the frame of rows 8..16.
+    let mut coverage = vec![0.0f32; 64];
+    coverage[6 * 8 + 3] = 0.5;
+    let t = trim(&coverage, 2, (16, 16), 2, 1, 0.25);
+    let (u0, v0, u1, v1) = (5.0 / 16.0, 3.0 / 8.0, 9.0 / 16.0, 7.0 / 8.0);
+    assert_eq!(
+        t,
+        Trim {
+            rect: [u0, v0, u1, v1],
+            diag: [u0 + v0, u1 + v1, u0 - v1, u1 - v0],
+        }
+    );
+    assert_eq!(trim(&coverage, 2, (16, 16), 2, 1, 0.5), Trim::WHOLE);
+    assert_eq!(trim(&[0.0; 64], 2, (16, 16), 2, 1, 0.0), Trim::WHOLE);
+}
+
 /// The shader's corners (`octagon_corner`) are the CPU's (`Trim::octagon`), for every
 /// built-in sprite at margins from none to most of the frame.
 #[test]
