@@ -7,10 +7,8 @@
 
 mod common;
 
-use common::{gpu, probe_pipeline};
+use common::gpu;
 use ignis::testing::gpu::GpuContext;
-use ignis::testing::sim::gpu_sim::map_read;
-use wgpu::util::DeviceExt;
 
 const PROBE: &str = r#"
 #import "raster_edges.wgsl"
@@ -152,49 +150,12 @@ fn the_tiles_exact_edges_are_the_64_bit_rule() {
 }
 
 fn run_probe(ctx: &GpuContext, input: &[[f32; 4]], n: usize) -> Vec<i32> {
-    let d = &ctx.device;
-    let pipeline = probe_pipeline(ctx, PROBE);
-    let cases = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: None,
-        contents: bytemuck::cast_slice(input),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let size = (n * 4) as u64;
-    let [out, staging] = [
-        wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-    ]
-    .map(|usage| {
-        d.create_buffer(&wgpu::BufferDescriptor {
-            label: None,
-            size,
-            usage,
-            mapped_at_creation: false,
-        })
-    });
-    let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: cases.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: out.as_entire_binding(),
-            },
-        ],
-    });
-    let mut enc = d.create_command_encoder(&Default::default());
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &group, &[]);
-        pass.dispatch_workgroups(n.div_ceil(64) as u32, 1, 1);
-    }
-    enc.copy_buffer_to_buffer(&out, 0, &staging, 0, size);
-    ctx.queue.submit([enc.finish()]);
-    let bytes = map_read(ctx, &staging).expect("read back");
+    let bytes = common::run_probe(
+        ctx,
+        PROBE,
+        bytemuck::cast_slice(input),
+        (n * 4) as u64,
+        n.div_ceil(64) as u32,
+    );
     bytemuck::cast_slice(&bytes).to_vec()
 }

@@ -13,8 +13,6 @@ use ignis::testing::render::sixway_maps::{PUFF_SEED, combined, puff, puff_sheet}
 use ignis::testing::render::sprite_trim::{OCTAGON_SHARE, Trim, trim};
 use ignis::testing::render::sprites::{TRIM_THRESHOLD, coverage, generate};
 use ignis::testing::shaders::ShaderLibrary;
-use ignis::testing::sim::gpu_sim::map_read;
-use wgpu::util::DeviceExt;
 
 const PROBE: &str = r#"
 #import "sprite_trim.wgsl"
@@ -182,50 +180,13 @@ fn the_shader_builds_the_cpus_octagon() {
 }
 
 fn run_probe(ctx: &GpuContext, cases: &[[f32; 4]], corners: usize) -> Vec<[f32; 2]> {
-    let pipeline = probe_pipeline(ctx, PROBE);
-    let d = &ctx.device;
-    let input = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: None,
-        contents: bytemuck::cast_slice(cases),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let size = (corners * 8) as u64;
-    let out = d.create_buffer(&wgpu::BufferDescriptor {
-        label: None,
-        size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let staging = d.create_buffer(&wgpu::BufferDescriptor {
-        label: None,
-        size,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: input.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: out.as_entire_binding(),
-            },
-        ],
-    });
-    let mut enc = d.create_command_encoder(&Default::default());
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &group, &[]);
-        pass.dispatch_workgroups((cases.len() / 3) as u32, 1, 1);
-    }
-    enc.copy_buffer_to_buffer(&out, 0, &staging, 0, size);
-    ctx.queue.submit([enc.finish()]);
-    let bytes = map_read(ctx, &staging).expect("read back");
+    let bytes = common::run_probe(
+        ctx,
+        PROBE,
+        bytemuck::cast_slice(cases),
+        (corners * 8) as u64,
+        (cases.len() / 3) as u32,
+    );
     bytemuck::cast_slice(&bytes).to_vec()
 }
 

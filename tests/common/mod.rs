@@ -307,3 +307,59 @@ pub fn probe_pipeline(ctx: &GpuContext, probe: &str) -> wgpu::ComputePipeline {
             cache: None,
         })
 }
+
+/// Runs `probe` (see [`probe_pipeline`]; group 0: binding 0 the `input` bytes as read-only
+/// storage, binding 1 an `out_size`-byte read-write storage buffer) as `workgroups`
+/// workgroups, and returns binding 1's bytes.
+pub fn run_probe(
+    ctx: &GpuContext,
+    probe: &str,
+    input: &[u8],
+    out_size: u64,
+    workgroups: u32,
+) -> Vec<u8> {
+    use wgpu::util::DeviceExt;
+    let d = &ctx.device;
+    let pipeline = probe_pipeline(ctx, probe);
+    let input = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: None,
+        contents: input,
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let [out, staging] = [
+        wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+    ]
+    .map(|usage| {
+        d.create_buffer(&wgpu::BufferDescriptor {
+            label: None,
+            size: out_size,
+            usage,
+            mapped_at_creation: false,
+        })
+    });
+    let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: input.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: out.as_entire_binding(),
+            },
+        ],
+    });
+    let mut enc = d.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.dispatch_workgroups(workgroups, 1, 1);
+    }
+    enc.copy_buffer_to_buffer(&out, 0, &staging, 0, out_size);
+    ctx.queue.submit([enc.finish()]);
+    ignis::testing::sim::gpu_sim::map_read(ctx, &staging).expect("read back")
+}
