@@ -39,6 +39,10 @@ struct GroupView<'g, 'a> {
     first_group: bool,
 }
 
+/// A sprite trim as the looks use it: the rectangle, the octagon's packed cuts and the
+/// share of the rectangle the octagon draws.
+pub(crate) type LookTrim = ([f32; 4], u32, f32);
+
 /// Uniform buffers, layouts and bind groups for the draw passes.
 pub struct FrameResources {
     /// Group 0 of both draw paths: camera + the looks of a draw's instances (storage,
@@ -75,8 +79,8 @@ pub struct FrameResources {
     /// Draw and sort only each emitter's live window of the ring (on by default; off
     /// visits every slot, for comparisons).
     pub live_window_only: bool,
-    /// Sprite trims by (sprite id, flipbook rows, columns, threshold bits).
-    trims: HashMap<(u64, u32, u32, u32), crate::render::sprite_trim::Trim>,
+    /// Sprite trims by (sprite id, flipbook rows, columns, threshold bits): found once.
+    trims: HashMap<(u64, u32, u32, u32), LookTrim>,
     /// Let small additive particles take the compute splat (off in the runtime player,
     /// which draws everything inside the host's pass).
     pub allow_splat: bool,
@@ -471,7 +475,7 @@ impl FrameResources {
             // Emitter i of every instance shares ramp row i: the first group's look bakes it.
             self.upload_ramp(ctx, i, &e.look);
         }
-        let (base, trim) = self.base_look(first.effect, i, &sprite);
+        let (base, octagon_share) = self.base_look(first.effect, i, &sprite);
         let GroupLooks {
             looks,
             members,
@@ -535,7 +539,7 @@ impl FrameResources {
         variant.octagon = self.octagons
             && !splat
             && !tiles
-            && trim.is_some_and(|t| t.octagon_share() <= crate::render::sprite_trim::OCTAGON_SHARE);
+            && octagon_share.is_some_and(|s| s <= crate::render::sprite_trim::OCTAGON_SHARE);
         Some(DrawItem {
             index: i,
             look_slot: 0,

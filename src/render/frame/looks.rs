@@ -6,17 +6,16 @@ use crate::gpu::types::{LookUniform, PARAMS_STRIDE};
 use crate::render::look_bake::ROWS_PER_EMITTER;
 use crate::render::scene_lighting::{LitUniform, SceneLighting, write_lit};
 use crate::render::sort::SortMember;
-use crate::render::sprite_trim::Trim;
 use crate::render::sprites::SpriteTexture;
 use crate::sim::Modules;
 
 use super::{FrameResources, GroupView};
+use crate::render::draw_item::Scene;
 
 /// A lit layer's quads keep texels down to the trim threshold over this gain: its light
 /// (sun, flames, host lights) has no bound known when the look is built. The built-in
 /// puff ends at its sphere, so the cut does not depend on it.
 const LIT_TRIM_GAIN: f32 = 256.0;
-use crate::render::draw_item::Scene;
 
 /// Emitter `i` across a group's instances (`FrameResources::group_looks`).
 pub(super) struct GroupLooks<'s> {
@@ -117,14 +116,15 @@ pub fn look_uniform(look: &Look, ramp_row: u32, salt: u32, sprite_integral: f32)
 
 impl FrameResources {
     /// Emitter `i`'s look of every instance (its salt, place and ring are set per
-    /// instance by `member_look`): the look's settings and the sprite's trim (also
-    /// returned; none for a streak, or with trimming off).
+    /// instance by `member_look`): the look's settings and the sprite's trim, and the
+    /// share of its rectangle the trim's octagon draws (none for a streak, or with
+    /// trimming off).
     pub(super) fn base_look(
         &mut self,
         effect: &Effect,
         i: usize,
         sprite: &SpriteTexture,
-    ) -> (LookUniform, Option<Trim>) {
+    ) -> (LookUniform, Option<f32>) {
         let e = &effect.emitters[i];
         let mut u = look_uniform(&e.look, ROWS_PER_EMITTER * i as u32, 0, sprite.integral);
         if !self.trim_sprites || e.look.streak.is_some() {
@@ -144,13 +144,16 @@ impl FrameResources {
         let gain = (e.look.intensity * effect.post.exposure).max(1.0);
         let gain = if lit { gain * LIT_TRIM_GAIN } else { gain };
         let threshold = crate::render::sprites::TRIM_THRESHOLD / gain;
-        let trim = *self
+        let (rect, cuts, share) = *self
             .trims
             .entry((sprite.id, rows, cols, threshold.to_bits()))
-            .or_insert_with(|| sprite.trim(rows, cols, threshold));
-        u.trim = trim.rect;
-        u.tiny_c[3] = trim.packed_cuts();
-        (u, Some(trim))
+            .or_insert_with(|| {
+                let t = sprite.trim(rows, cols, threshold);
+                (t.rect, t.packed_cuts(), t.octagon_share())
+            });
+        u.trim = rect;
+        u.tiny_c[3] = cuts;
+        (u, Some(share))
     }
 
     /// Writes lit emitter `i`'s `LitUniform` of every instance of the group into `block`
