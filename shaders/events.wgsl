@@ -173,6 +173,10 @@ fn scan_blocks(@builtin(local_invocation_index) lid: u32) {
     }
 }
 
+// Whether write_list's block lies wholly past this step's allowance (set by its first
+// invocation, read uniformly by all).
+var<workgroup> past_allowance: u32;
+
 @compute @workgroup_size(256)
 fn write_list(
     @builtin(workgroup_id) wg: vec3<u32>,
@@ -181,6 +185,16 @@ fn write_list(
 ) {
     let b = block_index(wg, nwg);
     if b * BLOCK >= params.update_window.y {
+        return;
+    }
+    // A block whose first child falls past the allowance writes no entry: without ribbons
+    // (whose born slots forget their last child in every block) its words are not read.
+    // Where deaths outnumber a capped child's room, that is most blocks.
+    if lid == 0u {
+        let skip = (cfg.rule_capacity_cap.w & RIBBON) == 0u && blocks[1u + b] >= blocks[bucket_at() + 1u];
+        past_allowance = select(0u, 1u, skip);
+    }
+    if workgroupUniformLoad(&past_allowance) != 0u {
         return;
     }
     let first = b * BLOCK + lid * PER_THREAD;

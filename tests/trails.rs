@@ -460,6 +460,22 @@ fn a_ribbon_per_parent_joins_several_children_a_step_in_spawn_order() {
     joins_children_in_order(effect, 512);
 }
 
+/// The same with the children's cap binding over a parent pool of two of the scan's
+/// blocks (1,100 parents, 1,024 slots a block): each step's allowance runs out in the
+/// first block, so the second, where parents are born, never lists a child — a parent
+/// born there must still forget its slot's last life's child.
+#[test]
+fn a_capped_ribbon_per_parent_forgets_the_last_life_past_the_allowance() {
+    let mut effect = ribbon_effect_at(12.0);
+    let parent = &mut effect.emitters[0];
+    parent.capacity = 1100;
+    parent.spawn_rate_per_sec = Param::Constant(2200.0);
+    parent.events[0].max_per_sec = 7200.0;
+    effect.emitters[1].capacity = 8192;
+    effect.validate().expect("valid");
+    joins_children_in_order(effect, 8192);
+}
+
 fn joins_children_in_order(effect: Effect, capacity: usize) {
     let ctx = gpu();
     let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
@@ -478,11 +494,16 @@ fn joins_children_in_order(effect: Effect, capacity: usize) {
             births += usize::from(links[s].stamp != stamps[s]);
             stamps[s] = links[s].stamp;
         }
-        // Children by ray (their parent's direction), nearest the origin (oldest) first.
-        let dir = |s: usize| glam::Vec3::from_slice(&children[s].pos_age[..3]).normalize();
+        // Children by ray (their parent's direction, to 1e-4 rad: a thousand parents' rays
+        // seldom come closer), nearest the origin (oldest) first.
+        let dir = |s: usize| {
+            glam::Vec3::from_slice(&children[s].pos_age[..3])
+                .as_dvec3()
+                .normalize()
+        };
         let mut rays: Vec<Vec<usize>> = Vec::new();
         for &s in &alive {
-            match rays.iter_mut().find(|r| dir(r[0]).dot(dir(s)) > 0.99999) {
+            match rays.iter_mut().find(|r| dir(r[0]).dot(dir(s)) > 1.0 - 5e-9) {
                 Some(r) => r.push(s),
                 None => rays.push(vec![s]),
             }
