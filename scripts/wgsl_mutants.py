@@ -50,7 +50,7 @@ TESTS = {
     "quad.wgsl": [("tiles", None), ("rendering", "--skip render_command")],
     "integrators.wgsl": [("core_sim", None), ("stability", "--skip ignis_check")],
     "tonemap.wgsl": [("tonemap", None), ("rendering", "--skip render_command")],
-    "bloom.wgsl": [("rendering", "--skip render_command")],
+    "bloom.wgsl": [("bloom", None), ("rendering", "--skip render_command")],
     "clear.wgsl": [("rendering", "--skip render_command")],
     "depth_on.wgsl": [("depth_collision", None)],
     "haze_apply.wgsl": [("haze", None)],

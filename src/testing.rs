@@ -125,6 +125,11 @@ pub mod render {
         pub use crate::render::sprites::{SpriteLibrary, TRIM_THRESHOLD, coverage, generate};
     }
 
+    /// The composite's bloom.
+    pub mod bloom {
+        pub use crate::render::bloom::BloomPass;
+    }
+
     /// The composite's tonemap.
     pub mod tonemap {
         pub use crate::render::tonemap::TonemapPass;

@@ -134,12 +134,12 @@ fn death_children_match_the_cpu_mirror_including_the_cap() {
     // One block of the scan; then a parent window of several blocks wrapping its ring.
     // The caps per second refill 12.5 and 100.5 children per 1/60 s step into buckets of
     // 75 and 603: once a bucket has drained, 12 or 13, 100 or 101, alternating.
-    check_against_the_mirror(1024, 900.0, 750.0, false);
+    check_against_the_mirror(Trigger::Death, 1024, 900.0, 750.0, false);
     // Children that inherit the parent's colour carry its age at the event.
-    check_against_the_mirror(4096, 9_000.0, 6030.0, true);
+    check_against_the_mirror(Trigger::Death, 4096, 9_000.0, 6030.0, true);
     // A window of more blocks than the scan's workgroup has invocations (about 350 blocks
     // of 1024 slots): each invocation places a run of consecutive blocks.
-    check_against_the_mirror(1 << 19, 900_000.0, 12_000.0, false);
+    check_against_the_mirror(Trigger::Death, 1 << 19, 900_000.0, 12_000.0, false);
 }
 
 /// A parent whose event records cannot fit one storage binding is refused with a message
@@ -165,7 +165,23 @@ fn events_too_large_for_the_device_are_a_clear_error() {
     );
 }
 
+/// The same for birth events, whose parents are the slots just spawned: across the
+/// steps where the parent's spawn ring wraps (2,000 births a second into 1,024 slots),
+/// the slots spawned past the ring's end still get their own keys.
+#[test]
+fn birth_children_match_the_cpu_mirror_where_the_ring_wraps() {
+    check_against_the_mirror(Trigger::Birth, 1024, 2000.0, 1500.0, false);
+}
+
+/// The same for children over life at 1,000 a second in steps of 0.1 s: 100 due per parent
+/// a step, held to the 64 one event spawns at most.
+#[test]
+fn over_life_children_match_the_cpu_mirror_up_to_the_per_event_limit() {
+    check_against_the_mirror(Trigger::OverLife, 1024, 300.0, 2_000.0, false);
+}
+
 fn check_against_the_mirror(
+    trigger: Trigger,
     parent_capacity: u32,
     parent_rate: f32,
     max_per_sec: f32,
@@ -173,7 +189,8 @@ fn check_against_the_mirror(
 ) {
     let ctx = strict_gpu();
     let event = Event {
-        trigger: Trigger::Death,
+        trigger,
+        rate_per_sec: 1000.0,
         count: CountRange { min: 1, max: 3 },
         probability: 0.8,
         inherit_velocity: 0.5,
@@ -183,16 +200,30 @@ fn check_against_the_mirror(
     };
     let mut effect = parent_and_child(event, parent_rate);
     effect.emitters[0].capacity = parent_capacity;
-    effect.emitters[1].capacity = 16384;
+    let child = &mut effect.emitters[1];
+    child.capacity = 16384;
+    // Children spread over a shape of their own and fly at a speed of their own, on top of
+    // where the event happened and what they inherit.
+    child.shape = Shape::Sphere {
+        radius_m: 0.1,
+        surface_only: false,
+    };
+    child.speed_m_per_s = Range::new(0.2, 0.4);
     effect.validate().expect("valid");
     let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
+    // Over life, long steps: more children due in a step than one event spawns.
+    let dt = if trigger == Trigger::OverLife {
+        0.1
+    } else {
+        DT
+    };
     let (mut head, mut last_count, mut dropped, mut capped_steps) = (0u32, 0u32, 0u32, 0);
     let child_cap = effect.emitters[1].capacity;
     let mut bucket = ignis::effect::RateCap::default();
     for step in 0..60 {
         sim.sync(&effect).expect("sync");
         let before = sim.read_particles(0).expect("read");
-        let plans = sim.plan(&effect, DT, 1);
+        let plans = sim.plan(&effect, dt, 1);
         sim.record_and_submit(&effect, &plans);
         let after = sim.read_particles(0).expect("read");
         let child = sim.read_particles(1).expect("read");
@@ -209,18 +240,6 @@ fn check_against_the_mirror(
         assert_eq!(cp.spawn_count, 0, "a fed emitter has no spawns of its own");
         for (k, s) in list.iter().enumerate() {
             let c = &child[((head + k as u32) % child_cap) as usize];
-            let want_pos = [s.pos_key[0], s.pos_key[1], s.pos_key[2]];
-            assert_eq!(
-                &c.pos_age[..3],
-                &want_pos,
-                "step {step} child {k}: position"
-            );
-            assert_eq!(c.pos_age[3], 0.0, "born this step");
-            assert_eq!(
-                &c.vel_life[..3],
-                &s.vel_j[..3],
-                "step {step} child {k}: velocity"
-            );
             let bits = s.vel_j[3].to_bits();
             let key = child_key(
                 cp.seed,
@@ -228,7 +247,28 @@ fn check_against_the_mirror(
                 s.pos_key[3].to_bits(),
                 bits & 0xFFFF,
             );
-            let want = ignis::testing::sim::cpu_reference::spawn_particle(&cp, key).vel_life[3];
+            // The child's own spawn: its shape's offset from its origin, its own velocity.
+            let q = ignis::testing::sim::cpu_reference::spawn_particle(&cp, key);
+            let origin = cp.world_from_emitter[3];
+            let want_pos: Vec<f32> = (0..3)
+                .map(|i| s.pos_key[i] + (q.pos_age[i] - origin[i]))
+                .collect();
+            // The shape's and the direction's trigonometry differ from the CPU's in the
+            // last bits.
+            let near = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-5);
+            assert!(
+                near(&c.pos_age[..3], &want_pos),
+                "step {step} child {k}: position {:?}, want {want_pos:?}",
+                &c.pos_age[..3]
+            );
+            assert_eq!(c.pos_age[3], 0.0, "born this step");
+            let want_vel: Vec<f32> = (0..3).map(|i| q.vel_life[i] + s.vel_j[i]).collect();
+            assert!(
+                near(&c.vel_life[..3], &want_vel),
+                "step {step} child {k}: velocity {:?}, want {want_vel:?}",
+                &c.vel_life[..3]
+            );
+            let want = q.vel_life[3];
             // Inheriting the colour, the lifetime's lowest 8 bits carry the parent's age.
             let want = if inherit_color {
                 f32::from_bits((want.to_bits() & !0xFF) | ((bits >> 16) & 0xFF))
@@ -290,6 +330,18 @@ fn a_burst_that_dies_leaves_exactly_count_children() {
         let world = c.position() + glam::Vec3::new(2.0, 0.5, 0.0);
         let r = world.length();
         assert!((0.24..0.76).contains(&r), "child at {world} (r = {r})");
+    }
+    // With no parent left to run, the children are never born again: ten steps on, each
+    // is ten steps older (a child reading a stale list would be reborn every step).
+    let born_at: Vec<f32> = children.iter().map(|c| c.pos_age[3]).collect();
+    sim.step(&effect, DT, 10).expect("step");
+    let later = sim.read_particles(1).expect("read");
+    for (c, age) in later.iter().zip(&born_at).filter(|(c, _)| c.is_alive()) {
+        let grown = c.pos_age[3] - age;
+        assert!(
+            (grown - 10.0 * DT).abs() < 1e-5,
+            "a child aged {grown} s in 10 steps"
+        );
     }
 }
 
@@ -816,7 +868,7 @@ fn children_at_step(effect: &Effect, dt: f32, secs: f32) -> Vec<u32> {
 
 /// Events' children are the same particles at any step: an over-life child is keyed by
 /// its number in its parent's life (not by the step it falls in), a bounce by the parent's
-/// age in 1/64 s (not by the age's bits, which differ with the step) — so the image of an
+/// age in 1/16 s (not by the age's bits, which differ with the step) — so the image of an
 /// effect with events converges as the step shrinks (`ignis tune`'s references).
 #[test]
 fn the_children_of_events_are_the_same_particles_at_any_step() {
@@ -836,6 +888,14 @@ fn the_children_of_events_are_the_same_particles_at_any_step() {
     over_life.emitters[0].lifetime_secs = Range::new(1.0, 1.0);
     let a = children_at_step(&over_life, 1.0 / 60.0, 0.55);
     assert_eq!(a.len(), 20 * 16, "born at 0: 0.55 s old");
+    // Keyed by their parent's life too: no two parents' k-th children alike.
+    let mut distinct = a.clone();
+    distinct.dedup();
+    assert_eq!(
+        distinct.len(),
+        a.len(),
+        "over-life children's lifetimes repeat"
+    );
     assert_eq!(a, children_at_step(&over_life, 1.0 / 240.0, 0.55));
     assert_eq!(a, children_at_step(&over_life, 1.0 / 20.0, 0.55));
 
@@ -871,6 +931,18 @@ fn the_children_of_events_are_the_same_particles_at_any_step() {
         shared_with_finest(1.0 / 480.0),
     );
     assert!(finest.len() > 400, "{} bounces", finest.len());
+    // Each bounce draws children of its own: a spark's bounces are told apart by their
+    // ordinal (its age in 1/16 s), so their lifetimes seldom repeat — only the last hops,
+    // less than 1/16 s apart, share one (without the ordinal, about one in eight would
+    // be distinct: 200 sparks).
+    let mut distinct = finest.clone();
+    distinct.dedup();
+    assert!(
+        distinct.len() * 4 >= finest.len() * 3,
+        "{} distinct lifetimes among {} children of bounces",
+        distinct.len(),
+        finest.len()
+    );
     assert!(
         fine > 0.8 && fine > coarse,
         "shared: {coarse} at 1/120 s, {fine} at 1/480 s"
