@@ -221,6 +221,11 @@ fn check_against_the_mirror(
     let child_cap = effect.emitters[1].capacity;
     let mut bucket = ignis::effect::RateCap::default();
     for step in 0..60 {
+        if step == 20 {
+            // The child emitter moved: events still place children where they happen
+            // (its simulation keeps its first origin, so its placement is now offset).
+            effect.emitters[1].transform.position_m = [2.3, 0.2, -0.4];
+        }
         sim.sync(&effect).expect("sync");
         let before = sim.read_particles(0).expect("read");
         let plans = sim.plan(&effect, dt, 1);
@@ -320,9 +325,16 @@ fn a_burst_that_dies_leaves_exactly_count_children() {
         0,
         "none dead yet"
     );
-    sim.step(&effect, DT, 35).expect("step");
+    // Step by step to the one step where they all die (and their children are listed).
+    let mut children = sim.read_particles(1).expect("read");
+    for _ in 0..35 {
+        sim.step(&effect, DT, 1).expect("step");
+        children = sim.read_particles(1).expect("read");
+        if alive_of(&children) > 0 {
+            break;
+        }
+    }
     assert_eq!(alive_of(&sim.read_particles(0).expect("read")), 0);
-    let children = sim.read_particles(1).expect("read");
     assert_eq!(alive_of(&children), 300);
     // Parents flew straight at 0.5..1.5 m/s for 0.5 s from the origin: children sit on
     // that shell (in the child's space, offset by its placement).
@@ -331,9 +343,11 @@ fn a_burst_that_dies_leaves_exactly_count_children() {
         let r = world.length();
         assert!((0.24..0.76).contains(&r), "child at {world} (r = {r})");
     }
-    // With no parent left to run, the children are never born again: ten steps on, each
-    // is ten steps older (a child reading a stale list would be reborn every step).
+    // With its parent switched off right after that step (no scan runs for it), the
+    // child's list of 300 is stale and spawns nothing: ten steps on, each child is ten
+    // steps older (a child reading the stale list would be born again every step).
     let born_at: Vec<f32> = children.iter().map(|c| c.pos_age[3]).collect();
+    effect.emitters[0].enabled = false;
     sim.step(&effect, DT, 10).expect("step");
     let later = sim.read_particles(1).expect("read");
     for (c, age) in later.iter().zip(&born_at).filter(|(c, _)| c.is_alive()) {

@@ -455,6 +455,17 @@ mod tests {
         assert!((peak.eval(1.5) - 0.625).abs() < 1e-12, "{}", peak.eval(1.5));
     }
 
+    /// Two keys at one time make a jump: its zero-length segment has slope 0, so the
+    /// keys beside it are local extremes of their smooth segments (tangent 0). By hand,
+    /// at the segments' middles: h10·h·2 + h01·1 = 0.625 and h00·3 + h01·4 + h11·h·2 = 3.375.
+    #[test]
+    fn a_jump_between_two_keys_at_one_time_flattens_the_segments_beside_it() {
+        let c = curve(&[(0.0, 0.0), (0.5, 1.0), (0.5, 3.0), (1.0, 4.0)], true);
+        assert!((c.eval(0.25) - 0.625).abs() < 1e-12, "{}", c.eval(0.25));
+        assert!((c.eval(0.75) - 3.375).abs() < 1e-12, "{}", c.eval(0.75));
+        assert_eq!(c.eval(0.5), 3.0, "the jump's later key holds at its time");
+    }
+
     #[test]
     fn smooth_curves_never_overshoot_their_keys() {
         let c = curve(
@@ -524,5 +535,18 @@ mod tests {
         }
         let r = Param::Range { min: 1.0, max: 4.0 };
         assert_eq!(r.to_mode(ParamMode::Curve).bounds(), (1.0, 4.0));
+    }
+
+    /// The names the editor's parameter menus show for the modes.
+    #[test]
+    fn modes_have_their_menu_names() {
+        let names = ParamMode::ALL.map(ParamMode::label);
+        let want = [
+            "constant",
+            "random range",
+            "curve",
+            "random between two curves",
+        ];
+        assert_eq!(names, want);
     }
 }
