@@ -450,6 +450,17 @@ mod tests {
         // t = 0.25: h00 = 27/32, h10 = 9/64, h01 = 5/32, h11 = −3/64.
         let quarter = 9.0 / 64.0 + 5.0 / 32.0 - 3.0 / 64.0 * 9.0 / 13.0;
         assert!((c.eval(0.25) - quarter).abs() < 1e-12, "{}", c.eval(0.25));
+        // Unequal spacings and slopes, none of them 1 or 2 (keys (0, 0), (0.5, 1.5),
+        // (2, 2.25): h 0.5 and 1.5, slopes 3 and 1/2): weights 3.5 and 2.5, the inner
+        // tangent 6 / (3.5/3 + 2.5/0.5) = 36/37; at t = 0.25, h10·0.5·3 + h01·1.5 +
+        // h11·0.5·36/37.
+        let uneven = curve(&[(0.0, 0.0), (0.5, 1.5), (2.0, 2.25)], true);
+        let want = 0.1875 + 0.75 - 0.0625 * 36.0 / 37.0;
+        assert!(
+            (uneven.eval(0.25) - want).abs() < 1e-12,
+            "{}",
+            uneven.eval(0.25)
+        );
         let peak = curve(&[(0.0, 0.0), (1.0, 1.0), (2.0, 0.0)], true);
         assert!((peak.eval(0.5) - 0.625).abs() < 1e-12, "{}", peak.eval(0.5));
         assert!((peak.eval(1.5) - 0.625).abs() < 1e-12, "{}", peak.eval(1.5));
