@@ -359,6 +359,47 @@ fn a_burst_that_dies_leaves_exactly_count_children() {
     }
 }
 
+/// Two parents feed one child in the same step: the second scan appends its children
+/// after the first's (each scan starts where the list ends), so ten still parents dying
+/// at x = −1 and ten at x = +1 leave ten children at each place.
+#[test]
+fn two_parents_feeding_one_child_in_one_step_both_get_their_children() {
+    let ctx = strict_gpu();
+    let event = Event {
+        count: CountRange { min: 1, max: 1 },
+        inherit_velocity: 0.0,
+        ..Event::default()
+    };
+    let mut effect = parent_and_child(event, 0.0);
+    let a = &mut effect.emitters[0];
+    a.bursts = vec![Burst {
+        time_secs: 0.0,
+        count: 10,
+    }];
+    a.lifetime_secs = Range::new(0.3, 0.3);
+    a.speed_m_per_s = Range::new(0.0, 0.0);
+    a.forces.gravity_m_per_s2 = [0.0; 3];
+    a.transform.position_m = [-1.0, 0.0, 0.0];
+    let mut b = a.clone();
+    b.name = "second parent".into();
+    b.transform.position_m = [1.0, 0.0, 0.0];
+    effect.emitters.insert(1, b);
+    effect.validate().expect("valid");
+    let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
+    sim.step(&effect, DT, 30).expect("step");
+    let children = sim.read_particles(2).expect("read");
+    let xs: Vec<f32> = children
+        .iter()
+        .filter(|c| c.is_alive())
+        .map(|c| c.position().x + 2.0)
+        .collect();
+    assert_eq!(xs.len(), 20, "children: {xs:?}");
+    for x in [-1.0f32, 1.0] {
+        let at = xs.iter().filter(|&&v| (v - x).abs() < 1e-4).count();
+        assert_eq!(at, 10, "children at x = {x}: {xs:?}");
+    }
+}
+
 /// A parent with two rules feeds two children, each exactly: every rule has its own
 /// records (a birth rule's two children and a death rule's three, per parent).
 #[test]
