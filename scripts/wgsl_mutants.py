@@ -41,6 +41,7 @@ TESTS = {
     "events_on.wgsl": [("events", None), ("trails", "parent")],
     "trail.wgsl": [("trails", None), ("looks", "reference_images"), ("tiles", "ribbons")],
     "trail_on.wgsl": [("trails", None)],
+    "trail_ring.wgsl": [("trails", None), ("events", None)],
     "tiles.wgsl": [("tiles", None)],
     "tile_lists.wgsl": [("tiles", None)],
     "splat.wgsl": [("splat", None), ("runtime", "splat reversed_z msaa")],

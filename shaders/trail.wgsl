@@ -25,12 +25,7 @@ override TRAIL: bool = false;
 // Point j ≥ 1 of the trail of `slot` (xyz position, w age).
 fn trail_point(slot: u32, j: u32) -> vec4<f32> {
     let n = max(trail_ring.points, 1u);
-    let every = max(trail_ring.every, 1u);
-    // The newest recording step before the last step (a particle born in the last step
-    // filled its whole ring, so any entry is its birth point).
-    let before = look.tiny_c.y - 1u;
-    let k = before - before % every;
-    let r = (k / every + n - (j - 1u) % n) % n;
+    let r = trail_point_entry(look.tiny_c.y, j, n, max(trail_ring.every, 1u));
     let slots = arrayLength(&trail_ring.history) / n;
     return trail_ring.history[ring_entry(look.flags.w + slot, r, slots)];
 }

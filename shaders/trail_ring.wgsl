@@ -24,3 +24,13 @@ struct TrailRing {
 fn ring_entry(slot: u32, r: u32, slots: u32) -> u32 {
     return r * slots + slot;
 }
+
+// The ring entry of point j ≥ 1 of a trail of `points` entries recorded every `every`
+// steps, after the step numbered `last`: the newest recording step before that step, then
+// `every` steps further back a point (a particle born in the last step filled its whole
+// ring, so any entry is its birth point). src/sim/trails.rs `trail_indices` is the same.
+fn trail_point_entry(last: u32, j: u32, points: u32, every: u32) -> u32 {
+    let before = last - 1u;
+    let k = before - before % every;
+    return (k / every + points - (j - 1u) % points) % points;
+}

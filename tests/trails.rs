@@ -124,6 +124,55 @@ fn ribbon_points_are_the_recorded_positions_of_one_life() {
     assert!(checked > 1000, "{checked} points checked");
 }
 
+const RING_PROBE: &str = r#"
+#import "trail_ring.wgsl"
+// Per case: the last step's number, the point j, the ring's points and its spacing.
+@group(0) @binding(0) var<storage, read> cases: array<vec4<u32>>;
+@group(0) @binding(1) var<storage, read_write> out: array<u32>;
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= arrayLength(&cases) {
+        return;
+    }
+    let c = cases[id.x];
+    out[id.x] = trail_point_entry(c.x, c.y, c.z, c.w);
+}
+"#;
+
+/// The entry the draw reads for each point of a trail (`trail_point_entry`) is the one
+/// `trail_indices` names, for rings of 2 to 16 points (powers of two and not), recorded
+/// every 1 to 5 steps, after each of the first 200 steps (the ring filling, every phase of
+/// the spacing, and the step before the first: the wrap of `last − 1`).
+#[test]
+fn the_draw_reads_the_ring_entries_the_recording_wrote() {
+    let ctx = gpu();
+    let mut cases: Vec<[u32; 4]> = Vec::new();
+    let mut want: Vec<u32> = Vec::new();
+    for points in [2u32, 3, 6, 9, 16] {
+        for every in 1u32..=5 {
+            for steps in 1u64..=200 {
+                let last = (steps - 1) as u32;
+                for (j, r) in (1..points).zip(trail_indices(points, every, steps)) {
+                    cases.push([last, j, points, every]);
+                    want.push(r);
+                }
+            }
+        }
+    }
+    let n = cases.len() as u32;
+    let bytes = run_probe(
+        &ctx,
+        RING_PROBE,
+        bytemuck::cast_slice(&cases),
+        u64::from(n) * 4,
+        n.div_ceil(64),
+    );
+    let got: &[u32] = bytemuck::cast_slice(&bytes);
+    for (i, (g, w)) in got.iter().zip(&want).enumerate() {
+        assert_eq!(g, w, "case {:?}", cases[i]);
+    }
+}
+
 /// The ribbon spans the same simulated time at any step: one particle flying with a
 /// trail of 6 points over 0.1 s, stepped at 1/30 to 1/240 s for the same 0.5 s — the ages
 /// recorded in its ring (read back from the GPU) run back 0.1 s from the newest point, in
