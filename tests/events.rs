@@ -11,7 +11,7 @@ use ignis::testing::gpu::types::{Particle, SimParams};
 use ignis::testing::shaders::ShaderLibrary;
 use ignis::testing::sim::GpuSim;
 use ignis::testing::sim::event_scan::{
-    EventRecord, ScanConfig, child_key, event_of, rules_of, scan_events,
+    EventRecord, EventSpawn, ScanConfig, child_key, event_of, rules_of, scan_events,
 };
 
 const DT: f32 = 1.0 / 60.0;
@@ -76,7 +76,7 @@ fn expected_list(
     p: &SimParams,
     (before, after): (&[Particle], &[Particle]),
     bucket: &mut ignis::effect::RateCap,
-) -> (Vec<ignis::testing::sim::event_scan::EventSpawn>, u32) {
+) -> (Vec<EventSpawn>, u32) {
     let rule = rules_of(&effect.emitters[0])[0];
     let mut records = Vec::new();
     for i in 0..p.update_window[1] {
@@ -245,46 +245,7 @@ fn check_against_the_mirror(
         assert_eq!(cp.spawn_count, 0, "a fed emitter has no spawns of its own");
         for (k, s) in list.iter().enumerate() {
             let c = &child[((head + k as u32) % child_cap) as usize];
-            let bits = s.vel_j[3].to_bits();
-            let key = child_key(
-                cp.seed,
-                cp.emitter_salt,
-                s.pos_key[3].to_bits(),
-                bits & 0xFFFF,
-            );
-            // The child's own spawn: its shape's offset from its origin, its own velocity.
-            let q = ignis::testing::sim::cpu_reference::spawn_particle(&cp, key);
-            let origin = cp.world_from_emitter[3];
-            let want_pos: Vec<f32> = (0..3)
-                .map(|i| s.pos_key[i] + (q.pos_age[i] - origin[i]))
-                .collect();
-            // The shape's and the direction's trigonometry differ from the CPU's in the
-            // last bits.
-            let near = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-5);
-            assert!(
-                near(&c.pos_age[..3], &want_pos),
-                "step {step} child {k}: position {:?}, want {want_pos:?}",
-                &c.pos_age[..3]
-            );
-            assert_eq!(c.pos_age[3], 0.0, "born this step");
-            let want_vel: Vec<f32> = (0..3).map(|i| q.vel_life[i] + s.vel_j[i]).collect();
-            assert!(
-                near(&c.vel_life[..3], &want_vel),
-                "step {step} child {k}: velocity {:?}, want {want_vel:?}",
-                &c.vel_life[..3]
-            );
-            let want = q.vel_life[3];
-            // Inheriting the colour, the lifetime's lowest 8 bits carry the parent's age.
-            let want = if inherit_color {
-                f32::from_bits((want.to_bits() & !0xFF) | ((bits >> 16) & 0xFF))
-            } else {
-                want
-            };
-            assert_eq!(
-                c.vel_life[3].to_bits(),
-                want.to_bits(),
-                "step {step} child {k}: lifetime"
-            );
+            check_child(c, s, &cp, inherit_color, &format!("step {step} child {k}"));
         }
         last_count = list.len() as u32;
     }
@@ -299,6 +260,46 @@ fn check_against_the_mirror(
         header.total - header.dropped,
         "children alive"
     );
+}
+
+/// Child `c` of list entry `s` against the CPU's spawn of the child `cp` plans: the event's
+/// position plus its own shape's offset, its own velocity plus what it inherits, and the
+/// lifetime its key draws (with the parent's age in its lowest bits when `inherit_color`).
+fn check_child(c: &Particle, s: &EventSpawn, cp: &SimParams, inherit_color: bool, what: &str) {
+    let bits = s.vel_j[3].to_bits();
+    let key = child_key(
+        cp.seed,
+        cp.emitter_salt,
+        s.pos_key[3].to_bits(),
+        bits & 0xFFFF,
+    );
+    let q = ignis::testing::sim::cpu_reference::spawn_particle(cp, key);
+    let origin = cp.world_from_emitter[3];
+    let want_pos: Vec<f32> = (0..3)
+        .map(|i| s.pos_key[i] + (q.pos_age[i] - origin[i]))
+        .collect();
+    // The shape's and the direction's trigonometry differ from the CPU's in the last bits.
+    let near = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-5);
+    assert!(
+        near(&c.pos_age[..3], &want_pos),
+        "{what}: position {:?}, want {want_pos:?}",
+        &c.pos_age[..3]
+    );
+    assert_eq!(c.pos_age[3], 0.0, "{what}: born this step");
+    let want_vel: Vec<f32> = (0..3).map(|i| q.vel_life[i] + s.vel_j[i]).collect();
+    assert!(
+        near(&c.vel_life[..3], &want_vel),
+        "{what}: velocity {:?}, want {want_vel:?}",
+        &c.vel_life[..3]
+    );
+    let want = q.vel_life[3];
+    // Inheriting the colour, the lifetime's lowest 8 bits carry the parent's age.
+    let want = if inherit_color {
+        f32::from_bits((want.to_bits() & !0xFF) | ((bits >> 16) & 0xFF))
+    } else {
+        want
+    };
+    assert_eq!(c.vel_life[3].to_bits(), want.to_bits(), "{what}: lifetime");
 }
 
 /// A burst of 100 parents of one fixed lifetime: once they are all dead there are exactly

@@ -548,6 +548,47 @@ mod tests {
         assert_eq!(r.to_mode(ParamMode::Curve).bounds(), (1.0, 4.0));
     }
 
+    /// A parameter's integral and scaling against their closed forms, for every mode: a
+    /// constant's integral is v·(b − a) (0 backwards), a range's the mix of its ends'.
+    #[test]
+    fn params_integrate_and_scale_as_their_closed_forms() {
+        let c = Param::Constant(3.0);
+        assert_eq!(c.integral(0.7, 0.25, 2.0), 3.0 * 1.75);
+        assert_eq!(c.integral(0.7, 2.0, 0.25), 0.0);
+        let r = Param::Range { min: 1.0, max: 5.0 };
+        assert!((r.integral(0.25, 0.0, 2.0) - 2.0 * 2.0).abs() < 1e-12);
+        assert_eq!(c.scaled(0.5), Param::Constant(1.5));
+        assert_eq!(
+            r.scaled(2.0),
+            Param::Range {
+                min: 2.0,
+                max: 10.0
+            }
+        );
+        let line = Param::Curve {
+            keys: vec![(0.0, 1.0), (1.0, 3.0)],
+            smooth: false,
+        };
+        assert_eq!(
+            line.scaled(2.0),
+            Param::Curve {
+                keys: vec![(0.0, 2.0), (1.0, 6.0)],
+                smooth: false
+            }
+        );
+        let two = Param::TwoCurves {
+            a: Curve::line(1.0, 3.0),
+            b: Curve::flat(0.5),
+        };
+        let want = Param::TwoCurves {
+            a: Curve::line(2.0, 6.0),
+            b: Curve::flat(1.0),
+        };
+        assert_eq!(two.scaled(2.0), want);
+        // ∫₀¹ (1 + 2t)·2 dt = 4.
+        assert!((line.scaled(2.0).integral(0.0, 0.0, 1.0) - 4.0).abs() < 1e-12);
+    }
+
     /// The names the editor's parameter menus show for the modes.
     #[test]
     fn modes_have_their_menu_names() {
