@@ -134,12 +134,12 @@ fn death_children_match_the_cpu_mirror_including_the_cap() {
     // One block of the scan; then a parent window of several blocks wrapping its ring.
     // The caps per second refill 12.5 and 100.5 children per 1/60 s step into buckets of
     // 75 and 603: once a bucket has drained, 12 or 13, 100 or 101, alternating.
-    check_against_the_mirror(Trigger::Death, 1024, 900.0, 750.0, false);
+    check_against_the_mirror(Trigger::Death, DT, 1024, 900.0, 750.0, false);
     // Children that inherit the parent's colour carry its age at the event.
-    check_against_the_mirror(Trigger::Death, 4096, 9_000.0, 6030.0, true);
+    check_against_the_mirror(Trigger::Death, DT, 4096, 9_000.0, 6030.0, true);
     // A window of more blocks than the scan's workgroup has invocations (about 350 blocks
     // of 1024 slots): each invocation places a run of consecutive blocks.
-    check_against_the_mirror(Trigger::Death, 1 << 19, 900_000.0, 12_000.0, false);
+    check_against_the_mirror(Trigger::Death, DT, 1 << 19, 900_000.0, 12_000.0, false);
 }
 
 /// A parent whose event records cannot fit one storage binding is refused with a message
@@ -170,18 +170,19 @@ fn events_too_large_for_the_device_are_a_clear_error() {
 /// the slots spawned past the ring's end still get their own keys.
 #[test]
 fn birth_children_match_the_cpu_mirror_where_the_ring_wraps() {
-    check_against_the_mirror(Trigger::Birth, 1024, 2000.0, 1500.0, false);
+    check_against_the_mirror(Trigger::Birth, DT, 1024, 2000.0, 1500.0, false);
 }
 
 /// The same for children over life at 1,000 a second in steps of 0.1 s: 100 due per parent
 /// a step, held to the 64 one event spawns at most.
 #[test]
 fn over_life_children_match_the_cpu_mirror_up_to_the_per_event_limit() {
-    check_against_the_mirror(Trigger::OverLife, 1024, 300.0, 2_000.0, false);
+    check_against_the_mirror(Trigger::OverLife, 0.1, 1024, 300.0, 2_000.0, false);
 }
 
 fn check_against_the_mirror(
     trigger: Trigger,
+    dt: f32,
     parent_capacity: u32,
     parent_rate: f32,
     max_per_sec: f32,
@@ -211,12 +212,6 @@ fn check_against_the_mirror(
     child.speed_m_per_s = Range::new(0.2, 0.4);
     effect.validate().expect("valid");
     let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
-    // Over life, long steps: more children due in a step than one event spawns.
-    let dt = if trigger == Trigger::OverLife {
-        0.1
-    } else {
-        DT
-    };
     let (mut head, mut last_count, mut dropped, mut capped_steps) = (0u32, 0u32, 0u32, 0);
     let child_cap = effect.emitters[1].capacity;
     let mut bucket = ignis::effect::RateCap::default();
@@ -302,23 +297,34 @@ fn check_child(c: &Particle, s: &EventSpawn, cp: &SimParams, inherit_color: bool
     assert_eq!(c.vel_life[3].to_bits(), want.to_bits(), "{what}: lifetime");
 }
 
+/// [`parent_and_child`] with one burst of `burst` parents at time 0, living `life_secs`
+/// each, with no gravity, each spawning `children` at its death (inheriting no velocity).
+fn burst_parents(children: u32, burst: u32, life_secs: f32) -> Effect {
+    let event = Event {
+        count: CountRange {
+            min: children,
+            max: children,
+        },
+        inherit_velocity: 0.0,
+        ..Event::default()
+    };
+    let mut effect = parent_and_child(event, 0.0);
+    let p = &mut effect.emitters[0];
+    p.bursts = vec![Burst {
+        time_secs: 0.0,
+        count: burst,
+    }];
+    p.lifetime_secs = Range::new(life_secs, life_secs);
+    p.forces.gravity_m_per_s2 = [0.0; 3];
+    effect
+}
+
 /// A burst of 100 parents of one fixed lifetime: once they are all dead there are exactly
 /// 100 × 3 children, born where the parents died.
 #[test]
 fn a_burst_that_dies_leaves_exactly_count_children() {
     let ctx = strict_gpu();
-    let event = Event {
-        count: CountRange { min: 3, max: 3 },
-        inherit_velocity: 0.0,
-        ..Event::default()
-    };
-    let mut effect = parent_and_child(event, 0.0);
-    effect.emitters[0].bursts = vec![Burst {
-        time_secs: 0.0,
-        count: 100,
-    }];
-    effect.emitters[0].lifetime_secs = Range::new(0.5, 0.5);
-    effect.emitters[0].forces.gravity_m_per_s2 = [0.0; 3];
+    let mut effect = burst_parents(3, 100, 0.5);
     let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
     sim.step(&effect, DT, 25).expect("step");
     assert_eq!(
@@ -366,20 +372,9 @@ fn a_burst_that_dies_leaves_exactly_count_children() {
 #[test]
 fn two_parents_feeding_one_child_in_one_step_both_get_their_children() {
     let ctx = strict_gpu();
-    let event = Event {
-        count: CountRange { min: 1, max: 1 },
-        inherit_velocity: 0.0,
-        ..Event::default()
-    };
-    let mut effect = parent_and_child(event, 0.0);
+    let mut effect = burst_parents(1, 10, 0.3);
     let a = &mut effect.emitters[0];
-    a.bursts = vec![Burst {
-        time_secs: 0.0,
-        count: 10,
-    }];
-    a.lifetime_secs = Range::new(0.3, 0.3);
     a.speed_m_per_s = Range::new(0.0, 0.0);
-    a.forces.gravity_m_per_s2 = [0.0; 3];
     a.transform.position_m = [-1.0, 0.0, 0.0];
     let mut b = a.clone();
     b.name = "second parent".into();
