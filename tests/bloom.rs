@@ -228,20 +228,14 @@ fn bloom_gpu(
             draft,
         )
         .expect("a result");
-    let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(result),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: out.as_entire_binding(),
-            },
+    let group = bind_in_order(
+        ctx,
+        &pipeline,
+        [
+            wgpu::BindingResource::TextureView(result),
+            out.as_entire_binding(),
         ],
-    });
+    );
     {
         let mut cp = enc.begin_compute_pass(&Default::default());
         cp.set_pipeline(&pipeline);

@@ -338,20 +338,11 @@ pub fn run_probe(
             mapped_at_creation: false,
         })
     });
-    let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: input.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: out.as_entire_binding(),
-            },
-        ],
-    });
+    let group = bind_in_order(
+        ctx,
+        &pipeline,
+        [input.as_entire_binding(), out.as_entire_binding()],
+    );
     let mut enc = d.create_command_encoder(&Default::default());
     {
         let mut pass = enc.begin_compute_pass(&Default::default());
@@ -362,4 +353,25 @@ pub fn run_probe(
     enc.copy_buffer_to_buffer(&out, 0, &staging, 0, out_size);
     ctx.queue.submit([enc.finish()]);
     ignis::testing::sim::gpu_sim::map_read(ctx, &staging).expect("read back")
+}
+
+/// Group 0 of `pipeline` with `resources` at bindings 0, 1, … in order.
+pub fn bind_in_order<const N: usize>(
+    ctx: &GpuContext,
+    pipeline: &wgpu::ComputePipeline,
+    resources: [wgpu::BindingResource<'_>; N],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry<'_>> = resources
+        .into_iter()
+        .enumerate()
+        .map(|(i, resource)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource,
+        })
+        .collect();
+    ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &entries,
+    })
 }
