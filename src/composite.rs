@@ -115,6 +115,7 @@ impl Composite {
         camera: &Camera,
     ) {
         let depth = self.draw_scene(ctx, enc, camera);
+        player.set_reduced_layers(self.reduced_layers(player.effect()));
         player.record_sampling(enc, camera, depth.as_ref());
         self.draw(ctx, enc, player, camera);
     }
@@ -185,6 +186,31 @@ impl Composite {
         }
     }
 
+    /// The layers this composite draws at reduced resolution for `effect` (none over the
+    /// test scene, whose depth the soft edges read at full resolution): the blended one
+    /// when `post.alpha_downscale` (or draft) asks, the glow (at half resolution) when
+    /// `post.glow_downscale` or draft does. The player is told
+    /// before its record ([`Player::set_reduced_layers`]).
+    pub fn reduced_layers(&self, effect: &crate::effect::Effect) -> Layers {
+        let mut layers = Layers::NONE;
+        if self.test_scene {
+            return layers;
+        }
+        if self.alpha_downscale(effect) > 1 {
+            layers |= Layers::BLENDED;
+        }
+        if self.draft || effect.post.glow_downscale > 1 {
+            layers |= Layers::GLOW;
+        }
+        layers
+    }
+
+    /// The blended layer's reduction: the preset's, halved again in draft (soft smoke
+    /// hides it).
+    fn alpha_downscale(&self, effect: &crate::effect::Effect) -> u32 {
+        effect.post.alpha_downscale.clamp(1, 4) << u32::from(self.draft)
+    }
+
     /// The particle draws of [`Composite::draw`] (into the HDR target and the reduced
     /// layers); returns the layers drawn into a layer of their own, for [`Composite::post`].
     pub fn draw_particles(
@@ -195,15 +221,12 @@ impl Composite {
         camera: &Camera,
     ) -> Layers {
         let size = self.targets(ctx, camera.size_px()).size;
-        let post = player.effect().post.clone();
         let drawn = player.drawn_layers();
+        let reduce = self.reduced_layers(player.effect());
         let mut layered = Layers::NONE;
-        // The blended layer at reduced resolution (draft halves it again: soft smoke
-        // hides it), added in the tonemap.
-        let downscale = post.alpha_downscale.clamp(1, 4) << u32::from(self.draft);
-        let reduce = !self.test_scene;
-        if reduce && downscale > 1 && drawn.contains(Layers::BLENDED) {
-            let low = reduced(size, downscale);
+        // The blended layer at reduced resolution, added in the tonemap.
+        if reduce.contains(Layers::BLENDED) && drawn.contains(Layers::BLENDED) {
+            let low = reduced(size, self.alpha_downscale(player.effect()));
             ensure_layer(ctx, &mut self.alpha_layer, "Composite::alpha_layer", low);
             if let Some((_, view)) = &self.alpha_layer {
                 self.clear.record(ctx, enc, view, low);
@@ -211,7 +234,7 @@ impl Composite {
                 layered |= Layers::BLENDED;
             }
         }
-        if reduce && self.draft && drawn.contains(Layers::GLOW) {
+        if reduce.contains(Layers::GLOW) && drawn.contains(Layers::GLOW) {
             let half = reduced(size, 2);
             ensure_layer(ctx, &mut self.glow_layer, "Composite::glow_layer", half);
             if let Some((_, view)) = &self.glow_layer {

@@ -112,6 +112,7 @@ impl Headless {
             ..
         } = self;
         let update = timer.time(ctx, |enc| player.simulate(enc));
+        player.set_reduced_layers(composite.reduced_layers(player.effect()));
         let record = timer.time(ctx, |enc| player.record_sampling(enc, camera, None));
         let mut layered = crate::Layers::NONE;
         let draw = timer.time(ctx, |enc| {

@@ -18,7 +18,9 @@ const SIZE: (u32, u32) = (192, 144);
 /// emitter on the billboards; the image and the number of items off the billboards.
 fn render(ctx: &GpuContext, effect: &Effect, auto: bool) -> (image::RgbaImage, usize) {
     let mut effect = effect.clone();
+    // Every layer at full resolution: a reduced one is the billboards' on every path.
     effect.post.alpha_downscale = 1;
+    effect.post.glow_downscale = 1;
     for e in &mut effect.emitters {
         e.look.draw_path = if auto {
             DrawPath::Auto
@@ -61,35 +63,42 @@ fn effects() -> Vec<(String, Effect)> {
     out
 }
 
-#[test]
-fn the_automatic_path_draws_the_billboards_image_under_both_profiles() {
-    let base = gpu();
+/// Every effect under `profile`: the automatic path's image within 1/255 mean of the
+/// billboards'; returns the number of items off the billboards.
+fn auto_matches_billboards(profile: AdapterProfile) -> usize {
+    let ctx = gpu().with_profile(Some(profile));
     let mut off_billboards = 0;
-    for profile in [AdapterProfile::SOFTWARE, AdapterProfile::GPU] {
-        let ctx = base.clone().with_profile(Some(profile));
-        for (what, effect) in effects() {
-            let (reference, _) = render(&ctx, &effect, false);
-            let (auto, off) = render(&ctx, &effect, true);
-            off_billboards += off;
-            assert!(
-                total_light(&reference) > 1e3,
-                "{what}: almost nothing drawn"
-            );
-            let (mean, max) = image_diff(&reference, &auto);
-            eprintln!(
-                "{what} ({profile:?}): {off} items off the billboards, mean {mean:.3}/255, max {max}/255"
-            );
-            assert!(
-                mean <= 1.0,
-                "{what} ({profile:?}): the automatic path differs from the billboards by \
-                 {mean:.3}/255 mean"
-            );
-        }
+    for (what, effect) in effects() {
+        let (reference, _) = render(&ctx, &effect, false);
+        let (auto, off) = render(&ctx, &effect, true);
+        off_billboards += off;
+        assert!(
+            total_light(&reference) > 1e3,
+            "{what}: almost nothing drawn"
+        );
+        let (mean, max) = image_diff(&reference, &auto);
+        eprintln!(
+            "{what} ({profile:?}): {off} items off the billboards, mean {mean:.3}/255, max {max}/255"
+        );
+        assert!(
+            mean <= 1.0,
+            "{what} ({profile:?}): the automatic path differs from the billboards by \
+             {mean:.3}/255 mean"
+        );
     }
-    // The splat under both profiles (the thesis's points, the sphere), the tiles under
-    // the GPU profile.
-    assert!(
-        off_billboards >= 3,
-        "{off_billboards} items left the billboards"
-    );
+    off_billboards
+}
+
+/// The software profile: the splat takes the dense sphere (and the thesis's points).
+#[test]
+fn the_automatic_path_draws_the_billboards_image_under_the_software_profile() {
+    let off = auto_matches_billboards(AdapterProfile::SOFTWARE);
+    assert!(off >= 1, "{off} items left the billboards");
+}
+
+/// The GPU profile: the splat and the tiles take their share.
+#[test]
+fn the_automatic_path_draws_the_billboards_image_under_the_gpu_profile() {
+    let off = auto_matches_billboards(AdapterProfile::GPU);
+    assert!(off >= 2, "{off} items left the billboards");
 }

@@ -448,6 +448,21 @@ fn malformed_cases() -> Vec<Case> {
         )],
     ));
 
+    let t = edit(
+        &base,
+        "    emitters: [",
+        "    post: (glow_downscale: 3),\n    emitters: [",
+    );
+    let at = t.find("glow_downscale: 3").expect("edited") + "glow_downscale: ".len();
+    cases.push(case(
+        "glow_downscale.ron",
+        t.clone(),
+        &[&format!(
+            "glow_downscale.ron:{}: post.glow_downscale = 3: must be 1 or 2 (1 = full resolution)",
+            pos_at(&t, at)
+        )],
+    ));
+
     // Two problems: both are listed, each located.
     let t = edit(
         &edit(&base, "fov_y_deg: 45.0", "fov_y_deg: 0.5"),
@@ -828,9 +843,10 @@ fn version_1_fixture_keeps_loading() {
 /// (The committed reference images, rendered from the version-1 presets, still match the
 /// version-2 frames: `looks.rs`.)
 /// `effect` without what shipped presets took after their migration to version 3 — lit
-/// smoke, heat-haze layers, collision with the host's depth (look and behaviour changes,
-/// not format changes: older files have none).
+/// smoke, heat-haze layers, collision with the host's depth, flames at reduced resolution
+/// (look and behaviour changes, not format changes: older files have none).
 fn unlit(mut effect: Effect) -> Effect {
+    effect.post.glow_downscale = 1;
     effect.emitters.retain(|e| e.look.heat_haze.is_none());
     for e in &mut effect.emitters {
         e.look.lit = None;
@@ -1556,6 +1572,7 @@ fn effect() -> BoxedStrategy<Effect> {
                     exposure: 1.5,
                     bloom: (seed % 2 == 0).then(Bloom::default),
                     alpha_downscale: 1 + seed % 4,
+                    glow_downscale: 1 + seed % 2,
                 },
                 lighting: Lighting {
                     sun_direction: [0.3, 1.0, -0.2],

@@ -526,18 +526,24 @@ fn billboards_beyond_one_draw_carry_all_their_light() {
 /// half resolution and added before the bloom, and the bloom from a quarter-resolution
 /// chain, look like the full-resolution frame — the same light within 3 % (measured
 /// 0.46/255 mean, 1.5 % less light: a 4×4 average clips less above the threshold), a
-/// little softer — while the thin embers stay in the full-resolution pass.
+/// little softer — while the thin embers stay in the full-resolution pass. So do the
+/// flames of `post.glow_downscale: 2` (the shipped campfire's), at full quality.
 #[test]
 fn draft_glow_layer_renders_like_full_resolution() {
     let ctx = gpu();
-    let effect = Effect::default_campfire();
+    let mut effect = Effect::default_campfire();
+    assert_eq!(
+        effect.post.glow_downscale, 2,
+        "the shipped campfire's flames"
+    );
+    effect.post.glow_downscale = 1;
     let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
     for _ in 0..150 {
         run.advance(1.0 / 60.0);
     }
     let full = run.render(SIZE).expect("render");
-    run.composite.draft = true;
-    let draft = run.render(SIZE).expect("render");
+    let unreduced = run.composite.reduced_layers(run.effect());
+    assert!(!unreduced.contains(ignis::Layers::GLOW), "{unreduced:?}");
     // The flames are glow, the streaked embers and the alpha smoke are not.
     let glow: Vec<&str> = run
         .player
@@ -547,13 +553,24 @@ fn draft_glow_layer_renders_like_full_resolution() {
         .map(|d| run.effect().emitters[d.index].name.as_str())
         .collect();
     assert_eq!(glow, ["flames"]);
-    let (mean, max) = image_diff(&full, &draft);
-    let (lf, ld) = (total_light(&full), total_light(&draft));
-    assert!(mean > 0.0, "draft took no other path");
-    assert!(
-        mean < 1.0 && (ld / lf - 1.0).abs() < 0.03,
-        "draft vs full: mean {mean} (max {max}), light {ld} vs {lf}"
-    );
+    for draft in [false, true] {
+        run.composite.draft = draft;
+        run.edit(|e| e.post.glow_downscale = if draft { 1 } else { 2 })
+            .expect("edit");
+        assert!(
+            run.composite
+                .reduced_layers(run.effect())
+                .contains(ignis::Layers::GLOW)
+        );
+        let reduced = run.render(SIZE).expect("render");
+        let (mean, max) = image_diff(&full, &reduced);
+        let (lf, lr) = (total_light(&full), total_light(&reduced));
+        assert!(mean > 0.0, "draft {draft}: no other path taken");
+        assert!(
+            mean < 1.0 && (lr / lf - 1.0).abs() < 0.03,
+            "draft {draft} vs full: mean {mean} (max {max}), light {lr} vs {lf}"
+        );
+    }
 }
 
 /// The adapter profile changes how the frame is made (render scale, draft layers, the UI

@@ -33,7 +33,7 @@ fn render_at(
     frames: u32,
     size: (u32, u32),
 ) -> image::RgbaImage {
-    let mut effect = effect.clone();
+    let mut effect = full_resolution(effect.clone());
     for e in &mut effect.emitters {
         if e.look.draw_path != DrawPath::Splat {
             e.look.draw_path = path;
@@ -57,6 +57,15 @@ fn render_at(
     img
 }
 
+/// `effect` with its smoke and flames drawn at full resolution: a layer the composite
+/// reduces is drawn by the billboards whatever its path
+/// (`a_reduced_blended_layer_is_drawn_by_the_billboards_whatever_the_path`).
+fn full_resolution(mut effect: Effect) -> Effect {
+    effect.post.alpha_downscale = 1;
+    effect.post.glow_downscale = 1;
+    effect
+}
+
 /// The shipped preset `presets/<name>.ron`.
 fn shipped(name: &str) -> Effect {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("presets/{name}.ron"));
@@ -64,8 +73,7 @@ fn shipped(name: &str) -> Effect {
 }
 
 /// Both paths of `effect` agree within 1/255 mean and 8/255 max; returns (mean, max).
-/// The blended layer at full resolution in both (the tiles always draw it so; the
-/// billboards at `post.alpha_downscale`).
+/// Every layer at full resolution in both ([`full_resolution`]).
 fn paths_agree(ctx: &GpuContext, what: &str, effect: &Effect, frames: u32) -> (f64, u8) {
     let (mean, max, _) = compare_paths(ctx, what, effect, frames);
     assert!(
@@ -78,10 +86,8 @@ fn paths_agree(ctx: &GpuContext, what: &str, effect: &Effect, frames: u32) -> (f
 /// Both paths' images of `effect` after `frames` frames: (mean and max difference in
 /// 8-bit levels, the share of channels over 8/255), as [`paths_agree`] renders them.
 fn compare_paths(ctx: &GpuContext, what: &str, effect: &Effect, frames: u32) -> (f64, u8, f64) {
-    let mut effect = effect.clone();
-    effect.post.alpha_downscale = 1;
-    let a = render(ctx, &effect, DrawPath::Billboard, frames);
-    let b = render(ctx, &effect, DrawPath::Tiles, frames);
+    let a = render(ctx, effect, DrawPath::Billboard, frames);
+    let b = render(ctx, effect, DrawPath::Tiles, frames);
     assert!(
         total_light(&a) > 1e3,
         "{what}: the billboards drew almost nothing"
@@ -233,7 +239,7 @@ fn each_look_module_draws_alike_with_tiles_and_billboards() {
 #[test]
 fn streaks_stay_billboards() {
     let ctx = gpu();
-    let mut effect = Effect::default_campfire();
+    let mut effect = full_resolution(Effect::default_campfire());
     for e in &mut effect.emitters {
         e.look.draw_path = DrawPath::Tiles;
     }
@@ -342,11 +348,11 @@ fn sprites_behind_the_camera_draw_nothing() {
 #[test]
 fn tiles_are_deterministic_and_the_automatic_choice_follows_the_profile() {
     let base = gpu();
-    let effect = Effect::default_campfire();
+    let effect = full_resolution(Effect::default_campfire());
     let a = render(&base, &effect, DrawPath::Tiles, 30);
     let b = render(&base, &effect, DrawPath::Tiles, 30);
     assert_eq!(a, b, "the same frame twice differs");
-    let chosen = |profile: AdapterProfile| {
+    let chosen_for = |effect: &Effect, profile: AdapterProfile| {
         let ctx = base.clone().with_profile(Some(profile));
         let mut run =
             Headless::new(&ctx, effect.clone(), ShaderLibrary::embedded()).expect("headless");
@@ -361,6 +367,7 @@ fn tiles_are_deterministic_and_the_automatic_choice_follows_the_profile() {
             .map(|d| (d.index, d.tiles, d.splat))
             .collect::<Vec<_>>()
     };
+    let chosen = |profile: AdapterProfile| chosen_for(&effect, profile);
     let gpu_choice = chosen(AdapterProfile::GPU);
     assert_eq!(
         gpu_choice,
@@ -379,6 +386,13 @@ fn tiles_are_deterministic_and_the_automatic_choice_follows_the_profile() {
             );
         }
     }
+    // As shipped, the campfire's smoke and flames are drawn at reduced resolution: by the
+    // billboards on either profile.
+    let shipped = chosen_for(&Effect::default_campfire(), AdapterProfile::GPU);
+    assert!(
+        shipped.iter().all(|(_, t, _)| !t),
+        "a reduced layer took the tiles: {shipped:?}"
+    );
     // A runtime host's batch of instances is judged by the fill of all of them: the torch's
     // smoke and flame tongues take the tiles as one draw of both instances, its sparks (streaks)
     // and small heads stay billboards.
@@ -624,5 +638,42 @@ fn tiny_sprites_beyond_a_chunk_draw_the_billboards_image() {
     assert!(
         mean <= 1.0 && max <= 8,
         "tiles in chunks differ by {mean:.3}/255 mean, {max}/255 max"
+    );
+}
+
+/// A blended layer drawn at reduced resolution (`post.alpha_downscale`) is drawn by the
+/// billboards whatever path its emitters ask for (the tiles resolve at the target's full
+/// size): the campfire with its smoke forced onto the tiles draws the billboards' image,
+/// bit for bit; at full resolution the tiles take the smoke.
+#[test]
+fn a_reduced_blended_layer_is_drawn_by_the_billboards_whatever_the_path() {
+    let ctx = gpu();
+    let image = |downscale: u32, path: DrawPath| {
+        let mut effect = shipped("campfire");
+        effect.post.alpha_downscale = downscale;
+        for e in &mut effect.emitters {
+            if e.look.blend == BlendMode::Alpha {
+                e.look.draw_path = path;
+            }
+        }
+        let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+        for _ in 0..60 {
+            run.advance(1.0 / 60.0);
+        }
+        let img = run.render(SIZE).expect("render");
+        let tiled = run.player.draw_items().iter().filter(|d| d.tiles).count();
+        (img, tiled)
+    };
+    let (billboards, _) = image(4, DrawPath::Billboard);
+    let (tiles, tiled) = image(4, DrawPath::Tiles);
+    assert_eq!(tiled, 0, "a reduced blended emitter took the tiles");
+    assert!(
+        total_light(&billboards) > 1e3,
+        "the campfire drew almost nothing"
+    );
+    assert!(billboards == tiles, "the reduced smoke differs by its path");
+    assert!(
+        image(1, DrawPath::Tiles).1 > 0,
+        "full-resolution smoke left the tiles"
     );
 }

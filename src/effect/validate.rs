@@ -216,6 +216,13 @@ impl Effect {
                 "must be 1..=4 (1 = full resolution)",
             );
         }
+        if !(1..=2).contains(&self.post.glow_downscale) {
+            c.push(
+                "post.glow_downscale".into(),
+                self.post.glow_downscale,
+                "must be 1 or 2 (1 = full resolution)",
+            );
+        }
         if let Some(b) = &self.post.bloom {
             c.num(|| "post.bloom.threshold".into(), b.threshold, 0.0, 1e3);
             c.num(|| "post.bloom.intensity".into(), b.intensity, 0.0, 100.0);

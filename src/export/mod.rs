@@ -434,6 +434,7 @@ pub fn export_effect(effect: &Effect) -> Effect {
         em.look.draw_path = DrawPath::Billboard;
     }
     e.post.alpha_downscale = 1;
+    e.post.glow_downscale = 1;
     e.post.bloom = None;
     e
 }

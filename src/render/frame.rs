@@ -88,6 +88,12 @@ pub struct FrameResources {
     pub soft_depth: bool,
     /// The tile rasteriser exists (the device's limits allow it).
     pub allow_tiles: bool,
+    /// The host draws the alpha-blended layer at reduced resolution: its emitters stay
+    /// off the tiles, which resolve at the host's full size.
+    pub blended_reduced: bool,
+    /// The host draws the glow layer at reduced resolution: large additive emitters
+    /// (what [`DrawItem::is_glow`] names) stay off the tiles too.
+    pub glow_reduced: bool,
     /// This frame's look blocks on their way to `looks`.
     look_bytes: Vec<u8>,
     /// The light lit layers are drawn in (the host's, or the effect's own `lighting`
@@ -152,6 +158,8 @@ impl FrameResources {
             allow_splat: true,
             soft_depth: false,
             allow_tiles: false,
+            blended_reduced: false,
+            glow_reduced: false,
             look_bytes: Vec::new(),
             lighting: None,
             slot_origins: Vec::new(),
@@ -621,6 +629,7 @@ impl FrameResources {
         // level the rasteriser decides per 2×2 pixels.
         let tiles = self.allow_splat
             && self.allow_tiles
+            && !self.reduced(look, size_px)
             && !splat
             && look.streak.is_none()
             && !trail
@@ -638,6 +647,19 @@ impl FrameResources {
                 DrawPath::Billboard | DrawPath::Splat => false,
             };
         (splat, tiles)
+    }
+
+    /// Whether an emitter with look `look`, its particles up to `size_px` on screen, is
+    /// in a layer the host draws at reduced resolution (then not on the tiles).
+    fn reduced(&self, look: &Look, size_px: f32) -> bool {
+        match look.blend {
+            BlendMode::Alpha => self.blended_reduced,
+            BlendMode::Additive => {
+                self.glow_reduced
+                    && look.streak.is_none()
+                    && size_px >= crate::render::draw_item::GLOW_MIN_PX
+            }
+        }
     }
 
     /// Creates the particle bind group `key` names unless it exists: `b`'s state, and

@@ -82,6 +82,20 @@ impl std::ops::BitOrAssign for Layers {
     }
 }
 
+impl super::Player {
+    /// Tells the player which `layers` the host draws into targets of reduced resolution
+    /// (with [`Player::draw_layers`](super::Player::draw_layers)), from the next
+    /// [`record`](super::Player::record) on; none by default. The tile rasteriser resolves
+    /// at the host's full size, so the alpha-blended emitters of a reduced
+    /// [`Layers::BLENDED`] and the large additive emitters of a reduced [`Layers::GLOW`]
+    /// are drawn by the billboards: at a quarter or a sixteenth of the pixels their fill is
+    /// small, and the reduction is what the host asked for.
+    pub fn set_reduced_layers(&mut self, layers: Layers) {
+        self.frame.blended_reduced = layers.contains(Layers::BLENDED);
+        self.frame.glow_reduced = layers.contains(Layers::GLOW);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::Layers;

@@ -107,13 +107,21 @@ fn post_ui(ui: &mut Ui, post: &mut Post) {
         post.bloom = on.then(Bloom::default);
     }
     ui.end_row();
-    let label = ui.label("Smoke resolution").on_hover_text(
-        "Alpha-blended layers (smoke) are drawn at 1/n of the resolution and upsampled in the \
-            composite: soft smoke looks the same and costs n² less fill",
+    let label = ui.label("Resolution").on_hover_text(
+        "Smoke: alpha-blended layers drawn at 1/n of the resolution and upsampled in the \
+            composite (soft smoke looks the same and costs n² less fill). Flames: large \
+            additive sprites (12 px or more on screen) drawn at 1/n into a glow layer the \
+            bloom and tonemap add (a quarter of the fill; sparks stay sharp)",
     );
     ui.horizontal(|ui| {
+        ui.label("smoke");
         for (n, text) in [(1, "full"), (2, "½"), (4, "¼")] {
             ui.radio_value(&mut post.alpha_downscale, n, text)
+                .labelled_by(label.id);
+        }
+        ui.label("flames");
+        for (n, text) in [(1, "full"), (2, "½")] {
+            ui.radio_value(&mut post.glow_downscale, n, text)
                 .labelled_by(label.id);
         }
     });
