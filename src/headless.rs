@@ -5,7 +5,7 @@
 use crate::composite::Composite;
 use crate::effect::Effect;
 use crate::gpu::GpuContext;
-use crate::gpu::timer::GpuTimer;
+use crate::gpu::timer::{GpuTimer, PassTimer};
 use crate::render::{Camera, OrbitCamera};
 use crate::runtime::{InstanceId, Player, PlayerError, PlayerSettings};
 use crate::shaders::{ShaderLibrary, ShaderSourceDir};
@@ -123,6 +123,43 @@ impl Headless {
             composite.post(ctx, enc, player, layered)
         });
         [update, record, draw, post]
+    }
+
+    /// [`Headless::timed_frame`] as a frame loop runs it: the four parts in one encoder
+    /// between `timer`'s timestamps ("update", "record", "draw", "composite"), submitted
+    /// without waiting, so the GPU stays busy from frame to frame. The parts' times reach
+    /// `timer.latest` a frame or two later (frames the timer's ring has no room for are
+    /// not timed).
+    pub fn pipelined_frame(&mut self, timer: &mut PassTimer, frame_dt_secs: f64, camera: &Camera) {
+        self.player.advance(frame_dt_secs);
+        let Self {
+            ctx,
+            player,
+            composite,
+            ..
+        } = self;
+        let timing = timer.begin_frame();
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        timer.scope(&mut enc, "update", |enc| player.simulate(enc));
+        player.set_reduced_layers(composite.reduced_layers(player.effect()));
+        timer.scope(&mut enc, "record", |enc| {
+            player.record_sampling(enc, camera, None)
+        });
+        let layered = timer.scope(&mut enc, "draw", |enc| {
+            composite.draw_particles(ctx, enc, player, camera)
+        });
+        timer.scope(&mut enc, "composite", |enc| {
+            composite.apply_haze(ctx, enc, player);
+            composite.post(ctx, enc, player, layered)
+        });
+        if timing {
+            timer.end_frame(&mut enc);
+        }
+        ctx.queue.submit([enc.finish()]);
+        if timing {
+            timer.after_submit();
+        }
+        timer.poll(ctx);
     }
 
     /// Alive particles over all emitters (blocking readback of the GPU counters).

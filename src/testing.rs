@@ -24,7 +24,7 @@ pub mod gpu {
 
     /// Timestamp queries.
     pub mod timer {
-        pub use crate::gpu::timer::PassTimer;
+        pub use crate::gpu::timer::{GpuTimer, PassTimer};
     }
 }
 

@@ -609,3 +609,53 @@ fn both_adapter_profiles_render_the_same_frame() {
         "gpu vs software profile: mean {mean}, max {max}"
     );
 }
+
+/// `ignis bench presets --pipelined`'s frames: the parts of each frame in one submission,
+/// frames back to back. They draw what the frames timed part by part draw (the same image
+/// after the same frames), and the pass timer labels all four parts.
+#[test]
+fn pipelined_frames_draw_what_timed_frames_draw_and_time_every_part() {
+    use ignis::testing::gpu::timer::{GpuTimer, PassTimer};
+    let ctx = gpu();
+    let effect = Effect::default_campfire();
+    let mut apart = Headless::new(&ctx, effect.clone(), ShaderLibrary::embedded()).expect("run");
+    let mut pipelined = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("run");
+    let camera = apart.camera.view(SIZE);
+    let timer = GpuTimer::new(&ctx);
+    let mut pass_timer = PassTimer::new_even_on_cpu(&ctx).expect("lavapipe has timestamps");
+    for _ in 0..12 {
+        apart.timed_frame(&timer, 1.0 / 60.0, &camera);
+        pipelined.pipelined_frame(&mut pass_timer, 1.0 / 60.0, &camera);
+    }
+    let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
+    pass_timer.poll(&ctx);
+    assert!(
+        pass_timer.completed >= 4,
+        "{} frames timed",
+        pass_timer.completed
+    );
+    let labels: Vec<&str> = pass_timer.latest.iter().map(|s| s.0).collect();
+    assert_eq!(labels, ["update", "record", "draw", "composite"]);
+    assert!(
+        pass_timer
+            .latest
+            .iter()
+            .all(|s| s.1 >= 0.0 && s.1.is_finite())
+    );
+    // The display images the last frames left.
+    let shown = |run: &Headless| {
+        use ignis::testing::gpu::TextureReadback;
+        let ldr = &run.composite.targets_ref().expect("targets").ldr;
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        let readback = TextureReadback::record(&ctx.device, &mut enc, ldr, "shown");
+        ctx.queue.submit([enc.finish()]);
+        let bytes = ignis::testing::sim::gpu_sim::map_read(&ctx, &readback.buffer).expect("read");
+        readback.rows(&bytes).expect("rows").concat()
+    };
+    let (a, b) = (shown(&apart), shown(&pipelined));
+    assert!(
+        a.iter().map(|&v| u64::from(v)).sum::<u64>() > 1e5 as u64,
+        "almost nothing drawn"
+    );
+    assert!(a == b, "pipelined frames drew another image");
+}

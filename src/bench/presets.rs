@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 use crate::effect::{DrawPath, Effect};
 use crate::gpu::GpuContext;
-use crate::gpu::timer::{GpuTimer, median};
+use crate::gpu::timer::{GpuTimer, PassTimer, median};
 use crate::headless::Headless;
 use crate::runtime::PlayerError;
 use crate::shaders::ShaderLibrary;
@@ -31,6 +31,9 @@ pub struct PresetsOptions {
     /// Where to save a close-up of the largest difference of each row whose image
     /// differs from the billboards' by more than 8/255 (none when `None`).
     pub diff_crops: Option<PathBuf>,
+    /// Time the parts of each frame inside one submission per frame, frames back to back
+    /// (as a frame loop runs them), instead of each part apart with the GPU idle between.
+    pub pipelined: bool,
 }
 
 /// One preset at one size with one path choice.
@@ -307,18 +310,10 @@ fn measure(
         run.advance(1.0 / 60.0);
     }
     let camera = run.camera.view(size);
-    let mut parts: [Vec<f64>; 4] = Default::default();
-    // Ten frames untimed first: the steps the warm-up planned, and the GPU's clocks up
-    // from idle.
-    for frame in 0..opts.frames + UNTIMED_FRAMES {
-        if frame == UNTIMED_FRAMES {
-            parts = Default::default();
-        }
-        let times = run.timed_frame(timer, 1.0 / 60.0, &camera);
-        for (p, t) in parts.iter_mut().zip(times) {
-            p.push(t);
-        }
-    }
+    let parts = match PassTimer::new(ctx).filter(|_| opts.pipelined) {
+        Some(mut pass_timer) => pipelined_parts(&mut run, &mut pass_timer, &camera, opts.frames),
+        None => apart_parts(&mut run, timer, &camera, opts.frames),
+    };
     let [update_ms, sort_ms, draw_ms, composite_ms] = parts.map(|mut p| median(&mut p));
     let row = Row {
         preset: name,
@@ -336,12 +331,68 @@ fn measure(
     Ok((row, run))
 }
 
+/// Each part's times over `frames` frames after `UNTIMED_FRAMES` untimed ones (the steps
+/// the warm-up planned, and the GPU's clocks up from idle), each part timed apart.
+fn apart_parts(
+    run: &mut Headless,
+    timer: &GpuTimer,
+    camera: &crate::render::Camera,
+    frames: usize,
+) -> [Vec<f64>; 4] {
+    let mut parts: [Vec<f64>; 4] = Default::default();
+    for frame in 0..frames + UNTIMED_FRAMES {
+        if frame == UNTIMED_FRAMES {
+            parts = Default::default();
+        }
+        let times = run.timed_frame(timer, 1.0 / 60.0, camera);
+        for (p, t) in parts.iter_mut().zip(times) {
+            p.push(t);
+        }
+    }
+    parts
+}
+
+/// Each part's times as [`apart_parts`] gives them, from the same number of frames
+/// submitted back to back ([`Headless::pipelined_frame`]; the images the rows compare are
+/// then of the same moment): the frames the pass timer's ring had room for, after the
+/// untimed ones.
+fn pipelined_parts(
+    run: &mut Headless,
+    timer: &mut PassTimer,
+    camera: &crate::render::Camera,
+    frames: usize,
+) -> [Vec<f64>; 4] {
+    let mut parts: [Vec<f64>; 4] = Default::default();
+    // Measurements completed before this count are the untimed frames'.
+    let mut seen = u64::MAX;
+    let keep = |timer: &PassTimer, seen: &mut u64, parts: &mut [Vec<f64>; 4]| {
+        if timer.completed != *seen {
+            *seen = timer.completed;
+            for (p, (_, ms)) in parts.iter_mut().zip(&timer.latest) {
+                p.push(*ms);
+            }
+        }
+    };
+    for frame in 0..frames + UNTIMED_FRAMES {
+        run.pipelined_frame(timer, 1.0 / 60.0, camera);
+        if frame == UNTIMED_FRAMES {
+            seen = timer.completed;
+        } else if frame > UNTIMED_FRAMES {
+            keep(timer, &mut seen, &mut parts);
+        }
+    }
+    let _ = run.ctx.device.poll(wgpu::PollType::wait_indefinitely());
+    timer.poll(&run.ctx);
+    keep(timer, &mut seen, &mut parts);
+    parts
+}
+
 fn report(ctx: &GpuContext, timer: &GpuTimer, opts: &PresetsOptions, rows: &[Row]) -> Report {
     let mut r = Report::new("ignis presets: what the shipped effects cost", ctx);
     r.para(&format!(
         "Each preset in steady state (played past its last burst and longest lifetime at \
          60 fps; an effect of bursts alone a quarter of its longest lifetime after its last \
-         burst), then 10 untimed frames, then {} frames; medians of each part, timed apart ({:?}): update, sort + \
+         burst), then 10 untimed frames, then {} frames; medians of each part, {} ({:?}): update, sort + \
          splat + the tiles' project, bin and shade (the player's record), particle draws \
          (billboards, the splat's and the tiles' composite into the target), composite \
          (heat haze + bloom + tonemap). `frame` is their sum. `auto` is the preset's own draw-path \
@@ -356,6 +407,12 @@ fn report(ctx: &GpuContext, timer: &GpuTimer, opts: &PresetsOptions, rows: &[Row
          last column compares the next frame's image with the billboards' (8-bit levels; the \
          first pass's, images are deterministic).",
         opts.frames,
+        if opts.pipelined && PassTimer::new(ctx).is_some() {
+            "timed inside one submission per frame, frames submitted back to back as a frame \
+             loop runs them (`--pipelined`)"
+        } else {
+            "each part timed apart (submitted alone, the GPU idle between)"
+        },
         timer.source,
         opts.passes.max(1)
     ));

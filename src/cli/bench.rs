@@ -25,6 +25,11 @@ pub(super) enum BenchKind {
         /// than 8/255 into this folder.
         #[arg(long)]
         diff_crops: Option<PathBuf>,
+        /// Time each frame's parts inside one submission, frames back to back (as a frame
+        /// loop runs them; GPU timestamps only), not each part apart with the GPU idle
+        /// between: a GPU that lowers its clocks when idle is then measured at work.
+        #[arg(long)]
+        pipelined: bool,
         /// Output folder.
         #[arg(long, default_value = "bench/results")]
         out: PathBuf,
@@ -137,6 +142,7 @@ pub(super) fn bench(kind: BenchKind, profile: &ProfileRequest) -> anyhow::Result
             frames,
             passes,
             diff_crops,
+            pipelined,
             out,
             name,
         } => {
@@ -146,6 +152,7 @@ pub(super) fn bench(kind: BenchKind, profile: &ProfileRequest) -> anyhow::Result
                 frames: frames.max(1),
                 passes: passes.max(1),
                 diff_crops,
+                pipelined,
             };
             let report = crate::bench::presets::run(&ctx, &opts)?;
             save_report(&report, &out, name, "presets", &ctx)?;

@@ -154,6 +154,8 @@ pub struct PassTimer {
     period_ns: f64,
     /// The latest complete measurement: (pass label, milliseconds).
     pub latest: Vec<(&'static str, f64)>,
+    /// How many measurements have completed (`latest` is the last of them).
+    pub completed: u64,
 }
 
 impl PassTimer {
@@ -205,6 +207,7 @@ impl PassTimer {
             next: 0,
             period_ns: ctx.queue.get_timestamp_period() as f64,
             latest: Vec::new(),
+            completed: 0,
         })
     }
 
@@ -311,6 +314,7 @@ impl PassTimer {
                             )
                         })
                         .collect();
+                    self.completed += 1;
                 }
             }
         }
