@@ -13,6 +13,11 @@ longer validates (tests/shaders.rs's composition check fails), and *missed* othe
     cargo test --release --features mutants --no-run          # once
     scripts/wgsl_mutants.py events.wgsl --jobs 4              # one shader
     scripts/wgsl_mutants.py --all --jobs 12 --out bench/results/mutants
+    scripts/wgsl_mutants.py tiles.wgsl --fail-fast --jobs 8   # stop at a mutant's first failure
+
+With --fail-fast each test runs alone, the fastest first (timed on the unmutated shaders),
+and a mutant's run stops at its first failing test: the same verdicts, sooner for the
+mutants a quick test catches (a survivor still runs every test).
 
 The test binaries are found under target/release/deps (or --bins DIR). Which tests cover
 which shader is the table TESTS below.
@@ -131,6 +136,50 @@ def run_tests(bins, tests, shader_dir, timeout):
     return "passed"
 
 
+def list_tests(bins, name, filt, env):
+    """The names of binary `name`'s tests that libtest arguments `filt` select."""
+    cmd = [str(bins[name]), "--list", "--format", "terse"] + (filt.split() if filt else [])
+    out = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True).stdout
+    return [l[: -len(": test")] for l in out.splitlines() if l.endswith(": test")]
+
+
+def run_alone(bins, name, test, env, timeout):
+    """'failed', 'timeout' or 'passed' for one test run by itself; and its seconds."""
+    start = time.time()
+    cmd = [str(bins[name]), "--exact", test, "--test-threads", "1"]
+    try:
+        r = subprocess.run(cmd, cwd=ROOT, env=env, stdout=subprocess.DEVNULL,
+                           stderr=subprocess.DEVNULL, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return "timeout", time.time() - start
+    return ("failed" if r.returncode != 0 else "passed"), time.time() - start
+
+
+def time_tests(bins, tests, shader_dir, timeout):
+    """Every test of `tests` alone on the shaders in `shader_dir`, fastest first:
+    [(binary, test, seconds)]; None when one does not pass."""
+    env = dict(os.environ, IGNIS_MUTANT_SHADERS=str(shader_dir))
+    timed = []
+    for name, filt in tests:
+        for test in list_tests(bins, name, filt, env):
+            outcome, secs = run_alone(bins, name, test, env, timeout)
+            if outcome != "passed":
+                return None
+            timed.append((name, test, secs))
+    return sorted(timed, key=lambda t: t[2])
+
+
+def run_fail_fast(bins, order, shader_dir, timeout):
+    """run_tests's verdict from the tests in `order` run one by one, stopping at the
+    first that fails; each under five times its unmutated time (at least 20 s)."""
+    env = dict(os.environ, IGNIS_MUTANT_SHADERS=str(shader_dir))
+    for name, test, secs in order:
+        outcome, _ = run_alone(bins, name, test, env, min(timeout, max(20.0, 5.0 * secs)))
+        if outcome != "passed":
+            return outcome
+    return "passed"
+
+
 def judge(args, bins, shader, mutant):
     line, what, text = mutant
     with tempfile.TemporaryDirectory(prefix="wgsl-mutant-") as tmp:
@@ -139,7 +188,10 @@ def judge(args, bins, shader, mutant):
         (copy / shader).write_text(text)
         if run_tests(bins, [VALIDATE], copy, args.timeout) != "passed":
             return (line, what, "unviable")
-        outcome = run_tests(bins, TESTS[shader], copy, args.timeout)
+        if args.orders is not None:
+            outcome = run_fail_fast(bins, args.orders[shader], copy, args.timeout)
+        else:
+            outcome = run_tests(bins, TESTS[shader], copy, args.timeout)
     return (line, what, "missed" if outcome == "passed" else "caught")
 
 
@@ -152,13 +204,21 @@ def baseline(args, bins, shaders):
         if run_tests(bins, [VALIDATE], copy, args.timeout) != "passed":
             sys.exit("the shader validation test fails on the unmutated shaders")
         tests = sorted({t for s in shaders for t in TESTS[s]}, key=str)
-        failing = {t for t in tests if run_tests(bins, [t], copy, args.timeout) != "passed"}
+        if args.fail_fast:
+            timed = {t: time_tests(bins, [t], copy, args.timeout) for t in tests}
+            failing = {t for t, order in timed.items() if order is None}
+            args.orders = {
+                s: sorted((x for t in TESTS[s] for x in timed[t] or []), key=lambda x: x[2])
+                for s in shaders
+            }
+        else:
+            failing = {t for t in tests if run_tests(bins, [t], copy, args.timeout) != "passed"}
     for t in sorted(failing, key=str):
         print(f"baseline: the tests {t} fail on the unmutated shaders", file=sys.stderr)
     return [s for s in shaders if not failing & set(TESTS[s])]
 
 
-def report(shader, results, seconds):
+def report(shader, results, seconds, fail_fast=False):
     viable = [r for r in results if r[2] != "unviable"]
     caught = [r for r in viable if r[2] == "caught"]
     missed = [r for r in viable if r[2] == "missed"]
@@ -166,7 +226,7 @@ def report(shader, results, seconds):
     lines = [
         f"# WGSL mutants: `shaders/{shader}`",
         "",
-        f"`scripts/wgsl_mutants.py {shader}` — tests: "
+        f"`scripts/wgsl_mutants.py {shader}{' --fail-fast' if fail_fast else ''}` — tests: "
         + ", ".join(f"`{b}`" + (f" ({f})" if f else "") for b, f in TESTS[shader])
         + f"; {seconds:.0f} s.",
         "",
@@ -192,7 +252,10 @@ def main():
     ap.add_argument("--bins", default=str(ROOT / "target/release/deps"))
     ap.add_argument("--out", help="folder for one results file per shader")
     ap.add_argument("--list", action="store_true", help="print the mutants and stop")
+    ap.add_argument("--fail-fast", action="store_true",
+                    help="each test alone, fastest first; a mutant stops at its first failure")
     args = ap.parse_args()
+    args.orders = None
     shaders = list(TESTS) if args.all else args.shaders
     unknown = [s for s in shaders if s not in TESTS]
     if not shaders or unknown:
@@ -223,9 +286,9 @@ def main():
                 results.append(job.result())
                 if path and len(results) < len(mutants):
                     # Progress on disk: a run cut short keeps what it judged.
-                    text, _ = report(shader, results, time.time() - start)
+                    text, _ = report(shader, results, time.time() - start, args.fail_fast)
                     path.write_text(f"{text}\n(partial: {len(results)} of {len(mutants)})\n")
-        text, row = report(shader, results, time.time() - start)
+        text, row = report(shader, results, time.time() - start, args.fail_fast)
         print(text)
         summary.append((shader, row))
         if path:
