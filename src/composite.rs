@@ -115,9 +115,21 @@ impl Composite {
         camera: &Camera,
     ) {
         let depth = self.draw_scene(ctx, enc, camera);
-        player.set_reduced_layers(self.reduced_layers(player.effect()));
-        player.record_sampling(enc, camera, depth.as_ref());
+        self.record_player(enc, player, camera, depth.as_ref());
         self.draw(ctx, enc, player, camera);
+    }
+
+    /// The player's record for `camera` (sampling `depth`, the scene's), told first which
+    /// layers this composite will draw at reduced resolution ([`Composite::reduced_layers`]).
+    pub fn record_player(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        player: &mut Player,
+        camera: &Camera,
+        depth: Option<&wgpu::TextureView>,
+    ) {
+        player.set_reduced_layers(self.reduced_layers(player.effect()));
+        player.record_sampling(enc, camera, depth);
     }
 
     /// With [`Composite::test_scene`] on, clears the HDR target and draws the props into

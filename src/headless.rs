@@ -112,8 +112,9 @@ impl Headless {
             ..
         } = self;
         let update = timer.time(ctx, |enc| player.simulate(enc));
-        player.set_reduced_layers(composite.reduced_layers(player.effect()));
-        let record = timer.time(ctx, |enc| player.record_sampling(enc, camera, None));
+        let record = timer.time(ctx, |enc| {
+            composite.record_player(enc, player, camera, None)
+        });
         let mut layered = crate::Layers::NONE;
         let draw = timer.time(ctx, |enc| {
             layered = composite.draw_particles(ctx, enc, player, camera);
@@ -141,9 +142,8 @@ impl Headless {
         let timing = timer.begin_frame();
         let mut enc = ctx.device.create_command_encoder(&Default::default());
         timer.scope(&mut enc, "update", |enc| player.simulate(enc));
-        player.set_reduced_layers(composite.reduced_layers(player.effect()));
         timer.scope(&mut enc, "record", |enc| {
-            player.record_sampling(enc, camera, None)
+            composite.record_player(enc, player, camera, None)
         });
         let layered = timer.scope(&mut enc, "draw", |enc| {
             composite.draw_particles(ctx, enc, player, camera)

@@ -407,7 +407,7 @@ fn report(ctx: &GpuContext, timer: &GpuTimer, opts: &PresetsOptions, rows: &[Row
          last column compares the next frame's image with the billboards' (8-bit levels; the \
          first pass's, images are deterministic).",
         opts.frames,
-        if opts.pipelined && PassTimer::new(ctx).is_some() {
+        if opts.pipelined && PassTimer::available(ctx) {
             "timed inside one submission per frame, frames submitted back to back as a frame \
              loop runs them (`--pipelined`)"
         } else {

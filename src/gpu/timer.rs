@@ -161,18 +161,25 @@ pub struct PassTimer {
 impl PassTimer {
     /// A pass timer when the device has trustworthy timestamps (not a CPU adapter).
     pub fn new(ctx: &GpuContext) -> Option<Self> {
-        if !ctx.profile.timestamps {
+        if !Self::available(ctx) {
             return None;
         }
         Self::new_even_on_cpu(ctx)
     }
 
+    /// Whether [`PassTimer::new`] gives a timer on this device.
+    pub fn available(ctx: &GpuContext) -> bool {
+        ctx.profile.timestamps && ctx.device.features().contains(Self::FEATURES)
+    }
+
+    /// The device features a pass timer needs.
+    const FEATURES: wgpu::Features =
+        wgpu::Features::TIMESTAMP_QUERY.union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
+
     /// A pass timer whenever the device has the timestamp features (tests use this on
     /// software adapters, whose readings are not trusted for figures).
     pub fn new_even_on_cpu(ctx: &GpuContext) -> Option<Self> {
-        let wanted =
-            wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
-        if !ctx.device.features().contains(wanted) {
+        if !ctx.device.features().contains(Self::FEATURES) {
             return None;
         }
         let count = MAX_SPANS * 2;

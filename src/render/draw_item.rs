@@ -82,12 +82,15 @@ impl DrawItem {
     /// A large additive billboard that a draft render draws at half resolution
     /// (streaks stay sharp: they are thin however long).
     pub fn is_glow(&self) -> bool {
-        !self.splat
-            && !self.tiles
-            && self.blend == BlendMode::Additive
-            && !self.variant.streak
-            && self.size_px >= GLOW_MIN_PX
+        !self.splat && !self.tiles && glow_sized(self.blend, self.variant.streak, self.size_px)
     }
+}
+
+/// Whether particles of `blend`, streaked or not, up to `size_px` on screen are glow when
+/// drawn as billboards: additive, not streaks (thin however long), at least
+/// [`GLOW_MIN_PX`].
+pub fn glow_sized(blend: BlendMode, streak: bool, size_px: f32) -> bool {
+    blend == BlendMode::Additive && !streak && size_px >= GLOW_MIN_PX
 }
 
 /// Billboards at least this large on screen (pixels at full resolution) count as glow.

@@ -24,6 +24,7 @@ use crate::sim::Modules;
 
 mod looks;
 
+use super::draw_item::glow_sized;
 pub use super::draw_item::{DrawItem, LOOKS_PER_DRAW, Scene, SceneGroup};
 pub use super::variant::{LookVariant, StateVariant};
 pub use looks::look_uniform;
@@ -655,9 +656,7 @@ impl FrameResources {
         match look.blend {
             BlendMode::Alpha => self.blended_reduced,
             BlendMode::Additive => {
-                self.glow_reduced
-                    && look.streak.is_none()
-                    && size_px >= crate::render::draw_item::GLOW_MIN_PX
+                self.glow_reduced && glow_sized(look.blend, look.streak.is_some(), size_px)
             }
         }
     }

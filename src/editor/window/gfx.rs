@@ -402,9 +402,8 @@ impl Gfx {
                 let depth = composite.draw_scene(ctx, &mut encoder, &camera);
                 player.collide_with(&camera, depth.as_ref());
                 t.scope(&mut encoder, "update", |enc| player.simulate(enc));
-                player.set_reduced_layers(composite.reduced_layers(player.effect()));
                 t.scope(&mut encoder, "sort + splat", |enc| {
-                    player.record_sampling(enc, &camera, depth.as_ref())
+                    composite.record_player(enc, player, &camera, depth.as_ref())
                 });
                 t.scope(&mut encoder, "draw + composite", |enc| {
                     composite.draw(ctx, enc, player, &camera)
