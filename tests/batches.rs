@@ -56,32 +56,48 @@ fn frame_commands(host: &Host, effect: &Effect, n: u32) -> (CommandCounts, bool)
     (player.recorded_commands(), lit)
 }
 
+// One test per path: each plays 1, 16, 17 and 100 torches twice (with and without
+// smoke), and the paths run side by side.
 #[test]
-fn instances_of_one_preset_share_their_batch_dispatches_and_draws() {
+fn instances_on_billboards_share_their_batch_dispatches_and_draws() {
+    instances_share_their_batch_commands(DrawPath::Billboard);
+}
+
+#[test]
+fn instances_on_tiles_share_their_batch_dispatches_and_draws() {
+    instances_share_their_batch_commands(DrawPath::Tiles);
+}
+
+#[test]
+fn instances_on_the_splat_share_their_batch_dispatches_and_draws() {
+    instances_share_their_batch_commands(DrawPath::Splat);
+}
+
+/// 1 and 16 torches on `path` record the same commands, and each further batch the same
+/// step (with smoke: the draws exactly, the dispatches within the sort's growth).
+fn instances_share_their_batch_commands(path: DrawPath) {
     let host = Host::new(vec3(0.0, 1.5, 3.5), vec3(0.0, 0.8, -1.0));
-    for path in [DrawPath::Billboard, DrawPath::Tiles, DrawPath::Splat] {
-        for smoke in [false, true] {
-            let [one, sixteen, two, hundred] = batch_commands(&host, path, smoke);
-            let what = format!("{path:?}, smoke {smoke}");
-            assert!(one.dispatches > 0 && one.draws > 0, "{what}: {one:?}");
-            assert_eq!(one, sixteen, "{what}: 16 instances in one batch");
-            let per_batch = two - one;
+    for smoke in [false, true] {
+        let [one, sixteen, two, hundred] = batch_commands(&host, path, smoke);
+        let what = format!("{path:?}, smoke {smoke}");
+        assert!(one.dispatches > 0 && one.draws > 0, "{what}: {one:?}");
+        assert_eq!(one, sixteen, "{what}: 16 instances in one batch");
+        let per_batch = two - one;
+        assert!(
+            per_batch.dispatches > 0,
+            "{what}: a second batch steps nowhere"
+        );
+        let third = hundred - two;
+        if smoke {
+            // The third batch's sort (64 members, not 32) may run a longer network.
+            assert_eq!(third.draws, per_batch.draws, "{what}: draws per batch");
+            let growth = third.dispatches - per_batch.dispatches;
             assert!(
-                per_batch.dispatches > 0,
-                "{what}: a second batch steps nowhere"
+                growth <= 8,
+                "{what}: the third batch {third:?}, the second {per_batch:?}"
             );
-            let third = hundred - two;
-            if smoke {
-                // The third batch's sort (64 members, not 32) may run a longer network.
-                assert_eq!(third.draws, per_batch.draws, "{what}: draws per batch");
-                let growth = third.dispatches - per_batch.dispatches;
-                assert!(
-                    growth <= 8,
-                    "{what}: the third batch {third:?}, the second {per_batch:?}"
-                );
-            } else {
-                assert_eq!(third, per_batch, "{what}: commands per batch");
-            }
+        } else {
+            assert_eq!(third, per_batch, "{what}: commands per batch");
         }
     }
 }
