@@ -12,6 +12,7 @@ use crate::effect::{DrawPath, Effect};
 use crate::gpu::GpuContext;
 use crate::gpu::timer::{GpuTimer, PassTimer, median};
 use crate::headless::Headless;
+use crate::render::tiles::TileStages;
 use crate::runtime::PlayerError;
 use crate::shaders::ShaderLibrary;
 
@@ -53,6 +54,10 @@ struct Row {
     diff_max: u8,
     /// The frame of every pass, ms (the row's parts are its fastest pass's).
     pass_frame_ms: Vec<f64>,
+    /// Where the row draws some of its layers on the tiles: the record timed apart with
+    /// the tiles stopped after each stage, as what each stage adds (ms): up to the
+    /// projection (with the sort and the splat), the binning, the shade.
+    tile_stages_ms: Option<[f64; 3]>,
 }
 
 /// Frames run before the timed ones of each row.
@@ -315,6 +320,7 @@ fn measure(
         None => apart_parts(&mut run, timer, &camera, opts.frames),
     };
     let [update_ms, sort_ms, draw_ms, composite_ms] = parts.map(|mut p| median(&mut p));
+    let tile_stages_ms = tile_stages(&mut run, timer, &camera, opts.frames);
     let row = Row {
         preset: name,
         size: format!("{}x{}", size.0, size.1),
@@ -327,8 +333,40 @@ fn measure(
         diff_mean: 0.0,
         diff_max: 0,
         pass_frame_ms: Vec::new(),
+        tile_stages_ms,
     };
     Ok((row, run))
+}
+
+/// What each of the tiles' stages adds to the record (ms: up to the projection, the
+/// binning, the shade; medians of `frames` records of the state the row's frames left,
+/// each timed apart), where some of the frame's layers are on the tiles.
+fn tile_stages(
+    run: &mut Headless,
+    timer: &GpuTimer,
+    camera: &crate::render::Camera,
+    frames: usize,
+) -> Option<[f64; 3]> {
+    if !run.player.draw_items().iter().any(|d| d.tiles) {
+        return None;
+    }
+    let mut upto = [0.0; 3];
+    for (ms, stages) in upto
+        .iter_mut()
+        .zip([TileStages::Project, TileStages::Bin, TileStages::All])
+    {
+        run.player.tile_pass()?.set_stages(stages);
+        let mut times: Vec<f64> = (0..frames.max(1))
+            .map(|_| {
+                timer.time(&run.ctx, |enc| {
+                    run.composite
+                        .record_player(enc, &mut run.player, camera, None)
+                })
+            })
+            .collect();
+        *ms = median(&mut times);
+    }
+    Some([upto[0], upto[1] - upto[0], upto[2] - upto[1]])
 }
 
 /// Each part's times over `frames` frames after `UNTIMED_FRAMES` untimed ones (the steps
@@ -405,7 +443,10 @@ fn report(ctx: &GpuContext, timer: &GpuTimer, opts: &PresetsOptions, rows: &[Row
          lent H100 has slow states that double every part of a frame for seconds at a time): \
          the parts shown are the row's fastest pass's, and every pass's frame is listed. The \
          last column compares the next frame's image with the billboards' (8-bit levels; the \
-         first pass's, images are deterministic).",
+         first pass's, images are deterministic). Where a row draws on the tiles, the \
+         record is timed again, apart, with the tiles stopped after each stage: what the \
+         projection (with the sort and the splat before it), the binning and the shade each \
+         add.",
         opts.frames,
         if opts.pipelined && PassTimer::available(ctx) {
             "timed inside one submission per frame, frames submitted back to back as a frame \
@@ -434,6 +475,9 @@ fn report(ctx: &GpuContext, timer: &GpuTimer, opts: &PresetsOptions, rows: &[Row
                     .collect::<Vec<_>>()
                     .join(" / "),
                 format!("{:.2} / {}", w.diff_mean, w.diff_max),
+                w.tile_stages_ms.map_or("-".to_owned(), |[p, b, s]| {
+                    format!("{p:.3} / {b:.3} / {s:.3}")
+                }),
             ]
         })
         .collect();
@@ -449,6 +493,7 @@ fn report(ctx: &GpuContext, timer: &GpuTimer, opts: &PresetsOptions, rows: &[Row
             "frame ms",
             "frame ms of each pass",
             "vs billboards (mean / max, of 255)",
+            "tiles: to project / bin / shade ms",
         ],
         &table,
     );
