@@ -6,8 +6,11 @@ use serde::Serialize;
 
 use crate::effect::{DrawPath, Effect, Emitter, Integrator, TimeMode};
 
-/// The fixed steps every sweep tries, seconds.
+/// The fixed steps a sweep tries unless asked for others, seconds.
 pub const STEPS: [f32; 4] = [1.0 / 30.0, 1.0 / 60.0, 1.0 / 120.0, 1.0 / 240.0];
+
+/// [`STEPS`] as steps per second.
+pub const RATES: [u32; 4] = [30, 60, 120, 240];
 
 /// A reference's step is this fraction of the step of the candidate it is compared with.
 pub const REFERENCE_DIVISOR: f32 = 16.0;
@@ -273,12 +276,14 @@ pub fn steps_per_frame(frame_secs: f64, step_secs: f32) -> u32 {
     ((frame_secs / f64::from(step_secs)).ceil() as u32 + 1).min(1000)
 }
 
-/// The first sweep: every integrator at every fixed step (and frame delta where the effect
-/// uses it), the other state layouts, each module of each emitter off on its own, and
-/// each draw path — one axis at a time from the effect as authored.
-pub fn axes(effect: &Effect) -> Vec<Candidate> {
+/// The first sweep: every integrator at every fixed step of `rates` (steps per second;
+/// and frame delta where the effect uses it), the other state layouts, each module of
+/// each emitter off on its own, and each draw path — one axis at a time from the effect
+/// as authored.
+pub fn axes(effect: &Effect, rates: &[u32]) -> Vec<Candidate> {
     let mut v = vec![Candidate::authored()];
-    let mut steps: Vec<StepChoice> = STEPS.iter().map(|&s| StepChoice::Fixed(s)).collect();
+    let fixed = |&r: &u32| StepChoice::Fixed(1.0 / r as f32);
+    let mut steps: Vec<StepChoice> = rates.iter().map(fixed).collect();
     if effect.time.mode == TimeMode::FrameDelta {
         steps.push(StepChoice::FrameDelta);
     }

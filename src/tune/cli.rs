@@ -32,6 +32,10 @@ pub struct TuneArgs {
     /// Frames timed after the span for each candidate (the median is its cost).
     #[arg(long, default_value_t = 10)]
     pub cost_frames: usize,
+    /// The fixed steps tried, in steps per second (the finest's reference sets most of
+    /// the sweep's time).
+    #[arg(long, value_delimiter = ',', default_value = "30,60,120,240")]
+    pub rates: Vec<u32>,
     /// Skip playing the reference at half its step (the check that it has converged).
     #[arg(long)]
     pub no_reference_check: bool,
@@ -60,6 +64,7 @@ impl TuneArgs {
             cost_frames: self.cost_frames.max(1),
             check_reference: !self.no_reference_check,
             asset_dir: self.preset.parent().map(Path::to_path_buf),
+            rates: self.rates.clone(),
         };
         opts.check()?;
         Ok(opts)

@@ -34,6 +34,10 @@ pub struct SweepOptions {
     pub check_reference: bool,
     /// The folder the preset's sprite paths are relative to.
     pub asset_dir: Option<PathBuf>,
+    /// The fixed steps tried, in steps per second (default [`super::RATES`]: 30, 60, 120
+    /// and 240). Each one's reference runs at a sixteenth of its step: the finest sets
+    /// most of the sweep's time.
+    pub rates: Vec<u32>,
 }
 
 impl SweepOptions {
@@ -48,6 +52,7 @@ impl SweepOptions {
             cost_frames: 10,
             check_reference: true,
             asset_dir: None,
+            rates: super::RATES.to_vec(),
         }
     }
 
@@ -76,6 +81,12 @@ impl SweepOptions {
         }
         if !(self.fps.is_finite() && self.fps >= 1.0 && self.fps <= 1000.0) {
             return bad("--fps", format!("{} must be in 1..=1000", self.fps));
+        }
+        if self.rates.is_empty() || self.rates.iter().any(|r| !(1..=2000).contains(r)) {
+            return bad(
+                "--rates",
+                format!("{:?} must be steps per second, each 1..=2000", self.rates),
+            );
         }
         Ok(())
     }
@@ -157,7 +168,7 @@ impl Sweep {
         effect.validate().map_err(crate::PlayerError::Invalid)?;
         let mut queue = VecDeque::new();
         let mut finest = f32::INFINITY;
-        for c in candidate::axes(effect) {
+        for c in candidate::axes(effect, &opts.rates) {
             let applied = c.apply(effect);
             if candidate::worth_measuring(&applied, effect, c.changes.is_empty()) {
                 let step = candidate::reference_step(&applied);

@@ -73,6 +73,7 @@ impl MeasurePanel {
             cost_frames: 5,
             check_reference: false,
             asset_dir,
+            rates: natural.rates,
         }
     }
 }
