@@ -6,10 +6,7 @@ use serde::Serialize;
 
 use crate::effect::{DrawPath, Effect, Emitter, Integrator, TimeMode};
 
-/// The fixed steps a sweep tries unless asked for others, seconds.
-pub const STEPS: [f32; 4] = [1.0 / 30.0, 1.0 / 60.0, 1.0 / 120.0, 1.0 / 240.0];
-
-/// [`STEPS`] as steps per second.
+/// The fixed steps a sweep tries unless asked for others, in steps per second.
 pub const RATES: [u32; 4] = [30, 60, 120, 240];
 
 /// A reference's step is this fraction of the step of the candidate it is compared with.

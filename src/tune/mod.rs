@@ -18,8 +18,8 @@ pub(crate) mod svg;
 mod sweep;
 
 pub use candidate::{
-    Candidate, Change, Module, RATES, REFERENCE_DIVISOR, STEPS, StateChoice, StepChoice, axes,
-    reference, reference_step,
+    Candidate, Change, Module, RATES, REFERENCE_DIVISOR, StateChoice, StepChoice, axes, reference,
+    reference_step,
 };
 pub use frontier::{Budget, choose, pareto};
 pub use image_error::{ErrorAccumulator, ImageError, Rgb, rgb_of};
