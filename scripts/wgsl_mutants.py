@@ -14,16 +14,22 @@ longer validates (tests/shaders.rs's composition check fails), and *missed* othe
     scripts/wgsl_mutants.py events.wgsl --jobs 4              # one shader
     scripts/wgsl_mutants.py --all --jobs 12 --out bench/results/mutants
     scripts/wgsl_mutants.py tiles.wgsl --fail-fast --jobs 8   # stop at a mutant's first failure
+    scripts/wgsl_mutants.py tiles.wgsl --out DIR --resume     # go on where a run was cut off
 
 With --fail-fast each test runs alone, the fastest first (timed on the unmutated shaders),
 and a mutant's run stops at its first failing test: the same verdicts, sooner for the
 mutants a quick test catches (a survivor still runs every test).
+
+With --out, every verdict is also appended to DIR/wgsl-<shader>.tsv as it comes; --resume
+judges only the mutants not in that file and reports them all (a run cut off by a time
+limit loses only the mutants it was judging).
 
 The test binaries are found under target/release/deps (or --bins DIR). Which tests cover
 which shader is the table TESTS below.
 """
 
 import argparse
+import json
 import concurrent.futures as futures
 import os
 import re
@@ -197,6 +203,19 @@ def judge(args, bins, shader, mutant):
     return (line, what, "missed" if outcome == "passed" else "caught")
 
 
+def timed_tests(args, bins, tests, copy):
+    """time_tests for each of `tests`; with --resume, read from (and otherwise saved to)
+    --out's timings.json, so a resumed run does not time the tests again."""
+    saved = Path(args.out) / "timings.json" if args.out else None
+    key = lambda t: f"{t[0]} {t[1] or ''}"
+    known = json.loads(saved.read_text()) if args.resume and saved and saved.exists() else {}
+    timed = {t: known.get(key(t)) or time_tests(bins, [t], copy, args.timeout) for t in tests}
+    if saved:
+        saved.parent.mkdir(parents=True, exist_ok=True)
+        saved.write_text(json.dumps({key(t): v for t, v in timed.items()}))
+    return timed
+
+
 def baseline(args, bins, shaders):
     """The shaders whose tests pass on the unmutated copy (a mutant of the others would
     mean nothing); those that fail are named."""
@@ -207,7 +226,7 @@ def baseline(args, bins, shaders):
             sys.exit("the shader validation test fails on the unmutated shaders")
         tests = sorted({t for s in shaders for t in TESTS[s]}, key=str)
         if args.fail_fast:
-            timed = {t: time_tests(bins, [t], copy, args.timeout) for t in tests}
+            timed = timed_tests(args, bins, tests, copy)
             failing = {t for t, order in timed.items() if order is None}
             args.orders = {
                 s: sorted((x for t in TESTS[s] for x in timed[t] or []), key=lambda x: x[2])
@@ -218,6 +237,14 @@ def baseline(args, bins, shaders):
     for t in sorted(failing, key=str):
         print(f"baseline: the tests {t} fail on the unmutated shaders", file=sys.stderr)
     return [s for s in shaders if not failing & set(TESTS[s])]
+
+
+def read_verdicts(log):
+    """The verdicts a cut-off run appended to `log`: [(line, mutation, verdict)]."""
+    if not log.exists():
+        return []
+    rows = [l.split("\t") for l in log.read_text().splitlines() if l.strip()]
+    return [(int(r[0]), r[1], r[2]) for r in rows if len(r) == 3]
 
 
 def report(shader, results, seconds, fail_fast=False):
@@ -254,6 +281,8 @@ def main():
     ap.add_argument("--bins", default=str(ROOT / "target/release/deps"))
     ap.add_argument("--out", help="folder for one results file per shader")
     ap.add_argument("--list", action="store_true", help="print the mutants and stop")
+    ap.add_argument("--resume", action="store_true",
+                    help="judge only the mutants not already in --out's .tsv of verdicts")
     ap.add_argument("--fail-fast", action="store_true",
                     help="each test alone, fastest first; a mutant stops at its first failure")
     args = ap.parse_args()
@@ -277,15 +306,24 @@ def main():
                 print(f"{shader}:{line}: {what}")
             continue
         start = time.time()
-        results = []
         out = Path(args.out) if args.out else None
         if out:
             out.mkdir(parents=True, exist_ok=True)
-        path = out / f"wgsl-{shader.replace('.wgsl', '')}.md" if out else None
+        stem = f"wgsl-{shader.replace('.wgsl', '')}"
+        path = out / f"{stem}.md" if out else None
+        log = out / f"{stem}.tsv" if out else None
+        results = read_verdicts(log) if args.resume and log else []
+        done = {(r[0], r[1]) for r in results}
+        todo = [m for m in mutants if (m[0], m[1]) not in done]
+        if args.resume:
+            print(f"{shader}: {len(results)} judged before, {len(todo)} to judge")
         with futures.ThreadPoolExecutor(args.jobs) as pool:
-            jobs = [pool.submit(judge, args, bins, shader, m) for m in mutants]
+            jobs = [pool.submit(judge, args, bins, shader, m) for m in todo]
             for job in futures.as_completed(jobs):
                 results.append(job.result())
+                if log:
+                    with log.open("a") as f:
+                        f.write("\t".join(map(str, results[-1])) + "\n")
                 if path and len(results) < len(mutants):
                     # Progress on disk: a run cut short keeps what it judged.
                     text, _ = report(shader, results, time.time() - start, args.fail_fast)
