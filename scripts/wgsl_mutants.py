@@ -32,6 +32,7 @@ import argparse
 import json
 import concurrent.futures as futures
 import os
+import random
 import re
 import shutil
 import subprocess
@@ -53,7 +54,7 @@ TESTS = {
     "trail.wgsl": [("trails", None), ("looks", "reference_images"), ("tiles", "ribbons")],
     "trail_on.wgsl": [("trails", None)],
     "trail_ring.wgsl": [("trails", None), ("events", None)],
-    "tiles.wgsl": [("tiles", None)],
+    "tiles.wgsl": [("tiles", None), ("runtime", "reversed_z")],
     "tile_lists.wgsl": [("tiles", None)],
     "splat.wgsl": [("splat", None), ("runtime", "splat reversed_z msaa")],
     "splat_accum.wgsl": [("splat", None)],
@@ -283,6 +284,9 @@ def main():
     ap.add_argument("--list", action="store_true", help="print the mutants and stop")
     ap.add_argument("--resume", action="store_true",
                     help="judge only the mutants not already in --out's .tsv of verdicts")
+    ap.add_argument("--shuffle", type=int, metavar="SEED",
+                    help="judge the mutants in an order shuffled with SEED (a partial run "
+                    "is then a random sample)")
     ap.add_argument("--fail-fast", action="store_true",
                     help="each test alone, fastest first; a mutant stops at its first failure")
     args = ap.parse_args()
@@ -315,6 +319,9 @@ def main():
         results = read_verdicts(log) if args.resume and log else []
         done = {(r[0], r[1]) for r in results}
         todo = [m for m in mutants if (m[0], m[1]) not in done]
+        if args.shuffle is not None:
+            # A run cut off by a time limit has then judged a random sample.
+            random.Random(args.shuffle).shuffle(todo)
         if args.resume:
             print(f"{shader}: {len(results)} judged before, {len(todo)} to judge")
         with futures.ThreadPoolExecutor(args.jobs) as pool:

@@ -4,14 +4,16 @@
 //! through a pixel centre; measured on lavapipe: at most 0.005/255 mean); sprites smaller than a
 //! pixel cover the rasteriser's pixels; sprites crossing tile borders, larger than the screen, behind the camera,
 //! piled hundreds deep on one tile, or thousands over several bins whose lists overflow keep
-//! all their light; binning is deterministic; the
+//! all their light, as do two emitters over different bins; lit flipbooks blend their
+//! frames alike on both paths; binning is deterministic; the
 //! automatic choice follows the adapter profile. All on the real adapter (lavapipe in CI).
 
 mod common;
 
 use common::{gpu, image_diff, share_off, total_light};
 use ignis::effect::{
-    BlendMode, DrawPath, Effect, Flipbook, FlipbookMode, Param, Range, Sprite, Streak,
+    BlendMode, DrawPath, Effect, Flipbook, FlipbookMode, Lighting, Param, Range, SixWayMaps,
+    Sprite, Streak,
 };
 use ignis::testing::gpu::{AdapterProfile, GpuContext};
 use ignis::testing::headless::Headless;
@@ -366,6 +368,54 @@ fn a_tile_with_more_sprites_than_a_workgroup_keeps_every_sprite() {
     // The billboards draw every sprite: a dropped chunk of 256 would take a twelfth of the
     // light, a dropped batch of 64 two percent.
     light_agrees(&ctx, "3000 deep", &effect);
+}
+
+#[test]
+fn two_emitters_over_different_bins_each_keep_their_light() {
+    let ctx = gpu();
+    // Two items of one chunk, one on each side of the 128-px bins' border at x = 128: the
+    // right one's sprites start a block of their own, and the bin it covers must be added
+    // to its shade (the bin scan finds a block's item by searching the items' first
+    // sprites), not to the left one's.
+    let mut effect = pile(40.0, 0.2, [-0.9, 0.0, 0.0]);
+    let mut right = effect.emitters[0].clone();
+    right.name = "right".into();
+    right.transform.position_m = [0.9, 0.1, 0.0];
+    right.look.size_m = Param::Constant(0.3);
+    effect.emitters.push(right);
+    light_agrees(&ctx, "two emitters", &effect);
+}
+
+#[test]
+fn lit_flipbooks_blend_their_frames_alike_on_both_paths() {
+    let ctx = gpu();
+    // The built-in 4 × 4 six-way sheet, its frames blended over life: a few puffs each
+    // between two frames at frames 20 and 31, lit once from the sides of each map (right,
+    // top, back; then left, below, front).
+    for sun_direction in [[1.0, 0.5, -0.7], [-1.0, -0.5, 0.7]] {
+        let lighting = Lighting {
+            sun_direction,
+            sun_color: [3.0, 3.0, 3.0],
+            ..Lighting::default()
+        };
+        let mut effect = common::still_smoke(SixWayMaps::PuffSheet, lighting, DrawPath::Billboard);
+        let e = &mut effect.emitters[0];
+        e.capacity = 16;
+        e.bursts[0].count = 5;
+        e.lifetime_secs = Range::new(0.9, 1.3);
+        e.spread_deg = 60.0;
+        e.speed_m_per_s = Range::new(0.2, 0.4);
+        e.look.size_m = Param::Constant(0.9);
+        e.look.flipbook = Some(Flipbook {
+            rows: 4,
+            cols: 4,
+            mode: FlipbookMode::OverLife,
+            blend_frames: true,
+            random_start: false,
+        });
+        let what = format!("lit flipbook, sun towards {sun_direction:?}");
+        paths_agree_at(&ctx, &what, &effect, &[20, 31]);
+    }
 }
 
 #[test]
