@@ -169,14 +169,26 @@ fn check_impossible_budget(sweep: &Sweep, effect: &Effect, adapter: &str) {
     assert!(!dir.path().join("campfire.tuned.ron").exists());
 }
 
-/// A second preset's references converge too (the campfire's are checked with its sweep).
+/// A second preset's references converge too (the campfire's are checked with its sweep):
+/// the sweep's first run, stopped there. The torch's reference differs from itself at half
+/// its step by 0.011–0.021/255 on lavapipe, its finest candidates by ~0.1/255, so the
+/// bound is the absolute one of `check_reference_converges`.
 #[test]
 fn the_torch_references_converge() {
     let ctx = gpu();
     let mut sweep = Sweep::new(&ctx, &preset("torch"), small(0.5)).expect("sweep");
-    run_sweep(&mut sweep, |_, _| {}).expect("run");
-    let report = TuneReport::new(&sweep, Budget::ErrorMean(2.0), &ctx.info.name).expect("report");
-    check_reference_converges(&report);
+    while sweep.reference_check().is_none() {
+        assert!(
+            !sweep.step().expect("step"),
+            "the sweep ended before its check"
+        );
+    }
+    let check = sweep.reference_check().expect("checked");
+    assert!(
+        check.mean > 0.0 && check.mean < 0.05,
+        "reference vs half its step: {} (/255 mean)",
+        check.mean
+    );
 }
 
 fn check_reference_converges(report: &TuneReport) {
