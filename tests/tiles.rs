@@ -655,27 +655,29 @@ fn a_frame_drawn_in_chunks_is_the_frame_drawn_at_once() {
         for e in &mut effect.emitters {
             e.look.draw_path = DrawPath::Tiles;
         }
-        let image = |chunk: Option<u32>, lists: Option<u32>| {
-            let mut run =
-                Headless::new(&ctx, effect.clone(), ShaderLibrary::embedded()).expect("headless");
+        // One run, its particles drawn again after 60 frames with other chunk sizes.
+        let mut run =
+            Headless::new(&ctx, effect.clone(), ShaderLibrary::embedded()).expect("headless");
+        for _ in 0..60 {
+            run.advance(1.0 / 60.0);
+        }
+        let image = |run: &mut Headless, chunk: Option<u32>, lists: Option<u32>| {
             let tiles = run.player.tile_pass().expect("the tiles");
             tiles.set_chunk_sprites(chunk);
             tiles.set_list_capacity(lists);
-            for _ in 0..60 {
-                run.advance(1.0 / 60.0);
-            }
-            let img = run.render(SIZE).expect("render");
-            let items = run.player.draw_items().iter().filter(|d| d.tiles);
-            let quads: u32 = items.map(|d| d.width * d.members).sum();
-            (img, quads)
+            run.render(SIZE).expect("render")
         };
-        let (whole, quads) = image(None, None);
+        let whole = image(&mut run, None, None);
+        let again = image(&mut run, None, None);
+        assert!(again == whole, "{name}: drawn again, the same image");
+        let items = run.player.draw_items().iter().filter(|d| d.tiles);
+        let quads: u32 = items.map(|d| d.width * d.members).sum();
         assert!(quads > 2 * 2048, "{name}: {quads} quads fit two chunks");
         assert!(total_light(&whole) > 1e3, "{name}: almost nothing drawn");
         // In chunks, and in chunks whose every bin list overflows (shaded from the
         // chunk's sprites directly).
         for lists in [None, Some(1)] {
-            let (chunked, _) = image(Some(2048), lists);
+            let chunked = image(&mut run, Some(2048), lists);
             let (mean, max) = image_diff(&whole, &chunked);
             assert!(
                 whole == chunked,
