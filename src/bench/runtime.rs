@@ -42,8 +42,11 @@ struct Row {
     record_ms: f64,
     draw_ms: f64,
     cpu_us: f64,
-    /// Of which `draw` (and finishing the encoder).
-    cpu_draw_us: f64,
+    /// Of which (medians apart): `advance`, `record`, `draw` in the host's pass, and
+    /// finishing the encoder (where wgpu encodes the commands it recorded for the driver).
+    cpu_parts_us: [f64; 4],
+    /// The dispatches and draws the player recorded for the last timed frame.
+    commands: crate::gpu::commands::CommandCounts,
 }
 
 /// Runs the bench and returns its report.
@@ -153,27 +156,31 @@ fn measure(
     let camera = host.camera(spots);
     let warm_up = (effect.longest_lifetime_secs() * 60.0).ceil() as usize + 10;
     let (mut record, mut draw) = (Vec::new(), Vec::new());
-    let (mut cpu, mut cpu_draw) = (Vec::new(), Vec::new());
+    let (mut cpu, mut parts) = (Vec::new(), [(); 4].map(|_| Vec::new()));
     for frame in 0..warm_up + opts.frames {
         // The CPU time of the calls alone: the GPU (on a CPU adapter, the same cores)
         // is idle while they run.
         let _ = host.ctx.device.poll(wgpu::PollType::wait_indefinitely());
-        let start = Instant::now();
+        let mut marks = [Instant::now(); 5];
         player.advance(1.0 / 60.0);
+        marks[1] = Instant::now();
         let mut enc = host.ctx.device.create_command_encoder(&Default::default());
         player.record(&mut enc, &camera, Some(&host.depth))?;
-        let recorded = Instant::now();
+        marks[2] = Instant::now();
         host.pass(&mut enc, |pass| player.draw(pass));
+        marks[3] = Instant::now();
         let commands = enc.finish();
-        let cpu_us = start.elapsed().as_secs_f64() * 1e6;
-        let cpu_draw_us = recorded.elapsed().as_secs_f64() * 1e6;
+        marks[4] = Instant::now();
         host.ctx.queue.submit([commands]);
+        let us = |a: Instant, b: Instant| (b - a).as_secs_f64() * 1e6;
         if frame < warm_up {
             continue;
         }
         // The next frame timed on the GPU, in two parts.
-        cpu.push(cpu_us);
-        cpu_draw.push(cpu_draw_us);
+        cpu.push(us(marks[0], marks[4]));
+        for (i, part) in parts.iter_mut().enumerate() {
+            part.push(us(marks[i], marks[i + 1]));
+        }
         player.advance(1.0 / 60.0);
         let mut recorded = Ok(());
         record.push(timer.time(&host.ctx, |enc| {
@@ -194,7 +201,8 @@ fn measure(
         record_ms: median(&mut record),
         draw_ms: median(&mut draw),
         cpu_us: median(&mut cpu),
-        cpu_draw_us: median(&mut cpu_draw),
+        cpu_parts_us: parts.map(|mut p| median(&mut p)),
+        commands: player.recorded_commands(),
     })
 }
 
@@ -215,8 +223,9 @@ fn report(
             warm-up past the longest lifetime, {} frames at 60 fps. `record` = the instances' \
             simulation steps and the smoke's sort; `draw` = every instance's billboards in the \
             host's pass, soft edges against its depth. CPU = the API calls of a frame (advance, \
-            record, draw and finishing the encoder; encoding, not waiting), and of it the draw. \
-            GPU times: {}.",
+            record, draw and finishing the encoder; encoding, not waiting), and each part's \
+            median apart (wgpu encodes the recorded commands for the driver when the encoder \
+            is finished). GPU times: {}.",
         opts.effect.name,
         opts.size.0,
         opts.size.1,
@@ -232,7 +241,8 @@ fn report(
             format!("{:.3}", x.draw_ms),
             format!("{:.3}", x.record_ms + x.draw_ms),
             format!("{:.0}", x.cpu_us),
-            format!("{:.0}", x.cpu_draw_us),
+            x.cpu_parts_us.map(|t| format!("{t:.0}")).join(" / "),
+            format!("{} / {}", x.commands.dispatches, x.commands.draws),
             format!("{:.1}", x.cpu_us / f64::from(x.instances.max(1))),
         ]
     };
@@ -243,7 +253,8 @@ fn report(
         "draw ms",
         "total ms",
         "CPU µs",
-        "of which draw µs",
+        "CPU: advance / record / draw / finish µs",
+        "dispatches / draws",
         "CPU µs / instance",
     ];
     r.heading("Instances in a host frame");
@@ -273,7 +284,12 @@ fn report(
             "record_ms": x.record_ms,
             "draw_ms": x.draw_ms,
             "cpu_us": x.cpu_us,
-            "cpu_draw_us": x.cpu_draw_us,
+            "cpu_advance_us": x.cpu_parts_us[0],
+            "cpu_record_us": x.cpu_parts_us[1],
+            "cpu_draw_us": x.cpu_parts_us[2],
+            "cpu_finish_us": x.cpu_parts_us[3],
+            "dispatches": x.commands.dispatches,
+            "draws": x.commands.draws,
         })).collect::<Vec<_>>(),
         "extra_gpu_ms_per_instance": per,
     });
