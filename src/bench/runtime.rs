@@ -157,6 +157,7 @@ fn measure(
     let warm_up = (effect.longest_lifetime_secs() * 60.0).ceil() as usize + 10;
     let (mut record, mut draw) = (Vec::new(), Vec::new());
     let (mut cpu, mut parts) = (Vec::new(), [(); 4].map(|_| Vec::new()));
+    let us = |a: Instant, b: Instant| (b - a).as_secs_f64() * 1e6;
     for frame in 0..warm_up + opts.frames {
         // The CPU time of the calls alone: the GPU (on a CPU adapter, the same cores)
         // is idle while they run.
@@ -172,7 +173,6 @@ fn measure(
         let commands = enc.finish();
         marks[4] = Instant::now();
         host.ctx.queue.submit([commands]);
-        let us = |a: Instant, b: Instant| (b - a).as_secs_f64() * 1e6;
         if frame < warm_up {
             continue;
         }

@@ -34,7 +34,7 @@ pub struct TuneArgs {
     pub cost_frames: usize,
     /// The fixed steps tried, in steps per second (the finest's reference sets most of
     /// the sweep's time).
-    #[arg(long, value_delimiter = ',', default_value = "30,60,120,240")]
+    #[arg(long, value_delimiter = ',', default_values_t = super::RATES)]
     pub rates: Vec<u32>,
     /// Skip playing the reference at half its step (the check that it has converged).
     #[arg(long)]
