@@ -164,17 +164,17 @@ def run_alone(bins, name, test, env, timeout):
     return ("failed" if r.returncode != 0 else "passed"), time.time() - start
 
 
-def time_tests(bins, tests, shader_dir, timeout):
-    """Every test of `tests` alone on the shaders in `shader_dir`, fastest first:
-    [(binary, test, seconds)]; None when one does not pass."""
+def time_tests(bins, tests, shader_dir, timeout, jobs=1):
+    """Every test of `tests` alone on the shaders in `shader_dir` (`jobs` at a time),
+    fastest first: [(binary, test, seconds)]; None when one does not pass."""
     env = dict(os.environ, IGNIS_MUTANT_SHADERS=str(shader_dir))
-    timed = []
-    for name, filt in tests:
-        for test in list_tests(bins, name, filt, env):
-            outcome, secs = run_alone(bins, name, test, env, timeout)
-            if outcome != "passed":
-                return None
-            timed.append((name, test, secs))
+    listed = [(name, test) for name, filt in tests for test in list_tests(bins, name, filt, env)]
+    with futures.ThreadPoolExecutor(jobs) as pool:
+        runs = [pool.submit(run_alone, bins, name, test, env, timeout) for name, test in listed]
+        outcomes = [r.result() for r in runs]
+    if any(outcome != "passed" for outcome, _ in outcomes):
+        return None
+    timed = [(name, test, secs) for (name, test), (_, secs) in zip(listed, outcomes)]
     return sorted(timed, key=lambda t: t[2])
 
 
@@ -210,10 +210,14 @@ def timed_tests(args, bins, tests, copy):
     saved = Path(args.out) / "timings.json" if args.out else None
     key = lambda t: f"{t[0]} {t[1] or ''}"
     known = json.loads(saved.read_text()) if args.resume and saved and saved.exists() else {}
-    timed = {t: known.get(key(t)) or time_tests(bins, [t], copy, args.timeout) for t in tests}
-    if saved:
-        saved.parent.mkdir(parents=True, exist_ok=True)
-        saved.write_text(json.dumps({key(t): v for t, v in timed.items()}))
+    timed = {}
+    for t in tests:
+        timed[t] = known.get(key(t)) or time_tests(bins, [t], copy, args.timeout, args.jobs)
+        if saved:
+            # Saved after each binary's tests: a run cut off here keeps what it timed.
+            saved.parent.mkdir(parents=True, exist_ok=True)
+            known[key(t)] = timed[t]
+            saved.write_text(json.dumps(known))
     return timed
 
 

@@ -305,8 +305,8 @@ fn a_loop_closes_and_a_plain_span_does_not() {
     let dir = tempfile::tempdir().expect("tempdir");
     let (looped, plain) = (dir.path().join("loop"), dir.path().join("plain"));
     let s = sequence(&plain, 16, 16.0 / 30.0);
-    export(&effect, s.clone());
-    export(
+    let plain_summary = export(&effect, s.clone());
+    let loop_summary = export(
         &effect,
         ExportSettings {
             looped: true,
@@ -316,6 +316,19 @@ fn a_loop_closes_and_a_plain_span_does_not() {
     );
     let (loop_seam, loop_median) = seam(&looped, 16);
     let (plain_seam, plain_median) = seam(&plain, 16);
+    // The sidecar's seam figures are the written frames' own (in 8-bit steps; it measures
+    // the frames before they are rounded to 8 bits).
+    for (summary, (last_first, median)) in [
+        (&plain_summary, (plain_seam, plain_median)),
+        (&loop_summary, (loop_seam, loop_median)),
+    ] {
+        let s = &summary.sidecar.seam;
+        assert!(
+            (s.last_to_first - last_first).abs() < 0.05 + 0.02 * last_first
+                && (s.median_consecutive - median).abs() < 0.05 + 0.02 * median,
+            "sidecar {s:?}, files {last_first:.3} and {median:.3}"
+        );
+    }
     assert!(
         loop_seam <= loop_median,
         "loop: last → first {loop_seam:.3} > median consecutive {loop_median:.3}"
@@ -496,6 +509,7 @@ fn the_export_command_writes_a_flipbook_and_refuses_bad_settings() {
     assert_eq!(v["frame_count"], 8);
     assert_eq!(v["frame_width"], 32);
     assert_eq!(v["alpha"], "premultiplied");
+    assert_eq!(v["format"], "png");
     assert_eq!(v["passes"], serde_json::json!(["color", "motion"]));
     assert!(v["motion_vector_scale"].as_f64().is_some_and(|s| s > 0.0));
     assert_eq!(
@@ -540,6 +554,27 @@ fn the_export_command_writes_a_flipbook_and_refuses_bad_settings() {
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("--loop needs at least 2 frames"), "{err}");
+    // 8 frames of 2048 (16,384 pixels) fit an atlas; 8 of 2049 do not.
+    let mut atlas = ExportSettings::new(bad.path().join("z"));
+    atlas.layout = Layout::Flipbook { cols: 8, rows: 1 };
+    atlas.frame_size = (2048, 16);
+    atlas.validate().expect("a 16384-pixel atlas");
+    atlas.frame_size = (2049, 16);
+    let err = atlas
+        .validate()
+        .expect_err("a 16392-pixel atlas")
+        .to_string();
+    assert!(
+        err.contains("16392x16") && err.contains("at most 16384"),
+        "{err}"
+    );
+    atlas.layout = Layout::Flipbook { cols: 1, rows: 8 };
+    atlas.frame_size = (16, 2049);
+    let err = atlas
+        .validate()
+        .expect_err("a 16392-pixel column")
+        .to_string();
+    assert!(err.contains("16x16392"), "{err}");
 }
 
 /// `--passes sixway`: the lit smoke's six-way lightmaps in Unity's packing, named in the

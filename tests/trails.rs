@@ -618,10 +618,16 @@ fn spawn_order_within_steps(
     }
 }
 
-/// Two children of one parent, still and side by side across the view: the ribbon per
-/// parent lights the row between them and nothing beyond (no sprites drawn).
-#[test]
-fn a_ribbon_per_parent_lights_the_pixels_between_the_children() {
+/// A parent born at x = −1, 1 m up, flying along +x at 4 m/s for `parent_life` seconds,
+/// spawning 5 still children a second (one at each 0.2 s of its age), each living
+/// `child_life`; the children drawn as a ribbon per parent (no sprites) of `size_m` ×
+/// `width`, narrowing to `tail_width` over a child's life; played 60 steps of
+/// [`side_view`], the effect changed by `edit` first.
+fn still_children_ribbon(
+    (parent_life, child_life): (f32, f32),
+    (size_m, width, tail_width): (f32, f32, f32),
+    edit: impl FnOnce(&mut Effect),
+) -> ignis::testing::headless::Headless {
     let ctx = gpu();
     let mut effect = ribbon_effect();
     let parent = &mut effect.emitters[0];
@@ -631,7 +637,7 @@ fn a_ribbon_per_parent_lights_the_pixels_between_the_children() {
         time_secs: 0.0,
         count: 1,
     }];
-    parent.lifetime_secs = Range::new(0.45, 0.45);
+    parent.lifetime_secs = Range::new(parent_life, parent_life);
     parent.transform.position_m = [-1.0, 1.0, 0.0];
     parent.direction = [1.0, 0.0, 0.0];
     parent.spread_deg = 0.0;
@@ -639,24 +645,34 @@ fn a_ribbon_per_parent_lights_the_pixels_between_the_children() {
     parent.events[0].rate_per_sec = 5.0;
     let ribbon = &mut effect.emitters[1];
     ribbon.transform.position_m = [-1.0, 1.0, 0.0];
-    ribbon.lifetime_secs = Range::new(5.0, 5.0);
-    ribbon.look.size_m = Param::Constant(0.05);
+    ribbon.lifetime_secs = Range::new(child_life, child_life);
+    ribbon.look.size_m = Param::Constant(size_m);
     ribbon.look.color_over_life = flat_color([1.0, 1.0, 1.0, 1.0]);
     ribbon.look.intensity = 4.0;
     ribbon.look.trail = Some(Trail {
         mode: TrailMode::PerParent,
-        tail_width: 1.0,
+        width,
+        tail_width,
         tail_opacity: 1.0,
         draw_sprite: false,
         ..Trail::default()
     });
     side_view(&mut effect);
+    edit(&mut effect);
     effect.validate().expect("valid");
     let mut run = ignis::testing::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
         .expect("headless");
     for _ in 0..60 {
         run.advance(f64::from(DT));
     }
+    run
+}
+
+/// Two children of one parent, still and side by side across the view: the ribbon per
+/// parent lights the row between them and nothing beyond (no sprites drawn).
+#[test]
+fn a_ribbon_per_parent_lights_the_pixels_between_the_children() {
+    let mut run = still_children_ribbon((0.45, 5.0), (0.05, 1.0, 1.0), |_| {});
     // Two children (5 a second over the parent's 0.45 s), where the parent was at ages
     // 0.2 and 0.4 (the end of the steps that crossed them): x ≈ −0.2 and 0.6.
     let mut xs: Vec<f32> = run
@@ -687,4 +703,218 @@ fn a_ribbon_per_parent_lights_the_pixels_between_the_children() {
         .filter(|&y| image.get_pixel(((a + b) / 2.0) as u32, y)[0] > 40)
         .count();
     assert!(lit_rows <= 4, "a thin ribbon: {lit_rows} rows lit");
+}
+
+/// The width tapers linearly over the ribbon's points, segment by segment, u = (segment +
+/// fraction) / segments: with three points (two segments) narrowing to 0.4, the lit
+/// height a quarter and three quarters into each segment is the width there, relative to
+/// the height a quarter into the first.
+#[test]
+fn the_ribbon_narrows_linearly_segment_by_segment() {
+    let (w, h) = (640u32, 480u32);
+    let (points, every) = (3u32, 4u32);
+    let tail_width = 0.4f32;
+    // Born at x = −3.5 at 4 m/s: the points 0.27 m apart, the particle 0.17 m on.
+    let mut run = ribbon_run((points, every), (0.15, 1.0, tail_width), |e| {
+        e.transform.position_m = [-3.5, 1.0, 0.0];
+        e.speed_m_per_s = Range::new(4.0, 4.0);
+    });
+    let image = run.render((w, h)).expect("render");
+    let after = |k: i64| side_view_px(-3.5 + 4.0 * (k as f32 + 0.5) * DT, (w, h));
+    let last = i64::from(RIBBON_FRAMES) - 1;
+    // The particle as drawn (between its last two states), then its ring's points.
+    let mut knots = vec![(after(last - 1) + after(last)) / 2.0];
+    knots.extend(
+        point_steps(points, every, u64::from(RIBBON_FRAMES))
+            .into_iter()
+            .map(after),
+    );
+    let height = |x: f32| {
+        (0..h)
+            .filter(|&y| image.get_pixel(x.round() as u32, y)[0] > 40)
+            .count() as f32
+    };
+    let width_at = |u: f32| 1.0 - (1.0 - tail_width) * u;
+    let at = |seg: usize, f: f32| knots[seg] + f * (knots[seg + 1] - knots[seg]);
+    let reference = height(at(0, 0.25));
+    assert!(
+        reference > 10.0,
+        "the ribbon is {reference} px high near the particle"
+    );
+    for seg in 0..2 {
+        for f in [0.25f32, 0.75] {
+            let u = (seg as f32 + f) / 2.0;
+            let want = reference * width_at(u) / width_at(0.125);
+            let got = height(at(seg, f));
+            assert!(
+                (got - want).abs() <= 0.1 * want + 1.5,
+                "segment {seg} at {f}: {got} px high, the taper gives {want:.1} (knots {knots:?})"
+            );
+        }
+    }
+}
+
+/// A ribbon per parent is each child's own width at its end (its size × the width,
+/// tapering to the tail width over its life): three still children of one parent, aged
+/// 0.8, 0.6 and 0.4 of their lives, light heights in proportion to those widths next to
+/// each child, along both segments.
+#[test]
+fn a_ribbon_per_parent_is_each_childs_width_at_its_age() {
+    let (w, h) = (640u32, 480u32);
+    let tail_width = 0.2f32;
+    let mut run = still_children_ribbon((0.65, 1.0), (0.1, 2.0, tail_width), |_| {});
+    // (world x, age over life) of each child (the parent has died).
+    let ages = run.player.particles(run.instance, 1).expect("read");
+    let ages = ages.iter().filter(|p| p.is_alive());
+    let places = run.player.particle_motion(run.instance).expect("read");
+    let mut children: Vec<(f32, f32)> = places
+        .iter()
+        .zip(ages)
+        .map(|((x, _), p)| (x.x, p.pos_age[3] / p.vel_life[3]))
+        .collect();
+    children.sort_by(|a, b| a.0.total_cmp(&b.0));
+    assert_eq!(children.len(), 3, "three children: {children:?}");
+    let image = run.render((w, h)).expect("render");
+    let height = |x: f32| {
+        (0..h)
+            .filter(|&y| image.get_pixel(x.round() as u32, y)[0] > 40)
+            .count() as f32
+    };
+    let width = |t: f32| 1.0 - (1.0 - tail_width) * t;
+    let px = |i: usize| side_view_px(children[i].0, (w, h));
+    // Beside each child, inside the segments that end there.
+    let newest = height(px(2) - 4.0);
+    assert!(newest > 10.0, "the newest child's end is {newest} px high");
+    for (i, x) in [(0, px(0) + 4.0), (1, px(1) - 4.0), (1, px(1) + 4.0)] {
+        let want = newest * width(children[i].1) / width(children[2].1);
+        let got = height(x);
+        assert!(
+            (got - want).abs() <= 0.1 * want + 1.5,
+            "beside child {i} (aged {:.2} of its life): {got} px high, want {want:.1}",
+            children[i].1
+        );
+    }
+}
+
+/// Ribbons lay their sprite's middle column across the motion with its top on the
+/// motion's left, as streaks do: moving right across the view, the flame wisp's bright
+/// base is below the middle, for a trail and for a ribbon per parent (dim enough not to
+/// saturate).
+#[test]
+fn ribbons_lay_their_sprite_with_its_top_on_the_motions_left() {
+    let wisp = |e: &mut Emitter| {
+        e.look.sprite = Sprite::FlameWisp;
+        e.look.intensity = 0.25;
+    };
+    let mut trail = ribbon_run((9, 2), (0.3, 1.0, 1.0), wisp);
+    // The motion runs along the middle row, y = 120.
+    let (_, y) = light_centroid(&trail.render((320, 240)).expect("render"));
+    assert!(y > 121.0, "a trail's light is centred at y = {y} px (down)");
+    let mut ribbon = still_children_ribbon((0.45, 5.0), (0.3, 1.0, 1.0), |e| {
+        wisp(&mut e.emitters[1]);
+    });
+    let (_, y) = light_centroid(&ribbon.render((320, 240)).expect("render"));
+    assert!(
+        y > 121.0,
+        "a ribbon per parent's light is centred at y = {y} px"
+    );
+}
+
+/// A child's trail takes the colour its parent hands it: white children of an orange
+/// parent (1, 0.5, 0.25) with `inherit_color` draw orange trails, red over green over blue.
+#[test]
+fn an_inherited_colour_tints_a_childs_trail() {
+    let mut effect = ribbon_effect();
+    let parent = &mut effect.emitters[0];
+    parent.look.color_over_life = flat_color([1.0, 0.5, 0.25, 1.0]);
+    parent.look.size_m = Param::Constant(0.001);
+    parent.events[0].inherit_color = true;
+    let child = &mut effect.emitters[1];
+    child.speed_m_per_s = Range::new(1.5, 1.5);
+    child.look.color_over_life = flat_color([1.0, 1.0, 1.0, 1.0]);
+    child.look.trail = Some(Trail {
+        points: 6,
+        length_secs: 0.1,
+        draw_sprite: false,
+        ..Trail::default()
+    });
+    side_view(&mut effect);
+    effect.validate().expect("valid");
+    let mut run =
+        ignis::testing::headless::Headless::new(&gpu(), effect, ShaderLibrary::embedded())
+            .expect("headless");
+    for _ in 0..30 {
+        run.advance(f64::from(DT));
+    }
+    let image = run.render((320, 240)).expect("render");
+    let sum = |c: usize| image.pixels().map(|p| f64::from(p[c])).sum::<f64>();
+    let (r, g, b) = (sum(0), sum(1), sum(2));
+    assert!(
+        r > 1000.0 && g < 0.85 * r && b < 0.85 * g,
+        "the trails' light: R {r}, G {g}, B {b}"
+    );
+}
+
+/// The light of [`side_view`]'s image `img` within 6 pixels of world point (x, y) (z = 0).
+fn light_near(img: &image::RgbaImage, (x, y): (f32, f32)) -> f64 {
+    let (w, h) = img.dimensions();
+    let px_per_m = side_view_px(1.0, (w, h)) - side_view_px(0.0, (w, h));
+    let (cx, cy) = (
+        side_view_px(x, (w, h)),
+        h as f32 / 2.0 - (y - 1.0) * px_per_m,
+    );
+    let mut sum = 0.0;
+    for (px, py, p) in img.enumerate_pixels() {
+        if (px as f32 + 0.5 - cx).abs() <= 6.0 && (py as f32 + 0.5 - cy).abs() <= 6.0 {
+            sum += f64::from(p[0]);
+        }
+    }
+    sum
+}
+
+/// A ribbon fades towards the ground by the height of each of its points (over a 2 m
+/// soft ground at y = 0), not by its emitter's: a trail running down at 45° is dimmer
+/// at the particle than at its tail, and so is a ribbon per parent between children
+/// dropped along the same slope.
+#[test]
+fn ribbons_fade_towards_the_ground_by_the_height_of_each_point() {
+    let ground = |e: &mut Emitter| {
+        e.collisions.ground = Some(GroundPlane {
+            height_m: 0.0,
+            kill_on_contact: false,
+        });
+        e.look.soft_ground_m = 2.0;
+        e.look.intensity = 0.5;
+    };
+    let down = [1.0, -1.0, 0.0];
+    // From (−3, 3.5) at 4 m/s for a second: the particle near (−0.17, 0.67), its tail
+    // 16 steps back near (−0.92, 1.42).
+    let mut trail = ribbon_run((9, 2), (0.1, 1.0, 1.0), |e| {
+        e.transform.position_m = [-3.0, 3.5, 0.0];
+        e.direction = down;
+        e.speed_m_per_s = Range::new(4.0, 4.0);
+        ground(e);
+    });
+    let img = trail.render((320, 240)).expect("render");
+    let (head, tail) = (light_near(&img, (-0.3, 0.8)), light_near(&img, (-0.8, 1.3)));
+    assert!(
+        head < 0.9 * tail,
+        "a trail's light near its head {head}, near its tail {tail}"
+    );
+    // Children 0.2 s apart along the parent's slope, from (−1, 2): y ≈ 1.43, 0.87, 0.30.
+    let mut ribbon = still_children_ribbon((0.65, 5.0), (0.1, 1.0, 1.0), |e| {
+        e.emitters[0].transform.position_m = [-1.0, 2.0, 0.0];
+        e.emitters[0].direction = down;
+        ground(&mut e.emitters[1]);
+    });
+    let img = ribbon.render((320, 240)).expect("render");
+    let s = 0.8f32 / 2f32.sqrt();
+    let (high, low) = (
+        light_near(&img, (-1.0 + 1.5 * s, 2.0 - 1.5 * s)),
+        light_near(&img, (-1.0 + 2.5 * s, 2.0 - 2.5 * s)),
+    );
+    assert!(
+        low < 0.75 * high,
+        "a ribbon's light near its lower child {low}, its higher {high}"
+    );
 }

@@ -300,3 +300,53 @@ pub(super) fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The table's interpolation stays on the transfer function it samples, at its knots
+    /// and between them.
+    #[test]
+    fn the_srgb_table_follows_the_transfer_function() {
+        for i in 0..=10_000 {
+            let v = i as f32 / 10_000.0;
+            let (got, want) = (srgb_table(v), linear_to_srgb(v));
+            assert!((got - want).abs() < 2e-5, "{v}: {got} against {want}");
+        }
+    }
+
+    /// A 128 × 96 frame box-filters to 64 × 64: each thumbnail pixel the mean of the 2 × 1
+    /// or 2 × 2 pixels it covers (rows 3 to 2: 96 rows onto 64, alternately 1 and 2).
+    #[test]
+    fn a_thumbnail_is_the_mean_of_the_pixels_it_covers() {
+        let (w, h) = (128u32, 96u32);
+        let pixels: Vec<[f32; 4]> = (0..w * h)
+            .map(|i| [(i % w) as f32, (i / w) as f32, 1.0, 0.5])
+            .collect();
+        let t = thumbnail(&pixels, (w, h));
+        assert_eq!(t.len(), 64 * 64);
+        for (k, p) in t.iter().enumerate() {
+            let (x, y) = (k % 64, k / 64);
+            let rows: Vec<usize> = (0..h as usize)
+                .filter(|r| r * 64 / h as usize == y)
+                .collect();
+            let mean_row = rows.iter().sum::<usize>() as f32 / rows.len() as f32;
+            assert_eq!(*p, [2.0 * x as f32 + 0.5, mean_row, 1.0, 0.5], "({x}, {y})");
+        }
+    }
+
+    /// The mean absolute difference over every channel, in 8-bit steps; the median the
+    /// middle value (the upper of the two middles for an even count).
+    #[test]
+    fn seam_statistics_are_mean_differences_and_medians() {
+        let a = [[0.0, 0.5, 1.0, 1.0], [0.2, 0.2, 0.2, 0.2]];
+        let b = [[1.0, 0.5, 0.0, 1.0], [0.1, 0.3, 0.2, 0.2]];
+        // (1 + 0 + 1 + 0 + 0.1 + 0.1 + 0 + 0) / 8 × 255.
+        let want = 2.2 / 8.0 * 255.0;
+        assert!((mean_difference(&a, &b) - want).abs() < 1e-4);
+        assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 3.0);
+        assert_eq!(median(&mut []), 0.0);
+    }
+}

@@ -118,6 +118,22 @@ pub fn total_light(img: &image::RgbaImage) -> f64 {
         .sum()
 }
 
+/// The light-weighted mean position of `img`'s red channel, in pixels (x right, y down):
+/// a sprite brighter at one side (the flame wisp's base) puts it off its middle that way.
+pub fn light_centroid(img: &image::RgbaImage) -> (f32, f32) {
+    let (mut sum, mut sx, mut sy) = (0.0f64, 0.0f64, 0.0f64);
+    for (x, y, p) in img.enumerate_pixels() {
+        let r = f64::from(p[0]);
+        (sum, sx, sy) = (
+            sum + r,
+            sx + r * (f64::from(x) + 0.5),
+            sy + r * (f64::from(y) + 0.5),
+        );
+    }
+    assert!(sum > 0.0, "nothing lit");
+    ((sx / sum) as f32, (sy / sum) as f32)
+}
+
 /// Runs `steps` single steps of `player` on the GPU (one submission each).
 pub fn play_steps(ctx: &GpuContext, player: &mut ignis::Player, steps: u32) {
     for _ in 0..steps {
