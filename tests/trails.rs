@@ -2,10 +2,12 @@
 //! positions after the steps that recorded them (the ring read back, its entries chosen as
 //! the vertex shader chooses them), a reused slot's ribbon holds only its new particle's
 //! points, and the drawn ribbon lights the pixels between the particle and its tail,
-//! narrowing from its width at the particle to its tail width, and along a curve passes
-//! through its recorded points. A
-//! ribbon per parent joins each parent's children in the order it spawned them, never two
-//! parents' lives, and lights the pixels between them.
+//! narrowing from its width at the particle to its tail width (linearly, segment by
+//! segment), and along a curve passes through its recorded points. A ribbon per parent
+//! joins each parent's children in the order it spawned them, never two parents' lives,
+//! lights the pixels between them, and is each child's own width at its age. Ribbons lay
+//! their sprite with its top on the motion's left, fade towards the ground by each point's
+//! height, and take a colour inherited from a parent.
 
 mod common;
 
