@@ -62,7 +62,7 @@ TESTS = {
     "sprite_project.wgsl": [("splat", None), ("tiles", None)],
     "quad.wgsl": [("tiles", None), ("rendering", "--skip render_command"),
                   ("runtime", "instances_add_up"), ("lit", None), ("looks", "reference"),
-                  ("events", "inherited_colour")],
+                  ("looks", "sprites_turn"), ("events", "inherited_colour")],
     "integrators.wgsl": [("core_sim", None), ("stability", "--skip ignis_check")],
     "tonemap.wgsl": [("tonemap", None), ("rendering", "--skip render_command")],
     "bloom.wgsl": [("bloom", None), ("rendering", "--skip render_command")],

@@ -1,5 +1,6 @@
 //! Looks on a real adapter: the WGSL flipbook and colour-ramp functions against
-//! hand-computed values, PNG sprites (missing, broken, reloaded), streaks, soft ground,
+//! hand-computed values, PNG sprites (missing, broken, reloaded), streaks, a sprite's turn
+//! (random rotation and spin), soft ground,
 //! bloom, and fixed-seed frames of presets against committed reference images.
 //!
 //! Reference images live in `tests/reference/`. They are regenerated only deliberately:
@@ -960,5 +961,52 @@ fn trimmed_billboards_draw_the_untrimmed_frame() {
     assert!(
         mean < 0.005 && max <= 1,
         "trimmed vs whole: mean {mean}, max {max}"
+    );
+}
+
+/// A sprite turns by its random rotation (within ± half the range) plus its spin over its
+/// age. The flame wisp's bright base, below its middle unturned, stays in the lower half
+/// with a 180° range, whatever the seed; after spinning 45° a second for 2 s (of a 10 s
+/// life) it is a quarter turn round, to the side.
+#[test]
+fn sprites_turn_by_their_random_rotation_and_their_spin() {
+    let ctx = gpu();
+    let wisp = Look {
+        size_m: Param::Constant(0.8),
+        sprite: Sprite::FlameWisp,
+        intensity: 0.3,
+        rotation_random_deg: 0.0,
+        spin_deg_per_s: Param::Constant(0.0),
+        ..Look::default()
+    };
+    // 200 × 200 frames, the particle at the middle (y down).
+    let mut below = 0.0;
+    for seed in 0..4 {
+        let mut e = single(
+            Vec3::ZERO,
+            Vec3::ZERO,
+            Look {
+                rotation_random_deg: 180.0,
+                ..wisp.clone()
+            },
+        );
+        e.seed = seed;
+        let (_, y) = light_centroid(&render_after(&ctx, e, 2));
+        assert!(y > 99.9, "seed {seed}: the light's centre at y = {y}");
+        below += y - 100.0;
+    }
+    assert!(below > 4.0, "the base {below} px below in all");
+    let spun = Look {
+        spin_deg_per_s: Param::Constant(45.0),
+        ..wisp
+    };
+    let (x, y) = light_centroid(&render_after(
+        &ctx,
+        single(Vec3::ZERO, Vec3::ZERO, spun),
+        120,
+    ));
+    assert!(
+        (x - 100.0).abs() > 2.0 && (y - 100.0).abs() < 0.3 * (x - 100.0).abs(),
+        "after a quarter turn the light's centre is at ({x}, {y})"
     );
 }
