@@ -1,7 +1,8 @@
 #![allow(dead_code)] // the host fixture serves runtime.rs too
 //! Lit smoke: six-way lightmaps (generated and brought by the user), mixed by where each
 //! light is — the scene's sun and ambient, the host's point lights and the effect's own
-//! light — on both draw paths, against the CPU formula.
+//! light — on both draw paths, against the CPU formula; a turned puff through its turned
+//! frame.
 
 mod common;
 #[path = "runtime/host.rs"]
@@ -121,6 +122,34 @@ fn the_six_way_mix_equals_the_cpu_formula_on_both_paths() {
     let lit = six_way(six, Vec3::X, e);
     let want: [f32; 3] = std::array::from_fn(|c| common::ALBEDO[c] * lit[c]);
     assert_close(centre(&frame), want, "a host point light");
+}
+
+/// A turned puff's six-way frame turns with it: spun about a quarter turn (2,160° a
+/// second, drawn about 2.5 steps of 1/60 s after its birth) under a sun from +X, the
+/// sprite's own −Y axis faces the light, so its bottom (−Y) map lights it, not its top.
+#[test]
+fn a_turned_puff_is_lit_through_its_turned_frame() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let lighting = Lighting {
+        sun_direction: [1.0, 0.0, 0.0],
+        sun_color: [1.0, 1.0, 1.0],
+        ambient: [0.0; 3],
+    };
+    let mut smoke =
+        common::still_smoke(common::flat_maps(dir.path()), lighting, DrawPath::Billboard);
+    smoke.emitters[0].look.spin_deg_per_s = Param::Constant(2160.0);
+    let (frame, _) = render(&smoke, |_| {});
+    let six = flat_six();
+    // Within the turn's uncertainty (±18°: cos² ≤ 0.1 of a side map), the bottom map.
+    let want: [f32; 3] = std::array::from_fn(|c| common::ALBEDO[c] * six[4]);
+    let got = centre(&frame);
+    for c in 0..3 {
+        assert!(
+            (got[c] / want[c] - 1.0).abs() < 0.08,
+            "got {got:?}, the bottom map gives {want:?} (the top map {:?})",
+            common::ALBEDO.map(|a| a * six[1])
+        );
+    }
 }
 
 /// The effect's own light (its additive layers, measured on the GPU the same frame)

@@ -1,6 +1,6 @@
 //! Looks on a real adapter: the WGSL flipbook and colour-ramp functions against
-//! hand-computed values, PNG sprites (missing, broken, reloaded), streaks, a sprite's turn
-//! (random rotation and spin), soft ground,
+//! hand-computed values, PNG sprites (missing, broken, reloaded), streaks (their cap and
+//! side), a sprite's turn (random rotation and spin), soft ground,
 //! bloom, and fixed-seed frames of presets against committed reference images.
 //!
 //! Reference images live in `tests/reference/`. They are regenerated only deliberately:
@@ -1008,5 +1008,46 @@ fn sprites_turn_by_their_random_rotation_and_their_spin() {
     assert!(
         (x - 100.0).abs() > 2.0 && (y - 100.0).abs() < 0.3 * (x - 100.0).abs(),
         "after a quarter turn the light's centre is at ({x}, {y})"
+    );
+}
+
+/// A streak is no longer than its cap (`max_length_m`): moving right at 2 m/s with a 0.2 s
+/// tail capped at 0.1 m, it is a third as long as uncapped, still longer than it is wide.
+/// And it lays its sprite along the motion as ribbons do (its top on the motion's left):
+/// moving right, the flame wisp's bright base is below the middle.
+#[test]
+fn a_streak_is_capped_at_its_longest_and_lays_its_sprite_as_ribbons_do() {
+    let ctx = gpu();
+    let streak = |max_length_m: f32, sprite: Sprite| Look {
+        size_m: Param::Constant(0.05),
+        streak: Some(Streak {
+            length_secs: 0.2,
+            max_length_m,
+        }),
+        sprite,
+        intensity: 0.3,
+        ..Look::default()
+    };
+    let moving = |look: Look| single(Vec3::new(-0.2, 0.0, 0.0), Vec3::X * 2.0, look);
+    let (long, _) = lit_extent(
+        &render_after(&ctx, moving(streak(10.0, Sprite::SoftDisc)), 2),
+        20,
+    );
+    let (capped, h) = lit_extent(
+        &render_after(&ctx, moving(streak(0.1, Sprite::SoftDisc)), 2),
+        20,
+    );
+    assert!(
+        capped * 2 < long && capped as f32 > 1.5 * h as f32,
+        "0.4 m long: {long} px; capped at 0.1 m: {capped} × {h} px"
+    );
+    let wide = Look {
+        size_m: Param::Constant(0.3),
+        ..streak(10.0, Sprite::FlameWisp)
+    };
+    let (_, y) = light_centroid(&render_after(&ctx, moving(wide), 2));
+    assert!(
+        y > 100.5,
+        "a streak's light is centred at y = {y} px (down)"
     );
 }
