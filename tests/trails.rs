@@ -4,7 +4,8 @@
 //! points, and the drawn ribbon lights the pixels between the particle and its tail,
 //! narrowing from its width at the particle to its tail width (linearly, segment by
 //! segment), and along a curve passes through its recorded points. A ribbon per parent
-//! joins each parent's children in the order it spawned them, never two parents' lives,
+//! joins each parent's children in the order it spawned them, never two parents' lives
+//! (nor a child to the new occupant of its predecessor's slot),
 //! lights the pixels between them, and is each child's own width at its age. Ribbons lay
 //! their sprite with its top on the motion's left, fade towards the ground by each point's
 //! height, and take a colour inherited from a parent.
@@ -919,4 +920,59 @@ fn ribbons_fade_towards_the_ground_by_the_height_of_each_point() {
         low < 0.75 * high,
         "a ribbon's light near its lower child {low}, its higher {high}"
     );
+}
+
+/// A ribbon per parent joins a child only to its own predecessor, never to whatever now
+/// fills that slot: two parents flying apart spawn a child each every 0.1 s into a pool of
+/// three slots, each child dead after 0.05 s. A child's predecessor has then always died,
+/// and its slot has gone to the other parent's newest child, alive — so nothing may be
+/// drawn (the parents themselves are black), on any of the frames looked at.
+#[test]
+fn a_ribbon_per_parent_never_joins_a_child_to_its_predecessors_reused_slot() {
+    let mut effect = ribbon_effect_at(10.0);
+    let parent = &mut effect.emitters[0];
+    parent.capacity = 2;
+    parent.spawn_rate_per_sec = Param::Constant(0.0);
+    parent.bursts = vec![Burst {
+        time_secs: 0.0,
+        count: 2,
+    }];
+    parent.lifetime_secs = Range::new(5.0, 5.0);
+    parent.transform.position_m = [0.0, 1.0, 0.0];
+    parent.spread_deg = 180.0;
+    parent.look.color_over_life = flat_color([0.0, 0.0, 0.0, 1.0]);
+    let ribbon = &mut effect.emitters[1];
+    ribbon.capacity = 3;
+    ribbon.lifetime_secs = Range::new(0.05, 0.05);
+    ribbon.look.size_m = Param::Constant(0.05);
+    ribbon.look.color_over_life = flat_color([1.0, 1.0, 1.0, 1.0]);
+    ribbon.look.trail = Some(Trail {
+        mode: TrailMode::PerParent,
+        draw_sprite: false,
+        ..Trail::default()
+    });
+    side_view(&mut effect);
+    effect.validate().expect("valid");
+    let mut run =
+        ignis::testing::headless::Headless::new(&gpu(), effect, ShaderLibrary::embedded())
+            .expect("headless");
+    let mut children = 0;
+    for frame in 0..40 {
+        run.advance(f64::from(DT));
+        children += run
+            .player
+            .particles(run.instance, 1)
+            .expect("read")
+            .iter()
+            .filter(|p| p.is_alive())
+            .count();
+        if frame % 2 == 1 {
+            let light = total_light(&run.render((160, 120)).expect("render"));
+            assert_eq!(
+                light, 0.0,
+                "frame {frame}: a ribbon drawn between living children"
+            );
+        }
+    }
+    assert!(children > 24, "only {children} living children seen");
 }
