@@ -66,6 +66,56 @@ fn host_geometry_hides_splatted_particles_exactly() {
     hides_the_fire_exactly(&effect, false);
 }
 
+/// A large sprite forced onto the splat (its integrated light at its centre) in front of
+/// a wall is tested at its own depth: a 0.3 m disc 3 m from the camera, a wall 1 m behind
+/// it, the disc's centre shows its light over the wall as it does with no wall.
+#[test]
+fn a_large_splatted_sprite_in_front_of_a_wall_shows() {
+    let mut e = common::plain_emitter();
+    e.capacity = 1;
+    e.spawn_rate_per_sec = ignis::effect::Param::Constant(0.0);
+    e.bursts = vec![ignis::effect::Burst {
+        time_secs: 0.0,
+        count: 1,
+    }];
+    e.lifetime_secs = ignis::effect::Range::new(10.0, 10.0);
+    e.transform.position_m = [0.0, 0.5, 0.0];
+    e.look.sprite = Sprite::SoftDisc;
+    e.look.size_m = ignis::effect::Param::Constant(0.3);
+    e.look.color_over_life = common::flat_color([1.0, 1.0, 1.0, 1.0]);
+    e.look.blend = BlendMode::Additive;
+    e.look.draw_path = ignis::effect::DrawPath::Splat;
+    let effect = common::bare_effect(e);
+    let host = Host::new(vec3(0.0, 0.5, 3.0), vec3(0.0, 0.5, 0.0));
+    let mut fire = host.player(&effect);
+    fire.add_instance(host.place(Mat4::IDENTITY), 3)
+        .expect("instance");
+    advance(&mut [&mut fire], &host, 30);
+    let wall = Quad(
+        [
+            vec3(-3.0, -2.0, -1.0),
+            vec3(3.0, -2.0, -1.0),
+            vec3(3.0, 3.0, -1.0),
+            vec3(-3.0, 3.0, -1.0),
+        ],
+        [0.2, 0.3, 0.4],
+    );
+    let bg = [0.05, 0.04, 0.03];
+    let host_only = host.frame(bg, std::slice::from_ref(&wall), &mut [], true);
+    let with_fire = host.frame(bg, std::slice::from_ref(&wall), &mut [&mut fire], true);
+    assert!(
+        fire.draw_items().iter().any(|d| d.splat),
+        "the disc was splatted"
+    );
+    let lit = (0..host_only.rgba.len())
+        .filter(|&i| differs(with_fire.rgba[i], host_only.rgba[i], 0.01))
+        .count();
+    assert!(
+        (1..=4).contains(&lit),
+        "{lit} pixels of the wall lit by the disc's centre (1 to 4 expected)"
+    );
+}
+
 /// The tile rasteriser tests the host's depth at every pixel it shades, as the splat.
 #[test]
 fn host_geometry_hides_tiled_particles_exactly() {

@@ -394,6 +394,39 @@ fn one_large_sprite_forced_onto_the_splat_lights_the_four_pixels_at_its_centre()
     assert!(d < 0.35, "centres {ca:?} and {cb:?}");
 }
 
+/// A large sprite forced onto the splat fades towards the ground by its centre's height,
+/// as the billboards fade its middle: 0.1 m above a ground that fades sprites over 0.4 m,
+/// its light is a quarter of the unfaded disc's (after the display's encoding, between
+/// 0.3 and 0.8 of it).
+#[test]
+fn a_large_splatted_sprite_fades_towards_the_ground_by_its_centre() {
+    let ctx = gpu();
+    let mut e = common::plain_emitter();
+    e.capacity = 1;
+    e.spawn_rate_per_sec = Param::Constant(1.0);
+    e.lifetime_secs = Range::new(10.0, 10.0);
+    plain_disc(&mut e.look);
+    e.look.soft_ground_m = 0.0;
+    e.look.size_m = Param::Constant(0.3);
+    e.look.intensity = 0.05;
+    e.look.blend = BlendMode::Additive;
+    let mut bright = common::bare_effect(e);
+    bright.camera.pitch_deg = 0.0;
+    bright.post.bloom = None;
+    let mut faded = bright.clone();
+    faded.emitters[0].collisions.ground = Some(ignis::effect::GroundPlane {
+        height_m: -0.1,
+        kill_on_contact: false,
+    });
+    faded.emitters[0].look.soft_ground_m = 0.4;
+    let a = total_light(&render(&ctx, &bright, &[0], 90, SIZE));
+    let b = total_light(&render(&ctx, &faded, &[0], 90, SIZE));
+    assert!(
+        a > 0.0 && b > 0.3 * a && b < 0.8 * a,
+        "light: unfaded {a}, faded {b}"
+    );
+}
+
 /// The light-weighted centre of `img` in pixels.
 fn centroid(img: &image::RgbaImage) -> (f64, f64) {
     let (mut sx, mut sy, mut total) = (0.0, 0.0, 0.0);
