@@ -87,6 +87,15 @@ pub(super) struct EmitterState {
     pub(super) depth: Option<DepthCollider>,
 }
 
+impl EmitterState {
+    /// Writes birth-table entry `seq` at its place in the ring (`seq & births_mask`),
+    /// through `queue` (before the next submission's steps read it).
+    pub(super) fn write_birth(&self, queue: &wgpu::Queue, seq: u64, entry: &Birth) {
+        let at = (seq & u64::from(self.births_mask)) * size_of::<Birth>() as u64;
+        queue.write_buffer(&self.births, at, bytemuck::bytes_of(entry));
+    }
+}
+
 /// A buffer for an emitter's baked over-life curves (rows A and B, [`CURVE_WIDTH`]
 /// texels of four f32 each; see `shaders/curves.wgsl`).
 pub(crate) fn over_life_buffer(device: &wgpu::Device) -> wgpu::Buffer {

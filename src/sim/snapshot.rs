@@ -144,10 +144,7 @@ impl GpuSim {
             // The tiny state's birth table: the entries the next steps may read.
             s.births_mirror.clone_from(&k.births_mirror);
             for (seq, entry) in &s.births_mirror {
-                let at = (seq & u64::from(s.births_mask)) * size_of::<Birth>() as u64;
-                self.ctx
-                    .queue
-                    .write_buffer(&s.births, at, bytemuck::bytes_of(entry));
+                s.write_birth(&self.ctx.queue, *seq, entry);
             }
         }
         self.planner.clone_from(&snapshot.planner);

@@ -387,10 +387,7 @@ impl GpuSim {
         }
         let s = &self.emitters[e];
         for (seq, entry) in fresh {
-            let at = (seq & u64::from(s.births_mask)) * size_of::<Birth>() as u64;
-            self.ctx
-                .queue
-                .write_buffer(&s.births, at, bytemuck::bytes_of(&entry));
+            s.write_birth(&self.ctx.queue, seq, &entry);
         }
         // Later submits read from the last step's window on.
         let keep = u64::from(last.tiny[2]);
