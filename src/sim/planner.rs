@@ -627,3 +627,66 @@ pub fn expected_spawns(rate: &Param, seed: u32, salt: u32, t0: f64, dt: f64) -> 
 pub fn instance_random(seed: u32, salt: u32) -> f64 {
     f64::from(rng::unorm(rng::pcg4d([seed, salt, 0x5A7E, 0])[0]))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::effect::{Burst, Param};
+
+    /// One emitter of `rate` a second, capped at `cap` a second (0: none), with `bursts`.
+    fn effect(rate: f32, cap: f32, bursts: Vec<Burst>) -> Effect {
+        let mut effect = Effect::default();
+        let e = &mut effect.emitters[0];
+        e.capacity = 10_000;
+        e.spawn_rate_per_sec = Param::Constant(rate);
+        e.max_spawn_per_sec = cap;
+        e.bursts = bursts;
+        effect
+    }
+
+    /// (count, first birth fraction, fraction between births) of the first `steps` steps
+    /// of 1/60 s.
+    fn births(effect: &Effect, steps: usize) -> Vec<(u32, f32, f32)> {
+        let mut planner = EffectPlanner::default();
+        (0..steps)
+            .map(|_| {
+                let p = planner.plan_step(effect, 1.0 / 60.0)[0].expect("enabled");
+                (p.spawn_count, p.spawn_frac0, p.spawn_frac_step)
+            })
+            .collect()
+    }
+
+    fn assert_births(got: (u32, f32, f32), want: (u32, f32, f32)) {
+        assert!(
+            got.0 == want.0 && (got.1 - want.1).abs() < 1e-5 && (got.2 - want.2).abs() < 1e-5,
+            "births {got:?}, want {want:?}"
+        );
+    }
+
+    /// A steady rate's particles are born where its running count crosses a whole one: at
+    /// 90 a second in 1/60 s steps (1.5 a step), one at 2/3 of the first step, then two at
+    /// 1/3 and 1 of the second.
+    #[test]
+    fn births_fall_where_the_rate_crosses_whole_particles() {
+        let got = births(&effect(90.0, 0.0, Vec::new()), 2);
+        assert_births(got[0], (1, 2.0 / 3.0, 2.0 / 3.0));
+        assert_births(got[1], (2, 1.0 / 3.0, 2.0 / 3.0));
+    }
+
+    /// A step a cap cuts, or one with a burst besides the rate, spreads its births evenly
+    /// (the k-th at (k + ½) / n); a step of a burst alone puts them at the burst's moment.
+    #[test]
+    fn capped_and_mixed_steps_spread_their_births_and_bursts_keep_their_moment() {
+        // 20 asked, the cap's bucket of 6 plus a step's 1 let through.
+        let capped = births(&effect(1200.0, 60.0, Vec::new()), 1);
+        assert_births(capped[0], (7, 0.5 / 7.0, 1.0 / 7.0));
+        let burst = |time_secs: f32| Burst {
+            time_secs,
+            count: 3,
+        };
+        let mixed = births(&effect(90.0, 0.0, vec![burst(0.005)]), 1);
+        assert_births(mixed[0], (4, 0.5 / 4.0, 1.0 / 4.0));
+        let alone = births(&effect(0.0, 0.0, vec![burst(0.01)]), 1);
+        assert_births(alone[0], (3, 0.6, 0.0));
+    }
+}
