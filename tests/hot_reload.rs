@@ -291,6 +291,34 @@ fn deleted_and_empty_files() {
     assert!(rig.reloader.errors.is_empty());
 }
 
+/// Each of the composite's own shaders saved empty fails its reload, named, and reloads
+/// cleanly once restored: the composite rebuilds every pipeline it owns.
+#[test]
+fn the_composites_shaders_each_reload() {
+    let mut rig = Rig::new();
+    for f in [
+        "tonemap.wgsl",
+        "bloom.wgsl",
+        "clear.wgsl",
+        "test_scene.wgsl",
+    ] {
+        std::fs::write(rig.path(f), "").expect("write");
+        let report = rig.reload(&[f]);
+        assert!(
+            report.failed.contains(&f),
+            "{f} saved empty: {:?}",
+            report.failed
+        );
+        std::fs::write(rig.path(f), original(f)).expect("write");
+        let report = rig.reload(&[f]);
+        assert!(
+            report.failed.is_empty(),
+            "{f} restored: {:?}",
+            rig.reloader.errors
+        );
+    }
+}
+
 /// Only pipelines that depend on a changed file are rebuilt.
 #[test]
 fn only_dependent_pipelines_rebuild() {

@@ -689,4 +689,21 @@ mod tests {
         let alone = births(&effect(0.0, 0.0, vec![burst(0.01)]), 1);
         assert_births(alone[0], (3, 0.6, 0.0));
     }
+
+    /// A rate that is not constant asks for its integral over the step: a range, drawn once
+    /// per instance, asks for its drawn rate × the step.
+    #[test]
+    fn a_ranged_rate_asks_for_its_drawn_rate_over_the_step() {
+        let rate = Param::Range {
+            min: 30.0,
+            max: 90.0,
+        };
+        let r = 30.0 + 60.0 * instance_random(7, 3);
+        let got = expected_spawns(&rate, 7, 3, 0.5, 0.1);
+        assert!(
+            (got - r * 0.1).abs() < 1e-9,
+            "{got} spawns, want {}",
+            r * 0.1
+        );
+    }
 }
