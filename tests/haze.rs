@@ -311,3 +311,34 @@ fn frame_with(ctx: &GpuContext, effect: &Effect, at: glam::Vec3) -> Framed {
         applied,
     }
 }
+
+/// The composite (the editor's, the renders' and the exports' frame) shows the refracted
+/// image: the campfire rendered headless differs from itself with its haze emitter off
+/// around the fire, by the haze's bending of the flames' light.
+#[test]
+fn the_composite_shows_the_refracted_image() {
+    let ctx = gpu();
+    let render = |effect: Effect| {
+        let mut run =
+            ignis::testing::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
+                .expect("headless");
+        for _ in 0..30 {
+            run.advance(1.0 / 60.0);
+        }
+        run.render((160, 120)).expect("render")
+    };
+    let hazed = Effect::default_campfire();
+    let haze = hazed
+        .emitters
+        .iter()
+        .position(|e| e.look.heat_haze.is_some())
+        .expect("the campfire's haze");
+    let mut plain = hazed.clone();
+    plain.emitters[haze].enabled = false;
+    let (a, b) = (render(hazed), render(plain));
+    let (mean, max) = image_diff(&a, &b);
+    assert!(
+        mean > 0.01 && max > 16,
+        "the haze moved the image by {mean:.3}/255 mean, {max}/255 max"
+    );
+}
