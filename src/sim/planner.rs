@@ -706,4 +706,54 @@ mod tests {
             r * 0.1
         );
     }
+
+    /// A burst at a step's end belongs to the next step only: 3 at 0.5 s over steps of
+    /// 0.25 s spawn once, in the third step.
+    #[test]
+    fn a_burst_on_a_step_boundary_spawns_once() {
+        let e = effect(
+            0.0,
+            0.0,
+            vec![Burst {
+                time_secs: 0.5,
+                count: 3,
+            }],
+        );
+        let mut planner = EffectPlanner::default();
+        let counts: Vec<u32> = (0..4)
+            .map(|_| planner.plan_step(&e, 0.25)[0].expect("enabled").spawn_count)
+            .collect();
+        assert_eq!(counts, [0, 0, 3, 0]);
+    }
+
+    /// The stats count what a step could not spawn and what the ring cut short: a burst
+    /// of 25 into 10 slots drops 15; one more, a second later, while the first 10 (living
+    /// 5 s) are alive, recycles the oldest.
+    #[test]
+    fn the_stats_count_drops_and_living_particles_overwritten() {
+        let mut e = effect(
+            0.0,
+            0.0,
+            vec![
+                Burst {
+                    time_secs: 0.0,
+                    count: 25,
+                },
+                Burst {
+                    time_secs: 1.0,
+                    count: 1,
+                },
+            ],
+        );
+        e.emitters[0].capacity = 10;
+        e.emitters[0].lifetime_secs = crate::effect::Range::new(5.0, 5.0);
+        let mut planner = EffectPlanner::default();
+        for _ in 0..8 {
+            planner.plan_step(&e, 0.25);
+        }
+        let stats = &planner.emitters[0].stats;
+        assert_eq!(stats.spawned, 11);
+        assert_eq!(stats.dropped_over_capacity, 15);
+        assert_eq!(stats.recycled_alive, 1);
+    }
 }
