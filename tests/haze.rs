@@ -314,19 +314,23 @@ fn frame_with(ctx: &GpuContext, effect: &Effect, at: glam::Vec3) -> Framed {
 
 /// The composite (the editor's, the renders' and the exports' frame) shows the refracted
 /// image: the campfire rendered headless differs from itself with its haze emitter off
-/// around the fire, by the haze's bending of the flames' light.
+/// around the fire, by the haze's bending of the flames' light; with the composite's haze
+/// switched off it is the image without the haze emitter.
 #[test]
 fn the_composite_shows_the_refracted_image() {
     let ctx = gpu();
-    let render = |effect: Effect| {
+    // `shown`: the composite's heat haze on (the editor's toggle).
+    let render_with = |effect: Effect, shown: bool| {
         let mut run =
             ignis::testing::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
                 .expect("headless");
+        run.composite.heat_haze = shown;
         for _ in 0..30 {
             run.advance(1.0 / 60.0);
         }
         run.render((160, 120)).expect("render")
     };
+    let render = |effect: Effect| render_with(effect, true);
     let hazed = Effect::default_campfire();
     let haze = hazed
         .emitters
@@ -335,10 +339,13 @@ fn the_composite_shows_the_refracted_image() {
         .expect("the campfire's haze");
     let mut plain = hazed.clone();
     plain.emitters[haze].enabled = false;
-    let (a, b) = (render(hazed), render(plain));
+    let (a, b) = (render(hazed.clone()), render(plain));
     let (mean, max) = image_diff(&a, &b);
     assert!(
         mean > 0.01 && max > 16,
         "the haze moved the image by {mean:.3}/255 mean, {max}/255 max"
     );
+    // With the composite's haze off, the image is the one without the haze emitter.
+    let off = render_with(hazed, false);
+    assert!(off == b, "the haze shown with the composite's haze off");
 }

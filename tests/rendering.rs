@@ -659,3 +659,25 @@ fn pipelined_frames_draw_what_timed_frames_draw_and_time_every_part() {
     );
     assert!(a == b, "pipelined frames drew another image");
 }
+
+/// One run rendered at one size, then another, then the first again gives at each size the
+/// image a fresh run gives: the composite's targets follow the frame's size.
+#[test]
+fn the_composite_follows_the_frames_size() {
+    let ctx = gpu();
+    let played = || {
+        let mut run = Headless::new(&ctx, Effect::default_campfire(), ShaderLibrary::embedded())
+            .expect("headless");
+        for _ in 0..20 {
+            run.advance(1.0 / 60.0);
+        }
+        run
+    };
+    let mut run = played();
+    for size in [(96, 72), (64, 48), (96, 72)] {
+        let image = run.render(size).expect("render");
+        assert_eq!(image.dimensions(), size);
+        let fresh = played().render(size).expect("render");
+        assert!(image == fresh, "{size:?}: not the image a fresh run gives");
+    }
+}
