@@ -681,3 +681,36 @@ fn the_composite_follows_the_frames_size() {
         assert!(image == fresh, "{size:?}: not the image a fresh run gives");
     }
 }
+
+/// The preset's exposure scales the light before the tonemap as the view's does: an
+/// additive effect at exposure 2 renders as itself with twice the intensity (no bloom, whose
+/// threshold is not linear).
+#[test]
+fn a_presets_exposure_multiplies_the_light() {
+    let ctx = gpu();
+    let mut e = plain_emitter();
+    e.spawn_rate_per_sec = ignis::effect::Param::Constant(200.0);
+    e.speed_m_per_s = ignis::effect::Range::new(0.3, 0.6);
+    e.spread_deg = 60.0;
+    e.look.intensity = 0.5;
+    let mut effect = bare_effect(e);
+    effect.post.bloom = None;
+    let render = |effect: Effect| {
+        let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+        for _ in 0..30 {
+            run.advance(1.0 / 60.0);
+        }
+        run.render((96, 72)).expect("render")
+    };
+    let mut exposed = effect.clone();
+    exposed.post.exposure = 2.0;
+    let mut brighter = effect;
+    brighter.emitters[0].look.intensity = 1.0;
+    let (a, b) = (render(exposed), render(brighter));
+    assert!(total_light(&a) > 1e4, "almost nothing drawn");
+    let (mean, max) = image_diff(&a, &b);
+    assert!(
+        mean < 0.1 && max <= 2,
+        "{mean:.3}/255 mean, {max}/255 max apart"
+    );
+}

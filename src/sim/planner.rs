@@ -728,7 +728,7 @@ mod tests {
 
     /// The stats count what a step could not spawn and what the ring cut short: a burst
     /// of 25 into 10 slots drops 15; one more, a second later, while the first 10 (living
-    /// 5 s) are alive, recycles the oldest.
+    /// 5 s) are alive, recycles the oldest — and none when they lived only 0.9 s.
     #[test]
     fn the_stats_count_drops_and_living_particles_overwritten() {
         let mut e = effect(
@@ -755,5 +755,12 @@ mod tests {
         assert_eq!(stats.spawned, 11);
         assert_eq!(stats.dropped_over_capacity, 15);
         assert_eq!(stats.recycled_alive, 1);
+        // Living 0.9 s, the first burst (born at 0 s) has died by 1 s: nothing recycled.
+        e.emitters[0].lifetime_secs = crate::effect::Range::new(0.9, 0.9);
+        let mut planner = EffectPlanner::default();
+        for _ in 0..8 {
+            planner.plan_step(&e, 0.25);
+        }
+        assert_eq!(planner.emitters[0].stats.recycled_alive, 0);
     }
 }
