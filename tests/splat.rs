@@ -354,16 +354,7 @@ fn the_compute_resolve_adds_what_the_resolve_draw_does() {
 #[test]
 fn one_large_sprite_forced_onto_the_splat_lights_the_four_pixels_at_its_centre() {
     let ctx = gpu();
-    let mut e = common::plain_emitter();
-    e.capacity = 1;
-    e.spawn_rate_per_sec = Param::Constant(1.0);
-    e.lifetime_secs = Range::new(10.0, 10.0);
-    plain_disc(&mut e.look);
-    e.look.soft_ground_m = 0.0;
-    e.look.size_m = Param::Constant(0.3);
-    e.look.intensity = 0.05;
-    e.look.blend = BlendMode::Additive;
-    let mut effect = common::bare_effect(e);
+    let mut effect = one_large_disc();
     // The disc a fraction of a pixel off the target's pixel corner: unequal weights.
     effect.camera.target_m = [0.011, 0.007, 0.0];
     effect.camera.pitch_deg = 0.0;
@@ -401,16 +392,7 @@ fn one_large_sprite_forced_onto_the_splat_lights_the_four_pixels_at_its_centre()
 #[test]
 fn a_large_splatted_sprite_fades_towards_the_ground_by_its_centre() {
     let ctx = gpu();
-    let mut e = common::plain_emitter();
-    e.capacity = 1;
-    e.spawn_rate_per_sec = Param::Constant(1.0);
-    e.lifetime_secs = Range::new(10.0, 10.0);
-    plain_disc(&mut e.look);
-    e.look.soft_ground_m = 0.0;
-    e.look.size_m = Param::Constant(0.3);
-    e.look.intensity = 0.05;
-    e.look.blend = BlendMode::Additive;
-    let mut bright = common::bare_effect(e);
+    let mut bright = one_large_disc();
     bright.camera.pitch_deg = 0.0;
     bright.post.bloom = None;
     let mut faded = bright.clone();
@@ -425,6 +407,21 @@ fn a_large_splatted_sprite_fades_towards_the_ground_by_its_centre() {
         a > 0.0 && b > 0.3 * a && b < 0.8 * a,
         "light: unfaded {a}, faded {b}"
     );
+}
+
+/// One still 0.3 m disc at the origin (tens of pixels: past the footprint's 8), dim and
+/// additive, born in the first second and living 10 s.
+fn one_large_disc() -> Effect {
+    let mut e = common::plain_emitter();
+    e.capacity = 1;
+    e.spawn_rate_per_sec = Param::Constant(1.0);
+    e.lifetime_secs = Range::new(10.0, 10.0);
+    plain_disc(&mut e.look);
+    e.look.soft_ground_m = 0.0;
+    e.look.size_m = Param::Constant(0.3);
+    e.look.intensity = 0.05;
+    e.look.blend = BlendMode::Additive;
+    common::bare_effect(e)
 }
 
 /// The light-weighted centre of `img` in pixels.

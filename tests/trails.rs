@@ -841,11 +841,7 @@ fn an_inherited_colour_tints_a_childs_trail() {
         draw_sprite: false,
         ..Trail::default()
     });
-    side_view(&mut effect);
-    effect.validate().expect("valid");
-    let mut run =
-        ignis::testing::headless::Headless::new(&gpu(), effect, ShaderLibrary::embedded())
-            .expect("headless");
+    let mut run = side_view_run(effect);
     for _ in 0..30 {
         run.advance(f64::from(DT));
     }
@@ -951,11 +947,7 @@ fn a_ribbon_per_parent_never_joins_a_child_to_its_predecessors_reused_slot() {
         draw_sprite: false,
         ..Trail::default()
     });
-    side_view(&mut effect);
-    effect.validate().expect("valid");
-    let mut run =
-        ignis::testing::headless::Headless::new(&gpu(), effect, ShaderLibrary::embedded())
-            .expect("headless");
+    let mut run = side_view_run(effect);
     let mut children = 0;
     for frame in 0..40 {
         run.advance(f64::from(DT));
@@ -975,4 +967,12 @@ fn a_ribbon_per_parent_never_joins_a_child_to_its_predecessors_reused_slot() {
         }
     }
     assert!(children > 24, "only {children} living children seen");
+}
+
+/// A headless run of `effect` in [`side_view`] (checked valid first).
+fn side_view_run(mut effect: Effect) -> ignis::testing::headless::Headless {
+    side_view(&mut effect);
+    effect.validate().expect("valid");
+    ignis::testing::headless::Headless::new(&gpu(), effect, ShaderLibrary::embedded())
+        .expect("headless")
 }
