@@ -1012,7 +1012,7 @@ fn sprites_turn_by_their_random_rotation_and_their_spin() {
 }
 
 /// A streak is no longer than its cap (`max_length_m`): moving right at 2 m/s with a 0.2 s
-/// tail capped at 0.1 m, it is a third as long as uncapped, still longer than it is wide.
+/// tail capped at 0.1 m, it is under half as long as uncapped, still longer than it is wide.
 /// And it lays its sprite along the motion as ribbons do (its top on the motion's left):
 /// moving right, the flame wisp's bright base is below the middle.
 #[test]

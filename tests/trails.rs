@@ -185,11 +185,7 @@ fn the_trail_spans_the_same_seconds_at_any_step() {
     let ctx = gpu();
     let mut e = plain_emitter();
     e.capacity = 4;
-    e.spawn_rate_per_sec = Param::Constant(0.0);
-    e.bursts = vec![Burst {
-        time_secs: 0.0,
-        count: 1,
-    }];
+    burst_at_start(&mut e, 1);
     e.lifetime_secs = Range::new(5.0, 5.0);
     e.look.trail = Some(Trail {
         points: 6,
@@ -254,11 +250,7 @@ fn ribbon_run(
 ) -> ignis::testing::headless::Headless {
     let mut e = plain_emitter();
     e.capacity = 4;
-    e.spawn_rate_per_sec = Param::Constant(0.0);
-    e.bursts = vec![Burst {
-        time_secs: 0.0,
-        count: 1,
-    }];
+    burst_at_start(&mut e, 1);
     e.lifetime_secs = Range::new(5.0, 5.0);
     e.transform.position_m = [-1.0, 1.0, 0.0];
     e.direction = [1.0, 0.0, 0.0];
@@ -635,11 +627,7 @@ fn still_children_ribbon(
     let mut effect = ribbon_effect();
     let parent = &mut effect.emitters[0];
     parent.capacity = 1;
-    parent.spawn_rate_per_sec = Param::Constant(0.0);
-    parent.bursts = vec![Burst {
-        time_secs: 0.0,
-        count: 1,
-    }];
+    burst_at_start(parent, 1);
     parent.lifetime_secs = Range::new(parent_life, parent_life);
     parent.transform.position_m = [-1.0, 1.0, 0.0];
     parent.direction = [1.0, 0.0, 0.0];
@@ -928,11 +916,7 @@ fn a_ribbon_per_parent_never_joins_a_child_to_its_predecessors_reused_slot() {
     let mut effect = ribbon_effect_at(10.0);
     let parent = &mut effect.emitters[0];
     parent.capacity = 2;
-    parent.spawn_rate_per_sec = Param::Constant(0.0);
-    parent.bursts = vec![Burst {
-        time_secs: 0.0,
-        count: 2,
-    }];
+    burst_at_start(parent, 2);
     parent.lifetime_secs = Range::new(5.0, 5.0);
     parent.transform.position_m = [0.0, 1.0, 0.0];
     parent.spread_deg = 180.0;
@@ -975,4 +959,13 @@ fn side_view_run(mut effect: Effect) -> ignis::testing::headless::Headless {
     effect.validate().expect("valid");
     ignis::testing::headless::Headless::new(&gpu(), effect, ShaderLibrary::embedded())
         .expect("headless")
+}
+
+/// `e` spawns `count` particles at time 0 and none after.
+fn burst_at_start(e: &mut Emitter, count: u32) {
+    e.spawn_rate_per_sec = Param::Constant(0.0);
+    e.bursts = vec![Burst {
+        time_secs: 0.0,
+        count,
+    }];
 }

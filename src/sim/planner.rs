@@ -631,7 +631,7 @@ pub fn instance_random(seed: u32, salt: u32) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::effect::{Burst, Param};
+    use crate::effect::{Burst, Param, Range};
 
     /// One emitter of `rate` a second, capped at `cap` a second (0: none), with `bursts`.
     fn effect(rate: f32, cap: f32, bursts: Vec<Burst>) -> Effect {
@@ -644,16 +644,22 @@ mod tests {
         effect
     }
 
-    /// (count, first birth fraction, fraction between births) of the first `steps` steps
-    /// of 1/60 s.
-    fn births(effect: &Effect, steps: usize) -> Vec<(u32, f32, f32)> {
+    /// A planner after `steps` steps of `dt` seconds of `effect`, and each step's (count,
+    /// first birth fraction, fraction between births).
+    fn planned(effect: &Effect, dt: f32, steps: usize) -> (EffectPlanner, Vec<(u32, f32, f32)>) {
         let mut planner = EffectPlanner::default();
-        (0..steps)
+        let births = (0..steps)
             .map(|_| {
-                let p = planner.plan_step(effect, 1.0 / 60.0)[0].expect("enabled");
+                let p = planner.plan_step(effect, dt)[0].expect("enabled");
                 (p.spawn_count, p.spawn_frac0, p.spawn_frac_step)
             })
-            .collect()
+            .collect();
+        (planner, births)
+    }
+
+    /// Each step's births over the first `steps` steps of 1/60 s.
+    fn births(effect: &Effect, steps: usize) -> Vec<(u32, f32, f32)> {
+        planned(effect, 1.0 / 60.0, steps).1
     }
 
     fn assert_births(got: (u32, f32, f32), want: (u32, f32, f32)) {
@@ -719,10 +725,7 @@ mod tests {
                 count: 3,
             }],
         );
-        let mut planner = EffectPlanner::default();
-        let counts: Vec<u32> = (0..4)
-            .map(|_| planner.plan_step(&e, 0.25)[0].expect("enabled").spawn_count)
-            .collect();
+        let counts: Vec<u32> = planned(&e, 0.25, 4).1.iter().map(|b| b.0).collect();
         assert_eq!(counts, [0, 0, 3, 0]);
     }
 
@@ -746,21 +749,15 @@ mod tests {
             ],
         );
         e.emitters[0].capacity = 10;
-        e.emitters[0].lifetime_secs = crate::effect::Range::new(5.0, 5.0);
-        let mut planner = EffectPlanner::default();
-        for _ in 0..8 {
-            planner.plan_step(&e, 0.25);
-        }
+        e.emitters[0].lifetime_secs = Range::new(5.0, 5.0);
+        let (planner, _) = planned(&e, 0.25, 8);
         let stats = &planner.emitters[0].stats;
         assert_eq!(stats.spawned, 11);
         assert_eq!(stats.dropped_over_capacity, 15);
         assert_eq!(stats.recycled_alive, 1);
         // Living 0.9 s, the first burst (born at 0 s) has died by 1 s: nothing recycled.
-        e.emitters[0].lifetime_secs = crate::effect::Range::new(0.9, 0.9);
-        let mut planner = EffectPlanner::default();
-        for _ in 0..8 {
-            planner.plan_step(&e, 0.25);
-        }
+        e.emitters[0].lifetime_secs = Range::new(0.9, 0.9);
+        let (planner, _) = planned(&e, 0.25, 8);
         assert_eq!(planner.emitters[0].stats.recycled_alive, 0);
     }
 }
