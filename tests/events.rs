@@ -203,6 +203,8 @@ fn check_against_the_mirror(
     effect.emitters[0].capacity = parent_capacity;
     let child = &mut effect.emitters[1];
     child.capacity = 16384;
+    // Off the parent's origin on every axis: the inherited offset has three components.
+    child.transform.position_m = [2.0, 0.5, -0.7];
     // Children spread over a shape of their own and fly at a speed of their own, on top of
     // where the event happened and what they inherit.
     child.shape = Shape::Sphere {
@@ -262,6 +264,11 @@ fn check_against_the_mirror(
 /// lifetime its key draws (with the parent's age in its lowest bits when `inherit_color`).
 fn check_child(c: &Particle, s: &EventSpawn, cp: &SimParams, inherit_color: bool, what: &str) {
     let bits = s.vel_j[3].to_bits();
+    assert_eq!(
+        bits >> 24 & 1 == 1,
+        inherit_color,
+        "{what}: the entry's colour flag"
+    );
     let key = child_key(
         cp.seed,
         cp.emitter_salt,

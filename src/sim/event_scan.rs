@@ -260,3 +260,153 @@ pub fn child_key(seed: u32, salt: u32, event_key: u32, j: u32) -> [u32; 4] {
         j.wrapping_mul(0x9E37_79B9),
     ])
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::effect::{Event, Trigger};
+
+    /// A parent whose one event feeds `child`, with the event's fields from `event`.
+    fn parent_and_child(event: Event, child_capacity: u32) -> Effect {
+        let parent = Emitter {
+            name: "parent".into(),
+            events: vec![Event {
+                emitter: "child".into(),
+                ..event
+            }],
+            ..Emitter::default()
+        };
+        let child = Emitter {
+            name: "child".into(),
+            capacity: child_capacity,
+            ..Emitter::default()
+        };
+        Effect {
+            emitters: vec![parent, child],
+            ..Effect::default()
+        }
+    }
+
+    /// A rule that always fires `count` children (probability 1).
+    fn rule(trigger: Trigger, count: u32) -> EventRule {
+        EventRule {
+            trigger: trigger.index(),
+            count_min: count,
+            count_max: count,
+            probability: 1.0,
+            ..EventRule::default()
+        }
+    }
+
+    fn params() -> SimParams {
+        SimParams {
+            capacity: 64,
+            seed: 0x1234_5678,
+            emitter_salt: 0x9ABC,
+            spawn_count: 3,
+            spawn_base_lo: 200,
+            ..SimParams::default()
+        }
+    }
+
+    /// A living particle of age `age` (of a 2 s life), before and after a step.
+    fn living(age: f32) -> Particle {
+        Particle {
+            pos_age: [0.0, 0.0, 0.0, age],
+            vel_life: [0.0, 0.0, 0.0, 2.0],
+        }
+    }
+
+    #[test]
+    fn unused_rule_slots_say_none() {
+        let effect = parent_and_child(
+            Event {
+                trigger: Trigger::Birth,
+                ..Event::default()
+            },
+            16,
+        );
+        let rules = rules_of(&effect.emitters[0]);
+        assert_eq!(rules[0].trigger, Trigger::Birth.index());
+        assert_eq!(
+            rules[1].trigger, TRIGGER_NONE,
+            "the second slot has no event"
+        );
+    }
+
+    /// The room per step is a full bucket (0.1 s of the cap) plus the longest step's
+    /// refill, rounded down, plus one; within the child's capacity, and at least one.
+    #[test]
+    fn a_step_cap_is_a_full_bucket_and_the_longest_steps_refill() {
+        let mut effect = parent_and_child(
+            Event {
+                max_per_sec: 750.0,
+                ..Event::default()
+            },
+            4096,
+        );
+        effect.time.mode = crate::effect::TimeMode::FixedStep;
+        effect.time.step_secs = 1.0 / 60.0;
+        // 75 + 12.5 → 87, + 1.
+        assert_eq!(step_cap(&effect, 0, 0), 88);
+        effect.time.step_secs = 0.1;
+        // 75 + 75 → 150, + 1.
+        assert_eq!(step_cap(&effect, 0, 0), 151);
+        effect.emitters[1].capacity = 100;
+        assert_eq!(step_cap(&effect, 0, 0), 100, "held to the child's capacity");
+    }
+
+    /// A collision fires for a living particle that hit, not for one that did not; two
+    /// hits in one ordinal (1/16 s of age) share a key, hits in different ones do not.
+    #[test]
+    fn a_collision_fires_on_a_hit_and_keys_by_the_hits_age() {
+        let (r, p) = (rule(Trigger::Collision, 2), params());
+        let at =
+            |age: f32, hit: bool| event_of(&r, 0, &p, 5, &living(0.1), &living(age), false, hit);
+        assert_eq!(at(0.50, false).0, 0, "no hit, no children");
+        let (n, key, first) = at(0.50, true);
+        assert_eq!((n, first), (2, 0));
+        assert_eq!(at(0.52, true).1, key, "the same ordinal: 0.50 s and 0.52 s");
+        assert_ne!(at(0.60, true).1, key, "the next ordinal: 0.5625 s on");
+        let dead = Particle::default();
+        assert_eq!(
+            event_of(&r, 0, &p, 5, &dead, &dead, false, true).0,
+            0,
+            "a slot that never lived does not collide"
+        );
+    }
+
+    /// An event fires when its draw is below the probability: a probability equal to the
+    /// draw does not fire, the next float up does (so 0 never fires and 1 always does).
+    #[test]
+    fn a_draw_equal_to_the_probability_does_not_fire() {
+        let (mut r, p) = (rule(Trigger::Death, 1), params());
+        let dies = |r: &EventRule| event_of(r, 0, &p, 7, &living(1.9), &living(2.0), false, false);
+        let (n, key, _) = dies(&r);
+        assert_eq!(n, 1, "probability 1 fires");
+        let draw = crate::rng::unorm(pcg4d([key, p.seed, 0, 0xC0])[2]);
+        r.probability = draw;
+        assert_eq!(dies(&r).0, 0, "a probability equal to the draw {draw}");
+        r.probability = f32::from_bits(draw.to_bits() + 1);
+        assert_eq!(dies(&r).0, 1, "the next float up");
+    }
+
+    /// A count range draws within itself; a rule with no trigger asks for nothing.
+    #[test]
+    fn counts_stay_in_their_range_and_no_trigger_asks_nothing() {
+        let mut r = rule(Trigger::Death, 0);
+        r.count_max = 3;
+        r.count_min = 1;
+        let p = params();
+        let counts: Vec<u32> = (0..64)
+            .map(|slot| event_of(&r, 0, &p, slot, &living(1.9), &living(2.0), false, false).0)
+            .collect();
+        assert!(counts.iter().all(|n| (1..=3).contains(n)), "{counts:?}");
+        assert!((1..=3).all(|n| counts.contains(&n)), "{counts:?}");
+        r.trigger = TRIGGER_NONE;
+        assert_eq!(
+            event_of(&r, 0, &p, 3, &living(1.9), &living(2.0), false, false),
+            (0, 0, 0)
+        );
+    }
+}
