@@ -262,12 +262,12 @@ impl Composite {
             }
             // The tiles are resolved by compute where the adapter can (between the
             // blended billboards under them and the light over them), else drawn; so is
-            // the splat's light (after the rest: it is added).
+            // the splat's light (after the rest: it is added). Both are the light layer's,
+            // which is never reduced: it is always drawn here.
             let main = Layers::ALL.without(layered);
-            let light = main.contains(Layers::LIGHT);
             let mut drawn = Resolves::DRAWN;
-            drawn.splat = !(light && player.splat_resolvable_into(size));
-            if light && player.tiles_resolvable_into(size) {
+            drawn.splat = !player.splat_resolvable_into(size);
+            if player.tiles_resolvable_into(size) {
                 if player.draws_under_tiles(main) {
                     player.draw_under_tiles(&mut load_hdr_pass(enc, view), main);
                 }

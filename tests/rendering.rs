@@ -573,6 +573,78 @@ fn draft_glow_layer_renders_like_full_resolution() {
     }
 }
 
+/// The layers [`Composite::draw_particles`] draws apart (into targets of their own, added
+/// in the tonemap) are exactly those reduced and drawn: the blended one at
+/// `post.alpha_downscale` > 1 or in draft, the glow at `glow_downscale` > 1 or in draft,
+/// and no layer the player has nothing in.
+#[test]
+fn only_reduced_layers_are_drawn_apart() {
+    use ignis::Layers;
+    let ctx = gpu();
+    let mut effect = Effect::default_campfire();
+    effect.post.bloom = None;
+    let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    for _ in 0..90 {
+        run.advance(1.0 / 60.0);
+    }
+    let layered = |run: &mut Headless, draft: bool, alpha: u32, glow: u32| {
+        run.composite.draft = draft;
+        run.edit(|e| (e.post.alpha_downscale, e.post.glow_downscale) = (alpha, glow))
+            .expect("edit");
+        let camera = run.camera.view(SIZE);
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        let Headless {
+            composite, player, ..
+        } = run;
+        composite.record_player(&mut enc, player, &camera, None);
+        let layered = composite.draw_particles(&ctx, &mut enc, player, &camera);
+        ctx.queue.submit([enc.finish()]);
+        layered
+    };
+    assert_eq!(layered(&mut run, false, 1, 1), Layers::NONE);
+    assert_eq!(layered(&mut run, false, 2, 1), Layers::BLENDED);
+    assert_eq!(layered(&mut run, false, 1, 2), Layers::GLOW);
+    assert_eq!(
+        layered(&mut run, true, 1, 1),
+        Layers::BLENDED | Layers::GLOW
+    );
+    // Without its smoke the campfire has no blended layer to draw apart.
+    run.edit(|e| {
+        e.emitters
+            .retain(|m| m.look.blend == ignis::effect::BlendMode::Additive);
+        e.emitters.iter_mut().for_each(|m| m.events.clear());
+    })
+    .expect("edit");
+    assert_eq!(layered(&mut run, false, 2, 2), Layers::GLOW);
+}
+
+/// Draft halves the blended layer's resolution again: the campfire in draft at
+/// `alpha_downscale` 2 is the frame at 4, and not the frame at 2.
+#[test]
+fn draft_halves_the_blended_layers_resolution_again() {
+    let ctx = gpu();
+    let mut effect = Effect::default_campfire();
+    // The bloom's own draft setting aside, draft changes only the reduced layers.
+    effect.post.bloom = None;
+    let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    for _ in 0..90 {
+        run.advance(1.0 / 60.0);
+    }
+    let mut frame = |draft: bool, alpha: u32| {
+        run.composite.draft = draft;
+        run.edit(|e| (e.post.alpha_downscale, e.post.glow_downscale) = (alpha, 2))
+            .expect("edit");
+        run.render(SIZE).expect("render")
+    };
+    let (draft_2, at_4, at_2) = (frame(true, 2), frame(false, 4), frame(false, 2));
+    assert_eq!(
+        image_diff(&draft_2, &at_4),
+        (0.0, 0),
+        "draft at 2 against 4"
+    );
+    assert!(image_diff(&draft_2, &at_2).0 > 0.0, "draft at 2 against 2");
+}
+
 /// The adapter profile changes how the frame is made (render scale, draft layers, the UI
 /// painter), never what the player draws: the
 /// campfire renders the same frame and keeps the same particles under either profile.
