@@ -272,6 +272,43 @@ fn beside_an_edge_the_normal_comes_from_the_same_surface() {
     }
 }
 
+/// A floor (y = 0, x > 0) meeting a 45° ramp that rises towards −x, seen from above: the
+/// crease at x = 0 runs down the image's middle, between two pixel columns. Sparks
+/// dropped onto the floor's first column beside it bounce straight up: the normal is
+/// built around the contact pixel's own centre, not a neighbour's on the ramp.
+#[test]
+fn beside_a_crease_the_normal_is_the_contact_pixels_own() {
+    let host = Host::new(vec3(0.0, 3.0, 0.3), Vec3::ZERO);
+    let floor = quad(vec3(1.0, 0.0, 0.0), Vec3::X, Vec3::Z * 2.0);
+    let ramp = quad(
+        vec3(-0.25, 0.25, 0.0),
+        vec3(0.25, -0.25, 0.0),
+        Vec3::Z * 2.0,
+    );
+    // x from 4 to 20 mm: inside the column right of the crease (2.4 cm wide here).
+    let effect = sparks(
+        200,
+        [0.012, 0.6, 0.0],
+        [0.008, 0.0, 0.3],
+        [0.0, -3.0, 0.0],
+        1.0,
+    );
+    let (_, last) = run(
+        &host,
+        &[floor, ramp],
+        &mut host.player(&effect),
+        16,
+        true,
+        |_| {},
+    );
+    assert_eq!(last.len(), 200);
+    for p in &last {
+        let v = vel(p);
+        assert!(v.y > 2.9, "{} did not bounce: {v}", pos(p));
+        assert!(v.x.abs() < 0.02 && v.z.abs() < 0.02, "{}: {v}", pos(p));
+    }
+}
+
 /// A plane tilted towards the camera: a perfectly elastic bounce reflects each spark
 /// about the plane's normal, which the depth around the contact gives to 1e-3.
 fn tilted_run(kind: HostKind) -> Vec<Particle> {
