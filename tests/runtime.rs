@@ -116,6 +116,62 @@ fn a_large_splatted_sprite_in_front_of_a_wall_shows() {
     );
 }
 
+/// A long, thin streak forced onto the splat (under 2 px wide, its pixel box wider than
+/// the footprint's 8 px) is added as its integrated light in one tap: the pixel its head
+/// is in, and no other.
+#[test]
+fn a_thin_splatted_streak_lights_the_pixel_its_head_is_in() {
+    let mut e = common::plain_emitter();
+    e.capacity = 1;
+    e.spawn_rate_per_sec = ignis::effect::Param::Constant(0.0);
+    e.bursts = vec![ignis::effect::Burst {
+        time_secs: 0.0,
+        count: 1,
+    }];
+    e.lifetime_secs = ignis::effect::Range::new(10.0, 10.0);
+    // 0.4 px below the middle row's top edge.
+    e.transform.position_m = [-0.3, 0.49, 0.0];
+    e.direction = [1.0, 0.0, 0.0];
+    e.spread_deg = 0.0;
+    e.speed_m_per_s = ignis::effect::Range::new(1.0, 1.0);
+    // 1.2 px wide, 0.3 m (12 px) long, 3 m from the camera.
+    e.look.size_m = ignis::effect::Param::Constant(0.03);
+    e.look.streak = Some(ignis::effect::Streak {
+        length_secs: 0.3,
+        max_length_m: 1.0,
+    });
+    e.look.color_over_life = common::flat_color([1.0, 1.0, 1.0, 1.0]);
+    e.look.blend = BlendMode::Additive;
+    e.look.draw_path = ignis::effect::DrawPath::Splat;
+    let origin = Vec3::from(e.transform.position_m);
+    let effect = common::bare_effect(e);
+    let host = Host::new(vec3(0.0, 0.5, 3.0), vec3(0.0, 0.5, 0.0));
+    let mut fire = host.player(&effect);
+    let id = fire
+        .add_instance(host.place(Mat4::IDENTITY), 3)
+        .expect("instance");
+    let bg = [0.05, 0.04, 0.03];
+    let dark = host.frame(bg, &[], &mut [], true);
+    for frames in [23, 7] {
+        advance(&mut [&mut fire], &host, frames);
+        let frame = host.frame(bg, &[], &mut [&mut fire], true);
+        assert!(
+            fire.draw_items().iter().any(|d| d.splat),
+            "the streak was splatted"
+        );
+        let p = fire.particles(id, 0).expect("particles")[0];
+        let at = host.pixel_of(Vec3::from_slice(&p.pos_age[..3]) + origin);
+        let inside = (at - at.round()).abs();
+        assert!(inside.min_element() > 0.05, "{at}: not near a pixel's edge");
+        let head = at.floor();
+        let lit: Vec<(u32, u32)> = (0..dark.rgba.len())
+            .filter(|&i| differs(frame.rgba[i], dark.rgba[i], 0.01))
+            .map(|i| (i as u32 % SIZE.0, i as u32 / SIZE.0))
+            .collect();
+        assert_eq!(lit, [(head.x as u32, head.y as u32)], "the head at {head}");
+    }
+}
+
 /// The tile rasteriser tests the host's depth at every pixel it shades, as the splat.
 #[test]
 fn host_geometry_hides_tiled_particles_exactly() {

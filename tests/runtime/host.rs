@@ -371,6 +371,15 @@ impl Host {
         )
     }
 
+    /// The pixel coordinates (x right, y down, 0 at the target's corner) of world point
+    /// `p` in this host's world.
+    pub fn pixel_of(&self, p: Vec3) -> glam::Vec2 {
+        let clip = self.clip_from_world * p.extend(1.0);
+        let ndc = clip.truncate().truncate() / clip.w;
+        let size = glam::vec2(SIZE.0 as f32, SIZE.1 as f32);
+        glam::vec2(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * size
+    }
+
     /// The view-space distance in front of the camera of (y-up) point `p`.
     pub fn distance_of(&self, eye: Vec3, target: Vec3, p: Vec3) -> f64 {
         let forward = (target - eye).normalize().as_dvec3();
