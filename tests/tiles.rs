@@ -12,7 +12,7 @@ mod common;
 
 use common::{gpu, image_diff, share_off, total_light};
 use ignis::effect::{
-    BlendMode, DrawPath, Effect, Flipbook, FlipbookMode, Lighting, Param, Range, SixWayMaps,
+    BlendMode, DrawPath, Effect, Flipbook, FlipbookMode, Lighting, Param, Range, Shape, SixWayMaps,
     Sprite, Streak,
 };
 use ignis::testing::gpu::{AdapterProfile, GpuContext};
@@ -415,6 +415,54 @@ fn lit_flipbooks_blend_their_frames_alike_on_both_paths() {
         });
         let what = format!("lit flipbook, sun towards {sun_direction:?}");
         paths_agree_at(&ctx, &what, &effect, &[20, 31]);
+    }
+}
+
+/// A lit item's sprites are followed by their six-way records, and the rest of its last
+/// block is filled with empty sprites. When the item shrinks within the block (500 puffs,
+/// then 200 in another place: the buffers are kept), that rest holds the larger frame's
+/// sprites until it is filled: the tiles still draw the billboards' image, not the
+/// earlier frame's puffs as well.
+#[test]
+fn a_lit_item_that_shrinks_leaves_none_of_its_earlier_sprites() {
+    let ctx = gpu();
+    let sun = Lighting {
+        sun_color: [3.0, 3.0, 3.0],
+        ..Lighting::default()
+    };
+    let mut effect = common::still_smoke(SixWayMaps::PuffSheet, sun, DrawPath::Billboard);
+    let e = &mut effect.emitters[0];
+    (e.capacity, e.bursts[0].count) = (500, 500);
+    e.shape = Shape::Sphere {
+        radius_m: 0.6,
+        surface_only: false,
+    };
+    e.look.size_m = Param::Constant(0.08);
+    let frames = |path: DrawPath| {
+        let mut effect = full_resolution(effect.clone());
+        effect.emitters[0].look.draw_path = path;
+        let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+        run.advance(1.0 / 60.0);
+        let before = run.render(SIZE).expect("render");
+        run.edit(|e| {
+            let e = &mut e.emitters[0];
+            (e.capacity, e.bursts[0].count) = (200, 200);
+            e.transform.position_m[0] += 0.8;
+        })
+        .expect("edit");
+        run.advance(1.0 / 60.0);
+        let tiled = run.player.draw_items().iter().any(|d| d.tiles);
+        assert_eq!(tiled, path == DrawPath::Tiles, "{path:?}");
+        (before, run.render(SIZE).expect("render"))
+    };
+    let (bill, tiles) = (frames(DrawPath::Billboard), frames(DrawPath::Tiles));
+    for (what, a, b) in [("500", &bill.0, &tiles.0), ("200", &bill.1, &tiles.1)] {
+        let (mean, max) = image_diff(a, b);
+        assert!(total_light(a) > 1e3, "{what}: the billboards drew little");
+        assert!(
+            mean <= 1.0 && max <= 8,
+            "{what} puffs: {mean:.3}/255 mean, {max}/255 max"
+        );
     }
 }
 
