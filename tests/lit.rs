@@ -124,31 +124,39 @@ fn the_six_way_mix_equals_the_cpu_formula_on_both_paths() {
     assert_close(centre(&frame), want, "a host point light");
 }
 
-/// A turned puff's six-way frame turns with it: spun about a quarter turn (2,160° a
-/// second, drawn about 2.5 steps of 1/60 s after its birth) under a sun from +X, the
-/// sprite's own −Y axis faces the light, so its bottom (−Y) map lights it, not its top.
+/// A turned puff's six-way frame turns with it: spun about a quarter turn counter-clockwise
+/// (2,160° a second, drawn about 2.5 steps of 1/60 s after its birth), its own −Y axis
+/// faces a sun from +X, so its bottom (−Y) map lights it, not its top; and its own +X axis
+/// faces a sun from above (+Y), so its right map lights it, not its left.
 #[test]
 fn a_turned_puff_is_lit_through_its_turned_frame() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let lighting = Lighting {
-        sun_direction: [1.0, 0.0, 0.0],
-        sun_color: [1.0, 1.0, 1.0],
-        ambient: [0.0; 3],
-    };
-    let mut smoke =
-        common::still_smoke(common::flat_maps(dir.path()), lighting, DrawPath::Billboard);
-    smoke.emitters[0].look.spin_deg_per_s = Param::Constant(2160.0);
-    let (frame, _) = render(&smoke, |_| {});
     let six = flat_six();
-    // Within the turn's uncertainty (±18°: cos² ≤ 0.1 of a side map), the bottom map.
-    let want: [f32; 3] = std::array::from_fn(|c| common::ALBEDO[c] * six[4]);
-    let got = centre(&frame);
-    for c in 0..3 {
-        assert!(
-            (got[c] / want[c] - 1.0).abs() < 0.08,
-            "got {got:?}, the bottom map gives {want:?} (the top map {:?})",
-            common::ALBEDO.map(|a| a * six[1])
-        );
+    // (towards the sun, the map facing it after the turn, the opposite one (`flat_six`'s
+    // order), the tolerance: within the turn's uncertainty (±18°) the other axis's maps
+    // weigh at most sin² 18° ≈ 0.1)
+    for (sun, facing, opposite, tolerance) in
+        [([1.0, 0.0, 0.0], 4, 1, 0.08), ([0.0, 1.0, 0.0], 0, 3, 0.12)]
+    {
+        let lighting = Lighting {
+            sun_direction: sun,
+            sun_color: [1.0, 1.0, 1.0],
+            ambient: [0.0; 3],
+        };
+        let mut smoke =
+            common::still_smoke(common::flat_maps(dir.path()), lighting, DrawPath::Billboard);
+        smoke.emitters[0].look.spin_deg_per_s = Param::Constant(2160.0);
+        let (frame, _) = render(&smoke, |_| {});
+        let want: [f32; 3] = std::array::from_fn(|c| common::ALBEDO[c] * six[facing]);
+        let got = centre(&frame);
+        for c in 0..3 {
+            assert!(
+                (got[c] / want[c] - 1.0).abs() < tolerance,
+                "sun towards {sun:?}: got {got:?}, the map facing it gives {want:?} (the \
+                 opposite one {:?})",
+                common::ALBEDO.map(|a| a * six[opposite])
+            );
+        }
     }
 }
 

@@ -1051,3 +1051,83 @@ fn a_streak_is_capped_at_its_longest_and_lays_its_sprite_as_ribbons_do() {
         "a streak's light is centred at y = {y} px (down)"
     );
 }
+
+/// A streak's soft-ground fade follows its ends' heights: rising through the ground plane
+/// (y = 0, the frame's middle row) with a 0.05 m soft edge, nothing of it shows below the
+/// plane, and its part above is (but for the last 0.05 m) as bright as without the fade.
+#[test]
+fn a_streak_through_the_ground_plane_fades_below_it_and_not_above() {
+    let ctx = gpu();
+    let streak = Look {
+        size_m: Param::Constant(0.15),
+        streak: Some(Streak {
+            length_secs: 0.2,
+            max_length_m: 10.0,
+        }),
+        intensity: 0.5,
+        ..Look::default()
+    };
+    // 2 m/s up from 0.15 m with a 0.2 s tail: drawn two frames later its head is about
+    // 0.2 m above the plane and its tail about 0.2 m below.
+    let rising = |look: Look| single(Vec3::new(0.0, 0.15, 0.0), Vec3::Y * 2.0, look);
+    let hard = render_after(&ctx, rising(streak.clone()), 2);
+    let soft = render_after(
+        &ctx,
+        rising(Look {
+            soft_ground_m: 0.05,
+            ..streak
+        }),
+        2,
+    );
+    // Red summed over rows y0..y1 (the plane y = 0 is at row 100).
+    let rows = |img: &image::RgbaImage, y0: u32, y1: u32| -> u64 {
+        (y0..y1)
+            .flat_map(|y| (0..img.width()).map(move |x| (x, y)))
+            .map(|(x, y)| u64::from(img.get_pixel(x, y)[0]))
+            .sum()
+    };
+    let (hard_above, hard_below) = (rows(&hard, 0, 100), rows(&hard, 100, 200));
+    let (soft_above, soft_below) = (rows(&soft, 0, 100), rows(&soft, 100, 200));
+    assert!(
+        hard_above > 500 && hard_below > 500,
+        "the streak crosses the plane: {hard_above} above, {hard_below} below"
+    );
+    assert!(
+        soft_below * 50 <= hard_below,
+        "below the plane it is gone: {soft_below} of {hard_below}"
+    );
+    assert!(
+        soft_above * 2 >= hard_above,
+        "above the plane it stays: {soft_above} of {hard_above}"
+    );
+}
+
+/// A streak whose tail is behind the camera is drawn at its head alone (the strip's tail
+/// put on its head): flying away from the eye at 10 m/s from 0.6 m in front of it with a
+/// 0.2 s tail (2 m, over a metre behind the eye), it is a sprite-sized square, not a wedge
+/// to the frame's edge.
+#[test]
+fn a_streak_with_its_tail_behind_the_camera_is_drawn_at_its_head() {
+    let ctx = gpu();
+    let look = Look {
+        size_m: Param::Constant(0.05),
+        streak: Some(Streak {
+            length_secs: 0.2,
+            max_length_m: 10.0,
+        }),
+        intensity: 0.3,
+        ..Look::default()
+    };
+    // `single`'s eye is at z = 4, looking down −z.
+    let img = render_after(
+        &ctx,
+        single(Vec3::new(0.1, 0.0, 3.4), Vec3::NEG_Z * 10.0, look),
+        2,
+    );
+    let (w, h) = lit_extent(&img, 20);
+    // 0.05 m about 0.8 m away: about 15 px.
+    assert!(
+        w > 3 && w <= 24 && h <= 24,
+        "a square at the head: {w}×{h} px"
+    );
+}

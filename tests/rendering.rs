@@ -573,6 +573,42 @@ fn draft_glow_layer_renders_like_full_resolution() {
     }
 }
 
+/// Opacity multiplies a particle's contribution as its colour's alpha does: at opacity
+/// 0.5 an emitter renders as itself with its colour's alpha halved, additive or blended.
+#[test]
+fn opacity_multiplies_like_the_colours_alpha() {
+    let ctx = gpu();
+    let render = |effect: Effect| {
+        let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+        for _ in 0..30 {
+            run.advance(1.0 / 60.0);
+        }
+        run.render((96, 72)).expect("render")
+    };
+    for blend in [
+        ignis::effect::BlendMode::Additive,
+        ignis::effect::BlendMode::Alpha,
+    ] {
+        let mut e = plain_emitter();
+        e.spawn_rate_per_sec = ignis::effect::Param::Constant(200.0);
+        e.speed_m_per_s = ignis::effect::Range::new(0.3, 0.6);
+        e.spread_deg = 60.0;
+        e.look.blend = blend;
+        e.look.color_over_life = flat_color([1.0, 0.6, 0.3, 0.5]);
+        let halved_alpha = bare_effect(e.clone());
+        e.look.color_over_life = flat_color([1.0, 0.6, 0.3, 1.0]);
+        e.look.opacity = ignis::effect::Param::Constant(0.5);
+        let half_opacity = bare_effect(e);
+        let (a, b) = (render(halved_alpha), render(half_opacity));
+        assert!(total_light(&a) > 1e4, "{blend:?}: almost nothing drawn");
+        assert_eq!(
+            image_diff(&a, &b),
+            (0.0, 0),
+            "{blend:?}: opacity 0.5 against alpha 0.5"
+        );
+    }
+}
+
 /// The layers [`Composite::draw_particles`] draws apart (into targets of their own, added
 /// in the tonemap) are exactly those reduced and drawn: the blended one at
 /// `post.alpha_downscale` > 1 or in draft, the glow at `glow_downscale` > 1 or in draft,
