@@ -59,7 +59,7 @@ TESTS = {
     "splat.wgsl": [("splat", None), ("runtime", "splat reversed_z msaa")],
     "splat_accum.wgsl": [("splat", None)],
     "splat_accum64.wgsl": [("splat", None)],
-    "sprite_project.wgsl": [("splat", None), ("tiles", None)],
+    "sprite_project.wgsl": [("splat", None), ("tiles", None), ("runtime", "soft")],
     "quad.wgsl": [("tiles", None), ("rendering", "--skip render_command"),
                   ("runtime", "instances_add_up"), ("lit", None), ("looks", "reference"),
                   ("looks", "sprites_turn"), ("looks", "a_streak"),

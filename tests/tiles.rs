@@ -601,6 +601,159 @@ fn many_sprites_over_several_bins_and_blocks_keep_their_light_when_lists_overflo
     );
 }
 
+/// `effect`, every emitter on the tiles, after `frames` frames, drawn at `size` once per
+/// (bins' lists' capacity, tiles' lists' capacity) of `capacities`, all from one run. Every
+/// draw starts from new, zeroed tile buffers (setting the tiles' lists' capacity drops them).
+fn images_with_capacities(
+    ctx: &GpuContext,
+    effect: &Effect,
+    frames: u32,
+    size: (u32, u32),
+    capacities: &[(Option<u32>, Option<u32>)],
+) -> Vec<image::RgbaImage> {
+    let mut effect = effect.clone();
+    for e in &mut effect.emitters {
+        e.look.draw_path = DrawPath::Tiles;
+    }
+    let mut run = Headless::new(ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    for _ in 0..frames {
+        run.advance(1.0 / 60.0);
+    }
+    capacities
+        .iter()
+        .map(|&(lists, tile_lists)| {
+            let tiles = run.player.tile_pass().expect("the tiles");
+            tiles.set_list_capacity(lists);
+            tiles.set_tile_list_capacity(tile_lists);
+            let image = run.render(size).expect("render");
+            assert!(
+                run.player.draw_items().iter().all(|d| d.tiles),
+                "an emitter left the tiles"
+            );
+            image
+        })
+        .collect()
+}
+
+/// Each of `images` (named) is `reference`, drawn with no tile lists (every tile filters
+/// its bin's list), bit for bit.
+fn all_as_bin_lists(
+    what: &str,
+    reference: &image::RgbaImage,
+    images: &[(&str, &image::RgbaImage)],
+) {
+    assert!(total_light(reference) > 1e4, "{what}: almost nothing drawn");
+    for (name, image) in images {
+        let (mean, max) = image_diff(reference, image);
+        assert!(
+            *image == reference,
+            "{what}, {name}: the tiles' lists differ from the bins' by {mean:.4}/255 mean, \
+             {max}/255 max"
+        );
+    }
+}
+
+/// 20 000 sprites strewn over the whole of a 256×256 target: each of its four bins lists
+/// over 5000 of them (every bin has tile lists, the first and the last too), and every tile
+/// of every bin, its corners too, has a list of its own, each a different one. The tiles'
+/// lists give the bins' lists' image bit for bit: as sized; with room to spare (the chunks'
+/// places far apart); with the bins' lists packed close (the chunks' places right after
+/// their counts); and with room for some bins' tile lists only (the rest shaded from their
+/// bin lists, nothing read past the room).
+#[test]
+fn tile_lists_of_every_bin_and_tile_give_the_bin_lists_image() {
+    let ctx = gpu();
+    // ±1.2 m at 3 m covers the target; 0.15 m sprites are about 15 px, some 70 over each
+    // pixel, each one's light seen in 8 bits.
+    let mut effect = pile(20_000.0, 0.15, [0.0; 3]);
+    let e = &mut effect.emitters[0];
+    e.capacity = 32_768;
+    e.shape = Shape::Box {
+        half_extents_m: [1.2, 1.2, 0.0],
+    };
+    e.look.intensity = 0.02;
+    let draws: [(&str, Option<u32>, Option<u32>); 6] = [
+        ("no tile lists", None, Some(0)),
+        ("as sized", None, None),
+        ("room to spare", Some(1 << 18), Some(1 << 22)),
+        ("bins' lists packed close", Some(28_000), Some(1 << 22)),
+        // About 70 000 tile list entries in all, 17 000 a bin: room for one or two bins'
+        // lists, then for three.
+        ("room for some bins' tile lists", None, Some(32_768)),
+        ("room for more bins' tile lists", None, Some(65_536)),
+    ];
+    let capacities: Vec<_> = draws.iter().map(|&(_, l, t)| (l, t)).collect();
+    let images = images_with_capacities(&ctx, &effect, 6, (256, 256), &capacities);
+    let named: Vec<(&str, &image::RgbaImage)> =
+        draws.iter().map(|d| d.0).zip(&images).skip(1).collect();
+    all_as_bin_lists("20 000 over every bin", &images[0], &named);
+}
+
+/// Bins' lists of more than 65 536 entries take more than 256 chunks of the tile lists'
+/// passes, whose workgroups then run two rows deep: 70 000 sprites of 4 px over the top two
+/// bins of a 256×256 target, and a second emitter's stack of 100 in the bottom-right bin
+/// (too few for tile lists: the last bin, shaded from its bin list). The tiles' lists give
+/// the bins' lists' image bit for bit: every chunk is counted and written, once, and no
+/// workgroup past the last chunk writes anything.
+#[test]
+fn tile_lists_over_more_than_256_chunks_give_the_bin_lists_image() {
+    let ctx = gpu();
+    // The top half: 0.62 m up, ±0.56 m (pixels 6..122 down), ±1.2 m across; 0.04 m is
+    // 4 px, some 40 sprites over each pixel. About 71 000 entries: 278 chunks.
+    let mut effect = pile(70_000.0, 0.04, [0.0, 0.62, 0.0]);
+    let e = &mut effect.emitters[0];
+    e.capacity = 1 << 17;
+    e.shape = Shape::Box {
+        half_extents_m: [1.2, 0.56, 0.0],
+    };
+    e.look.intensity = 0.02;
+    // 100 sprites on one spot around pixel (192, 192): the tiles it covers list 100 each.
+    let mut stack = pile(100.0, 0.12, [0.62, -0.62, 0.0]).emitters.remove(0);
+    stack.name = "stack".into();
+    effect.emitters.push(stack);
+    let images = images_with_capacities(
+        &ctx,
+        &effect,
+        6,
+        (256, 256),
+        &[(None, Some(0)), (None, None)],
+    );
+    all_as_bin_lists(
+        "70 000 over two bins",
+        &images[0],
+        &[("as sized", &images[1])],
+    );
+}
+
+/// A dozen bins (a 400×272 target, four by three) and 5000 sprites in the sixth (pixels
+/// 128..255 both ways), clear of its top row of tiles: the tile lists' places per bin, per
+/// tile and per chunk keep apart whatever the bins. The tiles' lists give the bins' lists'
+/// image bit for bit.
+#[test]
+fn tile_lists_among_a_dozen_bins_give_the_bin_lists_image() {
+    let ctx = gpu();
+    // 109 px a metre at 3 m: thrown out of pixel (192, 190), 0.2 m (22 px) sprites reach
+    // pixels 170..214 across and 168..212 down.
+    let mut effect = pile(5000.0, 0.2, [-0.073, -0.494, 0.0]);
+    let e = &mut effect.emitters[0];
+    e.capacity = 8192;
+    e.spread_deg = 180.0;
+    e.speed_m_per_s = Range::new(0.5, 1.0);
+    e.look.intensity = 0.05;
+    let images = images_with_capacities(
+        &ctx,
+        &effect,
+        6,
+        (400, 272),
+        &[(None, Some(0)), (None, None)],
+    );
+    all_as_bin_lists(
+        "5000 in one of twelve bins",
+        &images[0],
+        &[("as sized", &images[1])],
+    );
+}
+
 /// The fireball's debris leaves alpha-blended smoke lines (ribbons, which only the
 /// billboards draw): they stay billboards, drawn behind the tiles' blended layers, and the
 /// smoke puffs keep the tiles.
