@@ -391,6 +391,46 @@ mod tests {
         assert_eq!(dies(&r).0, 1, "the next float up");
     }
 
+    /// An event's key mixes in the whole spawn counter and the rule's number: a slot past
+    /// 2³² spawns, or the same slot's second rule, draws other children.
+    #[test]
+    fn the_counters_high_word_and_the_rule_number_change_the_key() {
+        let (r, p) = (rule(Trigger::Death, 1), params());
+        let key = |p: &SimParams, k: u32| {
+            event_of(&r, k, p, 9, &living(1.9), &living(2.0), false, false).1
+        };
+        let past = SimParams {
+            spawn_base_hi: 1,
+            ..p
+        };
+        assert_ne!(key(&p, 0), key(&past, 0), "the counter's high word");
+        assert_ne!(key(&p, 0), key(&p, 1), "the rule's number");
+        assert_ne!(key(&past, 0), key(&past, 1), "the rule's number past 2³²");
+    }
+
+    /// A scan's list holds at most the room it is given, in slot order; the children asked
+    /// for count them all.
+    #[test]
+    fn a_spawn_list_holds_at_most_its_room() {
+        let record = |n: u32| EventRecord {
+            pos_count: [0.0, 0.0, 0.0, f32::from_bits(n)],
+            ..EventRecord::default()
+        };
+        let records = [(2, record(3)), (5, record(4)), (6, record(2))];
+        let cfg = ScanConfig {
+            rule_capacity_cap: [0, 64, 6, 0],
+            ..ScanConfig::default()
+        };
+        let (list, asked) = scan_events((0, 8), 8, &records, &cfg);
+        assert_eq!((list.len(), asked), (6, 9));
+        let firsts: Vec<u32> = list.iter().map(|e| e.vel_j[3].to_bits() & 0xFFFF).collect();
+        assert_eq!(
+            firsts,
+            [0, 1, 2, 0, 1, 2],
+            "slot 2's three, then slot 5's first three"
+        );
+    }
+
     /// A count range draws within itself; a rule with no trigger asks for nothing.
     #[test]
     fn counts_stay_in_their_range_and_no_trigger_asks_nothing() {
