@@ -256,20 +256,7 @@ fn beside_an_edge_the_normal_comes_from_the_same_surface() {
     let floor = quad(vec3(1.0, 0.0, 0.0), Vec3::X, Vec3::Z * 2.0);
     let face = quad(vec3(0.0, 0.125, 0.0), Vec3::Z * 2.0, Vec3::Y * 0.125);
     let effect = sparks(400, [0.0, 0.6, 0.0], [0.1, 0.0, 0.3], [0.0, -3.0, 0.0], 1.0);
-    let (_, last) = run(
-        &host,
-        &[top, floor, face],
-        &mut host.player(&effect),
-        16,
-        true,
-        |_| {},
-    );
-    assert_eq!(last.len(), 400);
-    for p in &last {
-        let v = vel(p);
-        assert!(v.y > 2.9, "{} did not bounce: {v}", pos(p));
-        assert!(v.x.abs() < 0.02 && v.z.abs() < 0.02, "{}: {v}", pos(p));
-    }
+    all_bounce_straight_up(&host, &[top, floor, face], &effect, 400);
 }
 
 /// A floor (y = 0, x > 0) meeting a 45° ramp that rises towards −x, seen from above: the
@@ -293,15 +280,14 @@ fn beside_a_crease_the_normal_is_the_contact_pixels_own() {
         [0.0, -3.0, 0.0],
         1.0,
     );
-    let (_, last) = run(
-        &host,
-        &[floor, ramp],
-        &mut host.player(&effect),
-        16,
-        true,
-        |_| {},
-    );
-    assert_eq!(last.len(), 200);
+    all_bounce_straight_up(&host, &[floor, ramp], &effect, 200);
+}
+
+/// `effect`'s `count` sparks, dropped on `quads` at 3 m/s, all bounce straight up (16
+/// frames).
+fn all_bounce_straight_up(host: &Host, quads: &[Quad], effect: &Effect, count: usize) {
+    let (_, last) = run(host, quads, &mut host.player(effect), 16, true, |_| {});
+    assert_eq!(last.len(), count);
     for p in &last {
         let v = vel(p);
         assert!(v.y > 2.9, "{} did not bounce: {v}", pos(p));

@@ -609,6 +609,18 @@ fn opacity_multiplies_like_the_colours_alpha() {
     }
 }
 
+/// The campfire without its bloom (whose own draft setting aside, draft changes only the
+/// reduced layers), played 1.5 s.
+fn campfire_without_bloom(ctx: &ignis::testing::gpu::GpuContext) -> Headless {
+    let mut effect = Effect::default_campfire();
+    effect.post.bloom = None;
+    let mut run = Headless::new(ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    for _ in 0..90 {
+        run.advance(1.0 / 60.0);
+    }
+    run
+}
+
 /// The layers [`Composite::draw_particles`] draws apart (into targets of their own, added
 /// in the tonemap) are exactly those reduced and drawn: the blended one at
 /// `post.alpha_downscale` > 1 or in draft, the glow at `glow_downscale` > 1 or in draft,
@@ -617,12 +629,7 @@ fn opacity_multiplies_like_the_colours_alpha() {
 fn only_reduced_layers_are_drawn_apart() {
     use ignis::Layers;
     let ctx = gpu();
-    let mut effect = Effect::default_campfire();
-    effect.post.bloom = None;
-    let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
-    for _ in 0..90 {
-        run.advance(1.0 / 60.0);
-    }
+    let mut run = campfire_without_bloom(&ctx);
     let layered = |run: &mut Headless, draft: bool, alpha: u32, glow: u32| {
         run.composite.draft = draft;
         run.edit(|e| (e.post.alpha_downscale, e.post.glow_downscale) = (alpha, glow))
@@ -659,13 +666,7 @@ fn only_reduced_layers_are_drawn_apart() {
 #[test]
 fn draft_halves_the_blended_layers_resolution_again() {
     let ctx = gpu();
-    let mut effect = Effect::default_campfire();
-    // The bloom's own draft setting aside, draft changes only the reduced layers.
-    effect.post.bloom = None;
-    let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
-    for _ in 0..90 {
-        run.advance(1.0 / 60.0);
-    }
+    let mut run = campfire_without_bloom(&ctx);
     let mut frame = |draft: bool, alpha: u32| {
         run.composite.draft = draft;
         run.edit(|e| (e.post.alpha_downscale, e.post.glow_downscale) = (alpha, 2))

@@ -66,11 +66,8 @@ fn host_geometry_hides_splatted_particles_exactly() {
     hides_the_fire_exactly(&effect, false);
 }
 
-/// A large sprite forced onto the splat (its integrated light at its centre) in front of
-/// a wall is tested at its own depth: a 0.3 m disc 3 m from the camera, a wall 1 m behind
-/// it, the disc's centre shows its light over the wall as it does with no wall.
-#[test]
-fn a_large_splatted_sprite_in_front_of_a_wall_shows() {
+/// One white additive particle living 10 s, forced onto the splat.
+fn one_white_splat() -> ignis::effect::Emitter {
     let mut e = common::plain_emitter();
     e.capacity = 1;
     e.spawn_rate_per_sec = ignis::effect::Param::Constant(0.0);
@@ -79,12 +76,21 @@ fn a_large_splatted_sprite_in_front_of_a_wall_shows() {
         count: 1,
     }];
     e.lifetime_secs = ignis::effect::Range::new(10.0, 10.0);
-    e.transform.position_m = [0.0, 0.5, 0.0];
-    e.look.sprite = Sprite::SoftDisc;
-    e.look.size_m = ignis::effect::Param::Constant(0.3);
     e.look.color_over_life = common::flat_color([1.0, 1.0, 1.0, 1.0]);
     e.look.blend = BlendMode::Additive;
     e.look.draw_path = ignis::effect::DrawPath::Splat;
+    e
+}
+
+/// A large sprite forced onto the splat (its integrated light at its centre) in front of
+/// a wall is tested at its own depth: a 0.3 m disc 3 m from the camera, a wall 1 m behind
+/// it, the disc's centre shows its light over the wall as it does with no wall.
+#[test]
+fn a_large_splatted_sprite_in_front_of_a_wall_shows() {
+    let mut e = one_white_splat();
+    e.transform.position_m = [0.0, 0.5, 0.0];
+    e.look.sprite = Sprite::SoftDisc;
+    e.look.size_m = ignis::effect::Param::Constant(0.3);
     let effect = common::bare_effect(e);
     let host = Host::new(vec3(0.0, 0.5, 3.0), vec3(0.0, 0.5, 0.0));
     let mut fire = host.player(&effect);
@@ -121,14 +127,7 @@ fn a_large_splatted_sprite_in_front_of_a_wall_shows() {
 /// is in, and no other.
 #[test]
 fn a_thin_splatted_streak_lights_the_pixel_its_head_is_in() {
-    let mut e = common::plain_emitter();
-    e.capacity = 1;
-    e.spawn_rate_per_sec = ignis::effect::Param::Constant(0.0);
-    e.bursts = vec![ignis::effect::Burst {
-        time_secs: 0.0,
-        count: 1,
-    }];
-    e.lifetime_secs = ignis::effect::Range::new(10.0, 10.0);
+    let mut e = one_white_splat();
     // 0.4 px below the middle row's top edge.
     e.transform.position_m = [-0.3, 0.49, 0.0];
     e.direction = [1.0, 0.0, 0.0];
@@ -140,9 +139,6 @@ fn a_thin_splatted_streak_lights_the_pixel_its_head_is_in() {
         length_secs: 0.3,
         max_length_m: 1.0,
     });
-    e.look.color_over_life = common::flat_color([1.0, 1.0, 1.0, 1.0]);
-    e.look.blend = BlendMode::Additive;
-    e.look.draw_path = ignis::effect::DrawPath::Splat;
     let origin = Vec3::from(e.transform.position_m);
     let effect = common::bare_effect(e);
     let host = Host::new(vec3(0.0, 0.5, 3.0), vec3(0.0, 0.5, 0.0));
