@@ -633,6 +633,20 @@ mod tests {
     use super::*;
     use crate::effect::{Burst, Param, Range};
 
+    /// A collider sphere's centre is taken into the simulation's space, whose origin is
+    /// the emitter's first position: a sphere 0.5 m above an emitter at (1, 2, 3) sits at
+    /// (0, 0.5, 0) there.
+    #[test]
+    fn collider_spheres_sit_in_the_simulations_space() {
+        let mut e = crate::effect::Emitter::default();
+        e.collisions.spheres = vec![crate::effect::SphereCollider {
+            center_m: [1.0, 2.5, 3.0],
+            radius_m: 0.2,
+        }];
+        let p = params::static_params(&e, glam::DVec3::new(1.0, 2.0, 3.0), 0, 0, 16);
+        assert_eq!(p.spheres[0], [0.0, 0.5, 0.0, 0.2]);
+    }
+
     /// One emitter of `rate` a second, capped at `cap` a second (0: none), with `bursts`.
     fn effect(rate: f32, cap: f32, bursts: Vec<Burst>) -> Effect {
         let mut effect = Effect::default();
