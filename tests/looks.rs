@@ -1052,21 +1052,26 @@ fn a_streak_is_capped_at_its_longest_and_lays_its_sprite_as_ribbons_do() {
     );
 }
 
+/// A streak `size_m` wide of `intensity` whose tail is 0.2 s of its motion, uncapped.
+fn tailed_streak(size_m: f32, intensity: f32) -> Look {
+    Look {
+        size_m: Param::Constant(size_m),
+        streak: Some(Streak {
+            length_secs: 0.2,
+            max_length_m: 10.0,
+        }),
+        intensity,
+        ..Look::default()
+    }
+}
+
 /// A streak's soft-ground fade follows its ends' heights: rising through the ground plane
 /// (y = 0, the frame's middle row) with a 0.05 m soft edge, nothing of it shows below the
 /// plane, and its part above is (but for the last 0.05 m) as bright as without the fade.
 #[test]
 fn a_streak_through_the_ground_plane_fades_below_it_and_not_above() {
     let ctx = gpu();
-    let streak = Look {
-        size_m: Param::Constant(0.15),
-        streak: Some(Streak {
-            length_secs: 0.2,
-            max_length_m: 10.0,
-        }),
-        intensity: 0.5,
-        ..Look::default()
-    };
+    let streak = tailed_streak(0.15, 0.5);
     // 2 m/s up from 0.15 m with a 0.2 s tail: drawn two frames later its head is about
     // 0.2 m above the plane and its tail about 0.2 m below.
     let rising = |look: Look| single(Vec3::new(0.0, 0.15, 0.0), Vec3::Y * 2.0, look);
@@ -1109,15 +1114,7 @@ fn a_streak_through_the_ground_plane_fades_below_it_and_not_above() {
 #[test]
 fn a_streak_with_its_tail_behind_the_camera_is_drawn_at_its_head() {
     let ctx = gpu();
-    let look = Look {
-        size_m: Param::Constant(0.05),
-        streak: Some(Streak {
-            length_secs: 0.2,
-            max_length_m: 10.0,
-        }),
-        intensity: 0.3,
-        ..Look::default()
-    };
+    let look = tailed_streak(0.05, 0.3);
     // `single`'s eye is at z = 4, looking down −z.
     let img = render_after(
         &ctx,

@@ -309,6 +309,12 @@ mod tests {
         }
     }
 
+    /// Rule `k` of `r` for slot `slot` of a particle that dies this step: (children, key,
+    /// first child).
+    fn on_death(r: &EventRule, k: u32, p: &SimParams, slot: u32) -> (u32, u32, u32) {
+        event_of(r, k, p, slot, &living(1.9), &living(2.0), false, false)
+    }
+
     /// A living particle of age `age` (of a 2 s life), before and after a step.
     fn living(age: f32) -> Particle {
         Particle {
@@ -381,7 +387,7 @@ mod tests {
     #[test]
     fn a_draw_equal_to_the_probability_does_not_fire() {
         let (mut r, p) = (rule(Trigger::Death, 1), params());
-        let dies = |r: &EventRule| event_of(r, 0, &p, 7, &living(1.9), &living(2.0), false, false);
+        let dies = |r: &EventRule| on_death(r, 0, &p, 7);
         let (n, key, _) = dies(&r);
         assert_eq!(n, 1, "probability 1 fires");
         let draw = crate::rng::unorm(pcg4d([key, p.seed, 0, 0xC0])[2]);
@@ -396,9 +402,7 @@ mod tests {
     #[test]
     fn the_counters_high_word_and_the_rule_number_change_the_key() {
         let (r, p) = (rule(Trigger::Death, 1), params());
-        let key = |p: &SimParams, k: u32| {
-            event_of(&r, k, p, 9, &living(1.9), &living(2.0), false, false).1
-        };
+        let key = |p: &SimParams, k: u32| on_death(&r, k, p, 9).1;
         let past = SimParams {
             spawn_base_hi: 1,
             ..p
@@ -438,15 +442,10 @@ mod tests {
         r.count_max = 3;
         r.count_min = 1;
         let p = params();
-        let counts: Vec<u32> = (0..64)
-            .map(|slot| event_of(&r, 0, &p, slot, &living(1.9), &living(2.0), false, false).0)
-            .collect();
+        let counts: Vec<u32> = (0..64).map(|slot| on_death(&r, 0, &p, slot).0).collect();
         assert!(counts.iter().all(|n| (1..=3).contains(n)), "{counts:?}");
         assert!((1..=3).all(|n| counts.contains(&n)), "{counts:?}");
         r.trigger = TRIGGER_NONE;
-        assert_eq!(
-            event_of(&r, 0, &p, 3, &living(1.9), &living(2.0), false, false),
-            (0, 0, 0)
-        );
+        assert_eq!(on_death(&r, 0, &p, 3), (0, 0, 0));
     }
 }
