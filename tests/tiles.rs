@@ -438,32 +438,111 @@ fn a_lit_item_that_shrinks_leaves_none_of_its_earlier_sprites() {
         surface_only: false,
     };
     e.look.size_m = Param::Constant(0.08);
+    shrinks_leaving_none(&ctx, "puffs", &effect, 200, 0.8);
+}
+
+/// An unlit item that shrinks within its last block when it holds more than a block's
+/// worth (2000 discs, then 1500 elsewhere: two blocks of 1024 both times, so the buffers
+/// are kept) has the rest of that block filled with empty sprites too: the tiles do not
+/// draw the earlier frame's discs 1500..2000 again.
+#[test]
+fn an_item_of_several_blocks_that_shrinks_leaves_none_of_its_earlier_sprites() {
+    let ctx = gpu();
+    let mut effect = pile(2000.0, 0.1, [-0.6, 0.0, 0.0]);
+    let e = &mut effect.emitters[0];
+    e.capacity = 2000;
+    e.shape = Shape::Sphere {
+        radius_m: 0.3,
+        surface_only: false,
+    };
+    e.look.intensity = 0.03;
+    shrinks_leaving_none(&ctx, "discs", &effect, 1500, 1.2);
+}
+
+/// `effect` (one emitter, one burst) drawn on both paths after 0.1 s, then again 0.1 s after
+/// its capacity and burst are cut to `count` and it is moved `shift_m` along x: the tiles
+/// draw the billboards' light and image both times.
+fn shrinks_leaving_none(ctx: &GpuContext, what: &str, effect: &Effect, count: u32, shift_m: f32) {
     let frames = |path: DrawPath| {
         let mut effect = full_resolution(effect.clone());
         effect.emitters[0].look.draw_path = path;
-        let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
-        run.advance(1.0 / 60.0);
+        let mut run = Headless::new(ctx, effect, ShaderLibrary::embedded()).expect("headless");
+        for _ in 0..6 {
+            run.advance(1.0 / 60.0);
+        }
         let before = run.render(SIZE).expect("render");
         run.edit(|e| {
             let e = &mut e.emitters[0];
-            (e.capacity, e.bursts[0].count) = (200, 200);
-            e.transform.position_m[0] += 0.8;
+            (e.capacity, e.bursts[0].count) = (count, count);
+            e.transform.position_m[0] += shift_m;
         })
         .expect("edit");
-        run.advance(1.0 / 60.0);
+        for _ in 0..6 {
+            run.advance(1.0 / 60.0);
+        }
         let tiled = run.player.draw_items().iter().any(|d| d.tiles);
-        assert_eq!(tiled, path == DrawPath::Tiles, "{path:?}");
+        assert_eq!(tiled, path == DrawPath::Tiles, "{what}: {path:?}");
         (before, run.render(SIZE).expect("render"))
     };
     let (bill, tiles) = (frames(DrawPath::Billboard), frames(DrawPath::Tiles));
-    for (what, a, b) in [("500", &bill.0, &tiles.0), ("200", &bill.1, &tiles.1)] {
+    for (when, a, b) in [("before", &bill.0, &tiles.0), ("after", &bill.1, &tiles.1)] {
         let (mean, max) = image_diff(a, b);
-        assert!(total_light(a) > 1e3, "{what}: the billboards drew little");
+        let (la, lb) = (total_light(a), total_light(b));
+        assert!(la > 1e3, "{what} {when}: the billboards drew little ({la})");
+        assert!(
+            (la - lb).abs() <= 0.01 * la,
+            "{what} {when} shrinking: light {la} (billboards) vs {lb} (tiles)"
+        );
         assert!(
             mean <= 1.0 && max <= 8,
-            "{what} puffs: {mean:.3}/255 mean, {max}/255 max"
+            "{what} {when} shrinking: {mean:.3}/255 mean, {max}/255 max"
         );
     }
+}
+
+/// A host whose projection is turned against its view (a canted display): the clip w
+/// varies across the camera-facing quads, so the tiles map them projectively (the depth
+/// from the sprite's z and w rows). They draw the billboards' image.
+#[test]
+fn a_projection_turned_against_the_view_draws_projective_sprites_alike() {
+    let ctx = gpu();
+    let effect = full_resolution(pile(1.0, 0.5, [0.0; 3]));
+    let view = glam::camera::rh::view::look_at_mat4(
+        glam::Vec3::new(0.0, 0.0, 3.0),
+        glam::Vec3::ZERO,
+        glam::Vec3::Y,
+    );
+    let aspect = SIZE.0 as f32 / SIZE.1 as f32;
+    // Turned 0.3 rad about the view's y: w takes sin 0.3 of the camera's right axis.
+    let proj = glam::camera::rh::proj::directx::perspective(0.8, aspect, 0.05, 50.0)
+        * glam::Mat4::from_rotation_y(0.3);
+    let camera = ignis::Camera::new(view, proj, SIZE);
+    let draw = |path: DrawPath| {
+        let mut effect = effect.clone();
+        effect.emitters[0].look.draw_path = path;
+        let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+        for _ in 0..6 {
+            run.advance(1.0 / 60.0);
+        }
+        // Only this camera draws: no camera-facing frame fills the sprites' rows first.
+        let image = run
+            .composite
+            .render_image(&run.ctx, &mut run.player, &camera)
+            .expect("render");
+        let tiled = run.player.draw_items().iter().any(|d| d.tiles);
+        assert_eq!(tiled, path == DrawPath::Tiles, "{path:?}");
+        image
+    };
+    let (a, b) = (draw(DrawPath::Billboard), draw(DrawPath::Tiles));
+    let (la, lb) = (total_light(&a), total_light(&b));
+    eprintln!("turned projection: light {la} (billboards), {lb} (tiles)");
+    assert!(la > 1e3, "the billboards drew almost nothing");
+    assert!((la - lb).abs() <= 0.01 * la, "light {la} vs {lb}");
+    let (mean, max) = image_diff(&a, &b);
+    assert!(
+        mean <= 1.0 && max <= 8,
+        "turned projection: {mean:.3}/255 mean, {max}/255 max"
+    );
 }
 
 #[test]
@@ -818,6 +897,94 @@ fn the_compute_resolve_composites_what_the_resolve_draw_does() {
         };
         common::resolves_agree(name, &image(false), &image(true));
     }
+}
+
+/// Half-opaque dark smoke over the editor's test scene: the ground behind the tiles shows
+/// through as the billboards let it (what was drawn × the puffs' transmittance, plus their
+/// colour), by the resolve's draw and by the compute resolve alike. Over the cleared target
+/// of the other tests nothing is behind the tiles, and their coverage is never seen.
+#[test]
+fn alpha_blended_tiles_over_the_test_scene_let_it_show_as_the_billboards_do() {
+    let ctx = gpu();
+    // Four still puffs on one spot (transmittance 1/16 at their middle), seen from 25° up:
+    // the dark ground fills the image behind them.
+    let mut effect = full_resolution(pile(4.0, 0.5, [0.0; 3]));
+    effect.camera.pitch_deg = 25.0;
+    let e = &mut effect.emitters[0];
+    e.look.blend = BlendMode::Alpha;
+    e.look.opacity = Param::Constant(0.5);
+    e.look.intensity = 1.0;
+    e.look.color_over_life = common::flat_color([0.05, 0.05, 0.05, 1.0]);
+    let draw = |path: DrawPath, compute: bool| {
+        let mut effect = effect.clone();
+        effect.emitters[0].look.draw_path = path;
+        let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+        run.composite.test_scene = true;
+        run.player
+            .tile_pass()
+            .expect("the tiles")
+            .set_compute_resolve(compute);
+        for _ in 0..6 {
+            run.advance(1.0 / 60.0);
+        }
+        let image = run.render(SIZE).expect("render");
+        let tiled = run.player.draw_items().iter().any(|d| d.tiles);
+        assert_eq!(tiled, path == DrawPath::Tiles, "{path:?}");
+        let tiles = run.player.tile_pass().expect("the tiles");
+        assert_eq!(
+            tiles.can_resolve_into(SIZE),
+            compute,
+            "compute resolve {compute}"
+        );
+        image
+    };
+    let billboards = draw(DrawPath::Billboard, false);
+    let drawn = draw(DrawPath::Tiles, false);
+    let computed = draw(DrawPath::Tiles, true);
+    assert!(total_light(&billboards) > 1e4, "the scene was not drawn");
+    let (mean, max) = image_diff(&billboards, &drawn);
+    eprintln!("smoke over the scene: {mean:.3}/255 mean, {max}/255 max");
+    assert!(
+        mean <= 1.0 && max <= 8,
+        "over the scene: tiles differ from billboards by {mean:.3}/255 mean, {max}/255 max"
+    );
+    common::resolves_agree("smoke over the test scene", &drawn, &computed);
+}
+
+/// Three emitters piled on the middle of a 256×256 target — a whole number of bins across
+/// (as 1280 and 1920 are), where rounding the bins up must not add a column — each over all
+/// four bins: the tiles draw the billboards' light, every bin shaded in its place; and the
+/// same image, bit for bit, when every bin's list overflows (each item shaded from its own
+/// sprites only: the second's run ends at its last sprite, not in the third's).
+#[test]
+fn emitters_over_every_bin_of_a_whole_bins_target_keep_their_light_when_lists_overflow() {
+    let ctx = gpu();
+    let size = (256, 256);
+    // 0.5 m at 3 m is about 50 px around pixel (128, 128), where the four bins meet; 20
+    // sprites an emitter, a block each.
+    let mut effect = pile(20.0, 0.5, [0.0; 3]);
+    effect.emitters[0].look.intensity = 0.05;
+    for name in ["second", "third"] {
+        let mut e = effect.emitters[0].clone();
+        e.name = name.into();
+        effect.emitters.push(e);
+    }
+    let billboards = render_at(&ctx, &effect, DrawPath::Billboard, 6, size);
+    let tiles = images_with_capacities(&ctx, &effect, 6, size, &[(None, None), (Some(1), None)]);
+    let (la, lb) = (total_light(&billboards), total_light(&tiles[0]));
+    eprintln!("256 wide: light {la} (billboards), {lb} (tiles)");
+    assert!(la > 1e3, "nothing drawn");
+    assert!((la - lb).abs() <= 0.01 * la, "256 wide: light {la} vs {lb}");
+    let (mean, max) = image_diff(&billboards, &tiles[0]);
+    assert!(
+        mean <= 1.0 && max <= 8,
+        "256 wide: tiles differ from billboards by {mean:.3}/255 mean, {max}/255 max"
+    );
+    let (mean, max) = image_diff(&tiles[0], &tiles[1]);
+    assert!(
+        tiles[1] == tiles[0],
+        "every bin overflowing: the image differs by {mean:.4}/255 mean, {max}/255 max"
+    );
 }
 
 /// Sprites of a pixel or a few — the thesis preset's hard-edged points at 320×180 —
