@@ -196,15 +196,7 @@ fn hides_the_fire_in(kind: HostKind, effect: &Effect, depth: bool) -> Frame {
     fire.add_instance(host.place(Mat4::IDENTITY), 3)
         .expect("instance");
     advance(&mut [&mut fire], &host, 90);
-    let wall = Quad(
-        [
-            vec3(-3.0, -1.0, 1.2),
-            vec3(0.0, -1.0, 1.2),
-            vec3(0.0, 3.0, 1.2),
-            vec3(-3.0, 3.0, 1.2),
-        ],
-        [0.2, 0.3, 0.4],
-    );
+    let wall = wall();
     let bg = [0.05, 0.04, 0.03];
     let host_only = host.frame(bg, std::slice::from_ref(&wall), &mut [], depth);
     let with_fire = host.frame(bg, std::slice::from_ref(&wall), &mut [&mut fire], depth);
@@ -253,6 +245,75 @@ fn hides_the_fire_in(kind: HostKind, effect: &Effect, depth: bool) -> Frame {
     let tiles_fit = ignis::testing::render::TilePass::supported(&host.device);
     assert_eq!(tiled, wants_tiles && depth && tiles_fit, "the tiles ran");
     with_fire
+}
+
+/// The wall of [`hides_the_fire_in`]: x from −3 to 0 m, 1.2 m in front of the fire.
+fn wall() -> Quad {
+    Quad(
+        [
+            vec3(-3.0, -1.0, 1.2),
+            vec3(0.0, -1.0, 1.2),
+            vec3(0.0, 3.0, 1.2),
+            vec3(-3.0, 3.0, 1.2),
+        ],
+        [0.2, 0.3, 0.4],
+    )
+}
+
+/// A hard-edged disc on the tiles (no soft edges, whose fade alone hides a soft layer
+/// behind the host's geometry whatever the depth test): the tiles' own depth test hides its
+/// half behind the wall in an ordinary and a reversed_z host; and a host that asks for no
+/// depth test (`CompareFunction::Always`, its depth still handed over) sees all of it, over
+/// the wall and beside it, as the billboards draw it.
+#[test]
+fn hard_tiled_sprites_obey_ordinary_reversed_z_and_always_hosts() {
+    use ignis::effect::DrawPath;
+    let disc = |path: DrawPath| {
+        let mut e = still_disc(0.0);
+        e.emitters[0].look.draw_path = path;
+        e
+    };
+    let reversed = HostKind {
+        reversed_z: true,
+        ..HostKind::default()
+    };
+    for kind in [HostKind::default(), reversed] {
+        hides_the_fire_in(kind, &disc(DrawPath::Tiles), true);
+    }
+    let host = Host::new(vec3(0.0, 0.7, 3.0), vec3(0.0, 0.5, 0.0));
+    let settings = PlayerSettings {
+        depth_compare: wgpu::CompareFunction::Always,
+        ..host.settings()
+    };
+    let (bg, walls) = ([0.05, 0.04, 0.03], [wall()]);
+    let host_only = host.frame(bg, &walls, &mut [], true);
+    let [bill, tiles] = [DrawPath::Billboard, DrawPath::Tiles].map(|path| {
+        let mut fire =
+            Player::new(&host.device, &host.queue, &disc(path), settings.clone()).expect("player");
+        fire.add_instance(host.place(Mat4::IDENTITY), 3)
+            .expect("instance");
+        advance(&mut [&mut fire], &host, 90);
+        let frame = host.frame(bg, &walls, &mut [&mut fire], true);
+        let tiled = fire.draw_items().iter().any(|d| d.tiles);
+        assert_eq!(tiled, path == DrawPath::Tiles, "{path:?}: the tiles ran");
+        frame
+    });
+    let is_wall = |i: usize| !differs(host_only.rgba[i], [0.2, 0.3, 0.4, 1.0], 1e-3);
+    let lit = |on_wall: bool| {
+        (0..tiles.rgba.len())
+            .filter(|&i| is_wall(i) == on_wall && differs(tiles.rgba[i], host_only.rgba[i], 0.05))
+            .count()
+    };
+    let (over, beside) = (lit(true), lit(false));
+    assert!(
+        over > 150 && beside > 150,
+        "Always: the tiles lit {over} pixels over the wall, {beside} beside it"
+    );
+    let mean = mean_difference(&bill, &tiles);
+    assert!(
+        mean < 1.0 / 255.0,
+        "Always: the tiles differ from the billboards by {mean}"
+    );
 }
 
 /// One still, additive disc at (0, 0.2, 0), 1 m wide: its lower part crosses the ground.

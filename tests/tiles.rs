@@ -386,6 +386,36 @@ fn two_emitters_over_different_bins_each_keep_their_light() {
     light_agrees(&ctx, "two emitters", &effect);
 }
 
+/// Four items in one chunk: a dim sprite larger than the screen first (item 0 shades every
+/// tile, filling the resolve's list of shaded tiles), then three bright piles in the first
+/// bin. Each item's shade finds its bins in a list of its own after the shaded tiles, and
+/// the bin scan finds a block's item by searching four items' first sprites: every pile
+/// keeps its light.
+#[test]
+fn four_emitters_in_one_chunk_each_keep_their_light() {
+    let ctx = gpu();
+    let mut effect = pile(1.0, 12.0, [0.0; 3]);
+    effect.emitters[0].capacity = 16;
+    effect.emitters[0].look.intensity = 0.5;
+    let piles = [[-0.8, 0.5, 0.0], [-0.3, -0.4, 0.0], [-1.2, 0.0, 0.0]];
+    for (k, at) in piles.into_iter().enumerate() {
+        let mut e = pile(1.0, 0.25, at).emitters.remove(0);
+        e.name = format!("pile {k}");
+        e.capacity = 16;
+        e.look.intensity = 8.0;
+        effect.emitters.push(e);
+    }
+    // The piles show over the large sprite: losing one would be far over 8/255.
+    let mut first_only = effect.clone();
+    first_only.emitters.truncate(1);
+    let with = render(&ctx, &effect, DrawPath::Billboard, 6);
+    let without = render(&ctx, &first_only, DrawPath::Billboard, 6);
+    let (_, max) = image_diff(&with, &without);
+    assert!(total_light(&without) > 1e3, "the large sprite drew nothing");
+    assert!(max > 32, "the piles barely show: {max}/255");
+    light_agrees(&ctx, "four emitters", &effect);
+}
+
 #[test]
 fn lit_flipbooks_blend_their_frames_alike_on_both_paths() {
     let ctx = gpu();
