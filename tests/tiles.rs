@@ -575,6 +575,47 @@ fn a_projection_turned_against_the_view_draws_projective_sprites_alike() {
     );
 }
 
+/// A lit item's six-way records (after its sprites) and the rest of its last block are
+/// empty sprites, bounds (1, 1, 0, 0), which no bin lists: 600 lit puffs take 1,200
+/// records of two blocks, the padding the rest of the second.
+#[test]
+fn lit_records_and_block_padding_are_empty_sprites() {
+    let ctx = gpu();
+    let sun = Lighting {
+        sun_color: [3.0, 3.0, 3.0],
+        ..Lighting::default()
+    };
+    let mut effect = common::still_smoke(SixWayMaps::PuffSheet, sun, DrawPath::Tiles);
+    let e = &mut effect.emitters[0];
+    (e.capacity, e.bursts[0].count) = (600, 600);
+    e.shape = Shape::Sphere {
+        radius_m: 0.6,
+        surface_only: false,
+    };
+    e.look.size_m = Param::Constant(0.08);
+    let mut run =
+        Headless::new(&ctx, full_resolution(effect), ShaderLibrary::embedded()).expect("headless");
+    run.advance(1.0 / 60.0);
+    run.render(SIZE).expect("render");
+    let quads = run.player.draw_items()[0].width as usize;
+    assert!(quads > 512, "{quads} quads");
+    let bounds = run
+        .player
+        .tile_pass()
+        .expect("the tiles")
+        .read_sprite_bounds(&run.ctx)
+        .expect("read back");
+    assert!(bounds.len() >= 2048, "{} sprites", bounds.len());
+    let drawn = bounds[..quads].iter().filter(|b| b[0] <= b[2]).count();
+    assert!(
+        drawn > quads / 2,
+        "only {drawn} of {quads} puffs have pixels"
+    );
+    for (i, b) in bounds.iter().enumerate().take(2048).skip(quads) {
+        assert_eq!(*b, [1, 1, 0, 0], "sprite {i} of {quads} quads");
+    }
+}
+
 #[test]
 fn sprites_behind_the_camera_draw_nothing() {
     let ctx = gpu();

@@ -12,7 +12,7 @@
 use crate::gpu::commands::{CountedCompute, CountedRender};
 use std::collections::HashMap;
 
-use crate::gpu::GpuContext;
+use crate::gpu::{GpuContext, GpuError};
 use crate::render::billboard::DrawTarget;
 use crate::render::frame::{DrawItem, FrameResources, LookVariant};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
@@ -620,6 +620,13 @@ impl TilePass {
     #[doc(hidden)]
     pub fn set_chunk_sprites(&mut self, sprites: Option<u32>) {
         self.chunk_sprites = sprites;
+    }
+
+    /// Every sprite's pixel bounds as the last record left them (tests check that records
+    /// and block padding are empty sprites).
+    #[doc(hidden)]
+    pub fn read_sprite_bounds(&self, ctx: &GpuContext) -> Result<Vec<[i32; 4]>, GpuError> {
+        self.read_bounds(ctx)
     }
 
     /// Sets the tiles' lists' capacity in entries (`None`: twice the bins' lists'). Tests

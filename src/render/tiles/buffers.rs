@@ -124,7 +124,11 @@ impl TilePass {
         );
         let meta_words = bin_words + tile_words;
         let lists = [
-            buffer("TilePass::sprites", c * SPRITE_BYTES, none),
+            buffer(
+                "TilePass::sprites",
+                c * SPRITE_BYTES,
+                wgpu::BufferUsages::COPY_SRC,
+            ),
             buffer("TilePass::touched", touched_words * 4, indirect),
             buffer(
                 "TilePass::bin_lists",
@@ -161,6 +165,29 @@ impl TilePass {
             depth: depth.cloned(),
             _lists: [sprites_buf, bin_lists, meta, accum],
         });
+    }
+
+    /// Every sprite's pixel bounds in the buffers (lo x, lo y, hi x, hi y; empty when lo
+    /// exceeds hi), read back after the GPU's work so far (blocking); none before a draw.
+    pub(super) fn read_bounds(&self, ctx: &GpuContext) -> Result<Vec<[i32; 4]>, GpuError> {
+        let Some(b) = self.buffers.as_ref() else {
+            return Ok(Vec::new());
+        };
+        let sprites = &b._lists[0];
+        let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("TilePass::sprite_bounds"),
+            size: sprites.size(),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(sprites, 0, &staging, 0, sprites.size());
+        ctx.queue.submit([enc.finish()]);
+        let bytes = crate::gpu::readback::map_read(ctx, &staging)?;
+        Ok(bytes
+            .chunks_exact(SPRITE_BYTES as usize)
+            .map(|s| bytemuck::pod_read_unaligned::<[i32; 4]>(&s[..16]))
+            .collect())
     }
 
     /// The tile group (`lists`: sprites, touched, bin lists, bin meta, accumulation; the
