@@ -180,6 +180,91 @@ fn plain_disc(look: &mut ignis::effect::Look) {
     look.trail = None;
 }
 
+/// One still white additive particle living 10 s, a plain look, seen by the orbit camera
+/// 3 m out on +z (45°), with `look` applied.
+fn one_still(look: impl FnOnce(&mut ignis::effect::Look)) -> Effect {
+    let mut e = common::plain_emitter();
+    e.capacity = 1;
+    e.spawn_rate_per_sec = Param::Constant(0.0);
+    e.bursts = vec![ignis::effect::Burst {
+        time_secs: 0.0,
+        count: 1,
+    }];
+    e.lifetime_secs = Range::new(10.0, 10.0);
+    plain_disc(&mut e.look);
+    e.look.soft_ground_m = 0.0;
+    e.look.blend = BlendMode::Additive;
+    e.look.color_over_life = common::flat_color([1.0; 4]);
+    look(&mut e.look);
+    let mut effect = common::bare_effect(e);
+    effect.camera.target_m = [0.0; 3];
+    effect.camera.distance_m = 3.0;
+    effect.camera.pitch_deg = 0.0;
+    effect.camera.yaw_deg = 0.0;
+    effect
+}
+
+/// An upright sprite whose edges pass through pixel centres splats the rasteriser's pixels:
+/// the centres in the half-open box of its corners (the top-left rule: its left column and
+/// top row, not its right column or bottom row). A white square 4 px wide, centred on the
+/// middle pixel centre of a 193×145 target, lights the 4×4 pixels its billboard lights.
+#[test]
+fn an_upright_sprite_on_pixel_centres_splats_the_rasterisers_pixels() {
+    let ctx = gpu();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let size = (193, 145);
+    let effect = one_still(|look| {
+        look.sprite = common::white_sprite(dir.path());
+        look.size_m = Param::Constant((4.0 / common::px_per_m_at_3m(size.1)) as f32);
+        look.intensity = 0.5;
+    });
+    let expected: Vec<(u32, u32)> = (70..74)
+        .flat_map(|y| (94..98).map(move |x| (x, y)))
+        .collect();
+    let billboard = common::lit_pixels(&render(&ctx, &effect, &[], 10, size));
+    assert_eq!(billboard, expected, "the billboard's pixels");
+    let splat = common::lit_pixels(&render(&ctx, &effect, &[0], 10, size));
+    assert_eq!(splat, expected, "the splat's pixels");
+}
+
+/// A streak's depth comes from its projective map (clip z over clip w across the quad): a
+/// still streaked spark forced onto the splat is clipped by the depth range as the
+/// billboards clip it. The orbit camera 3 m out sees to 400 m: sparks of about 4 px 300 m
+/// out draw on both paths, 1 km out on neither.
+#[test]
+fn a_splatted_streak_beyond_the_far_plane_draws_nothing() {
+    let ctx = gpu();
+    let spark = |distance_m: f32| {
+        let mut effect = one_still(|look| {
+            look.streak = Some(ignis::effect::Streak {
+                length_secs: 0.01,
+                max_length_m: 0.01,
+            });
+            look.size_m = Param::Constant(0.024 * distance_m);
+            look.intensity = 1.0;
+        });
+        effect.emitters[0].transform.position_m = [0.0, 0.0, 3.0 - distance_m];
+        effect
+    };
+    let near = spark(300.0);
+    let (a, b) = (
+        render(&ctx, &near, &[], 10, SIZE),
+        render(&ctx, &near, &[0], 10, SIZE),
+    );
+    let (la, lb) = (total_light(&a), total_light(&b));
+    assert!(
+        la > 100.0 && lb > 0.5 * la,
+        "300 m: light {la} (billboards), {lb} (splat)"
+    );
+    let far = spark(1000.0);
+    let (a, b) = (
+        render(&ctx, &far, &[], 10, SIZE),
+        render(&ctx, &far, &[0], 10, SIZE),
+    );
+    assert_eq!(total_light(&a), 0.0, "billboards past the far plane");
+    assert_eq!(total_light(&b), 0.0, "the splat past the far plane");
+}
+
 /// A dense sphere of 3-px sparks at the test's size: 24000 in a 1 m sphere, 2 s lives,
 /// gravity and drag, a soft disc.
 fn dense_sphere(ctx: &GpuContext) -> Effect {

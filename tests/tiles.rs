@@ -616,6 +616,70 @@ fn lit_records_and_block_padding_are_empty_sprites() {
     }
 }
 
+/// A sprite turned by a few hundredths of a degree has corners that snap to a shape the
+/// upright test must reject: its left and right edges vertical on the 1/256-pixel grid, its
+/// bottom and top edges one grid step lower at their right ends. The tiles light the
+/// rasteriser's pixels, the bottom row included (its centres a fraction of a step inside
+/// the dipping edge), not the half-open box of two corners. A white square 4 px wide
+/// (half-size 512.5/256 px), 1/512 px right of the middle pixel centre of a 193×145
+/// target, turned −0.028° after 1 s of spin.
+#[test]
+fn a_nearly_upright_sprite_lights_the_rasterisers_pixels() {
+    let ctx = gpu();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let size = (193, 145);
+    let px_per_m = common::px_per_m_at_3m(size.1);
+    let half_px = 512.5 / 256.0;
+    let turn_deg = (-(0.25f64 / 512.5).asin()).to_degrees();
+    let at = [(1.0 / 512.0 / px_per_m) as f32, 0.0, 0.0];
+    let mut effect = pile(1.0, (2.0 * half_px / px_per_m) as f32, at);
+    let e = &mut effect.emitters[0];
+    e.lifetime_secs = Range::new(10.0, 10.0);
+    e.look.sprite = common::white_sprite(dir.path());
+    // The turn is reached at an age of 1 s (60 frames); up to twice it snaps alike.
+    e.look.spin_deg_per_s = Param::Constant(turn_deg as f32);
+    e.look.intensity = 0.5;
+    e.look.color_over_life = common::flat_color([1.0; 4]);
+    let billboard = common::lit_pixels(&render_at(&ctx, &effect, DrawPath::Billboard, 60, size));
+    // The design: the bottom edge dips below the centres of row 74 (x 95..=98).
+    assert!(
+        billboard.len() >= 24 && (95..99).all(|x| billboard.contains(&(x, 74))),
+        "the corners are not where the test puts them: {billboard:?}"
+    );
+    let tiles = common::lit_pixels(&render_at(&ctx, &effect, DrawPath::Tiles, 60, size));
+    assert_eq!(tiles, billboard, "the tiles' pixels");
+}
+
+/// The ground fade of a turned sprite whose quad its trim cuts on the left: one flame
+/// tongue of the 4 × 4 sheet (its tongues fill the middle of each frame), 1.2 m wide (about
+/// 70 px at 3 m: the 6 px mip margin keeps the cut), turned 45° by 0.1 s of spin, 0.2 m
+/// above a ground that fades it over 0.5 m. The fade's argument is affine in the frame's
+/// coordinates, its constant term taken at the cut quad's first corner: the tiles fade it
+/// as the billboards do.
+#[test]
+fn a_turned_sprite_cut_by_its_trim_fades_towards_the_ground_alike() {
+    let ctx = gpu();
+    let mut effect = pile(1.0, 1.2, [0.0, 0.2, 0.0]);
+    let look = &mut effect.emitters[0].look;
+    look.sprite = Sprite::FlameSheet;
+    look.flipbook = Some(Flipbook {
+        rows: 4,
+        cols: 4,
+        mode: FlipbookMode::OverLife,
+        blend_frames: false,
+        random_start: false,
+    });
+    look.spin_deg_per_s = Param::Constant(450.0);
+    look.soft_ground_m = 0.5;
+    look.intensity = 1.0;
+    look.color_over_life = common::flat_color([1.0, 0.6, 0.3, 1.0]);
+    light_agrees(
+        &ctx,
+        "a turned, trimmed tongue fading to the ground",
+        &effect,
+    );
+}
+
 #[test]
 fn sprites_behind_the_camera_draw_nothing() {
     let ctx = gpu();

@@ -2,7 +2,7 @@
 //! (lavapipe in CI); no adapter is a failure, never a skip.
 #![allow(dead_code)]
 
-use ignis::effect::{ColorStop, Effect, Emitter, Forces, Range, Shape, SpawnNoise};
+use ignis::effect::{ColorStop, Effect, Emitter, Forces, Range, Shape, SpawnNoise, Sprite};
 use ignis::testing::gpu::GpuContext;
 use ignis::testing::gpu::types::{Particle, SimParams};
 use ignis::testing::shaders::ShaderLibrary;
@@ -206,6 +206,31 @@ pub fn flat_maps(dir: &std::path::Path) -> ignis::effect::SixWayMaps {
         rtba: write("flat_rtba.png", FLAT_RTBA),
         lbfe: write("flat_lbfe.png", FLAT_LBFE),
     }
+}
+
+/// A 16×16 white image written into `dir`: a sprite bright up to its frame's edge (its
+/// trim the whole frame).
+pub fn white_sprite(dir: &std::path::Path) -> Sprite {
+    let path = dir.join("white.png");
+    image::RgbaImage::from_pixel(16, 16, image::Rgba([255; 4]))
+        .save(&path)
+        .expect("png");
+    Sprite::Image(path.display().to_string())
+}
+
+/// Pixels per metre on the default orbit camera's image plane 3 m out, `height_px` high
+/// (its 45° field of view as `Camera` takes it, in f32).
+pub fn px_per_m_at_3m(height_px: u32) -> f64 {
+    let f = 1.0 / (0.5 * f64::from(45f32.to_radians())).tan();
+    0.5 * f64::from(height_px) * f / 3.0
+}
+
+/// The pixels an image's light is in (any channel above zero), row by row.
+pub fn lit_pixels(img: &image::RgbaImage) -> Vec<(u32, u32)> {
+    img.enumerate_pixels()
+        .filter(|(_, _, p)| p[0] > 0 || p[1] > 0 || p[2] > 0)
+        .map(|(x, y, _)| (x, y))
+        .collect()
 }
 
 /// Runs `cmd` to completion and fails the test, with its stderr, unless it succeeded.
