@@ -174,3 +174,19 @@ fn the_stats_count_drops_and_living_particles_overwritten() {
     let (planner, _) = planned(&e, 0.25, 8);
     assert_eq!(planner.emitters[0].stats.recycled_alive, 0);
 }
+
+/// A steady rate into a small ring overwrites living particles of many batches, each
+/// counted once: 450 a second into 100 slots, living 10 s, for 1 s (60 steps of 7 or 8, so
+/// one step's births overwrite two earlier steps' particles): the last 350 births each
+/// overwrite a particle still alive.
+#[test]
+fn a_steady_rate_counts_every_living_particle_it_overwrites() {
+    let mut e = effect(450.0, 0.0, Vec::new());
+    e.emitters[0].capacity = 100;
+    e.emitters[0].lifetime_secs = Range::new(10.0, 10.0);
+    let (planner, births) = planned(&e, 1.0 / 60.0, 60);
+    let stats = &planner.emitters[0].stats;
+    assert_eq!(births.iter().map(|b| b.0).sum::<u32>(), 450);
+    assert_eq!(stats.spawned, 450);
+    assert_eq!(stats.recycled_alive, 350, "{stats:?}");
+}
