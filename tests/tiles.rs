@@ -617,37 +617,71 @@ fn lit_records_and_block_padding_are_empty_sprites() {
 }
 
 /// A sprite turned by a few hundredths of a degree has corners that snap to a shape the
-/// upright test must reject: its left and right edges vertical on the 1/256-pixel grid, its
-/// bottom and top edges one grid step lower at their right ends. The tiles light the
-/// rasteriser's pixels, the bottom row included (its centres a fraction of a step inside
-/// the dipping edge), not the half-open box of two corners. A white square 4 px wide
-/// (half-size 512.5/256 px), 1/512 px right of the middle pixel centre of a 193×145
-/// target, turned −0.028° after 1 s of spin.
+/// upright test must reject: its left and right edges vertical on the 1/256-pixel grid, and
+/// one or both of its bottom and top edges a grid step lower at their right ends. The tiles
+/// light the rasteriser's pixels, the dipping edge's row included (its centres a fraction
+/// of a step inside it), not the half-open box of two corners. On a 193×145 target: a white
+/// square 4 px wide (half-size 512.5/256 px), 1/512 px right of the middle pixel centre,
+/// both edges dipping; and one 4.5 px wide (576.25/256), 128.25 grid steps right and 192.25
+/// below, its top edge level on the grid and its bottom edge dipping.
 #[test]
 fn a_nearly_upright_sprite_lights_the_rasterisers_pixels() {
     let ctx = gpu();
     let dir = tempfile::tempdir().expect("tempdir");
+    let both_dip = nearly_upright_pixels(&ctx, dir.path(), 512.5, (0.5, 0.0));
+    // The design: the bottom edge dips below the centres of row 74 (x 95..=98).
+    assert!(
+        both_dip.0.len() >= 24 && (95..99).all(|x| both_dip.0.contains(&(x, 74))),
+        "the corners are not where the test puts them: {:?}",
+        both_dip.0
+    );
+    assert_eq!(
+        both_dip.1, both_dip.0,
+        "the tiles' pixels (both edges dipping)"
+    );
+    let top_level = nearly_upright_pixels(&ctx, dir.path(), 576.25, (128.25, -192.25));
+    // The design: columns 95..=98 of rows 71..=75, row 75 lit inside the dipping edge only.
+    let designed: Vec<(u32, u32)> = (71..76)
+        .flat_map(|y| (95..99).map(move |x| (x, y)))
+        .collect();
+    assert_eq!(
+        top_level.0, designed,
+        "the corners are not where the test puts them"
+    );
+    assert_eq!(
+        top_level.1, top_level.0,
+        "the tiles' pixels (a level top edge)"
+    );
+}
+
+/// The pixels the billboards and the tiles light for a white square of half-size
+/// `half_steps` grid steps (1/256 px) at `at_steps` (right, up) from the middle pixel centre
+/// of a 193×145 target, turned after 1 s of spin so that its horizontal edges fall by a
+/// quarter of a step across it.
+fn nearly_upright_pixels(
+    ctx: &GpuContext,
+    dir: &std::path::Path,
+    half_steps: f64,
+    at_steps: (f64, f64),
+) -> (Vec<(u32, u32)>, Vec<(u32, u32)>) {
     let size = (193, 145);
     let px_per_m = common::px_per_m_at_3m(size.1);
-    let half_px = 512.5 / 256.0;
-    let turn_deg = (-(0.25f64 / 512.5).asin()).to_degrees();
-    let at = [(1.0 / 512.0 / px_per_m) as f32, 0.0, 0.0];
-    let mut effect = pile(1.0, (2.0 * half_px / px_per_m) as f32, at);
+    let m = |steps: f64| (steps / 256.0 / px_per_m) as f32;
+    let turn_deg = (-(0.25f64 / half_steps).asin()).to_degrees();
+    let mut effect = pile(
+        1.0,
+        2.0 * m(half_steps),
+        [m(at_steps.0), m(at_steps.1), 0.0],
+    );
     let e = &mut effect.emitters[0];
     e.lifetime_secs = Range::new(10.0, 10.0);
-    e.look.sprite = common::white_sprite(dir.path());
+    e.look.sprite = common::white_sprite(dir);
     // The turn is reached at an age of 1 s (60 frames); up to twice it snaps alike.
     e.look.spin_deg_per_s = Param::Constant(turn_deg as f32);
     e.look.intensity = 0.5;
     e.look.color_over_life = common::flat_color([1.0; 4]);
-    let billboard = common::lit_pixels(&render_at(&ctx, &effect, DrawPath::Billboard, 60, size));
-    // The design: the bottom edge dips below the centres of row 74 (x 95..=98).
-    assert!(
-        billboard.len() >= 24 && (95..99).all(|x| billboard.contains(&(x, 74))),
-        "the corners are not where the test puts them: {billboard:?}"
-    );
-    let tiles = common::lit_pixels(&render_at(&ctx, &effect, DrawPath::Tiles, 60, size));
-    assert_eq!(tiles, billboard, "the tiles' pixels");
+    let lit = |path| common::lit_pixels(&render_at(ctx, &effect, path, 60, size));
+    (lit(DrawPath::Billboard), lit(DrawPath::Tiles))
 }
 
 /// The ground fade of a turned sprite whose quad its trim cuts on the left: one flame

@@ -22,8 +22,9 @@ pub(super) struct TileBuffers {
     pub(super) bin_group: wgpu::BindGroup,
     pub(super) resolve_group: wgpu::BindGroup,
     pub(super) depth: Option<wgpu::TextureView>,
-    /// Everything else the group binds (kept alive with it).
-    pub(super) _lists: [wgpu::Buffer; 4],
+    /// Everything else the group binds, kept alive with it: the sprites (read back by
+    /// tests), the bins' lists, their counts and places, and the accumulation.
+    pub(super) lists: [wgpu::Buffer; 4],
 }
 
 impl TilePass {
@@ -163,7 +164,7 @@ impl TilePass {
             bin_group,
             resolve_group,
             depth: depth.cloned(),
-            _lists: [sprites_buf, bin_lists, meta, accum],
+            lists: [sprites_buf, bin_lists, meta, accum],
         });
     }
 
@@ -173,7 +174,7 @@ impl TilePass {
         let Some(b) = self.buffers.as_ref() else {
             return Ok(Vec::new());
         };
-        let sprites = &b._lists[0];
+        let sprites = &b.lists[0];
         let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("TilePass::sprite_bounds"),
             size: sprites.size(),
