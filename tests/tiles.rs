@@ -536,7 +536,7 @@ fn shrinks_leaving_none(ctx: &GpuContext, what: &str, effect: &Effect, count: u3
 #[test]
 fn a_projection_turned_against_the_view_draws_projective_sprites_alike() {
     let ctx = gpu();
-    let effect = full_resolution(pile(1.0, 0.5, [0.0; 3]));
+    let dir = tempfile::tempdir().expect("tempdir");
     let view = glam::camera::rh::view::look_at_mat4(
         glam::Vec3::new(0.0, 0.0, 3.0),
         glam::Vec3::ZERO,
@@ -547,32 +547,39 @@ fn a_projection_turned_against_the_view_draws_projective_sprites_alike() {
     let proj = glam::camera::rh::proj::directx::perspective(0.8, aspect, 0.05, 50.0)
         * glam::Mat4::from_rotation_y(0.3);
     let camera = ignis::Camera::new(view, proj, SIZE);
-    let draw = |path: DrawPath| {
-        let mut effect = effect.clone();
-        effect.emitters[0].look.draw_path = path;
-        let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
-        for _ in 0..6 {
-            run.advance(1.0 / 60.0);
-        }
-        // Only this camera draws: no camera-facing frame fills the sprites' rows first.
-        let image = run
-            .composite
-            .render_image(&run.ctx, &mut run.player, &camera)
-            .expect("render");
-        let tiled = run.player.draw_items().iter().any(|d| d.tiles);
-        assert_eq!(tiled, path == DrawPath::Tiles, "{path:?}");
-        image
-    };
-    let (a, b) = (draw(DrawPath::Billboard), draw(DrawPath::Tiles));
-    let (la, lb) = (total_light(&a), total_light(&b));
-    eprintln!("turned projection: light {la} (billboards), {lb} (tiles)");
-    assert!(la > 1e3, "the billboards drew almost nothing");
-    assert!((la - lb).abs() <= 0.01 * la, "light {la} vs {lb}");
-    let (mean, max) = image_diff(&a, &b);
-    assert!(
-        mean <= 1.0 && max <= 8,
-        "turned projection: {mean:.3}/255 mean, {max}/255 max"
-    );
+    let disc = full_resolution(pile(1.0, 0.5, [0.0; 3]));
+    // A sprite its trim cuts on two sides, about 50 px wide: the map's constant column is
+    // taken at the cut quad's first corner.
+    let mut cornered = full_resolution(pile(1.0, 1.0, [0.0; 3]));
+    cornered.emitters[0].look.sprite = common::cornered_sprite(dir.path());
+    for (what, effect) in [("a disc", disc), ("a cut sprite", cornered)] {
+        let draw = |path: DrawPath| {
+            let mut effect = effect.clone();
+            effect.emitters[0].look.draw_path = path;
+            let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+            for _ in 0..6 {
+                run.advance(1.0 / 60.0);
+            }
+            // Only this camera draws: no camera-facing frame fills the sprites' rows first.
+            let image = run
+                .composite
+                .render_image(&run.ctx, &mut run.player, &camera)
+                .expect("render");
+            let tiled = run.player.draw_items().iter().any(|d| d.tiles);
+            assert_eq!(tiled, path == DrawPath::Tiles, "{what}: {path:?}");
+            image
+        };
+        let (a, b) = (draw(DrawPath::Billboard), draw(DrawPath::Tiles));
+        let (la, lb) = (total_light(&a), total_light(&b));
+        eprintln!("turned projection, {what}: light {la} (billboards), {lb} (tiles)");
+        assert!(la > 1e3, "{what}: the billboards drew almost nothing");
+        assert!((la - lb).abs() <= 0.01 * la, "{what}: light {la} vs {lb}");
+        let (mean, max) = image_diff(&a, &b);
+        assert!(
+            mean <= 1.0 && max <= 8,
+            "turned projection, {what}: {mean:.3}/255 mean, {max}/255 max"
+        );
+    }
 }
 
 /// A lit item's six-way records (after its sprites) and the rest of its last block are
@@ -684,17 +691,24 @@ fn nearly_upright_pixels(
     (lit(DrawPath::Billboard), lit(DrawPath::Tiles))
 }
 
-/// The ground fade of a turned sprite whose quad its trim cuts on the left: one flame
-/// tongue of the 4 × 4 sheet (its tongues fill the middle of each frame), 1.2 m wide (about
-/// 70 px at 3 m: the 6 px mip margin keeps the cut), turned 45° by 0.1 s of spin, 0.2 m
-/// above a ground that fades it over 0.5 m. The fade's argument is affine in the frame's
-/// coordinates, its constant term taken at the cut quad's first corner: the tiles fade it
-/// as the billboards do.
+/// The ground fade of a turned sprite whose quad its trim cuts: one flame tongue of the
+/// 4 × 4 sheet (its tongues fill the middle of each frame: cut on the left), and a white
+/// square cut on the left and at the bottom, 1.2 m wide (about 70 px at 3 m: the 6 px mip
+/// margin keeps the cut), turned 45° by 0.1 s of spin, 0.2 m above a ground that fades it
+/// over 0.5 m. The fade's argument is affine in the frame's coordinates, its constant term
+/// taken at the cut quad's first corner: the tiles fade it as the billboards do.
 #[test]
 fn a_turned_sprite_cut_by_its_trim_fades_towards_the_ground_alike() {
     let ctx = gpu();
+    let dir = tempfile::tempdir().expect("tempdir");
     let mut effect = pile(1.0, 1.2, [0.0, 0.2, 0.0]);
     let look = &mut effect.emitters[0].look;
+    look.spin_deg_per_s = Param::Constant(450.0);
+    look.soft_ground_m = 0.5;
+    look.intensity = 1.0;
+    look.color_over_life = common::flat_color([1.0, 0.6, 0.3, 1.0]);
+    let mut tongue = effect.clone();
+    let look = &mut tongue.emitters[0].look;
     look.sprite = Sprite::FlameSheet;
     look.flipbook = Some(Flipbook {
         rows: 4,
@@ -703,15 +717,10 @@ fn a_turned_sprite_cut_by_its_trim_fades_towards_the_ground_alike() {
         blend_frames: false,
         random_start: false,
     });
-    look.spin_deg_per_s = Param::Constant(450.0);
-    look.soft_ground_m = 0.5;
-    look.intensity = 1.0;
-    look.color_over_life = common::flat_color([1.0, 0.6, 0.3, 1.0]);
-    light_agrees(
-        &ctx,
-        "a turned, trimmed tongue fading to the ground",
-        &effect,
-    );
+    let mut square = effect;
+    square.emitters[0].look.sprite = common::cornered_sprite(dir.path());
+    light_agrees(&ctx, "a turned tongue cut on the left", &tongue);
+    light_agrees(&ctx, "a turned square cut on two sides", &square);
 }
 
 #[test]

@@ -218,6 +218,19 @@ pub fn white_sprite(dir: &std::path::Path) -> Sprite {
     Sprite::Image(path.display().to_string())
 }
 
+/// A 16×16 white image with its left five columns and bottom five rows clear, written
+/// into `dir`: a sprite whose trim cuts its quad on two sides (the quad's first corner off
+/// the frame's corner).
+pub fn cornered_sprite(dir: &std::path::Path) -> Sprite {
+    let path = dir.join("cornered.png");
+    image::RgbaImage::from_fn(16, 16, |x, y| {
+        image::Rgba(if x < 5 || y > 10 { [0; 4] } else { [255; 4] })
+    })
+    .save(&path)
+    .expect("png");
+    Sprite::Image(path.display().to_string())
+}
+
 /// Pixels per metre on the default orbit camera's image plane 3 m out, `height_px` high
 /// (its 45° field of view as `Camera` takes it, in f32).
 pub fn px_per_m_at_3m(height_px: u32) -> f64 {
