@@ -543,9 +543,11 @@ fn a_projection_turned_against_the_view_draws_projective_sprites_alike() {
         glam::Vec3::Y,
     );
     let aspect = SIZE.0 as f32 / SIZE.1 as f32;
-    // Turned 0.3 rad about the view's y: w takes sin 0.3 of the camera's right axis.
+    // Turned 0.3 rad about the view's y and 0.25 about its x: w takes some of the camera's
+    // right and of its up axis.
     let proj = glam::camera::rh::proj::directx::perspective(0.8, aspect, 0.05, 50.0)
-        * glam::Mat4::from_rotation_y(0.3);
+        * glam::Mat4::from_rotation_y(0.3)
+        * glam::Mat4::from_rotation_x(0.25);
     let camera = ignis::Camera::new(view, proj, SIZE);
     let disc = full_resolution(pile(1.0, 0.5, [0.0; 3]));
     // A sprite its trim cuts on two sides, about 50 px wide: the map's constant column is
