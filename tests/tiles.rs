@@ -637,31 +637,27 @@ fn lit_records_and_block_padding_are_empty_sprites() {
 fn a_nearly_upright_sprite_lights_the_rasterisers_pixels() {
     let ctx = gpu();
     let dir = tempfile::tempdir().expect("tempdir");
-    let both_dip = nearly_upright_pixels(&ctx, dir.path(), 512.5, (0.5, 0.0));
+    let [billboard, tiles] = nearly_upright_pixels(&ctx, dir.path(), 512.5, (0.5, 0.0));
     // The design: the bottom edge dips below the centres of row 74 (x 95..=98).
     assert!(
-        both_dip.0.len() >= 24 && (95..99).all(|x| both_dip.0.contains(&(x, 74))),
-        "the corners are not where the test puts them: {:?}",
-        both_dip.0
+        billboard.len() >= 24 && (95..99).all(|x| billboard.contains(&(x, 74))),
+        "the corners are not where the test puts them: {billboard:?}"
     );
-    assert_eq!(
-        both_dip.1, both_dip.0,
-        "the tiles' pixels (both edges dipping)"
-    );
-    let top_level = nearly_upright_pixels(&ctx, dir.path(), 576.25, (128.25, -192.25));
+    assert_eq!(tiles, billboard, "the tiles' pixels (both edges dipping)");
+    let [billboard, tiles] = nearly_upright_pixels(&ctx, dir.path(), 576.25, (128.25, -192.25));
     // The design: columns 95..=98 of rows 71..=75, row 75 lit inside the dipping edge only.
-    let designed: Vec<(u32, u32)> = (71..76)
+    let designed: Pixels = (71..76)
         .flat_map(|y| (95..99).map(move |x| (x, y)))
         .collect();
     assert_eq!(
-        top_level.0, designed,
+        billboard, designed,
         "the corners are not where the test puts them"
     );
-    assert_eq!(
-        top_level.1, top_level.0,
-        "the tiles' pixels (a level top edge)"
-    );
+    assert_eq!(tiles, billboard, "the tiles' pixels (a level top edge)");
 }
+
+/// The pixels an image's light is in, row by row.
+type Pixels = Vec<(u32, u32)>;
 
 /// The pixels the billboards and the tiles light for a white square of half-size
 /// `half_steps` grid steps (1/256 px) at `at_steps` (right, up) from the middle pixel centre
@@ -672,7 +668,7 @@ fn nearly_upright_pixels(
     dir: &std::path::Path,
     half_steps: f64,
     at_steps: (f64, f64),
-) -> (Vec<(u32, u32)>, Vec<(u32, u32)>) {
+) -> [Pixels; 2] {
     let size = (193, 145);
     let px_per_m = common::px_per_m_at_3m(size.1);
     let m = |steps: f64| (steps / 256.0 / px_per_m) as f32;
@@ -690,7 +686,7 @@ fn nearly_upright_pixels(
     e.look.intensity = 0.5;
     e.look.color_over_life = common::flat_color([1.0; 4]);
     let lit = |path| common::lit_pixels(&render_at(ctx, &effect, path, 60, size));
-    (lit(DrawPath::Billboard), lit(DrawPath::Tiles))
+    [lit(DrawPath::Billboard), lit(DrawPath::Tiles)]
 }
 
 /// The ground fade of a turned sprite whose quad its trim cuts: one flame tongue of the
