@@ -993,17 +993,6 @@ fn downlevel_devices_get_an_error_naming_each_limit() {
 #[test]
 fn a_depth_the_player_cannot_sample_is_an_error_and_the_fire_still_shows() {
     let (eye, target) = (vec3(0.0, 0.7, 3.0), vec3(0.0, 0.5, 0.0));
-    let wall = || {
-        Quad(
-            [
-                vec3(-3.0, -1.0, 1.2),
-                vec3(0.0, -1.0, 1.2),
-                vec3(0.0, 3.0, 1.2),
-                vec3(-3.0, 3.0, 1.2),
-            ],
-            [0.2, 0.3, 0.4],
-        )
-    };
     let transient = HostKind {
         transient_depth: true,
         ..HostKind::default()
@@ -1116,15 +1105,20 @@ fn the_effect_light_sits_on_the_particles_with_their_colour_and_power() {
         0.2126 * light.rgb_power[0] + 0.7152 * light.rgb_power[1] + 0.0722 * light.rgb_power[2];
     assert!((light.power - luma).abs() < 1e-5 * luma, "{light:?}");
     let (bigger, _) = lit(HostKind::default(), 2.0, 1.0);
-    let (brighter, _) = lit(HostKind::default(), 1.0, 3.0);
+    let (brighter, _) = lit(HostKind::default(), 1.0, 300.0);
     assert!(
         (bigger.power / light.power - 4.0).abs() < 1e-4,
         "{bigger:?}"
     );
     assert!(
-        (brighter.power / light.power - 3.0).abs() < 1e-4,
+        (brighter.power / light.power - 300.0).abs() < 1e-2,
         "{brighter:?}"
     );
+    // Still no spread, whatever the power (the brighter one's is well over 1): the spread
+    // is the power-weighted mean square distance about the centre, not scaled by it.
+    for l in [&bigger, &brighter] {
+        assert!(l.radius_m < 1e-2, "{l:?}");
+    }
     // A z-up host on the least device the player takes.
     let z_up = HostKind {
         z_up: true,
@@ -1182,4 +1176,6 @@ fn the_campfire_light_flickers_from_its_flames() {
     let sd = (powers.iter().map(|p| (p - mean).powi(2)).sum::<f64>() / powers.len() as f64).sqrt();
     eprintln!("campfire light: power {mean:.4} ± {sd:.4}");
     assert!(mean > 0.0 && sd / mean > 0.01, "no flicker: {mean} ± {sd}");
+    fire.set_light_estimate(false);
+    assert_eq!(fire.effect_light(id), None, "the estimate turned off");
 }
