@@ -316,6 +316,28 @@ fn hard_tiled_sprites_obey_ordinary_reversed_z_and_always_hosts() {
     );
 }
 
+/// In frame-delta mode a record runs one step of every frame advanced since the last one:
+/// frames of 10 ms and 20 ms advanced before one record make one step of 30 ms.
+#[test]
+fn frame_delta_frames_advanced_before_a_record_join_its_one_step() {
+    let host = Host::new(vec3(0.0, 0.7, 3.0), vec3(0.0, 0.5, 0.0));
+    let mut effect = still_disc(0.0);
+    effect.time.mode = ignis::effect::TimeMode::FrameDelta;
+    effect.time.max_frame_dt_secs = 0.1;
+    let mut fire = host.player(&effect);
+    let id = fire.add_instance(Mat4::IDENTITY, 3).expect("instance");
+    fire.advance(0.01);
+    fire.advance(0.02);
+    let mut enc = host.device.create_command_encoder(&Default::default());
+    fire.record(&mut enc, &host.camera, None).expect("record");
+    host.queue.submit([enc.finish()]);
+    let clock = fire.clock_stats();
+    assert_eq!(clock.steps, 1, "{clock:?}");
+    assert!((clock.step_secs - 0.03).abs() < 1e-6, "{clock:?}");
+    let t = fire.time_secs(id).expect("time");
+    assert!((t - 0.03).abs() < 1e-6, "simulated {t} s");
+}
+
 /// One still, additive disc at (0, 0.2, 0), 1 m wide: its lower part crosses the ground.
 fn still_disc(soft_m: f32) -> Effect {
     let mut e = common::plain_emitter();
