@@ -821,12 +821,7 @@ fn compact_state_renders_like_the_full_state(set: impl Fn(&mut Emitter), max_mea
         set(e);
     }
     let render = |effect: ignis::effect::Effect| {
-        let mut run =
-            ignis::testing::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
-                .expect("headless");
-        for _ in 0..60 {
-            run.advance(1.0 / 60.0);
-        }
+        let mut run = headless_after(&ctx, effect, 60);
         (
             run.render((240, 180)).expect("render"),
             run.alive().expect("alive"),
@@ -865,15 +860,11 @@ fn tiny_state_draws_between_steps_like_the_full_state() {
     full.time.step_secs = 1.0 / 20.0;
     let mut tiny = full.clone();
     tiny.emitters[0].tiny_state = true;
+    // 0.74 s: the last frame 0.8 of the way from the step before to the last.
     let render = |effect: ignis::effect::Effect| {
-        let mut run =
-            ignis::testing::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
-                .expect("headless");
-        // 0.74 s: the last frame 0.8 of the way from the step before to the last.
-        for _ in 0..37 {
-            run.advance(1.0 / 50.0);
-        }
-        run.render((160, 120)).expect("render")
+        headless_frames(&ctx, effect, 37, 1.0 / 50.0)
+            .render((160, 120))
+            .expect("render")
     };
     let (a, b) = (render(full), render(tiny));
     let (mean, max) = image_diff(&a, &b);

@@ -11,7 +11,7 @@ mod host;
 use glam::{Mat4, Vec3, vec3};
 use host::Host;
 use ignis::Player;
-use ignis::effect::{BlendMode, DrawPath, Effect, Lighting, Param, Range, SixWayMaps};
+use ignis::effect::{BlendMode, DrawPath, Effect, Lighting, Param, SixWayMaps};
 use ignis::testing::render::sixway_maps::{EXTINCTION, PUFF_SEED, puff, puff_density};
 
 /// Where the puff hangs, and the camera (looking down −Z: the sprite's back is −Z).
@@ -176,15 +176,9 @@ fn the_effects_own_light_lights_its_smoke_from_where_it_burns() {
         l.self_light = 1.0;
     }
     // A still, additive glow 0.6 m below the smoke, drawn first (its light is what counts).
-    let mut fire = common::plain_emitter();
+    let mut fire = common::still_burst(2, 100.0);
     fire.name = "fire".into();
     fire.capacity = 4;
-    fire.spawn_rate_per_sec = Param::Constant(0.0);
-    fire.bursts = vec![ignis::effect::Burst {
-        time_secs: 0.0,
-        count: 2,
-    }];
-    fire.lifetime_secs = Range::new(100.0, 100.0);
     fire.transform.position_m = (SMOKE - vec3(0.0, 0.6, 0.0)).into();
     fire.look.size_m = Param::Constant(0.3);
     fire.look.blend = BlendMode::Additive;

@@ -68,14 +68,7 @@ fn host_geometry_hides_splatted_particles_exactly() {
 
 /// One white additive particle living 10 s, forced onto the splat.
 fn one_white_splat() -> ignis::effect::Emitter {
-    let mut e = common::plain_emitter();
-    e.capacity = 1;
-    e.spawn_rate_per_sec = ignis::effect::Param::Constant(0.0);
-    e.bursts = vec![ignis::effect::Burst {
-        time_secs: 0.0,
-        count: 1,
-    }];
-    e.lifetime_secs = ignis::effect::Range::new(10.0, 10.0);
+    let mut e = common::still_burst(1, 10.0);
     e.look.color_over_life = common::flat_color([1.0, 1.0, 1.0, 1.0]);
     e.look.blend = BlendMode::Additive;
     e.look.draw_path = ignis::effect::DrawPath::Splat;

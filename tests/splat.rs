@@ -183,14 +183,7 @@ fn plain_disc(look: &mut ignis::effect::Look) {
 /// One still white additive particle living 10 s, a plain look, seen by the orbit camera
 /// 3 m out on +z (45°), with `look` applied.
 fn one_still(look: impl FnOnce(&mut ignis::effect::Look)) -> Effect {
-    let mut e = common::plain_emitter();
-    e.capacity = 1;
-    e.spawn_rate_per_sec = Param::Constant(0.0);
-    e.bursts = vec![ignis::effect::Burst {
-        time_secs: 0.0,
-        count: 1,
-    }];
-    e.lifetime_secs = Range::new(10.0, 10.0);
+    let mut e = common::still_burst(1, 10.0);
     plain_disc(&mut e.look);
     e.look.soft_ground_m = 0.0;
     e.look.blend = BlendMode::Additive;

@@ -301,14 +301,8 @@ fn streaks_stay_billboards() {
 
 /// Still particles on the camera's axis: `count` of them, `size_m` wide, at `at`.
 fn pile(count: f32, size_m: f32, at: [f32; 3]) -> Effect {
-    let mut e = common::plain_emitter();
+    let mut e = common::still_burst(count as u32, 1.0);
     e.capacity = 4096;
-    e.spawn_rate_per_sec = Param::Constant(0.0);
-    e.bursts = vec![ignis::effect::Burst {
-        time_secs: 0.0,
-        count: count as u32,
-    }];
-    e.lifetime_secs = Range::new(1.0, 1.0);
     e.transform.position_m = at;
     e.look.sprite = Sprite::SoftDisc;
     e.look.flipbook = None;

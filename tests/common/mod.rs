@@ -208,27 +208,44 @@ pub fn flat_maps(dir: &std::path::Path) -> ignis::effect::SixWayMaps {
     }
 }
 
+/// A 16×16 image sprite written into `dir` as `name`: white where `opaque(x, y)`, clear
+/// elsewhere.
+fn image_sprite(dir: &std::path::Path, name: &str, opaque: impl Fn(u32, u32) -> bool) -> Sprite {
+    let path = dir.join(name);
+    image::RgbaImage::from_fn(16, 16, |x, y| {
+        image::Rgba(if opaque(x, y) { [255; 4] } else { [0; 4] })
+    })
+    .save(&path)
+    .expect("png");
+    Sprite::Image(path.display().to_string())
+}
+
 /// A 16×16 white image written into `dir`: a sprite bright up to its frame's edge (its
 /// trim the whole frame).
 pub fn white_sprite(dir: &std::path::Path) -> Sprite {
-    let path = dir.join("white.png");
-    image::RgbaImage::from_pixel(16, 16, image::Rgba([255; 4]))
-        .save(&path)
-        .expect("png");
-    Sprite::Image(path.display().to_string())
+    image_sprite(dir, "white.png", |_, _| true)
 }
 
 /// A 16×16 white image with its left five columns and bottom five rows clear, written
 /// into `dir`: a sprite whose trim cuts its quad on two sides (the quad's first corner off
 /// the frame's corner).
 pub fn cornered_sprite(dir: &std::path::Path) -> Sprite {
-    let path = dir.join("cornered.png");
-    image::RgbaImage::from_fn(16, 16, |x, y| {
-        image::Rgba(if x < 5 || y > 10 { [0; 4] } else { [255; 4] })
-    })
-    .save(&path)
-    .expect("png");
-    Sprite::Image(path.display().to_string())
+    image_sprite(dir, "cornered.png", |x, y| x >= 5 && y <= 10)
+}
+
+/// [`plain_emitter`] as one burst of `count` still particles at its start, living
+/// `life_secs`, in a pool of exactly `count`.
+pub fn still_burst(count: u32, life_secs: f32) -> Emitter {
+    Emitter {
+        capacity: count,
+        spawn_rate_per_sec: ignis::effect::Param::Constant(0.0),
+        bursts: vec![ignis::effect::Burst {
+            time_secs: 0.0,
+            count,
+        }],
+        lifetime_secs: Range::new(life_secs, life_secs),
+        ..plain_emitter()
+    }
 }
 
 /// Pixels per metre on the default orbit camera's image plane 3 m out, `height_px` high
@@ -266,10 +283,20 @@ pub fn headless_after(
     effect: Effect,
     steps: u32,
 ) -> ignis::testing::headless::Headless {
+    headless_frames(ctx, effect, steps, 1.0 / 60.0)
+}
+
+/// A headless run of `effect` advanced `frames` frames of `frame_dt` seconds.
+pub fn headless_frames(
+    ctx: &GpuContext,
+    effect: Effect,
+    frames: u32,
+    frame_dt: f64,
+) -> ignis::testing::headless::Headless {
     let mut run = ignis::testing::headless::Headless::new(ctx, effect, ShaderLibrary::embedded())
         .expect("headless");
-    for _ in 0..steps {
-        run.advance(1.0 / 60.0);
+    for _ in 0..frames {
+        run.advance(frame_dt);
     }
     run
 }
