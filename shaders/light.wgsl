@@ -2,15 +2,17 @@
 // alive now give, and from where. Pass 1 (`light_sum`): each workgroup sums, over its
 // slots of one instance's pool, each living particle's emitted light E (colour · alpha ·
 // opacity · intensity · ∫ sprite brightness · (size / 2)², in m²) and its luminance-
-// weighted position moments; pass 2 (`light_total`): one invocation per instance sums its
-// workgroups' partials. The CPU reads the totals back a frame or two later.
+// weighted position moments; pass 2 (`light_total`, one dispatch for the whole frame): one
+// invocation per instance and emitter sums its workgroups' partials. The CPU reads the
+// totals back a frame or two later.
 //
 // Contract:
 // - groups 0 and 1: particle_bindings.wgsl (camera, looks with a dynamic offset per
 //   emitter, ramps; the state buffers).
 // - group 2: 0 `sums`: the partials (2 × vec4 per workgroup: (ΣE.rgb, ΣY), (ΣY·p, ΣY·|p|²)),
 //   then the totals (the same per instance) from `job.total_base` on; 2 `job` (dynamic
-//   offset per dispatch). One buffer for both: a device's 8 storage buffers per stage.
+//   offset per `light_sum` dispatch). One buffer for both: a device's 8 storage buffers
+//   per stage. `light_total` binds group 2 alone: 0 `sums`, 1 `totals_plan`.
 #import "common.wgsl"
 #import "rng.wgsl"
 #import "look.wgsl"
@@ -30,6 +32,9 @@ struct LightJob {
 
 @group(2) @binding(0) var<storage, read_write> sums_out: array<vec4<f32>>;
 @group(2) @binding(2) var<uniform> job: LightJob;
+// `light_total`'s plan: [0].x the totals; then per total (its first partial, its
+// partials, its index in `sums_out`).
+@group(2) @binding(1) var<storage, read> totals_plan: array<vec4<u32>>;
 
 // Rec. 709 luminance of linear RGB.
 const LUMA: vec3<f32> = vec3<f32>(0.2126, 0.7152, 0.0722);
@@ -87,19 +92,19 @@ fn light_sum(
     }
 }
 
+// Every total of the frame (each instance of each job) in one dispatch.
 @compute @workgroup_size(64)
 fn light_total(@builtin(global_invocation_id) id: vec3<u32>) {
-    let member = id.x;
-    if member >= job.members {
+    if id.x >= totals_plan[0].x {
         return;
     }
+    let p = totals_plan[id.x + 1u];
     var a = vec4<f32>(0.0);
     var b = vec4<f32>(0.0);
-    let first = job.partial_base + member * job.groups_per_member;
-    for (var k = 0u; k < job.groups_per_member; k++) {
-        a += sums_out[(first + k) * 2u];
-        b += sums_out[(first + k) * 2u + 1u];
+    for (var k = 0u; k < p.y; k++) {
+        a += sums_out[(p.x + k) * 2u];
+        b += sums_out[(p.x + k) * 2u + 1u];
     }
-    sums_out[(job.total_base + member) * 2u] = a;
-    sums_out[(job.total_base + member) * 2u + 1u] = b;
+    sums_out[p.z * 2u] = a;
+    sums_out[p.z * 2u + 1u] = b;
 }

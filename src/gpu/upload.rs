@@ -39,6 +39,21 @@ impl Uploads {
         Some(self.belt.write_buffer(enc, target, offset, size))
     }
 
+    /// Copies `data` into `target` at `offset` by a copy recorded now into `enc` (outside
+    /// any pass), in order with the commands around it. `offset` and the length of `data`
+    /// are multiples of 4.
+    pub fn write_bytes(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        target: &wgpu::Buffer,
+        offset: u64,
+        data: &[u8],
+    ) {
+        if let Some(mut view) = self.write(enc, target, offset, data.len() as u64) {
+            view.copy_from_slice(data);
+        }
+    }
+
     /// Closes this frame's chunks: they are mapped for reuse once `enc`'s commands are
     /// submitted and copied. Call it after the last [`Uploads::write`] into `enc`.
     pub fn finish(&mut self, enc: &wgpu::CommandEncoder) {

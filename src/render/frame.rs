@@ -52,6 +52,8 @@ pub struct FrameResources {
     /// Group 1: previous and current state.
     pub particle_layout: wgpu::BindGroupLayout,
     camera: wgpu::Buffer,
+    /// The camera the last `prepare` was given, for `upload_looks`.
+    camera_block: CameraUniform,
     looks: wgpu::Buffer,
     look_slots: usize,
     ramps: wgpu::Texture,
@@ -131,6 +133,7 @@ impl FrameResources {
             frame_layout,
             particle_layout,
             camera,
+            camera_block: Default::default(),
             looks,
             look_slots: 4,
             ramps,
@@ -369,9 +372,7 @@ impl FrameResources {
         sort: &mut crate::render::sort::SortPass,
         asset_dir: Option<&Path>,
     ) -> Vec<DrawItem> {
-        let cam = camera.uniform(alpha);
-        ctx.queue
-            .write_buffer(&self.camera, 0, bytemuck::bytes_of(&cam));
+        self.camera_block = camera.uniform(alpha);
         let emitters = |g: &SceneGroup<'_>| {
             g.iter()
                 .flatten()
@@ -437,13 +438,12 @@ impl FrameResources {
         &self.looks
     }
 
-    /// Uploads the looks the last [`FrameResources::prepare`] built, through `uploads`
-    /// with a copy recorded into `enc` (outside a pass).
+    /// Uploads the camera and the looks the last [`FrameResources::prepare`] built,
+    /// through `uploads` with copies recorded into `enc` (outside a pass).
     pub fn upload_looks(&self, uploads: &mut crate::gpu::Uploads, enc: &mut wgpu::CommandEncoder) {
-        let bytes = &self.look_bytes;
-        if let Some(mut view) = uploads.write(enc, &self.looks, 0, bytes.len() as u64) {
-            view.copy_from_slice(bytes);
-        }
+        let camera = bytemuck::bytes_of(&self.camera_block);
+        uploads.write_bytes(enc, &self.camera, 0, camera);
+        uploads.write_bytes(enc, &self.looks, 0, &self.look_bytes);
     }
 
     /// Writes emitter `i`'s look uniform of every instance of a group into `block` and

@@ -9,7 +9,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::effect::BlendMode;
-use crate::gpu::GpuContext;
+use crate::gpu::{GpuContext, Uploads};
 use crate::render::frame::StateVariant;
 use crate::render::light_apply::ItemTotals;
 use crate::render::{DrawItem, FrameResources};
@@ -29,22 +29,34 @@ const RING: usize = 3;
 pub struct LightPass<T> {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
+    /// The totals' group: the sums and the totals' plan.
+    total_layout: wgpu::BindGroupLayout,
+    total_pipeline_layout: wgpu::PipelineLayout,
     module: wgpu::ShaderModule,
     sums: HashMap<StateVariant, Option<wgpu::ComputePipeline>>,
     total: wgpu::ComputePipeline,
     /// Partials, totals and jobs, and their group (grown as needed).
     buffers: Option<Buffers>,
+    /// The last `prepare`'s jobs, for its dispatch and readback.
+    jobs: Vec<Job>,
+    /// The last `prepare`'s partials and totals.
+    counts: (u32, u32),
     ring: Vec<Readback<T>>,
     next: usize,
 }
 
-/// The sums buffer (partials, then totals) and the jobs' uniforms, with their sizes.
+/// The sums buffer (partials, then totals), the jobs' uniforms and the totals' plan
+/// (`light_total`'s: the count, then each total's first partial, partials and index), with
+/// their sizes in bytes.
 struct Buffers {
     sums: u64,
     jobs: u64,
+    totals: u64,
     sums_buffer: wgpu::Buffer,
     jobs_buffer: wgpu::Buffer,
+    totals_plan: wgpu::Buffer,
     group: wgpu::BindGroup,
+    total_group: wgpu::BindGroup,
 }
 
 /// A readback buffer and what it holds: `None` free, else the frame's owners (look slots
@@ -114,14 +126,32 @@ impl<T: Clone> LightPass<T> {
                 ],
                 immediate_size: 0,
             });
-        let (module, sums, total) = Self::build(ctx, lib, &pipeline_layout)?;
+        let entry = crate::gpu::compute_storage_entry;
+        let total_layout = crate::gpu::bind_group_layout(
+            ctx,
+            "LightPass::total_layout",
+            &[entry(0, false), entry(1, true)],
+        );
+        let total_pipeline_layout =
+            ctx.device
+                .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("LightPass::total_pipeline_layout"),
+                    bind_group_layouts: &[None, None, Some(&total_layout)],
+                    immediate_size: 0,
+                });
+        let layouts = (&pipeline_layout, &total_pipeline_layout);
+        let (module, sums, total) = Self::build(ctx, lib, layouts)?;
         Ok(Self {
             layout,
             pipeline_layout,
+            total_layout,
+            total_pipeline_layout,
             module,
             sums,
             total,
             buffers: None,
+            jobs: Vec::new(),
+            counts: (0, 0),
             ring: Vec::new(),
             next: 0,
         })
@@ -131,7 +161,7 @@ impl<T: Clone> LightPass<T> {
     fn build(
         ctx: &GpuContext,
         lib: &ShaderLibrary,
-        layout: &wgpu::PipelineLayout,
+        (layout, total_layout): (&wgpu::PipelineLayout, &wgpu::PipelineLayout),
     ) -> Result<
         (
             wgpu::ShaderModule,
@@ -147,7 +177,7 @@ impl<T: Clone> LightPass<T> {
             let total = crate::render::compute_pipeline(
                 ctx,
                 "LightPass::total",
-                layout,
+                total_layout,
                 module,
                 "light_total",
                 &[],
@@ -175,54 +205,52 @@ impl<T: Clone> LightPass<T> {
 
     /// Rebuilds the pipelines; keeps the old ones on error.
     pub fn rebuild(&mut self, ctx: &GpuContext, lib: &ShaderLibrary) -> Result<(), ShaderError> {
-        let (module, sums, total) = Self::build(ctx, lib, &self.pipeline_layout)?;
+        let layouts = (&self.pipeline_layout, &self.total_pipeline_layout);
+        let (module, sums, total) = Self::build(ctx, lib, layouts)?;
         (self.module, self.sums, self.total) = (module, sums, total);
         Ok(())
     }
 
-    /// Records the sums of every additive item's instances and returns where each item's
-    /// totals are in [`LightPass::sums_buffer`] (for the lit layers, `light_apply.rs`).
-    /// With `owner`, also their copy into a free readback buffer (nothing when all are in
-    /// flight): the results come from [`LightPass::collect`] once the GPU has finished,
-    /// each with what `owner` said of its look slot (the instance and emitter it
-    /// measures).
-    pub fn record(
+    /// Plans the sums of every additive item's instances and uploads the plan through
+    /// `uploads` (copies recorded into `enc`, outside a pass); returns where each item's
+    /// totals will be in [`LightPass::sums_buffer`] (for the lit layers, `light_apply.rs`).
+    /// [`LightPass::dispatch`] records the sums, [`LightPass::record_readback`] their
+    /// copy for the CPU.
+    pub fn prepare(
         &mut self,
         ctx: &GpuContext,
-        enc: &mut wgpu::CommandEncoder,
-        frame: &FrameResources,
+        (enc, uploads): (&mut wgpu::CommandEncoder, &mut Uploads),
         items: &[DrawItem],
-        owner: Option<&dyn Fn(usize) -> Option<T>>,
     ) -> Vec<ItemTotals> {
         let (jobs, partials, totals) = plan(items);
-        if jobs.is_empty() {
+        self.jobs = jobs;
+        self.counts = (partials, totals);
+        if self.jobs.is_empty() {
             return Vec::new();
         }
-        self.ensure_buffers(ctx, partials + totals, totals, jobs.len() as u64);
-        self.ensure_variants(ctx, items, &jobs);
+        self.ensure_buffers(ctx, partials + totals, totals, self.jobs.len() as u64);
+        self.ensure_variants(ctx, items);
         let Some(b) = &self.buffers else {
+            self.jobs.clear();
             return Vec::new();
         };
-        let mut bytes = vec![0u8; jobs.len() * JOB_STRIDE as usize];
-        for (k, j) in jobs.iter().enumerate() {
-            let words = [
-                j.partial_base,
-                j.groups,
-                partials + j.total_base,
-                items[j.item].members,
-            ];
+        let mut bytes = vec![0u8; self.jobs.len() * JOB_STRIDE as usize];
+        let mut totals_plan = vec![[totals, 0, 0, 0]];
+        for (k, j) in self.jobs.iter().enumerate() {
+            let members = items[j.item].members;
+            let words = [j.partial_base, j.groups, partials + j.total_base, members];
             bytes[k * JOB_STRIDE as usize..][..16].copy_from_slice(bytemuck::cast_slice(&words));
+            totals_plan.extend((0..members).map(|m| {
+                let first = j.partial_base + m * j.groups;
+                [first, j.groups, partials + j.total_base + m, 0]
+            }));
         }
-        ctx.queue.write_buffer(&b.jobs_buffer, 0, &bytes);
-        self.dispatch(enc, frame, items, &jobs);
-        let out = jobs
+        uploads.write_bytes(enc, &b.jobs_buffer, 0, &bytes);
+        uploads.write_bytes(enc, &b.totals_plan, 0, bytemuck::cast_slice(&totals_plan));
+        self.jobs
             .iter()
             .map(|j| (j.item, partials + j.total_base))
-            .collect();
-        if let Some(owner) = owner {
-            self.record_readback(enc, items, &jobs, (partials, totals), owner);
-        }
-        out
+            .collect()
     }
 
     /// The buffer of the last record's sums (partials, then totals).
@@ -230,19 +258,25 @@ impl<T: Clone> LightPass<T> {
         self.buffers.as_ref().map(|b| &b.sums_buffer)
     }
 
-    /// Copies the totals into a free readback buffer with their owners.
-    fn record_readback(
+    /// Copies the totals of the last [`LightPass::dispatch`] (outside its pass) into a
+    /// free readback buffer with what `owner` says of each look slot (the instance and
+    /// emitter it measures): [`LightPass::collect`] returns them once the GPU has
+    /// finished (nothing when every readback is in flight).
+    pub fn record_readback(
         &mut self,
         enc: &mut wgpu::CommandEncoder,
         items: &[DrawItem],
-        jobs: &[Job],
-        (partials, totals): (u32, u32),
         owner: &dyn Fn(usize) -> Option<T>,
     ) {
+        let (partials, totals) = self.counts;
         let (Some(ring), Some(b)) = (self.free_readback(), &self.buffers) else {
             return;
         };
-        let owners = jobs
+        if self.jobs.is_empty() {
+            return;
+        }
+        let owners = self
+            .jobs
             .iter()
             .flat_map(|j| {
                 let d = &items[j.item];
@@ -262,22 +296,21 @@ impl<T: Clone> LightPass<T> {
         self.next = (ring + 1) % RING;
     }
 
-    /// The two passes over `jobs`.
-    fn dispatch(
+    /// Records the sums the last [`LightPass::prepare`] planned into `pass`: each job's
+    /// partials, then every total in one dispatch.
+    pub fn dispatch(
         &self,
-        enc: &mut wgpu::CommandEncoder,
+        pass: &mut wgpu::ComputePass<'_>,
         frame: &FrameResources,
         items: &[DrawItem],
-        jobs: &[Job],
     ) {
         let Some(b) = &self.buffers else {
             return;
         };
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("LightPass"),
-            timestamp_writes: None,
-        });
-        for (k, j) in jobs.iter().enumerate() {
+        if self.jobs.is_empty() {
+            return;
+        }
+        for (k, j) in self.jobs.iter().enumerate() {
             let d = &items[j.item];
             let (Some(particles), Some(Some(sum))) =
                 (frame.particle_group(d.key), self.sums.get(&d.variant.state))
@@ -294,9 +327,10 @@ impl<T: Clone> LightPass<T> {
             pass.set_pipeline(sum);
             let (x, y) = dispatch_size(d.width);
             pass.dispatch(x, y, d.members);
-            pass.set_pipeline(&self.total);
-            pass.dispatch(d.members.div_ceil(64), 1, 1);
         }
+        pass.set_pipeline(&self.total);
+        pass.set_bind_group(2, &b.total_group, &[]);
+        pass.dispatch(self.counts.1.div_ceil(64), 1, 1);
     }
 
     /// The newest finished frame's sums with their owners, if one finished since the
@@ -355,13 +389,14 @@ impl<T: Clone> LightPass<T> {
     fn ensure_buffers(&mut self, ctx: &GpuContext, sums: u32, totals: u32, jobs: u64) {
         let s = u64::from(sums.max(1)) * 32;
         let j = jobs * JOB_STRIDE;
-        let fits = (self.buffers.as_ref()).is_some_and(|b| b.sums >= s && b.jobs >= j);
-        if !fits {
-            let grow =
-                |have: Option<u64>, need: u64| need.max(have.unwrap_or(0)).next_power_of_two();
-            let s = grow(self.buffers.as_ref().map(|b| b.sums), s);
-            let j = grow(self.buffers.as_ref().map(|b| b.jobs), j);
-            self.buffers = Some(Buffers::new(ctx, &self.layout, s, j));
+        // The totals' plan: a count, then one entry per total (16 bytes each).
+        let p = (u64::from(totals) + 1) * 16;
+        let have = self.buffers.as_ref().map(|b| (b.sums, b.jobs, b.totals));
+        if !have.is_some_and(|(hs, hj, hp)| hs >= s && hj >= j && hp >= p) {
+            let grow = |have: u64, need: u64| need.max(have).next_power_of_two();
+            let (hs, hj, hp) = have.unwrap_or_default();
+            let sizes = (grow(hs, s), grow(hj, j), grow(hp, p));
+            self.buffers = Some(Buffers::new(ctx, (&self.layout, &self.total_layout), sizes));
         }
         while self.ring.len() < RING {
             self.ring.push(Readback {
@@ -377,8 +412,8 @@ impl<T: Clone> LightPass<T> {
         }
     }
 
-    fn ensure_variants(&mut self, ctx: &GpuContext, items: &[DrawItem], jobs: &[Job]) {
-        for j in jobs {
+    fn ensure_variants(&mut self, ctx: &GpuContext, items: &[DrawItem]) {
+        for j in &self.jobs {
             let state = items[j.item].variant.state;
             if !self.sums.contains_key(&state) {
                 let p = crate::render::scoped_variant(
@@ -393,7 +428,11 @@ impl<T: Clone> LightPass<T> {
 }
 
 impl Buffers {
-    fn new(ctx: &GpuContext, layout: &wgpu::BindGroupLayout, sums: u64, jobs: u64) -> Self {
+    fn new(
+        ctx: &GpuContext,
+        (layout, total_layout): (&wgpu::BindGroupLayout, &wgpu::BindGroupLayout),
+        (sums, jobs, totals): (u64, u64, u64),
+    ) -> Self {
         let buffer = |label, size, usage| {
             ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -406,6 +445,8 @@ impl Buffers {
         let sums_buffer = buffer("LightPass::sums", sums, usage);
         let usage = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
         let jobs_buffer = buffer("LightPass::jobs", jobs, usage);
+        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+        let totals_plan = buffer("LightPass::totals_plan", totals, usage);
         let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("LightPass::group"),
             layout,
@@ -424,12 +465,29 @@ impl Buffers {
                 },
             ],
         });
+        let total_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("LightPass::total_group"),
+            layout: total_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: sums_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: totals_plan.as_entire_binding(),
+                },
+            ],
+        });
         Self {
             sums,
             jobs,
+            totals,
             sums_buffer,
             jobs_buffer,
+            totals_plan,
             group,
+            total_group,
         }
     }
 }

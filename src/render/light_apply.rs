@@ -4,8 +4,8 @@
 //! simulation space and writes it into that look slot's `LitUniform` — the same frame,
 //! with no readback.
 
-use crate::gpu::GpuContext;
 use crate::gpu::commands::CountedCompute;
+use crate::gpu::{GpuContext, Uploads};
 use crate::render::DrawItem;
 use crate::render::frame::FrameResources;
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
@@ -21,6 +21,8 @@ pub struct SelfLightPass {
     plan: Option<wgpu::Buffer>,
     /// The group over (sums, looks, plan), kept while those buffers are the same.
     group: Option<([wgpu::Buffer; 3], wgpu::BindGroup)>,
+    /// Lit look slots the last `prepare` planned for (0: nothing to dispatch).
+    targets: u32,
 }
 
 impl SelfLightPass {
@@ -46,6 +48,7 @@ impl SelfLightPass {
             pipeline,
             plan: None,
             group: None,
+            targets: 0,
         })
     }
 
@@ -67,21 +70,23 @@ impl SelfLightPass {
         Ok(())
     }
 
-    /// Records the apply of the frame's lit items: `totals` says where each additive
-    /// item's totals are in `sums` (the light pass's buffer, recorded before).
-    pub fn record(
+    /// Plans the apply of the frame's lit items and uploads the plan through `uploads`
+    /// (a copy recorded into `enc`, outside a pass): `totals` says where each additive
+    /// item's totals are in `sums` (the light pass's buffer). False when no item is lit;
+    /// else [`SelfLightPass::dispatch`] records it, after the light pass's sums.
+    pub fn prepare(
         &mut self,
         ctx: &GpuContext,
-        enc: &mut wgpu::CommandEncoder,
+        (enc, uploads): (&mut wgpu::CommandEncoder, &mut Uploads),
         frame: &FrameResources,
         items: &[DrawItem],
         totals: &[ItemTotals],
         sums: &wgpu::Buffer,
-    ) {
+    ) -> bool {
         let words = plan(items, totals, &frame.slot_origins);
-        let targets = words.first().map_or(0, |w| w[0]);
-        if targets == 0 {
-            return;
+        self.targets = words.first().map_or(0, |w| w[0]);
+        if self.targets == 0 {
+            return false;
         }
         let bytes: &[u8] = bytemuck::cast_slice(&words);
         let size = (bytes.len() as u64).next_power_of_two().max(256);
@@ -94,24 +99,26 @@ impl SelfLightPass {
             }));
         }
         let Some(plan) = &self.plan else {
-            return;
+            self.targets = 0;
+            return false;
         };
-        ctx.queue.write_buffer(plan, 0, bytes);
+        uploads.write_bytes(enc, plan, 0, bytes);
         let buffers = [sums.clone(), frame.looks_buffer().clone(), plan.clone()];
         if self.group.as_ref().is_none_or(|(b, _)| *b != buffers) {
             let group = self.bind_group(ctx, &buffers);
             self.group = Some((buffers, group));
         }
-        let Some((_, group)) = &self.group else {
+        true
+    }
+
+    /// Records the apply the last [`SelfLightPass::prepare`] planned into `pass`.
+    pub fn dispatch(&self, pass: &mut wgpu::ComputePass<'_>) {
+        let Some((_, group)) = self.group.as_ref().filter(|_| self.targets > 0) else {
             return;
         };
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("SelfLightPass"),
-            timestamp_writes: None,
-        });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, group, &[]);
-        pass.dispatch(targets.div_ceil(64), 1, 1);
+        pass.dispatch(self.targets.div_ceil(64), 1, 1);
     }
 }
 

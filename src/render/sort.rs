@@ -12,8 +12,8 @@ use std::collections::HashMap;
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::gpu::GpuContext;
 use crate::gpu::types::StateLayout;
+use crate::gpu::{GpuContext, Uploads};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
 use crate::sim::gpu_sim::{dispatch_size, map_read};
 
@@ -400,24 +400,7 @@ impl SortPass {
         count: u32,
         capacity: u32,
     ) {
-        let mut blocks = vec![0u8; dispatches.len() * STRIDE as usize];
-        for (i, d) in dispatches.iter().enumerate() {
-            let (k, j, mode) = match *d {
-                SortDispatch::Local { k } => (k, 0, 0),
-                SortDispatch::Global { k, j } => (k, j, 0),
-                SortDispatch::Merge { k } => (k, 0, 1),
-            };
-            let s = SortStep {
-                k,
-                j,
-                count,
-                capacity,
-                window: [0, 0, mode, 0],
-                ..Default::default()
-            };
-            let at = i * STRIDE as usize;
-            blocks[at..at + size_of::<SortStep>()].copy_from_slice(bytemuck::bytes_of(&s));
-        }
+        let blocks = step_blocks(dispatches, count, capacity);
         ctx.queue.write_buffer(steps, STRIDE, &blocks);
     }
 
@@ -435,25 +418,21 @@ impl SortPass {
         }
     }
 
-    /// Records depth keys for `job`'s slots (every member's live window of its current
-    /// state, each seen from its own eye, along `forward`) and the sort; afterwards the
-    /// first entries of `values` (the buffers of `job.key`) hold the state-buffer indices
-    /// of those slots farthest first (dead slots after the living, then padding).
-    ///
-    /// Recorded into the open compute pass `pass` of `enc` (opened on first need), so that
-    /// every sort of a frame shares one pass.
-    pub fn record(
+    /// Makes `job`'s buffers and uploads its head block, its members and (when the
+    /// network changed) its steps through `uploads`, with copies recorded into `enc`
+    /// (outside a pass); `false` when it has nothing to sort. [`SortPass::dispatch`]
+    /// records the sort itself.
+    fn upload(
         &mut self,
         ctx: &GpuContext,
-        enc: &mut wgpu::CommandEncoder,
-        pass: &mut Option<wgpu::ComputePass<'static>>,
+        (enc, uploads): (&mut wgpu::CommandEncoder, &mut Uploads),
         job: &SortJob,
         forward: glam::Vec3,
-    ) {
+    ) -> bool {
         let members = &job.members[..job.members.len().min(MAX_MEMBERS)];
         let elements = job.width * members.len() as u32;
         if elements == 0 {
-            return;
+            return false;
         }
         let size = self
             .buffers(ctx, job.key, job.capacity * members.len() as u32)
@@ -461,37 +440,15 @@ impl SortPass {
         let count = elements.max(2).next_power_of_two().min(size);
         let split = self.split_network;
         let Some(b) = self.buffers.get_mut(&job.key) else {
-            return;
+            return false;
         };
         if count != b.count || b.split != split {
-            Self::write_steps(ctx, &b.steps, &network(count, split), count, job.capacity);
+            let steps = step_blocks(&network(count, split), count, job.capacity);
+            uploads.write_bytes(enc, &b.steps, STRIDE, &steps);
             b.count = count;
             b.split = split;
         }
-        let state = &job.state;
-        if !b.state_groups.iter().any(|(s, _)| s == state) {
-            let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("SortPass::state_group"),
-                layout: &self.state_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: state.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: state.as_entire_binding(),
-                    },
-                ],
-            });
-            if b.state_groups.len() >= 2 {
-                b.state_groups.remove(0);
-            }
-            b.state_groups.push((state.clone(), group));
-        }
-        let Some(b) = self.buffers.get(&job.key) else {
-            return;
-        };
+        Self::ensure_state_group(ctx, &self.state_layout, b, &job.state);
         let head = SortStep {
             k: 0,
             j: 0,
@@ -501,17 +458,56 @@ impl SortPass {
             forward: forward.extend(0.0).to_array(),
             window: [job.width, members.len() as u32, 0, 0],
         };
-        ctx.queue
-            .write_buffer(&b.steps, 0, bytemuck::bytes_of(&head));
-        ctx.queue
-            .write_buffer(&b.members, 0, bytemuck::cast_slice(members));
-        let Some((_, state_group)) = b.state_groups.iter().find(|(s, _)| s == state) else {
+        uploads.write_bytes(enc, &b.steps, 0, bytemuck::bytes_of(&head));
+        uploads.write_bytes(enc, &b.members, 0, bytemuck::cast_slice(members));
+        true
+    }
+
+    /// A bind group of `state` for `b`'s sorts (the two last kept).
+    fn ensure_state_group(
+        ctx: &GpuContext,
+        layout: &wgpu::BindGroupLayout,
+        b: &mut SortBuffers,
+        state: &wgpu::Buffer,
+    ) {
+        if b.state_groups.iter().any(|(s, _)| s == state) {
+            return;
+        }
+        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("SortPass::state_group"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: state.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: state.as_entire_binding(),
+                },
+            ],
+        });
+        if b.state_groups.len() >= 2 {
+            b.state_groups.remove(0);
+        }
+        b.state_groups.push((state.clone(), group));
+    }
+
+    /// Records depth keys for `job`'s slots (every member's live window of its current
+    /// state, each seen from its own eye, along `forward`) and the sort, after its
+    /// [`SortPass::upload`]; afterwards the first entries of `values` (the buffers of
+    /// `job.key`) hold the state-buffer indices of those slots farthest first (dead
+    /// slots after the living, then padding).
+    fn dispatch(&self, pass: &mut wgpu::ComputePass<'_>, job: &SortJob) {
+        let Some(b) = self.buffers.get(&job.key) else {
+            return;
+        };
+        let Some((_, state_group)) = b.state_groups.iter().find(|(s, _)| *s == job.state) else {
             return;
         };
         let Some(keys) = self.keys.get(job.layout.index() as usize) else {
             return;
         };
-        let pass = crate::gpu::compute_pass(pass, enc, "SortPass::sort");
         pass.set_pipeline(keys);
         pass.set_bind_group(0, &b.group, &[0]);
         pass.set_bind_group(1, state_group, &[]);
@@ -638,21 +634,56 @@ impl SortPass {
 
     /// Sorts the alpha-blended items back to front for `camera` (nothing runs when there
     /// is none) and forgets the buffers of pools no longer drawn.
+    /// Their uploads go through `uploads` (copies recorded into `enc` first), and every
+    /// sort of the frame shares one compute pass.
     pub fn record_items(
         &mut self,
         ctx: &GpuContext,
-        enc: &mut wgpu::CommandEncoder,
+        (enc, uploads): (&mut wgpu::CommandEncoder, &mut Uploads),
         items: &[crate::render::DrawItem],
         camera: &crate::render::Camera,
     ) {
-        let mut pass = None;
+        let mut jobs = Vec::new();
         for job in items.iter().filter_map(|d| d.sort.as_ref()) {
-            self.record(ctx, enc, &mut pass, job, camera.forward());
+            if self.upload(ctx, (enc, uploads), job, camera.forward()) {
+                jobs.push(job);
+            }
         }
-        drop(pass);
+        if !jobs.is_empty() {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("SortPass::sort"),
+                timestamp_writes: None,
+            });
+            for job in jobs {
+                self.dispatch(&mut pass, job);
+            }
+        }
         let live: std::collections::HashSet<u64> = items.iter().map(|d| d.key.0).collect();
         self.retain(&live);
     }
+}
+
+/// The uniform blocks of every dispatch of a sort of `count` elements, `STRIDE` apart.
+fn step_blocks(dispatches: &[SortDispatch], count: u32, capacity: u32) -> Vec<u8> {
+    let mut blocks = vec![0u8; dispatches.len() * STRIDE as usize];
+    for (i, d) in dispatches.iter().enumerate() {
+        let (k, j, mode) = match *d {
+            SortDispatch::Local { k } => (k, 0, 0),
+            SortDispatch::Global { k, j } => (k, j, 0),
+            SortDispatch::Merge { k } => (k, 0, 1),
+        };
+        let s = SortStep {
+            k,
+            j,
+            count,
+            capacity,
+            window: [0, 0, mode, 0],
+            ..Default::default()
+        };
+        let at = i * STRIDE as usize;
+        blocks[at..at + size_of::<SortStep>()].copy_from_slice(bytemuck::bytes_of(&s));
+    }
+    blocks
 }
 
 #[cfg(test)]

@@ -12,7 +12,7 @@
 use crate::gpu::commands::{CountedCompute, CountedRender};
 use std::collections::HashMap;
 
-use crate::gpu::{GpuContext, GpuError};
+use crate::gpu::{GpuContext, GpuError, Uploads};
 use crate::render::billboard::DrawTarget;
 use crate::render::frame::{DrawItem, FrameResources, LookVariant};
 use crate::shaders::{ShaderError, ShaderLibrary, create_checked};
@@ -456,7 +456,7 @@ impl TilePass {
     pub fn record(
         &mut self,
         ctx: &GpuContext,
-        enc: &mut wgpu::CommandEncoder,
+        (enc, uploads): (&mut wgpu::CommandEncoder, &mut Uploads),
         frame: &FrameResources,
         items: &[DrawItem],
         size: (u32, u32),
@@ -485,7 +485,7 @@ impl TilePass {
         let Some(b) = self.buffers.as_ref() else {
             return false;
         };
-        self.upload_jobs(ctx, &chunks);
+        self.upload_jobs((enc, uploads), &chunks);
         enc.clear_buffer(&b.touched, TOUCHED_FLAGS * 4, Some(grid_tiles(size) * 4));
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("TilePass::tiles"),

@@ -7,7 +7,7 @@ use std::collections::HashMap;
 use glam::{DVec3, Vec3};
 
 use super::{InstanceId, Player};
-use crate::gpu::GpuContext;
+use crate::gpu::{GpuContext, Uploads};
 use crate::render::DrawItem;
 use crate::render::Scene;
 use crate::render::frame::FrameResources;
@@ -91,6 +91,7 @@ impl LightEstimate {
         &mut self,
         f: &LightFrame<'_>,
         enc: &mut wgpu::CommandEncoder,
+        uploads: &mut Uploads,
         owners: &[Option<LightOwner>],
     ) {
         let lit = f.items.iter().any(|d| d.variant.lit);
@@ -124,9 +125,26 @@ impl LightEstimate {
             }
             pass.map_recorded();
         }
-        let totals = pass.record(f.ctx, enc, f.frame, f.items, readback);
-        if let (true, Some(apply), Some(sums)) = (lit, self.apply.as_mut(), pass.sums_buffer()) {
-            apply.record(f.ctx, enc, f.frame, f.items, &totals, sums);
+        // Every upload first, then the sums, their totals and the apply in one pass.
+        let totals = pass.prepare(f.ctx, (enc, uploads), f.items);
+        let apply = match (lit, self.apply.as_mut(), pass.sums_buffer()) {
+            (true, Some(apply), Some(sums)) => apply
+                .prepare(f.ctx, (enc, uploads), f.frame, f.items, &totals, sums)
+                .then_some(&*apply),
+            _ => None,
+        };
+        if !totals.is_empty() || apply.is_some() {
+            let mut compute = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("LightPass"),
+                timestamp_writes: None,
+            });
+            pass.dispatch(&mut compute, f.frame, f.items);
+            if let Some(apply) = apply {
+                apply.dispatch(&mut compute);
+            }
+        }
+        if let Some(owner) = readback {
+            pass.record_readback(enc, f.items, owner);
         }
     }
 

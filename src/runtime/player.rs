@@ -440,9 +440,10 @@ impl Player {
             items: &self.items,
             host: self.settings.host_from_preset(),
         };
-        self.light.record(&light, encoder, &owners);
+        self.light
+            .record(&light, encoder, &mut self.uploads, &owners);
         self.sort
-            .record_items(&self.ctx, encoder, &self.items, camera);
+            .record_items(&self.ctx, (encoder, &mut self.uploads), &self.items, camera);
         self.splatted = self.splat.splat(
             &self.ctx,
             encoder,
@@ -454,7 +455,7 @@ impl Player {
         let tiled = self.tiles.as_mut().is_some_and(|t| {
             t.record(
                 &self.ctx,
-                encoder,
+                (&mut *encoder, &mut self.uploads),
                 &self.frame,
                 &self.items,
                 camera.size_px(),

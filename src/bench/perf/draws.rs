@@ -137,19 +137,22 @@ fn tile_costs(
     let size = opts.size;
     let (mut tiles_stages_ms, mut tiles_resolve_ms) = (None, None);
     let hdr = &targets.hdr_view;
+    let mut uploads = crate::gpu::Uploads::new(&ctx.device);
     let tiles_ms = tiles.and_then(|t| {
         let mut enc = ctx.device.create_command_encoder(&Default::default());
-        let fits = t.record(ctx, &mut enc, frame, all_tiles, size, None);
+        let fits = t.record(ctx, (&mut enc, &mut uploads), frame, all_tiles, size, None);
+        uploads.finish(&enc);
         ctx.queue.submit([enc.finish()]);
         let resolve = |t: &mut TilePass, enc: &mut wgpu::CommandEncoder| {
             if !t.resolve_into(ctx, enc, frame, hdr, size) {
                 t.resolve(&mut load_hdr_pass(enc, hdr), frame);
             }
         };
-        let time = |t: &mut TilePass, stages| {
+        let mut time = |t: &mut TilePass, stages| {
             t.set_stages(stages);
             time_median(timer, ctx, opts.repeats, |enc| {
-                t.record(ctx, enc, frame, all_tiles, size, None);
+                t.record(ctx, (enc, &mut uploads), frame, all_tiles, size, None);
+                uploads.finish(enc);
                 resolve(t, enc);
             })
         };

@@ -34,7 +34,11 @@ impl TilePass {
     /// `MAX_ITEMS` jobs a chunk; the resolve's draw arguments (six vertices per shaded tile,
     /// counted by the shades) and the shades' dispatch arguments (bins counted by the bin
     /// scan, 64 tiles each), `ARGS_STRIDE` bytes a chunk.
-    pub(super) fn upload_jobs(&self, ctx: &GpuContext, chunks: &[Chunk]) {
+    pub(super) fn upload_jobs(
+        &self,
+        (enc, uploads): (&mut wgpu::CommandEncoder, &mut Uploads),
+        chunks: &[Chunk],
+    ) {
         let Some(b) = self.buffers.as_ref() else {
             return;
         };
@@ -66,12 +70,9 @@ impl TilePass {
         // Up to the last chunk's last job (a frame of one chunk writes its items' only).
         let last = chunks.last().map_or(0, |c| c.pieces.len());
         jobs.truncate(((chunks.len().max(1) - 1) * MAX_ITEMS + last) * words);
-        ctx.queue
-            .write_buffer(&b.job_buffer, 0, bytemuck::cast_slice(&jobs));
-        ctx.queue
-            .write_buffer(&b.touched, 0, bytemuck::cast_slice(&[6u32, 0, 0, 0]));
-        ctx.queue
-            .write_buffer(&b.dispatch_args, 0, bytemuck::cast_slice(&args));
+        uploads.write_bytes(enc, &b.job_buffer, 0, bytemuck::cast_slice(&jobs));
+        uploads.write_bytes(enc, &b.touched, 0, bytemuck::cast_slice(&[6u32, 0, 0, 0]));
+        uploads.write_bytes(enc, &b.dispatch_args, 0, bytemuck::cast_slice(&args));
     }
 
     /// Creates the buffers for `size`, `sprites` quads a chunk (capacity in powers of
