@@ -15,6 +15,7 @@ use crate::bench::Report;
 use crate::effect::{BlendMode, Effect};
 use crate::gpu::GpuContext;
 use crate::gpu::timer::{GpuTimer, median};
+use crate::render::tiles::TileStages;
 use crate::runtime::{Camera, Player, PlayerError, PlayerSettings};
 
 const COLOR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -47,6 +48,10 @@ struct Row {
     cpu_parts_us: [f64; 4],
     /// The dispatches and draws the player recorded for the last timed frame.
     commands: crate::gpu::commands::CommandCounts,
+    /// The record's GPU time in parts (medians apart): the steps alone, then the rest
+    /// (light, sort, splat, tiles) with the tiles stopped after their projection, after
+    /// their binning, and whole.
+    stages_ms: [f64; 4],
 }
 
 /// Runs the bench and returns its report.
@@ -189,6 +194,8 @@ fn measure(
         recorded?;
         draw.push(timer.time(&host.ctx, |enc| host.pass(enc, |pass| player.draw(pass))));
     }
+    let commands = player.recorded_commands();
+    let stages_ms = stage_costs(host, timer, opts.frames, &mut player, &camera)?;
     Ok(Row {
         label,
         instances: spots.len() as u32,
@@ -202,8 +209,41 @@ fn measure(
         draw_ms: median(&mut draw),
         cpu_us: median(&mut cpu),
         cpu_parts_us: parts.map(|mut p| median(&mut p)),
-        commands: player.recorded_commands(),
+        commands,
+        stages_ms,
     })
+}
+
+/// The record's GPU time in parts, over `frames` frames each: the steps (`simulate`),
+/// then the rest of the record with the tiles stopped after their projection, after
+/// their binning, and whole (the same three without tiles where nothing takes them).
+fn stage_costs(
+    host: &Host,
+    timer: &GpuTimer,
+    frames: usize,
+    player: &mut Player,
+    camera: &Camera,
+) -> Result<[f64; 4], PlayerError> {
+    let mut parts = [(); 4].map(|_| Vec::new());
+    let stages = [TileStages::Project, TileStages::Bin, TileStages::All];
+    for _ in 0..frames {
+        for (k, stage) in stages.into_iter().enumerate() {
+            if let Some(t) = player.tile_pass() {
+                t.set_stages(stage);
+            }
+            player.advance(1.0 / 60.0);
+            let steps = timer.time(&host.ctx, |enc| player.simulate(enc));
+            if k == 0 {
+                parts[0].push(steps);
+            }
+            let mut recorded = Ok(());
+            parts[k + 1].push(timer.time(&host.ctx, |enc| {
+                recorded = player.record(enc, camera, Some(&host.depth));
+            }));
+            recorded?;
+        }
+    }
+    Ok(parts.map(|mut p| median(&mut p)))
 }
 
 fn report(
@@ -225,7 +265,10 @@ fn report(
             host's pass, soft edges against its depth. CPU = the API calls of a frame (advance, \
             record, draw and finishing the encoder; encoding, not waiting), and each part's \
             median apart (wgpu encodes the recorded commands for the driver when the encoder \
-            is finished). GPU times: {}.",
+            is finished). The last column splits the record's GPU time over as many frames \
+            more: the steps alone, then the rest of the record (the light, the sort, the \
+            splat and the tiles) with the tiles stopped after their projection, after their \
+            binning, and whole. GPU times: {}.",
         opts.effect.name,
         opts.size.0,
         opts.size.1,
@@ -244,6 +287,7 @@ fn report(
             x.cpu_parts_us.map(|t| format!("{t:.0}")).join(" / "),
             format!("{} / {}", x.commands.dispatches, x.commands.draws),
             format!("{:.1}", x.cpu_us / f64::from(x.instances.max(1))),
+            x.stages_ms.map(|t| format!("{t:.3}")).join(" / "),
         ]
     };
     let header = [
@@ -256,6 +300,7 @@ fn report(
         "CPU: advance / record / draw / finish µs",
         "dispatches / draws",
         "CPU µs / instance",
+        "record on the GPU: steps / rest to the tiles' projection / binning / shade ms",
     ];
     r.heading("Instances in a host frame");
     r.table(&header, &rows.iter().map(row).collect::<Vec<_>>());
@@ -290,6 +335,10 @@ fn report(
             "cpu_finish_us": x.cpu_parts_us[3],
             "dispatches": x.commands.dispatches,
             "draws": x.commands.draws,
+            "gpu_steps_ms": x.stages_ms[0],
+            "gpu_rest_to_tiles_projection_ms": x.stages_ms[1],
+            "gpu_rest_to_tiles_binning_ms": x.stages_ms[2],
+            "gpu_rest_ms": x.stages_ms[3],
         })).collect::<Vec<_>>(),
         "extra_gpu_ms_per_instance": per,
     });
