@@ -1087,7 +1087,7 @@ fn advance_and_wait(players: &mut [&mut Player], host: &Host, frames: u32) {
 /// The effect's light is where its light is: still particles at one point give a light
 /// there (in the host's world: the instance's place, a z-up world turned), of their colour,
 /// with no spread; its power adds up per particle, goes as the sprite's area and the
-/// intensity.
+/// intensity. A second instance of the batch, younger, has its own light at its own place.
 #[test]
 fn the_effect_light_sits_on_the_particles_with_their_colour_and_power() {
     let lit = |kind: HostKind, size_m: f32, intensity: f32| {
@@ -1100,15 +1100,34 @@ fn the_effect_light_sits_on_the_particles_with_their_colour_and_power() {
         let id = player
             .add_instance(Mat4::from_translation(vec3(1.0, 2.0, 3.0)), 1)
             .expect("instance");
-        advance_and_wait(&mut [&mut player], &host, 60);
-        let alive = player.count_particles(id).expect("count")[0].alive;
-        (player.effect_light(id).expect("a light"), alive)
+        advance_and_wait(&mut [&mut player], &host, 30);
+        // Added later, so it has fewer particles than the first (its own sums, not the
+        // first's at its place).
+        let other = player
+            .add_instance(Mat4::from_translation(vec3(-2.0, 0.5, 1.0)), 2)
+            .expect("instance");
+        advance_and_wait(&mut [&mut player], &host, 30);
+        let alive = |id| player.count_particles(id).expect("count")[0].alive;
+        let light = |id| player.effect_light(id).expect("a light");
+        let second = (light(other), alive(other));
+        ((light(id), alive(id)), second)
     };
-    let (light, alive) = lit(HostKind::default(), 1.0, 1.0);
+    let ((light, alive), (other, other_alive)) = lit(HostKind::default(), 1.0, 1.0);
     assert!(alive >= 3, "{alive} particles alive");
+    assert!(other_alive >= 1 && other_alive < alive, "{other_alive} of {alive}");
     assert!(
-        light.position.abs_diff_eq(vec3(1.0, 2.2, 3.0), 1e-5),
-        "{light:?}"
+        other.position.abs_diff_eq(vec3(-2.0, 0.7, 1.0), 1e-5),
+        "{other:?}"
+    );
+    // Its power is its own particles' (read two frames behind their count): a whole
+    // number of the first's particles, fewer than the first's.
+    let each = light.power / alive as f32;
+    let particles = other.power / each;
+    assert!(
+        (particles - particles.round()).abs() < 1e-3
+            && particles.round() >= 1.0
+            && particles.round() < alive as f32,
+        "{light:?} of {alive}, {other:?} of {other_alive}"
     );
     let [r, g, b] = light.color;
     assert!(
@@ -1119,8 +1138,8 @@ fn the_effect_light_sits_on_the_particles_with_their_colour_and_power() {
     let luma =
         0.2126 * light.rgb_power[0] + 0.7152 * light.rgb_power[1] + 0.0722 * light.rgb_power[2];
     assert!((light.power - luma).abs() < 1e-5 * luma, "{light:?}");
-    let (bigger, _) = lit(HostKind::default(), 2.0, 1.0);
-    let (brighter, _) = lit(HostKind::default(), 1.0, 300.0);
+    let ((bigger, _), _) = lit(HostKind::default(), 2.0, 1.0);
+    let ((brighter, _), _) = lit(HostKind::default(), 1.0, 300.0);
     assert!(
         (bigger.power / light.power - 4.0).abs() < 1e-4,
         "{bigger:?}"
@@ -1140,7 +1159,7 @@ fn the_effect_light_sits_on_the_particles_with_their_colour_and_power() {
         limits: Some(ignis::required_limits()),
         ..HostKind::default()
     };
-    let (turned, _) = lit(z_up, 1.0, 1.0);
+    let ((turned, _), _) = lit(z_up, 1.0, 1.0);
     assert!(
         turned.position.abs_diff_eq(vec3(1.0, 2.0, 3.2), 1e-5),
         "{turned:?}"
