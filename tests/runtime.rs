@@ -1114,7 +1114,10 @@ fn the_effect_light_sits_on_the_particles_with_their_colour_and_power() {
     };
     let ((light, alive), (other, other_alive)) = lit(HostKind::default(), 1.0, 1.0);
     assert!(alive >= 3, "{alive} particles alive");
-    assert!(other_alive >= 1 && other_alive < alive, "{other_alive} of {alive}");
+    assert!(
+        other_alive >= 1 && other_alive < alive,
+        "{other_alive} of {alive}"
+    );
     assert!(
         other.position.abs_diff_eq(vec3(-2.0, 0.7, 1.0), 1e-5),
         "{other:?}"
@@ -1164,6 +1167,47 @@ fn the_effect_light_sits_on_the_particles_with_their_colour_and_power() {
         turned.position.abs_diff_eq(vec3(1.0, 2.0, 3.2), 1e-5),
         "{turned:?}"
     );
+}
+
+/// The light's centre and spread sum every workgroup's partials: a crowd of still
+/// particles on a 0.5 m sphere over several workgroups an instance (256 slots each), and a
+/// younger second instance of the batch, have their lights at their particles' centres,
+/// with centre and spread on that sphere (|centre − origin|² + spread² = 0.25 m²).
+#[test]
+fn a_crowd_over_several_workgroups_has_its_light_at_its_particles_centre() {
+    let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+    let mut disc = still_disc(0.0);
+    disc.emitters[0].capacity = 1024;
+    disc.emitters[0].spawn_rate_per_sec = ignis::effect::Param::Constant(600.0);
+    disc.emitters[0].shape = ignis::effect::Shape::Sphere {
+        radius_m: 0.5,
+        surface_only: true,
+    };
+    let mut player = host.player(&disc);
+    player.set_light_estimate(true);
+    let place = |p: &mut Player, at: Vec3, seed| {
+        p.add_instance(Mat4::from_translation(at), seed)
+            .expect("instance")
+    };
+    let first = place(&mut player, vec3(1.0, 2.0, 3.0), 1);
+    advance_and_wait(&mut [&mut player], &host, 30);
+    let second = place(&mut player, vec3(-2.0, 0.5, 1.0), 2);
+    advance_and_wait(&mut [&mut player], &host, 30);
+    for (id, origin, least) in [
+        (first, vec3(1.0, 2.2, 3.0), 513),
+        (second, vec3(-2.0, 0.7, 1.0), 257),
+    ] {
+        let at = player.particle_positions(id).expect("positions");
+        assert!(at.len() >= least, "{} particles", at.len());
+        let centre = at.iter().sum::<Vec3>() / at.len() as f32;
+        let light = player.effect_light(id).expect("a light");
+        // Read two frames behind the particles: a few births fewer.
+        let on_sphere = light.position.distance_squared(origin) + light.radius_m.powi(2);
+        assert!(
+            light.position.distance(centre) < 0.01 && (on_sphere - 0.25).abs() < 1e-3,
+            "{light:?} against {centre}: {on_sphere} m²"
+        );
+    }
 }
 
 /// The campfire's light flickers as its flames do, from where they burn, two frames behind
