@@ -611,3 +611,50 @@ fn an_inspected_particle_reports_its_state_and_the_forces_on_it() {
         .expect("pick");
     assert!(none.is_none());
 }
+
+/// Over-life multipliers against their closed forms: speed over life 2 moves a particle
+/// twice its velocity's distance (its velocity unchanged by it), and drag over life 0
+/// switches a 3/s drag off — a half second's displacement of every living particle is
+/// exactly its velocity's, doubled; tripled after the multiplier is edited to 3.
+#[test]
+fn over_life_multipliers_scale_motion_as_their_closed_forms() {
+    let ctx = gpu();
+    let mut e = plain_emitter();
+    e.capacity = 256;
+    e.spawn_rate_per_sec = Param::Constant(60.0);
+    e.lifetime_secs = Range::new(10.0, 10.0);
+    e.speed_m_per_s = Range::new(1.0, 1.0);
+    e.forces.drag_per_sec = 3.0;
+    e.forces.drag_over_life = Param::Constant(0.0);
+    e.forces.speed_over_life = Param::Constant(2.0);
+    let effect = bare_effect(e);
+    let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
+    sim.step(&effect, 1.0 / 60.0, 30).expect("step");
+    let before = sim.read_particles(0).expect("read");
+    sim.step(&effect, 1.0 / 60.0, 30).expect("step");
+    let after = sim.read_particles(0).expect("read");
+    let mut compared = 0;
+    for (a, b) in before.iter().zip(&after).filter(|(a, _)| a.is_alive()) {
+        let v = a.velocity();
+        let moved = b.position() - a.position();
+        assert!(
+            (v.length() - 1.0).abs() < 1e-5 && b.velocity() == v,
+            "{a:?} → {b:?}"
+        );
+        assert!((moved - 2.0 * v * 0.5).length() < 1e-4, "{a:?} → {b:?}");
+        compared += 1;
+    }
+    assert!(compared >= 25, "{compared} compared");
+    // Edited to 3 while playing: the baked multipliers follow the edit.
+    let mut faster = effect.clone();
+    faster.emitters[0].forces.speed_over_life = Param::Constant(3.0);
+    sim.step(&faster, 1.0 / 60.0, 30).expect("step");
+    let last = sim.read_particles(0).expect("read");
+    for (b, c) in after.iter().zip(&last).filter(|(b, _)| b.is_alive()) {
+        let moved = c.position() - b.position();
+        assert!(
+            (moved - 3.0 * b.velocity() * 0.5).length() < 1e-4,
+            "{b:?} → {c:?}"
+        );
+    }
+}

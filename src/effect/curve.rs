@@ -546,6 +546,15 @@ mod tests {
         }
         let r = Param::Range { min: 1.0, max: 4.0 };
         assert_eq!(r.to_mode(ParamMode::Curve).bounds(), (1.0, 4.0));
+        // A constant becomes two straight lines with a key at each end to drag, not one
+        // flat key.
+        assert_eq!(
+            p.to_mode(ParamMode::TwoCurves),
+            Param::TwoCurves {
+                a: Curve::line(2.0, 2.0),
+                b: Curve::line(2.0, 2.0),
+            }
+        );
     }
 
     /// A parameter's integral and scaling against their closed forms, for every mode: a
