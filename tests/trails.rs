@@ -520,6 +520,22 @@ fn a_capped_ribbon_per_parent_forgets_the_last_life_past_the_allowance() {
     joins_children_in_order(effect, 8192);
 }
 
+/// The same with the cap binding inside one parent's children of a step: six parents ask
+/// six children a step each, the cap allows fifteen, so the parent the allowance runs out
+/// in lists only some of its children and links only those (its last listed child is the
+/// one its next step's first joins). The children live 0.71 s, between two steps: at a
+/// life of a whole number of steps, the last bit of each child's sampled life decides in
+/// which of two steps it dies, and one step's children would not die together.
+#[test]
+fn a_capped_ribbon_per_parent_links_only_the_children_listed() {
+    let mut effect = ribbon_effect_at(360.0);
+    effect.emitters[0].events[0].max_per_sec = 900.0;
+    effect.emitters[1].capacity = 1024;
+    effect.emitters[1].lifetime_secs = Range::new(0.71, 0.71);
+    effect.validate().expect("valid");
+    joins_children_in_order(effect, 1024);
+}
+
 fn joins_children_in_order(effect: Effect, capacity: usize) {
     let ctx = gpu();
     let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &effect).expect("sim");
