@@ -253,7 +253,7 @@ impl<T: Clone> LightPass<T> {
             .collect()
     }
 
-    /// The buffer of the last record's sums (partials, then totals).
+    /// The buffer of the last dispatch's sums (partials, then totals).
     pub fn sums_buffer(&self) -> Option<&wgpu::Buffer> {
         self.buffers.as_ref().map(|b| &b.sums_buffer)
     }
