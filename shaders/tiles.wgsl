@@ -580,8 +580,8 @@ fn shade_batch(lid: u32, count: u32, at: u32, origin: vec2<i32>, p: vec2<i32>, i
 // The cached sprites of `mask` (bit k: cache slot `first + k`, hit `at + first + k`)
 // blended into `acc` at pixel `p` in order, one at a time. One sprite's light in the loop
 // (not four fetched together) keeps the shade's registers few and the GPU's occupancy
-// high: on an H200, 100 distant torches' shade took 2.1 ms against 3.2 with four
-// (docs/performance.md), and large sprites' no longer.
+// high: on an H200 the shade of 100 distant torches took 1.7 ms against 2.7 with four
+// (bench/results/tiles-shade/).
 fn shade_listed(mask: u32, first: u32, at: u32, p: vec2<i32>, acc_in: vec4<f32>) -> vec4<f32> {
     var acc = acc_in;
     var m = mask;
