@@ -477,7 +477,7 @@ impl TilePass {
         }
         let sprites = chunks.iter().map(Chunk::sprites).max().unwrap_or(0);
         let lists = self.list_capacity.unwrap_or_else(|| {
-            let entries = |c: &Chunk| list_entries(&order, c, size, limit);
+            let entries = |c: &Chunk| list_entries(|i| order[i].size_px, c, size, limit);
             chunks.iter().map(entries).max().unwrap_or(1)
         });
         self.prepare(ctx, &order, &frame.sprites.sampler);

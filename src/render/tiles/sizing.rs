@@ -27,11 +27,12 @@ pub(super) fn chunk_sprites(limit: u64) -> u32 {
     1 << fit.ilog2()
 }
 
-/// Entries for the bins' lists of `chunk`'s sprites (pieces of `order`'s items) at `size`:
-/// every bin for each when that is small, else about twice what their projected sizes
-/// cover (a bin whose list does not fit is shaded from the sprites directly).
+/// Entries for the bins' lists of `chunk`'s sprites at `size` (`size_px`: the largest
+/// projected size of the sprites of the draw order's item `i`): every bin for each when
+/// that is small, else about twice what their projected sizes cover (a bin whose list does
+/// not fit is shaded from the sprites directly).
 pub(super) fn list_entries(
-    order: &[&DrawItem],
+    size_px: impl Fn(usize) -> f32,
     chunk: &Chunk,
     size: (u32, u32),
     limit: u64,
@@ -41,7 +42,7 @@ pub(super) fn list_entries(
         .pieces
         .iter()
         .map(|p| {
-            let side = (f64::from(order[p.item].size_px) * 1.5 / f64::from(BIN_PX)).ceil() + 1.0;
+            let side = (f64::from(size_px(p.item)) * 1.5 / f64::from(BIN_PX)).ceil() + 1.0;
             f64::from(p.quads) * side * side
         })
         .sum();
@@ -86,4 +87,89 @@ pub(super) fn draw_order(items: &[DrawItem]) -> Vec<&DrawItem> {
     let mut order: Vec<&DrawItem> = items.iter().filter(|d| d.tiles).collect();
     order.sort_by_key(|d| d.draw_key());
     order
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::tiles::chunks::Piece;
+
+    fn chunk(pieces: &[(usize, u32)]) -> Chunk {
+        let piece = |&(item, quads): &(usize, u32)| Piece {
+            item,
+            base: 0,
+            quads,
+            per_quad: 1,
+        };
+        Chunk {
+            pieces: pieces.iter().map(piece).collect(),
+        }
+    }
+
+    #[test]
+    fn the_grids_cover_the_target_in_whole_cells() {
+        assert_eq!(grid((1920, 1080), TILE_PX), (120, 68));
+        assert_eq!(grid((1920, 1080), BIN_PX), (15, 9));
+        assert_eq!(grid((129, 1), BIN_PX), (2, 1));
+        assert_eq!(grid((0, 0), BIN_PX), (1, 1));
+        assert_eq!(grid_tiles((1920, 1080)), 120 * 68);
+        assert_eq!(grid_bins((1920, 1080)), 15 * 9);
+        assert_eq!(grid_bins((129, 257)), 2 * 3);
+    }
+
+    #[test]
+    fn a_chunk_holds_what_a_binding_takes_in_a_power_of_two() {
+        // wgpu's default binding (128 MiB): 699,050 sprites of 192 bytes, so 2^19.
+        assert_eq!(chunk_sprites(128 << 20), 1 << 19);
+        assert_eq!(chunk_sprites(SPRITE_BYTES << 20), 1 << 20);
+        assert_eq!(chunk_sprites((SPRITE_BYTES << 20) - 1), 1 << 19);
+        // At most CHUNK_SPRITES, at least two blocks.
+        assert_eq!(chunk_sprites(u64::MAX), CHUNK_SPRITES);
+        assert_eq!(chunk_sprites(0), 2 * BLOCK);
+    }
+
+    #[test]
+    fn bin_lists_take_every_bin_when_small_else_twice_the_covered_bins() {
+        let size = (1920, 1080);
+        let big = 256 << 20;
+        // 100 sprites of 10 px in one block: every bin for each (135 bins × 1024).
+        assert_eq!(
+            list_entries(|_| 10.0, &chunk(&[(0, 100)]), size, big),
+            135 * 1024
+        );
+        // 100,000 sprites of 200 px cover 4 × 4 bins each: twice 1.6M, to 2^22.
+        let one = chunk(&[(0, 100_000)]);
+        assert_eq!(list_entries(|_| 200.0, &one, size, big), 1 << 22);
+        // With 400,000 of 10 px after them (2 × 2 bins each): twice 3.2M, to 2^23.
+        let two = chunk(&[(0, 100_000), (1, 400_000)]);
+        let sizes = |i: usize| [200.0, 10.0][i];
+        assert_eq!(list_entries(sizes, &two, size, big), 1 << 23);
+        // Within the binding (8 bytes an entry), and never none.
+        assert_eq!(list_entries(sizes, &two, size, 1 << 20), 1 << 17);
+        assert_eq!(list_entries(sizes, &chunk(&[]), size, big), 1);
+    }
+
+    #[test]
+    fn tile_lists_take_their_places_then_twice_the_bins_entries_within_the_binding() {
+        let size = (1920, 1080);
+        // ⌈1000 / 256⌉ chunks of the bins' lists, and one more per bin.
+        assert_eq!(chunk_capacity(1000, size), 4 + 135);
+        let places = 130 * 135 + 1 + 128 * (4 + 135);
+        let limit = 1 << 30;
+        assert_eq!(
+            tile_list_words((1000, None), size, 5000, limit),
+            places + 2000
+        );
+        assert_eq!(
+            tile_list_words((1000, Some(7)), size, 5000, limit),
+            places + 7
+        );
+        // Room for 100 entries after the bins' words and the places.
+        let tight = 4 * (5000 + places + 100);
+        assert_eq!(
+            tile_list_words((1000, None), size, 5000, tight),
+            places + 100
+        );
+        assert_eq!(tile_list_words((1000, None), size, 5000, 0), places);
+    }
 }
