@@ -78,6 +78,7 @@ pub mod sim {
 
 /// The renderer's passes and helpers (`render`).
 pub mod render {
+    pub use crate::render::tiles::TileStages;
     pub use crate::render::{OrbitCamera, TilePass};
 
     /// Heat haze's distortion target and refraction.

@@ -4,7 +4,9 @@
 //! through a pixel centre; measured on lavapipe: at most 0.005/255 mean); sprites smaller than a
 //! pixel cover the rasteriser's pixels; sprites crossing tile borders, larger than the screen, behind the camera,
 //! piled hundreds deep on one tile, or thousands over several bins whose lists overflow keep
-//! all their light, as do two emitters over different bins; lit flipbooks blend their
+//! all their light, as do two and sixteen emitters over different bins; every frame starts
+//! from empty tiles; a target wider in bins than tall scans every bin; a record the bench
+//! stops before the shade leaves the fire to the billboards; lit flipbooks blend their
 //! frames alike on both paths; binning is deterministic; the
 //! automatic choice follows the adapter profile. All on the real adapter (lavapipe in CI).
 
@@ -17,6 +19,7 @@ use ignis::effect::{
 };
 use ignis::testing::gpu::{AdapterProfile, GpuContext};
 use ignis::testing::headless::Headless;
+use ignis::testing::render::TileStages;
 use ignis::testing::shaders::ShaderLibrary;
 
 const SIZE: (u32, u32) = (192, 144);
@@ -414,6 +417,86 @@ fn four_emitters_in_one_chunk_each_keep_their_light() {
     assert!(total_light(&without) > 1e3, "the large sprite drew nothing");
     assert!(max > 32, "the piles barely show: {max}/255");
     light_agrees(&ctx, "four emitters", &effect);
+}
+
+#[test]
+fn every_frame_starts_from_tiles_no_sprite_has_shaded() {
+    let ctx = gpu();
+    // 12 m wide at 3 m: every tile of the target is shaded in every frame, the last ones
+    // included. Each frame's tiles must start empty and be listed for the resolve again:
+    // a flag left from the frame before adds to the last frame's sum and hides the tile.
+    let effect = pile(1.0, 12.0, [0.0; 3]);
+    paths_agree_at(&ctx, "every tile, frame after frame", &effect, &[6, 7, 8]);
+}
+
+/// The bench's stage stops (`TileStages`, which time the tiles' stages apart): a record
+/// stopped after the projection or the binning leaves the fire to the billboards, a whole
+/// record draws it on the tiles.
+#[test]
+fn a_record_stopped_before_the_shade_leaves_the_fire_to_the_billboards() {
+    let ctx = gpu();
+    let mut effect = pile(1.0, 12.0, [0.0; 3]);
+    effect.emitters[0].look.draw_path = DrawPath::Tiles;
+    let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    for _ in 0..6 {
+        run.advance(1.0 / 60.0);
+    }
+    for (stages, drawn) in [
+        (TileStages::Project, false),
+        (TileStages::Bin, false),
+        (TileStages::All, true),
+    ] {
+        run.player.tile_pass().expect("tiles").set_stages(stages);
+        let light = total_light(&run.render(SIZE).expect("render"));
+        let tiles = run.player.tile_pass().expect("tiles").drawn();
+        assert_eq!(tiles, drawn, "{stages:?}: the tiles drawn");
+        let on_tiles = run.player.draw_items().iter().any(|d| d.tiles);
+        assert_eq!(on_tiles, drawn, "{stages:?}: the item left on the tiles");
+        assert!(light > 1e3, "{stages:?}: no fire ({light})");
+    }
+}
+
+#[test]
+fn sixteen_emitters_in_one_chunk_each_keep_their_light() {
+    let ctx = gpu();
+    // Each item of a chunk lists its bins in its own place: sixteen items over the 2 × 2
+    // bins of the target.
+    let mut effect = pile(1.0, 12.0, [0.0; 3]);
+    effect.emitters[0].capacity = 16;
+    effect.emitters[0].look.intensity = 0.5;
+    for k in 0..15 {
+        let at = [
+            -1.0 + 0.5 * (k % 5) as f32,
+            -0.5 + 0.5 * (k / 5) as f32,
+            0.0,
+        ];
+        let mut e = pile(1.0, 0.25, at).emitters.remove(0);
+        e.name = format!("pile {k}");
+        e.capacity = 16;
+        e.look.intensity = 8.0;
+        effect.emitters.push(e);
+    }
+    light_agrees(&ctx, "sixteen emitters", &effect);
+    // The last pile shows: losing it would be far over 8/255.
+    let mut but_last = effect.clone();
+    but_last.emitters.pop();
+    let with = render(&ctx, &effect, DrawPath::Tiles, 6);
+    let without = render(&ctx, &but_last, DrawPath::Billboard, 6);
+    assert!(
+        image_diff(&with, &without).1 > 32,
+        "the last pile barely shows"
+    );
+}
+
+#[test]
+fn a_target_of_more_bins_across_than_down_scans_every_bin() {
+    let ctx = gpu();
+    // 384 × 256 pixels: 3 × 2 bins of 128 (six, where 3 + 2 is five), every one under
+    // the sprite.
+    let effect = pile(1.0, 12.0, [0.0; 3]);
+    let a = render_at(&ctx, &effect, DrawPath::Billboard, 6, (384, 256));
+    let b = render_at(&ctx, &effect, DrawPath::Tiles, 6, (384, 256));
+    images_agree("3 × 2 bins", &a, &b);
 }
 
 #[test]
