@@ -5,7 +5,8 @@
 //! pixel cover the rasteriser's pixels; sprites crossing tile borders, larger than the screen, behind the camera,
 //! piled hundreds deep on one tile, or thousands over several bins whose lists overflow keep
 //! all their light, as do two and sixteen emitters over different bins; every frame starts
-//! from empty tiles; a target wider in bins than tall scans every bin; a record the bench
+//! from empty tiles; a target wider in bins than tall scans every bin, and one of more bins
+//! than the tiles hold goes to the billboards; a record the bench
 //! stops before the shade leaves the fire to the billboards; lit flipbooks blend their
 //! frames alike on both paths; binning is deterministic; the
 //! automatic choice follows the adapter profile. All on the real adapter (lavapipe in CI).
@@ -497,6 +498,25 @@ fn a_target_of_more_bins_across_than_down_scans_every_bin() {
     let a = render_at(&ctx, &effect, DrawPath::Billboard, 6, (384, 256));
     let b = render_at(&ctx, &effect, DrawPath::Tiles, 6, (384, 256));
     images_agree("3 × 2 bins", &a, &b);
+}
+
+#[test]
+fn a_target_of_more_bins_than_the_tiles_hold_is_drawn_by_the_billboards() {
+    let ctx = gpu();
+    // 8192 × 4224 pixels: 64 × 33 = 2112 bins of 128, over the 2048 the tiles hold.
+    let mut effect = full_resolution(pile(1.0, 0.5, [0.0; 3]));
+    effect.emitters[0].look.draw_path = DrawPath::Tiles;
+    let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    for _ in 0..6 {
+        run.advance(1.0 / 60.0);
+    }
+    let image = run.render((8192, 4224)).expect("render");
+    let tiled = run.player.draw_items().iter().any(|d| d.tiles);
+    assert!(!tiled, "a target of 2112 bins left on the tiles");
+    assert!(total_light(&image) > 1e3, "the billboards drew nothing");
+    // The same effect at 1920 × 1080 stays on the tiles.
+    run.render((1920, 1080)).expect("render");
+    assert!(run.player.draw_items().iter().any(|d| d.tiles));
 }
 
 #[test]
