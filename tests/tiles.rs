@@ -398,17 +398,7 @@ fn two_emitters_over_different_bins_each_keep_their_light() {
 #[test]
 fn four_emitters_in_one_chunk_each_keep_their_light() {
     let ctx = gpu();
-    let mut effect = pile(1.0, 12.0, [0.0; 3]);
-    effect.emitters[0].capacity = 16;
-    effect.emitters[0].look.intensity = 0.5;
-    let piles = [[-0.8, 0.5, 0.0], [-0.3, -0.4, 0.0], [-1.2, 0.0, 0.0]];
-    for (k, at) in piles.into_iter().enumerate() {
-        let mut e = pile(1.0, 0.25, at).emitters.remove(0);
-        e.name = format!("pile {k}");
-        e.capacity = 16;
-        e.look.intensity = 8.0;
-        effect.emitters.push(e);
-    }
+    let effect = piles_over_the_screen(&[[-0.8, 0.5, 0.0], [-0.3, -0.4, 0.0], [-1.2, 0.0, 0.0]]);
     // The piles show over the large sprite: losing one would be far over 8/255.
     let mut first_only = effect.clone();
     first_only.emitters.truncate(1);
@@ -462,21 +452,14 @@ fn sixteen_emitters_in_one_chunk_each_keep_their_light() {
     let ctx = gpu();
     // Each item of a chunk lists its bins in its own place: sixteen items over the 2 × 2
     // bins of the target.
-    let mut effect = pile(1.0, 12.0, [0.0; 3]);
-    effect.emitters[0].capacity = 16;
-    effect.emitters[0].look.intensity = 0.5;
-    for k in 0..15 {
-        let at = [
+    let at = |k: usize| {
+        [
             -1.0 + 0.5 * (k % 5) as f32,
             -0.5 + 0.5 * (k / 5) as f32,
             0.0,
-        ];
-        let mut e = pile(1.0, 0.25, at).emitters.remove(0);
-        e.name = format!("pile {k}");
-        e.capacity = 16;
-        e.look.intensity = 8.0;
-        effect.emitters.push(e);
-    }
+        ]
+    };
+    let effect = piles_over_the_screen(&(0..15).map(at).collect::<Vec<_>>());
     light_agrees(&ctx, "sixteen emitters", &effect);
     // The last pile shows: losing it would be far over 8/255.
     let mut but_last = effect.clone();
@@ -517,6 +500,22 @@ fn a_target_of_more_bins_than_the_tiles_hold_is_drawn_by_the_billboards() {
     // The same effect at 1920 × 1080 stays on the tiles.
     run.render((1920, 1080)).expect("render");
     assert!(run.player.draw_items().iter().any(|d| d.tiles));
+}
+
+/// A sprite larger than the screen (faint), then a bright pile 0.25 m wide at each of `at`,
+/// each its own emitter.
+fn piles_over_the_screen(at: &[[f32; 3]]) -> Effect {
+    let mut effect = pile(1.0, 12.0, [0.0; 3]);
+    effect.emitters[0].capacity = 16;
+    effect.emitters[0].look.intensity = 0.5;
+    for (k, &at) in at.iter().enumerate() {
+        let mut e = pile(1.0, 0.25, at).emitters.remove(0);
+        e.name = format!("pile {k}");
+        e.capacity = 16;
+        e.look.intensity = 8.0;
+        effect.emitters.push(e);
+    }
+    effect
 }
 
 #[test]
