@@ -426,12 +426,7 @@ fn every_frame_starts_from_tiles_no_sprite_has_shaded() {
 #[test]
 fn a_record_stopped_before_the_shade_leaves_the_fire_to_the_billboards() {
     let ctx = gpu();
-    let mut effect = pile(1.0, 12.0, [0.0; 3]);
-    effect.emitters[0].look.draw_path = DrawPath::Tiles;
-    let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
-    for _ in 0..6 {
-        run.advance(1.0 / 60.0);
-    }
+    let mut run = played_on_tiles(&ctx, pile(1.0, 12.0, [0.0; 3]));
     for (stages, drawn) in [
         (TileStages::Project, false),
         (TileStages::Bin, false),
@@ -487,12 +482,7 @@ fn a_target_of_more_bins_across_than_down_scans_every_bin() {
 fn a_target_of_more_bins_than_the_tiles_hold_is_drawn_by_the_billboards() {
     let ctx = gpu();
     // 8192 × 4224 pixels: 64 × 33 = 2112 bins of 128, over the 2048 the tiles hold.
-    let mut effect = full_resolution(pile(1.0, 0.5, [0.0; 3]));
-    effect.emitters[0].look.draw_path = DrawPath::Tiles;
-    let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
-    for _ in 0..6 {
-        run.advance(1.0 / 60.0);
-    }
+    let mut run = played_on_tiles(&ctx, full_resolution(pile(1.0, 0.5, [0.0; 3])));
     let image = run.render((8192, 4224)).expect("render");
     let tiled = run.player.draw_items().iter().any(|d| d.tiles);
     assert!(!tiled, "a target of 2112 bins left on the tiles");
@@ -500,6 +490,16 @@ fn a_target_of_more_bins_than_the_tiles_hold_is_drawn_by_the_billboards() {
     // The same effect at 1920 × 1080 stays on the tiles.
     run.render((1920, 1080)).expect("render");
     assert!(run.player.draw_items().iter().any(|d| d.tiles));
+}
+
+/// `effect`'s one emitter asked onto the tiles, played 6 frames (0.1 s: a pile is born).
+fn played_on_tiles(ctx: &GpuContext, mut effect: Effect) -> Headless {
+    effect.emitters[0].look.draw_path = DrawPath::Tiles;
+    let mut run = Headless::new(ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    for _ in 0..6 {
+        run.advance(1.0 / 60.0);
+    }
+    run
 }
 
 /// A sprite larger than the screen (faint), then a bright pile 0.25 m wide at each of `at`,

@@ -92,18 +92,13 @@ pub(super) fn draw_order(items: &[DrawItem]) -> Vec<&DrawItem> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::tiles::chunks::Piece;
 
-    fn chunk(pieces: &[(usize, u32)]) -> Chunk {
-        let piece = |&(item, quads): &(usize, u32)| Piece {
-            item,
-            base: 0,
-            quads,
-            per_quad: 1,
-        };
-        Chunk {
-            pieces: pieces.iter().map(piece).collect(),
-        }
+    /// One chunk of items of `quads` unlit quads each, as the frame plans it.
+    fn chunk(quads: &[u32]) -> Chunk {
+        let shapes: Vec<(u32, u32)> = quads.iter().map(|&q| (q, 1)).collect();
+        let mut chunks = chunks::plan(&shapes, CHUNK_SPRITES);
+        assert!(chunks.len() <= 1, "{quads:?} in one chunk");
+        chunks.pop().unwrap_or_default()
     }
 
     #[test]
@@ -134,14 +129,14 @@ mod tests {
         let big = 256 << 20;
         // 100 sprites of 10 px in one block: every bin for each (135 bins × 1024).
         assert_eq!(
-            list_entries(|_| 10.0, &chunk(&[(0, 100)]), size, big),
+            list_entries(|_| 10.0, &chunk(&[100]), size, big),
             135 * 1024
         );
         // 100,000 sprites of 200 px cover 4 × 4 bins each: twice 1.6M, to 2^22.
-        let one = chunk(&[(0, 100_000)]);
+        let one = chunk(&[100_000]);
         assert_eq!(list_entries(|_| 200.0, &one, size, big), 1 << 22);
         // With 400,000 of 10 px after them (2 × 2 bins each): twice 3.2M, to 2^23.
-        let two = chunk(&[(0, 100_000), (1, 400_000)]);
+        let two = chunk(&[100_000, 400_000]);
         let sizes = |i: usize| [200.0, 10.0][i];
         assert_eq!(list_entries(sizes, &two, size, big), 1 << 23);
         // Within the binding (8 bytes an entry), and never none.
