@@ -295,10 +295,15 @@ impl ShaderLibrary {
         }
     }
 
-    /// `shaders/` in the working directory when it exists, else the embedded copies.
+    /// `shaders/` in the working directory when it exists, else the embedded copies
+    /// (with the `mutants` feature, IGNIS_MUTANT_SHADERS before either).
     pub fn discover(explicit: Option<&Path>) -> Self {
         if let Some(dir) = explicit {
             return Self::from_dir(dir);
+        }
+        #[cfg(feature = "mutants")]
+        if std::env::var_os("IGNIS_MUTANT_SHADERS").is_some() {
+            return Self::embedded();
         }
         let local = Path::new("shaders");
         if local.join("update.wgsl").is_file() {
