@@ -918,6 +918,45 @@ fn msaa_hosts_get_occlusion_and_soft_edges() {
     );
 }
 
+/// A host whose depth needs the copy to one sample (MSAA) while that copy's shader is
+/// broken: the frame is recorded without the host's depth, and the error says which
+/// shader failed and where.
+#[test]
+fn a_broken_depth_copy_shader_is_named_in_the_error() {
+    let msaa = HostKind {
+        color: wgpu::TextureFormat::Rgba16Float,
+        samples: 4,
+        ..HostKind::default()
+    };
+    let host = Host::of(msaa, vec3(0.0, 0.7, 3.0), vec3(0.0, 0.5, 0.0));
+    let dir = tempfile::tempdir().expect("tempdir");
+    for (name, text) in ignis::testing::shaders::EMBEDDED {
+        let text = if *name == "depth_resolve.wgsl" {
+            "fn broken("
+        } else {
+            text
+        };
+        std::fs::write(dir.path().join(name), text).expect("write");
+    }
+    let settings = PlayerSettings {
+        shader_dir: Some(dir.path().to_path_buf()),
+        ..host.settings()
+    };
+    let effect = preset("campfire");
+    let mut fire = Player::new(&host.device, &host.queue, &effect, settings).expect("player");
+    fire.add_instance(host.place(Mat4::IDENTITY), 3)
+        .expect("instance");
+    let depth = host.depth.create_view(&Default::default());
+    let mut enc = host.device.create_command_encoder(&Default::default());
+    let error = (fire.record(&mut enc, &host.camera, Some(&depth)))
+        .expect_err("no depth copy without its shader")
+        .to_string();
+    assert!(
+        error.contains("the depth copy's shader failed") && error.contains("depth_resolve.wgsl"),
+        "{error}"
+    );
+}
+
 /// The mean absolute difference of two frames' colour channels.
 fn mean_difference(a: &Frame, b: &Frame) -> f64 {
     let sum: f64 = (a.rgba.iter().zip(&b.rgba))

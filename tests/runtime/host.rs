@@ -82,6 +82,8 @@ pub struct Host {
     color: wgpu::Texture,
     resolve: Option<wgpu::Texture>,
     pub depth: wgpu::Texture,
+    /// The one view of `depth` every frame hands over, as a host keeps its views.
+    depth_view: wgpu::TextureView,
     quads: wgpu::RenderPipeline,
     pub camera: Camera,
     clip_from_world: Mat4,
@@ -138,6 +140,7 @@ impl Host {
         let color = target_texture(&device, &kind, kind.color, kind.samples);
         let resolve = (kind.samples > 1).then(|| target_texture(&device, &kind, kind.color, 1));
         let depth = target_texture(&device, &kind, kind.depth, kind.samples);
+        let depth_view = depth.create_view(&Default::default());
         let quads = quad_pipeline(&device, &kind);
         let (eye, target) = (kind.world(eye), kind.world(target));
         let view = glam::camera::rh::view::look_at_mat4(eye, target, kind.world(Vec3::Y));
@@ -160,6 +163,7 @@ impl Host {
             color,
             resolve,
             depth,
+            depth_view,
             quads,
             camera,
             clip_from_world: proj * view,
@@ -207,11 +211,11 @@ impl Host {
         players: &mut [&mut Player],
         soft: bool,
     ) -> Frame {
-        let depth = self.depth.create_view(&Default::default());
+        let depth = &self.depth_view;
         let mut enc = self.device.create_command_encoder(&Default::default());
         self.draw_opaque(&mut enc, background, quads, |_| {});
         for p in players.iter_mut() {
-            p.record(&mut enc, &self.camera, soft.then_some(&depth))
+            p.record(&mut enc, &self.camera, soft.then_some(depth))
                 .expect("record");
         }
         let color = self.color.create_view(&Default::default());
@@ -222,7 +226,7 @@ impl Host {
         let targets = HostTargets {
             color: &color,
             resolve_target: resolve.as_ref(),
-            depth: Some(&depth),
+            depth: Some(depth),
         };
         {
             let mut pass = targets.begin_pass(&mut enc);
@@ -264,9 +268,9 @@ impl Host {
             .resolve
             .as_ref()
             .map(|r| r.create_view(&Default::default()));
-        let depth = self.depth.create_view(&Default::default());
         let [r, g, b] = background;
-        let mut pass = self.begin_opaque(enc, &color, resolve.as_ref(), &depth, [r, g, b]);
+        let mut pass =
+            self.begin_opaque(enc, &color, resolve.as_ref(), &self.depth_view, [r, g, b]);
         pass.set_pipeline(&self.quads);
         pass.set_bind_group(0, &group, &[]);
         pass.set_vertex_buffer(0, vertices.slice(..));
