@@ -890,16 +890,21 @@ fn on_path(path: ignis::effect::DrawPath) -> Effect {
     effect
 }
 
+/// A host with MSAA 4× colour (`Rgba16Float`, which every adapter multisamples) and depth.
+fn msaa_host() -> HostKind {
+    HostKind {
+        color: wgpu::TextureFormat::Rgba16Float,
+        samples: 4,
+        ..HostKind::default()
+    }
+}
+
 /// MSAA 4× colour and depth: the player draws into the multisampled pass and samples a
 /// single-sample copy of the depth; the fire is hidden inside the wall on every path, and
 /// soft edges match a single-sample host's within 1/255.
 #[test]
 fn msaa_hosts_get_occlusion_and_soft_edges() {
-    let msaa = HostKind {
-        color: wgpu::TextureFormat::Rgba16Float,
-        samples: 4,
-        ..HostKind::default()
-    };
+    let msaa = msaa_host();
     for path in ALL_PATHS {
         hides_the_fire_in(msaa.clone(), &on_path(path), true);
     }
@@ -923,12 +928,7 @@ fn msaa_hosts_get_occlusion_and_soft_edges() {
 /// shader failed and where.
 #[test]
 fn a_broken_depth_copy_shader_is_named_in_the_error() {
-    let msaa = HostKind {
-        color: wgpu::TextureFormat::Rgba16Float,
-        samples: 4,
-        ..HostKind::default()
-    };
-    let host = Host::of(msaa, vec3(0.0, 0.7, 3.0), vec3(0.0, 0.5, 0.0));
+    let host = Host::of(msaa_host(), vec3(0.0, 0.7, 3.0), vec3(0.0, 0.5, 0.0));
     let dir = tempfile::tempdir().expect("tempdir");
     for (name, text) in ignis::testing::shaders::EMBEDDED {
         let text = if *name == "depth_resolve.wgsl" {
