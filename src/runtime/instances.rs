@@ -226,6 +226,7 @@ mod tests {
         let b = slab.insert("b");
         assert_eq!(slab.remove(a), Some("a"));
         assert_eq!(slab.remove(a), None, "removed twice");
+        assert_eq!(slab.len(), 1, "a removed item is not counted");
         let c = slab.insert("c");
         assert_ne!(a, c, "the reused slot has a new generation");
         assert_eq!(

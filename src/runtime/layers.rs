@@ -109,4 +109,16 @@ mod tests {
         assert!(soft.intersects(Layers::GLOW));
         assert!(!Layers::NONE.intersects(Layers::ALL));
     }
+
+    #[test]
+    fn a_layer_added_twice_is_there_once() {
+        assert_eq!(Layers::GLOW | Layers::GLOW, Layers::GLOW);
+        assert_eq!(Layers::BLENDED | Layers::ALL, Layers::ALL);
+        let mut drawn = Layers::NONE;
+        drawn |= Layers::LIGHT;
+        drawn |= Layers::LIGHT;
+        assert_eq!(drawn, Layers::LIGHT);
+        drawn |= Layers::GLOW;
+        assert_eq!(drawn, Layers::LIGHT | Layers::GLOW);
+    }
 }
