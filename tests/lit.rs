@@ -115,7 +115,12 @@ fn the_six_way_mix_equals_the_cpu_formula_on_both_paths() {
         glow: 1.0,
     };
     let smoke = common::still_smoke(maps, lighting, DrawPath::Billboard);
-    let (frame, _) = render(&smoke, |p| p.set_lighting(Some(host_light)));
+    let (frame, _) = render(&smoke, |p| {
+        p.set_lighting(Some(host_light.clone()));
+        // What the host set is what the player reports (the six-way export puts it back
+        // from there after its passes).
+        assert_eq!(p.lighting(), Some(&host_light), "the player's lighting");
+    });
     let (r2, range2) = (0.64f32, 16.0f32);
     let window = (1.0 - (r2 / range2).powi(2)).powi(2);
     let e = point.color.map(|c| c * window / r2);
