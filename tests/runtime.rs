@@ -929,15 +929,7 @@ fn msaa_hosts_get_occlusion_and_soft_edges() {
 #[test]
 fn a_broken_depth_copy_shader_is_named_in_the_error() {
     let host = Host::of(msaa_host(), vec3(0.0, 0.7, 3.0), vec3(0.0, 0.5, 0.0));
-    let dir = tempfile::tempdir().expect("tempdir");
-    for (name, text) in ignis::testing::shaders::EMBEDDED {
-        let text = if *name == "depth_resolve.wgsl" {
-            "fn broken("
-        } else {
-            text
-        };
-        std::fs::write(dir.path().join(name), text).expect("write");
-    }
+    let dir = common::shader_folder(&[("depth_resolve.wgsl", "fn broken(")]);
     let settings = PlayerSettings {
         shader_dir: Some(dir.path().to_path_buf()),
         ..host.settings()
@@ -946,9 +938,8 @@ fn a_broken_depth_copy_shader_is_named_in_the_error() {
     let mut fire = Player::new(&host.device, &host.queue, &effect, settings).expect("player");
     fire.add_instance(host.place(Mat4::IDENTITY), 3)
         .expect("instance");
-    let depth = host.depth.create_view(&Default::default());
     let mut enc = host.device.create_command_encoder(&Default::default());
-    let error = (fire.record(&mut enc, &host.camera, Some(&depth)))
+    let error = (fire.record(&mut enc, &host.camera, Some(&host.depth_view)))
         .expect_err("no depth copy without its shader")
         .to_string();
     assert!(

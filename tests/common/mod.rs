@@ -354,12 +354,11 @@ pub fn resolves_agree(what: &str, drawn: &image::RgbaImage, computed: &image::Rg
     );
 }
 
-/// A compute pipeline of `probe` (WGSL whose entry point is `main`; it may `#import` any
-/// embedded shader, or a mutant's under `IGNIS_MUTANT_SHADERS`), composed as the shader
-/// library composes the shipped shaders, with its bind group layouts taken from the shader.
-pub fn probe_pipeline(ctx: &GpuContext, probe: &str) -> wgpu::ComputePipeline {
+/// A folder holding the shaders under test (the embedded ones, or a mutant's copy when
+/// scripts/wgsl_mutants.py runs the tests), with each `(name, text)` of `replace` written
+/// over or beside them.
+pub fn shader_folder(replace: &[(&str, &str)]) -> tempfile::TempDir {
     let dir = tempfile::tempdir().expect("tempdir");
-    // The shaders under test: a mutant's copy when scripts/wgsl_mutants.py runs the tests.
     let mutant = std::env::var_os("IGNIS_MUTANT_SHADERS").map(std::path::PathBuf::from);
     for (name, text) in ignis::testing::shaders::EMBEDDED {
         let text = match &mutant {
@@ -368,7 +367,17 @@ pub fn probe_pipeline(ctx: &GpuContext, probe: &str) -> wgpu::ComputePipeline {
         };
         std::fs::write(dir.path().join(name), text).expect("write shader");
     }
-    std::fs::write(dir.path().join("probe.wgsl"), probe).expect("write probe");
+    for (name, text) in replace {
+        std::fs::write(dir.path().join(name), text).expect("write shader");
+    }
+    dir
+}
+
+/// A compute pipeline of `probe` (WGSL whose entry point is `main`; it may `#import` any
+/// embedded shader, or a mutant's under `IGNIS_MUTANT_SHADERS`), composed as the shader
+/// library composes the shipped shaders, with its bind group layouts taken from the shader.
+pub fn probe_pipeline(ctx: &GpuContext, probe: &str) -> wgpu::ComputePipeline {
+    let dir = shader_folder(&[("probe.wgsl", probe)]);
     let composed = ShaderLibrary::from_dir(dir.path())
         .compose("probe.wgsl")
         .expect("probe composes");

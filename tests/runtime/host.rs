@@ -83,7 +83,7 @@ pub struct Host {
     resolve: Option<wgpu::Texture>,
     pub depth: wgpu::Texture,
     /// The one view of `depth` every frame hands over, as a host keeps its views.
-    depth_view: wgpu::TextureView,
+    pub depth_view: wgpu::TextureView,
     quads: wgpu::RenderPipeline,
     pub camera: Camera,
     clip_from_world: Mat4,
