@@ -612,6 +612,177 @@ fn an_inspected_particle_reports_its_state_and_the_forces_on_it() {
     assert!(none.is_none());
 }
 
+/// The forces the Inspect view reports carry the particle's over-life multipliers at its
+/// age: drag over life a line from 0 to 2 over a 2 s life scales a 1.5/s drag by
+/// age (s) at every living particle.
+#[test]
+fn inspected_forces_carry_the_over_life_multipliers_at_the_particles_age() {
+    let ctx = gpu();
+    let mut e = plain_emitter();
+    e.capacity = 256;
+    e.spawn_rate_per_sec = Param::Constant(50.0);
+    e.lifetime_secs = Range::new(2.0, 2.0);
+    e.speed_m_per_s = Range::new(1.0, 1.0);
+    e.spread_deg = 30.0;
+    e.forces.drag_per_sec = 1.5;
+    e.forces.wind_m_per_s = [0.5, 0.0, 0.0];
+    e.forces.drag_over_life = Param::Curve {
+        keys: vec![(0.0, 0.0), (1.0, 2.0)],
+        smooth: false,
+    };
+    let mut run =
+        ignis::testing::headless::Headless::new(&ctx, bare_effect(e), ShaderLibrary::embedded())
+            .expect("headless");
+    for _ in 0..45 {
+        run.advance(1.0 / 60.0);
+    }
+    let particles = run.player.particles(run.instance, 0).expect("particles");
+    let mut checked = 0;
+    for (slot, p) in particles.iter().enumerate().filter(|(_, p)| p.is_alive()) {
+        let info = run
+            .player
+            .inspect_particle(run.instance, 0, slot as u32)
+            .expect("inspect")
+            .expect("alive");
+        let drag = info
+            .forces
+            .iter()
+            .find(|(n, _)| *n == "drag")
+            .expect("drag")
+            .1;
+        // The line's value at age / life: 2 · age / 2 s.
+        let multiplier = info.age_secs / info.lifetime_secs * 2.0;
+        let expected = -1.5 * multiplier * (p.velocity() - Vec3::new(0.5, 0.0, 0.0));
+        assert!(
+            (drag - expected).length() < 1e-4 * (1.0 + expected.length()),
+            "age {} s: drag {drag} against {expected}",
+            info.age_secs
+        );
+        checked += 1;
+    }
+    assert!(checked >= 20, "{checked} particles checked");
+}
+
+/// Particles at the same distance from the pointer: the pick is the first of them (the
+/// lowest slot of the first emitter), whatever else is in the pool.
+#[test]
+fn a_pick_among_equally_near_particles_is_the_first_slot() {
+    let ctx = gpu();
+    let mut e = plain_emitter();
+    e.capacity = 64;
+    e.spawn_rate_per_sec = Param::Constant(60.0);
+    // Every particle sits still at the emitter: all at one pixel.
+    let mut run =
+        ignis::testing::headless::Headless::new(&ctx, bare_effect(e), ShaderLibrary::embedded())
+            .expect("headless");
+    for _ in 0..20 {
+        run.advance(1.0 / 60.0);
+    }
+    let particles = run.player.particles(run.instance, 0).expect("particles");
+    let alive: Vec<usize> = (0..particles.len())
+        .filter(|&s| particles[s].is_alive())
+        .collect();
+    assert!(alive.len() >= 10, "{} alive", alive.len());
+    let camera = run.camera.view((640, 480));
+    let clip = camera.clip_from_world_mat4() * Vec3::ZERO.extend(1.0);
+    let ndc = clip.truncate() / clip.w;
+    let pixel = glam::Vec2::new((ndc.x + 1.0) * 320.0, (1.0 - ndc.y) * 240.0);
+    let picked = run
+        .player
+        .pick_particle(
+            run.instance,
+            &camera,
+            pixel + glam::Vec2::new(1.5, 0.0),
+            4.0,
+        )
+        .expect("pick")
+        .expect("a particle near the pointer");
+    assert_eq!(picked.slot as usize, alive[0], "alive slots {alive:?}");
+}
+
+/// The pick is the nearest particle within the radius, not the first or the last found:
+/// with a radius that holds many moving particles, the one nearest the pointer (found
+/// here from the positions read back) is the one picked.
+#[test]
+fn a_pick_within_a_wide_radius_is_the_nearest_particle() {
+    let ctx = gpu();
+    let mut e = plain_emitter();
+    e.capacity = 256;
+    e.spawn_rate_per_sec = Param::Constant(60.0);
+    e.speed_m_per_s = Range::new(0.5, 2.0);
+    e.spread_deg = 60.0;
+    let mut run =
+        ignis::testing::headless::Headless::new(&ctx, bare_effect(e), ShaderLibrary::embedded())
+            .expect("headless");
+    for _ in 0..40 {
+        run.advance(1.0 / 60.0);
+    }
+    let camera = run.camera.view((640, 480));
+    let to_pixel = |p: Vec3| {
+        let clip = camera.clip_from_world_mat4() * p.extend(1.0);
+        let ndc = clip.truncate() / clip.w;
+        glam::Vec2::new((ndc.x + 1.0) * 320.0, (1.0 - ndc.y) * 240.0)
+    };
+    let particles = run.player.particles(run.instance, 0).expect("particles");
+    let pixels: Vec<(usize, glam::Vec2)> = (particles.iter().enumerate())
+        .filter(|(_, p)| p.is_alive())
+        .map(|(s, p)| (s, to_pixel(p.position())))
+        .collect();
+    // A pointer off the crowd's middle, so that the nearest is neither first nor last.
+    let mean = pixels.iter().map(|(_, q)| *q).sum::<glam::Vec2>() / pixels.len() as f32;
+    let pointer = mean + glam::Vec2::new(7.0, -5.0);
+    let near = |r: f32| {
+        pixels
+            .iter()
+            .filter(|(_, q)| q.distance(pointer) <= r)
+            .count()
+    };
+    assert!(near(400.0) >= 20, "{} within the radius", near(400.0));
+    let (nearest, _) = (pixels.iter())
+        .min_by(|a, b| a.1.distance(pointer).total_cmp(&b.1.distance(pointer)))
+        .expect("particles");
+    let picked = run
+        .player
+        .pick_particle(run.instance, &camera, pointer, 400.0)
+        .expect("pick")
+        .expect("a particle within the radius");
+    assert_eq!(picked.slot as usize, *nearest);
+}
+
+/// A switched-off emitter is not drawn, and its particles are not picked: still particles
+/// of two emitters 1 m apart, the second switched off, and nothing under its pixel.
+#[test]
+fn a_switched_off_emitters_particles_are_not_picked() {
+    let ctx = gpu();
+    let mut a = plain_emitter();
+    a.capacity = 64;
+    a.spawn_rate_per_sec = Param::Constant(60.0);
+    a.transform.position_m = [-0.5, 0.0, 0.0];
+    let mut b = a.clone();
+    b.name = "second".into();
+    b.transform.position_m = [0.5, 0.0, 0.0];
+    let mut effect = bare_effect(a);
+    effect.emitters.push(b);
+    let mut run =
+        ignis::testing::headless::Headless::new(&ctx, effect.clone(), ShaderLibrary::embedded())
+            .expect("headless");
+    for _ in 0..20 {
+        run.advance(1.0 / 60.0);
+    }
+    let camera = run.camera.view((640, 480));
+    let clip = camera.clip_from_world_mat4() * Vec3::new(0.5, 0.0, 0.0).extend(1.0);
+    let ndc = clip.truncate() / clip.w;
+    let pixel = glam::Vec2::new((ndc.x + 1.0) * 320.0, (1.0 - ndc.y) * 240.0);
+    let pick = |run: &ignis::testing::headless::Headless| {
+        (run.player.pick_particle(run.instance, &camera, pixel, 4.0)).expect("pick")
+    };
+    assert_eq!(pick(&run).map(|p| p.emitter), Some(1), "on, it is picked");
+    effect.emitters[1].enabled = false;
+    run.player.set_effect(&effect).expect("edit");
+    run.advance(1.0 / 60.0);
+    assert_eq!(pick(&run), None, "switched off");
+}
+
 /// Over-life multipliers against their closed forms: speed over life 2 moves a particle
 /// twice its velocity's distance (its velocity unchanged by it), and drag over life 0
 /// switches a 3/s drag off — a half second's displacement of every living particle is

@@ -167,7 +167,8 @@ fn a_turned_puff_is_lit_through_its_turned_frame() {
 
 /// The effect's own light (its additive layers, measured on the GPU the same frame)
 /// lights its smoke: a still fire below the puff lights it from below by its power over
-/// the squared distance, in its colour — the power the effect light reports.
+/// the squared distance, in its colour — the power the effect light reports — and as
+/// much with the estimate off.
 #[test]
 fn the_effects_own_light_lights_its_smoke_from_where_it_burns() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -192,18 +193,29 @@ fn the_effects_own_light_lights_its_smoke_from_where_it_burns() {
     effect.emitters.push(fire);
     // The power the estimate reports (tested against its closed form in runtime.rs).
     let host = Host::new(EYE, SMOKE);
-    let mut player = host.player(&effect);
-    player.set_light_estimate(true);
-    let id = player.add_instance(Mat4::IDENTITY, 1).expect("instance");
-    let (mut light, mut frame) = (None, None);
-    for _ in 0..6 {
-        player.advance(1.0 / 60.0);
-        frame = Some(host.frame([0.0; 3], &[], &mut [&mut player], true));
-        let _ = host.device.poll(wgpu::PollType::wait_indefinitely());
-        light = player.effect_light(id).or(light);
-    }
-    let frame = frame.expect("a frame");
+    let play = |estimate: bool| {
+        let mut player = host.player(&effect);
+        player.set_light_estimate(estimate);
+        let id = player.add_instance(Mat4::IDENTITY, 1).expect("instance");
+        let (mut light, mut frame) = (None, None);
+        for _ in 0..6 {
+            player.advance(1.0 / 60.0);
+            frame = Some(host.frame([0.0; 3], &[], &mut [&mut player], true));
+            let _ = host.device.poll(wgpu::PollType::wait_indefinitely());
+            light = player.effect_light(id).or(light);
+        }
+        (frame.expect("a frame"), light)
+    };
+    let (frame, light) = play(true);
     let light = light.expect("the fire's light");
+    // The smoke's share of its fire's light is the same whether or not the host reads
+    // the estimate back.
+    let (unread, none) = play(false);
+    assert_eq!(none, None);
+    assert!(
+        unread.rgba == frame.rgba,
+        "the smoke unlit without the estimate"
+    );
     assert!(
         light
             .position

@@ -1287,3 +1287,85 @@ fn the_campfire_light_flickers_from_its_flames() {
     fire.set_light_estimate(false);
     assert_eq!(fire.effect_light(id), None, "the estimate turned off");
 }
+
+/// Off, the estimate records nothing for an effect without lit layers (the torch's
+/// flames and sparks): a frame's dispatches grow while it is on, and shrink back after.
+#[test]
+fn the_light_estimate_records_nothing_while_off() {
+    let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+    let mut flames = preset("torch");
+    flames
+        .emitters
+        .retain(|e| e.look.blend == BlendMode::Additive && e.look.lit.is_none());
+    let mut fire = host.player(&flames);
+    fire.add_instance(Mat4::IDENTITY, 3).expect("instance");
+    advance_and_wait(&mut [&mut fire], &host, 10);
+    let off = fire.recorded_commands();
+    fire.set_light_estimate(true);
+    advance_and_wait(&mut [&mut fire], &host, 1);
+    let on = fire.recorded_commands();
+    assert!(on.dispatches > off.dispatches, "on {on:?}, off {off:?}");
+    fire.set_light_estimate(false);
+    advance_and_wait(&mut [&mut fire], &host, 1);
+    assert_eq!(fire.recorded_commands(), off, "off again");
+}
+
+/// An instance whose particles emit no light (every layer at intensity 0) has no effect
+/// light while the estimate is on: `None`, not a light at 0 / 0.
+#[test]
+fn an_instance_whose_particles_emit_nothing_has_no_effect_light() {
+    let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+    let mut dark = preset("campfire");
+    for e in &mut dark.emitters {
+        e.look.intensity = 0.0;
+    }
+    let mut fire = host.player(&dark);
+    let id = fire.add_instance(Mat4::IDENTITY, 3).expect("instance");
+    fire.set_light_estimate(true);
+    advance_and_wait(&mut [&mut fire], &host, 6);
+    let counts = fire.count_particles(id).expect("count");
+    assert!(counts.iter().any(|c| c.alive > 0), "{counts:?}");
+    assert_eq!(fire.effect_light(id), None);
+    assert_eq!(fire.light_estimate_error(), None);
+}
+
+/// A broken `light.wgsl` in the player's shader folder: the estimate says why it has no
+/// light (naming the file) and the fire plays on; fixed and reloaded, the light comes.
+#[test]
+fn a_broken_light_shader_is_named_and_a_fixed_one_brings_the_light_back() {
+    let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+    let dir = common::shader_folder(&[("light.wgsl", "fn broken(")]);
+    let settings = PlayerSettings {
+        shader_dir: Some(dir.path().to_path_buf()),
+        ..host.settings()
+    };
+    let mut fire =
+        Player::new(&host.device, &host.queue, &preset("campfire"), settings).expect("player");
+    let id = fire.add_instance(Mat4::IDENTITY, 3).expect("instance");
+    fire.set_light_estimate(true);
+    advance_and_wait(&mut [&mut fire], &host, 4);
+    assert_eq!(fire.effect_light(id), None);
+    let error = fire
+        .light_estimate_error()
+        .expect("the light's error")
+        .to_string();
+    assert!(error.contains("light.wgsl"), "{error}");
+    assert!(
+        fire.count_particles(id)
+            .expect("count")
+            .iter()
+            .any(|c| c.alive > 0),
+        "the fire plays on"
+    );
+    let good = ignis::testing::shaders::EMBEDDED
+        .iter()
+        .find(|(name, _)| *name == "light.wgsl")
+        .expect("light.wgsl")
+        .1;
+    std::fs::write(dir.path().join("light.wgsl"), good).expect("write");
+    fire.reload_shader(dir.path(), "light.wgsl")
+        .expect("the fixed shader builds");
+    assert_eq!(fire.light_estimate_error(), None);
+    advance_and_wait(&mut [&mut fire], &host, 4);
+    assert!(fire.effect_light(id).is_some(), "the light is back");
+}

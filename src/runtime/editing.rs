@@ -186,15 +186,8 @@ impl Player {
             }
             "sort.wgsl" => self.sort.rebuild(&self.ctx, &lib)?,
             "depth_resolve.wgsl" => self.host_depth.rebuild(&self.ctx, &lib)?,
-            "light.wgsl" => {
-                if let Some(pass) = &mut self.light.pass {
-                    pass.rebuild(&self.ctx, &lib)?;
-                }
-            }
-            "light_apply.wgsl" => {
-                if let Some(pass) = &mut self.light.apply {
-                    pass.rebuild(&self.ctx, &lib)?;
-                }
+            "light.wgsl" | "light_apply.wgsl" => {
+                self.light.reload(&self.ctx, &lib, &self.frame, entry)?;
             }
             "haze_apply.wgsl" => {
                 if self.haze.is_some() {

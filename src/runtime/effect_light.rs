@@ -13,7 +13,7 @@ use crate::render::Scene;
 use crate::render::frame::FrameResources;
 use crate::render::light::{LightPass, LightSums};
 use crate::render::light_apply::SelfLightPass;
-use crate::shaders::ShaderLibrary;
+use crate::shaders::{ShaderError, ShaderLibrary};
 
 /// The light of one instance, as a point light a host can place in its scene.
 ///
@@ -47,8 +47,9 @@ pub(super) struct LightEstimate {
     pub pass: Option<LightPass<LightOwner>>,
     /// The lit layers' share of the light (built with `pass`).
     pub apply: Option<SelfLightPass>,
-    /// The passes could not be built on this device (logged once; not tried again).
-    pub failed: bool,
+    /// Why the passes could not be built (logged once; not tried again until a reload of
+    /// their shaders).
+    pub error: Option<String>,
     pub on: bool,
     pub latest: HashMap<InstanceId, EffectLight>,
 }
@@ -69,6 +70,15 @@ impl Player {
     /// first readback, with the estimate off, or for an instance with no light alive.
     pub fn effect_light(&self, id: InstanceId) -> Option<EffectLight> {
         self.light.latest.get(&id).copied()
+    }
+
+    /// Why the effect light cannot be estimated, naming the file: its passes failed to
+    /// build from the player's shaders or on this device (then [`Player::effect_light`] is
+    /// `None` and lit layers are drawn without their effect's own light). `None` while
+    /// they work or before they are first needed. [`Player::reload_shader`] of
+    /// `light.wgsl` or `light_apply.wgsl` builds them again.
+    pub fn light_estimate_error(&self) -> Option<&str> {
+        self.light.error.as_deref()
     }
 }
 
@@ -95,20 +105,13 @@ impl LightEstimate {
         owners: &[Option<LightOwner>],
     ) {
         let lit = f.items.iter().any(|d| d.variant.lit);
-        if (!self.on && !lit) || self.failed {
+        if (!self.on && !lit) || self.error.is_some() {
             return;
         }
         if self.pass.is_none() || self.apply.is_none() {
-            // Built in an error scope: whatever the host's device refuses is logged, not a
-            // panic in its error handler.
-            let scope = f.ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
-            let built = LightPass::new(f.ctx, f.library, f.frame)
-                .and_then(|p| Ok((p, SelfLightPass::new(f.ctx, f.library)?)));
-            let refused = pollster::block_on(scope.pop());
-            match (built, refused) {
-                (Ok((p, a)), None) => (self.pass, self.apply) = (Some(p), Some(a)),
-                (Err(e), _) => return self.failed_with(&e),
-                (_, Some(e)) => return self.failed_with(&e),
+            match build(f.ctx, f.library, f.frame) {
+                Ok((p, a)) => (self.pass, self.apply) = (Some(p), Some(a)),
+                Err(e) => return self.failed_with(&e),
             }
         }
         let Some(pass) = self.pass.as_mut() else {
@@ -148,14 +151,56 @@ impl LightEstimate {
         }
     }
 
-    /// Turns the estimate off after its passes could not be built, saying why.
-    fn failed_with(&mut self, why: &dyn std::fmt::Display) {
+    /// Stops the estimate after its passes could not be built, saying why (a reload of
+    /// their shaders tries again).
+    fn failed_with(&mut self, why: &ShaderError) {
         log::error!(
-            "the effect light cannot be estimated on this device (lit layers are drawn \
-             without it): {why}"
+            "the effect light cannot be estimated (lit layers are drawn without it): {why}"
         );
-        self.on = false;
-        self.failed = true;
+        self.error = Some(why.to_string());
+    }
+
+    /// Rebuilds the pass `entry` names (`light.wgsl` or `light_apply.wgsl`) from `lib`;
+    /// after a failure, builds both anew, and the error goes when they build.
+    pub(super) fn reload(
+        &mut self,
+        ctx: &GpuContext,
+        lib: &ShaderLibrary,
+        frame: &FrameResources,
+        entry: &str,
+    ) -> Result<(), ShaderError> {
+        match (&mut self.pass, &mut self.apply) {
+            (Some(pass), _) if entry == "light.wgsl" => pass.rebuild(ctx, lib),
+            (_, Some(apply)) if entry == "light_apply.wgsl" => apply.rebuild(ctx, lib),
+            _ if self.error.is_some() => {
+                let (pass, apply) = build(ctx, lib, frame)?;
+                (self.pass, self.apply, self.error) = (Some(pass), Some(apply), None);
+                Ok(())
+            }
+            // Built on first need, from the reloaded shaders.
+            _ => Ok(()),
+        }
+    }
+}
+
+/// The light's passes, built in an error scope: whatever the host's device refuses is
+/// returned, not a panic in its error handler.
+fn build(
+    ctx: &GpuContext,
+    lib: &ShaderLibrary,
+    frame: &FrameResources,
+) -> Result<(LightPass<LightOwner>, SelfLightPass), ShaderError> {
+    let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let built =
+        LightPass::new(ctx, lib, frame).and_then(|p| Ok((p, SelfLightPass::new(ctx, lib)?)));
+    let refused = pollster::block_on(scope.pop());
+    match (built, refused) {
+        (Ok(passes), None) => Ok(passes),
+        (Err(e), _) => Err(e),
+        (_, Some(e)) => Err(ShaderError::Pipeline {
+            file: "light.wgsl, light_apply.wgsl".into(),
+            message: e.to_string(),
+        }),
     }
 }
 
