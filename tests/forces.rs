@@ -8,8 +8,11 @@ mod common;
 
 use common::*;
 use glam::{DVec3, Vec3};
+use ignis::Camera;
 use ignis::effect::*;
+use ignis::testing::gpu::GpuContext;
 use ignis::testing::gpu::types::Particle;
+use ignis::testing::headless::Headless;
 use ignis::testing::shaders::ShaderLibrary;
 use ignis::testing::sim::cpu_reference::{Forces as CpuForces, curl_noise};
 use ignis::testing::sim::{GpuSim, Modules};
@@ -542,6 +545,23 @@ fn stick_on_contact_stops_particles_where_they_touch() {
     assert_eq!(out[0].velocity(), Vec3::ZERO);
 }
 
+/// `effect` played headless for `frames` frames at 60 fps (the player the Inspect view
+/// reads).
+fn played(ctx: &GpuContext, effect: Effect, frames: u32) -> Headless {
+    let mut run = Headless::new(ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    for _ in 0..frames {
+        run.advance(1.0 / 60.0);
+    }
+    run
+}
+
+/// Where `p` (world, metres) lands on `camera`'s 640×480 screen, in pixels.
+fn pixel_of(camera: &Camera, p: Vec3) -> glam::Vec2 {
+    let clip = camera.clip_from_world_mat4() * p.extend(1.0);
+    let ndc = clip.truncate() / clip.w;
+    glam::Vec2::new((ndc.x + 1.0) * 320.0, (1.0 - ndc.y) * 240.0)
+}
+
 /// The Inspect view's look inside: the particle under a pixel is found (the nearest one
 /// projected within the radius), and the forces reported on it are the force model's —
 /// the constant part, the drag toward the wind from its own velocity, and their sum.
@@ -558,12 +578,7 @@ fn an_inspected_particle_reports_its_state_and_the_forces_on_it() {
     e.forces.drag_per_sec = 1.5;
     e.forces.wind_m_per_s = [0.5, 0.0, 0.0];
     e.transform.position_m = [3.0, 1.0, -2.0];
-    let effect = bare_effect(e);
-    let mut run = ignis::testing::headless::Headless::new(&ctx, effect, ShaderLibrary::embedded())
-        .expect("headless");
-    for _ in 0..30 {
-        run.advance(1.0 / 60.0);
-    }
+    let run = played(&ctx, bare_effect(e), 30);
     let camera = run.camera.view((640, 480));
     let particles = run.player.particles(run.instance, 0).expect("particles");
     let (slot, p) = particles
@@ -596,9 +611,7 @@ fn an_inspected_particle_reports_its_state_and_the_forces_on_it() {
     assert!((force("total") - (constant + drag)).length() < 1e-4);
     assert_eq!(info.forces.len(), 3, "{:?}", info.forces);
     // Picking: the pixel the particle projects to finds it; far from every particle, none.
-    let clip = camera.clip_from_world_mat4() * info.position_m.extend(1.0);
-    let ndc = clip.truncate() / clip.w;
-    let pixel = glam::Vec2::new((ndc.x + 1.0) * 320.0, (1.0 - ndc.y) * 240.0);
+    let pixel = pixel_of(&camera, info.position_m);
     let picked = run
         .player
         .pick_particle(run.instance, &camera, pixel, 0.5)
@@ -630,12 +643,7 @@ fn inspected_forces_carry_the_over_life_multipliers_at_the_particles_age() {
         keys: vec![(0.0, 0.0), (1.0, 2.0)],
         smooth: false,
     };
-    let mut run =
-        ignis::testing::headless::Headless::new(&ctx, bare_effect(e), ShaderLibrary::embedded())
-            .expect("headless");
-    for _ in 0..45 {
-        run.advance(1.0 / 60.0);
-    }
+    let run = played(&ctx, bare_effect(e), 45);
     let particles = run.player.particles(run.instance, 0).expect("particles");
     let mut checked = 0;
     for (slot, p) in particles.iter().enumerate().filter(|(_, p)| p.is_alive()) {
@@ -672,21 +680,14 @@ fn a_pick_among_equally_near_particles_is_the_first_slot() {
     e.capacity = 64;
     e.spawn_rate_per_sec = Param::Constant(60.0);
     // Every particle sits still at the emitter: all at one pixel.
-    let mut run =
-        ignis::testing::headless::Headless::new(&ctx, bare_effect(e), ShaderLibrary::embedded())
-            .expect("headless");
-    for _ in 0..20 {
-        run.advance(1.0 / 60.0);
-    }
+    let run = played(&ctx, bare_effect(e), 20);
     let particles = run.player.particles(run.instance, 0).expect("particles");
     let alive: Vec<usize> = (0..particles.len())
         .filter(|&s| particles[s].is_alive())
         .collect();
     assert!(alive.len() >= 10, "{} alive", alive.len());
     let camera = run.camera.view((640, 480));
-    let clip = camera.clip_from_world_mat4() * Vec3::ZERO.extend(1.0);
-    let ndc = clip.truncate() / clip.w;
-    let pixel = glam::Vec2::new((ndc.x + 1.0) * 320.0, (1.0 - ndc.y) * 240.0);
+    let pixel = pixel_of(&camera, Vec3::ZERO);
     let picked = run
         .player
         .pick_particle(
@@ -711,22 +712,12 @@ fn a_pick_within_a_wide_radius_is_the_nearest_particle() {
     e.spawn_rate_per_sec = Param::Constant(60.0);
     e.speed_m_per_s = Range::new(0.5, 2.0);
     e.spread_deg = 60.0;
-    let mut run =
-        ignis::testing::headless::Headless::new(&ctx, bare_effect(e), ShaderLibrary::embedded())
-            .expect("headless");
-    for _ in 0..40 {
-        run.advance(1.0 / 60.0);
-    }
+    let run = played(&ctx, bare_effect(e), 40);
     let camera = run.camera.view((640, 480));
-    let to_pixel = |p: Vec3| {
-        let clip = camera.clip_from_world_mat4() * p.extend(1.0);
-        let ndc = clip.truncate() / clip.w;
-        glam::Vec2::new((ndc.x + 1.0) * 320.0, (1.0 - ndc.y) * 240.0)
-    };
     let particles = run.player.particles(run.instance, 0).expect("particles");
     let pixels: Vec<(usize, glam::Vec2)> = (particles.iter().enumerate())
         .filter(|(_, p)| p.is_alive())
-        .map(|(s, p)| (s, to_pixel(p.position())))
+        .map(|(s, p)| (s, pixel_of(&camera, p.position())))
         .collect();
     // A pointer off the crowd's middle, so that the nearest is neither first nor last.
     let mean = pixels.iter().map(|(_, q)| *q).sum::<glam::Vec2>() / pixels.len() as f32;
@@ -763,17 +754,10 @@ fn a_switched_off_emitters_particles_are_not_picked() {
     b.transform.position_m = [0.5, 0.0, 0.0];
     let mut effect = bare_effect(a);
     effect.emitters.push(b);
-    let mut run =
-        ignis::testing::headless::Headless::new(&ctx, effect.clone(), ShaderLibrary::embedded())
-            .expect("headless");
-    for _ in 0..20 {
-        run.advance(1.0 / 60.0);
-    }
+    let mut run = played(&ctx, effect.clone(), 20);
     let camera = run.camera.view((640, 480));
-    let clip = camera.clip_from_world_mat4() * Vec3::new(0.5, 0.0, 0.0).extend(1.0);
-    let ndc = clip.truncate() / clip.w;
-    let pixel = glam::Vec2::new((ndc.x + 1.0) * 320.0, (1.0 - ndc.y) * 240.0);
-    let pick = |run: &ignis::testing::headless::Headless| {
+    let pixel = pixel_of(&camera, Vec3::new(0.5, 0.0, 0.0));
+    let pick = |run: &Headless| {
         (run.player.pick_particle(run.instance, &camera, pixel, 4.0)).expect("pick")
     };
     assert_eq!(pick(&run).map(|p| p.emitter), Some(1), "on, it is picked");

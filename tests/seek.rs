@@ -148,6 +148,12 @@ fn seeks_from_snapshots_give_the_played_state() {
                 state(&run) == *want,
                 "{layout}: the state after seeking to {t:.2} s differs from the played one"
             );
+            // From the latest snapshot at or before the target (one every 0.5 s).
+            let start = run.player.last_seek_start_secs().expect("from a snapshot");
+            assert!(
+                start <= t + 1e-9 && t - start < 0.52,
+                "{layout}: {t} s from {start} s"
+            );
         }
         // Every seek restored a snapshot (a refused restore forgets them all and replays
         // from time 0, which reaches the same state).
@@ -200,6 +206,147 @@ fn seek_snapshots_stay_within_their_memory_bound() {
         bytes >= count as u64 * states && bytes < count as u64 * 2 * states,
         "{count} snapshots, {bytes} bytes: {states} bytes of state each"
     );
+}
+
+/// The snapshots' schedule as documented: one every `every_secs` of simulated time, none
+/// for an interval of 0 or less; within a bound of exactly four snapshots' bytes, the
+/// fifth drops every other one and the interval doubles — against that rule run over the
+/// steps the clock took (frames of one step: the campfire's 1/120 s).
+#[test]
+fn seek_snapshots_follow_their_interval_and_thin_at_their_bound() {
+    let ctx = gpu();
+    let effect = ignis::Effect::default_campfire();
+    let dt = f64::from(effect.time.step_secs);
+    // Each frame's step and the snapshots kept after it, and their bytes at the end.
+    let play = |every_secs: f64, bound: u64, frames: u32| {
+        let mut run = unbatched(&ctx, effect.clone());
+        run.player.keep_seek_snapshots(every_secs, bound);
+        let kept: Vec<(u64, usize)> = (0..frames)
+            .map(|_| {
+                run.advance(dt);
+                let secs = run.player.time_secs(run.instance).expect("time");
+                (
+                    (secs / dt).round() as u64,
+                    run.player.seek_snapshot_bytes().1,
+                )
+            })
+            .collect();
+        (kept, run.player.seek_snapshot_bytes().0)
+    };
+    for every in [0.0, -1.0] {
+        let (none, _) = play(every, u64::MAX, 30);
+        assert!(
+            none.iter().all(|&(_, n)| n == 0),
+            "every {every} s: {none:?}"
+        );
+    }
+    let every = (0.1 / dt).round() as u64;
+    let (first, bytes) = play(0.1, u64::MAX, 40);
+    let taken = counts(&first);
+    assert_eq!(taken, schedule(&first, every, usize::MAX));
+    let one = bytes / taken.last().map_or(1, |&n| n.max(1)) as u64;
+    let (kept, _) = play(0.1, 4 * one, 150);
+    let want = schedule(&kept, every, 4);
+    assert_eq!(counts(&kept), want);
+    let thinned = want.windows(2).filter(|w| w[1] < w[0]).count();
+    assert!(thinned >= 2 && want.contains(&4), "{want:?}");
+}
+
+/// The snapshots kept after each frame.
+fn counts(kept: &[(u64, usize)]) -> Vec<usize> {
+    kept.iter().map(|&(_, n)| n).collect()
+}
+
+/// The documented rule over the steps after each frame: a snapshot at the first step at
+/// least `every` after the last one; past `max` snapshots every other one goes (the
+/// older of each pair) and the interval doubles. The snapshots kept after each frame.
+fn schedule(kept: &[(u64, usize)], mut every: u64, max: usize) -> Vec<usize> {
+    let mut list: Vec<u64> = Vec::new();
+    kept.iter()
+        .map(|&(step, _)| {
+            if step >= list.last().copied().unwrap_or(0) + every && !list.contains(&step) {
+                list.push(step);
+                if list.len() > max {
+                    list = list.iter().skip(1).step_by(2).copied().collect();
+                    every *= 2;
+                }
+            }
+            list.len()
+        })
+        .collect()
+}
+
+/// A frame-delta effect seeks by replaying its frames even while snapshots are kept
+/// (they stand only for fixed steps): the thesis preset's state after 90 frames of
+/// 1/45 s is what a seek to 2 s in frames of 1/45 s gives.
+#[test]
+fn a_frame_delta_effect_seeks_by_replaying_its_frames_with_snapshots_kept() {
+    let ctx = gpu();
+    let effect = ignis::preset::load(std::path::Path::new("presets/thesis_2006.ron"))
+        .expect("the thesis preset");
+    assert_eq!(effect.time.mode, ignis::effect::TimeMode::FrameDelta);
+    let mut run = unbatched(&ctx, effect);
+    run.player.keep_seek_snapshots(0.25, 256 << 20);
+    for _ in 0..90 {
+        run.advance(1.0 / 45.0);
+    }
+    let want = state(&run);
+    assert_eq!(run.seek(2.0, 1.0 / 45.0), 90);
+    assert!(
+        state(&run) == want,
+        "the seek's state differs from the played one"
+    );
+}
+
+/// A seek from a snapshot replays every step after it, in records of at most 32 steps
+/// (here 40: two records), and says which snapshot it started from.
+#[test]
+fn a_seek_replays_every_step_after_its_snapshot() {
+    let ctx = gpu();
+    let effect = ignis::Effect::default_campfire();
+    let dt = f64::from(effect.time.step_secs);
+    let mut run = unbatched(&ctx, effect);
+    run.player.keep_seek_snapshots(0.5, 256 << 20);
+    for _ in 0..100 {
+        run.advance(dt);
+    }
+    let want = state(&run);
+    let (_, count) = run.player.seek_snapshot_bytes();
+    assert_eq!(count, 1, "one snapshot, at 0.5 s");
+    assert_eq!(run.seek(100.0 * dt, dt), 100);
+    assert!(state(&run) == want, "about 60 steps restored, 40 replayed");
+    let start = run.player.last_seek_start_secs();
+    assert!(
+        start.is_some_and(|s| (s - 0.5).abs() < 1.5 * dt),
+        "{start:?}"
+    );
+    run.seek(0.25, dt);
+    assert_eq!(
+        run.player.last_seek_start_secs(),
+        None,
+        "before the first snapshot"
+    );
+}
+
+/// A seek to a time or in frames that are not positive finite numbers replays nothing:
+/// the clock goes back to 0, at once.
+#[test]
+fn a_seek_to_an_impossible_time_goes_back_to_the_start() {
+    let ctx = gpu();
+    let mut run = unbatched(&ctx, ignis::Effect::default_campfire());
+    for _ in 0..10 {
+        run.advance(1.0 / FPS);
+    }
+    for (secs, dt) in [
+        (1.0, 0.0),
+        (1.0, -1.0 / FPS),
+        (f64::INFINITY, 1.0 / FPS),
+        (f64::NAN, 1.0 / FPS),
+        (-2.0, 1.0 / FPS),
+    ] {
+        assert_eq!(run.seek(secs, dt), 0, "seek({secs}, {dt})");
+        assert_eq!(run.player.time_secs(run.instance), Some(0.0));
+    }
 }
 
 /// A frame-delta effect's state depends on every frame's duration: replaying the frames

@@ -34,6 +34,8 @@ pub(super) struct SeekSnapshots {
     max_bytes: u64,
     /// Oldest first, each with the step after which it was taken.
     list: Vec<(u64, Vec<SimSnapshot>)>,
+    /// The step the last seek restored a snapshot of (`None`: it replayed from time 0).
+    last_start: Option<u64>,
 }
 
 impl SeekSnapshots {
@@ -78,6 +80,7 @@ impl Player {
             clean: false,
             max_bytes,
             list: Vec::new(),
+            last_start: None,
         };
         // A player still at time 0 may take snapshots from now; else from its next restart.
         if self.steps_done().is_none_or(|s| s == 0) {
@@ -88,6 +91,14 @@ impl Player {
     /// GPU memory the seek snapshots hold now, and how many there are.
     pub fn seek_snapshot_bytes(&self) -> (u64, usize) {
         (self.snapshots.bytes(), self.snapshots.list.len())
+    }
+
+    /// Where the last [`Player::seek`] started its replay: the simulated time (seconds) of
+    /// the snapshot it restored, or `None` when it replayed from time 0 (no snapshot at or
+    /// before its target, or none kept). A tool can show what a seek cost with it.
+    pub fn last_seek_start_secs(&self) -> Option<f64> {
+        let step = self.snapshots.last_start?;
+        Some(step as f64 * f64::from(self.effect.time.step_secs))
     }
 
     /// Whether snapshots can stand for this player's state: fixed steps, and every
@@ -148,7 +159,8 @@ impl Player {
     /// draw — from the latest snapshot at or before the target when there is one. The
     /// state after it is bit-identical to playing those frames one by one (with fixed
     /// steps, to playing to `secs` at any frame rate), and so is the next frame's
-    /// interpolation. The pause is kept. Returns the frames the seek stands for.
+    /// interpolation. The pause is kept. Returns the frames the seek stands for: 0 for a
+    /// time or frame duration that is not a positive finite number (the clock restarts).
     pub fn seek(&mut self, secs: f64, frame_dt_secs: f64) -> u64 {
         let frames = if secs > 0.0 && frame_dt_secs > 0.0 && secs.is_finite() {
             ((secs / frame_dt_secs).round() as u64).min(MAX_SEEK_FRAMES)
@@ -176,6 +188,7 @@ impl Player {
         let was_paused = std::mem::replace(&mut self.is_paused, false);
         self.restart();
         self.snapshots.clean = true;
+        self.snapshots.last_start = None;
         for (frame, dt) in frame_dts_secs.enumerate() {
             self.advance(dt);
             self.submit_steps(frame as u64);
@@ -198,6 +211,7 @@ impl Player {
         self.restart();
         self.snapshots.clean = true;
         let from = self.restore_latest(steps);
+        self.snapshots.last_start = (from > 0).then_some(from);
         let dt = self.effect.time.step_secs;
         let mut done = from;
         let mut submits = 0;
