@@ -277,8 +277,9 @@ fn schedule(kept: &[(u64, usize)], mut every: u64, max: usize) -> Vec<usize> {
 }
 
 /// A frame-delta effect seeks by replaying its frames even while snapshots are kept
-/// (they stand only for fixed steps): the thesis preset's state after 90 frames of
-/// 1/45 s is what a seek to 2 s in frames of 1/45 s gives.
+/// (they stand only for fixed steps): the thesis preset's state after 100 frames of
+/// 1/45 s is what a seek to 100/45 s in frames of 1/45 s gives — a target between the
+/// steps a snapshot would be taken at, so that no snapshot can stand for it.
 #[test]
 fn a_frame_delta_effect_seeks_by_replaying_its_frames_with_snapshots_kept() {
     let ctx = gpu();
@@ -287,11 +288,11 @@ fn a_frame_delta_effect_seeks_by_replaying_its_frames_with_snapshots_kept() {
     assert_eq!(effect.time.mode, ignis::effect::TimeMode::FrameDelta);
     let mut run = unbatched(&ctx, effect);
     run.player.keep_seek_snapshots(0.25, 256 << 20);
-    for _ in 0..90 {
+    for _ in 0..100 {
         run.advance(1.0 / 45.0);
     }
     let want = state(&run);
-    assert_eq!(run.seek(2.0, 1.0 / 45.0), 90);
+    assert_eq!(run.seek(100.0 / 45.0, 1.0 / 45.0), 100);
     assert!(
         state(&run) == want,
         "the seek's state differs from the played one"

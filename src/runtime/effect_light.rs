@@ -151,6 +151,11 @@ impl LightEstimate {
         }
     }
 
+    /// Whether a frame's light is read back: the estimate is on and its passes built.
+    pub(super) fn reads_back(&self) -> bool {
+        self.on && self.error.is_none()
+    }
+
     /// Stops the estimate after its passes could not be built, saying why (a reload of
     /// their shaders tries again).
     fn failed_with(&mut self, why: &ShaderError) {

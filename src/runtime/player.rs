@@ -416,8 +416,8 @@ impl Player {
             .map(|b| (0..b.active()).map(|slot| b.member(slot)).collect())
             .collect();
         let (groups, ids) = Self::draw_groups(&self.instances, &members, camera);
-        // Who each look slot measures: only for the light estimate, when it is on.
-        let owners = match self.light.on {
+        // Who each look slot measures: only for the light estimate, when it reads back.
+        let owners = match self.light.reads_back() {
             true => super::effect_light::light_owners(&groups, &ids),
             false => Vec::new(),
         };
