@@ -187,6 +187,28 @@ fn an_invalid_effect_is_shown_and_the_last_valid_one_keeps_running() {
 }
 
 #[test]
+fn a_light_that_failed_to_build_is_named_in_the_panel() {
+    let mut harness = panel_harness(campfire_state());
+    assert!(
+        harness
+            .query_by_label_contains("light on the scene is off")
+            .is_none()
+    );
+    harness.state_mut().light_error =
+        Some("light.wgsl: expected `;`, found `}` (line 12)".to_string());
+    harness.run();
+    harness.get_by_label_contains("light on the scene is off");
+    harness.get_by_label_contains("light.wgsl: expected");
+    harness.state_mut().light_error = None;
+    harness.run();
+    assert!(
+        harness
+            .query_by_label_contains("light on the scene is off")
+            .is_none()
+    );
+}
+
+#[test]
 fn widgets_clamp_out_of_range_values() {
     let mut harness = panel_harness(campfire_state());
     harness.get_by_label("Spread").set_value_accesskit(1.0e9);

@@ -108,6 +108,9 @@ pub struct EditorState {
     pub sprite_errors: Vec<(usize, String)>,
     /// The effect's own light as last measured (the grid is lit by it).
     pub fire_light: Option<crate::runtime::EffectLight>,
+    /// Why the effect's light on the scene is off (its shaders failed to build), until a
+    /// shader reload builds them.
+    pub light_error: Option<String>,
     /// Panel sections to open (all others closed) on the next frame, then cleared.
     pub open_sections: Option<Vec<String>>,
     /// The last simulation failure (the simulation pauses), until playback resumes.
@@ -179,6 +182,7 @@ impl EditorState {
             gpu_rejected: None,
             sprite_errors: Vec::new(),
             fire_light: None,
+            light_error: None,
             open_sections: None,
             sim_error: None,
             device_notice: None,

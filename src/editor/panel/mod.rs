@@ -321,6 +321,12 @@ fn problems_ui(ui: &mut Ui, state: &mut EditorState) {
             }
         });
     }
+    if let Some(err) = &state.light_error {
+        error_box_ui(ui, |ui| {
+            ui.label(RichText::new("The fire's light on the scene is off.").strong());
+            ui.label(RichText::new(err).monospace().size(11.0));
+        });
+    }
     if let Some(err) = &state.sim_error {
         error_box_ui(ui, |ui| {
             ui.label(RichText::new("The simulation stopped (paused).").strong());

@@ -382,6 +382,7 @@ impl Gfx {
         let lights_grid = state.view.show_grid && state.view.fire_lights_grid;
         self.player.set_light_estimate(lights_grid);
         state.fire_light = self.player.effect_light(self.instance);
+        state.light_error = self.player.light_estimate_error().map(str::to_owned);
         let mut encoder = self
             .ctx
             .device
