@@ -212,6 +212,23 @@ fn a_haze_layer_bends_the_image_only_around_its_particles() {
     }
 }
 
+/// The haze pass, built at its first use, reloads from a host's shader folder: a broken
+/// `haze_apply.wgsl` is refused and named (the last good pass keeps refracting), a good
+/// one builds.
+#[test]
+fn a_broken_haze_shader_reload_is_named_and_a_good_one_builds() {
+    let ctx = gpu();
+    let mut frame = frame_with(&ctx, &bare_effect(haze_emitter()), glam::Vec3::ZERO);
+    assert!(frame.applied);
+    let broken = shader_folder(&[("haze_apply.wgsl", "fn broken(")]);
+    let Err(err) = frame.player.reload_shader(broken.path(), "haze_apply.wgsl") else {
+        panic!("a broken haze_apply.wgsl is refused");
+    };
+    assert!(err.to_string().contains("haze_apply.wgsl"), "{err}");
+    let good = shader_folder(&[]);
+    (frame.player.reload_shader(good.path(), "haze_apply.wgsl")).expect("the good shader builds");
+}
+
 /// An invisible emitter of 40 particles 0.6 m wide at the origin, haze on.
 fn haze_emitter() -> Emitter {
     let mut e = Emitter {
@@ -243,11 +260,12 @@ fn haze_emitter() -> Emitter {
 }
 
 /// What a host frame held: after the particles' pass, after the haze, and whether haze
-/// was applied.
+/// was applied; the player that drew it.
 struct Framed {
     drawn: Vec<u8>,
     hazed: Vec<u8>,
     applied: bool,
+    player: Player,
 }
 
 /// `effect` played 10 frames at `at`, seen from 1.5 m in front of the origin, each frame
@@ -309,6 +327,7 @@ fn frame_with(ctx: &GpuContext, effect: &Effect, at: glam::Vec3) -> Framed {
         drawn: read(ctx, enc(), &copy),
         hazed: read(ctx, enc(), &host),
         applied,
+        player,
     }
 }
 

@@ -1369,3 +1369,35 @@ fn a_broken_light_shader_is_named_and_a_fixed_one_brings_the_light_back() {
     advance_and_wait(&mut [&mut fire], &host, 4);
     assert!(fire.effect_light(id).is_some(), "the light is back");
 }
+
+/// Every shader a player builds reloads from a host's folder: a broken one is refused and
+/// named, the good one builds again. The depth copy (an MSAA host's) and the haze are
+/// built at their first use; the depth copy is built here, the haze in `tests/haze.rs`.
+#[test]
+fn every_player_shader_reloads_and_a_broken_one_is_named() {
+    let host = Host::of(msaa_host(), vec3(0.0, 0.7, 3.0), vec3(0.0, 0.5, 0.0));
+    let mut fire = host.player(&preset("campfire"));
+    fire.add_instance(host.place(Mat4::IDENTITY), 3)
+        .expect("instance");
+    assert!(fire.tile_pass().is_some(), "this adapter has the tiles");
+    let mut enc = host.device.create_command_encoder(&Default::default());
+    (fire.record(&mut enc, &host.camera, Some(&host.depth_view))).expect("record");
+    host.queue.submit([enc.finish()]);
+    let good = common::shader_folder(&[]);
+    let player_shaders = ignis::PLAYER_SHADERS
+        .iter()
+        .filter(|e| **e != "haze_apply.wgsl");
+    for entry in player_shaders {
+        let broken = common::shader_folder(&[(entry, "fn broken(")]);
+        let Err(err) = fire.reload_shader(broken.path(), entry) else {
+            panic!("a broken {entry} is refused");
+        };
+        assert!(err.to_string().contains(entry), "{entry}: {err}");
+        fire.reload_shader(good.path(), entry)
+            .unwrap_or_else(|e| panic!("{entry} builds again: {e}"));
+    }
+    // Not a player's shader (the host's composite reloads it): nothing to rebuild.
+    let broken = common::shader_folder(&[("bloom.wgsl", "fn broken(")]);
+    fire.reload_shader(broken.path(), "bloom.wgsl")
+        .expect("the player ignores a shader it does not build");
+}
