@@ -1401,3 +1401,57 @@ fn every_player_shader_reloads_and_a_broken_one_is_named() {
     fire.reload_shader(broken.path(), "bloom.wgsl")
         .expect("the player ignores a shader it does not build");
 }
+
+/// A new seed changes the particles born from then on, in a batch and in a simulation of
+/// the instance's own, alike (a packed pool's lives, drawn from the seed, included); the
+/// same seed again changes nothing, and a removed instance's seed cannot be set.
+#[test]
+fn a_new_seed_changes_the_particles_born_from_then_on() {
+    let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+    let mut torch = preset("torch");
+    for e in &mut torch.emitters {
+        e.packed_state = !e.stateless && !e.tiny_state;
+    }
+    let reseeded = |batched: bool| {
+        let settings = PlayerSettings {
+            batch_instances: batched,
+            ..host.settings()
+        };
+        let make = || {
+            let mut p =
+                Player::new(&host.device, &host.queue, &torch, settings.clone()).expect("player");
+            let id = p.add_instance(Mat4::IDENTITY, 3).expect("instance");
+            (p, id)
+        };
+        let (mut kept, k) = make();
+        let (mut same, s) = make();
+        let (mut changed, c) = make();
+        advance_and_wait(&mut [&mut kept, &mut same, &mut changed], &host, 10);
+        assert!(same.set_seed(s, 3));
+        assert!(changed.set_seed(c, 9));
+        advance_and_wait(&mut [&mut kept, &mut same, &mut changed], &host, 10);
+        let of = |p: &Player, id| -> Vec<_> {
+            (0..torch.emitters.len())
+                .map(|e| p.particles(id, e).expect("particles"))
+                .collect()
+        };
+        assert_eq!(
+            of(&same, s),
+            of(&kept, k),
+            "batched {batched}: the same seed"
+        );
+        let new = of(&changed, c);
+        assert_ne!(new, of(&kept, k), "batched {batched}: a new seed");
+        assert!(changed.remove_instance(c));
+        assert!(
+            !changed.set_seed(c, 5),
+            "batched {batched}: a removed instance"
+        );
+        new
+    };
+    assert_eq!(
+        reseeded(true),
+        reseeded(false),
+        "batched and on its own alike"
+    );
+}
