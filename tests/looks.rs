@@ -499,6 +499,51 @@ fn missing_or_broken_pngs_fall_back_with_a_clear_error_and_changed_files_reload(
     assert!(errors[0].1.to_string().contains("fire.png"));
 }
 
+/// A player's PNG sprites through its own calls, as the editor drives them: looked up in
+/// the asset folder it is given, that folder reported to watch, and a changed file
+/// redrawn only once the player is told of it (an unrelated file changes nothing).
+#[test]
+fn a_players_sprite_folder_is_watched_and_a_changed_sprite_is_redrawn() {
+    let ctx = gpu();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("dot.png");
+    write_png(&path, 16, 16, |_, _| [255, 255, 255, 255]);
+    let mut e = bare_effect(plain_emitter());
+    e.emitters[0].look.sprite = Sprite::Image("dot.png".into());
+    e.emitters[0].look.draw_path = DrawPath::Billboard;
+    let mut run = Headless::new(&ctx, e, ShaderLibrary::embedded()).expect("headless");
+    run.player.set_asset_dir(Some(dir.path().to_path_buf()));
+    for _ in 0..30 {
+        run.advance(1.0 / 60.0);
+    }
+    let first = run.render((160, 120)).expect("render");
+    assert!(
+        run.player.sprite_errors().is_empty(),
+        "{:?}",
+        run.player.sprite_errors()
+    );
+    assert!(first.pixels().any(|p| p[0] > 40), "the sprite is drawn");
+    assert_eq!(run.player.sprite_folders(), vec![dir.path().to_path_buf()]);
+
+    // A dot in the middle instead of the square: drawn as before until the player is told.
+    write_png(&path, 16, 16, |x, y| {
+        let inside = (6..10).contains(&x) && (6..10).contains(&y);
+        [255, 255, 255, if inside { 255 } else { 0 }]
+    });
+    let unrelated = dir.path().join("other.png");
+    assert!(!run.player.reload_sprites(std::slice::from_ref(&unrelated)));
+    assert!(run.render((160, 120)).expect("render") == first, "cached");
+    assert!(run.player.reload_sprites(std::slice::from_ref(&path)));
+    let second = run.render((160, 120)).expect("render");
+    let changed = (first.pixels().zip(second.pixels()))
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(
+        changed > 20,
+        "redrawn with the new file: {changed} pixels changed"
+    );
+}
+
 /// One emitter of particles at rest at `pos` (or moving with `vel`), drawn as billboards.
 fn single(pos: Vec3, vel: Vec3, look: Look) -> Effect {
     let mut em = plain_emitter();

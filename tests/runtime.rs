@@ -1455,3 +1455,55 @@ fn a_new_seed_changes_the_particles_born_from_then_on() {
         "batched and on its own alike"
     );
 }
+
+/// An edit that a simulation of its own refuses (a pool over the device's limit) leaves
+/// every instance as it was, the ones that took the edit before the refusal and the ones
+/// that never saw it: each emitter keeps its pool, though the edit also reordered them.
+#[test]
+fn a_refused_edit_leaves_every_own_instance_as_it_was() {
+    let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+    let settings = PlayerSettings {
+        batch_instances: false,
+        ..host.settings()
+    };
+    let torch = preset("torch");
+    let mut player = Player::new(&host.device, &host.queue, &torch, settings).expect("player");
+    let ids = [(0.0, 5), (2.0, 6), (-2.0, 7)].map(|(x, seed)| {
+        player
+            .add_instance(Mat4::from_translation(vec3(x, 0.0, 0.0)), seed)
+            .expect("instance")
+    });
+    advance_and_wait(&mut [&mut player], &host, 30);
+    let pools = |p: &Player| -> Vec<Vec<_>> {
+        let all = ids
+            .iter()
+            .flat_map(|id| (0..torch.emitters.len()).map(move |e| (*id, e)));
+        all.map(|(id, e)| p.particles(id, e).expect("particles"))
+            .collect()
+    };
+    let before = pools(&player);
+    let mut refused = torch.clone();
+    refused.emitters.reverse();
+    let limit = host.device.limits().max_storage_buffer_binding_size;
+    refused.emitters[0].capacity = u32::try_from(limit / 32 + 1).expect("a valid capacity");
+    assert!(
+        refused.validate().is_ok(),
+        "valid, only over the device's limit"
+    );
+    let err = player
+        .set_effect(&refused)
+        .expect_err("over the device's limit");
+    assert!(err.to_string().contains(&refused.emitters[0].name), "{err}");
+    assert_eq!(player.effect(), &torch, "a refused edit changes nothing");
+    assert!(pools(&player) == before, "every instance keeps its pools");
+    advance_and_wait(&mut [&mut player], &host, 2);
+    for id in ids {
+        let alive: u32 = player
+            .count_particles(id)
+            .expect("count")
+            .iter()
+            .map(|c| c.alive)
+            .sum();
+        assert!(alive > 0, "the instance plays on");
+    }
+}
