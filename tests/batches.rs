@@ -142,3 +142,47 @@ fn a_frames_draws_are_counted_on_top_of_its_record() {
         "a record alone {recorded:?}, with the draw {drawn:?}"
     );
 }
+
+/// An edit that adds a trail (trails are not batched) moves every instance to a
+/// simulation of its own, which draws its trail; the edit back batches them again: a
+/// frame's commands are again those of the batch.
+#[test]
+fn an_edit_that_adds_a_trail_unbatches_the_instances_and_its_undo_batches_them() {
+    let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+    let torch = torch_on(DrawPath::Billboard, false);
+    let mut player: Player = host.player(&torch);
+    let ids: Vec<_> = (0..4)
+        .map(|i| {
+            let at = Mat4::from_translation(vec3(i as f32 * 0.5 - 0.75, 0.0, 0.0));
+            player.add_instance(at, i + 1).expect("instance")
+        })
+        .collect();
+    let frames = |player: &mut Player, n: u32| {
+        for _ in 0..n {
+            let mut enc = host.device.create_command_encoder(&Default::default());
+            player.advance(1.0 / 60.0);
+            player.record(&mut enc, &host.camera, None).expect("record");
+            host.queue.submit([enc.finish()]);
+        }
+        player.recorded_commands()
+    };
+    let batched = frames(&mut player, 10);
+    let mut trailed = torch.clone();
+    trailed.emitters[0].look.trail = Some(ignis::effect::Trail::default());
+    assert!(!ignis::testing::sim::batch::batchable(&trailed));
+    player.set_effect(&trailed).expect("the trail");
+    let own = frames(&mut player, 10);
+    assert!(
+        own.dispatches > batched.dispatches,
+        "{own:?} against {batched:?}"
+    );
+    for id in &ids {
+        let ring = player.trail(*id, 0).expect("read");
+        assert!(ring.is_some(), "instance {id:?} has its trail");
+    }
+    player.set_effect(&torch).expect("back");
+    assert_eq!(frames(&mut player, 10), batched, "batched again");
+    for id in &ids {
+        assert!(player.trail(*id, 0).expect("read").is_none());
+    }
+}

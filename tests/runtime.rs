@@ -1507,3 +1507,38 @@ fn a_refused_edit_leaves_every_own_instance_as_it_was() {
         assert!(alive > 0, "the instance plays on");
     }
 }
+
+/// A switched-off emitter is counted as empty, batched or on its own, though its pool
+/// keeps the particles it had (switched back on, they play on).
+#[test]
+fn a_switched_off_emitter_counts_no_particles() {
+    let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+    for batched in [true, false] {
+        let settings = PlayerSettings {
+            batch_instances: batched,
+            ..host.settings()
+        };
+        let torch = preset("torch");
+        let mut player = Player::new(&host.device, &host.queue, &torch, settings).expect("player");
+        let id = player.add_instance(Mat4::IDENTITY, 3).expect("instance");
+        advance_and_wait(&mut [&mut player], &host, 30);
+        let mut off = torch.clone();
+        off.emitters[0].enabled = false;
+        player.set_effect(&off).expect("switched off");
+        let counts = player.count_particles(id).expect("count");
+        assert_eq!(
+            counts[0],
+            ignis::ParticleCount::default(),
+            "batched {batched}"
+        );
+        assert!(
+            counts[1..].iter().all(|c| c.alive > 0),
+            "batched {batched}: {counts:?}"
+        );
+        let kept = player.particles(id, 0).expect("particles");
+        assert!(
+            kept.iter().any(|p| p.is_alive()),
+            "batched {batched}: the pool keeps them"
+        );
+    }
+}
