@@ -1540,5 +1540,65 @@ fn a_switched_off_emitter_counts_no_particles() {
             kept.iter().any(|p| p.is_alive()),
             "batched {batched}: the pool keeps them"
         );
+        let alive: u32 = counts.iter().map(|c| c.alive).sum();
+        let positions = player.particle_positions(id).expect("positions");
+        assert_eq!(
+            positions.len(),
+            alive as usize,
+            "batched {batched}: positions"
+        );
     }
+}
+
+/// Edits play alike batched and on their own: an emitter switched to another integrator
+/// (a pipeline the player had not built) moves its particles by it in both, bit for bit;
+/// a pool edit keeps an own instance's particles (batched ones restart).
+#[test]
+fn edits_play_alike_batched_and_on_their_own() {
+    let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+    let torch = preset("torch");
+    let mut other = torch.clone();
+    other.emitters[0].integrator = match torch.emitters[0].integrator {
+        ignis::effect::Integrator::Rk4 => ignis::effect::Integrator::Heun,
+        _ => ignis::effect::Integrator::Rk4,
+    };
+    let player = |batched: bool| {
+        let settings = PlayerSettings {
+            batch_instances: batched,
+            ..host.settings()
+        };
+        let mut p = Player::new(&host.device, &host.queue, &torch, settings).expect("player");
+        let ids = [(0.0, 4), (1.0, 5)].map(|(x, seed)| {
+            (p.add_instance(Mat4::from_translation(vec3(x, 0.0, 0.0)), seed)).expect("instance")
+        });
+        (p, ids)
+    };
+    let ((mut batched, b), (mut own, o)) = (player(true), player(false));
+    let pools = |p: &Player, ids: [ignis::InstanceId; 2]| -> Vec<Vec<_>> {
+        let all = ids
+            .into_iter()
+            .flat_map(|id| (0..torch.emitters.len()).map(move |e| (id, e)));
+        all.map(|(id, e)| p.particles(id, e).expect("particles"))
+            .collect()
+    };
+    advance_and_wait(&mut [&mut batched, &mut own], &host, 10);
+    batched.set_effect(&other).expect("batched edit");
+    own.set_effect(&other).expect("own edit");
+    advance_and_wait(&mut [&mut batched, &mut own], &host, 10);
+    assert!(
+        pools(&batched, b) == pools(&own, o),
+        "the new integrator, batched and own"
+    );
+
+    let mut larger = other.clone();
+    larger.emitters[0].capacity *= 2;
+    let alive = |p: &Player, id| p.count_particles(id).expect("count")[0].alive;
+    let before = alive(&own, o[0]);
+    own.set_effect(&larger).expect("own pool edit");
+    assert!(
+        before > 0 && alive(&own, o[0]) == before,
+        "kept: {before} before"
+    );
+    batched.set_effect(&larger).expect("batched pool edit");
+    assert_eq!(alive(&batched, b[0]), 0, "batched instances restart");
 }
