@@ -484,19 +484,26 @@ fn missing_or_broken_pngs_fall_back_with_a_clear_error_and_changed_files_reload(
     assert_eq!(lib.watched_dirs(), vec![dir.path().to_path_buf()]);
 
     // A whole frame with a missing sprite: drawn with the fallback, error reported.
-    let mut e = bare_effect(plain_emitter());
-    e.emitters[0].look.sprite = Sprite::Image("missing/fire.png".into());
-    e.emitters[0].look.draw_path = DrawPath::Billboard;
-    let mut run = Headless::new(&ctx, e, ShaderLibrary::embedded()).expect("headless");
-    run.player.set_asset_dir(Some(dir.path().to_path_buf()));
-    for _ in 0..30 {
-        run.advance(1.0 / 60.0);
-    }
+    let mut run = sprite_run(&ctx, "missing/fire.png", dir.path());
     let img = run.render((160, 120)).expect("render");
     assert!(img.pixels().any(|p| p[0] > 40), "fallback sprite drawn");
     let errors = run.player.sprite_errors();
     assert_eq!(errors.len(), 1);
     assert!(errors[0].1.to_string().contains("fire.png"));
+}
+
+/// The plain emitter on billboards with the PNG sprite `sprite` of the asset folder `dir`,
+/// played for half a second.
+fn sprite_run(ctx: &GpuContext, sprite: &str, dir: &Path) -> Headless {
+    let mut e = bare_effect(plain_emitter());
+    e.emitters[0].look.sprite = Sprite::Image(sprite.into());
+    e.emitters[0].look.draw_path = DrawPath::Billboard;
+    let mut run = Headless::new(ctx, e, ShaderLibrary::embedded()).expect("headless");
+    run.player.set_asset_dir(Some(dir.to_path_buf()));
+    for _ in 0..30 {
+        run.advance(1.0 / 60.0);
+    }
+    run
 }
 
 /// A player's PNG sprites through its own calls, as the editor drives them: looked up in
@@ -508,14 +515,7 @@ fn a_players_sprite_folder_is_watched_and_a_changed_sprite_is_redrawn() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = dir.path().join("dot.png");
     write_png(&path, 16, 16, |_, _| [255, 255, 255, 255]);
-    let mut e = bare_effect(plain_emitter());
-    e.emitters[0].look.sprite = Sprite::Image("dot.png".into());
-    e.emitters[0].look.draw_path = DrawPath::Billboard;
-    let mut run = Headless::new(&ctx, e, ShaderLibrary::embedded()).expect("headless");
-    run.player.set_asset_dir(Some(dir.path().to_path_buf()));
-    for _ in 0..30 {
-        run.advance(1.0 / 60.0);
-    }
+    let mut run = sprite_run(&ctx, "dot.png", dir.path());
     let first = run.render((160, 120)).expect("render");
     assert!(
         run.player.sprite_errors().is_empty(),
