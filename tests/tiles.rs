@@ -1163,9 +1163,16 @@ fn the_compute_resolve_composites_what_the_resolve_draw_does() {
                 "{name}: the compute resolve was {}used",
                 if compute { "not " } else { "" }
             );
-            image
+            (image, run.player.recorded_commands())
         };
-        common::resolves_agree(name, &image(false), &image(true));
+        let ((drawn, by_draw), (computed, by_compute)) = (image(false), image(true));
+        common::resolves_agree(name, &drawn, &computed);
+        // The resolve's draw became a dispatch.
+        assert_eq!(
+            (by_compute.dispatches, by_compute.draws + 1),
+            (by_draw.dispatches + 1, by_draw.draws),
+            "{name}"
+        );
     }
 }
 
