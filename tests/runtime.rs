@@ -1602,3 +1602,25 @@ fn edits_play_alike_batched_and_on_their_own() {
     batched.set_effect(&larger).expect("batched pool edit");
     assert_eq!(alive(&batched, b[0]), 0, "batched instances restart");
 }
+
+/// Frames advanced without a record add their steps up to the preset's `max_substeps`;
+/// the excess is dropped and counted, as the stepper counts its own.
+#[test]
+fn steps_of_frames_not_recorded_join_up_to_the_cap_and_the_rest_are_counted_dropped() {
+    let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+    let mut effect = preset("torch");
+    effect.time.step_secs = 1.0 / 128.0;
+    effect.time.max_substeps = 5;
+    let mut player = host.player(&effect);
+    let id = player.add_instance(Mat4::IDENTITY, 3).expect("instance");
+    // Two steps a frame: 2, 4, then 6 asked of a cap of 5 (1 dropped), then 7 (2 more).
+    for _ in 0..4 {
+        player.advance(2.0 / 128.0);
+    }
+    let mut enc = host.device.create_command_encoder(&Default::default());
+    player.record(&mut enc, &host.camera, None).expect("record");
+    host.queue.submit([enc.finish()]);
+    let stats = player.clock_stats();
+    assert_eq!((stats.steps, stats.dropped_steps), (5, 3));
+    assert_eq!(player.time_secs(id), Some(5.0 / 128.0));
+}
