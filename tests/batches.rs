@@ -186,3 +186,42 @@ fn an_edit_that_adds_a_trail_unbatches_the_instances_and_its_undo_batches_them()
         assert!(player.trail(*id, 0).expect("read").is_none());
     }
 }
+
+/// Batches are drawn far to near by their instances' mean depth: 16 torches near the
+/// camera fill the first batch, a 17th far behind them starts the second, whose draws
+/// come first.
+#[test]
+fn batches_are_drawn_far_to_near() {
+    let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+    let torch = torch_on(DrawPath::Billboard, true);
+    let mut player: Player = host.player(&torch);
+    for i in 0..17 {
+        let at = if i < 16 {
+            vec3((i % 4) as f32 * 0.3 - 0.45, 0.0, 2.0 - (i / 4) as f32 * 0.1)
+        } else {
+            vec3(0.0, 0.0, -6.0)
+        };
+        player
+            .add_instance(Mat4::from_translation(at), i + 1)
+            .expect("instance");
+    }
+    let mut enc = host.device.create_command_encoder(&Default::default());
+    player.advance(1.0 / 60.0);
+    player.record(&mut enc, &host.camera, None).expect("record");
+    host.queue.submit([enc.finish()]);
+    let groups: Vec<(usize, u32)> = player
+        .draw_items()
+        .iter()
+        .map(|d| (d.group, d.members))
+        .collect();
+    let first = groups.iter().find(|(g, _)| *g == 0).expect("a first group");
+    let second = groups
+        .iter()
+        .find(|(g, _)| *g == 1)
+        .expect("a second group");
+    assert_eq!(
+        (first.1, second.1),
+        (1, 16),
+        "the far batch first: {groups:?}"
+    );
+}
