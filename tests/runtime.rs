@@ -1624,3 +1624,25 @@ fn steps_of_frames_not_recorded_join_up_to_the_cap_and_the_rest_are_counted_drop
     assert_eq!((stats.steps, stats.dropped_steps), (5, 3));
     assert_eq!(player.time_secs(id), Some(5.0 / 128.0));
 }
+
+/// An edit from fixed steps to frame deltas between an advance that planned no step and
+/// the next: the frame-delta step is that frame's delta alone.
+#[test]
+fn a_frame_delta_step_after_a_fixed_step_edit_is_the_frames_delta() {
+    let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+    let mut effect = preset("torch");
+    effect.time.mode = ignis::effect::TimeMode::FixedStep;
+    effect.time.step_secs = 1.0 / 64.0;
+    effect.time.max_frame_dt_secs = 0.25;
+    let mut player = host.player(&effect);
+    let id = player.add_instance(Mat4::IDENTITY, 3).expect("instance");
+    player.advance(1.0 / 256.0);
+    let mut delta = effect.clone();
+    delta.time.mode = ignis::effect::TimeMode::FrameDelta;
+    player.set_effect(&delta).expect("frame deltas");
+    player.advance(1.0 / 32.0);
+    let mut enc = host.device.create_command_encoder(&Default::default());
+    player.record(&mut enc, &host.camera, None).expect("record");
+    host.queue.submit([enc.finish()]);
+    assert_eq!(player.time_secs(id), Some(1.0 / 32.0));
+}
