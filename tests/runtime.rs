@@ -1646,3 +1646,20 @@ fn a_frame_delta_step_after_a_fixed_step_edit_is_the_frames_delta() {
     host.queue.submit([enc.finish()]);
     assert_eq!(player.time_secs(id), Some(1.0 / 32.0));
 }
+
+/// A frame-by-frame step of a frame-delta effect is a 60 Hz frame (or the preset's
+/// largest delta, when smaller).
+#[test]
+fn a_frame_delta_step_is_a_60_hz_frame() {
+    let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+    let mut effect = preset("torch");
+    effect.time.mode = ignis::effect::TimeMode::FrameDelta;
+    effect.time.max_frame_dt_secs = 0.25;
+    let mut player = host.player(&effect);
+    let id = player.add_instance(Mat4::IDENTITY, 3).expect("instance");
+    player.step();
+    let mut enc = host.device.create_command_encoder(&Default::default());
+    player.record(&mut enc, &host.camera, None).expect("record");
+    host.queue.submit([enc.finish()]);
+    assert_eq!(player.time_secs(id), Some(f64::from(1.0f32 / 60.0)));
+}
