@@ -1617,9 +1617,7 @@ fn steps_of_frames_not_recorded_join_up_to_the_cap_and_the_rest_are_counted_drop
     for _ in 0..4 {
         player.advance(2.0 / 128.0);
     }
-    let mut enc = host.device.create_command_encoder(&Default::default());
-    player.record(&mut enc, &host.camera, None).expect("record");
-    host.queue.submit([enc.finish()]);
+    record_now(&mut player, &host);
     let stats = player.clock_stats();
     assert_eq!((stats.steps, stats.dropped_steps), (5, 3));
     assert_eq!(player.time_secs(id), Some(5.0 / 128.0));
@@ -1641,9 +1639,7 @@ fn a_frame_delta_step_after_a_fixed_step_edit_is_the_frames_delta() {
     delta.time.mode = ignis::effect::TimeMode::FrameDelta;
     player.set_effect(&delta).expect("frame deltas");
     player.advance(1.0 / 32.0);
-    let mut enc = host.device.create_command_encoder(&Default::default());
-    player.record(&mut enc, &host.camera, None).expect("record");
-    host.queue.submit([enc.finish()]);
+    record_now(&mut player, &host);
     assert_eq!(player.time_secs(id), Some(1.0 / 32.0));
 }
 
@@ -1658,8 +1654,13 @@ fn a_frame_delta_step_is_a_60_hz_frame() {
     let mut player = host.player(&effect);
     let id = player.add_instance(Mat4::IDENTITY, 3).expect("instance");
     player.step();
+    record_now(&mut player, &host);
+    assert_eq!(player.time_secs(id), Some(f64::from(1.0f32 / 60.0)));
+}
+
+/// Records what the player planned (no advance), and submits it.
+fn record_now(player: &mut Player, host: &Host) {
     let mut enc = host.device.create_command_encoder(&Default::default());
     player.record(&mut enc, &host.camera, None).expect("record");
     host.queue.submit([enc.finish()]);
-    assert_eq!(player.time_secs(id), Some(f64::from(1.0f32 / 60.0)));
 }
