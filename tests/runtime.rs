@@ -1608,11 +1608,10 @@ fn edits_play_alike_batched_and_on_their_own() {
 #[test]
 fn steps_of_frames_not_recorded_join_up_to_the_cap_and_the_rest_are_counted_dropped() {
     let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
-    let mut effect = preset("torch");
-    effect.time.step_secs = 1.0 / 128.0;
-    effect.time.max_substeps = 5;
-    let mut player = host.player(&effect);
-    let id = player.add_instance(Mat4::IDENTITY, 3).expect("instance");
+    let (_, mut player, id) = timed_torch(&host, |t| {
+        t.step_secs = 1.0 / 128.0;
+        t.max_substeps = 5;
+    });
     // Two steps a frame: 2, 4, then 6 asked of a cap of 5 (1 dropped), then 7 (2 more).
     for _ in 0..4 {
         player.advance(2.0 / 128.0);
@@ -1628,12 +1627,11 @@ fn steps_of_frames_not_recorded_join_up_to_the_cap_and_the_rest_are_counted_drop
 #[test]
 fn a_frame_delta_step_after_a_fixed_step_edit_is_the_frames_delta() {
     let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
-    let mut effect = preset("torch");
-    effect.time.mode = ignis::effect::TimeMode::FixedStep;
-    effect.time.step_secs = 1.0 / 64.0;
-    effect.time.max_frame_dt_secs = 0.25;
-    let mut player = host.player(&effect);
-    let id = player.add_instance(Mat4::IDENTITY, 3).expect("instance");
+    let (effect, mut player, id) = timed_torch(&host, |t| {
+        t.mode = ignis::effect::TimeMode::FixedStep;
+        t.step_secs = 1.0 / 64.0;
+        t.max_frame_dt_secs = 0.25;
+    });
     player.advance(1.0 / 256.0);
     let mut delta = effect.clone();
     delta.time.mode = ignis::effect::TimeMode::FrameDelta;
@@ -1648,14 +1646,26 @@ fn a_frame_delta_step_after_a_fixed_step_edit_is_the_frames_delta() {
 #[test]
 fn a_frame_delta_step_is_a_60_hz_frame() {
     let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
-    let mut effect = preset("torch");
-    effect.time.mode = ignis::effect::TimeMode::FrameDelta;
-    effect.time.max_frame_dt_secs = 0.25;
-    let mut player = host.player(&effect);
-    let id = player.add_instance(Mat4::IDENTITY, 3).expect("instance");
+    let (_, mut player, id) = timed_torch(&host, |t| {
+        t.mode = ignis::effect::TimeMode::FrameDelta;
+        t.max_frame_dt_secs = 0.25;
+    });
     player.step();
     record_now(&mut player, &host);
     assert_eq!(player.time_secs(id), Some(f64::from(1.0f32 / 60.0)));
+}
+
+/// The torch with its time settings changed by `time`, and a player of it with one
+/// instance.
+fn timed_torch(
+    host: &Host,
+    time: impl FnOnce(&mut ignis::effect::TimeSettings),
+) -> (Effect, Player, ignis::InstanceId) {
+    let mut effect = preset("torch");
+    time(&mut effect.time);
+    let mut player = host.player(&effect);
+    let id = player.add_instance(Mat4::IDENTITY, 3).expect("instance");
+    (effect, player, id)
 }
 
 /// Records what the player planned (no advance), and submits it.
