@@ -542,3 +542,23 @@ fn large_sprites_forced_onto_the_splat_keep_their_light_at_their_centres() {
         "large sprites took their footprint: {mean:.3}/255"
     );
 }
+
+/// A frame whose only particles are splatted reports its light layer drawn (a host's
+/// composite reads it to know there is light to add); before any record, nothing is.
+#[test]
+fn a_frame_of_splatted_light_alone_reports_the_light_layer_drawn() {
+    let ctx = gpu();
+    let mut effect = one_still(|look| look.draw_path = DrawPath::Splat);
+    effect.post.alpha_downscale = 1;
+    let mut run = Headless::new(&ctx, effect, ShaderLibrary::embedded()).expect("headless");
+    assert_eq!(
+        run.player.drawn_layers(),
+        ignis::Layers::NONE,
+        "nothing recorded"
+    );
+    run.advance(1.0 / 60.0);
+    run.render(SIZE).expect("render");
+    let items = run.player.draw_items();
+    assert!(items.iter().all(|d| d.splat), "every emitter splatted");
+    assert_eq!(run.player.drawn_layers(), ignis::Layers::LIGHT);
+}
