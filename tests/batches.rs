@@ -1,10 +1,11 @@
 //! The runtime's batches as a host sees them: instances of one preset share their
 //! batch's dispatches and draws. The commands a frame records (`Player::recorded_commands`)
-//! for 1, 16, 17 and 100 torches on every draw path: the same for 1 and 16 (one batch),
-//! and the same step from each further batch (17: two, 100: three: batches of 16, 32 and
-//! 64). The smoke's sort is one per batch, but its bitonic network grows with the log² of
-//! the batch's particles: with smoke, the draws are checked exactly and the dispatches
-//! within that growth; the additive torch's commands are checked exactly.
+//! for 1, 16, 17 and 100 torches on every draw path: one batch grows to hold them all
+//! (the same commands whatever the count); with batches of at most 16, each further
+//! batch adds the same step (17: two, 100: seven). The smoke's sort is one per batch, but
+//! its bitonic network grows with the log² of the batch's particles: with smoke, the
+//! draws are checked exactly and the dispatches within that growth; the additive
+//! torch's commands are checked exactly.
 
 // The runtime tests' host (this file uses part of it).
 #[allow(dead_code)]
@@ -34,10 +35,15 @@ fn torch_on(path: DrawPath, smoke: bool) -> Effect {
     effect
 }
 
-/// A frame's commands with `n` torches on a grid 0.3 m apart, after the same 30 frames
-/// of warm-up whatever `n` (the same steps), and whether the frame shows fire.
-fn frame_commands(host: &Host, effect: &Effect, n: u32) -> (CommandCounts, bool) {
-    let mut player: Player = host.player(effect);
+/// A frame's commands with `n` torches on a grid 0.3 m apart in batches of at most
+/// `max` instances, after the same 30 frames of warm-up whatever `n` (the same steps),
+/// and whether the frame shows fire.
+fn frame_commands(host: &Host, effect: &Effect, n: u32, max: u32) -> (CommandCounts, bool) {
+    let settings = ignis::PlayerSettings {
+        max_batch_instances: max,
+        ..host.settings()
+    };
+    let mut player = Player::new(&host.device, &host.queue, effect, settings).expect("player");
     for i in 0..n {
         let (x, z) = ((i % 10) as f32 * 0.3 - 1.35, -((i / 10) as f32) * 0.3);
         player
@@ -56,8 +62,8 @@ fn frame_commands(host: &Host, effect: &Effect, n: u32) -> (CommandCounts, bool)
     (player.recorded_commands(), lit)
 }
 
-// One test per path: each plays 1, 16, 17 and 100 torches twice (with and without
-// smoke), and the paths run side by side.
+// One test per path: each plays 1, 16, 17 and 100 torches in one batch and 17 and 100
+// in batches of 16, with and without smoke; the paths run side by side.
 #[test]
 fn instances_on_billboards_share_their_batch_dispatches_and_draws() {
     instances_share_their_batch_commands(DrawPath::Billboard);
@@ -73,45 +79,64 @@ fn instances_on_the_splat_share_their_batch_dispatches_and_draws() {
     instances_share_their_batch_commands(DrawPath::Splat);
 }
 
-/// 1 and 16 torches on `path` record the same commands, and each further batch the same
-/// step (with smoke: the draws exactly, the dispatches within the sort's growth).
+/// 1, 16, 17 and 100 torches on `path` record the commands of one batch; in batches of
+/// 16, 17 record two batches' and 100 seven's, each further batch the same step (with
+/// smoke: the draws exactly, the dispatches within the sort's growth).
 fn instances_share_their_batch_commands(path: DrawPath) {
     let host = Host::new(vec3(0.0, 1.5, 3.5), vec3(0.0, 0.8, -1.0));
     for smoke in [false, true] {
-        let [one, sixteen, two, hundred] = batch_commands(&host, path, smoke);
         let what = format!("{path:?}, smoke {smoke}");
+        let effect = torch_on(path, smoke);
+        let [one, sixteen, seventeen, hundred] =
+            [1, 16, 17, 100].map(|n| commands(&host, &effect, n, 128));
+        eprintln!(
+            "{what}: 1, 16, 17, 100 torches in one batch record {one:?}, {sixteen:?}, {seventeen:?}, {hundred:?}"
+        );
         assert!(one.dispatches > 0 && one.draws > 0, "{what}: {one:?}");
         assert_eq!(one, sixteen, "{what}: 16 instances in one batch");
+        assert_eq!(
+            one, seventeen,
+            "{what}: 17 instances in one batch grown to 32"
+        );
+        let [two, seven] = [17, 100].map(|n| commands(&host, &effect, n, 16));
+        eprintln!("{what}: 17, 100 torches in batches of 16 record {two:?}, {seven:?}");
         let per_batch = two - one;
         assert!(
             per_batch.dispatches > 0,
             "{what}: a second batch steps nowhere"
         );
-        let third = hundred - two;
+        let five = seven - two;
+        assert_eq!(five.draws, 5 * per_batch.draws, "{what}: draws per batch");
         if smoke {
-            // The third batch's sort (64 members, not 32) may run a longer network.
-            assert_eq!(third.draws, per_batch.draws, "{what}: draws per batch");
-            let growth = third.dispatches - per_batch.dispatches;
+            // One sort of 100 instances' smoke runs a longer network than one of 1 (and
+            // each batch of 16 than the batch of 1 that ends the seven).
+            assert_eq!(hundred.draws, one.draws, "{what}: draws of one batch");
+            let growth = hundred.dispatches - one.dispatches;
+            assert!(
+                growth <= 24,
+                "{what}: 100 in one batch {hundred:?}, 1 {one:?}"
+            );
+            let growth = 5 * per_batch.dispatches - five.dispatches;
             assert!(
                 growth <= 8,
-                "{what}: the third batch {third:?}, the second {per_batch:?}"
+                "{what}: five batches {five:?}, the second {per_batch:?}"
             );
         } else {
-            assert_eq!(third, per_batch, "{what}: commands per batch");
+            assert_eq!(hundred, one, "{what}: 100 instances in one batch");
+            assert_eq!(
+                five.dispatches,
+                5 * per_batch.dispatches,
+                "{what}: dispatches per batch"
+            );
         }
     }
 }
 
-/// The commands of 1, 16, 17 and 100 torches on `path`.
-fn batch_commands(host: &Host, path: DrawPath, smoke: bool) -> [CommandCounts; 4] {
-    let effect = torch_on(path, smoke);
-    let counts = [1, 16, 17, 100].map(|n| {
-        let (c, lit) = frame_commands(host, &effect, n);
-        assert!(lit, "{path:?}, {n} torches: no fire drawn");
-        c
-    });
-    eprintln!("{path:?}, smoke {smoke}: 1, 16, 17, 100 torches record {counts:?}");
-    counts
+/// The commands of `n` torches of `effect` in batches of at most `max`, checked to draw.
+fn commands(host: &Host, effect: &Effect, n: u32, max: u32) -> CommandCounts {
+    let (c, lit) = frame_commands(host, effect, n, max);
+    assert!(lit, "{n} torches in batches of {max}: no fire drawn");
+    c
 }
 
 /// The draws a frame reports are the record's plus the host's draw: more than a frame
@@ -187,14 +212,18 @@ fn an_edit_that_adds_a_trail_unbatches_the_instances_and_its_undo_batches_them()
     }
 }
 
-/// Batches are drawn far to near by their instances' mean depth: 16 torches near the
-/// camera fill the first batch, a 17th far behind them starts the second, whose draws
-/// come first.
+/// Batches are drawn far to near by their instances' mean depth: in batches of at most
+/// 16, 16 torches near the camera fill the first batch, a 17th far behind them starts
+/// the second, whose draws come first.
 #[test]
 fn batches_are_drawn_far_to_near() {
     let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
     let torch = torch_on(DrawPath::Billboard, true);
-    let mut player: Player = host.player(&torch);
+    let settings = ignis::PlayerSettings {
+        max_batch_instances: 16,
+        ..host.settings()
+    };
+    let mut player = Player::new(&host.device, &host.queue, &torch, settings).expect("player");
     for i in 0..17 {
         let at = if i < 16 {
             vec3((i % 4) as f32 * 0.3 - 0.45, 0.0, 2.0 - (i / 4) as f32 * 0.1)

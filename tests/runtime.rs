@@ -12,7 +12,7 @@ use host::{Frame, Host, HostKind, Quad, SIZE};
 use ignis::effect::{BlendMode, ColorStop, Effect, Sprite};
 use ignis::testing::shaders::ShaderLibrary;
 use ignis::testing::sim::{GpuSim, Stepper};
-use ignis::{Player, PlayerSettings};
+use ignis::{InstanceId, Player, PlayerSettings};
 
 fn preset(name: &str) -> Effect {
     let path = format!("{}/presets/{name}.ron", env!("CARGO_MANIFEST_DIR"));
@@ -538,46 +538,84 @@ fn a_batched_instance_steps_exactly_as_a_simulation_of_its_own() {
     advance(&mut [&mut player], &host, 20);
     assert!(player.remove_instance(ids[1]));
     let late = player.add_instance(places[1], 77).expect("instance");
-    let ctx = ignis::testing::gpu::GpuContext::from_device(&host.device, &host.queue);
-    // The instance's own simulation, stepped as the player's clock stepped it from frame
-    // `from` (a clock's steps per frame depend on its history: it is replayed).
-    let own = |id, from: u32, frames: u32| {
-        let placed = player.instance_effect(id).expect("instance").clone();
-        let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &placed).expect("sim");
-        let mut stepper = Stepper::default();
-        for frame in 0..from + frames {
-            let plan = stepper.advance(1.0 / 60.0, &placed.time);
-            if frame >= from {
-                sim.step(&placed, plan.dt_secs, plan.steps).expect("step");
-            }
-        }
-        sim
-    };
-    let first = own(ids[0], 0, 50);
-    let newcomer = own(late, 20, 30);
+    let first = own_simulation(&host, &player, ids[0], 0, 50);
+    let newcomer = own_simulation(&host, &player, late, 20, 30);
     advance(&mut [&mut player], &host, 30);
+    for (id, sim) in [(ids[0], &first), (late, &newcomer)] {
+        assert_steps_as_its_own(&player, id, sim);
+    }
+}
+
+/// A batch's buffers grow when an instance finds them full: 3 instances play 20 frames,
+/// 15 more come (18: buffers for 16 grow to 32), and after 30 more frames the first and
+/// the last step bit for bit as simulations of their own. Until its first record a new
+/// instance beyond the old buffers has no particle.
+#[test]
+fn a_batch_that_grows_keeps_its_instances_stepping_as_their_own() {
+    let host = Host::new(vec3(0.0, 1.0, 4.0), vec3(0.0, 0.5, 0.0));
+    let effect = batchable_campfire();
+    let mut player = host.player(&effect);
+    let place = |k: u32| Mat4::from_translation(vec3(k as f32 * 0.2 - 1.8, 0.0, -(k as f32) * 0.1));
+    let first = player.add_instance(place(0), 10).expect("instance");
+    for k in 1..3 {
+        player.add_instance(place(k), 10 + k).expect("instance");
+    }
+    advance(&mut [&mut player], &host, 20);
+    let late: Vec<_> = (3..18)
+        .map(|k| player.add_instance(place(k), 10 + k).expect("instance"))
+        .collect();
+    let last = late[late.len() - 1];
     for e in 0..effect.emitters.len() {
-        for (id, sim) in [(ids[0], &first), (late, &newcomer)] {
-            let batched = player.particles(id, e).expect("read");
-            let alone = sim.read_particles(e).expect("read");
-            assert!(
-                alone.iter().any(|p| p.is_alive()),
-                "emitter {e} has particles"
-            );
-            let differ: Vec<usize> = (0..alone.len())
-                .filter(|&k| bytemuck::bytes_of(&batched[k]) != bytemuck::bytes_of(&alone[k]))
-                .collect();
-            assert!(
-                differ.is_empty(),
-                "emitter {e}: {} of {} slots differ from the instance's own simulation, \
-                 first {:?}: {:?} vs {:?}",
-                differ.len(),
-                alone.len(),
-                differ.first(),
-                differ.first().map(|&k| batched[k]),
-                differ.first().map(|&k| alone[k]),
-            );
+        let unrecorded = player.particles(last, e).expect("read");
+        assert!(unrecorded.iter().all(|p| !p.is_alive()), "emitter {e}");
+    }
+    let own_first = own_simulation(&host, &player, first, 0, 50);
+    let own_last = own_simulation(&host, &player, last, 20, 30);
+    advance(&mut [&mut player], &host, 30);
+    for (id, sim) in [(first, &own_first), (last, &own_last)] {
+        assert_steps_as_its_own(&player, id, sim);
+    }
+}
+
+/// Instance `id`'s own simulation, stepped as `player`'s clock stepped it from frame
+/// `from` for `frames` frames (a clock's steps per frame depend on its history: it is
+/// replayed).
+fn own_simulation(host: &Host, player: &Player, id: InstanceId, from: u32, frames: u32) -> GpuSim {
+    let ctx = ignis::testing::gpu::GpuContext::from_device(&host.device, &host.queue);
+    let placed = player.instance_effect(id).expect("instance").clone();
+    let mut sim = GpuSim::new(&ctx, ShaderLibrary::embedded(), &placed).expect("sim");
+    let mut stepper = Stepper::default();
+    for frame in 0..from + frames {
+        let plan = stepper.advance(1.0 / 60.0, &placed.time);
+        if frame >= from {
+            sim.step(&placed, plan.dt_secs, plan.steps).expect("step");
         }
+    }
+    sim
+}
+
+/// Every emitter of instance `id` in `player` holds `sim`'s particles, bit for bit.
+fn assert_steps_as_its_own(player: &Player, id: InstanceId, sim: &GpuSim) {
+    for e in 0..player.effect().emitters.len() {
+        let batched = player.particles(id, e).expect("read");
+        let alone = sim.read_particles(e).expect("read");
+        assert!(
+            alone.iter().any(|p| p.is_alive()),
+            "emitter {e} has particles"
+        );
+        let differ: Vec<usize> = (0..alone.len())
+            .filter(|&k| bytemuck::bytes_of(&batched[k]) != bytemuck::bytes_of(&alone[k]))
+            .collect();
+        assert!(
+            differ.is_empty(),
+            "{id:?}, emitter {e}: {} of {} slots differ from the instance's own simulation, \
+             first {:?}: {:?} vs {:?}",
+            differ.len(),
+            alone.len(),
+            differ.first(),
+            differ.first().map(|&k| batched[k]),
+            differ.first().map(|&k| alone[k]),
+        );
     }
 }
 

@@ -86,7 +86,8 @@ impl Player {
         for (world, seed) in placed {
             let instance = Instance::effect_for(effect, world, seed);
             let backing = if batched {
-                batch_slot(&self.ctx, &update, effect, &mut batches, seed)?
+                let max = self.settings.max_batch_instances;
+                batch_slot(&self.ctx, &update, effect, &mut batches, (seed, max))?
             } else {
                 let sim = GpuSim::with_update(
                     &self.ctx,
@@ -246,22 +247,22 @@ impl Player {
     }
 }
 
-/// A slot for a new instance with `seed` in `batches` of `template`'s instances: a free one,
-/// or one of a new batch when every one is full (the others are not touched).
+/// A slot for a new instance with `seed` in `batches` of `template`'s instances, each of
+/// up to `max` instances (`(seed, max)`): one in the first batch that takes it, or in a new
+/// batch when every one holds its limit (the others are not touched).
 pub(super) fn batch_slot(
     ctx: &crate::gpu::GpuContext,
     update: &crate::sim::gpu_sim::SharedUpdate,
     template: &Effect,
     batches: &mut Vec<InstanceBatch>,
-    seed: u32,
+    (seed, max): (u32, u32),
 ) -> Result<Backing, PlayerError> {
     for (batch, b) in batches.iter_mut().enumerate() {
         if let Some(slot) = b.insert(seed) {
             return Ok(Backing::Batched { batch, slot });
         }
     }
-    let slots = crate::sim::batch::batch_slots(batches.len());
-    let mut b = InstanceBatch::new(ctx, update.clone(), template, slots)?;
+    let mut b = InstanceBatch::new(ctx, update.clone(), template, max)?;
     let slot = b
         .insert(seed)
         .ok_or_else(|| SimError::Readback("a new batch is full".into()))?;

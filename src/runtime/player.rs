@@ -208,7 +208,7 @@ impl Player {
             &self.update,
             &self.effect,
             &mut self.batches,
-            placed.seed,
+            (placed.seed, self.settings.max_batch_instances),
         )
     }
 

@@ -28,18 +28,10 @@ const _: () = assert!(size_of::<SimParams>().is_multiple_of(16));
 /// emitter's pool times this would not fit one storage binding).
 pub const BATCH_SLOTS: u32 = 128;
 
-/// Instances the first batch of a player holds; each further batch holds twice as many
-/// as the one before (up to [`BATCH_SLOTS`]): one instance allocates few pools, a
-/// hundred take three batches.
+/// Instances a new batch has buffers for: a batch doubles its buffers when an instance
+/// finds it full (16, 32, 64, 128), so one instance allocates few pools and a hundred
+/// share one batch.
 pub const FIRST_BATCH_SLOTS: u32 = 16;
-
-/// The instances the `index`-th batch of a player holds at most.
-pub fn batch_slots(index: usize) -> u32 {
-    FIRST_BATCH_SLOTS
-        .checked_shl(index.min(31) as u32)
-        .unwrap_or(BATCH_SLOTS)
-        .min(BATCH_SLOTS)
-}
 
 /// Written for an empty segment or a disabled emitter.
 const ZERO_BLOCK: [u8; size_of::<SimParams>()] = [0; size_of::<SimParams>()];
@@ -95,8 +87,12 @@ pub struct InstanceBatch {
     params: wgpu::Buffer,
     /// Bytes of one (step, emitter) block: a `SimParams` per slot, 256-aligned.
     block_bytes: u64,
-    /// Instances this batch holds.
+    /// Instances the buffers hold now.
     slots: u32,
+    /// Instances the buffers may grow to hold.
+    limit: u32,
+    /// The instances (a slot each): more than `slots` after an insert into full
+    /// buffers, until the next record grows them.
     members: Vec<Option<Member>>,
     /// Slots taken since the last record, whose segments it clears first.
     pending_clears: Vec<u32>,
@@ -106,9 +102,10 @@ pub struct InstanceBatch {
 }
 
 impl InstanceBatch {
-    /// Buffers for up to `max_slots` instances of `effect` (at most [`BATCH_SLOTS`]; as
+    /// A batch of up to `max_slots` instances of `effect` (at most [`BATCH_SLOTS`]; as
     /// many as one storage binding holds of its largest pool, and as
-    /// [`BATCH_STATE_BYTES`] of state hold; at least one) on batched update pipelines.
+    /// [`BATCH_STATE_BYTES`] of state hold; at least one) on batched update pipelines,
+    /// with buffers for [`FIRST_BATCH_SLOTS`] of them to begin with.
     pub fn new(
         ctx: &GpuContext,
         update: SharedUpdate,
@@ -127,18 +124,11 @@ impl InstanceBatch {
             .iter()
             .map(|e| 2 * Modules::of(e).state_layout().bytes(e.capacity.max(1)))
             .sum();
-        let slots = (ctx.max_capacity() / u64::from(largest))
+        let limit = (ctx.max_capacity() / u64::from(largest))
             .min(BATCH_STATE_BYTES / instance_bytes.max(1))
             .clamp(1, u64::from(max_slots.clamp(1, BATCH_SLOTS))) as u32;
-        let block_bytes = (u64::from(slots) * size_of::<SimParams>() as u64).next_multiple_of(
-            u64::from(ctx.device.limits().min_storage_buffer_offset_alignment),
-        );
-        let params = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("InstanceBatch::params"),
-            size: block_bytes * (MAX_STEPS * effect.emitters.len().max(1)) as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let slots = limit.min(FIRST_BATCH_SLOTS);
+        let (params, block_bytes) = params_buffer(ctx, slots, effect.emitters.len());
         let mut batch = Self {
             ctx: ctx.clone(),
             update,
@@ -146,20 +136,51 @@ impl InstanceBatch {
             params,
             block_bytes,
             slots,
+            limit,
             pending_clears: Vec::new(),
             planned: Vec::new(),
-            members: (0..slots).map(|_| None).collect(),
+            members: Vec::new(),
         };
         for (i, e) in effect.emitters.iter().enumerate() {
-            ctx.check_capacity(&e.name, e.capacity.max(1).saturating_mul(slots))?;
+            ctx.check_capacity(&e.name, e.capacity.max(1).saturating_mul(limit))?;
             let layout = Modules::of(e).state_layout();
-            let mut pool = batch.pool(e.capacity.max(1), layout);
+            let curves = over_life_buffer(&ctx.device);
+            let mut pool = batch.pool(e.capacity.max(1), layout, curves);
             pool.life_range = (e.lifetime_secs.min, e.lifetime_secs.max);
             pool.salt = crate::rng::emitter_salt(i as u32, e.seed_offset);
             batch.pools.push(pool);
         }
         batch.follow(effect);
         Ok(batch)
+    }
+
+    /// Grows the buffers to hold every instance (doubling, up to the limit), their
+    /// state copied by commands recorded into `enc` before any of this record's: the
+    /// instances step on as they would have (slots and bytes are kept).
+    fn grow(&mut self, enc: &mut wgpu::CommandEncoder) {
+        let needed = self.members.len() as u32;
+        if needed <= self.slots {
+            return;
+        }
+        let mut slots = self.slots;
+        while slots < needed {
+            slots *= 2;
+        }
+        self.slots = slots.min(self.limit);
+        (self.params, self.block_bytes) = params_buffer(&self.ctx, self.slots, self.pools.len());
+        for k in 0..self.pools.len() {
+            let old = &self.pools[k];
+            let mut pool = self.pool(old.capacity, old.layout, old.curves.clone());
+            let old = &self.pools[k];
+            for (from, to) in old.buffers.iter().zip(&pool.buffers) {
+                enc.copy_buffer_to_buffer(from, 0, to, 0, from.size());
+            }
+            pool.current = old.current;
+            pool.life_range = old.life_range;
+            pool.salt = old.salt;
+            pool.curves_key = old.curves_key;
+            self.pools[k] = pool;
+        }
     }
 
     /// Re-bakes the pools' over-life curves that `effect` changed.
@@ -171,7 +192,8 @@ impl InstanceBatch {
         }
     }
 
-    fn pool(&self, capacity: u32, layout: StateLayout) -> Pool {
+    /// An emitter's buffers for the batch's slots (bound with its baked `curves`).
+    fn pool(&self, capacity: u32, layout: StateLayout, curves: wgpu::Buffer) -> Pool {
         let d = &self.ctx.device;
         let bytes = layout.bytes(capacity * self.slots).max(32);
         let buffer = |label| {
@@ -202,7 +224,6 @@ impl InstanceBatch {
             spare("InstanceBatch::counters"),
             spare("InstanceBatch::births"),
         );
-        let curves = over_life_buffer(d);
         let update = lock(&self.update);
         let group = |src: usize| {
             let entry = |binding, resource| wgpu::BindGroupEntry { binding, resource };
@@ -241,22 +262,33 @@ impl InstanceBatch {
         }
     }
 
-    /// Takes a free slot for a new instance with `seed` (`None` when the batch is full).
-    /// Its segments are cleared by the next [`InstanceBatch::clear_taken`], in the same
-    /// encoder as (and before) the steps, so work of the slot's earlier occupant already
-    /// recorded still runs before the clear.
+    /// Takes a free slot for a new instance with `seed` (`None` when the batch holds
+    /// its limit). Buffers that are full grow at the next [`InstanceBatch::clear_taken`],
+    /// and the slot's segments are cleared there, in the same encoder as (and before)
+    /// the steps: work already recorded (the last frame's, or the slot's earlier
+    /// occupant's) still runs on the buffers as they were.
     pub fn insert(&mut self, seed: u32) -> Option<u32> {
-        let slot = self.members.iter().position(Option::is_none)?;
-        self.pending_clears.push(slot as u32);
-        self.members[slot] = Some(Member {
+        let member = Some(Member {
             planner: EffectPlanner::default(),
             seed,
         });
+        let slot = match self.members.iter().position(Option::is_none) {
+            Some(free) => free,
+            None if (self.members.len() as u32) < self.limit => {
+                self.members.push(None);
+                self.members.len() - 1
+            }
+            None => return None,
+        };
+        self.pending_clears.push(slot as u32);
+        self.members[slot] = member;
         Some(slot as u32)
     }
 
-    /// Clears the segments of the slots taken since the last call (outside a pass).
+    /// Grows the buffers to hold every instance taken since the last call, then clears
+    /// the segments of those slots (outside a pass).
     pub fn clear_taken(&mut self, enc: &mut wgpu::CommandEncoder) {
+        self.grow(enc);
         for slot in self.pending_clears.drain(..) {
             for p in &self.pools {
                 let bytes = p.layout.bytes(p.capacity);
@@ -299,9 +331,9 @@ impl InstanceBatch {
             .map_or(0, |i| i as u32 + 1)
     }
 
-    /// Instances this batch holds.
+    /// Slots taken or freed so far (each instance's slot is below this).
     pub fn slots(&self) -> u32 {
-        self.slots
+        self.members.len() as u32
     }
 
     /// Empties every instance and restarts their clocks.
@@ -429,8 +461,11 @@ impl InstanceBatch {
         self.planned.clear();
     }
 
-    /// Instance `slot` as the draw passes see it.
+    /// Instance `slot` as the draw passes see it (`None` until the buffers hold it).
     pub fn member(&self, slot: u32) -> Option<BatchMember<'_>> {
+        if slot >= self.slots {
+            return None;
+        }
         let m = self.members.get(slot as usize)?.as_ref()?;
         Some(BatchMember {
             batch: self,
@@ -446,6 +481,10 @@ impl InstanceBatch {
         else {
             return Err(SimError::Readback(format!("no emitter {e} in slot {slot}")));
         };
+        if slot >= self.slots {
+            // Not recorded since it came: no particle yet.
+            return Ok(vec![Particle::default(); pool.capacity as usize]);
+        }
         let bytes = pool.layout.bytes(pool.capacity);
         let all = read_buffer(
             &self.ctx,
@@ -512,4 +551,20 @@ impl SimState for BatchMember<'_> {
     fn planner(&self) -> &EffectPlanner {
         self.planner
     }
+}
+
+/// The parameter blocks of a batch of `slots` instances with `emitters` emitters: every
+/// step's block per emitter, `slots` `SimParams` each (aligned for a dynamic offset), and
+/// the bytes of one block.
+fn params_buffer(ctx: &GpuContext, slots: u32, emitters: usize) -> (wgpu::Buffer, u64) {
+    let block_bytes = (u64::from(slots) * size_of::<SimParams>() as u64).next_multiple_of(
+        u64::from(ctx.device.limits().min_storage_buffer_offset_alignment),
+    );
+    let params = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("InstanceBatch::params"),
+        size: block_bytes * (MAX_STEPS * emitters.max(1)) as u64,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    (params, block_bytes)
 }

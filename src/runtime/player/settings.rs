@@ -19,11 +19,17 @@ pub struct PlayerSettings {
     /// The folder the preset's PNG sprite paths are relative to (the preset's own
     /// folder); `None`: the working directory.
     pub asset_dir: Option<PathBuf>,
-    /// Batch instances (on by default): up to 16 instances share each emitter's buffers
-    /// and one update dispatch. Off, every instance has a simulation of its own: it
+    /// Batch instances (on by default): up to [`PlayerSettings::max_batch_instances`]
+    /// instances share each emitter's buffers and one update dispatch. Off, every instance has a simulation of its own: it
     /// costs a dispatch per instance, and in return an edit ([`Player::set_effect`]) that
     /// resizes a pool keeps the particles that fit — what an editor wants.
     pub batch_instances: bool,
+    /// Instances one batch holds at most (1 to 128; 128 by default). A batch's buffers
+    /// double as instances come (16, 32, 64, 128 instances' worth) and a full batch
+    /// starts another; an effect with large pools holds fewer (a batch allocates at
+    /// most 64 MiB of particle state unless one instance needs more). Lower it to bound
+    /// the memory one batch grows to; each batch costs its own dispatches and draws.
+    pub max_batch_instances: u32,
     /// A folder of WGSL files to build the pipelines from instead of the shaders built
     /// into the library (a host that edits them; see [`Player::reload_shader`]).
     pub shader_dir: Option<PathBuf>,
@@ -49,6 +55,7 @@ impl PlayerSettings {
             sample_count: 1,
             asset_dir: None,
             batch_instances: true,
+            max_batch_instances: crate::sim::batch::BATCH_SLOTS,
             shader_dir: None,
             adapter_profile: None,
             world_up: Vec3::Y,
