@@ -29,6 +29,14 @@ pub(super) struct GroupLooks<'s> {
     pub(super) distance: f32,
 }
 
+/// Emitter `index` as every instance of a group has it: whether it is stateless, and the
+/// colour ramp row + 1 of the parent it inherits its colour from (0: none).
+struct GroupEmitter {
+    index: usize,
+    stateless: bool,
+    color_row: u32,
+}
+
 /// Writes the draw's looks into `block` (one per instance, at `PARAMS_STRIDE`), each with
 /// the draw's widest window `width`; a missing instance gets an empty segment of its pool
 /// of `capacity` slots (no window, nothing drawn).
@@ -193,14 +201,14 @@ impl FrameResources {
         &self,
         view: &GroupView<'_, '_>,
         scene: &Scene<'s>,
-        i: usize,
+        emitter: &GroupEmitter,
         base: &LookUniform,
     ) -> Option<(
         LookUniform,
         crate::sim::gpu_sim::EmitterBuffers<'s>,
         SortMember,
     )> {
-        let (sim, effect) = (scene.sim, scene.effect);
+        let (sim, effect, i) = (scene.sim, scene.effect, emitter.index);
         let e = effect.emitters.get(i)?;
         let origin = sim
             .planner()
@@ -213,7 +221,7 @@ impl FrameResources {
         u.clip_from_sim = view.camera.clip_from_sim(origin).to_cols_array_2d();
         let ground = e.collisions.ground.as_ref().map_or(0.0, |g| g.height_m);
         u.soft[0] = (f64::from(ground) - origin.y) as f32;
-        if Modules::in_effect(effect, i).contains(Modules::STATELESS) {
+        if emitter.stateless {
             // Closed-form evaluation at the render time (between the last two steps).
             let planner = sim.planner();
             let t = planner.time_secs - (1.0 - view.alpha as f64) * planner.last_dt_secs as f64;
@@ -245,9 +253,7 @@ impl FrameResources {
         // The trail's newest entries are from before the last step (trail.wgsl).
         u.tiny_c[1] = b.last_step;
         // An emitter that inherits its parent's colour: the parent's ramp row + 1.
-        u.tiny_c[2] = effect
-            .color_parent(i)
-            .map_or(0, |p| ROWS_PER_EMITTER * p as u32 + 1);
+        u.tiny_c[2] = emitter.color_row;
         u.flags[3] = b.slot_base;
         // The window ends at the ring's head (u.ring[0]).
         let cap = b.capacity.max(1);
@@ -275,6 +281,12 @@ impl FrameResources {
         i: usize,
         base: &LookUniform,
     ) -> GroupLooks<'s> {
+        // What the instances' effects share (their emitters and events are the player's).
+        let emitter = view.group.iter().flatten().next().map(|s| GroupEmitter {
+            index: i,
+            stateless: Modules::in_effect(s.effect, i).contains(Modules::STATELESS),
+            color_row: (s.effect.color_parent(i)).map_or(0, |p| ROWS_PER_EMITTER * p as u32 + 1),
+        });
         let mut out = GroupLooks {
             looks: Vec::with_capacity(view.group.len()),
             members: Vec::new(),
@@ -284,7 +296,8 @@ impl FrameResources {
         for scene in view.group {
             let Some((scene, (u, b, sort))) = scene
                 .as_ref()
-                .and_then(|s| Some((s, self.member_look(view, s, i, base)?)))
+                .zip(emitter.as_ref())
+                .and_then(|(s, emitter)| Some((s, self.member_look(view, s, emitter, base)?)))
             else {
                 out.looks.push(None);
                 out.members.push(SortMember::default());
