@@ -27,6 +27,7 @@ pub use lit::{Lighting, Lit, SixWayMaps};
 pub use look::{
     BlendMode, ColorStop, DrawPath, Flipbook, FlipbookMode, HeatHaze, Look, MAX_COLOR_STOPS,
     SPLAT_BELOW_PX, SPLAT_PX_PER_QUAD, Sprite, Streak, TILES_ABOVE_PX, TILES_MIN_FILL_PX,
+    TILES_MIN_QUADS,
 };
 pub use rate_cap::RateCap;
 pub(crate) use rate_cap::cap_burst;

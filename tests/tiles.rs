@@ -303,6 +303,43 @@ fn streaks_stay_billboards() {
     );
 }
 
+/// Many small sprites take the tiles on a GPU whatever their fill: 20,000 sprites of 5 px
+/// thrown out of one point (500,000 px of fill, under `TILES_MIN_FILL_PX`) are past
+/// `TILES_MIN_QUADS` and on the tiles, and their light agrees with the billboards'; 16,000
+/// stay billboards.
+#[test]
+fn many_small_sprites_take_the_tiles_though_their_fill_is_light() {
+    let base = gpu();
+    let ctx = base.clone().with_profile(Some(AdapterProfile::GPU));
+    let size_m = (5.0 / common::px_per_m_at_3m(SIZE.1)) as f32;
+    let thrown = |count: u32| {
+        let mut effect = pile(count as f32, size_m, [0.0; 3]);
+        let e = &mut effect.emitters[0];
+        e.capacity = count;
+        e.spread_deg = 180.0;
+        e.speed_m_per_s = Range::new(0.5, 1.0);
+        e.look.intensity = 0.01;
+        effect
+    };
+    let on_tiles = |count: u32| {
+        let mut run =
+            Headless::new(&ctx, thrown(count), ShaderLibrary::embedded()).expect("headless");
+        for _ in 0..6 {
+            run.advance(1.0 / 60.0);
+        }
+        run.render(SIZE).expect("render");
+        let items = run.player.draw_items();
+        let d = items.first().expect("a draw");
+        assert!(d.size_px >= 4.9 && d.size_px <= 5.1, "{} px", d.size_px);
+        assert!(!d.splat, "{count} sprites splatted");
+        d.tiles
+    };
+    assert!(ignis::effect::TILES_MIN_QUADS > 16_000 && ignis::effect::TILES_MIN_QUADS <= 20_000);
+    assert!(on_tiles(20_000), "20,000 small sprites stayed billboards");
+    assert!(!on_tiles(16_000), "16,000 small sprites took the tiles");
+    light_agrees(&base, "20,000 sprites of 5 px", &thrown(20_000));
+}
+
 /// Still particles on the camera's axis: `count` of them, `size_m` wide, at `at`.
 fn pile(count: f32, size_m: f32, at: [f32; 3]) -> Effect {
     let mut e = common::still_burst(count as u32, 1.0);

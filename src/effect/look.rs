@@ -115,9 +115,19 @@ pub const TILES_ABOVE_PX: f32 = 4.0;
 
 /// Auto draw path: an emitter takes the tile rasteriser only when its quads (all its
 /// instances' live windows) at their largest projected size would cover at least this
-/// many pixels: light fill costs the billboards little, and the tiles a fixed ~0.1 ms on
-/// the H100 (`ignis bench presets`: the spark fountain's 26-sprite glow).
+/// many pixels, or when it has [`TILES_MIN_QUADS`] of them: light fill costs the
+/// billboards little, and the tiles a fixed ~0.1 ms on the H100 (`ignis bench presets`:
+/// the spark fountain's 26-sprite glow).
 pub const TILES_MIN_FILL_PX: f32 = 1.0e6;
+
+/// Auto draw path: an emitter with at least this many quads (all its instances' live
+/// windows) takes the tile rasteriser whatever their fill: many small quads cost the
+/// billboards their count, not their pixels. On the H200 at 1920×1080 the torch's heads
+/// (0.04 m embers, about 5 px) of 100 torches on a grid, some 30,000 quads, took 0.20 ms
+/// as billboards and made the frame 1.378 ms; on the tiles it was 1.290 ms. Ten torches'
+/// 3,000 heads were cheaper as billboards (0.650 against 0.685 ms;
+/// `bench/results/runtime-heads/`).
+pub const TILES_MIN_QUADS: u32 = 16_384;
 
 /// A sprite texture: one of the procedural set generated at start, or a PNG with alpha.
 #[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]

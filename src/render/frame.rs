@@ -9,7 +9,8 @@ use std::sync::Arc;
 
 use crate::effect::rows_key;
 use crate::effect::{
-    BlendMode, DrawPath, Look, SPLAT_BELOW_PX, SPLAT_PX_PER_QUAD, TILES_ABOVE_PX, TILES_MIN_FILL_PX,
+    BlendMode, DrawPath, Look, SPLAT_BELOW_PX, SPLAT_PX_PER_QUAD, TILES_ABOVE_PX,
+    TILES_MIN_FILL_PX, TILES_MIN_QUADS,
 };
 use crate::gpu::types::{CameraUniform, PARAMS_STRIDE};
 use crate::gpu::{AdapterProfile, GpuContext};
@@ -640,9 +641,11 @@ impl FrameResources {
                     // instance of a group (a runtime host's batch is one group): on an
                     // H100 at 1080p, 100 torches on a grid took 2.2 ms a frame on the
                     // tiles against 3.2 on billboards, and 100 at one spot 15.7 ms against
-                    // 31.2 (`bench/results/runtime-nvidia-h100-80gb.md`).
+                    // 31.2 (`bench/results/runtime-nvidia-h100-80gb.md`). Many quads take
+                    // them whatever their fill.
                     let fill = quads as f32 * size_px * size_px;
-                    profile.tile_raster && size_px >= TILES_ABOVE_PX && fill >= TILES_MIN_FILL_PX
+                    let heavy = fill >= TILES_MIN_FILL_PX || quads >= TILES_MIN_QUADS;
+                    profile.tile_raster && size_px >= TILES_ABOVE_PX && heavy
                 }
                 DrawPath::Tiles => true,
                 DrawPath::Billboard | DrawPath::Splat => false,
