@@ -139,6 +139,58 @@ fn commands(host: &Host, effect: &Effect, n: u32, max: u32) -> CommandCounts {
     c
 }
 
+/// A batch's buffers double as instances come, at the record after an instance finds
+/// them full: 1 torch is held by buffers for 16, 17 by 32, 33 by 64, 100 by 128; with
+/// batches of at most 16, 17 torches are two batches, each with buffers for 16.
+#[test]
+fn a_batchs_buffers_double_as_instances_come() {
+    let host = Host::new(vec3(0.0, 1.5, 3.5), vec3(0.0, 0.8, -1.0));
+    let effect = torch_on(DrawPath::Billboard, false);
+    let record = |player: &mut Player| {
+        let mut enc = host.device.create_command_encoder(&Default::default());
+        player.advance(1.0 / 60.0);
+        player.record(&mut enc, &host.camera, None).expect("record");
+        host.queue.submit([enc.finish()]);
+    };
+    let mut player = host.player(&effect);
+    let mut added = 0;
+    for (n, slots) in [(1, 16), (16, 16), (17, 32), (33, 64), (100, 128)] {
+        while added < n {
+            player
+                .add_instance(
+                    Mat4::from_translation(vec3(added as f32 * 0.1, 0.0, 0.0)),
+                    added + 1,
+                )
+                .expect("instance");
+            added += 1;
+        }
+        if n > 1 {
+            assert!(
+                player.batch_buffer_slots()[0] <= slots,
+                "{n} torches grew before the record"
+            );
+        }
+        record(&mut player);
+        assert_eq!(player.batch_buffer_slots(), [slots], "{n} torches");
+    }
+    let settings = ignis::PlayerSettings {
+        max_batch_instances: 16,
+        ..host.settings()
+    };
+    let mut player = Player::new(&host.device, &host.queue, &effect, settings).expect("player");
+    for i in 0..17 {
+        player
+            .add_instance(Mat4::IDENTITY, i + 1)
+            .expect("instance");
+    }
+    record(&mut player);
+    assert_eq!(
+        player.batch_buffer_slots(),
+        [16, 16],
+        "17 torches in batches of 16"
+    );
+}
+
 /// The draws a frame reports are the record's plus the host's draw: more than a frame
 /// recorded without drawing, and by no more than a handful (a count that wraps or
 /// subtracts fails).

@@ -195,6 +195,13 @@ impl Player {
         Ok(read?)
     }
 
+    /// The instances each batch's buffers hold now, batch by batch (they grow at the
+    /// record after an instance finds them full; for tests of the growth).
+    #[doc(hidden)]
+    pub fn batch_buffer_slots(&self) -> Vec<u32> {
+        self.batches.iter().map(|b| b.buffer_slots()).collect()
+    }
+
     /// Emitter `emitter`'s trail ring in instance `id` (a blocking readback; none without
     /// a trail — an emitter with one runs a simulation of its own).
     #[doc(hidden)]

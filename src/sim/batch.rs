@@ -323,6 +323,11 @@ impl InstanceBatch {
         }
     }
 
+    /// Instances the buffers hold now.
+    pub fn buffer_slots(&self) -> u32 {
+        self.slots
+    }
+
     /// Segments up to the last taken one (what an update or a draw covers).
     pub fn active(&self) -> u32 {
         self.members
