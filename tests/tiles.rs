@@ -334,7 +334,9 @@ fn many_small_sprites_take_the_tiles_though_their_fill_is_light() {
         assert!(!d.splat, "{count} sprites splatted");
         d.tiles
     };
-    assert!(ignis::effect::TILES_MIN_QUADS > 16_000 && ignis::effect::TILES_MIN_QUADS <= 20_000);
+    const {
+        assert!(ignis::effect::TILES_MIN_QUADS > 16_000 && ignis::effect::TILES_MIN_QUADS <= 20_000)
+    };
     assert!(on_tiles(20_000), "20,000 small sprites stayed billboards");
     assert!(!on_tiles(16_000), "16,000 small sprites took the tiles");
     light_agrees(&base, "20,000 sprites of 5 px", &thrown(20_000));

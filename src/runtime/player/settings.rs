@@ -20,15 +20,17 @@ pub struct PlayerSettings {
     /// folder); `None`: the working directory.
     pub asset_dir: Option<PathBuf>,
     /// Batch instances (on by default): up to [`PlayerSettings::max_batch_instances`]
-    /// instances share each emitter's buffers and one update dispatch. Off, every instance has a simulation of its own: it
-    /// costs a dispatch per instance, and in return an edit ([`Player::set_effect`]) that
-    /// resizes a pool keeps the particles that fit — what an editor wants.
+    /// instances share each emitter's buffers and one update dispatch. Off, every
+    /// instance has a simulation of its own: it costs a dispatch per instance, and in
+    /// return an edit ([`Player::set_effect`]) that resizes a pool keeps the particles
+    /// that fit — what an editor wants.
     pub batch_instances: bool,
-    /// Instances one batch holds at most (1 to 128; 128 by default). A batch's buffers
-    /// double as instances come (16, 32, 64, 128 instances' worth) and a full batch
-    /// starts another; an effect with large pools holds fewer (a batch allocates at
-    /// most 64 MiB of particle state unless one instance needs more). Lower it to bound
-    /// the memory one batch grows to; each batch costs its own dispatches and draws.
+    /// Instances one batch holds at most (128 by default; taken between 1 and 128). A
+    /// batch's buffers double as instances come (16, 32, 64, 128 instances' worth) and a
+    /// full batch starts another; an effect with large pools holds fewer (a batch
+    /// allocates at most 64 MiB of particle state unless one instance needs more). Lower
+    /// it to bound the memory one batch grows to; each batch costs its own dispatches and
+    /// draws.
     pub max_batch_instances: u32,
     /// A folder of WGSL files to build the pipelines from instead of the shaders built
     /// into the library (a host that edits them; see [`Player::reload_shader`]).
