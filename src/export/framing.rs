@@ -257,3 +257,50 @@ impl Bounds {
         self.rect
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::effect::Param;
+
+    /// A fitted perspective camera holds every particle's sphere (its quad's reach) inside
+    /// the preset's field of view, each checked as a circle against the edges of the
+    /// frame's wedge (its distance from each edge plane), with the tightest no farther
+    /// back than the margin asks.
+    #[test]
+    fn a_fitted_camera_holds_every_particles_sphere_in_its_field_of_view() {
+        let mut effect = Effect::default_campfire();
+        effect.camera.fov_y_deg = 90.0;
+        for e in &mut effect.emitters {
+            e.look.size_m = Param::Constant(1.0);
+            e.look.streak = None;
+        }
+        let r = reach(&effect);
+        let mut samples = Samples::default();
+        samples.add(&[
+            (Vec3::new(0.3, 1.0, -0.2), Vec3::ZERO),
+            (Vec3::new(-0.5, 0.2, 0.4), Vec3::ZERO),
+            (Vec3::new(0.1, -0.3, 0.0), Vec3::ZERO),
+        ]);
+        let Wide::Perspective {
+            eye, centre, fov_y, ..
+        } = enclosing(&effect, &samples, CameraMode::Fit)
+        else {
+            panic!("a fitted camera is a perspective one");
+        };
+        let forward = (centre - eye).normalize();
+        let right = forward.cross(Vec3::Y).normalize();
+        let up = right.cross(forward);
+        let t = (0.5 * fov_y).tan();
+        let mut tightest = f32::INFINITY;
+        for &(p, _) in &samples.points {
+            let v = p - eye;
+            for lateral in [v.dot(right).abs(), v.dot(up).abs()] {
+                let clearance = (t * v.dot(forward) - lateral) / (1.0 + t * t).sqrt();
+                assert!(clearance >= r, "{p}: {clearance} m from the edge, reach {r}");
+                tightest = tightest.min(clearance);
+            }
+        }
+        assert!(tightest <= 1.3 * r, "{tightest} m from the edge, reach {r}");
+    }
+}
