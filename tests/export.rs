@@ -275,6 +275,34 @@ fn flipbook_cells_are_the_sequence_frames() {
     }
 }
 
+/// The export's preview (what the editor shows while it runs) is, once it is done, the
+/// colour atlas it wrote; before its first frame there is none to show.
+#[test]
+fn the_preview_is_the_written_colour_atlas() {
+    let ctx = gpu();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let settings = ExportSettings {
+        layout: Layout::Flipbook { cols: 2, rows: 2 },
+        frame_size: (40, 32),
+        ..sequence(dir.path(), 4, 1.0)
+    };
+    let effect = preset("torch");
+    let mut export = ignis::export::Export::new(&ctx, &effect, Some("presets".into()), settings)
+        .expect("export");
+    assert!(
+        export
+            .preview()
+            .is_none_or(|p| p.pixels().all(|p| p[3] == 0))
+    );
+    while export.step().expect("step").is_some() {}
+    let atlas = rgba8(&dir.path().join("torch_color.png"));
+    assert!(atlas.pixels().any(|p| p[3] > 0), "an empty atlas");
+    assert!(
+        export.preview() == Some(atlas),
+        "the preview is not the atlas written"
+    );
+}
+
 /// The mean absolute difference of two images' channels, in 8-bit steps.
 fn difference(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
     let sum: u64 = a

@@ -297,7 +297,10 @@ mod tests {
             let v = p - eye;
             for lateral in [v.dot(right).abs(), v.dot(up).abs()] {
                 let clearance = (t * v.dot(forward) - lateral) / (1.0 + t * t).sqrt();
-                assert!(clearance >= r, "{p}: {clearance} m from the edge, reach {r}");
+                assert!(
+                    clearance >= r,
+                    "{p}: {clearance} m from the edge, reach {r}"
+                );
                 tightest = tightest.min(clearance);
             }
         }
