@@ -349,4 +349,32 @@ mod tests {
         assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 3.0);
         assert_eq!(median(&mut []), 0.0);
     }
+
+    /// Cells rotated in an atlas of two rows: every pixel of cell k is cell
+    /// `source(k)`'s, and the cells past `frames` stay as they were.
+    #[test]
+    fn rotated_cells_move_whole_across_rows() {
+        let (size, cols, rows) = ((3u32, 2u32), 2u32, 3u32);
+        let (w, h) = (size.0 as usize, size.1 as usize);
+        let stride = cols as usize * w;
+        // Each pixel holds its cell, x and y.
+        let atlas: Vec<[f32; 4]> = (0..stride * rows as usize * h)
+            .map(|i| {
+                let (x, y) = (i % stride, i / stride);
+                let cell = (y / h) * cols as usize + x / w;
+                [cell as f32, (x % w) as f32, (y % h) as f32, 1.0]
+            })
+            .collect();
+        let out = rotate_cells(&atlas, size, cols, 5, |k| (k + 2) % 5);
+        for (i, p) in out.iter().enumerate() {
+            let (x, y) = (i % stride, i / stride);
+            let cell = ((y / h) * cols as usize + x / w) as u32;
+            let want = if cell < 5 { (cell + 2) % 5 } else { cell };
+            assert_eq!(
+                *p,
+                [want as f32, (x % w) as f32, (y % h) as f32, 1.0],
+                "pixel {x}, {y}"
+            );
+        }
+    }
 }
