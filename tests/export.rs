@@ -303,6 +303,26 @@ fn the_preview_is_the_written_colour_atlas() {
     );
 }
 
+/// An export reports its progress after every step, one step of work more each time,
+/// and ends with all of it done (three steps a frame: framed, probed, rendered).
+#[test]
+fn progress_counts_every_step_to_the_total() {
+    let ctx = gpu();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut seen = Vec::new();
+    ignis::export::run(
+        &ctx,
+        &preset("torch"),
+        Some("presets".into()),
+        sequence(dir.path(), 4, 1.0),
+        |p| seen.push((p.done, p.total)),
+    )
+    .expect("export");
+    let steps: Vec<u32> = seen.iter().map(|&(done, _)| done).collect();
+    assert_eq!(steps, (1..=12).collect::<Vec<_>>(), "{seen:?}");
+    assert!(seen.iter().all(|&(_, total)| total == 12), "{seen:?}");
+}
+
 /// The mean absolute difference of two images' channels, in 8-bit steps.
 fn difference(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
     let sum: u64 = a

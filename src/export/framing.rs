@@ -306,4 +306,56 @@ mod tests {
         }
         assert!(tightest <= 1.3 * r, "{tightest} m from the edge, reach {r}");
     }
+
+    /// A fitted orthographic camera's half extents are the particles' spheres' box on the
+    /// view plane, 10 % wider: every sphere inside, the widest touching 1/1.1 of it.
+    #[test]
+    fn a_fitted_orthographic_camera_holds_the_spheres_box_with_a_tenth_to_spare() {
+        let mut effect = Effect::default_campfire();
+        for e in &mut effect.emitters {
+            e.look.size_m = Param::Constant(0.2);
+            e.look.streak = None;
+        }
+        let r = reach(&effect);
+        let mut samples = Samples::default();
+        samples.add(&[
+            (Vec3::new(0.3, 1.0, -0.2), Vec3::ZERO),
+            (Vec3::new(-0.5, 0.2, 0.4), Vec3::ZERO),
+        ]);
+        let Wide::Ortho {
+            centre,
+            forward,
+            half,
+            ..
+        } = enclosing(&effect, &samples, CameraMode::Ortho)
+        else {
+            panic!("an orthographic camera");
+        };
+        let right = forward.cross(Vec3::Y).normalize();
+        let up = right.cross(forward);
+        let (mut widest_x, mut widest_y) = (0.0f32, 0.0f32);
+        for &(p, _) in &samples.points {
+            let v = p - centre;
+            widest_x = widest_x.max(v.dot(right).abs() + r);
+            widest_y = widest_y.max(v.dot(up).abs() + r);
+        }
+        assert!(
+            (half.x - 1.1 * widest_x).abs() < 1e-4,
+            "{half} against {widest_x}"
+        );
+        assert!(
+            (half.y - 1.1 * widest_y).abs() < 1e-4,
+            "{half} against {widest_y}"
+        );
+    }
+
+    /// The probe keeps the export's aspect with 256 pixels on its long side, and at
+    /// least 8 on the short one.
+    #[test]
+    fn the_probe_is_256_pixels_on_its_long_side() {
+        assert_eq!(probe_size((1920, 1080)), (256, 144));
+        assert_eq!(probe_size((64, 64)), (256, 256));
+        assert_eq!(probe_size((100, 1000)), (26, 256));
+        assert_eq!(probe_size((4000, 10)), (256, 8));
+    }
 }
