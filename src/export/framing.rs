@@ -358,4 +358,30 @@ mod tests {
         assert_eq!(probe_size((100, 1000)), (26, 256));
         assert_eq!(probe_size((4000, 10)), (256, 8));
     }
+
+    /// An orthographic camera frames its box whatever the frame's aspect: on a frame twice
+    /// as wide as high, a box twice as high as wide fills the height, its corners on the
+    /// frame's top and bottom edges, inside its sides.
+    #[test]
+    fn an_orthographic_frame_holds_its_box_at_any_aspect() {
+        let wide = Wide::Ortho {
+            centre: Vec3::ZERO,
+            forward: Vec3::NEG_Z,
+            half: glam::vec2(1.0, 2.0),
+            depth: 5.0,
+        };
+        for size in [(200, 100), (100, 200), (128, 128)] {
+            let clip = wide.camera(size).clip_from_world_mat4();
+            let (mut x, mut y) = (0.0f32, 0.0f32);
+            for corner in [Vec3::new(1.0, 2.0, 0.0), Vec3::new(-1.0, -2.0, 0.0)] {
+                let c = clip.project_point3(corner);
+                (x, y) = (x.max(c.x.abs()), y.max(c.y.abs()));
+            }
+            assert!(x <= 1.0 + 1e-5 && y <= 1.0 + 1e-5, "{size:?}: {x}, {y}");
+            assert!(
+                (x.max(y) - 1.0).abs() < 1e-5,
+                "{size:?}: {x}, {y} (not tight)"
+            );
+        }
+    }
 }
