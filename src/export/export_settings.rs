@@ -288,3 +288,37 @@ impl ExportSettings {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Any one pass alone is enough to export, and none is refused with the passes named.
+    #[test]
+    fn any_one_pass_exports_and_none_is_refused() {
+        let none = Passes {
+            color: false,
+            emissive: false,
+            motion: false,
+            sixway: false,
+            distortion: false,
+        };
+        let alone: [fn(&mut Passes); 5] = [
+            |p| p.color = true,
+            |p| p.emissive = true,
+            |p| p.motion = true,
+            |p| p.sixway = true,
+            |p| p.distortion = true,
+        ];
+        for (k, set) in alone.iter().enumerate() {
+            let mut settings = ExportSettings::new("out".into());
+            settings.passes = none;
+            set(&mut settings.passes);
+            assert!(settings.validate().is_ok(), "pass {k} alone refused");
+        }
+        let mut settings = ExportSettings::new("out".into());
+        settings.passes = none;
+        let err = settings.validate().expect_err("no pass accepted").to_string();
+        assert!(err.contains("--passes"), "{err}");
+    }
+}
