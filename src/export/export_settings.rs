@@ -318,7 +318,10 @@ mod tests {
         }
         let mut settings = ExportSettings::new("out".into());
         settings.passes = none;
-        let err = settings.validate().expect_err("no pass accepted").to_string();
+        let err = settings
+            .validate()
+            .expect_err("no pass accepted")
+            .to_string();
         assert!(err.contains("--passes"), "{err}");
     }
 }

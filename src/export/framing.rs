@@ -384,4 +384,24 @@ mod tests {
             );
         }
     }
+
+    /// The motion pass's scale is twice the largest sampled motion in frame UV units
+    /// (half the clip range) with 5 % to spare, up or across: through an orthographic
+    /// frame 2 m high, a particle moving 0.5 m/s up over 1 s moves a quarter of the frame.
+    #[test]
+    fn the_motion_scale_is_twice_the_largest_motion_in_frame_units() {
+        let wide = Wide::Ortho {
+            centre: Vec3::ZERO,
+            forward: Vec3::NEG_Z,
+            half: glam::vec2(1.0, 1.0),
+            depth: 5.0,
+        };
+        let camera = wide.camera((64, 64));
+        for v in [Vec3::new(0.0, 0.5, 0.0), Vec3::new(-0.5, 0.0, 0.0)] {
+            let mut samples = Samples::default();
+            samples.add(&[(Vec3::new(0.1, -0.2, 0.0), v), (Vec3::ZERO, 0.2 * v)]);
+            let scale = samples.motion_scale(&camera, 1.0);
+            assert!((scale - 2.0 * 0.25 * 1.05).abs() < 1e-5, "{v}: {scale}");
+        }
+    }
 }
