@@ -472,3 +472,33 @@ fn timeline(effect: &Effect, settings: &ExportSettings) -> Timeline {
         fade,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A loop fades over a quarter of its frames on each side of the seam, at most 16,
+    /// and no more than `HELD_BYTES` of held frames (16 bytes a pixel and pass, two frames
+    /// held per fade frame): 2048² frames of two passes hold 8.
+    #[test]
+    fn a_loops_fade_is_a_quarter_of_its_frames_within_the_memory_it_may_hold() {
+        let effect = Effect::default_campfire();
+        let mut settings = ExportSettings::new("out".into());
+        settings.looped = true;
+        settings.frames = Some(40);
+        settings.frame_size = (64, 64);
+        assert_eq!(timeline(&effect, &settings).fade, 10);
+        settings.frames = Some(200);
+        assert_eq!(timeline(&effect, &settings).fade, 16);
+        settings.frame_size = (2048, 2048);
+        settings.passes.color = true;
+        settings.passes.emissive = true;
+        settings.passes.motion = false;
+        settings.passes.sixway = false;
+        settings.passes.distortion = false;
+        let held = u64::from(timeline(&effect, &settings).fade) * 2 * 2048 * 2048 * 16 * 2;
+        assert_eq!(held, HELD_BYTES, "8 fade frames");
+        settings.looped = false;
+        assert_eq!(timeline(&effect, &settings).fade, 0);
+    }
+}
