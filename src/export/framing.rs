@@ -263,25 +263,33 @@ mod tests {
     use super::*;
     use crate::effect::Param;
 
+    /// The campfire with every sprite `size_m` wide and no streaks, and still particles
+    /// sampled at `points`.
+    fn sampled(size_m: f32, points: &[[f32; 3]]) -> (Effect, Samples) {
+        let mut effect = Effect::default_campfire();
+        for e in &mut effect.emitters {
+            e.look.size_m = Param::Constant(size_m);
+            e.look.streak = None;
+        }
+        let mut samples = Samples::default();
+        let frame: Vec<(Vec3, Vec3)> = points
+            .iter()
+            .map(|&p| (Vec3::from(p), Vec3::ZERO))
+            .collect();
+        samples.add(&frame);
+        (effect, samples)
+    }
+
     /// A fitted perspective camera holds every particle's sphere (its quad's reach) inside
     /// the preset's field of view, each checked as a circle against the edges of the
     /// frame's wedge (its distance from each edge plane), with the tightest no farther
     /// back than the margin asks.
     #[test]
     fn a_fitted_camera_holds_every_particles_sphere_in_its_field_of_view() {
-        let mut effect = Effect::default_campfire();
+        let (mut effect, samples) =
+            sampled(1.0, &[[0.3, 1.0, -0.2], [-0.5, 0.2, 0.4], [0.1, -0.3, 0.0]]);
         effect.camera.fov_y_deg = 90.0;
-        for e in &mut effect.emitters {
-            e.look.size_m = Param::Constant(1.0);
-            e.look.streak = None;
-        }
         let r = reach(&effect);
-        let mut samples = Samples::default();
-        samples.add(&[
-            (Vec3::new(0.3, 1.0, -0.2), Vec3::ZERO),
-            (Vec3::new(-0.5, 0.2, 0.4), Vec3::ZERO),
-            (Vec3::new(0.1, -0.3, 0.0), Vec3::ZERO),
-        ]);
         let Wide::Perspective {
             eye, centre, fov_y, ..
         } = enclosing(&effect, &samples, CameraMode::Fit)
@@ -311,17 +319,8 @@ mod tests {
     /// view plane, 10 % wider: every sphere inside, the widest touching 1/1.1 of it.
     #[test]
     fn a_fitted_orthographic_camera_holds_the_spheres_box_with_a_tenth_to_spare() {
-        let mut effect = Effect::default_campfire();
-        for e in &mut effect.emitters {
-            e.look.size_m = Param::Constant(0.2);
-            e.look.streak = None;
-        }
+        let (effect, samples) = sampled(0.2, &[[0.3, 1.0, -0.2], [-0.5, 0.2, 0.4]]);
         let r = reach(&effect);
-        let mut samples = Samples::default();
-        samples.add(&[
-            (Vec3::new(0.3, 1.0, -0.2), Vec3::ZERO),
-            (Vec3::new(-0.5, 0.2, 0.4), Vec3::ZERO),
-        ]);
         let Wide::Ortho {
             centre,
             forward,
