@@ -21,7 +21,6 @@ use crate::render::look_bake::{
 use crate::render::scene_lighting::SceneLighting;
 use crate::render::sort::{SortJob, SortMember};
 use crate::render::sprites::{SpriteError, SpriteLibrary, SpriteTexture};
-use crate::sim::Modules;
 
 mod looks;
 
@@ -486,12 +485,13 @@ impl FrameResources {
             self.upload_ramp(ctx, i, &e.look);
         }
         let (base, octagon_share) = self.base_look(first.effect, i, &sprite);
+        let emitter = looks::GroupEmitter::of(first.effect, i);
         let GroupLooks {
             looks,
             members,
             pool,
             distance,
-        } = self.group_looks(view, i, &base);
+        } = self.group_looks(view, &emitter, &base);
         let b = pool?;
         let width = looks
             .iter()
@@ -540,7 +540,7 @@ impl FrameResources {
             &e.look,
             StateVariant {
                 layout: b.layout,
-                stateless: Modules::in_effect(first.effect, i).contains(Modules::STATELESS),
+                stateless: emitter.stateless,
             },
         );
         variant.soft_depth = self.soft_depth;

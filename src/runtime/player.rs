@@ -560,7 +560,7 @@ impl Player {
     fn record_steps(&mut self, encoder: &mut wgpu::CommandEncoder) {
         // New instances' segments are cleared before any step of this record.
         for batch in &mut self.batches {
-            batch.clear_taken(encoder);
+            batch.settle_taken(encoder);
         }
         let (steps, dt_secs) = std::mem::take(&mut self.pending);
         self.last_steps = (steps, dt_secs);
@@ -605,7 +605,7 @@ impl Player {
         let mut effects: Vec<Option<(&Effect, u64)>> = Vec::new();
         for (b, batch) in self.batches.iter_mut().enumerate() {
             effects.clear();
-            effects.resize(batch.slots() as usize, None);
+            effects.resize(batch.slot_count() as usize, None);
             for i in self.instances.iter() {
                 if let Backing::Batched { batch, slot } = i.state
                     && batch == b

@@ -169,17 +169,18 @@ impl InstanceBatch {
         self.slots = slots.min(self.limit);
         (self.params, self.block_bytes) = params_buffer(&self.ctx, self.slots, self.pools.len());
         for k in 0..self.pools.len() {
-            let old = &self.pools[k];
-            let mut pool = self.pool(old.capacity, old.layout, old.curves.clone());
-            let old = &self.pools[k];
+            let (capacity, layout, curves) = {
+                let p = &self.pools[k];
+                (p.capacity, p.layout, p.curves.clone())
+            };
+            let grown = self.pool(capacity, layout, curves);
+            let old = std::mem::replace(&mut self.pools[k], grown);
+            let pool = &mut self.pools[k];
             for (from, to) in old.buffers.iter().zip(&pool.buffers) {
                 enc.copy_buffer_to_buffer(from, 0, to, 0, from.size());
             }
-            pool.current = old.current;
-            pool.life_range = old.life_range;
-            pool.salt = old.salt;
+            (pool.current, pool.life_range, pool.salt) = (old.current, old.life_range, old.salt);
             pool.curves_key = old.curves_key;
-            self.pools[k] = pool;
         }
     }
 
@@ -263,7 +264,7 @@ impl InstanceBatch {
     }
 
     /// Takes a free slot for a new instance with `seed` (`None` when the batch holds
-    /// its limit). Buffers that are full grow at the next [`InstanceBatch::clear_taken`],
+    /// its limit). Buffers that are full grow at the next [`InstanceBatch::settle_taken`],
     /// and the slot's segments are cleared there, in the same encoder as (and before)
     /// the steps: work already recorded (the last frame's, or the slot's earlier
     /// occupant's) still runs on the buffers as they were.
@@ -285,9 +286,9 @@ impl InstanceBatch {
         Some(slot as u32)
     }
 
-    /// Grows the buffers to hold every instance taken since the last call, then clears
-    /// the segments of those slots (outside a pass).
-    pub fn clear_taken(&mut self, enc: &mut wgpu::CommandEncoder) {
+    /// Settles the instances taken since the last call: grows the buffers to hold every
+    /// instance, then clears the taken slots' segments (outside a pass).
+    pub fn settle_taken(&mut self, enc: &mut wgpu::CommandEncoder) {
         self.grow(enc);
         for slot in self.pending_clears.drain(..) {
             for p in &self.pools {
@@ -337,7 +338,7 @@ impl InstanceBatch {
     }
 
     /// Slots taken or freed so far (each instance's slot is below this).
-    pub fn slots(&self) -> u32 {
+    pub fn slot_count(&self) -> u32 {
         self.members.len() as u32
     }
 

@@ -29,12 +29,26 @@ pub(super) struct GroupLooks<'s> {
     pub(super) distance: f32,
 }
 
-/// Emitter `index` as every instance of a group has it: whether it is stateless, and the
-/// colour ramp row + 1 of the parent it inherits its colour from (0: none).
-struct GroupEmitter {
-    index: usize,
-    stateless: bool,
+/// Emitter `index` as every instance of a group has it (their emitters and events are
+/// the player's): whether it is stateless, and the colour ramp row + 1 of the parent it
+/// inherits its colour from (0: none).
+pub(super) struct GroupEmitter {
+    pub(super) index: usize,
+    pub(super) stateless: bool,
     color_row: u32,
+}
+
+impl GroupEmitter {
+    /// Emitter `i` of `effect`.
+    pub(super) fn of(effect: &Effect, i: usize) -> Self {
+        Self {
+            index: i,
+            stateless: Modules::in_effect(effect, i).contains(Modules::STATELESS),
+            color_row: effect
+                .color_parent(i)
+                .map_or(0, |p| ROWS_PER_EMITTER * p as u32 + 1),
+        }
+    }
 }
 
 /// Writes the draw's looks into `block` (one per instance, at `PARAMS_STRIDE`), each with
@@ -278,15 +292,10 @@ impl FrameResources {
     pub(super) fn group_looks<'s>(
         &self,
         view: &GroupView<'_, 's>,
-        i: usize,
+        emitter: &GroupEmitter,
         base: &LookUniform,
     ) -> GroupLooks<'s> {
-        // What the instances' effects share (their emitters and events are the player's).
-        let emitter = view.group.iter().flatten().next().map(|s| GroupEmitter {
-            index: i,
-            stateless: Modules::in_effect(s.effect, i).contains(Modules::STATELESS),
-            color_row: (s.effect.color_parent(i)).map_or(0, |p| ROWS_PER_EMITTER * p as u32 + 1),
-        });
+        let i = emitter.index;
         let mut out = GroupLooks {
             looks: Vec::with_capacity(view.group.len()),
             members: Vec::new(),
@@ -296,8 +305,7 @@ impl FrameResources {
         for scene in view.group {
             let Some((scene, (u, b, sort))) = scene
                 .as_ref()
-                .zip(emitter.as_ref())
-                .and_then(|(s, emitter)| Some((s, self.member_look(view, s, emitter, base)?)))
+                .and_then(|s| Some((s, self.member_look(view, s, emitter, base)?)))
             else {
                 out.looks.push(None);
                 out.members.push(SortMember::default());
