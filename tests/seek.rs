@@ -456,6 +456,7 @@ fn timeline_playback_speed_parked_steps_and_the_loop_region() {
     };
     frames(&mut run, &mut playback, 60);
     assert!((now(&run) - 0.25).abs() <= step, "0.25×: {}", now(&run));
+    assert!(!run.player.is_paused(), "a playing timeline's player runs");
     playback.speed = 2.0;
     frames(&mut run, &mut playback, 60);
     assert!((now(&run) - 2.25).abs() <= step, "2×: {}", now(&run));
@@ -472,6 +473,10 @@ fn timeline_playback_speed_parked_steps_and_the_loop_region() {
     playback.seek_to = Some(1.0);
     frames(&mut run, &mut playback, 1);
     assert!(playback.is_paused && (now(&run) - 1.0).abs() <= 0.5 * step);
+    assert!(
+        run.player.is_paused(),
+        "a parked timeline pauses its player"
+    );
     frames(&mut run, &mut playback, 2);
     assert_eq!(playback.parked_at, Some(1.0), "still parked");
     let parked = now(&run);

@@ -1246,6 +1246,13 @@ fn alpha_blended_tiles_over_the_test_scene_let_it_show_as_the_billboards_do() {
         let image = run.render(SIZE).expect("render");
         let tiled = run.player.draw_items().iter().any(|d| d.tiles);
         assert_eq!(tiled, path == DrawPath::Tiles, "{path:?}");
+        // Tiled smoke is composited with the light layer (the tiles' resolve); no blended
+        // billboard is left to draw.
+        let layers = match path {
+            DrawPath::Tiles => ignis::Layers::LIGHT,
+            _ => ignis::Layers::BLENDED,
+        };
+        assert_eq!(run.player.drawn_layers(), layers, "{path:?}");
         let tiles = run.player.tile_pass().expect("the tiles");
         assert_eq!(
             tiles.can_resolve_into(SIZE),
