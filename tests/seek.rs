@@ -414,6 +414,36 @@ fn an_edit_forgets_the_snapshots_and_seeks_land_on_steps() {
     }
 }
 
+/// Moving an instance forgets the snapshots (they hold particles born at the old place);
+/// setting the transform it already has keeps them. A seek back then replays from the
+/// start at the new place.
+#[test]
+fn moving_an_instance_forgets_the_snapshots_and_standing_still_keeps_them() {
+    let ctx = gpu();
+    let effect = ignis::Effect::default_campfire();
+    let moved = glam::Mat4::from_translation(glam::vec3(0.5, 0.0, 0.0));
+    let mut run = unbatched(&ctx, effect.clone());
+    run.player.keep_seek_snapshots(0.25, 64 << 20);
+    for _ in 0..120 {
+        run.advance(1.0 / FPS);
+    }
+    let kept = run.player.seek_snapshot_bytes().1;
+    assert!(kept >= 4, "{kept} snapshots");
+    let id = run.instance;
+    let here = run.player.transform(id).expect("a transform");
+    assert!(run.player.set_transform(id, here));
+    assert_eq!(run.player.seek_snapshot_bytes().1, kept, "standing still");
+    assert!(run.player.set_transform(id, moved));
+    assert_eq!(run.player.seek_snapshot_bytes().1, 0, "moved");
+    run.seek(1.0, 1.0 / FPS);
+    let mut fresh = unbatched(&ctx, effect);
+    assert!(fresh.player.set_transform(fresh.instance, moved));
+    for _ in 0..60 {
+        fresh.advance(1.0 / FPS);
+    }
+    assert!(state(&run) == state(&fresh), "a seek back after a move");
+}
+
 /// Plays `n` frames of 1/60 s through the editor's timeline (`editor::timeline::play`,
 /// then the simulation) and returns the instance's clock after each.
 fn timeline_frames(
