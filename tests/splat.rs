@@ -418,9 +418,16 @@ fn the_compute_resolve_adds_what_the_resolve_draw_does() {
             let used = run.player.splat_pass().can_resolve_into(SIZE);
             assert_eq!(used, compute, "{name}: compute resolve used: {used}");
             assert!(run.player.draw_items().iter().any(|d| d.splat), "{name}");
-            image
+            (image, run.player.recorded_commands())
         };
-        common::resolves_agree(name, &image(false), &image(true));
+        let ((drawn, by_draw), (computed, by_compute)) = (image(false), image(true));
+        common::resolves_agree(name, &drawn, &computed);
+        // The resolve's draw became a dispatch.
+        assert_eq!(
+            (by_compute.dispatches, by_compute.draws + 1),
+            (by_draw.dispatches + 1, by_draw.draws),
+            "{name}"
+        );
     }
 }
 
