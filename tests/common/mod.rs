@@ -354,6 +354,22 @@ pub fn resolves_agree(what: &str, drawn: &image::RgbaImage, computed: &image::Rg
     );
 }
 
+/// A frame resolved by compute (`computed`, with the commands its player recorded) is the
+/// frame the resolve's draw gives (`drawn`): the same image ([`resolves_agree`]), with the
+/// resolve's draw become one dispatch.
+pub fn compute_resolve_replaces_the_draw(
+    what: &str,
+    (drawn, by_draw): &(image::RgbaImage, ignis::CommandCounts),
+    (computed, by_compute): &(image::RgbaImage, ignis::CommandCounts),
+) {
+    resolves_agree(what, drawn, computed);
+    assert_eq!(
+        (by_compute.dispatches, by_compute.draws + 1),
+        (by_draw.dispatches + 1, by_draw.draws),
+        "{what}: the resolve's draw became a dispatch"
+    );
+}
+
 /// A folder holding the shaders under test (the embedded ones, or a mutant's copy when
 /// scripts/wgsl_mutants.py runs the tests), with each `(name, text)` of `replace` written
 /// over or beside them.
